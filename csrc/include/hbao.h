@@ -1,0 +1,253 @@
+/* SPDX-License-Identifier: GPL-2.0-or-later */
+/*
+ * libhbao: horizon-based ambient occlusion (HBAO) from a depth buffer.
+ *
+ * The library turns Blender's Depth pass (planar camera-space depth: the
+ * positive distance along the view axis) and, optionally, its Normal pass
+ * (world space) into an ambient-occlusion image, 1 = unoccluded, 0 = fully
+ * occluded. It follows Bavoil & Sainz 2008 ("Image-space horizon-based
+ * ambient occlusion"): per pixel, N directions evenly spaced around the
+ * pixel and rotated by an interleaved 4x4 pattern are marched for S jittered
+ * steps inside the projected radius; the highest horizon found along each
+ * direction, attenuated per sample, gives that direction's occlusion.
+ *
+ *   hbao_params params = HBAO_PARAMS_DEFAULT_INITIALIZER;
+ *   hbao_camera camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
+ *   hbao_channel depth = { depth_pixels, 1, width };     // strides in floats
+ *   hbao_result r = hbao_compute(&params, &camera, width, height,
+ *                                &depth, NULL, ao, width);
+ *   if (r != HBAO_SUCCESS) fprintf(stderr, "%s\n", hbao_result_message(r));
+ *
+ * Conventions
+ * - Images are row-major; row 0 is the TOP row of the picture. A bottom-up
+ *   buffer (Blender's render passes, OpenGL) is described with a pointer to
+ *   its last row and a negative row stride.
+ * - Strides count floats, not bytes.
+ * - Background: a depth that is not finite, <= 0, or >= params.background_depth
+ *   (Cycles writes 1e10, EEVEE's half float 65504) gets AO = 1 and never
+ *   occludes anything.
+ * - The output is always finite and in [0, 1].
+ * - Every call returns a result code; hbao_result_message() turns it into
+ *   text. There is no global state: calls may run concurrently from several
+ *   threads. The output is bit-identical whatever the number of threads.
+ * - Outputs are allocated by the caller.
+ */
+#ifndef HBAO_H
+#define HBAO_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "hbao_export.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define HBAO_VERSION_MAJOR 0
+#define HBAO_VERSION_MINOR 1
+#define HBAO_VERSION_PATCH 0
+/** Packed version: major * 10000 + minor * 100 + patch. */
+#define HBAO_VERSION \
+    (HBAO_VERSION_MAJOR * 10000 + HBAO_VERSION_MINOR * 100 + HBAO_VERSION_PATCH)
+
+/**
+ * The result codes and their messages, generated from one list so that they
+ * cannot drift apart.
+ */
+#define HBAO_RESULT_LIST(X)                                                          \
+    X(HBAO_SUCCESS, "success")                                                       \
+    X(HBAO_ERROR_NULL_ARGUMENT, "a required pointer argument is NULL")               \
+    X(HBAO_ERROR_INVALID_SIZE, "image width and height must be in [1, 65536]")       \
+    X(HBAO_ERROR_INVALID_STRIDE, "a pixel or row stride is too small for the image") \
+    X(HBAO_ERROR_INVALID_PARAMETER,                                                  \
+      "a parameter is not a number, negative where it must not be, or an unknown " \
+      "enum value")                                                                  \
+    X(HBAO_ERROR_INVALID_CAMERA,                                                     \
+      "the camera is invalid (lens, sensor, ortho scale and pixel aspect must be "  \
+      "finite and > 0; the matrix must be finite and invertible)")                  \
+    X(HBAO_ERROR_OUT_OF_MEMORY, "out of memory")                                     \
+    X(HBAO_ERROR_THREAD, "could not start a worker thread")
+
+typedef enum hbao_result_code {
+#define HBAO_RESULT_ENUM_ENTRY(name, message) name,
+    HBAO_RESULT_LIST(HBAO_RESULT_ENUM_ENTRY)
+#undef HBAO_RESULT_ENUM_ENTRY
+        HBAO_RESULT_COUNT
+} hbao_result_code;
+
+/** Every call returns one of hbao_result_code as a fixed-width integer. */
+typedef int32_t hbao_result;
+
+/** How the horizon angles are turned into occlusion. */
+typedef enum hbao_integration {
+    /** Bavoil & Sainz: occlusion = sin(horizon elevation above the tangent
+     *  plane), averaged over directions: the fraction of the hemisphere's
+     *  solid angle that is occluded. */
+    HBAO_INTEGRATION_HBAO = 0,
+    /** Cosine-weighted visibility, the quantity Blender's ray-traced AO pass
+     *  (Cycles) measures. Directions are integrated as slices around the view
+     *  vector, exactly for a height field. */
+    HBAO_INTEGRATION_COSINE = 1
+} hbao_integration;
+
+/** Per-sample attenuation W(r), r = distance / radius. */
+typedef enum hbao_falloff {
+    HBAO_FALLOFF_QUADRATIC = 0, /**< W(r) = 1 - r^2 (Bavoil & Sainz). */
+    HBAO_FALLOFF_NONE = 1       /**< W(r) = 1 inside the radius. */
+} hbao_falloff;
+
+/** Documented limits. Values outside them are clamped (counts, sizes) or
+ *  rejected with HBAO_ERROR_INVALID_PARAMETER (NaN, negative radius). */
+#define HBAO_MAX_DIRECTIONS 64
+#define HBAO_MAX_STEPS 64
+#define HBAO_MAX_BLUR_SIZE 65
+#define HBAO_MAX_BLUR_SHARPNESS 1000.0f
+#define HBAO_MAX_ANGLE_BIAS_DEGREES 60.0f
+#define HBAO_MAX_STRENGTH 16.0f
+#define HBAO_MAX_THREADS 256
+#define HBAO_MAX_IMAGE_SIZE 65536
+
+/** Algorithm parameters. Initialise with HBAO_PARAMS_DEFAULT_INITIALIZER or
+ *  hbao_params_default(), then change what you need. */
+typedef struct hbao_params {
+    /** AO radius in scene units; 0 gives AO = 1 everywhere. Must be finite
+     *  and >= 0. A pixel whose radius projects to less than one pixel gets
+     *  AO = 1 without sampling. */
+    float radius;
+    /** Occluders less than this many degrees above the tangent plane are
+     *  ignored (hides low-tessellation creases). Clamped to [0, 60]. */
+    float angle_bias_degrees;
+    /** Directions per pixel, clamped to [1, 64]. */
+    int32_t directions;
+    /** Steps per direction, clamped to [1, 64]. */
+    int32_t steps;
+    /** hbao_falloff. */
+    int32_t falloff;
+    /** hbao_integration. */
+    int32_t integration;
+    /** Width in pixels of the cross-bilateral blur kernel; 0 or 1 = no blur.
+     *  Even sizes round down to the odd size below. Clamped to [0, 65]. */
+    int32_t blur_size;
+    /** How strongly the blur stops at depth edges; 0 = plain Gaussian.
+     *  Clamped to [0, 1000]. */
+    float blur_sharpness;
+    /** Non-zero: AO at half resolution, then a depth-aware upsample and the
+     *  blur at full resolution. */
+    int32_t half_resolution;
+    /** Applied last: ao = ao^strength. 0 = no AO, 1 = as computed, larger =
+     *  darker. Clamped to [0, 16]. */
+    float strength;
+    /** Worker threads; 0 = one per available core. Clamped to [1, 256]. */
+    int32_t threads;
+    /** Depths at or beyond this are background. Must be > 0. */
+    float background_depth;
+} hbao_params;
+
+#define HBAO_DEFAULT_RADIUS 1.0f
+#define HBAO_DEFAULT_ANGLE_BIAS_DEGREES 10.0f
+#define HBAO_DEFAULT_DIRECTIONS 8
+#define HBAO_DEFAULT_STEPS 6
+#define HBAO_DEFAULT_BLUR_SIZE 9
+#define HBAO_DEFAULT_BLUR_SHARPNESS 8.0f
+#define HBAO_DEFAULT_STRENGTH 1.0f
+/** EEVEE's half-float Depth pass stores background as 65504, Cycles as 1e10. */
+#define HBAO_DEFAULT_BACKGROUND_DEPTH 65504.0f
+
+#define HBAO_PARAMS_DEFAULT_INITIALIZER                                         \
+    {                                                                           \
+        HBAO_DEFAULT_RADIUS, HBAO_DEFAULT_ANGLE_BIAS_DEGREES,                   \
+            HBAO_DEFAULT_DIRECTIONS, HBAO_DEFAULT_STEPS, HBAO_FALLOFF_QUADRATIC, \
+            HBAO_INTEGRATION_COSINE, HBAO_DEFAULT_BLUR_SIZE,                    \
+            HBAO_DEFAULT_BLUR_SHARPNESS, 0, HBAO_DEFAULT_STRENGTH, 0,           \
+            HBAO_DEFAULT_BACKGROUND_DEPTH                                       \
+    }
+
+typedef enum hbao_projection {
+    HBAO_PROJECTION_PERSPECTIVE = 0,
+    HBAO_PROJECTION_ORTHOGRAPHIC = 1
+} hbao_projection;
+
+/** Blender's Camera.sensor_fit. */
+typedef enum hbao_sensor_fit {
+    HBAO_SENSOR_FIT_AUTO = 0,       /**< sensor_width spans the larger image side */
+    HBAO_SENSOR_FIT_HORIZONTAL = 1, /**< sensor_width spans the image width */
+    HBAO_SENSOR_FIT_VERTICAL = 2    /**< sensor_height spans the image height */
+} hbao_sensor_fit;
+
+/** Blender's camera model, with Blender's property names and defaults. */
+typedef struct hbao_camera {
+    int32_t projection;     /**< hbao_projection */
+    float lens;             /**< focal length, mm (perspective) */
+    float sensor_width;     /**< mm */
+    float sensor_height;    /**< mm */
+    int32_t sensor_fit;     /**< hbao_sensor_fit */
+    float shift_x;          /**< lens shift, in units of the fitted sensor side */
+    float shift_y;
+    float ortho_scale;      /**< view width of the fitted side (orthographic) */
+    float pixel_aspect_x;   /**< scene.render.pixel_aspect_x */
+    float pixel_aspect_y;
+    /** Row-major 4x4 world-to-camera matrix (camera.matrix_world inverted).
+     *  Only its rotation is used: it maps the world-space Normal pass into
+     *  camera space. Identity when the normals are already in camera space. */
+    float world_to_camera[16];
+} hbao_camera;
+
+#define HBAO_CAMERA_DEFAULT_INITIALIZER                                          \
+    {                                                                            \
+        HBAO_PROJECTION_PERSPECTIVE, 50.0f, 36.0f, 24.0f, HBAO_SENSOR_FIT_AUTO,  \
+            0.0f, 0.0f, 6.0f, 1.0f, 1.0f,                                        \
+        {                                                                        \
+            1.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f,    \
+                0.0f, 0.0f, 0.0f, 0.0f, 1.0f                                     \
+        }                                                                        \
+    }
+
+/** A read-only view of one image channel (or of 3 consecutive channels, for
+ *  normals). Strides count floats; row_stride may be negative. */
+typedef struct hbao_channel {
+    const float *data;    /**< the top-left pixel */
+    int32_t pixel_stride; /**< floats from one pixel to its right neighbour, >= 1
+                               (>= 3 for normals) */
+    int64_t row_stride;   /**< floats from one row to the row below it */
+} hbao_channel;
+
+/** Packed HBAO_VERSION of the library that is loaded. */
+HBAO_EXPORT int32_t hbao_version(void);
+
+/** A static, human-readable message for a result code (never NULL). */
+HBAO_EXPORT const char *hbao_result_message(hbao_result result);
+
+/** Fill *params with the defaults (for callers that cannot use the macro). */
+HBAO_EXPORT void hbao_params_default(hbao_params *params);
+
+/** Fill *camera with Blender's default camera. */
+HBAO_EXPORT void hbao_camera_default(hbao_camera *camera);
+
+/** sizeof(hbao_params) and sizeof(hbao_camera) as compiled into the library,
+ *  so that bindings (ctypes) can check their struct layouts on load. */
+HBAO_EXPORT size_t hbao_params_size(void);
+HBAO_EXPORT size_t hbao_camera_size(void);
+
+/**
+ * Compute ambient occlusion.
+ *
+ * @param width, height  image size, each in [1, 65536]
+ * @param depth          planar depth (required)
+ * @param normal         world-space normals, X Y Z consecutive; NULL (or
+ *                       data NULL) = face normals reconstructed from depth.
+ *                       A normal shorter than 0.1 (anti-aliased edges,
+ *                       background) or not finite is reconstructed too.
+ * @param ao             output, width x height floats, caller-allocated
+ * @param ao_row_stride  floats from one output row to the next (|s| >= width)
+ */
+HBAO_EXPORT hbao_result hbao_compute(const hbao_params *params, const hbao_camera *camera,
+                                     int32_t width, int32_t height, const hbao_channel *depth,
+                                     const hbao_channel *normal, float *ao,
+                                     int64_t ao_row_stride);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* HBAO_H */
