@@ -1,0 +1,31 @@
+/* SPDX-License-Identifier: GPL-2.0-or-later */
+/* Version, result messages and defaults: the small parts of the public API. */
+#include "internal_hbao.h"
+
+int32_t hbao_version(void) { return HBAO_VERSION; }
+
+const char *hbao_result_message(hbao_result result) {
+    static const char *const messages[] = {
+#define HBAO_RESULT_MESSAGE_ENTRY(name, message) message,
+        HBAO_RESULT_LIST(HBAO_RESULT_MESSAGE_ENTRY)
+#undef HBAO_RESULT_MESSAGE_ENTRY
+    };
+    if (result < 0 || result >= HBAO_RESULT_COUNT) return "unknown result code";
+    return messages[result];
+}
+
+void hbao_params_default(hbao_params *params) {
+    if (params == NULL) return;
+    const hbao_params defaults = HBAO_PARAMS_DEFAULT_INITIALIZER;
+    *params = defaults;
+}
+
+void hbao_camera_default(hbao_camera *camera) {
+    if (camera == NULL) return;
+    const hbao_camera defaults = HBAO_CAMERA_DEFAULT_INITIALIZER;
+    *camera = defaults;
+}
+
+size_t hbao_params_size(void) { return sizeof(hbao_params); }
+
+size_t hbao_camera_size(void) { return sizeof(hbao_camera); }

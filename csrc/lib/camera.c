@@ -1,0 +1,67 @@
+/* SPDX-License-Identifier: GPL-2.0-or-later */
+/* Blender's camera model: where each pixel lies in the view plane.
+ * Follows BKE_camera_params_compute_viewplane (docs/algorithm.md, "Camera"). */
+#include <math.h>
+
+#include "internal_hbao.h"
+
+static int finite_positive(float value) { return isfinite(value) && value > 0.0f; }
+
+hbao_result hbao_validate_camera(const hbao_camera *camera) {
+    if (camera->projection != HBAO_PROJECTION_PERSPECTIVE &&
+        camera->projection != HBAO_PROJECTION_ORTHOGRAPHIC)
+        return HBAO_ERROR_INVALID_CAMERA;
+    if (camera->sensor_fit < HBAO_SENSOR_FIT_AUTO || camera->sensor_fit > HBAO_SENSOR_FIT_VERTICAL)
+        return HBAO_ERROR_INVALID_CAMERA;
+    if (!finite_positive(camera->pixel_aspect_x) || !finite_positive(camera->pixel_aspect_y))
+        return HBAO_ERROR_INVALID_CAMERA;
+    if (!isfinite(camera->shift_x) || !isfinite(camera->shift_y)) return HBAO_ERROR_INVALID_CAMERA;
+    if (camera->projection == HBAO_PROJECTION_PERSPECTIVE) {
+        if (!finite_positive(camera->lens) || !finite_positive(camera->sensor_width) ||
+            !finite_positive(camera->sensor_height))
+            return HBAO_ERROR_INVALID_CAMERA;
+    } else if (!finite_positive(camera->ortho_scale)) {
+        return HBAO_ERROR_INVALID_CAMERA;
+    }
+    const float *m = camera->world_to_camera;
+    for (int k = 0; k < 16; k++)
+        if (!isfinite(m[k])) return HBAO_ERROR_INVALID_CAMERA;
+    /* The rotation part maps normals; a singular one would turn every normal
+     * into nothing. */
+    const double determinant = (double)m[0] * ((double)m[5] * m[10] - (double)m[6] * m[9]) -
+                               (double)m[1] * ((double)m[4] * m[10] - (double)m[6] * m[8]) +
+                               (double)m[2] * ((double)m[4] * m[9] - (double)m[5] * m[8]);
+    if (!(fabs(determinant) > 1e-12)) return HBAO_ERROR_INVALID_CAMERA;
+    return HBAO_SUCCESS;
+}
+
+void hbao_grid_set_projection(hbao_grid *grid, const hbao_camera *camera, int full_width,
+                              int full_height, int scale) {
+    const double aspect_x = camera->pixel_aspect_x, aspect_y = camera->pixel_aspect_y;
+    const double ycor = aspect_y / aspect_x;
+    int horizontal_fit;
+    if (camera->sensor_fit == HBAO_SENSOR_FIT_AUTO)
+        horizontal_fit = aspect_x * full_width >= aspect_y * full_height;
+    else
+        horizontal_fit = camera->sensor_fit == HBAO_SENSOR_FIT_HORIZONTAL;
+    /* AUTO always uses sensor_width, for whichever side is larger. */
+    const double sensor_size = camera->sensor_fit == HBAO_SENSOR_FIT_VERTICAL
+                                   ? camera->sensor_height
+                                   : camera->sensor_width;
+    const double viewfac = horizontal_fit ? (double)full_width : ycor * full_height;
+    const int orthographic = camera->projection == HBAO_PROJECTION_ORTHOGRAPHIC;
+    const double pixel_size =
+        (orthographic ? camera->ortho_scale : sensor_size / camera->lens) / viewfac;
+    const double left = -0.5 * full_width + camera->shift_x * viewfac;
+    const double bottom = -0.5 * ycor * full_height + camera->shift_y * viewfac;
+
+    for (int i = 0; i < grid->width; i++)
+        grid->column_x[i] = (float)((left + scale * i + 0.5) * pixel_size);
+    for (int j = 0; j < grid->height; j++) {
+        const double row_from_bottom = full_height - 1 - scale * j;
+        grid->row_y[j] = (float)((bottom + (row_from_bottom + 0.5) * ycor) * pixel_size);
+    }
+    grid->orthographic = orthographic;
+    grid->pixel_size = (float)(pixel_size * scale);
+    grid->ycor = (float)ycor;
+}

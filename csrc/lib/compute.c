@@ -1,0 +1,196 @@
+/* SPDX-License-Identifier: GPL-2.0-or-later */
+/* hbao_compute(): argument checks, parameter clamping and the pipeline. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal_hbao.h"
+
+static int clamp_int(int value, int low, int high) {
+    return value < low ? low : (value > high ? high : value);
+}
+
+static float clamp_float(float value, float low, float high) {
+    return value < low ? low : (value > high ? high : value);
+}
+
+static hbao_result make_settings(const hbao_params *params, hbao_settings *s) {
+    if (!isfinite(params->radius) || params->radius < 0.0f || !isfinite(params->angle_bias_degrees) ||
+        !isfinite(params->blur_sharpness) || !isfinite(params->strength) ||
+        isnan(params->background_depth) || !(params->background_depth > 0.0f))
+        return HBAO_ERROR_INVALID_PARAMETER;
+    if (params->falloff != HBAO_FALLOFF_QUADRATIC && params->falloff != HBAO_FALLOFF_NONE)
+        return HBAO_ERROR_INVALID_PARAMETER;
+    if (params->integration != HBAO_INTEGRATION_HBAO &&
+        params->integration != HBAO_INTEGRATION_COSINE)
+        return HBAO_ERROR_INVALID_PARAMETER;
+    s->radius = params->radius;
+    const float bias_degrees =
+        clamp_float(params->angle_bias_degrees, 0.0f, HBAO_MAX_ANGLE_BIAS_DEGREES);
+    s->bias_rad = bias_degrees * (HBAO_PI / 180.0f);
+    s->sin_bias = sinf(s->bias_rad);
+    s->cos_bias = cosf(s->bias_rad);
+    s->directions = clamp_int(params->directions, 1, HBAO_MAX_DIRECTIONS);
+    s->steps = clamp_int(params->steps, 1, HBAO_MAX_STEPS);
+    s->falloff = params->falloff;
+    s->integration = params->integration;
+    const int blur_size = clamp_int(params->blur_size, 0, HBAO_MAX_BLUR_SIZE);
+    s->blur_radius = blur_size >= 2 ? (blur_size - 1) / 2 : 0;
+    s->blur_sharpness = clamp_float(params->blur_sharpness, 0.0f, HBAO_MAX_BLUR_SHARPNESS);
+    s->half_resolution = params->half_resolution != 0;
+    s->strength = clamp_float(params->strength, 0.0f, HBAO_MAX_STRENGTH);
+    s->threads = params->threads <= 0 ? hbao_available_cores()
+                                      : clamp_int(params->threads, 1, HBAO_MAX_THREADS);
+    s->background_depth = params->background_depth;
+    return HBAO_SUCCESS;
+}
+
+/* The row stride must keep rows from overlapping: |row_stride| covers a row. */
+static int stride_fits(int32_t pixel_stride, int64_t row_stride, int width, int height,
+                       int channels) {
+    if (pixel_stride < channels) return 0;
+    if (height == 1) return 1;
+    const int64_t row_extent = (int64_t)(width - 1) * pixel_stride + channels;
+    const int64_t magnitude = row_stride < 0 ? -row_stride : row_stride;
+    return magnitude >= row_extent;
+}
+
+typedef struct depth_job {
+    const hbao_channel *source;
+    float background_depth;
+    int width;
+    float *depth;
+} depth_job;
+
+/* Dense depth with background (not finite, <= 0, >= background_depth) as 0. */
+static void convert_depth_row(void *context, int j) {
+    const depth_job *job = context;
+    const float *row = job->source->data + (int64_t)j * job->source->row_stride;
+    float *out = job->depth + (size_t)j * job->width;
+    for (int i = 0; i < job->width; i++) {
+        const float z = row[(int64_t)i * job->source->pixel_stride];
+        out[i] = (isfinite(z) && z > 0.0f && z < job->background_depth) ? z : 0.0f;
+    }
+}
+
+typedef struct output_job {
+    const float *ao;
+    const float *depth;
+    int width;
+    float strength;
+    float *out;
+    int64_t out_row_stride;
+} output_job;
+
+static void write_output_row(void *context, int j) {
+    const output_job *job = context;
+    float *out = job->out + (int64_t)j * job->out_row_stride;
+    for (int i = 0; i < job->width; i++) {
+        const size_t index = (size_t)j * job->width + i;
+        float ao = job->depth[index] > 0.0f ? job->ao[index] : 1.0f;
+        if (job->strength != 1.0f) ao = powf(ao, job->strength);
+        /* Written so that a NaN could never pass through. */
+        out[i] = ao > 0.0f ? (ao < 1.0f ? ao : 1.0f) : 0.0f;
+    }
+}
+
+typedef struct half_depth_job {
+    const float *full;
+    int full_width;
+    hbao_grid *half;
+} half_depth_job;
+
+static void half_depth_row(void *context, int j) {
+    const half_depth_job *job = context;
+    const float *source = job->full + (size_t)(2 * j) * job->full_width;
+    float *out = job->half->depth + (size_t)j * job->half->width;
+    for (int i = 0; i < job->half->width; i++) out[i] = source[2 * i];
+}
+
+static void fill_ones(float *ao, int64_t row_stride, int width, int height) {
+    for (int j = 0; j < height; j++) {
+        float *row = ao + (int64_t)j * row_stride;
+        for (int i = 0; i < width; i++) row[i] = 1.0f;
+    }
+}
+
+hbao_result hbao_compute(const hbao_params *params, const hbao_camera *camera, int32_t width,
+                         int32_t height, const hbao_channel *depth, const hbao_channel *normal,
+                         float *ao, int64_t ao_row_stride) {
+    if (params == NULL || camera == NULL || depth == NULL || depth->data == NULL || ao == NULL)
+        return HBAO_ERROR_NULL_ARGUMENT;
+    if (width < 1 || height < 1 || width > HBAO_MAX_IMAGE_SIZE || height > HBAO_MAX_IMAGE_SIZE)
+        return HBAO_ERROR_INVALID_SIZE;
+    if (normal != NULL && normal->data == NULL) normal = NULL;
+    if (!stride_fits(depth->pixel_stride, depth->row_stride, width, height, 1) ||
+        (normal != NULL &&
+         !stride_fits(normal->pixel_stride, normal->row_stride, width, height, 3)) ||
+        !stride_fits(1, ao_row_stride, width, height, 1))
+        return HBAO_ERROR_INVALID_STRIDE;
+    hbao_settings s;
+    hbao_result result = make_settings(params, &s);
+    if (result != HBAO_SUCCESS) return result;
+    result = hbao_validate_camera(camera);
+    if (result != HBAO_SUCCESS) return result;
+    if (s.radius == 0.0f) {
+        fill_ones(ao, ao_row_stride, width, height);
+        return HBAO_SUCCESS;
+    }
+
+    const size_t pixels = (size_t)width * height;
+    const int scale = s.half_resolution ? 2 : 1;
+    hbao_grid grid;
+    grid.width = (width + scale - 1) / scale;
+    grid.height = (height + scale - 1) / scale;
+    const size_t grid_pixels = (size_t)grid.width * grid.height;
+
+    float *full_depth = malloc(pixels * sizeof(float));
+    float *full_ao = malloc(pixels * sizeof(float));
+    float *scratch = malloc(pixels * sizeof(float));
+    float *half_depth = s.half_resolution ? malloc(grid_pixels * sizeof(float)) : NULL;
+    float *half_ao = s.half_resolution ? malloc(grid_pixels * sizeof(float)) : NULL;
+    grid.normal = malloc(grid_pixels * 3 * sizeof(float));
+    grid.column_x = malloc((size_t)grid.width * sizeof(float));
+    grid.row_y = malloc((size_t)grid.height * sizeof(float));
+    if (full_depth == NULL || full_ao == NULL || scratch == NULL || grid.normal == NULL ||
+        grid.column_x == NULL || grid.row_y == NULL ||
+        (s.half_resolution && (half_depth == NULL || half_ao == NULL))) {
+        result = HBAO_ERROR_OUT_OF_MEMORY;
+        goto done;
+    }
+
+    depth_job convert = {depth, s.background_depth, width, full_depth};
+    hbao_parallel_rows(s.threads, height, convert_depth_row, &convert);
+
+    hbao_grid_set_projection(&grid, camera, width, height, scale);
+    if (s.half_resolution) {
+        grid.depth = half_depth;
+        half_depth_job halve = {full_depth, width, &grid};
+        hbao_parallel_rows(s.threads, grid.height, half_depth_row, &halve);
+    } else {
+        grid.depth = full_depth;
+    }
+    hbao_compute_normals(&s, camera, &grid, normal, scale);
+
+    if (s.half_resolution) {
+        hbao_compute_horizons(&s, &grid, half_ao);
+        hbao_upsample(&s, &grid, half_ao, full_depth, width, height, full_ao);
+    } else {
+        hbao_compute_horizons(&s, &grid, full_ao);
+    }
+    hbao_blur(&s, full_depth, width, height, full_ao, scratch);
+
+    output_job output = {full_ao, full_depth, width, s.strength, ao, ao_row_stride};
+    hbao_parallel_rows(s.threads, height, write_output_row, &output);
+
+done:
+    free(full_depth);
+    free(full_ao);
+    free(scratch);
+    free(half_depth);
+    free(half_ao);
+    free(grid.normal);
+    free(grid.column_x);
+    free(grid.row_y);
+    return result;
+}

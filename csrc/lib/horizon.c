@@ -1,0 +1,312 @@
+/* SPDX-License-Identifier: GPL-2.0-or-later */
+/* The horizon search: for every grid pixel, march N rotated directions for S
+ * jittered steps inside the projected radius and integrate the occlusion of
+ * the highest horizon found, per docs/algorithm.md. */
+#include <math.h>
+
+#include "internal_hbao.h"
+
+#define HALF_PI (0.5f * HBAO_PI)
+
+/* The interleaved 4x4 pattern (a Bayer matrix): neighbouring pixels get
+ * rotations and jitters far apart, so a small blur averages them out. */
+static const int bayer_4x4[16] = {0, 8, 2, 10, 12, 4, 14, 6, 3, 11, 1, 9, 15, 7, 13, 5};
+
+typedef struct horizon_job {
+    const hbao_settings *settings;
+    const hbao_grid *grid;
+    float *ao;
+    /* Per pattern cell: direction cosines/sines and the step jitter. */
+    float direction_cos[16][HBAO_MAX_DIRECTIONS];
+    float direction_sin[16][HBAO_MAX_DIRECTIONS];
+    float jitter[16];
+} horizon_job;
+
+/* One pixel's march along one direction. */
+typedef struct march {
+    const hbao_grid *grid;
+    int i, j;
+    float p[3];      /* the pixel's position */
+    float dc, ds;    /* the direction, view plane */
+    float inv_ycor;
+    float jitter;
+    float step_px;
+    float radius2;
+} march;
+
+enum { SAMPLE_END = -1, SAMPLE_SKIP = 0, SAMPLE_OK = 1 };
+
+/* The vector to the sample of a step and its squared length. */
+static inline int march_sample(const march *m, int step, float delta[3], float *dist2) {
+    const hbao_grid *g = m->grid;
+    const float t = 1.0f + ((float)step + m->jitter) * m->step_px;
+    const float x = (float)m->i + 0.5f + m->dc * t;
+    const float y = (float)m->j + 0.5f - m->ds * t * m->inv_ycor;
+    /* Test before converting: a huge projected radius must not overflow int. */
+    if (!(x >= 0.0f && y >= 0.0f && x < (float)g->width && y < (float)g->height))
+        return SAMPLE_END;
+    const int si = (int)x, sj = (int)y;
+    if (si >= g->width || sj >= g->height) return SAMPLE_END;
+    if (si == m->i && sj == m->j) return SAMPLE_SKIP;
+    const float zs = g->depth[(size_t)sj * g->width + si];
+    if (zs <= 0.0f) return SAMPLE_SKIP;
+    float q[3];
+    hbao_grid_position(g, si, sj, zs, q);
+    delta[0] = q[0] - m->p[0];
+    delta[1] = q[1] - m->p[1];
+    delta[2] = q[2] - m->p[2];
+    *dist2 = delta[0] * delta[0] + delta[1] * delta[1] + delta[2] * delta[2];
+    if (!(*dist2 < m->radius2) || !(*dist2 > 0.0f)) return SAMPLE_SKIP;
+    return SAMPLE_OK;
+}
+
+/* The slice of a direction: its axes and the normal projected into it. */
+typedef struct slice {
+    float e[3];          /* in-slice axis perpendicular to V, marching side */
+    float np_length;     /* |normal projected into the slice| */
+    float cos_gamma;     /* angle of the projected normal from V towards e */
+    float sin_gamma;
+    int usable;
+} slice;
+
+static inline void slice_setup(const float v[3], const float n[3], float dc, float ds, slice *sl) {
+    const float dir_dot_v = dc * v[0] + ds * v[1];
+    float e[3] = {dc - v[0] * dir_dot_v, ds - v[1] * dir_dot_v, -v[2] * dir_dot_v};
+    const float e_inv = 1.0f / sqrtf(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+    for (int c = 0; c < 3; c++) sl->e[c] = e[c] * e_inv;
+    const float m[3] = {v[1] * sl->e[2] - v[2] * sl->e[1], v[2] * sl->e[0] - v[0] * sl->e[2],
+                        v[0] * sl->e[1] - v[1] * sl->e[0]};
+    const float n_dot_m = n[0] * m[0] + n[1] * m[1] + n[2] * m[2];
+    const float np[3] = {n[0] - m[0] * n_dot_m, n[1] - m[1] * n_dot_m, n[2] - m[2] * n_dot_m};
+    sl->np_length = sqrtf(np[0] * np[0] + np[1] * np[1] + np[2] * np[2]);
+    sl->usable = sl->np_length > 1e-6f;
+    if (sl->usable) {
+        sl->cos_gamma = (np[0] * v[0] + np[1] * v[1] + np[2] * v[2]) / sl->np_length;
+        sl->sin_gamma = (np[0] * sl->e[0] + np[1] * sl->e[1] + np[2] * sl->e[2]) / sl->np_length;
+    } else {
+        sl->cos_gamma = 1.0f;
+        sl->sin_gamma = 0.0f;
+    }
+}
+
+/* HBAO integration of one direction: sum of W * (increase of the sine of the
+ * elevation above the tangent plane), Bavoil & Sainz with seed 003's rule. */
+static float direction_occlusion_hbao(const hbao_settings *s, const march *m, const float n[3],
+                                      const float v[3], const slice *sl) {
+    const int quadratic = s->falloff == HBAO_FALLOFF_QUADRATIC;
+    const float inv_radius2 = 1.0f / m->radius2;
+    const float half_occluded = 0.5f * (1.0f - s->sin_bias);
+    const int check_past_normal = sl->usable && sl->sin_gamma > 0.0f;
+    float sin_max = s->sin_bias;
+    float occlusion = 0.0f;
+    for (int step = 0; step < s->steps; step++) {
+        float delta[3], dist2;
+        const int status = march_sample(m, step, delta, &dist2);
+        if (status == SAMPLE_END) break;
+        if (status == SAMPLE_SKIP) continue;
+        const float inv_dist = 1.0f / sqrtf(dist2);
+        if (check_past_normal) {
+            const float cos_h = (delta[0] * v[0] + delta[1] * v[1] + delta[2] * v[2]) * inv_dist;
+            if (cos_h > sl->cos_gamma) {
+                /* Beyond the normal inside the slice: the screen-space march
+                 * has no proper data here; count the direction half occluded. */
+                if (occlusion < half_occluded) occlusion = half_occluded;
+                break;
+            }
+        }
+        const float sin_s = (delta[0] * n[0] + delta[1] * n[1] + delta[2] * n[2]) * inv_dist;
+        if (sin_s > sin_max) {
+            const float weight = quadratic ? 1.0f - dist2 * inv_radius2 : 1.0f;
+            occlusion += weight * (sin_s - sin_max);
+            sin_max = sin_s;
+        }
+    }
+    return occlusion;
+}
+
+/* Visibility of a half slice from V up to angle h: the integral of
+ * cos(t - gamma) sin(t) over [0, h] (docs/algorithm.md, T(h)). */
+static inline float half_slice_visibility(float h, float cos_h, float sin_h, const slice *sl) {
+    const float cos_2h = 2.0f * cos_h * cos_h - 1.0f;
+    const float sin_2h = 2.0f * sin_h * cos_h;
+    const float cos_2h_minus_gamma = cos_2h * sl->cos_gamma + sin_2h * sl->sin_gamma;
+    return 0.25f * (-cos_2h_minus_gamma + sl->cos_gamma + 2.0f * h * sl->sin_gamma);
+}
+
+/* The horizon angle h = gamma + acos(elevation) (from V), clamped to >= 0,
+ * with its cosine and sine. */
+static inline void horizon_from_elevation(float elevation, float gamma, const slice *sl, float *h,
+                                          float *cos_h, float *sin_h) {
+    const float cos_a = elevation, sin_a = sqrtf(fmaxf(0.0f, 1.0f - elevation * elevation));
+    *h = gamma + hbao_acos(elevation);
+    if (*h <= 0.0f) {
+        *h = 0.0f;
+        *cos_h = 1.0f;
+        *sin_h = 0.0f;
+        return;
+    }
+    *cos_h = sl->cos_gamma * cos_a - sl->sin_gamma * sin_a;
+    *sin_h = sl->sin_gamma * cos_a + sl->cos_gamma * sin_a;
+}
+
+static inline void horizon_state(int past_normal, float cos_past_max, float elevation_max,
+                                 float gamma, const slice *sl, float *h, float *cos_h,
+                                 float *sin_h) {
+    if (past_normal) {
+        *cos_h = cos_past_max;
+        *sin_h = sqrtf(fmaxf(0.0f, 1.0f - cos_past_max * cos_past_max));
+        *h = hbao_acos(cos_past_max);
+    } else {
+        horizon_from_elevation(elevation_max, gamma, sl, h, cos_h, sin_h);
+    }
+}
+
+/* Cosine integration of one direction: the visibility lost to the horizon,
+ * attenuated per sample. Returns the occluded part; *open_part receives the
+ * visibility of the unoccluded half slice.
+ * A sample's angle h from V is measured through its elevation above the
+ * tangent plane, sin(phi) = dot(n, D) / (|D| |np|), h = gamma + pi/2 - phi:
+ * exact for samples in the slice, and, unlike the angle to V, still exact
+ * (0) for snapped samples that lie on the tangent plane but off the slice.
+ * Past the normal (h < gamma) the elevation turns back, so there the angle
+ * to V is used. */
+static float direction_occlusion_cosine(const hbao_settings *s, const march *m, const float n[3],
+                                        const float v[3], const slice *sl, float *open_part) {
+    const float gamma = HALF_PI - hbao_acos(sl->sin_gamma); /* asin; cos_gamma >= 0 */
+    *open_part = 0.25f * (2.0f * sl->cos_gamma + (2.0f * gamma + HBAO_PI) * sl->sin_gamma);
+    const float inv_np = 1.0f / sl->np_length;
+    const int check_past_normal = sl->sin_gamma > 0.0f;
+    const int quadratic = s->falloff == HBAO_FALLOFF_QUADRATIC;
+    const float inv_radius2 = 1.0f / m->radius2;
+
+    /* Horizon state: the highest elevation sine (starting at the bias), and
+     * once past the normal, the highest cosine to V. */
+    float elevation_max = s->sin_bias;
+    int past_normal = 0;
+    float cos_past_max = sl->cos_gamma;
+    float visibility_start = 0.0f, visibility_at_max = 0.0f;
+    float h, cos_h, sin_h;
+    horizon_from_elevation(elevation_max, gamma, sl, &h, &cos_h, &sin_h);
+    visibility_start = half_slice_visibility(h, cos_h, sin_h, sl);
+    visibility_at_max = visibility_start;
+    float occlusion = 0.0f;
+
+    for (int step = 0; step < s->steps; step++) {
+        float delta[3], dist2;
+        const int status = march_sample(m, step, delta, &dist2);
+        if (status == SAMPLE_END) break;
+        if (status == SAMPLE_SKIP) continue;
+        const float inv_dist = 1.0f / sqrtf(dist2);
+        int raised = 0;
+        if (check_past_normal) {
+            const float cos_v = (delta[0] * v[0] + delta[1] * v[1] + delta[2] * v[2]) * inv_dist;
+            if (cos_v > sl->cos_gamma) {
+                if (cos_v > cos_past_max) {
+                    past_normal = 1;
+                    cos_past_max = cos_v > 1.0f ? 1.0f : cos_v;
+                    raised = 1;
+                }
+            }
+        }
+        if (!raised) {
+            if (past_normal) continue; /* nothing below the normal can raise it now */
+            const float elevation =
+                (delta[0] * n[0] + delta[1] * n[1] + delta[2] * n[2]) * inv_dist * inv_np;
+            if (elevation <= elevation_max) continue;
+            elevation_max = elevation > 1.0f ? 1.0f : elevation;
+            raised = 1;
+        }
+        if (quadratic) {
+            /* Each rise of the horizon costs visibility, weighted by the
+             * attenuation of the sample that caused it. */
+            horizon_state(past_normal, cos_past_max, elevation_max, gamma, sl, &h, &cos_h, &sin_h);
+            const float visibility = half_slice_visibility(h, cos_h, sin_h, sl);
+            occlusion += (1.0f - dist2 * inv_radius2) * (visibility_at_max - visibility);
+            visibility_at_max = visibility;
+        }
+    }
+    if (!quadratic) {
+        horizon_state(past_normal, cos_past_max, elevation_max, gamma, sl, &h, &cos_h, &sin_h);
+        occlusion = visibility_start - half_slice_visibility(h, cos_h, sin_h, sl);
+    }
+    return occlusion;
+}
+
+static float pixel_ao(const horizon_job *job, int i, int j) {
+    const hbao_settings *s = job->settings;
+    const hbao_grid *g = job->grid;
+    const float z = g->depth[(size_t)j * g->width + i];
+    if (z <= 0.0f) return 1.0f;
+
+    march m;
+    m.grid = g;
+    m.i = i;
+    m.j = j;
+    hbao_grid_position(g, i, j, z, m.p);
+    const float radius_px =
+        g->orthographic ? s->radius / g->pixel_size : s->radius / (g->pixel_size * z);
+    if (!(radius_px >= 1.0f)) return 1.0f;
+    const int cell = (i & 3) + 4 * (j & 3);
+    m.inv_ycor = 1.0f / g->ycor;
+    m.jitter = job->jitter[cell];
+    m.step_px = (radius_px - 1.0f) / (float)s->steps;
+    m.radius2 = s->radius * s->radius;
+
+    float v[3] = {0.0f, 0.0f, 1.0f};
+    if (!g->orthographic) {
+        const float inv = 1.0f / sqrtf(m.p[0] * m.p[0] + m.p[1] * m.p[1] + m.p[2] * m.p[2]);
+        for (int c = 0; c < 3; c++) v[c] = -m.p[c] * inv;
+    }
+    const float *n = g->normal + 3 * ((size_t)j * g->width + i);
+    const int cosine = s->integration == HBAO_INTEGRATION_COSINE;
+
+    float occlusion_sum = 0.0f;                /* HBAO */
+    float visible_sum = 0.0f, open_sum = 0.0f; /* COSINE */
+    for (int d = 0; d < s->directions; d++) {
+        m.dc = job->direction_cos[cell][d];
+        m.ds = job->direction_sin[cell][d];
+        slice sl;
+        slice_setup(v, n, m.dc, m.ds, &sl);
+        if (cosine) {
+            if (!sl.usable) continue; /* weight |np| = 0 */
+            float open;
+            const float occlusion = direction_occlusion_cosine(s, &m, n, v, &sl, &open);
+            visible_sum += sl.np_length * (open - occlusion);
+            open_sum += sl.np_length * open;
+        } else {
+            occlusion_sum += direction_occlusion_hbao(s, &m, n, v, &sl);
+        }
+    }
+
+    float ao;
+    if (cosine)
+        ao = open_sum > 1e-12f ? visible_sum / open_sum : 1.0f;
+    else
+        ao = 1.0f - occlusion_sum / ((float)s->directions * (1.0f - s->sin_bias));
+    if (!(ao > 0.0f)) return 0.0f; /* also catches NaN */
+    return ao < 1.0f ? ao : 1.0f;
+}
+
+static void horizon_row(void *context, int j) {
+    const horizon_job *job = context;
+    float *out = job->ao + (size_t)j * job->grid->width;
+    for (int i = 0; i < job->grid->width; i++) out[i] = pixel_ao(job, i, j);
+}
+
+void hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *grid, float *ao) {
+    horizon_job job;
+    job.settings = settings;
+    job.grid = grid;
+    job.ao = ao;
+    for (int cell = 0; cell < 16; cell++) {
+        const int i = cell & 3, j = cell >> 2;
+        const double rotation = (bayer_4x4[cell] + 0.5) / 16.0;
+        job.jitter[cell] = (float)((bayer_4x4[j + 4 * i] + 0.5) / 16.0);
+        for (int d = 0; d < settings->directions; d++) {
+            const double theta = 2.0 * 3.14159265358979323846 * (d + rotation) / settings->directions;
+            job.direction_cos[cell][d] = (float)cos(theta);
+            job.direction_sin[cell][d] = (float)sin(theta);
+        }
+    }
+    hbao_parallel_rows(settings->threads, grid->height, horizon_row, &job);
+}

@@ -1,0 +1,143 @@
+/* SPDX-License-Identifier: GPL-2.0-or-later */
+/* Private declarations shared by the library's source files. The pipeline
+ * (compute.c) is: convert depth -> [half-resolution grid] -> camera-space
+ * normals -> horizon sampling -> [depth-aware upsample] -> cross-bilateral
+ * blur -> strength. Every stage works on whole rows so that rows can be
+ * handed to worker threads; no stage reads what another thread writes in the
+ * same stage, so the result does not depend on the number of threads. */
+#ifndef HBAO_INTERNAL_H
+#define HBAO_INTERNAL_H
+
+#include <stddef.h>
+#include <math.h>
+#include <stdint.h>
+
+#include "hbao.h"
+
+#define HBAO_PI 3.14159265358979323846f
+
+/* A normal shorter than this before the transform is not trusted (Cycles
+ * averages normals over samples, so anti-aliased edges are short; background
+ * is zero) and is reconstructed from depth instead. */
+#define HBAO_MIN_NORMAL_LENGTH 0.1f
+
+/* How strongly the half-resolution upsample rejects samples at other depths,
+ * in units of 1 / relative depth difference (docs/algorithm.md). */
+#define HBAO_UPSAMPLE_SHARPNESS 16.0f
+
+/* Parameters after clamping to the documented limits. */
+typedef struct hbao_settings {
+    float radius;
+    float bias_rad;  /* angle bias */
+    float sin_bias;
+    float cos_bias;
+    int directions;
+    int steps;
+    int falloff;
+    int integration;
+    int blur_radius; /* taps on each side; 0 = no blur */
+    float blur_sharpness;
+    int half_resolution;
+    float strength;
+    int threads;
+    float background_depth;
+} hbao_settings;
+
+/* The image that horizons are searched on: the full image, or the
+ * half-resolution grid. Depth is dense and positive; 0 marks background. */
+typedef struct hbao_grid {
+    int width, height;
+    float *depth;     /* width * height */
+    float *normal;    /* width * height * 3, camera space, facing the viewer */
+    float *column_x;  /* view-plane x of each column (per unit depth if perspective) */
+    float *row_y;     /* view-plane y of each row */
+    int orthographic;
+    float pixel_size; /* view-plane width of one grid pixel (per unit depth if perspective) */
+    float ycor;       /* pixel height / pixel width */
+} hbao_grid;
+
+/* camera.c */
+hbao_result hbao_validate_camera(const hbao_camera *camera);
+/* Fill grid->column_x, row_y, pixel_size, ycor, orthographic for a grid whose
+ * pixel (i, j) is full-resolution pixel (scale * i, scale * j) of a
+ * full_width x full_height image. */
+void hbao_grid_set_projection(hbao_grid *grid, const hbao_camera *camera, int full_width,
+                              int full_height, int scale);
+
+static inline void hbao_grid_position(const hbao_grid *grid, int i, int j, float depth,
+                                      float position[3]) {
+    if (grid->orthographic) {
+        position[0] = grid->column_x[i];
+        position[1] = grid->row_y[j];
+    } else {
+        position[0] = grid->column_x[i] * depth;
+        position[1] = grid->row_y[j] * depth;
+    }
+    position[2] = -depth;
+}
+
+/* parallel.c: run job(context, row) for every row in [0, rows), on up to
+ * `threads` threads (the calling thread included). If a thread cannot be
+ * started, the threads that did start do its rows. */
+typedef void (*hbao_row_job)(void *context, int row);
+void hbao_parallel_rows(int threads, int rows, hbao_row_job job, void *context);
+int hbao_available_cores(void);
+
+/* normals.c: grid->normal from the given normals (world space, sampled at
+ * full-resolution pixel (scale*i, scale*j)) or reconstructed from depth. */
+void hbao_compute_normals(const hbao_settings *settings, const hbao_camera *camera,
+                          hbao_grid *grid, const hbao_channel *normal, int scale);
+
+/* horizon.c: raw AO on the grid (dense, grid->width wide). */
+void hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *grid, float *ao);
+
+/* upsample.c: half-resolution AO to full resolution, guided by full depth. */
+void hbao_upsample(const hbao_settings *settings, const hbao_grid *half, const float *half_ao,
+                   const float *full_depth, int width, int height, float *full_ao);
+
+/* blur.c: separable cross-bilateral blur, in place on ao (uses scratch). */
+void hbao_blur(const hbao_settings *settings, const float *depth, int width, int height, float *ao,
+               float *scratch);
+
+/* exp(-x) for x >= 0, to 3e-5 relative error (a degree-6 Taylor polynomial of 2^-f), without libm: the blur
+ * and the upsample evaluate it for every tap. */
+static inline float hbao_exp_negative(float x) {
+    if (!(x < 87.0f)) return 0.0f; /* also for NaN */
+    /* 2^(-x * log2 e) = 2^-n * 2^-f with n integer, f in [0, 1). */
+    const float y = x * 1.44269504088896341f;
+    const int n = (int)y;
+    const float f = y - (float)n;
+    /* 2^-f on [0, 1): minimax-style polynomial in f. */
+    float p = -1.530163e-4f;
+    p = p * f + 1.3333558e-3f;
+    p = p * f - 9.6181291e-3f;
+    p = p * f + 5.5504109e-2f;
+    p = p * f - 2.4022651e-1f;
+    p = p * f + 6.9314718e-1f;
+    p = 1.0f - p * f;
+    union {
+        float f;
+        uint32_t u;
+    } scale;
+    scale.u = (uint32_t)(127 - n) << 23; /* 2^-n, n <= 125 */
+    return p * scale.f;
+}
+
+/* acos(x) for x in [-1, 1] to 2e-8 absolute (Abramowitz & Stegun 4.4.46):
+ * the cosine integration needs an angle for every new horizon. */
+static inline float hbao_acos(float x) {
+    const float ax = x < 0.0f ? -x : x;
+    float p = -0.0012624911f;
+    p = p * ax + 0.0066700901f;
+    p = p * ax - 0.0170881256f;
+    p = p * ax + 0.0308918810f;
+    p = p * ax - 0.0501743046f;
+    p = p * ax + 0.0889789874f;
+    p = p * ax - 0.2145988016f;
+    p = p * ax + 1.5707963050f;
+    const float one_minus = 1.0f - ax;
+    const float r = (one_minus > 0.0f ? sqrtf(one_minus) : 0.0f) * p;
+    return x < 0.0f ? HBAO_PI - r : r;
+}
+
+#endif /* HBAO_INTERNAL_H */

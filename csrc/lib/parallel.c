@@ -1,0 +1,57 @@
+/* SPDX-License-Identifier: GPL-2.0-or-later */
+/* Rows handed out to worker threads from a shared counter. Which thread
+ * computes a row never changes the row's values, so results are identical
+ * for any number of threads. */
+#include <pthread.h>
+#include <stdatomic.h>
+#include <unistd.h>
+
+#include "internal_hbao.h"
+
+/* Rows taken per grab: enough to keep the counter off the hot path, few
+ * enough to balance rows of uneven cost (background vs. geometry). */
+#define HBAO_ROWS_PER_GRAB 4
+
+typedef struct row_queue {
+    atomic_int next_row;
+    int rows;
+    hbao_row_job job;
+    void *context;
+} row_queue;
+
+static void *drain_rows(void *argument) {
+    row_queue *queue = argument;
+    for (;;) {
+        const int first = atomic_fetch_add(&queue->next_row, HBAO_ROWS_PER_GRAB);
+        if (first >= queue->rows) break;
+        const int last = first + HBAO_ROWS_PER_GRAB < queue->rows ? first + HBAO_ROWS_PER_GRAB
+                                                                   : queue->rows;
+        for (int row = first; row < last; row++) queue->job(queue->context, row);
+    }
+    return NULL;
+}
+
+int hbao_available_cores(void) {
+    const long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    if (cores < 1) return 1;
+    return cores > HBAO_MAX_THREADS ? HBAO_MAX_THREADS : (int)cores;
+}
+
+void hbao_parallel_rows(int threads, int rows, hbao_row_job job, void *context) {
+    row_queue queue;
+    atomic_init(&queue.next_row, 0);
+    queue.rows = rows;
+    queue.job = job;
+    queue.context = context;
+
+    const int useful = (rows + HBAO_ROWS_PER_GRAB - 1) / HBAO_ROWS_PER_GRAB;
+    if (threads > useful) threads = useful;
+    pthread_t workers[HBAO_MAX_THREADS];
+    int started = 0;
+    for (int t = 1; t < threads; t++) {
+        if (pthread_create(&workers[started], NULL, drain_rows, &queue) != 0) break;
+        started++;
+    }
+    drain_rows(&queue);
+    for (int t = 0; t < started; t++) pthread_join(workers[t], NULL);
+}

@@ -1,0 +1,655 @@
+/* SPDX-License-Identifier: GPL-2.0-or-later */
+/* Correctness of hbao_compute() on analytic scenes: flat and tilted planes,
+ * the 90-degree corner against its analytic value, scale invariance,
+ * convergence towards a brute-force reference, threads, half resolution,
+ * blur, strength and background handling. */
+#include <stdint.h>
+#include <string.h>
+
+#include "hbao.h"
+#include "scene.h"
+#include "test_harness.h"
+
+#define PI 3.14159265358979323846
+
+/* --- helpers ------------------------------------------------------------- */
+
+static hbao_params exact_params(int integration) {
+    hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+    p.integration = integration;
+    p.angle_bias_degrees = 0.0f;
+    p.blur_size = 0;
+    p.falloff = HBAO_FALLOFF_NONE;
+    return p;
+}
+
+static float *run(const hbao_params *p, const scene_view *view, const float *depth, const float *normal) {
+    float *ao = malloc((size_t)view->width * view->height * sizeof(float));
+    hbao_channel d = {depth, 1, view->width};
+    hbao_channel n = {normal, 3, 3 * (int64_t)view->width};
+    CHECK_RESULT(hbao_compute(p, &view->camera, view->width, view->height, &d, normal ? &n : NULL, ao,
+                              view->width),
+                 HBAO_SUCCESS);
+    return ao;
+}
+
+static scene_view make_view(int width, int height, const double eye[3], const double target[3]) {
+    scene_view view;
+    memset(&view, 0, sizeof view);
+    view.width = width;
+    view.height = height;
+    hbao_camera_default(&view.camera);
+    scene_look_at(&view, eye, target);
+    return view;
+}
+
+static scene_plane infinite_plane(double px, double py, double pz, double nx, double ny, double nz) {
+    scene_plane p;
+    memset(&p, 0, sizeof p);
+    p.point[0] = px; p.point[1] = py; p.point[2] = pz;
+    double l = sqrt(nx * nx + ny * ny + nz * nz);
+    p.normal[0] = nx / l; p.normal[1] = ny / l; p.normal[2] = nz / l;
+    return p;
+}
+
+static void add_clip(scene_plane *p, double nx, double ny, double nz, double offset) {
+    p->clip_normal[p->clips][0] = nx;
+    p->clip_normal[p->clips][1] = ny;
+    p->clip_normal[p->clips][2] = nz;
+    p->clip_offset[p->clips] = offset;
+    p->clips++;
+}
+
+/* The floor z = 0 for x <= 0 and the wall x = 0 for z >= 0, facing -x. */
+static scene corner_scene(void) {
+    scene s;
+    memset(&s, 0, sizeof s);
+    s.planes = 2;
+    s.plane[0] = infinite_plane(0, 0, 0, 0, 0, 1);
+    add_clip(&s.plane[0], 1, 0, 0, 0);
+    s.plane[1] = infinite_plane(0, 0, 0, -1, 0, 0);
+    add_clip(&s.plane[1], 0, 0, -1, 0);
+    return s;
+}
+
+/* --- planes -------------------------------------------------------------- */
+
+/* A single plane occludes nothing: AO = 1. Tolerance 1e-4: samples on the
+ * plane have elevation 0 up to float rounding of positions (~1e-6 relative). */
+static void check_plane_is_unoccluded(const double eye[3], const double target[3], scene_plane plane) {
+    scene s;
+    memset(&s, 0, sizeof s);
+    s.planes = 1;
+    s.plane[0] = plane;
+    scene_view view = make_view(96, 64, eye, target);
+    float *depth, *normal;
+    scene_render(&s, &view, &depth, &normal);
+    for (int integration = 0; integration <= 1; integration++) {
+        for (int given = 0; given <= 1; given++) {
+            hbao_params p = exact_params(integration);
+            p.radius = 2.0f;
+            float *ao = run(&p, &view, depth, given ? normal : NULL);
+            float worst = 1.0f;
+            for (int k = 0; k < view.width * view.height; k++) worst = ao[k] < worst ? ao[k] : worst;
+            if (worst < 1.0f - 1e-4f) printf("  integration %d given normals %d\n", integration, given);
+            CHECK_NEAR(worst, 1.0f, 1e-4);
+            free(ao);
+        }
+    }
+    free(depth);
+    free(normal);
+}
+
+TEST_CASE(plane_facing_camera_is_unoccluded) {
+    const double eye[3] = {0, 0, 5}, target[3] = {0, 0, 0};
+    /* looking straight down at the floor */
+    const double eye_down[3] = {0, -1e-3, 5};
+    (void)eye;
+    check_plane_is_unoccluded(eye_down, target, infinite_plane(0, 0, 0, 0, 0, 1));
+}
+
+TEST_CASE(tilted_plane_is_unoccluded) {
+    const double eye[3] = {0, -6, 3}, target[3] = {0, 0, 0};
+    check_plane_is_unoccluded(eye, target, infinite_plane(0, 0, 0, 0.3, -0.2, 1));
+}
+
+/* --- the corner ---------------------------------------------------------- */
+
+/* Occluded fraction at distance a = d / R from an infinite wall, radius R,
+ * for a floor point (falloff none, no bias).
+ * Cosine-weighted: cosine-distributed directions project to points spread
+ * uniformly on the unit disk (Malley); a direction hits the wall within R
+ * iff its component towards the wall exceeds a, i.e. the disk segment
+ * x > a, of area acos(a) - a sqrt(1 - a^2) out of pi. */
+static double corner_cosine_occlusion(double a) {
+    if (a >= 1.0) return 0.0;
+    return (acos(a) - a * sqrt(1.0 - a * a)) / PI;
+}
+
+/* The classic HBAO estimator for the same point, as the library integrates
+ * it: the mean over screen directions of sin(elevation of the highest wall
+ * point within R in that direction's slice), with seed 003's half-occluded
+ * rule. Derived per slice from the geometry: the slice is the plane through
+ * the eye, P and P's screen direction; it cuts the wall in a line. */
+static double corner_hbao_occlusion(const scene_view *view, int i, int j, double depth) {
+    const int directions = 720;
+    double p_cam[3], o[3], d[3];
+    scene_pixel_ray(view, i, j, o, d);
+    for (int c = 0; c < 3; c++) p_cam[c] = o[c] + depth * d[c];
+    double vlen = sqrt(p_cam[0] * p_cam[0] + p_cam[1] * p_cam[1] + p_cam[2] * p_cam[2]);
+    const double v[3] = {-p_cam[0] / vlen, -p_cam[1] / vlen, -p_cam[2] / vlen};
+    double p_world[3];
+    mat_mul_point(view->camera_to_world, p_cam, p_world);
+    const double n_world[3] = {0, 0, 1};
+    double sum = 0.0;
+    for (int k = 0; k < directions; k++) {
+        const double theta = 2.0 * PI * (k + 0.5) / directions;
+        const double dir[3] = {cos(theta), sin(theta), 0};
+        const double dv = dir[0] * v[0] + dir[1] * v[1];
+        double e[3] = {dir[0] - v[0] * dv, dir[1] - v[1] * dv, -v[2] * dv};
+        double el = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+        for (int c = 0; c < 3; c++) e[c] /= el;
+        double e_w[3], v_w[3];
+        mat_mul_dir(view->camera_to_world, e, e_w);
+        mat_mul_dir(view->camera_to_world, v, v_w);
+        /* in-slice projected normal angle: cos/sin of gamma */
+        const double nv = n_world[0] * v_w[0] + n_world[1] * v_w[1] + n_world[2] * v_w[2];
+        const double ne = n_world[0] * e_w[0] + n_world[1] * e_w[1] + n_world[2] * e_w[2];
+        const double np_len = sqrt(nv * nv + ne * ne);
+        /* slice points: P + a V + b e with b > 0; on the wall x = 0. March
+         * outwards in b (screen distance grows with b) and keep the highest
+         * elevation, as a dense march would. */
+        double occlusion = 0.0;
+        const double vx = v_w[0], ex = e_w[0];
+        for (int step = 1; step <= 4000; step++) {
+            const double b = step * 1e-3 * 4.0; /* up to 16 scene units sideways */
+            if (fabs(vx) < 1e-12) break;
+            const double a = -(p_world[0] + b * ex) / vx; /* x = 0 */
+            double x[3];
+            for (int c = 0; c < 3; c++) x[c] = p_world[c] + a * v_w[c] + b * e_w[c];
+            if (x[2] < 0.0) continue;                   /* below the floor: hidden */
+            double delta[3] = {x[0] - p_world[0], x[1] - p_world[1], x[2] - p_world[2]};
+            const double dist = sqrt(delta[0] * delta[0] + delta[1] * delta[1] + delta[2] * delta[2]);
+            if (dist >= 1.0) continue;                  /* radius R = 1 */
+            const double cos_h = (delta[0] * v_w[0] + delta[1] * v_w[1] + delta[2] * v_w[2]) / dist;
+            if (ne > 0.0 && cos_h > nv / np_len) {     /* past the normal */
+                if (occlusion < 0.5) occlusion = 0.5;
+                break;
+            }
+            const double sin_e = delta[2] / dist;
+            if (sin_e > occlusion) occlusion = sin_e;
+        }
+        sum += occlusion;
+    }
+    return sum / directions;
+}
+
+/* Floor pixels of the corner, away from the image border by more than the
+ * projected radius (no sampling outside the image). */
+static void check_corner(int integration) {
+    const double eye[3] = {-5.0, -2.5, 3.5}, target[3] = {-0.8, 0, 0.3};
+    scene s = corner_scene();
+    scene_view view = make_view(200, 150, eye, target);
+    float *depth, *normal;
+    scene_render(&s, &view, &depth, &normal);
+    hbao_params p = exact_params(integration);
+    p.radius = 1.0f;
+    p.directions = 32;
+    p.steps = 32;
+    float *ao = run(&p, &view, depth, normal);
+    double error_sum = 0.0, worst = 0.0;
+    int count = 0;
+    for (int j = 0; j < view.height; j += 3) {
+        for (int i = 0; i < view.width; i += 3) {
+            const size_t k = (size_t)j * view.width + i;
+            if (normal[3 * k + 2] < 0.5f) continue; /* floor pixels only */
+            double w[3];
+            scene_pixel_position(&view, i, j, depth[k], w);
+            const double a = -w[0]; /* distance to the wall, R = 1 */
+            /* projected radius in pixels, with a margin to the border */
+            const double radius_px = 1.0 / (36.0 / 50.0 / view.width * depth[k]);
+            if (i < radius_px || j < radius_px || i >= view.width - radius_px ||
+                j >= view.height - radius_px || a < 0.05 || a > 1.2)
+                continue;
+            const double expected = 1.0 - (integration == HBAO_INTEGRATION_COSINE
+                                                ? corner_cosine_occlusion(a)
+                                                : corner_hbao_occlusion(&view, i, j, depth[k]));
+            const double error = fabs(ao[k] - expected);
+            error_sum += error;
+            worst = error > worst ? error : worst;
+            count++;
+        }
+    }
+    CHECK(count > 40);
+    /* 32 directions x 32 steps: the steps find the horizon up to one step
+     * (1/32 of the radius) and pixel snapping; 0.02 mean and 0.06 worst
+     * leave room for that and nothing like a wrong formula (which is off by
+     * 0.1 or more near the wall). */
+    printf("  corner (%s): %d pixels, mean |error| %.4f, worst %.4f\n",
+           integration == HBAO_INTEGRATION_COSINE ? "cosine" : "hbao", count, error_sum / count, worst);
+    CHECK(error_sum / count < 0.02);
+    CHECK(worst < 0.06);
+    free(ao);
+    free(depth);
+    free(normal);
+}
+
+TEST_CASE(corner_matches_analytic_cosine) { check_corner(HBAO_INTEGRATION_COSINE); }
+
+TEST_CASE(corner_matches_analytic_hbao) { check_corner(HBAO_INTEGRATION_HBAO); }
+
+TEST_CASE(corner_value_at_the_crease_is_one_half) {
+    /* At the crease the wall takes exactly half the hemisphere, in both
+     * solid angle and cosine weighting. */
+    CHECK_NEAR(corner_cosine_occlusion(0.0), 0.5, 1e-12);
+}
+
+/* --- invariances --------------------------------------------------------- */
+
+static scene boxes_scene(void) {
+    scene s = corner_scene();
+    /* a box standing on the floor: two visible faces and the top */
+    scene_plane front = infinite_plane(-1.5, 0, 0, -1, 0, 0);
+    add_clip(&front, 0, 0, 1, 0.6);
+    add_clip(&front, 0, 1, 0, 0.5);
+    scene_plane side = infinite_plane(0, -0.5, 0, 0, -1, 0);
+    add_clip(&side, 0, 0, 1, 0.6);
+    add_clip(&side, -1, 0, 0, 1.5);
+    s.plane[s.planes++] = front;
+    s.plane[s.planes++] = side;
+    return s;
+}
+
+TEST_CASE(scaling_depth_and_radius_keeps_ao) {
+    const double eye[3] = {-5.0, -2.5, 3.5}, target[3] = {-0.8, 0, 0.3};
+    scene s = boxes_scene();
+    scene_view view = make_view(128, 96, eye, target);
+    float *depth, *normal;
+    scene_render(&s, &view, &depth, &normal);
+    const size_t pixels = (size_t)view.width * view.height;
+    float *scaled = malloc(pixels * sizeof(float));
+    const float factor = 7.5f;
+    for (size_t k = 0; k < pixels; k++) scaled[k] = depth[k] < 1e9f ? depth[k] * factor : depth[k];
+    for (int integration = 0; integration <= 1; integration++) {
+        for (int half = 0; half <= 1; half++) {
+            hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+            p.integration = integration;
+            p.half_resolution = half;
+            p.blur_size = 7;
+            p.radius = 0.8f;
+            float *a = run(&p, &view, depth, NULL);
+            p.radius *= factor;
+            float *b = run(&p, &view, scaled, NULL);
+            float worst = 0.0f;
+            for (size_t k = 0; k < pixels; k++) worst = fmaxf(worst, fabsf(a[k] - b[k]));
+            /* Same geometry in other units: only float rounding differs
+             * (positions carry ~1e-7 relative error; a snapped sample can
+             * flip at a pixel boundary, hence 1e-3 rather than 1e-6). */
+            CHECK_NEAR(worst, 0.0, 1e-3);
+            free(a);
+            free(b);
+        }
+    }
+    free(scaled);
+    free(depth);
+    free(normal);
+}
+
+/* Brute force, written here independently from docs/algorithm.md: the
+ * cosine estimator with 512 directions, marching every quarter pixel up to
+ * the radius, in double precision, with the scene's exact normals. */
+static double brute_force_cosine(const scene_view *view, const float *depth, const float *normal_w,
+                                 int i, int j, double radius) {
+    const int directions = 512;
+    double o[3], d[3];
+    double p[3];
+    scene_pixel_ray(view, i, j, o, d);
+    for (int c = 0; c < 3; c++) p[c] = o[c] + depth[(size_t)j * view->width + i] * d[c];
+    const double pl = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+    const double v[3] = {-p[0] / pl, -p[1] / pl, -p[2] / pl};
+    const float *m = view->camera.world_to_camera;
+    const float *nw = normal_w + 3 * ((size_t)j * view->width + i);
+    double n[3];
+    for (int r = 0; r < 3; r++) n[r] = m[4 * r] * nw[0] + m[4 * r + 1] * nw[1] + m[4 * r + 2] * nw[2];
+    const double pixel = 36.0 / 50.0 / view->width; /* per unit depth, horizontal fit */
+    const double radius_px = radius / (pixel * -p[2]);
+    double visible = 0.0, open = 0.0;
+    for (int k = 0; k < directions; k++) {
+        const double theta = 2.0 * PI * (k + 0.5) / directions;
+        const double dc = cos(theta), ds = sin(theta);
+        const double dv = dc * v[0] + ds * v[1];
+        double e[3] = {dc - v[0] * dv, ds - v[1] * dv, -v[2] * dv};
+        const double el = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+        for (int c = 0; c < 3; c++) e[c] /= el;
+        const double mm[3] = {v[1] * e[2] - v[2] * e[1], v[2] * e[0] - v[0] * e[2], v[0] * e[1] - v[1] * e[0]};
+        const double nm = n[0] * mm[0] + n[1] * mm[1] + n[2] * mm[2];
+        const double np[3] = {n[0] - mm[0] * nm, n[1] - mm[1] * nm, n[2] - mm[2] * nm};
+        const double npl = sqrt(np[0] * np[0] + np[1] * np[1] + np[2] * np[2]);
+        if (npl < 1e-9) continue;
+        const double gamma = atan2((np[0] * e[0] + np[1] * e[1] + np[2] * e[2]) / npl,
+                                   (np[0] * v[0] + np[1] * v[1] + np[2] * v[2]) / npl);
+        double h = gamma + PI / 2;
+        const double h_open = h;
+        for (double t = 1.0; t <= radius_px; t += 0.25) {
+            const int si = (int)floor(i + 0.5 + dc * t), sj = (int)floor(j + 0.5 - ds * t);
+            if (si < 0 || sj < 0 || si >= view->width || sj >= view->height) break;
+            if (si == i && sj == j) continue;
+            const double zs = depth[(size_t)sj * view->width + si];
+            if (zs >= 1e9) continue;
+            double q[3];
+            scene_pixel_ray(view, si, sj, o, d);
+            for (int c = 0; c < 3; c++) q[c] = o[c] + zs * d[c] - p[c];
+            const double dist = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+            if (dist >= radius) continue;
+            /* the sample's angle from V: through its elevation above the
+             * tangent plane, or past the normal through its angle to V */
+            const double cos_v = (q[0] * v[0] + q[1] * v[1] + q[2] * v[2]) / dist;
+            double hs;
+            if (gamma > 0 && cos_v > cos(gamma))
+                hs = acos(fmin(1.0, cos_v));
+            else
+                hs = gamma + acos(fmax(-1.0, fmin(1.0, (q[0] * n[0] + q[1] * n[1] + q[2] * n[2]) / dist / npl)));
+            if (hs < h) h = hs;
+        }
+        /* visibility integral from 0 to h of cos(t - gamma) sin(t) dt */
+#define HALF_SLICE(x) (0.25 * (-cos(2 * (x) - gamma) + cos(gamma) + 2 * (x) * sin(gamma)))
+        visible += npl * HALF_SLICE(h);
+        open += npl * HALF_SLICE(h_open);
+#undef HALF_SLICE
+    }
+    return open > 0 ? visible / open : 1.0;
+}
+
+TEST_CASE(more_samples_converge_to_brute_force) {
+    const double eye[3] = {-5.0, -2.5, 3.5}, target[3] = {-0.8, 0, 0.3};
+    scene s = boxes_scene();
+    scene_view view = make_view(120, 90, eye, target);
+    float *depth, *normal;
+    scene_render(&s, &view, &depth, &normal);
+    const double radius = 0.7;
+    /* reference on a sparse grid of pixels */
+    int count = 0;
+    static double reference[120 * 90];
+    for (int j = 2; j < view.height; j += 4)
+        for (int i = 2; i < view.width; i += 4) {
+            const size_t k = (size_t)j * view.width + i;
+            reference[k] = depth[k] < 1e9f ? brute_force_cosine(&view, depth, normal, i, j, radius) : 1.0;
+            count++;
+        }
+    const int settings[4][2] = {{4, 3}, {8, 6}, {16, 16}, {32, 32}};
+    double errors[4];
+    for (int k = 0; k < 4; k++) {
+        hbao_params p = exact_params(HBAO_INTEGRATION_COSINE);
+        p.radius = (float)radius;
+        p.directions = settings[k][0];
+        p.steps = settings[k][1];
+        float *ao = run(&p, &view, depth, normal);
+        double sum = 0.0;
+        for (int j = 2; j < view.height; j += 4)
+            for (int i = 2; i < view.width; i += 4) {
+                const size_t q = (size_t)j * view.width + i;
+                sum += fabs(ao[q] - reference[q]);
+            }
+        errors[k] = sum / count;
+        printf("  %2d directions x %2d steps: mean |AO - brute force| = %.4f\n", settings[k][0],
+               settings[k][1], errors[k]);
+        free(ao);
+    }
+    /* Each doubling of the samples lowers the error; the finest setting is
+     * within 0.01 of the brute force (one step = 1/32 radius). */
+    CHECK(errors[1] < errors[0]);
+    CHECK(errors[2] < errors[1]);
+    CHECK(errors[3] <= errors[2] + 1e-4);
+    CHECK(errors[3] < 0.01);
+    free(depth);
+    free(normal);
+}
+
+/* --- robustness ---------------------------------------------------------- */
+
+static uint32_t rng_state = 12345u;
+static uint32_t next_random(void) {
+    rng_state ^= rng_state << 13;
+    rng_state ^= rng_state >> 17;
+    rng_state ^= rng_state << 5;
+    return rng_state;
+}
+static float random_unit(void) { return (float)(next_random() >> 8) / 16777216.0f; }
+
+TEST_CASE(random_and_degenerate_inputs_give_finite_ao_in_range) {
+    static const float specials[] = {NAN, INFINITY, -INFINITY, 0.0f, -1.0f, 1e10f, 65504.0f, 1e-38f,
+                                     1e-45f, 3e38f, 1e-3f, 1.0f};
+    const int sizes[][2] = {{1, 1}, {1, 7}, {9, 1}, {2, 2}, {37, 23}, {64, 48}};
+    for (int trial = 0; trial < 60; trial++) {
+        const int w = sizes[trial % 6][0], h = sizes[trial % 6][1];
+        const size_t pixels = (size_t)w * h;
+        float *depth = malloc(pixels * sizeof(float));
+        float *normal = malloc(pixels * 3 * sizeof(float));
+        float *ao = malloc(pixels * sizeof(float));
+        for (size_t k = 0; k < pixels; k++) {
+            depth[k] = (next_random() % 4 == 0) ? specials[next_random() % 12] : 0.5f + 20.0f * random_unit();
+            for (int c = 0; c < 3; c++)
+                normal[3 * k + c] = (next_random() % 8 == 0) ? specials[next_random() % 12] : 2.0f * random_unit() - 1.0f;
+        }
+        hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+        p.radius = (trial % 5 == 0) ? 1e30f : 0.01f + 5.0f * random_unit();
+        p.directions = (int)(next_random() % 80) - 5;
+        p.steps = (int)(next_random() % 80) - 5;
+        p.blur_size = (int)(next_random() % 80) - 5;
+        p.blur_sharpness = 100.0f * random_unit();
+        p.half_resolution = trial & 1;
+        p.integration = (trial >> 1) & 1;
+        p.falloff = (trial >> 2) & 1;
+        p.angle_bias_degrees = 120.0f * random_unit() - 30.0f;
+        p.strength = 20.0f * random_unit();
+        p.threads = 1 + trial % 3;
+        hbao_camera camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
+        camera.projection = trial % 3 == 0 ? HBAO_PROJECTION_ORTHOGRAPHIC : HBAO_PROJECTION_PERSPECTIVE;
+        camera.lens = 1.0f + 200.0f * random_unit();
+        camera.shift_x = random_unit() - 0.5f;
+        camera.sensor_fit = trial % 3;
+        hbao_channel d = {depth, 1, w};
+        hbao_channel n = {normal, 3, 3 * (int64_t)w};
+        CHECK_RESULT(hbao_compute(&p, &camera, w, h, &d, (trial & 4) ? &n : NULL, ao, w), HBAO_SUCCESS);
+        int bad = 0;
+        for (size_t k = 0; k < pixels; k++)
+            if (!(ao[k] >= 0.0f && ao[k] <= 1.0f)) bad++;
+        CHECK(bad == 0);
+        free(depth);
+        free(normal);
+        free(ao);
+    }
+}
+
+TEST_CASE(identical_output_for_any_thread_count) {
+    const double eye[3] = {-5.0, -2.5, 3.5}, target[3] = {-0.8, 0, 0.3};
+    scene s = boxes_scene();
+    scene_view view = make_view(161, 117, eye, target);
+    float *depth, *normal;
+    scene_render(&s, &view, &depth, &normal);
+    const size_t bytes = (size_t)view.width * view.height * sizeof(float);
+    for (int variant = 0; variant < 4; variant++) {
+        hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+        p.half_resolution = variant & 1;
+        p.integration = variant >> 1;
+        p.blur_size = 15;
+        p.threads = 1;
+        float *one = run(&p, &view, depth, variant & 2 ? normal : NULL);
+        const int counts[] = {2, 3, 8};
+        for (int c = 0; c < 3; c++) {
+            p.threads = counts[c];
+            float *many = run(&p, &view, depth, variant & 2 ? normal : NULL);
+            CHECK(memcmp(one, many, bytes) == 0);
+            free(many);
+        }
+        free(one);
+    }
+    free(depth);
+    free(normal);
+}
+
+TEST_CASE(bottom_up_rows_with_negative_stride) {
+    const double eye[3] = {-5.0, -2.5, 3.5}, target[3] = {-0.8, 0, 0.3};
+    scene s = boxes_scene();
+    scene_view view = make_view(64, 48, eye, target);
+    float *depth, *normal;
+    scene_render(&s, &view, &depth, &normal);
+    const int w = view.width, h = view.height;
+    /* The same image stored bottom-up, as Blender's render passes are, with
+     * depth in an RGBA-like 4-float pixel. */
+    float *flipped = malloc((size_t)w * h * 4 * sizeof(float));
+    for (int j = 0; j < h; j++)
+        for (int i = 0; i < w; i++) flipped[4 * ((size_t)(h - 1 - j) * w + i)] = depth[(size_t)j * w + i];
+    hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+    float *top_down = run(&p, &view, depth, NULL);
+    float *ao = malloc((size_t)w * h * sizeof(float));
+    hbao_channel d = {flipped + 4 * (size_t)(h - 1) * w, 4, -4 * (int64_t)w};
+    /* the output bottom-up too */
+    CHECK_RESULT(hbao_compute(&p, &view.camera, w, h, &d, NULL, ao + (size_t)(h - 1) * w, -(int64_t)w),
+                 HBAO_SUCCESS);
+    int mismatches = 0;
+    for (int j = 0; j < h; j++)
+        for (int i = 0; i < w; i++)
+            if (ao[(size_t)(h - 1 - j) * w + i] != top_down[(size_t)j * w + i]) mismatches++;
+    CHECK(mismatches == 0);
+    free(flipped);
+    free(ao);
+    free(top_down);
+    free(depth);
+    free(normal);
+}
+
+/* --- stages ---------------------------------------------------------------- */
+
+TEST_CASE(half_resolution_is_close_to_full) {
+    const double eye[3] = {-5.0, -2.5, 3.5}, target[3] = {-0.8, 0, 0.3};
+    scene s = boxes_scene();
+    scene_view view = make_view(160, 120, eye, target);
+    float *depth, *normal;
+    scene_render(&s, &view, &depth, &normal);
+    hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+    p.directions = 16;
+    p.steps = 12;
+    p.blur_size = 9;
+    float *full = run(&p, &view, depth, normal);
+    p.half_resolution = 1;
+    float *half = run(&p, &view, depth, normal);
+    double sum = 0.0;
+    const int pixels = view.width * view.height;
+    for (int k = 0; k < pixels; k++) sum += fabs(full[k] - half[k]);
+    printf("  mean |full - half| = %.4f\n", sum / pixels);
+    /* Half resolution samples a quarter of the pixels; on smooth AO the
+     * difference stays small (measured ~0.01), edges add a little. */
+    CHECK(sum / pixels < 0.03);
+    free(full);
+    free(half);
+    free(depth);
+    free(normal);
+}
+
+TEST_CASE(blur_keeps_depth_edges) {
+    /* Left half: AO 1 region on a near plane; right half: far plane. The blur
+     * must not move AO across the edge, and must average noise inside. */
+    const int w = 64, h = 16;
+    float depth[64 * 16];
+    for (int j = 0; j < h; j++)
+        for (int i = 0; i < w; i++) depth[j * w + i] = i < w / 2 ? 2.0f : 6.0f;
+    hbao_camera camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
+    hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+    p.blur_size = 15;
+    p.blur_sharpness = 8.0f;
+    float ao[64 * 16];
+    hbao_channel d = {depth, 1, w};
+    CHECK_RESULT(hbao_compute(&p, &camera, w, h, &d, NULL, ao, w), HBAO_SUCCESS);
+    /* The far plane right of the edge is occluded by the near plane's edge?
+     * No: the near plane is in front, the far plane behind it; the near
+     * plane's pixels see nothing above them. */
+    CHECK_NEAR(ao[8 * w + 5], 1.0f, 1e-4);
+    p.blur_size = 0;
+    float sharp[64 * 16];
+    CHECK_RESULT(hbao_compute(&p, &camera, w, h, &d, NULL, sharp, w), HBAO_SUCCESS);
+    /* near-plane pixels next to the edge: unchanged by the blur, because the
+     * far plane's taps are 200% deeper (weight exp(-(8*2)^2) ~ 0) */
+    CHECK_NEAR(ao[8 * w + w / 2 - 1], sharp[8 * w + w / 2 - 1], 1e-4);
+}
+
+TEST_CASE(strength_is_a_power) {
+    const double eye[3] = {-5.0, -2.5, 3.5}, target[3] = {-0.8, 0, 0.3};
+    scene s = corner_scene();
+    scene_view view = make_view(64, 48, eye, target);
+    float *depth, *normal;
+    scene_render(&s, &view, &depth, &normal);
+    hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+    float *base = run(&p, &view, depth, normal);
+    p.strength = 2.0f;
+    float *squared = run(&p, &view, depth, normal);
+    p.strength = 0.0f;
+    float *none = run(&p, &view, depth, normal);
+    double darkest = 1.0;
+    for (int k = 0; k < view.width * view.height; k++) {
+        CHECK_NEAR(squared[k], base[k] * base[k], 1e-5);
+        CHECK_NEAR(none[k], 1.0f, 0.0);
+        darkest = fmin(darkest, base[k]);
+    }
+    CHECK(darkest < 0.8); /* the corner is occluded at all */
+    free(base);
+    free(squared);
+    free(none);
+    free(depth);
+    free(normal);
+}
+
+TEST_CASE(background_never_occludes) {
+    /* A floor seen from above with a square of background (a hole, depth
+     * 1e10) in the middle: the hole must not darken the floor around it. */
+    const double eye[3] = {0, -1e-3, 5}, target[3] = {0, 0, 0};
+    scene s;
+    memset(&s, 0, sizeof s);
+    s.planes = 1;
+    s.plane[0] = infinite_plane(0, 0, 0, 0, 0, 1);
+    scene_view view = make_view(64, 64, eye, target);
+    float *depth, *normal;
+    scene_render(&s, &view, &depth, &normal);
+    for (int j = 24; j < 40; j++)
+        for (int i = 24; i < 40; i++) depth[j * 64 + i] = (i + j) % 2 ? 1e10f : 65504.0f;
+    depth[0] = NAN;
+    depth[1] = INFINITY;
+    for (int integration = 0; integration <= 1; integration++) {
+        hbao_params p = exact_params(integration);
+        p.radius = 1.0f;
+        p.blur_size = 9;
+        float *ao = run(&p, &view, depth, NULL);
+        float worst = 1.0f;
+        for (int k = 0; k < 64 * 64; k++) worst = fminf(worst, ao[k]);
+        CHECK_NEAR(worst, 1.0f, 1e-4);
+        free(ao);
+    }
+    free(depth);
+    free(normal);
+}
+
+TEST_CASE(tiny_projected_radius_gives_one) {
+    const double eye[3] = {-5.0, -2.5, 3.5}, target[3] = {-0.8, 0, 0.3};
+    scene s = corner_scene();
+    scene_view view = make_view(64, 48, eye, target);
+    float *depth, *normal;
+    scene_render(&s, &view, &depth, &normal);
+    hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+    /* under one pixel: 1e-3 units at depth ~6 with 64 px over a 36/50 view */
+    p.radius = 1e-3f;
+    float *ao = run(&p, &view, depth, normal);
+    for (int k = 0; k < view.width * view.height; k++) CHECK_NEAR(ao[k], 1.0f, 0.0);
+    free(ao);
+    free(depth);
+    free(normal);
+}
+
+TEST_MAIN(TEST_ENTRY(plane_facing_camera_is_unoccluded), TEST_ENTRY(tilted_plane_is_unoccluded),
+          TEST_ENTRY(corner_matches_analytic_cosine), TEST_ENTRY(corner_matches_analytic_hbao),
+          TEST_ENTRY(corner_value_at_the_crease_is_one_half),
+          TEST_ENTRY(scaling_depth_and_radius_keeps_ao), TEST_ENTRY(more_samples_converge_to_brute_force),
+          TEST_ENTRY(random_and_degenerate_inputs_give_finite_ao_in_range),
+          TEST_ENTRY(identical_output_for_any_thread_count), TEST_ENTRY(bottom_up_rows_with_negative_stride),
+          TEST_ENTRY(half_resolution_is_close_to_full), TEST_ENTRY(blur_keeps_depth_edges),
+          TEST_ENTRY(strength_is_a_power), TEST_ENTRY(background_never_occludes),
+          TEST_ENTRY(tiny_projected_radius_gives_one))
