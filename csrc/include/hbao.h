@@ -142,7 +142,20 @@ typedef struct hbao_params {
     int32_t threads;
     /** Depths at or beyond this are background. Must be > 0. */
     float background_depth;
+    /** hbao_implementation: which code computes the horizons. All give
+     *  bit-identical results; choosing one exists for tests and benchmarks. */
+    int32_t implementation;
 } hbao_params;
+
+/** The horizon search exists as a portable scalar reference and as SIMD
+ *  kernels chosen at run time. A kernel the CPU lacks falls back to the best
+ *  one below it. Unknown values are rejected. */
+typedef enum hbao_implementation {
+    HBAO_IMPLEMENTATION_AUTO = 0,   /**< the fastest this CPU runs */
+    HBAO_IMPLEMENTATION_SCALAR = 1, /**< portable C, the reference */
+    HBAO_IMPLEMENTATION_AVX2 = 2,   /**< 8 pixels at a time (x86-64) */
+    HBAO_IMPLEMENTATION_AVX512 = 3  /**< 16 pixels at a time (x86-64) */
+} hbao_implementation;
 
 #define HBAO_DEFAULT_RADIUS 1.0f
 #define HBAO_DEFAULT_ANGLE_BIAS_DEGREES 10.0f
@@ -160,7 +173,7 @@ typedef struct hbao_params {
             HBAO_DEFAULT_DIRECTIONS, HBAO_DEFAULT_STEPS, HBAO_FALLOFF_QUADRATIC, \
             HBAO_INTEGRATION_COSINE, HBAO_DEFAULT_BLUR_SIZE,                    \
             HBAO_DEFAULT_BLUR_SHARPNESS, 0, HBAO_DEFAULT_STRENGTH, 0,           \
-            HBAO_DEFAULT_BACKGROUND_DEPTH                                       \
+            HBAO_DEFAULT_BACKGROUND_DEPTH, 0                                    \
     }
 
 typedef enum hbao_projection {

@@ -3,6 +3,7 @@
  * (Bavoil & Sainz; the filter is not separable, but the separable version is
  * close and costs 2r+1 taps instead of (2r+1)^2). */
 #include <math.h>
+#include <stdlib.h>
 
 #include "internal_hbao.h"
 
@@ -15,41 +16,61 @@ typedef struct blur_job {
     const float *source;
     float *target;
     float spatial[MAX_BLUR_RADIUS + 1]; /* Gaussian weight by tap distance */
-    int step;      /* floats between taps: 1 for rows, width for columns */
-    int along_row; /* 1: taps along the row */
+    int along_row; /* 1: taps along the row, 0: along the column */
 } blur_job;
 
+/* One output row. Taps run in the outer loop and pixels in the inner one,
+ * so the inner loop reads contiguous memory and vectorizes; each pixel still
+ * sums its taps in the same order. Taps on background get weight 0. */
 static void blur_row(void *context, int j) {
     const blur_job *job = context;
     const int radius = job->settings->blur_radius;
     const float sharpness = job->settings->blur_sharpness;
     const int width = job->width;
-    for (int i = 0; i < width; i++) {
-        const size_t center = (size_t)j * width + i;
-        const float zc = job->depth[center];
-        if (zc <= 0.0f) {
-            job->target[center] = 1.0f;
-            continue;
-        }
-        const int position = job->along_row ? i : j;
-        const int extent = job->along_row ? width : job->height;
-        const int first = position - radius < 0 ? -position : -radius;
-        const int last = position + radius >= extent ? extent - 1 - position : radius;
-        const float inv_zc = sharpness / zc;
-        float sum = 0.0f, weight_sum = 0.0f;
-        for (int k = first; k <= last; k++) {
-            const size_t tap = (size_t)((ptrdiff_t)center + (ptrdiff_t)k * job->step);
-            const float z = job->depth[tap];
-            if (z <= 0.0f) continue;
-            const float difference = (z - zc) * inv_zc;
-            const float weight =
-                job->spatial[k < 0 ? -k : k] * hbao_exp_negative(difference * difference);
-            sum += weight * job->source[tap];
-            weight_sum += weight;
-        }
-        /* The centre tap always counts, so weight_sum > 0. */
-        job->target[center] = sum / weight_sum;
+    const size_t row_start = (size_t)j * width;
+    const float *zc = job->depth + row_start;
+    float *target = job->target + row_start;
+    float *sums = malloc(3 * (size_t)width * sizeof(float));
+    if (sums == NULL) {
+        /* Without scratch memory, leave the row unblurred rather than fail. */
+        for (int i = 0; i < width; i++) target[i] = zc[i] > 0.0f ? job->source[row_start + i] : 1.0f;
+        return;
     }
+    float *sum = sums, *weight_sum = sums + width, *inv_zc = sums + 2 * (size_t)width;
+    for (int i = 0; i < width; i++) {
+        sum[i] = 0.0f;
+        weight_sum[i] = 0.0f;
+        inv_zc[i] = zc[i] > 0.0f ? sharpness / zc[i] : 0.0f;
+    }
+    for (int k = -radius; k <= radius; k++) {
+        const float spatial = job->spatial[k < 0 ? -k : k];
+        int first, last; /* pixels i whose tap i + k (or row j + k) exists */
+        ptrdiff_t offset;
+        if (job->along_row) {
+            first = k < 0 ? -k : 0;
+            last = k > 0 ? width - k : width;
+            offset = (ptrdiff_t)row_start + k;
+        } else {
+            if (j + k < 0 || j + k >= job->height) continue;
+            first = 0;
+            last = width;
+            offset = (ptrdiff_t)(j + k) * width;
+        }
+        const float *z = job->depth + offset;
+        const float *ao = job->source + offset;
+        for (int i = first; i < last; i++) {
+            const float difference = (z[i] - zc[i]) * inv_zc[i];
+            const float weight = z[i] > 0.0f
+                                     ? spatial * hbao_exp_negative(difference * difference)
+                                     : 0.0f;
+            sum[i] += weight * ao[i];
+            weight_sum[i] += weight;
+        }
+    }
+    /* The centre tap always counts (weight > 0) unless the pixel is
+     * background, which stays 1. */
+    for (int i = 0; i < width; i++) target[i] = zc[i] > 0.0f ? sum[i] / weight_sum[i] : 1.0f;
+    free(sums);
 }
 
 void hbao_blur(const hbao_settings *settings, const float *depth, int width, int height, float *ao,
@@ -66,13 +87,11 @@ void hbao_blur(const hbao_settings *settings, const float *depth, int width, int
 
     job.source = ao;
     job.target = scratch;
-    job.step = 1;
     job.along_row = 1;
     hbao_parallel_rows(settings->threads, height, blur_row, &job);
 
     job.source = scratch;
     job.target = ao;
-    job.step = width;
     job.along_row = 0;
     hbao_parallel_rows(settings->threads, height, blur_row, &job);
 }

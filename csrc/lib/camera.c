@@ -55,12 +55,13 @@ void hbao_grid_set_projection(hbao_grid *grid, const hbao_camera *camera, int fu
     const double left = -0.5 * full_width + camera->shift_x * viewfac;
     const double bottom = -0.5 * ycor * full_height + camera->shift_y * viewfac;
 
-    for (int i = 0; i < grid->width; i++)
-        grid->column_x[i] = (float)((left + scale * i + 0.5) * pixel_size);
-    for (int j = 0; j < grid->height; j++) {
-        const double row_from_bottom = full_height - 1 - scale * j;
-        grid->row_y[j] = (float)((bottom + (row_from_bottom + 0.5) * ycor) * pixel_size);
-    }
+    /* Column i of the grid is full-resolution pixel scale * i, whose centre
+     * lies at (left + scale * i + 0.5) * pixel_size; likewise for rows,
+     * counted from the top. */
+    grid->x_step = (float)(scale * pixel_size);
+    grid->x_offset = (float)((left + 0.5) / scale);
+    grid->y_step = (float)(-scale * ycor * pixel_size);
+    grid->y_offset = (float)((bottom + (full_height - 0.5) * ycor) / (-scale * ycor));
     grid->orthographic = orthographic;
     grid->pixel_size = (float)(pixel_size * scale);
     grid->ycor = (float)ycor;

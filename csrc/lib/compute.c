@@ -24,6 +24,9 @@ static hbao_result make_settings(const hbao_params *params, hbao_settings *s) {
     if (params->integration != HBAO_INTEGRATION_HBAO &&
         params->integration != HBAO_INTEGRATION_COSINE)
         return HBAO_ERROR_INVALID_PARAMETER;
+    if (params->implementation < HBAO_IMPLEMENTATION_AUTO ||
+        params->implementation > HBAO_IMPLEMENTATION_AVX512)
+        return HBAO_ERROR_INVALID_PARAMETER;
     s->radius = params->radius;
     const float bias_degrees =
         clamp_float(params->angle_bias_degrees, 0.0f, HBAO_MAX_ANGLE_BIAS_DEGREES);
@@ -42,6 +45,7 @@ static hbao_result make_settings(const hbao_params *params, hbao_settings *s) {
     s->threads = params->threads <= 0 ? hbao_available_cores()
                                       : clamp_int(params->threads, 1, HBAO_MAX_THREADS);
     s->background_depth = params->background_depth;
+    s->implementation = params->implementation;
     return HBAO_SUCCESS;
 }
 
@@ -150,10 +154,7 @@ hbao_result hbao_compute(const hbao_params *params, const hbao_camera *camera, i
     float *half_depth = s.half_resolution ? malloc(grid_pixels * sizeof(float)) : NULL;
     float *half_ao = s.half_resolution ? malloc(grid_pixels * sizeof(float)) : NULL;
     grid.normal = malloc(grid_pixels * 3 * sizeof(float));
-    grid.column_x = malloc((size_t)grid.width * sizeof(float));
-    grid.row_y = malloc((size_t)grid.height * sizeof(float));
     if (full_depth == NULL || full_ao == NULL || scratch == NULL || grid.normal == NULL ||
-        grid.column_x == NULL || grid.row_y == NULL ||
         (s.half_resolution && (half_depth == NULL || half_ao == NULL))) {
         result = HBAO_ERROR_OUT_OF_MEMORY;
         goto done;
@@ -190,7 +191,5 @@ done:
     free(half_depth);
     free(half_ao);
     free(grid.normal);
-    free(grid.column_x);
-    free(grid.row_y);
     return result;
 }

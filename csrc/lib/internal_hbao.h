@@ -41,6 +41,7 @@ typedef struct hbao_settings {
     float strength;
     int threads;
     float background_depth;
+    int implementation; /* hbao_implementation as asked for */
 } hbao_settings;
 
 /* The image that horizons are searched on: the full image, or the
@@ -49,8 +50,10 @@ typedef struct hbao_grid {
     int width, height;
     float *depth;     /* width * height */
     float *normal;    /* width * height * 3, camera space, facing the viewer */
-    float *column_x;  /* view-plane x of each column (per unit depth if perspective) */
-    float *row_y;     /* view-plane y of each row */
+    /* View-plane coordinates (per unit depth if perspective) of column i and
+     * row j: (i + x_offset) * x_step and (j + y_offset) * y_step. Computed,
+     * not tabulated, so that SIMD code needs no gather for them. */
+    float x_offset, x_step, y_offset, y_step;
     int orthographic;
     float pixel_size; /* view-plane width of one grid pixel (per unit depth if perspective) */
     float ycor;       /* pixel height / pixel width */
@@ -58,20 +61,28 @@ typedef struct hbao_grid {
 
 /* camera.c */
 hbao_result hbao_validate_camera(const hbao_camera *camera);
-/* Fill grid->column_x, row_y, pixel_size, ycor, orthographic for a grid whose
+/* Fill the grid's view-plane mapping, pixel_size, ycor, orthographic for a grid whose
  * pixel (i, j) is full-resolution pixel (scale * i, scale * j) of a
  * full_width x full_height image. */
 void hbao_grid_set_projection(hbao_grid *grid, const hbao_camera *camera, int full_width,
                               int full_height, int scale);
 
+static inline float hbao_grid_x(const hbao_grid *grid, int i) {
+    return ((float)i + grid->x_offset) * grid->x_step;
+}
+
+static inline float hbao_grid_y(const hbao_grid *grid, int j) {
+    return ((float)j + grid->y_offset) * grid->y_step;
+}
+
 static inline void hbao_grid_position(const hbao_grid *grid, int i, int j, float depth,
                                       float position[3]) {
     if (grid->orthographic) {
-        position[0] = grid->column_x[i];
-        position[1] = grid->row_y[j];
+        position[0] = hbao_grid_x(grid, i);
+        position[1] = hbao_grid_y(grid, j);
     } else {
-        position[0] = grid->column_x[i] * depth;
-        position[1] = grid->row_y[j] * depth;
+        position[0] = hbao_grid_x(grid, i) * depth;
+        position[1] = hbao_grid_y(grid, j) * depth;
     }
     position[2] = -depth;
 }
@@ -91,6 +102,30 @@ void hbao_compute_normals(const hbao_settings *settings, const hbao_camera *came
 /* horizon.c: raw AO on the grid (dense, grid->width wide). */
 void hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *grid, float *ao);
 
+/* What every horizon kernel needs: settings, grid and per-pattern-cell
+ * tables (4x4 interleaved rotation and jitter, docs/algorithm.md). */
+typedef struct hbao_horizon_job {
+    const hbao_settings *settings;
+    const hbao_grid *grid;
+    float *ao;
+    float direction_cos[16][HBAO_MAX_DIRECTIONS];
+    float direction_sin[16][HBAO_MAX_DIRECTIONS];
+    float jitter[16];
+} hbao_horizon_job;
+
+/* The scalar reference for one pixel (horizon.c). */
+float hbao_horizon_pixel(const hbao_horizon_job *job, int i, int j);
+
+/* SIMD kernels (horizon_avx2.c, horizon_avx512.c, both made from
+ * horizon_simd.h): whether this CPU and build can run each, and the kernel
+ * that computes pixels [x0, x1) of row j bit-identically to
+ * hbao_horizon_pixel(). */
+typedef void (*hbao_horizon_span)(const hbao_horizon_job *job, int x0, int x1, int j);
+int hbao_horizon_avx2_available(void);
+void hbao_horizon_span_avx2(const hbao_horizon_job *job, int x0, int x1, int j);
+int hbao_horizon_avx512_available(void);
+void hbao_horizon_span_avx512(const hbao_horizon_job *job, int x0, int x1, int j);
+
 /* upsample.c: half-resolution AO to full resolution, guided by full depth. */
 void hbao_upsample(const hbao_settings *settings, const hbao_grid *half, const float *half_ao,
                    const float *full_depth, int width, int height, float *full_ao);
@@ -102,12 +137,15 @@ void hbao_blur(const hbao_settings *settings, const float *depth, int width, int
 /* exp(-x) for x >= 0, to 3e-5 relative error (a degree-6 Taylor polynomial of 2^-f), without libm: the blur
  * and the upsample evaluate it for every tap. */
 static inline float hbao_exp_negative(float x) {
-    if (!(x < 87.0f)) return 0.0f; /* also for NaN */
+    /* Branch-free so that loops calling it vectorize. Beyond 87 the result
+     * is below FLT_MIN: 0. NaN compares false and gives 0 too. */
+    const int in_range = x < 87.0f;
+    const float clamped = in_range ? x : 0.0f;
     /* 2^(-x * log2 e) = 2^-n * 2^-f with n integer, f in [0, 1). */
-    const float y = x * 1.44269504088896341f;
+    const float y = clamped * 1.44269504088896341f;
     const int n = (int)y;
     const float f = y - (float)n;
-    /* 2^-f on [0, 1): minimax-style polynomial in f. */
+    /* 2^-f on [0, 1): degree-6 Taylor polynomial of exp(-f ln 2). */
     float p = -1.530163e-4f;
     p = p * f + 1.3333558e-3f;
     p = p * f - 9.6181291e-3f;
@@ -119,8 +157,8 @@ static inline float hbao_exp_negative(float x) {
         float f;
         uint32_t u;
     } scale;
-    scale.u = (uint32_t)(127 - n) << 23; /* 2^-n, n <= 125 */
-    return p * scale.f;
+    scale.u = (uint32_t)(127 - n) << 23; /* 2^-n, 0 <= n <= 125 */
+    return in_range ? p * scale.f : 0.0f;
 }
 
 /* acos(x) for x in [-1, 1] to 2e-8 absolute (Abramowitz & Stegun 4.4.46):

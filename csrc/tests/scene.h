@@ -31,17 +31,17 @@ typedef struct scene_view {
     double camera_to_world[16]; /* row-major, rigid */
 } scene_view;
 
-static void mat_mul_point(const double m[16], const double p[3], double out[3]) {
+static inline void mat_mul_point(const double m[16], const double p[3], double out[3]) {
     for (int r = 0; r < 3; r++) out[r] = m[4 * r] * p[0] + m[4 * r + 1] * p[1] + m[4 * r + 2] * p[2] + m[4 * r + 3];
 }
 
-static void mat_mul_dir(const double m[16], const double p[3], double out[3]) {
+static inline void mat_mul_dir(const double m[16], const double p[3], double out[3]) {
     for (int r = 0; r < 3; r++) out[r] = m[4 * r] * p[0] + m[4 * r + 1] * p[1] + m[4 * r + 2] * p[2];
 }
 
 /* A camera at `eye` looking at `target`, world up +Z (Blender's convention:
  * the camera looks down its local -Z, local +Y is up). Fills both matrices. */
-static void scene_look_at(scene_view *view, const double eye[3], const double target[3]) {
+static inline void scene_look_at(scene_view *view, const double eye[3], const double target[3]) {
     double f[3] = {target[0] - eye[0], target[1] - eye[1], target[2] - eye[2]};
     double fl = sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
     for (int c = 0; c < 3; c++) f[c] /= fl;
@@ -74,7 +74,7 @@ static void scene_look_at(scene_view *view, const double eye[3], const double ta
 }
 
 /* The camera-space ray of pixel (i, j): origin and direction with z = -1. */
-static void scene_pixel_ray(const scene_view *view, double i, double j, double origin[3],
+static inline void scene_pixel_ray(const scene_view *view, double i, double j, double origin[3],
                             double direction[3]) {
     const hbao_camera *c = &view->camera;
     const double w = view->width, h = view->height;
@@ -97,7 +97,7 @@ static void scene_pixel_ray(const scene_view *view, double i, double j, double o
 }
 
 /* Nearest hit of a world-space ray: returns t (or INFINITY), normal in world. */
-static double scene_trace(const scene *s, const double o[3], const double d[3], double normal[3]) {
+static inline double scene_trace(const scene *s, const double o[3], const double d[3], double normal[3]) {
     double best = INFINITY;
     for (int k = 0; k < s->planes; k++) {
         const scene_plane *p = &s->plane[k];
@@ -121,7 +121,7 @@ static double scene_trace(const scene *s, const double o[3], const double d[3], 
 
 /* Depth (planar, Cycles' 1e10 for background) and world normals (xyz per
  * pixel, 0 for background) of the scene; caller frees both. */
-static void scene_render(const scene *s, const scene_view *view, float **depth_out, float **normal_out) {
+static inline void scene_render(const scene *s, const scene_view *view, float **depth_out, float **normal_out) {
     const size_t pixels = (size_t)view->width * view->height;
     float *depth = malloc(pixels * sizeof(float));
     float *normal = malloc(pixels * 3 * sizeof(float));
@@ -143,7 +143,7 @@ static void scene_render(const scene *s, const scene_view *view, float **depth_o
 }
 
 /* World position of pixel (i, j) at its depth. */
-static void scene_pixel_position(const scene_view *view, int i, int j, double depth, double world[3]) {
+static inline void scene_pixel_position(const scene_view *view, int i, int j, double depth, double world[3]) {
     double o[3], d[3], p[3];
     scene_pixel_ray(view, i, j, o, d);
     for (int c = 0; c < 3; c++) p[c] = o[c] + depth * d[c];

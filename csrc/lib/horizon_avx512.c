@@ -1,0 +1,66 @@
+/* SPDX-License-Identifier: GPL-2.0-or-later */
+/* The horizon search, 16 pixels at a time with AVX-512F: horizon_simd.h
+ * instantiated with 512-bit vectors and mask registers. Compiled with
+ * -mavx512f and only called after hbao_horizon_avx512_available() said yes. */
+#include "internal_hbao.h"
+
+#if defined(__x86_64__) && defined(__AVX512F__)
+#include <immintrin.h>
+
+#define SIMD_LANES 16
+#define SIMD_NAME(name) name##_avx512
+#define VF __m512
+#define VI __m512i
+#define VM __mmask16
+#define V_ADD _mm512_add_ps
+#define V_SUB _mm512_sub_ps
+#define V_MUL _mm512_mul_ps
+#define V_DIV _mm512_div_ps
+#define V_SQRT _mm512_sqrt_ps
+#define V_SET _mm512_set1_ps
+#define V_LOADU _mm512_loadu_ps
+#define V_STOREU _mm512_storeu_ps
+#define V_NEG(a) _mm512_castsi512_ps(_mm512_xor_si512(_mm512_castps_si512(a), _mm512_set1_epi32((int)0x80000000u)))
+#define V_MAX0(a) _mm512_max_ps((a), _mm512_setzero_ps()) /* NaN -> 0, like fmaxf(0, a) */
+#define V_GT(a, b) _mm512_cmp_ps_mask((a), (b), _CMP_GT_OQ)
+#define V_GE(a, b) _mm512_cmp_ps_mask((a), (b), _CMP_GE_OQ)
+#define V_LT(a, b) _mm512_cmp_ps_mask((a), (b), _CMP_LT_OQ)
+#define V_LE(a, b) _mm512_cmp_ps_mask((a), (b), _CMP_LE_OQ)
+#define M_AND(a, b) ((__mmask16)((a) & (b)))
+#define M_OR(a, b) ((__mmask16)((a) | (b)))
+#define M_ANDNOT(a, b) ((__mmask16)(~(a) & (b)))
+#define M_ANY(m) ((m) != 0)
+#define V_SELECT(m, a, b) _mm512_mask_blend_ps((m), (a), (b))
+#define V_ZERO_UNLESS(m, v) _mm512_maskz_mov_ps((m), (v))
+#define I_SET _mm512_set1_epi32
+#define I_ADD _mm512_add_epi32
+#define I_MULLO _mm512_mullo_epi32
+#define I_LANES _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15)
+#define I_CVTT _mm512_cvttps_epi32
+#define I_TO_F _mm512_cvtepi32_ps
+#define I_CMPEQ(a, b) _mm512_cmpeq_epi32_mask((a), (b))
+#define I_ZERO_UNLESS(m, v) _mm512_maskz_mov_epi32((m), (v))
+#define V_GATHER(base, index, mask) \
+    _mm512_mask_i32gather_ps(_mm512_setzero_ps(), (mask), (index), (base), 4)
+
+#include "horizon_simd.h"
+
+int hbao_horizon_avx512_available(void) {
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx512f") != 0;
+}
+
+void hbao_horizon_span_avx512(const hbao_horizon_job *job, int x0, int x1, int j) {
+    span_avx512(job, x0, x1, j);
+}
+
+#else /* not built for x86-64: never chosen */
+
+int hbao_horizon_avx512_available(void) { return 0; }
+
+void hbao_horizon_span_avx512(const hbao_horizon_job *job, int x0, int x1, int j) {
+    float *out = job->ao + (size_t)j * job->grid->width;
+    for (int i = x0; i < x1; i++) out[i] = hbao_horizon_pixel(job, i, j);
+}
+
+#endif

@@ -1,0 +1,311 @@
+/* SPDX-License-Identifier: GPL-2.0-or-later */
+/* The horizon search on SIMD_LANES neighbouring pixels at once, written once
+ * for every instruction set: a file that includes this header first defines
+ * the vector vocabulary below (horizon_avx2.c, horizon_avx512.c). The kernel
+ * performs the same float operations in the same order as the scalar
+ * reference in horizon.c (no FMA contraction), so every instance gives
+ * bit-identical results (tested in test_ao.c); where the scalar code leaves
+ * a loop with break or continue, lanes are masked instead.
+ *
+ * Vocabulary: VF float vector, VI int32 vector, VM lane mask;
+ * V_ADD V_SUB V_MUL V_DIV V_SQRT V_SET V_LOADU V_STOREU V_NEG V_MAX0 (max
+ * with 0, NaN -> 0); comparisons V_GT V_GE V_LT V_LE -> VM; masks M_AND M_OR
+ * M_ANDNOT(a, b) = ~a & b, M_ANY; V_SELECT(m, a, b) = m ? b : a;
+ * V_ZERO_UNLESS(m, v); I_SET I_ADD I_MULLO I_LANES (0, 1, ...) I_CVTT
+ * (truncate) I_TO_F I_CMPEQ -> VM, I_ZERO_UNLESS(m, v), I_STOREU;
+ * SIMD_NAME(x) gives the instance's function names. */
+
+static inline VF SIMD_NAME(dot3)(VF a0, VF a1, VF a2, VF b0, VF b1, VF b2) {
+    return V_ADD(V_ADD(V_MUL(a0, b0), V_MUL(a1, b1)), V_MUL(a2, b2));
+}
+
+/* hbao_acos, lane by lane */
+static inline VF SIMD_NAME(acos)(VF x) {
+    const VM negative = V_LT(x, V_SET(0.0f));
+    const VF ax = V_SELECT(negative, x, V_NEG(x));
+    VF p = V_SET(-0.0012624911f);
+    p = V_ADD(V_MUL(p, ax), V_SET(0.0066700901f));
+    p = V_SUB(V_MUL(p, ax), V_SET(0.0170881256f));
+    p = V_ADD(V_MUL(p, ax), V_SET(0.0308918810f));
+    p = V_SUB(V_MUL(p, ax), V_SET(0.0501743046f));
+    p = V_ADD(V_MUL(p, ax), V_SET(0.0889789874f));
+    p = V_SUB(V_MUL(p, ax), V_SET(0.2145988016f));
+    p = V_ADD(V_MUL(p, ax), V_SET(1.5707963050f));
+    const VF one_minus = V_SUB(V_SET(1.0f), ax);
+    const VF root = V_ZERO_UNLESS(V_GT(one_minus, V_SET(0.0f)), V_SQRT(one_minus));
+    const VF r = V_MUL(root, p);
+    return V_SELECT(negative, r, V_SUB(V_SET(HBAO_PI), r));
+}
+
+typedef struct SIMD_NAME(slice) {
+    VF np_length, cos_gamma, sin_gamma;
+    VM usable;
+} SIMD_NAME(slice);
+
+static inline void SIMD_NAME(slice_setup)(const VF v[3], const VF n[3], VF dc, VF ds,
+                                          SIMD_NAME(slice) * sl) {
+    const VF dir_dot_v = V_ADD(V_MUL(dc, v[0]), V_MUL(ds, v[1]));
+    VF e0 = V_SUB(dc, V_MUL(v[0], dir_dot_v));
+    VF e1 = V_SUB(ds, V_MUL(v[1], dir_dot_v));
+    VF e2 = V_MUL(V_NEG(v[2]), dir_dot_v);
+    const VF e_inv = V_DIV(V_SET(1.0f), V_SQRT(SIMD_NAME(dot3)(e0, e1, e2, e0, e1, e2)));
+    e0 = V_MUL(e0, e_inv);
+    e1 = V_MUL(e1, e_inv);
+    e2 = V_MUL(e2, e_inv);
+    const VF m0 = V_SUB(V_MUL(v[1], e2), V_MUL(v[2], e1));
+    const VF m1 = V_SUB(V_MUL(v[2], e0), V_MUL(v[0], e2));
+    const VF m2 = V_SUB(V_MUL(v[0], e1), V_MUL(v[1], e0));
+    const VF n_dot_m = SIMD_NAME(dot3)(n[0], n[1], n[2], m0, m1, m2);
+    const VF np0 = V_SUB(n[0], V_MUL(m0, n_dot_m));
+    const VF np1 = V_SUB(n[1], V_MUL(m1, n_dot_m));
+    const VF np2 = V_SUB(n[2], V_MUL(m2, n_dot_m));
+    sl->np_length = V_SQRT(SIMD_NAME(dot3)(np0, np1, np2, np0, np1, np2));
+    sl->usable = V_GT(sl->np_length, V_SET(1e-6f));
+    sl->cos_gamma = V_SELECT(sl->usable, V_SET(1.0f),
+                             V_DIV(SIMD_NAME(dot3)(np0, np1, np2, v[0], v[1], v[2]), sl->np_length));
+    sl->sin_gamma = V_SELECT(sl->usable, V_SET(0.0f),
+                             V_DIV(SIMD_NAME(dot3)(np0, np1, np2, e0, e1, e2), sl->np_length));
+}
+
+/* The block of pixels and what does not change between directions. */
+typedef struct SIMD_NAME(block) {
+    const hbao_grid *grid;
+    VI lane_i;
+    VF base_x, base_y; /* pixel centre, in pixels */
+    VF p[3], v[3], n[3];
+    VF jitter, step_px, radius2, inv_radius2, inv_ycor;
+    int j;
+} SIMD_NAME(block);
+
+/* One step of the march for all lanes: the sample vector, its squared
+ * length and which lanes have a usable sample (returned); lanes whose step
+ * left the image are removed from *alive. */
+static inline VM SIMD_NAME(march_step)(const SIMD_NAME(block) * b, int step, VF dc, VF ds,
+                                       VM *alive, VF delta[3], VF *dist2) {
+    const hbao_grid *g = b->grid;
+    const VF t = V_ADD(V_SET(1.0f), V_MUL(V_ADD(V_SET((float)step), b->jitter), b->step_px));
+    const VF x = V_ADD(b->base_x, V_MUL(dc, t));
+    const VF y = V_SUB(b->base_y, V_MUL(V_MUL(ds, t), b->inv_ycor));
+    const VM inside = M_AND(M_AND(V_GE(x, V_SET(0.0f)), V_GE(y, V_SET(0.0f))),
+                            M_AND(V_LT(x, V_SET((float)g->width)), V_LT(y, V_SET((float)g->height))));
+    *alive = M_AND(*alive, inside);
+    const VI si = I_ZERO_UNLESS(*alive, I_CVTT(x));
+    const VI sj = I_ZERO_UNLESS(*alive, I_CVTT(y));
+    const VM same = M_AND(I_CMPEQ(si, b->lane_i), I_CMPEQ(sj, I_SET(b->j)));
+    const VM candidate = M_ANDNOT(same, *alive);
+    const VI index = I_ZERO_UNLESS(candidate, I_ADD(I_MULLO(sj, I_SET(g->width)), si));
+    const VF zs = V_ZERO_UNLESS(candidate, V_GATHER(g->depth, index, candidate));
+    const VM valid = M_AND(candidate, V_GT(zs, V_SET(0.0f)));
+    const VF column = V_MUL(V_ADD(I_TO_F(si), V_SET(g->x_offset)), V_SET(g->x_step));
+    const VF row = V_MUL(V_ADD(I_TO_F(sj), V_SET(g->y_offset)), V_SET(g->y_step));
+    const VF q0 = g->orthographic ? column : V_MUL(column, zs);
+    const VF q1 = g->orthographic ? row : V_MUL(row, zs);
+    delta[0] = V_SUB(q0, b->p[0]);
+    delta[1] = V_SUB(q1, b->p[1]);
+    delta[2] = V_SUB(V_NEG(zs), b->p[2]);
+    *dist2 = SIMD_NAME(dot3)(delta[0], delta[1], delta[2], delta[0], delta[1], delta[2]);
+    return M_AND(valid, M_AND(V_LT(*dist2, b->radius2), V_GT(*dist2, V_SET(0.0f))));
+}
+
+static VF SIMD_NAME(direction_occlusion_hbao)(const hbao_settings *s, const SIMD_NAME(block) * b,
+                                              VM active, VF dc, VF ds,
+                                              const SIMD_NAME(slice) * sl) {
+    const int quadratic = s->falloff == HBAO_FALLOFF_QUADRATIC;
+    const VF half_occluded = V_SET(0.5f * (1.0f - s->sin_bias));
+    const VM check_past_normal = M_AND(sl->usable, V_GT(sl->sin_gamma, V_SET(0.0f)));
+    const int any_check = M_ANY(M_AND(check_past_normal, active));
+    VF sin_max = V_SET(s->sin_bias);
+    VF occlusion = V_SET(0.0f);
+    VM alive = active;
+    for (int step = 0; step < s->steps && M_ANY(alive); step++) {
+        VF delta[3], dist2;
+        const VM ok = SIMD_NAME(march_step)(b, step, dc, ds, &alive, delta, &dist2);
+        if (!M_ANY(ok)) continue;
+        const VF inv_dist = V_DIV(V_SET(1.0f), V_SQRT(dist2));
+        VM rest = ok;
+        if (any_check) {
+            const VF cos_h = V_MUL(SIMD_NAME(dot3)(delta[0], delta[1], delta[2], b->v[0], b->v[1], b->v[2]),
+                                   inv_dist);
+            const VM past = M_AND(M_AND(ok, check_past_normal), V_GT(cos_h, sl->cos_gamma));
+            occlusion = V_SELECT(M_AND(past, V_LT(occlusion, half_occluded)), occlusion, half_occluded);
+            alive = M_ANDNOT(past, alive);
+            rest = M_ANDNOT(past, ok);
+        }
+        const VF sin_s = V_MUL(SIMD_NAME(dot3)(delta[0], delta[1], delta[2], b->n[0], b->n[1], b->n[2]),
+                               inv_dist);
+        const VM rise = M_AND(rest, V_GT(sin_s, sin_max));
+        const VF weight = quadratic ? V_SUB(V_SET(1.0f), V_MUL(dist2, b->inv_radius2)) : V_SET(1.0f);
+        occlusion = V_SELECT(rise, occlusion, V_ADD(occlusion, V_MUL(weight, V_SUB(sin_s, sin_max))));
+        sin_max = V_SELECT(rise, sin_max, sin_s);
+    }
+    return occlusion;
+}
+
+static inline VF SIMD_NAME(half_slice_visibility)(VF h, VF cos_h, VF sin_h, const SIMD_NAME(slice) * sl) {
+    const VF cos_2h = V_SUB(V_MUL(V_MUL(V_SET(2.0f), cos_h), cos_h), V_SET(1.0f));
+    const VF sin_2h = V_MUL(V_MUL(V_SET(2.0f), sin_h), cos_h);
+    const VF cos_2h_minus_gamma = V_ADD(V_MUL(cos_2h, sl->cos_gamma), V_MUL(sin_2h, sl->sin_gamma));
+    return V_MUL(V_SET(0.25f), V_ADD(V_ADD(V_NEG(cos_2h_minus_gamma), sl->cos_gamma),
+                                     V_MUL(V_MUL(V_SET(2.0f), h), sl->sin_gamma)));
+}
+
+static inline VF SIMD_NAME(horizon_visibility)(VM past_normal, VF cos_past_max, VF elevation_max,
+                                               VF gamma, const SIMD_NAME(slice) * sl) {
+    /* horizon_from_elevation */
+    const VF cos_a = elevation_max;
+    const VF sin_a = V_SQRT(V_MAX0(V_SUB(V_SET(1.0f), V_MUL(elevation_max, elevation_max))));
+    const VF angle = V_ADD(gamma, SIMD_NAME(acos)(elevation_max));
+    const VM flat = V_LE(angle, V_SET(0.0f));
+    VF h = V_SELECT(flat, angle, V_SET(0.0f));
+    VF cos_h = V_SELECT(flat, V_SUB(V_MUL(sl->cos_gamma, cos_a), V_MUL(sl->sin_gamma, sin_a)), V_SET(1.0f));
+    VF sin_h = V_SELECT(flat, V_ADD(V_MUL(sl->sin_gamma, cos_a), V_MUL(sl->cos_gamma, sin_a)), V_SET(0.0f));
+    if (M_ANY(past_normal)) {
+        const VF past_sin = V_SQRT(V_MAX0(V_SUB(V_SET(1.0f), V_MUL(cos_past_max, cos_past_max))));
+        h = V_SELECT(past_normal, h, SIMD_NAME(acos)(cos_past_max));
+        cos_h = V_SELECT(past_normal, cos_h, cos_past_max);
+        sin_h = V_SELECT(past_normal, sin_h, past_sin);
+    }
+    return SIMD_NAME(half_slice_visibility)(h, cos_h, sin_h, sl);
+}
+
+static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SIMD_NAME(block) * b,
+                                                VM active, VF dc, VF ds,
+                                                const SIMD_NAME(slice) * sl, VF *open_part) {
+    const VF gamma = V_SUB(V_SET(0.5f * HBAO_PI), SIMD_NAME(acos)(sl->sin_gamma));
+    *open_part = V_MUL(V_SET(0.25f), V_ADD(V_MUL(V_SET(2.0f), sl->cos_gamma),
+                                           V_MUL(V_ADD(V_MUL(V_SET(2.0f), gamma), V_SET(HBAO_PI)),
+                                                 sl->sin_gamma)));
+    const VF inv_np = V_DIV(V_SET(1.0f), sl->np_length);
+    const VM check_past_normal = V_GT(sl->sin_gamma, V_SET(0.0f));
+    const int any_check = M_ANY(M_AND(check_past_normal, active));
+    const int quadratic = s->falloff == HBAO_FALLOFF_QUADRATIC;
+
+    VF elevation_max = V_SET(s->sin_bias);
+    VM past_normal = M_ANDNOT(active, active); /* no lane */
+    VF cos_past_max = sl->cos_gamma;
+    const VF visibility_start =
+        SIMD_NAME(horizon_visibility)(past_normal, cos_past_max, elevation_max, gamma, sl);
+    VF visibility_at_max = visibility_start;
+    VF occlusion = V_SET(0.0f);
+    VM alive = active;
+    for (int step = 0; step < s->steps && M_ANY(alive); step++) {
+        VF delta[3], dist2;
+        const VM ok = SIMD_NAME(march_step)(b, step, dc, ds, &alive, delta, &dist2);
+        if (!M_ANY(ok)) continue;
+        const VF inv_dist = V_DIV(V_SET(1.0f), V_SQRT(dist2));
+        VM raised = M_ANDNOT(ok, ok); /* no lane */
+        if (any_check) {
+            const VF cos_v = V_MUL(SIMD_NAME(dot3)(delta[0], delta[1], delta[2], b->v[0], b->v[1], b->v[2]),
+                                   inv_dist);
+            const VM newly = M_AND(M_AND(M_AND(ok, check_past_normal), V_GT(cos_v, sl->cos_gamma)),
+                                   V_GT(cos_v, cos_past_max));
+            past_normal = M_OR(past_normal, newly);
+            cos_past_max = V_SELECT(newly, cos_past_max, V_SELECT(V_GT(cos_v, V_SET(1.0f)), cos_v, V_SET(1.0f)));
+            raised = newly;
+        }
+        const VM elevation_candidates = M_ANDNOT(past_normal, M_ANDNOT(raised, ok));
+        const VF elevation = V_MUL(
+            V_MUL(SIMD_NAME(dot3)(delta[0], delta[1], delta[2], b->n[0], b->n[1], b->n[2]), inv_dist), inv_np);
+        const VM rise = M_AND(elevation_candidates, V_GT(elevation, elevation_max));
+        elevation_max = V_SELECT(rise, elevation_max,
+                                 V_SELECT(V_GT(elevation, V_SET(1.0f)), elevation, V_SET(1.0f)));
+        raised = M_OR(raised, rise);
+        if (quadratic && M_ANY(raised)) {
+            const VF visibility =
+                SIMD_NAME(horizon_visibility)(past_normal, cos_past_max, elevation_max, gamma, sl);
+            const VF weight = V_SUB(V_SET(1.0f), V_MUL(dist2, b->inv_radius2));
+            occlusion = V_SELECT(raised, occlusion,
+                                 V_ADD(occlusion, V_MUL(weight, V_SUB(visibility_at_max, visibility))));
+            visibility_at_max = V_SELECT(raised, visibility_at_max, visibility);
+        }
+    }
+    if (!quadratic)
+        occlusion = V_SUB(visibility_start, SIMD_NAME(horizon_visibility)(past_normal, cos_past_max,
+                                                                          elevation_max, gamma, sl));
+    return occlusion;
+}
+
+static void SIMD_NAME(block_ao)(const hbao_horizon_job *job, int i0, int j, float *out) {
+    const hbao_settings *s = job->settings;
+    const hbao_grid *g = job->grid;
+    SIMD_NAME(block) b;
+    b.grid = g;
+    b.j = j;
+    const VF z = V_LOADU(g->depth + (size_t)j * g->width + i0);
+    b.lane_i = I_ADD(I_SET(i0), I_LANES);
+    const VF column = V_MUL(V_ADD(I_TO_F(b.lane_i), V_SET(g->x_offset)), V_SET(g->x_step));
+    const VF row = V_SET(hbao_grid_y(g, j));
+    b.p[0] = g->orthographic ? column : V_MUL(column, z);
+    b.p[1] = g->orthographic ? row : V_MUL(row, z);
+    b.p[2] = V_NEG(z);
+    const VF radius_px = g->orthographic ? V_SET(s->radius / g->pixel_size)
+                                         : V_DIV(V_SET(s->radius), V_MUL(V_SET(g->pixel_size), z));
+    const VM active = M_AND(V_GT(z, V_SET(0.0f)), V_GE(radius_px, V_SET(1.0f)));
+    if (!M_ANY(active)) {
+        V_STOREU(out, V_SET(1.0f));
+        return;
+    }
+    b.base_x = V_ADD(I_TO_F(b.lane_i), V_SET(0.5f));
+    b.base_y = V_SET((float)j + 0.5f);
+    /* i0 is a multiple of 4, so lane k has pattern cell (k & 3) + cell0 */
+    const int cell0 = 4 * (j & 3);
+    float lane_values[SIMD_LANES];
+    for (int k = 0; k < SIMD_LANES; k++) lane_values[k] = job->jitter[cell0 + (k & 3)];
+    b.jitter = V_LOADU(lane_values);
+    b.step_px = V_DIV(V_SUB(radius_px, V_SET(1.0f)), V_SET((float)s->steps));
+    b.radius2 = V_SET(s->radius * s->radius);
+    b.inv_radius2 = V_SET(1.0f / (s->radius * s->radius));
+    b.inv_ycor = V_SET(1.0f / g->ycor);
+    if (g->orthographic) {
+        b.v[0] = V_SET(0.0f);
+        b.v[1] = V_SET(0.0f);
+        b.v[2] = V_SET(1.0f);
+    } else {
+        const VF inv = V_DIV(V_SET(1.0f), V_SQRT(SIMD_NAME(dot3)(b.p[0], b.p[1], b.p[2], b.p[0], b.p[1], b.p[2])));
+        for (int c = 0; c < 3; c++) b.v[c] = V_MUL(V_NEG(b.p[c]), inv);
+    }
+    float normal_lanes[3][SIMD_LANES];
+    const float *normal = g->normal + 3 * ((size_t)j * g->width + i0);
+    for (int k = 0; k < SIMD_LANES; k++)
+        for (int c = 0; c < 3; c++) normal_lanes[c][k] = normal[3 * k + c];
+    for (int c = 0; c < 3; c++) b.n[c] = V_LOADU(normal_lanes[c]);
+
+    const int cosine = s->integration == HBAO_INTEGRATION_COSINE;
+    VF occlusion_sum = V_SET(0.0f), visible_sum = V_SET(0.0f), open_sum = V_SET(0.0f);
+    float dc_lanes[SIMD_LANES], ds_lanes[SIMD_LANES];
+    for (int d = 0; d < s->directions; d++) {
+        for (int k = 0; k < SIMD_LANES; k++) {
+            dc_lanes[k] = job->direction_cos[cell0 + (k & 3)][d];
+            ds_lanes[k] = job->direction_sin[cell0 + (k & 3)][d];
+        }
+        const VF dc = V_LOADU(dc_lanes), ds = V_LOADU(ds_lanes);
+        SIMD_NAME(slice) sl;
+        SIMD_NAME(slice_setup)(b.v, b.n, dc, ds, &sl);
+        if (cosine) {
+            const VM lanes = M_AND(active, sl.usable);
+            if (!M_ANY(lanes)) continue;
+            VF open;
+            const VF occlusion = SIMD_NAME(direction_occlusion_cosine)(s, &b, lanes, dc, ds, &sl, &open);
+            visible_sum = V_SELECT(lanes, visible_sum, V_ADD(visible_sum, V_MUL(sl.np_length, V_SUB(open, occlusion))));
+            open_sum = V_SELECT(lanes, open_sum, V_ADD(open_sum, V_MUL(sl.np_length, open)));
+        } else {
+            occlusion_sum = V_ADD(occlusion_sum, SIMD_NAME(direction_occlusion_hbao)(s, &b, active, dc, ds, &sl));
+        }
+    }
+    VF ao;
+    if (cosine)
+        ao = V_SELECT(V_GT(open_sum, V_SET(1e-12f)), V_SET(1.0f), V_DIV(visible_sum, open_sum));
+    else
+        ao = V_SUB(V_SET(1.0f), V_DIV(occlusion_sum, V_SET((float)s->directions * (1.0f - s->sin_bias))));
+    ao = V_ZERO_UNLESS(V_GT(ao, V_SET(0.0f)), ao); /* !(ao > 0) -> 0, NaN included */
+    ao = V_SELECT(V_LT(ao, V_SET(1.0f)), V_SET(1.0f), ao);
+    ao = V_SELECT(active, V_SET(1.0f), ao);
+    V_STOREU(out, ao);
+}
+
+static void SIMD_NAME(span)(const hbao_horizon_job *job, int x0, int x1, int j) {
+    float *out = job->ao + (size_t)j * job->grid->width;
+    int i = x0;
+    for (; i + SIMD_LANES <= x1; i += SIMD_LANES) SIMD_NAME(block_ao)(job, i, j, out + i);
+    for (; i < x1; i++) out[i] = hbao_horizon_pixel(job, i, j);
+}

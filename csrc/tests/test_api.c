@@ -1,0 +1,227 @@
+/* SPDX-License-Identifier: GPL-2.0-or-later */
+/* The public API's contract: result codes for bad arguments, clamping of
+ * out-of-range parameters, messages, version and struct sizes. */
+#include <pthread.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "hbao.h"
+#include "test_harness.h"
+
+#define W 16
+#define H 12
+
+static float depth[W * H];
+static float normal[W * H * 3];
+static float ao[W * H];
+
+static void fill_inputs(void) {
+    for (int k = 0; k < W * H; k++) {
+        depth[k] = 3.0f + 0.1f * (float)(k % W);
+        normal[3 * k] = 0.0f;
+        normal[3 * k + 1] = 0.0f;
+        normal[3 * k + 2] = 1.0f;
+    }
+}
+
+static hbao_result compute_with(const hbao_params *p, const hbao_camera *c) {
+    hbao_channel d = {depth, 1, W};
+    return hbao_compute(p, c, W, H, &d, NULL, ao, W);
+}
+
+TEST_CASE(null_arguments_are_rejected) {
+    fill_inputs();
+    hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+    hbao_camera c = HBAO_CAMERA_DEFAULT_INITIALIZER;
+    hbao_channel d = {depth, 1, W};
+    hbao_channel no_data = {NULL, 1, W};
+    CHECK_RESULT(hbao_compute(NULL, &c, W, H, &d, NULL, ao, W), HBAO_ERROR_NULL_ARGUMENT);
+    CHECK_RESULT(hbao_compute(&p, NULL, W, H, &d, NULL, ao, W), HBAO_ERROR_NULL_ARGUMENT);
+    CHECK_RESULT(hbao_compute(&p, &c, W, H, NULL, NULL, ao, W), HBAO_ERROR_NULL_ARGUMENT);
+    CHECK_RESULT(hbao_compute(&p, &c, W, H, &no_data, NULL, ao, W), HBAO_ERROR_NULL_ARGUMENT);
+    CHECK_RESULT(hbao_compute(&p, &c, W, H, &d, NULL, NULL, W), HBAO_ERROR_NULL_ARGUMENT);
+    /* a normal channel without data means "reconstruct" */
+    CHECK_RESULT(hbao_compute(&p, &c, W, H, &d, &no_data, ao, W), HBAO_SUCCESS);
+}
+
+TEST_CASE(sizes_and_strides_are_checked) {
+    fill_inputs();
+    hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+    hbao_camera c = HBAO_CAMERA_DEFAULT_INITIALIZER;
+    hbao_channel d = {depth, 1, W};
+    CHECK_RESULT(hbao_compute(&p, &c, 0, H, &d, NULL, ao, W), HBAO_ERROR_INVALID_SIZE);
+    CHECK_RESULT(hbao_compute(&p, &c, W, -1, &d, NULL, ao, W), HBAO_ERROR_INVALID_SIZE);
+    CHECK_RESULT(hbao_compute(&p, &c, 70000, 1, &d, NULL, ao, W), HBAO_ERROR_INVALID_SIZE);
+    hbao_channel overlapping = {depth, 1, W - 1};
+    CHECK_RESULT(hbao_compute(&p, &c, W, H, &overlapping, NULL, ao, W), HBAO_ERROR_INVALID_STRIDE);
+    hbao_channel zero_pixel_stride = {depth, 0, W};
+    CHECK_RESULT(hbao_compute(&p, &c, W, H, &zero_pixel_stride, NULL, ao, W), HBAO_ERROR_INVALID_STRIDE);
+    hbao_channel thin_normals = {normal, 2, 3 * W};
+    CHECK_RESULT(hbao_compute(&p, &c, W, H, &d, &thin_normals, ao, W), HBAO_ERROR_INVALID_STRIDE);
+    CHECK_RESULT(hbao_compute(&p, &c, W, H, &d, NULL, ao, W - 1), HBAO_ERROR_INVALID_STRIDE);
+    /* a single row may use any row stride */
+    CHECK_RESULT(hbao_compute(&p, &c, W, 1, &d, NULL, ao, 0), HBAO_SUCCESS);
+}
+
+TEST_CASE(invalid_parameters_are_rejected) {
+    fill_inputs();
+    hbao_camera c = HBAO_CAMERA_DEFAULT_INITIALIZER;
+    const hbao_params defaults = HBAO_PARAMS_DEFAULT_INITIALIZER;
+    hbao_params p = defaults;
+    p.radius = NAN;
+    CHECK_RESULT(compute_with(&p, &c), HBAO_ERROR_INVALID_PARAMETER);
+    p = defaults;
+    p.radius = -1.0f;
+    CHECK_RESULT(compute_with(&p, &c), HBAO_ERROR_INVALID_PARAMETER);
+    p = defaults;
+    p.radius = INFINITY;
+    CHECK_RESULT(compute_with(&p, &c), HBAO_ERROR_INVALID_PARAMETER);
+    p = defaults;
+    p.strength = NAN;
+    CHECK_RESULT(compute_with(&p, &c), HBAO_ERROR_INVALID_PARAMETER);
+    p = defaults;
+    p.angle_bias_degrees = INFINITY;
+    CHECK_RESULT(compute_with(&p, &c), HBAO_ERROR_INVALID_PARAMETER);
+    p = defaults;
+    p.blur_sharpness = NAN;
+    CHECK_RESULT(compute_with(&p, &c), HBAO_ERROR_INVALID_PARAMETER);
+    p = defaults;
+    p.background_depth = 0.0f;
+    CHECK_RESULT(compute_with(&p, &c), HBAO_ERROR_INVALID_PARAMETER);
+    p = defaults;
+    p.falloff = 7;
+    CHECK_RESULT(compute_with(&p, &c), HBAO_ERROR_INVALID_PARAMETER);
+    p = defaults;
+    p.integration = -1;
+    CHECK_RESULT(compute_with(&p, &c), HBAO_ERROR_INVALID_PARAMETER);
+    p = defaults;
+    p.implementation = 4;
+    CHECK_RESULT(compute_with(&p, &c), HBAO_ERROR_INVALID_PARAMETER);
+}
+
+TEST_CASE(invalid_cameras_are_rejected) {
+    fill_inputs();
+    hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+    const hbao_camera defaults = HBAO_CAMERA_DEFAULT_INITIALIZER;
+    hbao_camera c = defaults;
+    c.lens = 0.0f;
+    CHECK_RESULT(compute_with(&p, &c), HBAO_ERROR_INVALID_CAMERA);
+    c = defaults;
+    c.sensor_width = NAN;
+    CHECK_RESULT(compute_with(&p, &c), HBAO_ERROR_INVALID_CAMERA);
+    c = defaults;
+    c.projection = HBAO_PROJECTION_ORTHOGRAPHIC;
+    c.ortho_scale = -2.0f;
+    CHECK_RESULT(compute_with(&p, &c), HBAO_ERROR_INVALID_CAMERA);
+    c = defaults;
+    c.pixel_aspect_y = 0.0f;
+    CHECK_RESULT(compute_with(&p, &c), HBAO_ERROR_INVALID_CAMERA);
+    c = defaults;
+    c.sensor_fit = 3;
+    CHECK_RESULT(compute_with(&p, &c), HBAO_ERROR_INVALID_CAMERA);
+    c = defaults;
+    memset(c.world_to_camera, 0, sizeof c.world_to_camera);
+    CHECK_RESULT(compute_with(&p, &c), HBAO_ERROR_INVALID_CAMERA);
+    c = defaults;
+    c.shift_x = INFINITY;
+    CHECK_RESULT(compute_with(&p, &c), HBAO_ERROR_INVALID_CAMERA);
+    /* orthographic cameras do not need a lens */
+    c = defaults;
+    c.projection = HBAO_PROJECTION_ORTHOGRAPHIC;
+    c.lens = 0.0f;
+    CHECK_RESULT(compute_with(&p, &c), HBAO_SUCCESS);
+}
+
+TEST_CASE(out_of_range_counts_are_clamped) {
+    fill_inputs();
+    hbao_camera c = HBAO_CAMERA_DEFAULT_INITIALIZER;
+    hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+    float clamped[W * H], limit[W * H];
+    p.directions = 1000;
+    p.steps = -4;
+    p.blur_size = 999;
+    p.threads = 100000;
+    p.angle_bias_degrees = 200.0f;
+    p.strength = -3.0f;
+    CHECK_RESULT(compute_with(&p, &c), HBAO_SUCCESS);
+    memcpy(clamped, ao, sizeof ao);
+    p.directions = HBAO_MAX_DIRECTIONS;
+    p.steps = 1;
+    p.blur_size = HBAO_MAX_BLUR_SIZE;
+    p.threads = HBAO_MAX_THREADS;
+    p.angle_bias_degrees = HBAO_MAX_ANGLE_BIAS_DEGREES;
+    p.strength = 0.0f;
+    CHECK_RESULT(compute_with(&p, &c), HBAO_SUCCESS);
+    memcpy(limit, ao, sizeof ao);
+    CHECK(memcmp(clamped, limit, sizeof ao) == 0);
+}
+
+TEST_CASE(zero_radius_gives_ones) {
+    fill_inputs();
+    hbao_camera c = HBAO_CAMERA_DEFAULT_INITIALIZER;
+    hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+    p.radius = 0.0f;
+    for (int k = 0; k < W * H; k++) ao[k] = -1.0f;
+    CHECK_RESULT(compute_with(&p, &c), HBAO_SUCCESS);
+    for (int k = 0; k < W * H; k++) CHECK_NEAR(ao[k], 1.0f, 0.0);
+}
+
+TEST_CASE(messages_version_and_sizes) {
+    for (int code = 0; code < HBAO_RESULT_COUNT; code++) {
+        const char *message = hbao_result_message(code);
+        CHECK(message != NULL && strlen(message) > 3);
+    }
+    CHECK(strcmp(hbao_result_message(-5), "unknown result code") == 0);
+    CHECK(strcmp(hbao_result_message(HBAO_RESULT_COUNT), "unknown result code") == 0);
+    CHECK(hbao_version() == HBAO_VERSION);
+    CHECK(hbao_params_size() == sizeof(hbao_params));
+    CHECK(hbao_camera_size() == sizeof(hbao_camera));
+    hbao_params p;
+    hbao_params_default(&p);
+    const hbao_params expected = HBAO_PARAMS_DEFAULT_INITIALIZER;
+    CHECK(memcmp(&p, &expected, sizeof p) == 0);
+    hbao_camera c;
+    hbao_camera_default(&c);
+    const hbao_camera expected_camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
+    CHECK(memcmp(&c, &expected_camera, sizeof c) == 0);
+    hbao_params_default(NULL); /* must not crash */
+    hbao_camera_default(NULL);
+}
+
+typedef struct concurrent_call {
+    float out[W * H];
+    hbao_result result;
+} concurrent_call;
+
+static void *call_in_thread(void *argument) {
+    concurrent_call *call = argument;
+    hbao_camera c = HBAO_CAMERA_DEFAULT_INITIALIZER;
+    hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+    p.threads = 2;
+    p.half_resolution = 1;
+    hbao_channel d = {depth, 1, W};
+    for (int repeat = 0; repeat < 50 && call->result == HBAO_SUCCESS; repeat++)
+        call->result = hbao_compute(&p, &c, W, H, &d, NULL, call->out, W);
+    return NULL;
+}
+
+TEST_CASE(concurrent_calls_agree) {
+    /* No global state: four threads calling at once get what one call alone
+     * gets (run under ThreadSanitizer or ASan to see races, if any). */
+    fill_inputs();
+    static concurrent_call calls[5];
+    memset(calls, 0, sizeof calls);
+    call_in_thread(&calls[0]);
+    pthread_t threads[4];
+    for (int t = 0; t < 4; t++) CHECK(pthread_create(&threads[t], NULL, call_in_thread, &calls[t + 1]) == 0);
+    for (int t = 0; t < 4; t++) pthread_join(threads[t], NULL);
+    for (int t = 0; t < 5; t++) {
+        CHECK_RESULT(calls[t].result, HBAO_SUCCESS);
+        CHECK(memcmp(calls[0].out, calls[t].out, sizeof calls[0].out) == 0);
+    }
+}
+
+TEST_MAIN(TEST_ENTRY(null_arguments_are_rejected), TEST_ENTRY(sizes_and_strides_are_checked),
+          TEST_ENTRY(invalid_parameters_are_rejected), TEST_ENTRY(invalid_cameras_are_rejected),
+          TEST_ENTRY(out_of_range_counts_are_clamped), TEST_ENTRY(zero_radius_gives_ones),
+          TEST_ENTRY(messages_version_and_sizes), TEST_ENTRY(concurrent_calls_agree))

@@ -1,0 +1,260 @@
+/* SPDX-License-Identifier: GPL-2.0-or-later */
+#include "ao_command.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "atomic_file.h"
+#include "blender_layers.h"
+#include "camera_json.h"
+#include "exr_reader.h"
+#include "exr_writer.h"
+#include "png_writer.h"
+
+/* Refuse an output path that is the input file itself, through any name
+ * (hard link, symbolic link, "./x" vs "x"): stat() identity, not strings. */
+static int refuse_overwriting_input(const char *output, const char *flag,
+                                    const struct stat *input_status, tool_error *error)
+{
+    struct stat output_status;
+    if (stat(output, &output_status) != 0) return TOOL_EXIT_SUCCESS;
+    if (output_status.st_dev == input_status->st_dev &&
+        output_status.st_ino == input_status->st_ino)
+        return tool_fail(error, TOOL_EXIT_USAGE,
+                         "%s %s is the input file; refusing to overwrite it", flag, output);
+    if (S_ISDIR(output_status.st_mode))
+        return tool_fail(error, TOOL_EXIT_USAGE, "%s %s is a directory", flag, output);
+    return TOOL_EXIT_SUCCESS;
+}
+
+/* Defaults, then the EXR header's pixel aspect, then the JSON file, then flags. */
+static int resolve_camera(const cli_options *options, const exr_input *input,
+                          camera_settings *resolved, tool_error *error)
+{
+    camera_settings_init(resolved);
+    if (input->has_pixel_aspect_ratio && input->pixel_aspect_ratio > 0.0f &&
+        isfinite(input->pixel_aspect_ratio)) {
+        /* pixelAspectRatio = pixel width / pixel height = aspect_x / aspect_y. */
+        resolved->camera.pixel_aspect_x = input->pixel_aspect_ratio;
+        resolved->camera.pixel_aspect_y = 1.0f;
+        resolved->fields_set |= CAMERA_FIELD_PIXEL_ASPECT_X | CAMERA_FIELD_PIXEL_ASPECT_Y;
+    }
+    if (options->camera_path != NULL) {
+        camera_settings from_file;
+        camera_settings_init(&from_file);
+        int status = camera_json_load(options->camera_path, &from_file, error);
+        if (status != TOOL_EXIT_SUCCESS) return status;
+        camera_settings_apply(resolved, &from_file);
+    }
+    camera_settings_apply(resolved, &options->camera_flags);
+    return TOOL_EXIT_SUCCESS;
+}
+
+typedef struct pass_buffers {
+    float *depth;
+    float *normal; /* X Y Z interleaved; NULL when not used */
+    float *ao;
+    uint8_t **copies; /* --keep-input: one native-type buffer per input channel */
+    int copy_count;
+} pass_buffers;
+
+static void free_buffers(pass_buffers *buffers)
+{
+    free(buffers->depth);
+    free(buffers->normal);
+    free(buffers->ao);
+    for (int c = 0; c < buffers->copy_count; ++c) free(buffers->copies[c]);
+    free(buffers->copies);
+    memset(buffers, 0, sizeof *buffers);
+}
+
+static exr_channel_request float_request(const char *name, float *data, int components,
+                                         int32_t width)
+{
+    exr_channel_request request = {name, EXR_PIXEL_FLOAT, (uint8_t *)data,
+                                   (int32_t)(components * sizeof(float)),
+                                   (int64_t)width * components * (int64_t)sizeof(float)};
+    return request;
+}
+
+static int read_passes(exr_input *input, const blender_passes *passes, bool use_normals,
+                       pass_buffers *buffers, tool_error *error)
+{
+    const size_t pixel_count = (size_t)input->width * (size_t)input->height;
+    buffers->depth = malloc(pixel_count * sizeof(float));
+    buffers->ao = malloc(pixel_count * sizeof(float));
+    if (use_normals) buffers->normal = malloc(3 * pixel_count * sizeof(float));
+    if (buffers->depth == NULL || buffers->ao == NULL || (use_normals && buffers->normal == NULL))
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "out of memory for a %dx%d image",
+                         input->width, input->height);
+    exr_channel_request requests[4];
+    int count = 0;
+    requests[count++] = float_request(passes->depth, buffers->depth, 1, input->width);
+    for (int axis = 0; axis < 3 && use_normals; ++axis)
+        requests[count++] =
+            float_request(passes->normal[axis], buffers->normal + axis, 3, input->width);
+    return exr_input_read(input, requests, count, error);
+}
+
+/* --keep-input: every channel but a previous AO, decoded in its own type. */
+static int read_copies(exr_input *input, const char *ao_channel, pass_buffers *buffers,
+                       exr_output_channel *outputs, int *output_count, tool_error *error)
+{
+    const int channel_count = input->channels->num_channels;
+    const size_t pixel_count = (size_t)input->width * (size_t)input->height;
+    buffers->copies = calloc((size_t)channel_count, sizeof *buffers->copies);
+    exr_channel_request *requests = calloc((size_t)channel_count, sizeof *requests);
+    if (buffers->copies == NULL || requests == NULL) {
+        free(requests);
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "out of memory");
+    }
+    int count = 0;
+    for (int c = 0; c < channel_count; ++c) {
+        const exr_attr_chlist_entry_t *channel = &input->channels->entries[c];
+        if (strcmp(channel->name.str, ao_channel) == 0) {
+            tool_warn("%s: replacing the input's channel \"%s\" with the new AO", input->path,
+                      ao_channel);
+            continue;
+        }
+        const int size = exr_pixel_type_size(channel->pixel_type);
+        uint8_t *data = malloc(pixel_count * (size_t)size);
+        if (data == NULL) {
+            free(requests);
+            return tool_fail(error, TOOL_EXIT_RUNTIME, "out of memory");
+        }
+        buffers->copies[buffers->copy_count++] = data;
+        exr_channel_request request = {channel->name.str, channel->pixel_type, data, size,
+                                       (int64_t)input->width * size};
+        requests[count] = request;
+        exr_output_channel output = {channel->name.str, channel->pixel_type,
+                                     (exr_perceptual_treatment_t)channel->p_linear, data, size,
+                                     (int64_t)input->width * size};
+        outputs[(*output_count)++] = output;
+        ++count;
+    }
+    int status = exr_input_read(input, requests, count, error);
+    free(requests);
+    return status;
+}
+
+static int write_outputs(const cli_options *options, const exr_input *input,
+                         const exr_output_channel *channels, int channel_count, const float *ao,
+                         tool_error *error)
+{
+    atomic_file exr_file, png_file;
+    int status = atomic_file_begin(&exr_file, options->output_path, error);
+    if (status != TOOL_EXIT_SUCCESS) return status;
+    exr_output_layout layout = {input->data_window,
+                                input->display_window,
+                                input->pixel_aspect_ratio,
+                                input->screen_window_center,
+                                input->screen_window_width,
+                                options->compression,
+                                options->keep_input ? input->context : NULL};
+    status = exr_write_image(exr_file.fd, options->output_path, &layout, channels, channel_count,
+                             error);
+    if (status != TOOL_EXIT_SUCCESS) {
+        atomic_file_abort(&exr_file);
+        return status;
+    }
+    bool with_preview = options->preview_path != NULL;
+    if (with_preview) {
+        status = atomic_file_begin(&png_file, options->preview_path, error);
+        if (status == TOOL_EXIT_SUCCESS) {
+            status = png_write_gray(png_file.fd, options->preview_path, ao, input->width,
+                                    input->height, input->width, error);
+            if (status != TOOL_EXIT_SUCCESS) atomic_file_abort(&png_file);
+        }
+        if (status != TOOL_EXIT_SUCCESS) {
+            atomic_file_abort(&exr_file);
+            return status;
+        }
+    }
+    /* Both files are complete: only now replace the destinations. */
+    status = atomic_file_commit(&exr_file, error);
+    if (status != TOOL_EXIT_SUCCESS) {
+        if (with_preview) atomic_file_abort(&png_file);
+        return status;
+    }
+    if (with_preview) status = atomic_file_commit(&png_file, error);
+    return status;
+}
+
+int ao_command(const cli_options *options, tool_error *error)
+{
+    struct stat input_status;
+    if (stat(options->input_path, &input_status) != 0)
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot open %s: %s", options->input_path,
+                         strerror(errno));
+    if (!S_ISREG(input_status.st_mode))
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "%s is not a regular file",
+                         options->input_path);
+    int status = refuse_overwriting_input(options->output_path, "-o", &input_status, error);
+    if (status == TOOL_EXIT_SUCCESS && options->preview_path != NULL)
+        status = refuse_overwriting_input(options->preview_path, "--preview", &input_status,
+                                          error);
+    if (status != TOOL_EXIT_SUCCESS) return status;
+
+    exr_input input;
+    status = exr_input_open(&input, options->input_path, error);
+    if (status != TOOL_EXIT_SUCCESS) return status;
+
+    pass_buffers buffers = {0};
+    exr_output_channel *outputs = NULL;
+    blender_passes passes;
+    status = blender_find_passes(&input, options->layer, &passes, error);
+    if (status != TOOL_EXIT_SUCCESS) goto done;
+
+    camera_settings camera;
+    status = resolve_camera(options, &input, &camera, error);
+    if (status != TOOL_EXIT_SUCCESS) goto done;
+    const bool use_normals = passes.has_normal && !options->ignore_normals;
+    const hbao_camera cropped =
+        camera_for_data_window(&camera.camera, &input.display_window, &input.data_window);
+
+    status = read_passes(&input, &passes, use_normals, &buffers, error);
+    if (status != TOOL_EXIT_SUCCESS) goto done;
+    if (use_normals && !(camera.fields_set & CAMERA_FIELD_WORLD_TO_CAMERA))
+        tool_warn("the Normal pass (%s) is in world space but no world-to-camera matrix was "
+                  "given; using the identity, which is right only for a camera at the origin "
+                  "looking down -Z. Give --camera FILE.json or --world-to-camera, or "
+                  "--no-normals to reconstruct normals from depth",
+                  passes.normal[0]);
+
+    hbao_channel depth = {buffers.depth, 1, input.width};
+    hbao_channel normal = {buffers.normal, 3, (int64_t)input.width * 3};
+    hbao_result result = hbao_compute(&options->params, &cropped, input.width, input.height,
+                                      &depth, use_normals ? &normal : NULL, buffers.ao,
+                                      input.width);
+    if (result != HBAO_SUCCESS) {
+        status = tool_fail(error, TOOL_EXIT_RUNTIME, "%s: cannot compute AO: %s",
+                           options->input_path, hbao_result_message(result));
+        goto done;
+    }
+
+    outputs = calloc((size_t)input.channels->num_channels + 1, sizeof *outputs);
+    if (outputs == NULL) {
+        status = tool_fail(error, TOOL_EXIT_RUNTIME, "out of memory");
+        goto done;
+    }
+    int output_count = 0;
+    /* AO is a linear quantity (a visibility fraction). */
+    exr_output_channel ao_channel = {options->ao_channel, EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LINEAR,
+                                     (uint8_t *)buffers.ao, sizeof(float),
+                                     (int64_t)input.width * sizeof(float)};
+    outputs[output_count++] = ao_channel;
+    if (options->keep_input) {
+        status = read_copies(&input, options->ao_channel, &buffers, outputs, &output_count, error);
+        if (status != TOOL_EXIT_SUCCESS) goto done;
+    }
+    status = write_outputs(options, &input, outputs, output_count, buffers.ao, error);
+
+done:
+    free(outputs);
+    free_buffers(&buffers);
+    exr_input_close(&input);
+    return status;
+}

@@ -1,0 +1,102 @@
+/* SPDX-License-Identifier: GPL-2.0-or-later */
+#include "blender_layers.h"
+
+#include <stdio.h>
+#include <string.h>
+
+static const char depth_suffix[] = ".Depth.Z";
+static const char *const normal_names[3] = {"Normal.X", "Normal.Y", "Normal.Z"};
+
+/* Length of the layer prefix when `name` is "<layer>.Depth.Z", else -1. */
+static int depth_layer_length(const char *name)
+{
+    size_t length = strlen(name), suffix = strlen(depth_suffix);
+    if (length <= suffix || strcmp(name + length - suffix, depth_suffix) != 0) return -1;
+    return (int)(length - suffix);
+}
+
+int blender_depth_layers(const exr_input *input, const char **names, int capacity)
+{
+    int found = 0;
+    for (int c = 0; c < input->channels->num_channels; ++c) {
+        const char *name = input->channels->entries[c].name.str;
+        if (depth_layer_length(name) < 0) continue;
+        if (found < capacity) names[found] = name;
+        ++found;
+    }
+    return found;
+}
+
+static bool set_name(char *out, const char *prefix, int prefix_length, const char *suffix)
+{
+    int written = snprintf(out, BLENDER_CHANNEL_NAME_MAX, "%.*s%s", prefix_length, prefix, suffix);
+    return written >= 0 && written < BLENDER_CHANNEL_NAME_MAX;
+}
+
+/* `layer` may be "" (a file without view layers: "Depth.Z", "Normal.X"). */
+static int fill_passes(const exr_input *input, const char *layer, int layer_length,
+                       const char *depth_channel, bool look_for_normals, blender_passes *passes,
+                       tool_error *error)
+{
+    memset(passes, 0, sizeof *passes);
+    if (!set_name(passes->layer, layer, layer_length, "") ||
+        !set_name(passes->depth, depth_channel, (int)strlen(depth_channel), ""))
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: channel name too long", input->path);
+    passes->has_normal = look_for_normals;
+    for (int axis = 0; axis < 3 && passes->has_normal; ++axis) {
+        char prefix[BLENDER_CHANNEL_NAME_MAX];
+        if (!set_name(prefix, layer, layer_length, layer_length > 0 ? "." : "") ||
+            !set_name(passes->normal[axis], prefix, (int)strlen(prefix), normal_names[axis]))
+            return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: channel name too long", input->path);
+        passes->has_normal = exr_input_find_channel(input, passes->normal[axis]) >= 0;
+    }
+    return TOOL_EXIT_SUCCESS;
+}
+
+static int fail_listing_layers(const exr_input *input, const char *problem, tool_error *error)
+{
+    char list[600] = "";
+    for (int c = 0; c < input->channels->num_channels; ++c) {
+        const char *name = input->channels->entries[c].name.str;
+        int length = depth_layer_length(name);
+        if (length < 0) continue;
+        size_t used = strlen(list);
+        snprintf(list + used, sizeof list - used, "%s\"%.*s\"", used ? ", " : "", length, name);
+    }
+    if (list[0] == '\0')
+        return tool_fail(error, TOOL_EXIT_RUNTIME,
+                         "%s: %s; the file has no Depth pass (no channel "
+                         "<ViewLayer>.Depth.Z or Z): enable the Z/Depth pass in Blender's "
+                         "View Layer properties",
+                         input->path, problem);
+    return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: %s; layers with a Depth pass: %s",
+                     input->path, problem, list);
+}
+
+int blender_find_passes(const exr_input *input, const char *requested, blender_passes *passes,
+                        tool_error *error)
+{
+    if (requested != NULL) {
+        char depth[BLENDER_CHANNEL_NAME_MAX];
+        if (!set_name(depth, requested, (int)strlen(requested), depth_suffix))
+            return tool_fail(error, TOOL_EXIT_USAGE, "--layer: name too long");
+        if (exr_input_find_channel(input, depth) < 0) {
+            char problem[BLENDER_CHANNEL_NAME_MAX + 64];
+            snprintf(problem, sizeof problem, "no layer \"%s\" with a Depth pass (%s)", requested,
+                     depth);
+            return fail_listing_layers(input, problem, error);
+        }
+        return fill_passes(input, requested, (int)strlen(requested), depth, true, passes,
+                           error);
+    }
+    for (int c = 0; c < input->channels->num_channels; ++c) {
+        const char *name = input->channels->entries[c].name.str;
+        int length = depth_layer_length(name);
+        if (length >= 0) return fill_passes(input, name, length, name, true, passes, error);
+    }
+    static const char *const plain_depth[] = {"Depth.Z", "Z"};
+    for (int i = 0; i < 2; ++i)
+        if (exr_input_find_channel(input, plain_depth[i]) >= 0)
+            return fill_passes(input, "", 0, plain_depth[i], i == 0, passes, error);
+    return fail_listing_layers(input, "no Depth pass", error);
+}

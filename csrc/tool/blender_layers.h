@@ -1,0 +1,36 @@
+/* SPDX-License-Identifier: GPL-2.0-or-later */
+/*
+ * Finding Blender's render passes among an EXR's channels. A multilayer EXR
+ * names them <ViewLayer>.<Pass>.<Channel>: "ViewLayer.Depth.Z",
+ * "ViewLayer.Normal.X". A single-layer EXR saved with a Z buffer has a plain
+ * "Z" channel.
+ */
+#ifndef HBAO_TOOL_BLENDER_LAYERS_H
+#define HBAO_TOOL_BLENDER_LAYERS_H
+
+#include <stdbool.h>
+
+#include "exr_reader.h"
+#include "tool_error.h"
+
+#define BLENDER_CHANNEL_NAME_MAX 512
+
+typedef struct blender_passes {
+    char layer[BLENDER_CHANNEL_NAME_MAX]; /**< "" for a file without layers */
+    char depth[BLENDER_CHANNEL_NAME_MAX];
+    char normal[3][BLENDER_CHANNEL_NAME_MAX];
+    bool has_normal; /**< all three normal channels exist */
+} blender_passes;
+
+/**
+ * Choose the layer: `requested` when not NULL, else the first layer (in the
+ * channel list's alphabetical order) with a Depth pass, else a plain
+ * "Depth.Z" or "Z" channel. Fails listing the layers that do exist.
+ */
+int blender_find_passes(const exr_input *input, const char *requested, blender_passes *passes,
+                        tool_error *error);
+
+/** Number of layers with a Depth pass; their names go to `names` (up to `capacity`). */
+int blender_depth_layers(const exr_input *input, const char **names, int capacity);
+
+#endif /* HBAO_TOOL_BLENDER_LAYERS_H */

@@ -1,0 +1,60 @@
+/* SPDX-License-Identifier: GPL-2.0-or-later */
+/*
+ * Camera settings gathered from several sources, each of which may set only
+ * some fields: the EXR header (pixel aspect), a camera JSON file and the
+ * command-line flags. Later sources override earlier ones field by field.
+ */
+#ifndef HBAO_TOOL_CAMERA_SETTINGS_H
+#define HBAO_TOOL_CAMERA_SETTINGS_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "hbao.h"
+
+/** Bits of camera_settings.fields_set, one per hbao_camera field. */
+enum {
+    CAMERA_FIELD_PROJECTION = 1u << 0,
+    CAMERA_FIELD_LENS = 1u << 1,
+    CAMERA_FIELD_SENSOR_WIDTH = 1u << 2,
+    CAMERA_FIELD_SENSOR_HEIGHT = 1u << 3,
+    CAMERA_FIELD_SENSOR_FIT = 1u << 4,
+    CAMERA_FIELD_SHIFT_X = 1u << 5,
+    CAMERA_FIELD_SHIFT_Y = 1u << 6,
+    CAMERA_FIELD_ORTHO_SCALE = 1u << 7,
+    CAMERA_FIELD_PIXEL_ASPECT_X = 1u << 8,
+    CAMERA_FIELD_PIXEL_ASPECT_Y = 1u << 9,
+    CAMERA_FIELD_WORLD_TO_CAMERA = 1u << 10
+};
+
+typedef struct camera_settings {
+    hbao_camera camera; /**< only the fields named in fields_set are meaningful */
+    uint32_t fields_set;
+} camera_settings;
+
+/** No field set; the values are Blender's defaults. */
+void camera_settings_init(camera_settings *settings);
+
+/** Copy into `base` every field that `override` sets. */
+void camera_settings_apply(camera_settings *base, const camera_settings *override);
+
+/** Image rectangle in pixels, y growing downwards (EXR convention). */
+typedef struct pixel_rect {
+    int32_t min_x, min_y, max_x, max_y; /* inclusive */
+} pixel_rect;
+
+/**
+ * The camera for the sub-rectangle `data` of the full frame `display`
+ * (Blender's border render): same focal length per pixel and same view
+ * rays, with the sensor fit made explicit, the fitted sensor side (or the
+ * ortho scale) scaled to the crop and the lens shift moved to the crop's
+ * centre. Follows Blender's BKE_camera_params_compute_viewplane(). Identical
+ * rectangles return the camera unchanged.
+ */
+hbao_camera camera_for_data_window(const hbao_camera *camera, const pixel_rect *display,
+                                   const pixel_rect *data);
+
+/** True when the 4x4 matrix is the identity. */
+bool matrix_is_identity(const float matrix[16]);
+
+#endif /* HBAO_TOOL_CAMERA_SETTINGS_H */

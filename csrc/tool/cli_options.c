@@ -1,0 +1,479 @@
+/* SPDX-License-Identifier: GPL-2.0-or-later */
+#include "cli_options.h"
+
+#include <float.h>
+#include <string.h>
+
+#include "number_parsing.h"
+
+typedef enum option_id {
+    OPTION_OUTPUT,
+    OPTION_LAYER,
+    OPTION_AO_CHANNEL,
+    OPTION_KEEP_INPUT,
+    OPTION_NO_NORMALS,
+    OPTION_PREVIEW,
+    OPTION_COMPRESSION,
+    OPTION_RADIUS,
+    OPTION_ANGLE_BIAS,
+    OPTION_DIRECTIONS,
+    OPTION_STEPS,
+    OPTION_BLUR,
+    OPTION_BLUR_SHARPNESS,
+    OPTION_HALF_RES,
+    OPTION_FALLOFF,
+    OPTION_INTEGRATION,
+    OPTION_STRENGTH,
+    OPTION_THREADS,
+    OPTION_CAMERA,
+    OPTION_CAMERA_TYPE,
+    OPTION_LENS,
+    OPTION_SENSOR_WIDTH,
+    OPTION_SENSOR_HEIGHT,
+    OPTION_SENSOR_FIT,
+    OPTION_SHIFT_X,
+    OPTION_SHIFT_Y,
+    OPTION_ORTHO_SCALE,
+    OPTION_PIXEL_ASPECT_X,
+    OPTION_PIXEL_ASPECT_Y,
+    OPTION_WORLD_TO_CAMERA,
+    OPTION_INFO,
+    OPTION_JSON,
+    OPTION_HELP,
+    OPTION_VERSION
+} option_id;
+
+typedef struct option_spec {
+    const char *name; /* without the leading "--" */
+    char short_name;  /* 0: none */
+    option_id id;
+    bool takes_value;
+} option_spec;
+
+static const option_spec option_specs[] = {
+    {"output", 'o', OPTION_OUTPUT, true},
+    {"layer", 0, OPTION_LAYER, true},
+    {"ao-channel", 0, OPTION_AO_CHANNEL, true},
+    {"keep-input", 0, OPTION_KEEP_INPUT, false},
+    {"no-normals", 0, OPTION_NO_NORMALS, false},
+    {"preview", 0, OPTION_PREVIEW, true},
+    {"compression", 0, OPTION_COMPRESSION, true},
+    {"radius", 0, OPTION_RADIUS, true},
+    {"angle-bias", 0, OPTION_ANGLE_BIAS, true},
+    {"directions", 0, OPTION_DIRECTIONS, true},
+    {"steps", 0, OPTION_STEPS, true},
+    {"blur", 0, OPTION_BLUR, true},
+    {"blur-sharpness", 0, OPTION_BLUR_SHARPNESS, true},
+    {"half-res", 0, OPTION_HALF_RES, false},
+    {"falloff", 0, OPTION_FALLOFF, true},
+    {"integration", 0, OPTION_INTEGRATION, true},
+    {"strength", 0, OPTION_STRENGTH, true},
+    {"threads", 0, OPTION_THREADS, true},
+    {"camera", 0, OPTION_CAMERA, true},
+    {"camera-type", 0, OPTION_CAMERA_TYPE, true},
+    {"lens", 0, OPTION_LENS, true},
+    {"sensor-width", 0, OPTION_SENSOR_WIDTH, true},
+    {"sensor-height", 0, OPTION_SENSOR_HEIGHT, true},
+    {"sensor-fit", 0, OPTION_SENSOR_FIT, true},
+    {"shift-x", 0, OPTION_SHIFT_X, true},
+    {"shift-y", 0, OPTION_SHIFT_Y, true},
+    {"ortho-scale", 0, OPTION_ORTHO_SCALE, true},
+    {"pixel-aspect-x", 0, OPTION_PIXEL_ASPECT_X, true},
+    {"pixel-aspect-y", 0, OPTION_PIXEL_ASPECT_Y, true},
+    {"world-to-camera", 0, OPTION_WORLD_TO_CAMERA, true},
+    {"info", 0, OPTION_INFO, false},
+    {"json", 0, OPTION_JSON, false},
+    {"help", 'h', OPTION_HELP, false},
+    {"version", 0, OPTION_VERSION, false},
+};
+
+#define OPTION_COUNT (sizeof option_specs / sizeof option_specs[0])
+
+typedef struct choice {
+    const char *name;
+    int32_t value;
+} choice;
+
+static const choice falloff_choices[] = {
+    {"quadratic", HBAO_FALLOFF_QUADRATIC}, {"none", HBAO_FALLOFF_NONE}, {NULL, 0}};
+static const choice integration_choices[] = {
+    {"hbao", HBAO_INTEGRATION_HBAO}, {"cosine", HBAO_INTEGRATION_COSINE}, {NULL, 0}};
+static const choice camera_type_choices[] = {
+    {"PERSP", HBAO_PROJECTION_PERSPECTIVE}, {"ORTHO", HBAO_PROJECTION_ORTHOGRAPHIC}, {NULL, 0}};
+static const choice sensor_fit_choices[] = {{"AUTO", HBAO_SENSOR_FIT_AUTO},
+                                            {"HORIZONTAL", HBAO_SENSOR_FIT_HORIZONTAL},
+                                            {"VERTICAL", HBAO_SENSOR_FIT_VERTICAL},
+                                            {NULL, 0}};
+/* Lossless methods only: AO is stored as 32-bit float, which the lossy
+ * methods would quantise (pxr24) or pass through uncompressed (b44). */
+static const choice compression_choices[] = {{"none", EXR_COMPRESSION_NONE},
+                                             {"rle", EXR_COMPRESSION_RLE},
+                                             {"zips", EXR_COMPRESSION_ZIPS},
+                                             {"zip", EXR_COMPRESSION_ZIP},
+                                             {"piz", EXR_COMPRESSION_PIZ},
+                                             {NULL, 0}};
+
+static int parse_choice(const char *flag, const char *text, const choice *choices, int32_t *out,
+                        tool_error *error)
+{
+    char names[128] = "";
+    for (const choice *c = choices; c->name != NULL; ++c) {
+        if (strcmp(c->name, text) == 0) {
+            *out = c->value;
+            return TOOL_EXIT_SUCCESS;
+        }
+        strncat(names, c == choices ? "" : ", ", sizeof names - strlen(names) - 1);
+        strncat(names, c->name, sizeof names - strlen(names) - 1);
+    }
+    return tool_fail(error, TOOL_EXIT_USAGE, "--%s: \"%s\" is not one of %s", flag, text, names);
+}
+
+/* A finite float in [minimum, maximum]; `positive` makes the minimum exclusive of 0. */
+static int parse_float_flag(const char *flag, const char *text, float minimum, float maximum,
+                            bool positive, float *out, tool_error *error)
+{
+    float value;
+    if (!parse_finite_float(text, &value))
+        return tool_fail(error, TOOL_EXIT_USAGE, "--%s: \"%s\" is not a finite number", flag,
+                         text);
+    if (positive && !(value > 0.0f))
+        return tool_fail(error, TOOL_EXIT_USAGE, "--%s: must be > 0 (got %s)", flag, text);
+    if (value < minimum || value > maximum)
+        return tool_fail(error, TOOL_EXIT_USAGE, "--%s: must be in [%g, %g] (got %s)", flag,
+                         (double)minimum, (double)maximum, text);
+    *out = value;
+    return TOOL_EXIT_SUCCESS;
+}
+
+static int parse_int_flag(const char *flag, const char *text, int32_t minimum, int32_t maximum,
+                          int32_t *out, tool_error *error)
+{
+    int32_t value;
+    if (!parse_int32(text, &value))
+        return tool_fail(error, TOOL_EXIT_USAGE, "--%s: \"%s\" is not an integer", flag, text);
+    if (value < minimum || value > maximum)
+        return tool_fail(error, TOOL_EXIT_USAGE, "--%s: must be in [%d, %d] (got %s)", flag,
+                         minimum, maximum, text);
+    *out = value;
+    return TOOL_EXIT_SUCCESS;
+}
+
+static const option_spec *find_long_option(const char *name, size_t length)
+{
+    for (size_t i = 0; i < OPTION_COUNT; ++i)
+        if (strlen(option_specs[i].name) == length &&
+            strncmp(option_specs[i].name, name, length) == 0)
+            return &option_specs[i];
+    return NULL;
+}
+
+static const option_spec *find_short_option(char name)
+{
+    for (size_t i = 0; i < OPTION_COUNT; ++i)
+        if (option_specs[i].short_name == name) return &option_specs[i];
+    return NULL;
+}
+
+static int apply_option(const option_spec *spec, const char *value, cli_options *options,
+                        tool_error *error)
+{
+    hbao_params *params = &options->params;
+    camera_settings *flags = &options->camera_flags;
+    hbao_camera *camera = &flags->camera;
+    const char *flag = spec->name;
+    int status = TOOL_EXIT_SUCCESS;
+    switch (spec->id) {
+    case OPTION_OUTPUT: options->output_path = value; break;
+    case OPTION_LAYER: options->layer = value; break;
+    case OPTION_AO_CHANNEL:
+        if (value[0] == '\0')
+            return tool_fail(error, TOOL_EXIT_USAGE, "--ao-channel: the name is empty");
+        options->ao_channel = value;
+        break;
+    case OPTION_KEEP_INPUT: options->keep_input = true; break;
+    case OPTION_NO_NORMALS: options->ignore_normals = true; break;
+    case OPTION_PREVIEW: options->preview_path = value; break;
+    case OPTION_COMPRESSION: {
+        int32_t compression = EXR_COMPRESSION_ZIP;
+        status = parse_choice(flag, value, compression_choices, &compression, error);
+        options->compression = (exr_compression_t)compression;
+        break;
+    }
+    case OPTION_RADIUS:
+        status = parse_float_flag(flag, value, 0.0f, FLT_MAX, false, &params->radius, error);
+        break;
+    case OPTION_ANGLE_BIAS:
+        status = parse_float_flag(flag, value, 0.0f, HBAO_MAX_ANGLE_BIAS_DEGREES, false,
+                                  &params->angle_bias_degrees, error);
+        break;
+    case OPTION_DIRECTIONS:
+        status = parse_int_flag(flag, value, 1, HBAO_MAX_DIRECTIONS, &params->directions, error);
+        break;
+    case OPTION_STEPS:
+        status = parse_int_flag(flag, value, 1, HBAO_MAX_STEPS, &params->steps, error);
+        break;
+    case OPTION_BLUR:
+        status = parse_int_flag(flag, value, 0, HBAO_MAX_BLUR_SIZE, &params->blur_size, error);
+        break;
+    case OPTION_BLUR_SHARPNESS:
+        status = parse_float_flag(flag, value, 0.0f, HBAO_MAX_BLUR_SHARPNESS, false,
+                                  &params->blur_sharpness, error);
+        break;
+    case OPTION_HALF_RES: params->half_resolution = 1; break;
+    case OPTION_FALLOFF:
+        status = parse_choice(flag, value, falloff_choices, &params->falloff, error);
+        break;
+    case OPTION_INTEGRATION:
+        status = parse_choice(flag, value, integration_choices, &params->integration, error);
+        break;
+    case OPTION_STRENGTH:
+        status = parse_float_flag(flag, value, 0.0f, HBAO_MAX_STRENGTH, false, &params->strength,
+                                  error);
+        break;
+    case OPTION_THREADS:
+        status = parse_int_flag(flag, value, 0, HBAO_MAX_THREADS, &params->threads, error);
+        break;
+    case OPTION_CAMERA: options->camera_path = value; break;
+    case OPTION_CAMERA_TYPE:
+        status = parse_choice(flag, value, camera_type_choices, &camera->projection, error);
+        flags->fields_set |= CAMERA_FIELD_PROJECTION;
+        break;
+    case OPTION_LENS:
+        status = parse_float_flag(flag, value, 0.0f, FLT_MAX, true, &camera->lens, error);
+        flags->fields_set |= CAMERA_FIELD_LENS;
+        break;
+    case OPTION_SENSOR_WIDTH:
+        status = parse_float_flag(flag, value, 0.0f, FLT_MAX, true, &camera->sensor_width, error);
+        flags->fields_set |= CAMERA_FIELD_SENSOR_WIDTH;
+        break;
+    case OPTION_SENSOR_HEIGHT:
+        status =
+            parse_float_flag(flag, value, 0.0f, FLT_MAX, true, &camera->sensor_height, error);
+        flags->fields_set |= CAMERA_FIELD_SENSOR_HEIGHT;
+        break;
+    case OPTION_SENSOR_FIT:
+        status = parse_choice(flag, value, sensor_fit_choices, &camera->sensor_fit, error);
+        flags->fields_set |= CAMERA_FIELD_SENSOR_FIT;
+        break;
+    case OPTION_SHIFT_X:
+        status = parse_float_flag(flag, value, -FLT_MAX, FLT_MAX, false, &camera->shift_x, error);
+        flags->fields_set |= CAMERA_FIELD_SHIFT_X;
+        break;
+    case OPTION_SHIFT_Y:
+        status = parse_float_flag(flag, value, -FLT_MAX, FLT_MAX, false, &camera->shift_y, error);
+        flags->fields_set |= CAMERA_FIELD_SHIFT_Y;
+        break;
+    case OPTION_ORTHO_SCALE:
+        /* An ortho scale only means something for an orthographic camera. */
+        status = parse_float_flag(flag, value, 0.0f, FLT_MAX, true, &camera->ortho_scale, error);
+        camera->projection = HBAO_PROJECTION_ORTHOGRAPHIC;
+        flags->fields_set |= CAMERA_FIELD_ORTHO_SCALE | CAMERA_FIELD_PROJECTION;
+        break;
+    case OPTION_PIXEL_ASPECT_X:
+        status =
+            parse_float_flag(flag, value, 0.0f, FLT_MAX, true, &camera->pixel_aspect_x, error);
+        flags->fields_set |= CAMERA_FIELD_PIXEL_ASPECT_X;
+        break;
+    case OPTION_PIXEL_ASPECT_Y:
+        status =
+            parse_float_flag(flag, value, 0.0f, FLT_MAX, true, &camera->pixel_aspect_y, error);
+        flags->fields_set |= CAMERA_FIELD_PIXEL_ASPECT_Y;
+        break;
+    case OPTION_WORLD_TO_CAMERA:
+        if (!parse_float_list(value, camera->world_to_camera, 16))
+            return tool_fail(error, TOOL_EXIT_USAGE,
+                             "--world-to-camera: expected one argument holding 16 finite "
+                             "numbers (row-major, separated by commas or spaces), got \"%s\"",
+                             value);
+        flags->fields_set |= CAMERA_FIELD_WORLD_TO_CAMERA;
+        break;
+    case OPTION_INFO: options->mode = TOOL_MODE_INFO; break;
+    case OPTION_JSON: options->info_json = true; break;
+    case OPTION_HELP: /* handled after parsing */ break;
+    case OPTION_VERSION: break;
+    }
+    return status;
+}
+
+static void options_init(cli_options *options)
+{
+    memset(options, 0, sizeof *options);
+    options->mode = TOOL_MODE_COMPUTE;
+    options->compression = EXR_COMPRESSION_ZIP;
+    options->ao_channel = "AO";
+    hbao_params defaults = HBAO_PARAMS_DEFAULT_INITIALIZER;
+    options->params = defaults;
+    camera_settings_init(&options->camera_flags);
+}
+
+int cli_parse(int argc, char **argv, cli_options *options, tool_error *error)
+{
+    options_init(options);
+    bool only_positionals = false;
+    bool wants_help = false, wants_version = false;
+    for (int i = 1; i < argc; ++i) {
+        const char *argument = argv[i];
+        if (only_positionals || argument[0] != '-' || strcmp(argument, "-") == 0) {
+            if (options->input_path != NULL)
+                return tool_fail(error, TOOL_EXIT_USAGE,
+                                 "more than one input file (\"%s\" and \"%s\")",
+                                 options->input_path, argument);
+            options->input_path = argument;
+            continue;
+        }
+        if (strcmp(argument, "--") == 0) {
+            only_positionals = true;
+            continue;
+        }
+        const option_spec *spec = NULL;
+        const char *inline_value = NULL;
+        if (argument[1] == '-') {
+            const char *name = argument + 2;
+            const char *equals = strchr(name, '=');
+            size_t length = equals ? (size_t)(equals - name) : strlen(name);
+            spec = find_long_option(name, length);
+            if (equals != NULL) inline_value = equals + 1;
+        } else if (argument[2] == '\0') {
+            spec = find_short_option(argument[1]);
+        }
+        if (spec == NULL)
+            return tool_fail(error, TOOL_EXIT_USAGE, "unknown option %s (see hbao --help)",
+                             argument);
+        const char *value = NULL;
+        if (spec->takes_value) {
+            if (inline_value != NULL) {
+                value = inline_value;
+            } else {
+                if (i + 1 >= argc)
+                    return tool_fail(error, TOOL_EXIT_USAGE, "%s needs a value", argument);
+                value = argv[++i];
+            }
+        } else if (inline_value != NULL) {
+            return tool_fail(error, TOOL_EXIT_USAGE, "--%s takes no value", spec->name);
+        }
+        wants_help |= spec->id == OPTION_HELP;
+        wants_version |= spec->id == OPTION_VERSION;
+        int status = apply_option(spec, value, options, error);
+        if (status != TOOL_EXIT_SUCCESS) return status;
+    }
+
+    /* --help, then --version, win over everything else, as users expect. */
+    if (wants_help || wants_version) {
+        options->mode = wants_help ? TOOL_MODE_HELP : TOOL_MODE_VERSION;
+        return TOOL_EXIT_SUCCESS;
+    }
+
+    if (options->input_path == NULL)
+        return tool_fail(error, TOOL_EXIT_USAGE, "no input file (usage: hbao INPUT.exr -o "
+                                                 "OUTPUT.exr [options]; see hbao --help)");
+    if (options->mode == TOOL_MODE_INFO) {
+        if (options->output_path != NULL || options->preview_path != NULL)
+            return tool_fail(error, TOOL_EXIT_USAGE, "--info writes nothing: drop -o/--preview");
+        return TOOL_EXIT_SUCCESS;
+    }
+    if (options->info_json)
+        return tool_fail(error, TOOL_EXIT_USAGE, "--json only goes with --info");
+    if (options->output_path == NULL)
+        return tool_fail(error, TOOL_EXIT_USAGE, "no output file: give -o OUTPUT.exr");
+    if (options->output_path[0] == '\0' ||
+        (options->preview_path != NULL && options->preview_path[0] == '\0') ||
+        options->input_path[0] == '\0')
+        return tool_fail(error, TOOL_EXIT_USAGE, "a file name is empty");
+    if (options->preview_path != NULL && strcmp(options->preview_path, options->output_path) == 0)
+        return tool_fail(error, TOOL_EXIT_USAGE, "--preview and -o name the same file");
+    return TOOL_EXIT_SUCCESS;
+}
+
+void cli_print_help(FILE *stream)
+{
+    fprintf(stream,
+"usage: hbao INPUT.exr -o OUTPUT.exr [options]\n"
+"       hbao --info FILE.exr [--json]\n"
+"\n"
+"Horizon-based ambient occlusion from the Depth (and Normal) pass of a Blender\n"
+"multilayer OpenEXR render. Writes an EXR whose float channel `AO` holds the\n"
+"occlusion: 1 = unoccluded, 0 = fully occluded; background pixels get 1.\n"
+"\n"
+"Input and output:\n"
+"  -o, --output FILE       output EXR (required). Written to a temporary file\n"
+"                          next to it and renamed when complete; never the input.\n"
+"  --layer NAME            view layer to use (channels NAME.Depth.Z and, if\n"
+"                          present, NAME.Normal.X/Y/Z). Default: the first layer,\n"
+"                          in channel-name order, that has a Depth pass; a plain\n"
+"                          `Depth.Z` or `Z` channel is used if no layer has one.\n"
+"  --no-normals            ignore the Normal pass; reconstruct normals from depth.\n"
+"  --ao-channel NAME       name of the output channel (default AO). `Y` makes\n"
+"                          image viewers and Blender show the AO as grayscale.\n"
+"  --keep-input            also copy every input channel (same names and pixel\n"
+"                          types) and header attributes into the output; an input\n"
+"                          channel with the AO channel's name is replaced.\n"
+"  --compression METHOD    none, rle, zips, zip (default) or piz (lossless only).\n"
+"  --preview FILE.png      also write the AO as an 8-bit grayscale PNG: the linear\n"
+"                          AO value 0..1 maps to 0..255, no gamma curve.\n"
+"  --info                  print the file's layout (layers, channels, pixel types,\n"
+"                          compression, windows) and per-channel min/max/mean of\n"
+"                          the finite values and the count of non-finite ones.\n"
+"  --json                  with --info: print it as JSON.\n"
+"\n"
+"AO parameters (defaults from libhbao):\n"
+"  --radius R              AO radius in scene units (>= 0; default %g)\n"
+"  --angle-bias DEG        ignore occluders this far above the tangent plane\n"
+"                          [0, %g] (default %g)\n"
+"  --directions N          directions per pixel [1, %d] (default %d)\n"
+"  --steps N               steps per direction [1, %d] (default %d)\n"
+"  --blur N                bilateral blur width in pixels [0, %d]; 0 or 1 = off\n"
+"                          (default %d)\n"
+"  --blur-sharpness S      how strongly the blur stops at depth edges [0, %g]\n"
+"                          (default %g)\n"
+"  --half-res              compute at half resolution, upsample depth-aware\n"
+"  --falloff F             quadratic (default) or none\n"
+"  --integration I         cosine (default: what Cycles' AO pass measures) or hbao\n"
+"  --strength S            ao = ao^S, [0, %g] (default %g)\n"
+"  --threads N             worker threads [0, %d]; 0 = one per core (default)\n"
+"\n"
+"Camera (Blender's camera model and names; flags override --camera):\n"
+"  --camera FILE.json      JSON object with Blender's property names: type\n"
+"                          (\"PERSP\"/\"ORTHO\"), lens, sensor_width, sensor_height,\n"
+"                          sensor_fit (\"AUTO\"/\"HORIZONTAL\"/\"VERTICAL\"), shift_x,\n"
+"                          shift_y, ortho_scale, pixel_aspect_x, pixel_aspect_y,\n"
+"                          world_to_camera (4 rows of 4 numbers). Missing keys keep\n"
+"                          their defaults; unknown keys are ignored.\n"
+"  --camera-type T         PERSP or ORTHO\n"
+"  --lens MM               focal length (default 50)\n"
+"  --sensor-width MM       (default 36)\n"
+"  --sensor-height MM      (default 24)\n"
+"  --sensor-fit FIT        AUTO (default), HORIZONTAL or VERTICAL\n"
+"  --shift-x S, --shift-y S  lens shift in units of the fitted sensor side\n"
+"  --ortho-scale S         orthographic view size; implies --camera-type ORTHO\n"
+"  --pixel-aspect-x A, --pixel-aspect-y A\n"
+"                          default: x = the EXR header's pixelAspectRatio, y = 1\n"
+"  --world-to-camera \"M\"   ONE argument holding the 16 numbers of the row-major\n"
+"                          world-to-camera matrix (camera.matrix_world inverted),\n"
+"                          separated by commas and/or spaces, e.g.\n"
+"                          --world-to-camera \"1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1\".\n"
+"                          It maps Blender's world-space Normal pass into camera\n"
+"                          space. Without it (and without world_to_camera in the\n"
+"                          JSON) the identity is used, i.e. normals are taken as\n"
+"                          already in camera space: wrong for Blender's Normal pass\n"
+"                          unless the camera sits at the origin looking down -Z, so\n"
+"                          the tool warns; pass the matrix or --no-normals.\n"
+"\n"
+"Data window: the tool works on the EXR's data window and writes the output with\n"
+"the same data and display windows; when the data window is a part of the\n"
+"display window, the camera is adjusted to that part (same view rays). Blender\n"
+"itself always writes data window = display window: a border render without\n"
+"cropping is a full frame (unrendered pixels are background, AO 1); with\n"
+"\"Crop to Render Region\" nothing in the file says where the region was, so\n"
+"the camera must describe the cropped view (sensor and shift).\n"
+"\n"
+"Exit status: 0 success, 1 runtime error (unreadable or corrupt file, cannot\n"
+"write), 2 usage error (bad flag or value, output would overwrite the input).\n"
+"  -h, --help              this help\n"
+"  --version               print the tool's and libhbao's versions\n",
+            (double)HBAO_DEFAULT_RADIUS, (double)HBAO_MAX_ANGLE_BIAS_DEGREES,
+            (double)HBAO_DEFAULT_ANGLE_BIAS_DEGREES, HBAO_MAX_DIRECTIONS,
+            HBAO_DEFAULT_DIRECTIONS, HBAO_MAX_STEPS, HBAO_DEFAULT_STEPS, HBAO_MAX_BLUR_SIZE,
+            HBAO_DEFAULT_BLUR_SIZE, (double)HBAO_MAX_BLUR_SHARPNESS,
+            (double)HBAO_DEFAULT_BLUR_SHARPNESS, (double)HBAO_MAX_STRENGTH,
+            (double)HBAO_DEFAULT_STRENGTH, HBAO_MAX_THREADS);
+}

@@ -1,0 +1,42 @@
+/* SPDX-License-Identifier: GPL-2.0-or-later */
+/* The hbao tool's command line: parsing, validation and --help. */
+#ifndef HBAO_TOOL_CLI_OPTIONS_H
+#define HBAO_TOOL_CLI_OPTIONS_H
+
+#include <openexr.h>
+#include <stdbool.h>
+#include <stdio.h>
+
+#include "camera_settings.h"
+#include "hbao.h"
+#include "tool_error.h"
+
+typedef enum tool_mode {
+    TOOL_MODE_COMPUTE, /**< hbao INPUT.exr -o OUTPUT.exr */
+    TOOL_MODE_INFO,    /**< hbao --info FILE.exr */
+    TOOL_MODE_HELP,
+    TOOL_MODE_VERSION
+} tool_mode;
+
+typedef struct cli_options {
+    tool_mode mode;
+    const char *input_path;
+    const char *output_path;
+    const char *preview_path;  /**< NULL: no PNG */
+    const char *camera_path;   /**< NULL: no camera JSON */
+    const char *layer;         /**< NULL: first view layer with a Depth pass */
+    const char *ao_channel;    /**< name of the output channel, "AO" by default */
+    bool keep_input;
+    bool ignore_normals;
+    bool info_json;
+    exr_compression_t compression;
+    hbao_params params;
+    camera_settings camera_flags; /**< camera fields given as flags */
+} cli_options;
+
+/** Fill *options from argv; TOOL_EXIT_USAGE with a message on a bad command line. */
+int cli_parse(int argc, char **argv, cli_options *options, tool_error *error);
+
+void cli_print_help(FILE *stream);
+
+#endif /* HBAO_TOOL_CLI_OPTIONS_H */

@@ -1,0 +1,75 @@
+/* SPDX-License-Identifier: GPL-2.0-or-later */
+/*
+ * Reading single-part scanline EXR files (what Blender writes) through
+ * OpenEXRCore. The image is the part's data window; rows are stored top row
+ * first, whatever the file's line order.
+ */
+#ifndef HBAO_TOOL_EXR_READER_H
+#define HBAO_TOOL_EXR_READER_H
+
+#include <openexr.h>
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "camera_settings.h"
+#include "tool_error.h"
+
+typedef struct exr_input {
+    exr_context_t context;
+    const char *path;
+    pixel_rect data_window;
+    pixel_rect display_window;
+    int32_t width, height; /**< of the data window */
+    float pixel_aspect_ratio; /**< pixel width / height; 1 when absent */
+    bool has_pixel_aspect_ratio;
+    exr_attr_v2f_t screen_window_center;
+    float screen_window_width;
+    exr_compression_t compression;
+    exr_lineorder_t line_order;
+    const exr_attr_chlist_t *channels; /**< sorted by name; owned by the context */
+} exr_input;
+
+/** Where one channel's pixels go. Strides are in bytes. */
+typedef struct exr_channel_request {
+    const char *name;
+    exr_pixel_type_t type; /**< EXR_PIXEL_FLOAT converts half and uint to float */
+    uint8_t *data;         /**< the top-left pixel of the data window */
+    int32_t pixel_stride;
+    int64_t row_stride;
+} exr_channel_request;
+
+/**
+ * Open `path`, check that it is an image the tool can read (one scanline
+ * part, channels not subsampled, size within hbao's limits) and fill *input.
+ * On failure *input needs no exr_input_close().
+ */
+int exr_input_open(exr_input *input, const char *path, tool_error *error);
+
+/** Decode the requested channels (each must exist) for the whole data window. */
+int exr_input_read(exr_input *input, const exr_channel_request *requests, int count,
+                   tool_error *error);
+
+/** Index of the channel called `name`, or -1. */
+int exr_input_find_channel(const exr_input *input, const char *name);
+
+void exr_input_close(exr_input *input);
+
+/** Bytes per pixel of a channel type (2 for half, 4 otherwise). */
+int exr_pixel_type_size(exr_pixel_type_t type);
+
+/** "half", "float", "uint". */
+const char *exr_pixel_type_name(exr_pixel_type_t type);
+
+/** Lower-case compression names as used by --compression ("zip", "piz", ...). */
+const char *exr_compression_name(exr_compression_t compression);
+
+/** Context initializer whose error handler keeps the library's last message
+ *  (see exr_last_error_message()) instead of printing it. */
+exr_context_initializer_t exr_quiet_initializer(void);
+
+/** A message for an OpenEXRCore result: the library's last detailed message
+ *  if it reported one since exr_clear_last_error(), else the default text. */
+const char *exr_error_text(exr_result_t result);
+void exr_clear_last_error(void);
+
+#endif /* HBAO_TOOL_EXR_READER_H */

@@ -1,0 +1,32 @@
+/* SPDX-License-Identifier: GPL-2.0-or-later */
+/*
+ * Error reporting for the hbao tool: each step fills a tool_error with a
+ * message and returns the exit status the failure deserves, so that main()
+ * prints one line (`hbao: error: ...`) and exits with it.
+ */
+#ifndef HBAO_TOOL_ERROR_H
+#define HBAO_TOOL_ERROR_H
+
+#include <stddef.h>
+
+/** Exit statuses of the tool. */
+enum {
+    TOOL_EXIT_SUCCESS = 0,
+    TOOL_EXIT_RUNTIME = 1, /**< a file could not be read or written, out of memory, ... */
+    TOOL_EXIT_USAGE = 2    /**< bad command line: unknown flag, bad number, ... */
+};
+
+#define TOOL_ERROR_MESSAGE_SIZE 1024
+
+typedef struct tool_error {
+    char message[TOOL_ERROR_MESSAGE_SIZE];
+} tool_error;
+
+/** printf-style: set the message and return `status` (for `return tool_fail(...)`). */
+int tool_fail(tool_error *error, int status, const char *format, ...)
+    __attribute__((format(printf, 3, 4)));
+
+/** Print "hbao: warning: ..." to stderr. */
+void tool_warn(const char *format, ...) __attribute__((format(printf, 1, 2)));
+
+#endif /* HBAO_TOOL_ERROR_H */

@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-2.0-or-later
+# The whole test suite, from a fresh Debian 12 machine:
+#   1. install what is missing (scripts/setup.sh),
+#   2. build (Release) and run the C tests (ctest),
+#   3. build again with AddressSanitizer + UndefinedBehaviorSanitizer and run
+#      the C tests and a fuzz pass of the CLI under it,
+#   4. check PEP 8 of all Python code,
+#   5. run the Python tests (pytest): the ctypes binding, the CLI on EXRs
+#      written by Blender, the add-on in real headless and Xvfb Blender renders,
+#      the GLSL viewport preview under Xvfb.
+set -euo pipefail
+REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+cd "$REPO"
+JOBS="${JOBS:-2}"
+# Debian's Python, which has the numpy and pytest that setup.sh installs (a
+# python3 earlier on PATH, e.g. pyenv's, may not).
+PYTHON="${PYTHON:-/usr/bin/python3}"
+
+"$REPO/scripts/setup.sh"
+
+echo "== build (Release) and C tests"
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build build -j"$JOBS"
+ctest --test-dir build --output-on-failure -j"$JOBS"
+
+echo "== build with AddressSanitizer + UndefinedBehaviorSanitizer and C tests"
+cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=Debug -DHBAO_SANITIZE=ON \
+    -DHBAO_BUILD_BENCHMARKS=OFF >/dev/null
+cmake --build build-sanitize -j"$JOBS"
+ASAN_OPTIONS=detect_leaks=1 ctest --test-dir build-sanitize --output-on-failure -j"$JOBS"
+if [ -x scripts/fuzz_cli.sh ]; then
+    # 100 mutations per fixture keep this step short; the script defaults to 500
+    scripts/fuzz_cli.sh 100 1
+fi
+
+echo "== PEP 8"
+"$PYTHON" -m pycodestyle addon scripts tests $( [ -d bench ] && echo bench )
+
+echo "== Python tests (real Blender)"
+"$PYTHON" -m pytest tests -q -p no:cacheprovider
