@@ -1,0 +1,87 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The scene camera as the camera dict native.compute_ao() takes."""
+
+
+class CameraError(ValueError):
+    """The scene has no camera the library can model."""
+
+
+def camera_from_blender(scene, camera_object=None):
+    """Blender's camera model of `scene` (its camera, or `camera_object`,
+    which may be an evaluated copy) with Blender's property names."""
+    camera_object = camera_object or scene.camera
+    if camera_object is None:
+        raise CameraError(f"scene {scene.name!r} has no camera")
+    camera = camera_object.data
+    if getattr(camera, "type", None) not in ("PERSP", "ORTHO"):
+        kind = getattr(camera, "type", "not a camera")
+        raise CameraError(f"camera {camera_object.name!r} is {kind}: HBAO supports "
+                          f"perspective and orthographic cameras")
+    world_to_camera = camera_object.matrix_world.inverted_safe()
+    render = scene.render
+    return {
+        "type": camera.type,
+        "lens": float(camera.lens),
+        "sensor_width": float(camera.sensor_width),
+        "sensor_height": float(camera.sensor_height),
+        "sensor_fit": camera.sensor_fit,
+        "shift_x": float(camera.shift_x),
+        "shift_y": float(camera.shift_y),
+        "ortho_scale": float(camera.ortho_scale),
+        "pixel_aspect_x": float(render.pixel_aspect_x),
+        "pixel_aspect_y": float(render.pixel_aspect_y),
+        "world_to_camera": [[float(v) for v in row] for row in world_to_camera],
+    }
+
+
+def render_size(scene):
+    """(width, height) in pixels of the scene's Render Result: resolution times
+    percentage, cropped to the border when the border is cropped."""
+    render = scene.render
+    scale = render.resolution_percentage / 100.0
+    width = int(render.resolution_x * scale)
+    height = int(render.resolution_y * scale)
+    if render.use_border and render.use_crop_to_border:
+        x0, x1, y0, y1 = _border_pixels(render, width, height)
+        return x1 - x0, y1 - y0
+    return width, height
+
+
+def _border_pixels(render, width, height):
+    # Blender rounds the border to whole pixels the same way (rcti from rctf).
+    x0 = int(render.border_min_x * width)
+    x1 = int(render.border_max_x * width)
+    y0 = int(render.border_min_y * height)
+    y1 = int(render.border_max_y * height)
+    return x0, max(x1, x0 + 1), y0, max(y1, y0 + 1)
+
+
+def camera_for_render_result(scene, camera_object=None):
+    """camera_from_blender(), turned into the camera of the cropped image when
+    the scene renders a cropped border: same focal length in pixels, the
+    principal point moved by a lens shift, the sensor fitted horizontally."""
+    description = camera_from_blender(scene, camera_object)
+    render = scene.render
+    if not (render.use_border and render.use_crop_to_border):
+        return description
+    scale = render.resolution_percentage / 100.0
+    width, height = int(render.resolution_x * scale), int(render.resolution_y * scale)
+    aspect_x, aspect_y = description["pixel_aspect_x"], description["pixel_aspect_y"]
+    full_w, full_h = width * aspect_x, height * aspect_y  # aspect-corrected pixels
+    fit = description["sensor_fit"]
+    if fit == "AUTO":
+        fit = "HORIZONTAL" if full_w >= full_h else "VERTICAL"
+    fitted_pixels = full_w if fit == "HORIZONTAL" else full_h
+    fitted_sensor = (description["sensor_width"] if fit == "HORIZONTAL"
+                     else description["sensor_height"])
+    x0, x1, y0, y1 = _border_pixels(render, width, height)
+    crop_w = (x1 - x0) * aspect_x
+    # Crop centre relative to the full frame's centre, aspect-corrected pixels.
+    dx = ((x0 + x1) / 2.0 - width / 2.0) * aspect_x
+    dy = ((y0 + y1) / 2.0 - height / 2.0) * aspect_y
+    description["sensor_fit"] = "HORIZONTAL"
+    description["sensor_width"] = fitted_sensor * crop_w / fitted_pixels
+    description["ortho_scale"] = description["ortho_scale"] * crop_w / fitted_pixels
+    description["shift_x"] = (description["shift_x"] * fitted_pixels + dx) / crop_w
+    description["shift_y"] = (description["shift_y"] * fitted_pixels + dy) / crop_w
+    return description

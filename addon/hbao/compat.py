@@ -1,0 +1,108 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The few Blender API differences between 3.x, 4.x and 5.x, in one place."""
+import bpy
+
+VERSION = bpy.app.version
+# 4.0 replaced tree.inputs/outputs with tree.interface.
+HAS_TREE_INTERFACE = VERSION >= (4, 0, 0)
+# 5.0 replaced scene.node_tree with scene.compositing_node_group and the
+# Composite node with the group's Group Output.
+HAS_COMPOSITING_NODE_GROUP = VERSION >= (5, 0, 0)
+
+
+def compositor_tree(scene):
+    """The scene's compositor node tree, or None."""
+    if HAS_COMPOSITING_NODE_GROUP:
+        return getattr(scene, "compositing_node_group", None)
+    return scene.node_tree
+
+
+def ensure_compositor_tree(scene):
+    """The scene's compositor tree, created (with compositing turned on) if needed."""
+    if HAS_COMPOSITING_NODE_GROUP:
+        tree = scene.compositing_node_group
+        if tree is None:
+            tree = bpy.data.node_groups.new(f"{scene.name} Compositing", "CompositorNodeTree")
+            scene.compositing_node_group = tree
+        return tree
+    scene.use_nodes = True
+    return scene.node_tree
+
+
+def scene_of_tree(tree):
+    """The scene whose compositor tree is `tree`, or None."""
+    for scene in bpy.data.scenes:
+        if compositor_tree(scene) == tree:
+            return scene
+    return None
+
+
+def new_group_socket(tree, in_out, socket_type, name):
+    """Add an input ('INPUT') or output ('OUTPUT') to a node group's interface."""
+    if HAS_TREE_INTERFACE:
+        return tree.interface.new_socket(name, in_out=in_out, socket_type=socket_type)
+    sockets = tree.inputs if in_out == "INPUT" else tree.outputs
+    return sockets.new(socket_type, name)
+
+
+def group_socket_names(tree, in_out):
+    if HAS_TREE_INTERFACE:
+        return [item.name for item in tree.interface.items_tree
+                if getattr(item, "item_type", "") == "SOCKET" and item.in_out == in_out]
+    sockets = tree.inputs if in_out == "INPUT" else tree.outputs
+    return [socket.name for socket in sockets]
+
+
+def clear_group_interface(tree):
+    if HAS_TREE_INTERFACE:
+        tree.interface.clear()
+    else:
+        tree.inputs.clear()
+        tree.outputs.clear()
+
+
+def new_multiply_node(tree):
+    """A node that multiplies a colour by a factor-like value (Image x AO).
+    Returns (node, first colour input, second input, output)."""
+    try:
+        node = tree.nodes.new("CompositorNodeMixRGB")
+        node.blend_type = "MULTIPLY"
+        node.inputs[0].default_value = 1.0
+        return node, node.inputs[1], node.inputs[2], node.outputs[0]
+    except RuntimeError:
+        # 5.x compositor: the shared Mix node in RGBA mode.
+        node = tree.nodes.new("ShaderNodeMix")
+        node.data_type = "RGBA"
+        node.blend_type = "MULTIPLY"
+        node.inputs["Factor"].default_value = 1.0
+        colour_inputs = [s for s in node.inputs if s.type == "RGBA"]
+        colour_output = [s for s in node.outputs if s.type == "RGBA"][0]
+        return node, colour_inputs[0], colour_inputs[1], colour_output
+
+
+def new_composite_output(tree):
+    """The node that receives the final image: Composite (<5.0) or Group Output."""
+    if HAS_COMPOSITING_NODE_GROUP:
+        node = tree.nodes.new("NodeGroupOutput")
+        if "Image" not in group_socket_names(tree, "OUTPUT"):
+            new_group_socket(tree, "OUTPUT", "NodeSocketColor", "Image")
+        return node
+    return tree.nodes.new("CompositorNodeComposite")
+
+
+def find_fcurve(id_data, data_path, index=0):
+    """The F-Curve animating `data_path` of `id_data`, or None (legacy and
+    4.4+ layered actions)."""
+    animation = getattr(id_data, "animation_data", None)
+    action = animation.action if animation else None
+    if action is None:
+        return None
+    fcurves = getattr(action, "fcurves", None)
+    if fcurves is not None and VERSION < (5, 0, 0):
+        return fcurves.find(data_path, index=index)
+    try:
+        from bpy_extras import anim_utils
+        channelbag = anim_utils.action_get_channelbag_for_slot(action, animation.action_slot)
+    except (ImportError, AttributeError):
+        return None
+    return channelbag.fcurves.find(data_path, index=index) if channelbag else None

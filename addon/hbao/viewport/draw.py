@@ -1,0 +1,106 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The draw handler: registered while at least one 3D view has the preview on,
+removed as soon as none has, so that the preview costs nothing when off.
+
+It runs in POST_VIEW, where the view's depth buffer is still bound: the depth
+is read back (the gpu module of 3.4 to 5.x exposes no depth texture of the
+viewport; see scripts/bench_viewport.py for what the round trip costs),
+linearised, turned into AO and multiplied over the view.
+"""
+import bpy
+import gpu
+
+from . import pipeline, projection, settings
+
+SHADINGS = {"SOLID", "MATERIAL"}
+
+_handler = None
+# Region pointer -> AOPipeline; each keeps targets the size of its region.
+_pipelines = {}
+_reported_errors = set()
+
+
+def handler_registered():
+    return _handler is not None
+
+
+def sync_handler():
+    """Add the draw handler if any view has the preview on, remove it if none has."""
+    global _handler
+    wanted = settings.any_enabled()
+    if wanted and _handler is None:
+        _handler = bpy.types.SpaceView3D.draw_handler_add(_draw, (), "WINDOW", "POST_VIEW")
+    elif not wanted and _handler is not None:
+        bpy.types.SpaceView3D.draw_handler_remove(_handler, "WINDOW")
+        _handler = None
+        _pipelines.clear()
+    _redraw_3d_views()
+
+
+def _redraw_3d_views():
+    window_manager = getattr(bpy.context, "window_manager", None)
+    for window in getattr(window_manager, "windows", ()):
+        for area in window.screen.areas:
+            if area.type == "VIEW_3D":
+                area.tag_redraw()
+
+
+def _draw():
+    context = bpy.context
+    space = context.space_data
+    region_3d = context.region_data
+    if space is None or region_3d is None or space.shading.type not in SHADINGS:
+        return
+    view_settings = settings.find(context.screen, context.area)
+    if view_settings is None or not view_settings.enabled:
+        return
+    try:
+        key = context.region.as_pointer()
+        ao_pipeline = _pipelines.get(key)
+        if ao_pipeline is None:
+            ao_pipeline = _pipelines[key] = pipeline.AOPipeline()
+        draw_preview(ao_pipeline, region_3d.window_matrix, view_settings.params())
+    except Exception as error:  # never let the preview break the viewport
+        message = f"{type(error).__name__}: {error}"
+        if message not in _reported_errors:
+            _reported_errors.add(message)
+            print(f"HBAO viewport preview failed: {message}")
+
+
+def draw_preview(ao_pipeline, matrix, params):
+    """AO of the bound framebuffer's depth (drawn with projection `matrix`),
+    multiplied over it, using `ao_pipeline`'s targets. Also the unit that
+    scripts/bench_viewport_blender.py times."""
+    framebuffer = gpu.state.active_framebuffer_get()
+    x, y, width, height = gpu.state.viewport_get()
+    if width < 1 or height < 1:
+        return
+    depth = framebuffer.read_depth(x, y, width, height)
+    depth.dimensions = width * height
+    depth_buffer_texture = gpu.types.GPUTexture((width, height), format="R32F", data=depth)
+
+    frame = projection.frame_from_projection_matrix(matrix, width, height)
+
+    depth_test = gpu.state.depth_test_get()
+    depth_mask = gpu.state.depth_mask_get()
+    gpu.state.depth_test_set("NONE")
+    gpu.state.depth_mask_set(False)
+    try:
+        linear_depth = ao_pipeline.linearize(depth_buffer_texture,
+                                             projection.depth_coefficients(matrix))
+        ao_texture = ao_pipeline.ambient_occlusion(linear_depth, frame, params)
+        # Our passes bound their own framebuffers; draw back into the view.
+        gpu.state.viewport_set(x, y, width, height)
+        pipeline.composite(ao_texture, params["strength"], (x, y))
+    finally:
+        gpu.state.depth_mask_set(depth_mask)
+        gpu.state.depth_test_set(depth_test)
+
+
+def unregister():
+    global _handler
+    if _handler is not None:
+        bpy.types.SpaceView3D.draw_handler_remove(_handler, "WINDOW")
+        _handler = None
+    _pipelines.clear()
+    pipeline.release()

@@ -1,0 +1,118 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The preview's GPU passes: viewport depth -> planar depth -> AO -> blur ->
+composite. One AOPipeline per 3D view region keeps its targets and re-creates
+them when the region's size changes."""
+import math
+
+import gpu
+from gpu_extras.batch import batch_for_shader
+
+from . import parameters, shaders
+
+# Two triangles covering normalised device coordinates.
+_QUAD = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+_batches = {}
+
+
+def _draw_quad(name):
+    """Draws the full-screen quad with shader `name`, which must be bound."""
+    shader = shaders.get(name)
+    batch = _batches.get(name)
+    if batch is None:
+        batch = _batches[name] = batch_for_shader(shader, "TRIS", {"position": _QUAD})
+    batch.draw(shader)
+
+
+def release():
+    """Drop cached batches and shaders (on unregister)."""
+    _batches.clear()
+    shaders.release()
+
+
+class _Target:
+    """A single-channel float texture and the framebuffer that draws into it."""
+
+    def __init__(self, width, height):
+        self.texture = gpu.types.GPUTexture((width, height), format="R32F")
+        self.framebuffer = gpu.types.GPUFrameBuffer(color_slots=self.texture)
+
+
+class AOPipeline:
+    def __init__(self):
+        self.size = None
+        self._linear_depth = self._ao = self._blurred_rows = None
+
+    def _ensure_size(self, width, height):
+        if self.size == (width, height):
+            return
+        self._linear_depth = _Target(width, height)
+        self._ao = _Target(width, height)
+        self._blurred_rows = _Target(width, height)
+        self.size = (width, height)
+
+    def linearize(self, buffer_depth_texture, coefficients):
+        """Planar depth (background 0) from a [0, 1] depth-buffer texture;
+        coefficients from projection.depth_coefficients."""
+        self._ensure_size(buffer_depth_texture.width, buffer_depth_texture.height)
+        shader = shaders.get("linearize")
+        with self._linear_depth.framebuffer.bind():
+            shader.bind()
+            shader.uniform_sampler("buffer_depth", buffer_depth_texture)
+            shader.uniform_float("depth_coefficients", coefficients)
+            _draw_quad("linearize")
+        return self._linear_depth.texture
+
+    def ambient_occlusion(self, depth_texture, frame, params):
+        """Blurred AO (before strength) of a planar-depth texture, as an R32F
+        texture the size of `frame`. `params` as parameters.resolved returns."""
+        width, height = frame.width, frame.height
+        self._ensure_size(width, height)
+        shader = shaders.get("ao")
+        with self._ao.framebuffer.bind():
+            shader.bind()
+            shader.uniform_sampler("depth_texture", depth_texture)
+            shader.uniform_int("image_size", (width, height))
+            shader.uniform_float("pixel_size", (frame.pixel_size_x, frame.pixel_size_y))
+            shader.uniform_float("origin", (frame.origin_x, frame.origin_y))
+            shader.uniform_int("perspective", 1 if frame.perspective else 0)
+            shader.uniform_float("radius", params["radius"])
+            shader.uniform_float("angle_bias", math.radians(params["angle_bias_degrees"]))
+            shader.uniform_int("directions", params["directions"])
+            shader.uniform_int("steps", params["steps"])
+            shader.uniform_int("falloff", parameters.FALLOFF_VALUES[params["falloff"]])
+            shader.uniform_int("integration",
+                               parameters.INTEGRATION_VALUES[params["integration"]])
+            shader.uniform_float("background_depth", params["background_depth"])
+            _draw_quad("ao")
+        kernel_radius = parameters.blur_kernel_radius(params["blur_size"])
+        if kernel_radius < 1:
+            return self._ao.texture
+        shader = shaders.get("blur")
+        for source, target, step in ((self._ao, self._blurred_rows, (1, 0)),
+                                     (self._blurred_rows, self._ao, (0, 1))):
+            with target.framebuffer.bind():
+                shader.bind()
+                shader.uniform_sampler("depth_texture", depth_texture)
+                shader.uniform_sampler("ao_texture", source.texture)
+                shader.uniform_int("image_size", (width, height))
+                shader.uniform_int("blur_step", step)
+                shader.uniform_int("kernel_radius", kernel_radius)
+                shader.uniform_float("sharpness", params["blur_sharpness"])
+                shader.uniform_float("background_depth", params["background_depth"])
+                _draw_quad("blur")
+        return self._ao.texture
+
+
+def composite(ao_texture, strength, pixel_offset=(0, 0)):
+    """Multiplies the bound framebuffer by ao^strength (see COMPOSITE_FRAGMENT)."""
+    shader = shaders.get("composite")
+    previous_blend = gpu.state.blend_get()
+    gpu.state.blend_set("ALPHA_PREMULT")
+    try:
+        shader.bind()
+        shader.uniform_sampler("ao_texture", ao_texture)
+        shader.uniform_int("pixel_offset", pixel_offset)
+        shader.uniform_float("strength", strength)
+        _draw_quad("composite")
+    finally:
+        gpu.state.blend_set(previous_blend)

@@ -1,0 +1,106 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""How a pixel of the preview maps to camera space. Needs neither bpy nor gpu,
+so that plain pytest can check it.
+
+The shaders place pixel (i, j) (column i from the left, row j from the top, as in
+docs/algorithm.md) at
+
+    x = origin_x + (i + 0.5) * pixel_size_x
+    y = origin_y + (H - 1 - j + 0.5) * pixel_size_y
+
+per unit depth (perspective: P = (x * depth, y * depth, -depth)) or in scene
+units (orthographic: P = (x, y, -depth)). A ViewFrame holds those four numbers.
+The C library derives them from a Blender camera (frame_from_camera); the 3D
+viewport has no camera in free view, only its projection matrix
+(frame_from_projection_matrix). Both give the same frame for the same view, which
+tests/test_viewport_projection.py checks.
+"""
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class ViewFrame:
+    width: int
+    height: int
+    perspective: bool
+    pixel_size_x: float
+    pixel_size_y: float
+    origin_x: float
+    origin_y: float
+
+    @property
+    def pixel_aspect(self):
+        """ycor of docs/algorithm.md: a pixel's height over its width."""
+        return self.pixel_size_y / self.pixel_size_x
+
+
+def frame_from_camera(camera, width, height):
+    """The frame of docs/algorithm.md's camera model (Blender's
+    BKE_camera_params_compute_viewplane) for a camera dict as native.compute_ao takes."""
+    if width < 1 or height < 1:
+        raise ValueError(f"image size must be positive, not {width}x{height}")
+    camera = dict(camera or {})
+    projection = camera.get("type", "PERSP")
+    if projection not in ("PERSP", "ORTHO"):
+        raise ValueError(f"camera type must be PERSP or ORTHO, not {projection!r}")
+    aspect_x = float(camera.get("pixel_aspect_x", 1.0))
+    aspect_y = float(camera.get("pixel_aspect_y", 1.0))
+    ycor = aspect_y / aspect_x
+    requested_fit = camera.get("sensor_fit", "AUTO")
+    fit = requested_fit
+    if fit == "AUTO":
+        fit = "HORIZONTAL" if aspect_x * width >= aspect_y * height else "VERTICAL"
+    # AUTO spans the larger side with sensor_width, even when that side is vertical.
+    sensor_size = float(camera.get("sensor_height", 24.0)) if requested_fit == "VERTICAL" \
+        else float(camera.get("sensor_width", 36.0))
+    viewfac = width if fit == "HORIZONTAL" else ycor * height
+    if projection == "PERSP":
+        pixel_size = sensor_size / float(camera.get("lens", 50.0)) / viewfac
+    else:
+        pixel_size = float(camera.get("ortho_scale", 6.0)) / viewfac
+    shift_x = float(camera.get("shift_x", 0.0))
+    shift_y = float(camera.get("shift_y", 0.0))
+    return ViewFrame(
+        width=width, height=height, perspective=projection == "PERSP",
+        pixel_size_x=pixel_size, pixel_size_y=ycor * pixel_size,
+        origin_x=(-width / 2.0 + shift_x * viewfac) * pixel_size,
+        origin_y=(-ycor * height / 2.0 + shift_y * viewfac) * pixel_size)
+
+
+def frame_from_projection_matrix(matrix, width, height):
+    """The frame of an OpenGL projection matrix (Blender's RegionView3D.window_matrix;
+    `matrix[row][column]`) drawn into `width` x `height` pixels. Normalised device x
+    of pixel centre i is 2 (i + 0.5) / W - 1; with z = -depth, perspective clip
+    x = P00 x + P02 z over w = depth gives x / depth = (ndc_x + P02) / P00;
+    orthographic ndc_x = P00 x + P03 gives x = (ndc_x - P03) / P00."""
+    if width < 1 or height < 1:
+        raise ValueError(f"image size must be positive, not {width}x{height}")
+    p = [[float(matrix[r][c]) for c in range(4)] for r in range(4)]
+    perspective = is_perspective_matrix(p)
+    if perspective:
+        origin_x = (p[0][2] - 1.0) / p[0][0]
+        origin_y = (p[1][2] - 1.0) / p[1][1]
+    else:
+        origin_x = (-1.0 - p[0][3]) / p[0][0]
+        origin_y = (-1.0 - p[1][3]) / p[1][1]
+    return ViewFrame(
+        width=width, height=height, perspective=perspective,
+        pixel_size_x=2.0 / (width * p[0][0]), pixel_size_y=2.0 / (height * p[1][1]),
+        origin_x=origin_x, origin_y=origin_y)
+
+
+def is_perspective_matrix(matrix):
+    """A perspective projection puts -z into w (row 3 = 0 0 -1 0); an orthographic one
+    keeps w = 1."""
+    return abs(float(matrix[3][3])) < 0.5
+
+
+def depth_coefficients(matrix):
+    """(a, b, c, d) with planar depth = (a ndc + b) / (c ndc + d), ndc = 2 d_buffer - 1,
+    for the depth buffer of projection `matrix`. Perspective: ndc = (P22 z + P23) / -z
+    gives depth = P23 / (ndc + P22); orthographic: ndc = P22 z + P23 gives
+    depth = (P23 - ndc) / P22."""
+    p22, p23 = float(matrix[2][2]), float(matrix[2][3])
+    if is_perspective_matrix(matrix):
+        return (0.0, p23, 1.0, p22)
+    return (-1.0 / p22, p23 / p22, 0.0, 1.0)

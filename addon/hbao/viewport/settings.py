@@ -1,0 +1,195 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Per-3D-view preview settings, saved in the .blend.
+
+Where they live, and why: a 3D view (SpaceView3D) and its area are not ID
+blocks, so Python cannot add properties to them. The Screen that holds the
+area is an ID (one per workspace and window layout) and is saved with the file,
+so each Screen carries a collection `hbao_viewport_views` with one entry per 3D
+view that ever had the preview turned on, keyed by the area's position in
+`screen.areas`. Areas have no stable identifier across saves, and their
+positions shift when an area before them is joined away, so while Blender runs
+an entry follows its area by the area's memory address (which stays valid as
+long as the area exists), and the saved positions are refreshed just before
+every save. Per scene or per workspace settings would be simpler but are not per
+view: two 3D views side by side could not differ.
+"""
+import bpy
+from bpy.app.handlers import persistent
+from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty,
+                       IntProperty)
+
+from . import parameters
+
+COLLECTION_NAME = "hbao_viewport_views"
+
+FALLOFF_ITEMS = [
+    ("QUADRATIC", "Quadratic", "Occluders count less with distance: 1 - (d/radius)^2"),
+    ("NONE", "None", "Every occluder inside the radius counts fully"),
+]
+INTEGRATION_ITEMS = [
+    ("COSINE", "Cosine", "Cosine-weighted visibility, as Cycles' AO pass measures it"),
+    ("HBAO", "HBAO", "Bavoil & Sainz: the occluded fraction of the hemisphere"),
+]
+
+# (screen pointer, area pointer) -> entry name, for the areas seen this session.
+_entry_by_area = {}
+# Called with no arguments when a view's `enabled` changes (draw.sync_handler).
+enabled_change_callbacks = []
+
+
+def _enabled_changed(_self, _context):
+    for callback in enabled_change_callbacks:
+        callback()
+
+
+def _redraw(_self, context):
+    # The preview redraws with the view; a changed setting must redraw it now.
+    if context is not None and context.area is not None:
+        context.area.tag_redraw()
+
+
+_D = parameters.DEFAULTS
+
+
+class HBAOViewSettings(bpy.types.PropertyGroup):
+    """The preview settings of one 3D view (see the module's docstring)."""
+    area_index: IntProperty(
+        name="Area Index", default=-1,
+        description="Position of this view's area in its screen, refreshed on save")
+    enabled: BoolProperty(
+        name="HBAO Preview", default=False, update=_enabled_changed,
+        description="Multiply ambient occlusion over this 3D view (Solid and Material "
+                    "Preview shading)")
+    radius: FloatProperty(
+        name="Radius", default=_D["radius"], min=0.0, soft_max=10.0, unit="LENGTH",
+        update=_redraw, description="AO radius in scene units")
+    angle_bias_degrees: FloatProperty(
+        name="Angle Bias", default=_D["angle_bias_degrees"], min=0.0,
+        max=parameters.MAX_ANGLE_BIAS_DEGREES, update=_redraw,
+        description="Occluders less than this many degrees above the surface are "
+                    "ignored")
+    directions: IntProperty(
+        name="Directions", default=_D["directions"], min=1, max=parameters.MAX_DIRECTIONS,
+        update=_redraw, description="Directions searched around each pixel")
+    steps: IntProperty(
+        name="Steps", default=_D["steps"], min=1, max=parameters.MAX_STEPS,
+        update=_redraw, description="Samples per direction")
+    falloff: EnumProperty(name="Falloff", items=FALLOFF_ITEMS, default=_D["falloff"],
+                          update=_redraw)
+    integration: EnumProperty(name="Integration", items=INTEGRATION_ITEMS,
+                              default=_D["integration"], update=_redraw)
+    blur_size: IntProperty(
+        name="Blur Size", default=_D["blur_size"], min=0, max=parameters.MAX_BLUR_SIZE,
+        update=_redraw, description="Width in pixels of the depth-aware blur; 0 or 1 = none")
+    blur_sharpness: FloatProperty(
+        name="Blur Sharpness", default=_D["blur_sharpness"], min=0.0,
+        max=parameters.MAX_BLUR_SHARPNESS, soft_max=50.0, update=_redraw,
+        description="How strongly the blur stops at depth edges")
+    strength: FloatProperty(
+        name="Strength", default=_D["strength"], min=0.0, max=parameters.MAX_STRENGTH,
+        soft_max=4.0, update=_redraw, description="AO is raised to this power")
+
+    def params(self):
+        """These settings as the C library's parameters (native.compute_ao's dict)."""
+        return parameters.resolved({name: getattr(self, name) for name in parameters.DEFAULTS
+                                    if name != "background_depth"})
+
+
+def _views(screen):
+    return getattr(screen, COLLECTION_NAME)
+
+
+def _area_index(screen, area):
+    for index, candidate in enumerate(screen.areas):
+        if candidate == area:
+            return index
+    return -1
+
+
+def find(screen, area):
+    """The settings of the 3D view in `area`, or None if it has none yet. Reads
+    only, so panels and draw callbacks may call it."""
+    if screen is None or area is None:
+        return None
+    views = _views(screen)
+    key = (screen.as_pointer(), area.as_pointer())
+    name = _entry_by_area.get(key)
+    if name is not None:
+        entry = views.get(name)
+        if entry is not None:
+            return entry
+    index = _area_index(screen, area)
+    # Entries that follow another live area of this screen are taken; an entry
+    # whose area was closed is free again.
+    live = {candidate.as_pointer() for candidate in screen.areas}
+    claimed = {n for (s, a), n in _entry_by_area.items() if s == key[0] and a in live}
+    for entry in views:
+        if entry.area_index == index and entry.name not in claimed:
+            _entry_by_area[key] = entry.name
+            return entry
+    return None
+
+
+def ensure(screen, area):
+    """The settings of the 3D view in `area`, created if needed (writes the
+    Screen: call from operators, not from draw code)."""
+    entry = find(screen, area)
+    if entry is not None:
+        return entry
+    views = _views(screen)
+    existing = {entry.name for entry in views}
+    number = len(views) + 1
+    while f"View {number}" in existing:
+        number += 1
+    entry = views.add()
+    entry.name = f"View {number}"
+    entry.area_index = _area_index(screen, area)
+    _entry_by_area[(screen.as_pointer(), area.as_pointer())] = entry.name
+    return entry
+
+
+def any_enabled():
+    """Whether any 3D view of any screen has the preview on."""
+    return any(entry.enabled for screen in bpy.data.screens for entry in _views(screen))
+
+
+@persistent
+def _refresh_area_indices(*_args):
+    """Before a save: write each entry's current area position, so the file maps
+    entries to the right areas when it is opened again."""
+    for screen in bpy.data.screens:
+        views = _views(screen)
+        screen_pointer = screen.as_pointer()
+        for index, area in enumerate(screen.areas):
+            name = _entry_by_area.get((screen_pointer, area.as_pointer()))
+            entry = views.get(name) if name is not None else None
+            if entry is not None and entry.area_index != index:
+                entry.area_index = index
+
+
+@persistent
+def _forget_areas(*_args):
+    """After a load: areas are new objects; entries are found by position again."""
+    _entry_by_area.clear()
+
+
+CLASSES = (HBAOViewSettings,)
+
+
+def register():
+    for cls in CLASSES:
+        bpy.utils.register_class(cls)
+    setattr(bpy.types.Screen, COLLECTION_NAME, CollectionProperty(type=HBAOViewSettings))
+    bpy.app.handlers.save_pre.append(_refresh_area_indices)
+    bpy.app.handlers.load_pre.append(_forget_areas)
+
+
+def unregister():
+    for handlers, function in ((bpy.app.handlers.save_pre, _refresh_area_indices),
+                               (bpy.app.handlers.load_pre, _forget_areas)):
+        while function in handlers:
+            handlers.remove(function)
+    _entry_by_area.clear()
+    delattr(bpy.types.Screen, COLLECTION_NAME)
+    for cls in reversed(CLASSES):
+        bpy.utils.unregister_class(cls)

@@ -1,0 +1,61 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The preview's shaders, built with GPUShaderCreateInfo (Blender 3.4 and later;
+the only way from 5.0). Compiled once, on first use, and dropped on unregister."""
+import gpu
+
+from . import shader_sources
+
+_shaders = {}
+
+
+def _create_info(fragment_source, push_constants, samplers, defines=None):
+    info = gpu.types.GPUShaderCreateInfo()
+    for glsl_type, name in push_constants:
+        info.push_constant(glsl_type, name)
+    for slot, name in enumerate(samplers):
+        info.sampler(slot, "FLOAT_2D", name)
+    info.vertex_in(0, "VEC2", "position")
+    info.fragment_out(0, "VEC4", "frag_output")
+    info.vertex_source(shader_sources.FULL_SCREEN_VERTEX)
+    # Plain #define lines rather than GPUShaderCreateInfo.define, which 3.4 lacks.
+    define_lines = "".join(f"#define {name} {value}\n" for name, value in (defines or {}).items())
+    info.fragment_source(define_lines + fragment_source)
+    return info
+
+
+_DEFINITIONS = {
+    "linearize": lambda: _create_info(
+        shader_sources.LINEARIZE_FRAGMENT,
+        [("VEC4", "depth_coefficients")],
+        ["buffer_depth"]),
+    "ao": lambda: _create_info(
+        shader_sources.AO_FRAGMENT,
+        [("IVEC2", "image_size"), ("VEC2", "pixel_size"), ("VEC2", "origin"),
+         ("INT", "perspective"), ("FLOAT", "radius"), ("FLOAT", "angle_bias"),
+         ("INT", "directions"), ("INT", "steps"), ("INT", "falloff"),
+         ("INT", "integration"), ("FLOAT", "background_depth")],
+        ["depth_texture"],
+        shader_sources.AO_DEFINES),
+    "blur": lambda: _create_info(
+        shader_sources.BLUR_FRAGMENT,
+        [("IVEC2", "image_size"), ("IVEC2", "blur_step"), ("INT", "kernel_radius"),
+         ("FLOAT", "sharpness"), ("FLOAT", "background_depth")],
+        ["depth_texture", "ao_texture"]),
+    "composite": lambda: _create_info(
+        shader_sources.COMPOSITE_FRAGMENT,
+        [("IVEC2", "pixel_offset"), ("FLOAT", "strength")],
+        ["ao_texture"]),
+}
+
+
+def get(name):
+    """The compiled shader `name` (linearize, ao, blur, composite)."""
+    shader = _shaders.get(name)
+    if shader is None:
+        shader = gpu.shader.create_from_info(_DEFINITIONS[name]())
+        _shaders[name] = shader
+    return shader
+
+
+def release():
+    _shaders.clear()

@@ -1,0 +1,380 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Scenes built from scratch inside Blender, for renders, fixtures and demos.
+
+Importable inside Blender only:
+
+    sys.path.insert(0, scripts_dir)
+    import blender_scenes
+    scene = blender_scenes.build_demo_scene()
+
+Every builder empties the scene it is given (objects, not other scenes), so the
+repository holds no binary .blend file. Units are metres.
+"""
+import math
+
+import bpy
+from mathutils import Vector
+
+# Debian's Blender has no OpenImageDenoise; renders with denoising on fail.
+# Small sample counts keep test renders at a few seconds on 2 CPU cores.
+DEFAULT_SAMPLES = 16
+DEFAULT_RESOLUTION = (640, 360)
+DEFAULT_AO_DISTANCE = 1.0
+
+# Names of the collections the builders create; view layers exclude them by name.
+ROOM_COLLECTION = "Room"
+PROPS_COLLECTION = "Props"
+
+# Soft grey world: lights the scene a little from everywhere, so shadowed
+# parts still show their colour and the AO pass has something to darken.
+WORLD_COLOUR = (0.45, 0.5, 0.58, 1.0)
+WORLD_STRENGTH = 0.6
+
+ENGINES = ("CYCLES", "BLENDER_EEVEE")
+
+
+# --- helpers ----------------------------------------------------------------
+
+def _scene_or_current(scene):
+    return scene if scene is not None else bpy.context.scene
+
+
+def clear_scene(scene):
+    """Removes every object of `scene` and its child collections."""
+    for obj in list(scene.objects):
+        bpy.data.objects.remove(obj, do_unlink=True)
+    for collection in list(scene.collection.children):
+        scene.collection.children.unlink(collection)
+        if collection.users == 0:
+            bpy.data.collections.remove(collection)
+
+
+def _collection(scene, name):
+    collection = bpy.data.collections.new(name)
+    scene.collection.children.link(collection)
+    return collection
+
+
+def _material(name, colour, roughness=0.6):
+    material = bpy.data.materials.new(name)
+    material.use_nodes = True
+    bsdf = material.node_tree.nodes.get("Principled BSDF")
+    bsdf.inputs["Base Color"].default_value = (*colour, 1.0)
+    bsdf.inputs["Roughness"].default_value = roughness
+    material.diffuse_color = (*colour, 1.0)
+    return material
+
+
+def _link(obj, collection, material=None):
+    """Moves a freshly added object from wherever bpy.ops put it into `collection`."""
+    for owner in list(obj.users_collection):
+        owner.objects.unlink(obj)
+    collection.objects.link(obj)
+    if material is not None:
+        obj.data.materials.clear()
+        obj.data.materials.append(material)
+    return obj
+
+
+def _add(operator, collection, material, name, **kwargs):
+    operator(**kwargs)
+    obj = bpy.context.active_object
+    obj.name = name
+    return _link(obj, collection, material)
+
+
+def _smooth(obj):
+    for polygon in obj.data.polygons:
+        polygon.use_smooth = True
+
+
+def _box(collection, material, name, size, location, rotation=(0.0, 0.0, 0.0)):
+    """A box of `size` (x, y, z) metres whose centre is `location`."""
+    obj = _add(bpy.ops.mesh.primitive_cube_add, collection, material, name,
+               size=1.0, location=location, rotation=rotation)
+    obj.scale = size
+    return obj
+
+
+def _look_at(obj, target):
+    direction = Vector(target) - obj.location
+    obj.rotation_euler = direction.to_track_quat("-Z", "Y").to_euler()
+
+
+def _camera(scene, collection, location, target, lens=35.0, name="Camera"):
+    data = bpy.data.cameras.new(name)
+    data.lens = lens
+    data.sensor_fit = "AUTO"
+    camera = bpy.data.objects.new(name, data)
+    collection.objects.link(camera)
+    camera.location = location
+    _look_at(camera, target)
+    scene.camera = camera
+    return camera
+
+
+def _sun(collection, rotation_deg, strength=3.0, angle_deg=8.0):
+    data = bpy.data.lights.new("Sun", type="SUN")
+    data.energy = strength
+    # A sun a few degrees wide gives soft-edged shadows.
+    data.angle = math.radians(angle_deg)
+    sun = bpy.data.objects.new("Sun", data)
+    collection.objects.link(sun)
+    sun.rotation_euler = [math.radians(a) for a in rotation_deg]
+    return sun
+
+
+def _world(scene):
+    world = scene.world or bpy.data.worlds.new("World")
+    scene.world = world
+    world.use_nodes = True
+    background = world.node_tree.nodes.get("Background")
+    background.inputs["Color"].default_value = WORLD_COLOUR
+    background.inputs["Strength"].default_value = WORLD_STRENGTH
+    world.color = WORLD_COLOUR[:3]
+    return world
+
+
+def configure_render(scene, resolution=DEFAULT_RESOLUTION, engine="CYCLES",
+                     samples=DEFAULT_SAMPLES):
+    """Engine, resolution and sampling; denoising always off."""
+    if engine not in ENGINES:
+        raise ValueError(f"unknown engine {engine!r}: use one of {', '.join(ENGINES)}")
+    render = scene.render
+    render.engine = engine
+    render.resolution_x, render.resolution_y = resolution
+    render.resolution_percentage = 100
+    render.pixel_aspect_x = render.pixel_aspect_y = 1.0
+    render.film_transparent = False
+    scene.cycles.device = "CPU"
+    scene.cycles.samples = samples
+    scene.cycles.preview_samples = samples
+    scene.cycles.use_denoising = False
+    scene.cycles.use_preview_denoising = False
+    scene.cycles.use_adaptive_sampling = False
+    # Same seed each run: fixtures stay the same when re-rendered.
+    scene.cycles.seed = 0
+    scene.eevee.taa_render_samples = samples
+    return scene
+
+
+# --- passes -----------------------------------------------------------------
+
+def enable_passes(view_layer, depth=True, normal=True, ao=False):
+    """Turns on the render passes the HBAO tools read: Depth (Z), Normal, AO."""
+    view_layer.use_pass_combined = True
+    view_layer.use_pass_z = depth
+    view_layer.use_pass_normal = normal
+    view_layer.use_pass_ambient_occlusion = ao
+    return view_layer
+
+
+def configure_ao_reference(scene, distance=DEFAULT_AO_DISTANCE):
+    """Makes the AO pass of every view layer a reference with rays `distance` long.
+
+    Cycles traces the AO pass with world.light_settings.distance as ray length;
+    EEVEE uses scene.eevee.gtao_distance."""
+    if distance <= 0.0 or not math.isfinite(distance):
+        raise ValueError(f"AO distance must be a positive number of metres, got {distance}")
+    world = scene.world or _world(scene)
+    world.light_settings.distance = distance
+    scene.eevee.gtao_distance = distance
+    for view_layer in scene.view_layers:
+        view_layer.use_pass_ambient_occlusion = True
+    return scene
+
+
+# --- cameras ----------------------------------------------------------------
+
+def make_orthographic(scene, ortho_scale=None):
+    """Switches the scene camera to orthographic, keeping its view.
+
+    Without `ortho_scale`, the width seen at the camera's target distance is
+    kept, so the framing stays about the same."""
+    camera = scene.camera.data
+    if ortho_scale is None:
+        target_distance = scene.get("hbao_target_distance", 6.0)
+        ortho_scale = target_distance * camera.sensor_width / camera.lens
+    camera.type = "ORTHO"
+    camera.ortho_scale = ortho_scale
+    return scene
+
+
+def camera_description(scene):
+    """The scene camera as the JSON object the `hbao` CLI reads with --camera.
+
+    Keys are Blender's own property names; world_to_camera is row-major."""
+    camera_object = scene.camera
+    if camera_object is None:
+        raise ValueError(f"scene {scene.name!r} has no camera")
+    camera = camera_object.data
+    if camera.type not in ("PERSP", "ORTHO"):
+        raise ValueError(f"camera type {camera.type} is not supported (PERSP or ORTHO)")
+    world_to_camera = camera_object.matrix_world.inverted()
+    return {
+        "type": camera.type,
+        "lens": float(camera.lens),
+        "sensor_width": float(camera.sensor_width),
+        "sensor_height": float(camera.sensor_height),
+        "sensor_fit": camera.sensor_fit,
+        "shift_x": float(camera.shift_x),
+        "shift_y": float(camera.shift_y),
+        "ortho_scale": float(camera.ortho_scale),
+        "pixel_aspect_x": float(scene.render.pixel_aspect_x),
+        "pixel_aspect_y": float(scene.render.pixel_aspect_y),
+        "world_to_camera": [[float(v) for v in row] for row in world_to_camera],
+    }
+
+
+# --- scenes -----------------------------------------------------------------
+
+def _room(scene, floor_size=12.0, wall_height=4.0, wall_y=2.0):
+    """A floor at z = 0 and a back wall at y = wall_y: a concave corner."""
+    room = _collection(scene, ROOM_COLLECTION)
+    floor_material = _material("Floor", (0.72, 0.70, 0.66), roughness=0.8)
+    wall_material = _material("Wall", (0.78, 0.76, 0.72), roughness=0.9)
+    floor = _add(bpy.ops.mesh.primitive_plane_add, room, floor_material, "Floor",
+                 size=floor_size, location=(0.0, 0.0, 0.0))
+    wall = _add(bpy.ops.mesh.primitive_plane_add, room, wall_material, "Wall",
+                size=1.0, location=(0.0, wall_y, wall_height / 2.0),
+                rotation=(math.radians(90.0), 0.0, 0.0))
+    wall.scale = (floor_size, wall_height, 1.0)
+    return room
+
+
+def build_corner_scene(scene=None, resolution=(96, 64), engine="CYCLES",
+                       samples=DEFAULT_SAMPLES, with_props=True):
+    """A small test scene: floor, back wall, a cube in the corner and a sphere
+    on the floor, seen from the front and a little above."""
+    scene = _scene_or_current(scene)
+    clear_scene(scene)
+    _world(scene)
+    room = _room(scene, floor_size=8.0, wall_height=3.0, wall_y=1.0)
+    props = _collection(scene, PROPS_COLLECTION)
+    if with_props:
+        _box(props, _material("Cube", (0.75, 0.25, 0.2)), "Cube",
+             (0.8, 0.8, 0.8), (-0.6, 0.55, 0.4), rotation=(0.0, 0.0, math.radians(20.0)))
+        sphere = _add(bpy.ops.mesh.primitive_uv_sphere_add, props,
+                      _material("Sphere", (0.2, 0.4, 0.75)), "Sphere",
+                      radius=0.4, segments=32, ring_count=16, location=(0.6, -0.2, 0.4))
+        _smooth(sphere)
+    _camera(scene, room, location=(0.6, -4.2, 2.0), target=(0.0, 0.3, 0.4), lens=40.0)
+    scene["hbao_target_distance"] = (Vector((0.6, -4.2, 2.0)) - Vector((0.0, 0.3, 0.4))).length
+    _sun(room, rotation_deg=(50.0, 10.0, 35.0))
+    configure_render(scene, resolution, engine, samples)
+    for view_layer in scene.view_layers:
+        enable_passes(view_layer)
+    return scene
+
+
+def build_two_layer_scene(scene=None, resolution=(96, 64), engine="CYCLES",
+                          samples=DEFAULT_SAMPLES):
+    """The corner scene with two view layers, both with Depth and Normal:
+    "Front" sees the room and the props, "Back" only the room (props excluded),
+    so the same pixels hold different depths in the two layers."""
+    scene = build_corner_scene(scene, resolution, engine, samples)
+    front = scene.view_layers[0]
+    front.name = "Front"
+    back = scene.view_layers.get("Back") or scene.view_layers.new("Back")
+    enable_passes(front)
+    enable_passes(back)
+    back.layer_collection.children[PROPS_COLLECTION].exclude = True
+    return scene
+
+
+def build_demo_scene(scene=None, resolution=DEFAULT_RESOLUTION, engine="CYCLES",
+                     samples=DEFAULT_SAMPLES):
+    """Objects with creases and contacts that show ambient occlusion well:
+    a cube, a torus, steps, an open box, a cylinder leaning on the wall and
+    touching spheres, on a floor meeting a back wall, seen in a 3/4 view."""
+    scene = _scene_or_current(scene)
+    clear_scene(scene)
+    _world(scene)
+    room = _room(scene, floor_size=14.0, wall_height=4.0, wall_y=1.6)
+    props = _collection(scene, PROPS_COLLECTION)
+
+    # A cube resting on the floor, turned a little.
+    _box(props, _material("Cube", (0.80, 0.28, 0.22)), "Cube",
+         (0.9, 0.9, 0.9), (-1.9, 0.2, 0.45), rotation=(0.0, 0.0, math.radians(25.0)))
+
+    # Three steps against the wall: inner and outer edges at each riser.
+    steps_material = _material("Steps", (0.85, 0.78, 0.55))
+    step_depth, step_height, step_width = 0.35, 0.25, 1.2
+    for index in range(3):
+        depth = step_depth * (3 - index)
+        _box(props, steps_material, f"Step{index}",
+             (step_width, depth, step_height),
+             (-0.35, 1.6 - depth / 2.0, step_height * (index + 0.5)))
+
+    # A cylinder leaning against the wall: a contact line on the floor and
+    # one on the wall.
+    lean = math.radians(18.0)
+    cylinder_length, cylinder_radius = 2.2, 0.18
+    cylinder = _add(bpy.ops.mesh.primitive_cylinder_add, props,
+                    _material("Pillar", (0.30, 0.55, 0.80)), "Pillar",
+                    radius=cylinder_radius, depth=cylinder_length, vertices=48,
+                    location=(1.1,
+                              1.6 - cylinder_radius - math.sin(lean) * cylinder_length / 2.0,
+                              math.cos(lean) * cylinder_length / 2.0 + 0.05),
+                    rotation=(-lean, 0.0, 0.0))
+    _smooth(cylinder)
+
+    # An open box (no lid): inner corners along all four walls.
+    box_material = _material("OpenBox", (0.35, 0.70, 0.45))
+    box_centre = Vector((1.9, -0.4, 0.0))
+    box_size, wall_thickness, box_height = 1.0, 0.06, 0.5
+    half = box_size / 2.0
+    _box(props, box_material, "OpenBoxBottom", (box_size, box_size, wall_thickness),
+         box_centre + Vector((0.0, 0.0, wall_thickness / 2.0)))
+    for name, size, offset in (
+            ("OpenBoxLeft", (wall_thickness, box_size, box_height), (-half, 0.0)),
+            ("OpenBoxRight", (wall_thickness, box_size, box_height), (half, 0.0)),
+            ("OpenBoxBack", (box_size, wall_thickness, box_height), (0.0, half)),
+            ("OpenBoxFront", (box_size, wall_thickness, box_height), (0.0, -half))):
+        _box(props, box_material, name, size,
+             box_centre + Vector((offset[0], offset[1], box_height / 2.0)))
+    open_box = [o for o in props.objects if o.name.startswith("OpenBox")]
+    for obj in open_box:
+        obj.rotation_euler.z = math.radians(-15.0)
+        # Rotate the walls about the box centre, not their own.
+        relative = obj.location - box_centre
+        relative.rotate(obj.rotation_euler)
+        obj.location = box_centre + relative
+
+    # A torus lying on the floor.
+    torus_major, torus_minor = 0.45, 0.15
+    torus = _add(bpy.ops.mesh.primitive_torus_add, props,
+                 _material("Torus", (0.90, 0.60, 0.20)), "Torus",
+                 major_radius=torus_major, minor_radius=torus_minor,
+                 major_segments=64, minor_segments=24,
+                 location=(-0.6, -1.2, torus_minor))
+    _smooth(torus)
+
+    # Spheres touching each other and the floor.
+    sphere_material = _material("Spheres", (0.65, 0.35, 0.75))
+    radius = 0.3
+    for index, x in enumerate((0.35, 0.35 + 2.0 * radius)):
+        sphere = _add(bpy.ops.mesh.primitive_uv_sphere_add, props, sphere_material,
+                      f"Sphere{index}", radius=radius, segments=48, ring_count=24,
+                      location=(x, -1.5, radius))
+        _smooth(sphere)
+    top = _add(bpy.ops.mesh.primitive_uv_sphere_add, props, sphere_material, "SphereTop",
+               radius=radius, segments=48, ring_count=24,
+               location=(0.35 + radius, -1.5, radius + math.sqrt(3.0) * radius))
+    _smooth(top)
+
+    camera_location, target = (4.6, -6.2, 3.4), (0.0, 0.0, 0.5)
+    _camera(scene, room, location=camera_location, target=target, lens=32.0)
+    scene["hbao_target_distance"] = (Vector(camera_location) - Vector(target)).length
+    _sun(room, rotation_deg=(48.0, 0.0, 28.0), strength=3.5)
+    configure_render(scene, resolution, engine, samples)
+    for view_layer in scene.view_layers:
+        enable_passes(view_layer)
+    return scene
+
+
+SCENE_BUILDERS = {
+    "demo": build_demo_scene,
+    "corner": build_corner_scene,
+    "two_layers": build_two_layer_scene,
+}

@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-2.0-or-later
+# Builds libhbao if needed, copies the add-on (with lib/libhbao.so) into the
+# current user's Blender add-ons folder, enables it and saves the preferences.
+#   scripts/install_addon.sh            (BLENDER=/path/to/blender to choose one)
+set -euo pipefail
+REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+BUILD="${HBAO_BUILD_DIR:-$REPO/build}"
+BLENDER="${BLENDER:-blender}"
+
+if [ ! -f "$BUILD/libhbao.so" ]; then
+    cmake -S "$REPO" -B "$BUILD" -DCMAKE_BUILD_TYPE=Release
+    cmake --build "$BUILD" -j2 --target hbao
+fi
+
+# Blender's own idea of the user add-ons folder (honours BLENDER_USER_SCRIPTS).
+ADDONS_DIR="$("$BLENDER" -b --factory-startup --python-expr \
+    'import bpy; print("ADDONS_DIR=" + bpy.utils.user_resource("SCRIPTS", path="addons", create=True))' \
+    2>/dev/null | sed -n 's/^ADDONS_DIR=//p')"
+if [ -z "$ADDONS_DIR" ]; then
+    echo "install_addon.sh: could not ask $BLENDER for its add-ons folder" >&2
+    exit 1
+fi
+
+TARGET="$ADDONS_DIR/hbao"
+rm -rf "$TARGET"
+mkdir -p "$TARGET/lib"
+# Copy the package without caches; the viewport subpackage comes along.
+(cd "$REPO/addon/hbao" && find . -name '__pycache__' -prune -o -name 'lib' -prune -o \
+    -type f -print | while read -r file; do
+        mkdir -p "$TARGET/$(dirname "$file")"
+        cp "$file" "$TARGET/$file"
+    done)
+cp "$BUILD/libhbao.so" "$TARGET/lib/libhbao.so"
+
+"$BLENDER" -b --python-expr '
+import addon_utils, bpy, sys
+addon_utils.enable("hbao", default_set=True, persistent=True, handle_error=None)
+if "hbao" not in bpy.context.preferences.addons:
+    sys.exit("install_addon.sh: Blender could not enable the hbao add-on")
+bpy.ops.wm.save_userpref()
+print("HBAO add-on enabled and preferences saved")
+' --python-exit-code 1
+echo "Installed to $TARGET"

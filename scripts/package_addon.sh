@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-2.0-or-later
+# Makes dist/hbao-<version>.zip: the add-on folder hbao/ with lib/libhbao.so
+# inside, for Edit > Preferences > Add-ons > Install (3.x-4.1) or Install
+# from Disk (4.2+ extensions, via blender_manifest.toml).
+set -euo pipefail
+REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+BUILD="${HBAO_BUILD_DIR:-$REPO/build}"
+
+if [ ! -f "$BUILD/libhbao.so" ]; then
+    cmake -S "$REPO" -B "$BUILD" -DCMAKE_BUILD_TYPE=Release
+    cmake --build "$BUILD" -j2 --target hbao
+fi
+VERSION="$(sed -n 's/^version = "\(.*\)"/\1/p' "$REPO/addon/hbao/blender_manifest.toml")"
+STAGE="$(mktemp -d)"
+trap 'rm -rf "$STAGE"' EXIT
+mkdir -p "$STAGE/hbao/lib" "$REPO/dist"
+(cd "$REPO/addon/hbao" && find . -name '__pycache__' -prune -o -name 'lib' -prune -o \
+    -type f -print | while read -r file; do
+        mkdir -p "$STAGE/hbao/$(dirname "$file")"
+        cp "$file" "$STAGE/hbao/$file"
+    done)
+cp "$BUILD/libhbao.so" "$STAGE/hbao/lib/libhbao.so"
+ZIP="$REPO/dist/hbao-$VERSION.zip"
+rm -f "$ZIP"
+(cd "$STAGE" && python3 -c '
+import sys, zipfile, os
+with zipfile.ZipFile(sys.argv[1], "w", zipfile.ZIP_DEFLATED) as archive:
+    for root, _dirs, files in os.walk("hbao"):
+        for name in sorted(files):
+            archive.write(os.path.join(root, name))
+' "$ZIP")
+echo "$ZIP"

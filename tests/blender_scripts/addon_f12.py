@@ -1,0 +1,89 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Run in a real Blender window (xvfb) by tests/test_addon.py: an F12-style
+render in the render job thread (render.render('INVOKE_DEFAULT') from a
+timer), waits for render_complete, saves the Render Result and the node's AO
+(File Output), then quits.
+
+  blender --addons hbao --python addon_f12.py -- <out dir>
+"""
+import os
+import sys
+
+import bpy
+
+out_dir = sys.argv[sys.argv.index("--") + 1]
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(REPO, "scripts"))
+import blender_scenes  # noqa: E402
+
+# Wait for the render at most this long (Cycles at 96x64 takes a second).
+RENDER_TIMEOUT_S = 240.0
+
+scene = blender_scenes.build_corner_scene(bpy.context.scene, (96, 64), "CYCLES", 4)
+scene.use_nodes = True
+tree = scene.node_tree
+tree.nodes.clear()
+layers = tree.nodes.new("CompositorNodeRLayers")
+hbao = tree.nodes.new("CompositorNodeHBAO")
+hbao.name = "HBAO0"
+hbao.inputs["Radius"].default_value = 0.9
+composite = tree.nodes.new("CompositorNodeComposite")
+tree.links.new(layers.outputs["Image"], hbao.inputs["Image"])
+tree.links.new(layers.outputs["Depth"], hbao.inputs["Depth"])
+tree.links.new(layers.outputs["Normal"], hbao.inputs["Normal"])
+tree.links.new(hbao.outputs["Image"], composite.inputs["Image"])
+files = tree.nodes.new("CompositorNodeOutputFile")
+files.base_path = os.path.join(out_dir, "nodes_")
+files.format.file_format = "OPEN_EXR_MULTILAYER"
+files.format.color_depth = "32"
+files.format.exr_codec = "NONE"
+files.file_slots.clear()
+for name, socket in (("Render", layers.outputs["Image"]), ("HBAO0_AO", hbao.outputs["AO"]),
+                     ("HBAO0_Image", hbao.outputs["Image"])):
+    files.file_slots.new(name)
+    tree.links.new(socket, files.inputs[name])
+os.makedirs(out_dir, exist_ok=True)
+bpy.context.view_layer.update()  # matrix_world of the new camera
+with open(os.path.join(out_dir, "camera_0001.json"), "w") as stream:
+    import json
+    json.dump(blender_scenes.camera_description(scene), stream)
+
+state = {"done": False, "started": None}
+
+
+def on_complete(*_args):
+    state["done"] = True
+
+
+bpy.app.handlers.render_complete.append(on_complete)
+bpy.app.handlers.render_cancel.append(on_complete)
+
+
+def start_render():
+    print("F12: invoking render in the job thread")
+    bpy.ops.render.render("INVOKE_DEFAULT")
+    return None
+
+
+def wait_and_quit():
+    import time
+    if state["started"] is None:
+        state["started"] = time.monotonic()
+    if not state["done"]:
+        if time.monotonic() - state["started"] > RENDER_TIMEOUT_S:
+            print("F12: TIMEOUT")
+            bpy.ops.wm.quit_blender()
+        return 0.25
+    settings = scene.render.image_settings
+    settings.file_format = "OPEN_EXR_MULTILAYER"
+    settings.color_depth = "32"
+    settings.exr_codec = "NONE"
+    bpy.data.images["Render Result"].save_render(os.path.join(out_dir, "frame_0001.exr"),
+                                                 scene=scene)
+    print("F12: RENDERED")
+    bpy.ops.wm.quit_blender()
+    return None
+
+
+bpy.app.timers.register(start_render, first_interval=1.0)
+bpy.app.timers.register(wait_and_quit, first_interval=1.5)

@@ -1,0 +1,133 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Run inside Blender by tests/test_addon.py: builds a test scene with HBAO
+nodes as a JSON spec says, renders frames, and writes per frame
+
+  <out>/frame_<NNNN>.exr  the main render (multilayer: every pass + Composite)
+  <out>/nodes_<NNNN>.exr  a File Output of each node's Image and AO, the
+                          render's Image and, when asked, Cycles' AO pass
+
+both uncompressed 32-bit float. Usage:
+
+  blender -b --addons hbao --python addon_render.py -- '<json spec>' <out dir>
+
+Spec keys (all optional): resolution [w, h], samples, engine, scene
+("corner" | "two_layers"), frames [..], ao_reference (distance: adds Cycles'
+AO pass), orthographic, save_blend (path: saved after the setup, before
+rendering), nodes: [{name, layer, normal (bool), radius, keyframes [[frame,
+radius], ..], radius_from_value_node, falloff, integration, blur_size,
+angle_bias, directions, steps, mute}], disable_normal_pass, disable_depth_pass.
+"""
+import json
+import os
+import sys
+
+import bpy
+
+argv = sys.argv[sys.argv.index("--") + 1:]
+spec = json.loads(argv[0])
+out_dir = argv[1]
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(REPO, "scripts"))
+import blender_scenes  # noqa: E402
+
+os.makedirs(out_dir, exist_ok=True)
+resolution = tuple(spec.get("resolution", (96, 64)))
+samples = spec.get("samples", 4)
+engine = spec.get("engine", "CYCLES")
+scene = bpy.context.scene
+if spec.get("scene", "corner") == "two_layers":
+    blender_scenes.build_two_layer_scene(scene, resolution, engine, samples)
+else:
+    blender_scenes.build_corner_scene(scene, resolution, engine, samples)
+if spec.get("ao_reference"):
+    blender_scenes.configure_ao_reference(scene, spec["ao_reference"])
+if spec.get("orthographic"):
+    blender_scenes.make_orthographic(scene)
+
+scene.use_nodes = True
+tree = scene.node_tree
+for node in list(tree.nodes):
+    tree.nodes.remove(node)
+composite = tree.nodes.new("CompositorNodeComposite")
+composite.location = (900, 0)
+render_layers = {}
+for index, view_layer in enumerate(scene.view_layers):
+    node = tree.nodes.new("CompositorNodeRLayers")
+    node.layer = view_layer.name
+    node.location = (-400, -400 * index)
+    render_layers[view_layer.name] = node
+
+file_output = tree.nodes.new("CompositorNodeOutputFile")
+file_output.location = (900, -300)
+file_output.base_path = os.path.join(out_dir, "nodes_")
+file_output.format.file_format = "OPEN_EXR_MULTILAYER"
+file_output.format.color_depth = "32"
+file_output.format.exr_codec = "NONE"
+file_output.file_slots.clear()
+
+
+def output_slot(name, socket):
+    file_output.file_slots.new(name)
+    tree.links.new(socket, file_output.inputs[name])
+
+
+first_layer = scene.view_layers[0].name
+output_slot("Render", render_layers[first_layer].outputs["Image"])
+if spec.get("ao_reference"):
+    output_slot("CyclesAO", render_layers[first_layer].outputs["AO"])
+
+for index, node_spec in enumerate(spec.get("nodes", [{}])):
+    hbao = tree.nodes.new("CompositorNodeHBAO")
+    hbao.name = node_spec.get("name", f"HBAO{index}")
+    hbao.location = (300, -400 * index)
+    source = render_layers[node_spec.get("layer", first_layer)]
+    tree.links.new(source.outputs["Image"], hbao.inputs["Image"])
+    tree.links.new(source.outputs["Depth"], hbao.inputs["Depth"])
+    if node_spec.get("normal", True):
+        tree.links.new(source.outputs["Normal"], hbao.inputs["Normal"])
+    for key, socket_name in (("radius", "Radius"), ("angle_bias", "Angle Bias"),
+                             ("directions", "Directions"), ("steps", "Steps"),
+                             ("blur_size", "Blur Size"), ("strength", "Strength")):
+        if key in node_spec:
+            hbao.inputs[socket_name].default_value = node_spec[key]
+    for key in ("falloff", "integration", "half_resolution"):
+        if key in node_spec:
+            setattr(hbao, key, node_spec[key])
+    if node_spec.get("radius_from_value_node") is not None:
+        value = tree.nodes.new("CompositorNodeValue")
+        value.outputs[0].default_value = node_spec["radius_from_value_node"]
+        tree.links.new(value.outputs[0], hbao.inputs["Radius"])
+    for frame, radius in node_spec.get("keyframes", []):
+        hbao.inputs["Radius"].default_value = radius
+        hbao.inputs["Radius"].keyframe_insert("default_value", frame=frame)
+    hbao.mute = node_spec.get("mute", False)
+    if index == 0:
+        tree.links.new(hbao.outputs["Image"], composite.inputs["Image"])
+    output_slot(f"{hbao.name}_Image", hbao.outputs["Image"])
+    output_slot(f"{hbao.name}_AO", hbao.outputs["AO"])
+
+# Passes switched off after linking: the add-on must turn them back on.
+for view_layer in scene.view_layers:
+    if spec.get("disable_normal_pass"):
+        view_layer.use_pass_normal = False
+    if spec.get("disable_depth_pass"):
+        view_layer.use_pass_z = False
+
+scene.render.image_settings.file_format = "OPEN_EXR_MULTILAYER"
+scene.render.image_settings.color_depth = "32"
+scene.render.image_settings.exr_codec = "NONE"
+scene.render.use_file_extension = True
+
+if spec.get("save_blend"):
+    bpy.ops.wm.save_as_mainfile(filepath=spec["save_blend"])
+    print("SAVED", spec["save_blend"])
+    sys.exit(0)
+
+for frame in spec.get("frames", [1]):
+    scene.frame_set(frame)
+    with open(os.path.join(out_dir, f"camera_{frame:04d}.json"), "w") as stream:
+        json.dump(blender_scenes.camera_description(scene), stream)
+    # Still renders do not replace '#' in the path: name the frame here.
+    scene.render.filepath = os.path.join(out_dir, f"frame_{frame:04d}")
+    bpy.ops.render.render(write_still=True)
+print("RENDERED", json.dumps({"frames": spec.get("frames", [1])}))

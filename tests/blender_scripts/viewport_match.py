@@ -1,0 +1,189 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Runs inside Blender with a window (xvfb): renders the viewport preview's GLSL
+AO of synthetic depth images offscreen and the C library's AO of the same
+images, and writes the per-case differences as JSON for
+tests/test_viewport.py to judge.
+
+    blender --factory-startup --python viewport_match.py -- OUT.json
+"""
+import json
+import sys
+from pathlib import Path
+
+import bpy
+import gpu
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[2]
+if str(REPO / "addon") not in sys.path:
+    sys.path.insert(0, str(REPO / "addon"))
+
+from hbao import native  # noqa: E402
+from hbao.viewport import parameters, pipeline, projection  # noqa: E402
+
+WIDTH, HEIGHT = 200, 150
+PERSPECTIVE_CAMERA = {"type": "PERSP", "lens": 35.0, "sensor_width": 36.0,
+                      "sensor_height": 24.0, "sensor_fit": "AUTO"}
+# Pixels 1.5x as tall as wide, lens shifted: the non-square, off-centre frame.
+SHIFTED_CAMERA = dict(PERSPECTIVE_CAMERA, shift_x=0.1, shift_y=-0.05,
+                      pixel_aspect_x=1.0, pixel_aspect_y=1.5)
+ORTHOGRAPHIC_CAMERA = {"type": "ORTHO", "ortho_scale": 7.0, "sensor_fit": "AUTO"}
+
+# The compared cases: (name, camera, parameters). Blur off shows the horizon
+# search alone; blur on adds the two bilateral passes.
+CASES = [
+    ("persp_cosine", PERSPECTIVE_CAMERA, {"blur_size": 0}),
+    ("persp_hbao", PERSPECTIVE_CAMERA, {"integration": "HBAO", "blur_size": 0}),
+    ("persp_cosine_no_falloff", PERSPECTIVE_CAMERA,
+     {"falloff": "NONE", "blur_size": 0, "directions": 6, "steps": 10, "radius": 1.5}),
+    ("shifted_hbao_bias", SHIFTED_CAMERA,
+     {"integration": "HBAO", "blur_size": 0, "angle_bias_degrees": 25.0}),
+    ("ortho_cosine", ORTHOGRAPHIC_CAMERA, {"blur_size": 0, "radius": 0.8}),
+    ("persp_cosine_blur", PERSPECTIVE_CAMERA, {"blur_size": 9, "blur_sharpness": 8.0}),
+    ("persp_hbao_blur_strength", PERSPECTIVE_CAMERA,
+     {"integration": "HBAO", "blur_size": 15, "blur_sharpness": 4.0, "strength": 2.0}),
+    ("ortho_cosine_blur", ORTHOGRAPHIC_CAMERA, {"blur_size": 7, "radius": 0.8}),
+]
+
+
+def synthetic_depth(frame):
+    """Planar depth (top row first) of a floor, a back wall with sky above it, a box
+    and a sphere, ray cast per pixel centre through `frame` (camera space, camera
+    looking down -z)."""
+    columns = frame.origin_x + (np.arange(frame.width) + 0.5) * frame.pixel_size_x
+    rows = frame.origin_y + (frame.height - 1 - np.arange(frame.height) + 0.5) * frame.pixel_size_y
+    x, y = np.meshgrid(columns, rows)
+    if frame.perspective:
+        # Ray through the pixel: (x, y, -1) t, t = planar depth.
+        origin = np.stack([np.zeros_like(x), np.zeros_like(y), np.zeros_like(x)], -1)
+        direction = np.stack([x, y, -np.ones_like(x)], -1)
+    else:
+        # Rays along -z from the image plane.
+        origin = np.stack([x, y, np.zeros_like(x)], -1)
+        direction = np.stack([np.zeros_like(x), np.zeros_like(y), -np.ones_like(x)], -1)
+    depth = np.full(x.shape, np.inf)
+
+    def hit(t):
+        np.minimum(depth, np.where((t > 0) & np.isfinite(t), t, np.inf), out=depth)
+
+    with np.errstate(divide="ignore", invalid="ignore"):
+        if frame.perspective:
+            # Floor y = -1 up to z = -9, wall z = -9 up to y = 2.5, sky above.
+            t = (-1.0 - origin[..., 1]) / direction[..., 1]
+            point = origin + direction * t[..., None]
+            hit(np.where(point[..., 2] > -9.0, t, np.inf))
+            t = (-9.0 - origin[..., 2]) / direction[..., 2]
+            point = origin + direction * t[..., None]
+            hit(np.where(point[..., 1] < 2.5, t, np.inf))
+        else:
+            # A gentle ramp that the box and the sphere stand in: creases all round.
+            t = 4.4 + 0.15 * origin[..., 1]
+            hit(np.where(origin[..., 1] < 2.0, t, np.inf))
+        # Box (slab test).
+        low = np.array([-1.6, -1.0, -5.2])
+        high = np.array([-0.3, 0.1, -3.8])
+        t1 = (low - origin) / direction
+        t2 = (high - origin) / direction
+        t_near = np.nanmax(np.minimum(t1, t2), axis=-1)
+        t_far = np.nanmin(np.maximum(t1, t2), axis=-1)
+        hit(np.where(t_near <= t_far, t_near, np.inf))
+        # Sphere resting on the floor.
+        centre = np.array([1.0, -0.4, -4.5])
+        radius = 0.6
+        oc = origin - centre
+        a = np.sum(direction * direction, -1)
+        b = 2.0 * np.sum(oc * direction, -1)
+        c = np.sum(oc * oc, -1) - radius * radius
+        disc = b * b - 4 * a * c
+        hit(np.where(disc >= 0, (-b - np.sqrt(np.maximum(disc, 0))) / (2 * a), np.inf))
+    # Blender's Cycles background.
+    return np.where(np.isfinite(depth), depth, 1e10).astype(np.float32)
+
+
+def glsl_ao(depth, frame, params):
+    """The preview pipeline's AO of `depth` (top row first): uploaded bottom-up as
+    OpenGL wants, AO + blur passes, then the composite pass multiplying a white
+    float target, read back and flipped to top-down."""
+    height, width = depth.shape
+    upload = gpu.types.Buffer("FLOAT", width * height, depth[::-1].ravel().tolist())
+    depth_texture = gpu.types.GPUTexture((width, height), format="R32F", data=upload)
+    ao_pipeline = pipeline.AOPipeline()
+    ao_texture = ao_pipeline.ambient_occlusion(depth_texture, frame, params)
+    result = gpu.types.GPUTexture((width, height), format="RGBA32F")
+    framebuffer = gpu.types.GPUFrameBuffer(color_slots=result)
+    with framebuffer.bind():
+        framebuffer.clear(color=(1.0, 1.0, 1.0, 1.0))
+        pipeline.composite(ao_texture, params["strength"])
+        pixels = framebuffer.read_color(0, 0, width, height, 4, 0, "FLOAT")
+    pixels.dimensions = width * height * 4
+    return np.array(pixels, dtype=np.float32).reshape(height, width, 4)[::-1, :, 0]
+
+
+def blender_frame(camera, width, height):
+    """The viewport path's frame: from the projection matrix Blender itself builds
+    for `camera` (Object.calc_matrix_camera), as RegionView3D.window_matrix is in
+    camera view."""
+    scene = bpy.context.scene
+    scene.render.resolution_x, scene.render.resolution_y = width, height
+    scene.render.pixel_aspect_x = camera.get("pixel_aspect_x", 1.0)
+    scene.render.pixel_aspect_y = camera.get("pixel_aspect_y", 1.0)
+    data = bpy.data.cameras.new("MatchCamera")
+    data.type = camera["type"]
+    for name in ("lens", "sensor_width", "sensor_height", "sensor_fit", "shift_x", "shift_y",
+                 "ortho_scale"):
+        if name in camera:
+            setattr(data, name, camera[name])
+    data.clip_start, data.clip_end = 0.1, 100.0
+    obj = bpy.data.objects.new("MatchCamera", data)
+    scene.collection.objects.link(obj)
+    matrix = obj.calc_matrix_camera(bpy.context.evaluated_depsgraph_get(), x=width, y=height,
+                                    scale_x=scene.render.pixel_aspect_x,
+                                    scale_y=scene.render.pixel_aspect_y)
+    bpy.data.objects.remove(obj)
+    bpy.data.cameras.remove(data)
+    return projection.frame_from_projection_matrix(matrix, width, height)
+
+
+def frame_difference(a, b):
+    """Largest difference of the frames' numbers relative to the pixel size."""
+    return max(abs(getattr(a, n) - getattr(b, n)) / abs(a.pixel_size_x)
+               for n in ("pixel_size_x", "pixel_size_y", "origin_x", "origin_y"))
+
+
+def main():
+    out_path = Path(sys.argv[sys.argv.index("--") + 1])
+    report = {"renderer": gpu.platform.renderer_get(), "cases": {}}
+    for name, camera, overrides in CASES:
+        params = parameters.resolved(overrides)
+        frame = projection.frame_from_camera(camera, WIDTH, HEIGHT)
+        viewport_frame = blender_frame(camera, WIDTH, HEIGHT)
+        depth = synthetic_depth(frame)
+        reference = native.compute_ao(depth, None, camera=camera,
+                                      params=dict(params, threads=1))
+        preview = glsl_ao(depth, viewport_frame, params)
+        difference = np.abs(preview.astype(np.float64) - reference)
+        report["cases"][name] = {
+            "frame_vs_blender_matrix": frame_difference(frame, viewport_frame),
+            "frames_same_projection": frame.perspective == viewport_frame.perspective,
+            "mean_abs": float(difference.mean()),
+            "p99_abs": float(np.percentile(difference, 99)),
+            "max_abs": float(difference.max()),
+            "reference_mean_ao": float(reference.mean()),
+            "preview_mean_ao": float(preview.mean()),
+            "occluded_fraction": float((reference < 0.9).mean()),
+            "background_fraction": float((depth >= 1e9).mean()),
+            "finite": bool(np.isfinite(preview).all()),
+        }
+        print(name, report["cases"][name])
+        if "--save" in sys.argv:
+            np.save(out_path.with_name(f"{name}_ref.npy"), reference)
+            np.save(out_path.with_name(f"{name}_glsl.npy"), preview)
+            np.save(out_path.with_name(f"{name}_depth.npy"), depth)
+    out_path.write_text(json.dumps(report, indent=2))
+
+
+try:
+    main()
+finally:
+    # --python-exit-code makes an exception exit Blender with an error code.
+    bpy.ops.wm.quit_blender()

@@ -1,0 +1,124 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Runs inside Blender with a window (xvfb) and the hbao add-on enabled: builds
+the demo scene, looks through its camera in Solid shading in a 3D view filling
+the window, and takes three screenshots of that view: before the preview was
+ever on, with it on (kept as the artifact for people to look at), and after it
+was turned off again. Writes what it saw as JSON for tests/test_viewport.py.
+
+    blender --factory-startup --addons hbao --python viewport_toggle.py -- OUT.json SHOT.png
+"""
+import json
+import sys
+from pathlib import Path
+
+import bpy
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(REPO / "scripts"))
+
+import blender_scenes  # noqa: E402
+
+# The preview of a 3D view is switched by its operator, as the panel does.
+TOGGLE = "hbao.viewport_preview_toggle"
+# Strong enough to see in a screenshot; the demo scene's props are ~1 m.
+PREVIEW_SETTINGS = {"radius": 0.6, "strength": 1.5}
+
+
+def arguments():
+    args = sys.argv[sys.argv.index("--") + 1:]
+    return Path(args[0]), Path(args[1])
+
+
+def view_3d(window):
+    return max((a for a in window.screen.areas if a.type == "VIEW_3D"),
+               key=lambda a: a.width * a.height)
+
+
+def window_region(area):
+    return next(r for r in area.regions if r.type == "WINDOW")
+
+
+def override(window, area):
+    return bpy.context.temp_override(window=window, screen=window.screen, area=area,
+                                     region=window_region(area))
+
+
+def redraw(window, area):
+    with override(window, area):
+        bpy.ops.wm.redraw_timer(type="DRAW_WIN_SWAP", iterations=2)
+
+
+def screenshot(window, area, path):
+    redraw(window, area)
+    with override(window, area):
+        bpy.ops.screen.screenshot_area(filepath=str(path), check_existing=False)
+    image = bpy.data.images.load(str(path), check_existing=False)
+    pixels = np.empty(image.size[0] * image.size[1] * image.channels, dtype=np.float32)
+    image.pixels.foreach_get(pixels)
+    shape = (image.size[1], image.size[0], image.channels)
+    bpy.data.images.remove(image)
+    return pixels.reshape(shape)[..., :3]
+
+
+def run():
+    out_path, shot_path = arguments()
+    viewport = sys.modules["hbao.viewport"]
+    draw = sys.modules["hbao.viewport.draw"]
+    view_settings_module = sys.modules["hbao.viewport.settings"]
+
+    window = bpy.context.window_manager.windows[0]
+    blender_scenes.build_demo_scene(bpy.context.scene)
+    with override(window, view_3d(window)):
+        bpy.ops.screen.screen_full_area(use_hide_panels=True)
+    area = view_3d(window)
+    space = area.spaces.active
+    space.shading.type = "SOLID"
+    space.overlay.show_overlays = False
+    space.show_gizmo = False
+    space.region_3d.view_perspective = "CAMERA"
+    with override(window, area):
+        bpy.ops.view3d.view_center_camera()
+
+    report = {"registered_add_on_viewport": viewport.is_registered(),
+              "handler_before": draw.handler_registered()}
+    before = screenshot(window, area, shot_path.with_name("viewport_never_on.png"))
+
+    with override(window, area):
+        bpy.ops.hbao.viewport_preview_toggle()
+    view_settings = view_settings_module.find(window.screen, area)
+    for name, value in PREVIEW_SETTINGS.items():
+        setattr(view_settings, name, value)
+    report["handler_on"] = draw.handler_registered()
+    report["enabled_on"] = view_settings.enabled
+    on = screenshot(window, area, shot_path)
+
+    with override(window, area):
+        bpy.ops.hbao.viewport_preview_toggle()
+    report["handler_after"] = draw.handler_registered()
+    report["enabled_after"] = view_settings.enabled
+    after = screenshot(window, area, shot_path.with_name("viewport_turned_off.png"))
+
+    luminance_before = before.mean(axis=2)
+    luminance_on = on.mean(axis=2)
+    report.update({
+        "size": list(before.shape[:2]),
+        "off_vs_never_max_abs": float(np.abs(after - before).max()),
+        "on_vs_never_mean": float((luminance_before - luminance_on).mean()),
+        "darkened_fraction": float((luminance_on < luminance_before - 2.0 / 255.0).mean()),
+        "brightened_fraction": float((luminance_on > luminance_before + 1.0 / 255.0).mean()),
+        "preview_errors": sorted(draw._reported_errors),
+    })
+    print(json.dumps(report, indent=2))
+    out_path.write_text(json.dumps(report, indent=2))
+
+
+def step():
+    try:
+        run()
+    finally:
+        bpy.ops.wm.quit_blender()
+
+
+# The window exists only once the event loop runs: start from a timer.
+bpy.app.timers.register(step, first_interval=0.5)

@@ -1,0 +1,292 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The HBAO compositor node in real headless Blender renders (Cycles CPU,
+96x64, few samples): tests/blender_scripts/addon_render.py builds the scene,
+this file checks the EXRs Blender wrote."""
+import importlib.util
+import json
+import subprocess
+
+import numpy as np
+import pytest
+
+from conftest import BLENDER, REPO, blender_environment
+
+SCRIPTS = REPO / "tests" / "blender_scripts"
+RENDER_SCRIPT = SCRIPTS / "addon_render.py"
+# The node computes from the same 32-bit float passes, camera and parameters
+# as a direct library call on the written EXR, and the library is
+# deterministic: the results must be bit-identical.
+EXACT = 0.0
+# Image x AO is one float32 multiply in the compositor: one rounding, at most
+# half an ulp, 2^-24 relative; 1e-6 relative (+1e-7 absolute) bounds it.
+PRODUCT_RELATIVE_TOLERANCE = 1e-6
+PRODUCT_ABSOLUTE_TOLERANCE = 1e-7
+# Node AO (COSINE integration, no falloff, radius = AO distance) against
+# Cycles' ray-traced AO pass (64 samples) over the pixels that are not
+# background: the mean absolute difference is the screen-space method's
+# error plus Cycles' noise. Measured 0.040 on this scene; 0.08 leaves room
+# for Cycles version differences but fails for a wrong camera, radius or sign.
+CYCLES_MEAN_ERROR_TOLERANCE = 0.08
+# Background depth in Cycles' Depth pass.
+CYCLES_BACKGROUND_DEPTH = 1e9
+
+
+def _load(name, path):
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+exr = _load("hbao_exr_passes_under_test", REPO / "addon" / "hbao" / "exr_passes.py")
+
+
+@pytest.fixture(scope="module")
+def native(built_library):
+    import os
+    os.environ["HBAO_LIBRARY"] = str(built_library)
+    module = _load("hbao_native_for_addon_tests", REPO / "addon" / "hbao" / "native.py")
+    return module
+
+
+def render(run_blender, tmp_path, spec, env=None, name="render"):
+    out = tmp_path / name
+    completed = run_blender(RENDER_SCRIPT, json.dumps(spec), out, env=env)
+    assert "RENDERED" in completed.stdout or "SAVED" in completed.stdout, completed.stdout[-3000:]
+    return out, completed.stdout
+
+
+def frame_passes(out, frame, layer="ViewLayer"):
+    path = out / f"frame_{frame:04d}.exr"
+    channels = exr.read_channels(path, [f"{layer}.Depth.Z"] + [
+        f"{layer}.Normal.{axis}" for axis in "XYZ"])
+    depth = channels[f"{layer}.Depth.Z"]
+    normal = np.stack([channels[f"{layer}.Normal.{axis}"] for axis in "XYZ"], axis=-1)
+    return depth, normal
+
+
+def node_outputs(out, frame, node="HBAO0"):
+    path = out / f"nodes_{frame:04d}.exr"
+    names = exr.channel_names(path)
+    wanted = [n for n in names if n.startswith(f"{node}_") or n.startswith("Render.")
+              or n.startswith("CyclesAO.")]
+    channels = exr.read_channels(path, wanted)
+    result = {"ao": channels[f"{node}_AO.V"],
+              "image": np.stack([channels[f"{node}_Image.{c}"] for c in "RGB"], axis=-1),
+              "render": np.stack([channels[f"Render.{c}"] for c in "RGB"], axis=-1)}
+    if "CyclesAO.R" in channels:
+        result["cycles_ao"] = channels["CyclesAO.R"]
+    return result
+
+
+def camera(out, frame):
+    return json.loads((out / f"camera_{frame:04d}.json").read_text())
+
+
+def library_ao(native, out, frame, params, with_normal=True, layer="ViewLayer"):
+    depth, normal = frame_passes(out, frame, layer)
+    return native.compute_ao(depth, normal if with_normal else None, params=params,
+                             camera=camera(out, frame))
+
+
+def node_params(**overrides):
+    """The node's defaults (node.py) as library params, with overrides."""
+    params = {"radius": 1.0, "angle_bias_degrees": 10.0, "directions": 8, "steps": 6,
+              "blur_size": 9, "strength": 1.0, "falloff": "QUADRATIC",
+              "integration": "COSINE", "half_resolution": 0, "blur_sharpness": 8.0}
+    params.update(overrides)
+    return params
+
+
+def test_node_ao_matches_library_cycles_and_composites_image_times_ao(
+        run_blender, tmp_path, native):
+    spec = {"samples": 64, "ao_reference": 1.0,
+            "nodes": [{"radius": 1.0, "integration": "COSINE", "falloff": "NONE"}]}
+    out, log = render(run_blender, tmp_path, spec)
+    assert "pass hand-over" in log  # the timing line is printed
+    outputs = node_outputs(out, 1)
+    ao = outputs["ao"]
+    assert np.all(np.isfinite(ao)) and ao.min() >= 0.0 and ao.max() <= 1.0
+    assert ao.min() < 0.6  # the corner and the contacts are occluded
+
+    expected = library_ao(native, out, 1, node_params(integration="COSINE", falloff="NONE"))
+    assert np.abs(ao - expected).max() <= EXACT
+
+    product = outputs["render"] * ao[..., None]
+    tolerance = PRODUCT_RELATIVE_TOLERANCE * np.abs(product) + PRODUCT_ABSOLUTE_TOLERANCE
+    assert np.all(np.abs(outputs["image"] - product) <= tolerance)
+
+    depth, _ = frame_passes(out, 1)
+    foreground = depth < CYCLES_BACKGROUND_DEPTH
+    error = np.abs(ao - outputs["cycles_ao"])[foreground].mean()
+    print(f"node AO vs Cycles AO: mean absolute difference {error:.4f}")
+    assert error <= CYCLES_MEAN_ERROR_TOLERANCE
+
+
+def test_node_ao_matches_cli(run_blender, tmp_path, hbao_tool):
+    """The same passes through the command-line tool (its own OpenEXR reader)."""
+    spec = {"nodes": [{"radius": 0.7, "blur_size": 0}]}
+    out, _ = render(run_blender, tmp_path, spec)
+    cli_out = out / "cli_ao.exr"
+    completed = subprocess.run(
+        [str(hbao_tool), str(out / "frame_0001.exr"), "-o", str(cli_out), "--layer",
+         "ViewLayer", "--camera", str(out / "camera_0001.json"), "--radius", "0.7",
+         "--blur", "0", "--compression", "none"],
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    assert completed.returncode == 0, completed.stdout
+    cli_ao = exr.read_channels(cli_out, ["AO"])["AO"]
+    assert np.abs(node_outputs(out, 1)["ao"] - cli_ao).max() <= EXACT
+
+
+def test_keyframed_radius_and_value_node(run_blender, tmp_path, native):
+    spec = {"frames": [1, 2], "orthographic": True, "nodes": [
+        {"name": "Keyed", "keyframes": [[1, 0.15], [2, 1.2]], "blur_size": 0},
+        {"name": "Valued", "radius_from_value_node": 0.5, "normal": False}]}
+    out, _ = render(run_blender, tmp_path, spec)
+    ao = {frame: node_outputs(out, frame, "Keyed")["ao"] for frame in (1, 2)}
+    for frame, radius in ((1, 0.15), (2, 1.2)):
+        expected = library_ao(native, out, frame, node_params(radius=radius, blur_size=0))
+        assert np.abs(ao[frame] - expected).max() <= EXACT
+    # A larger radius sees more occluders: clearly darker on average.
+    assert ao[2].mean() < ao[1].mean() - 0.02
+    valued = node_outputs(out, 1, "Valued")["ao"]
+    expected = library_ao(native, out, 1, node_params(radius=0.5), with_normal=False)
+    assert np.abs(valued - expected).max() <= EXACT
+
+
+def test_two_nodes_two_view_layers_and_muted_node(run_blender, tmp_path, native):
+    spec = {"scene": "two_layers", "nodes": [
+        {"name": "Small", "layer": "Front", "radius": 0.2},
+        {"name": "Large", "layer": "Back", "radius": 1.5},
+        {"name": "Muted", "layer": "Front", "radius": 1.0, "mute": True}]}
+    out, log = render(run_blender, tmp_path, spec)
+    small = node_outputs(out, 1, "Small")["ao"]
+    large = node_outputs(out, 1, "Large")["ao"]
+    assert np.abs(small - large).max() > 0.1
+    assert np.abs(small - library_ao(native, out, 1, node_params(radius=0.2),
+                                     layer="Front")).max() <= EXACT
+    assert np.abs(large - library_ao(native, out, 1, node_params(radius=1.5),
+                                     layer="Back")).max() <= EXACT
+    assert "2 AO pass(es)" in log  # the muted node was not computed
+
+
+def test_missing_normal_pass_is_enabled_with_a_message(run_blender, tmp_path, native):
+    spec = {"disable_normal_pass": True, "nodes": [{"radius": 0.8}]}
+    out, log = render(run_blender, tmp_path, spec)
+    assert "enabled the Normal pass of view layer 'ViewLayer'" in log
+    expected = library_ao(native, out, 1, node_params(radius=0.8))
+    assert np.abs(node_outputs(out, 1)["ao"] - expected).max() <= EXACT
+
+
+def test_missing_library_renders_without_ao_and_says_so(run_blender, tmp_path):
+    missing = tmp_path / "no" / "libhbao.so"
+    out, log = render(run_blender, tmp_path, {"nodes": [{"radius": 1.0}]},
+                      env={"HBAO_LIBRARY": str(missing)})
+    assert f"libhbao not found at {missing}" in log
+    outputs = node_outputs(out, 1)
+    assert np.all(outputs["ao"] == 1.0)
+    assert np.abs(outputs["image"] - outputs["render"]).max() <= EXACT
+
+
+def test_saved_file_renders_from_the_command_line(run_blender, tmp_path, native):
+    blend = tmp_path / "hbao.blend"
+    out = tmp_path / "cli"
+    render(run_blender, tmp_path, {"save_blend": str(blend),
+                                   "nodes": [{"radius": 0.6, "integration": "HBAO"}]},
+           name="setup")
+    # The file was saved before any render: the command line must render the
+    # node as an artist's `blender -b file.blend -f 1` does, add-on enabled.
+    # The script saved its outputs under the setup folder; redirect them.
+    command = [BLENDER, "-b", str(blend), "--factory-startup", "-noaudio", "--addons", "hbao",
+               "-o", str(out / "frame_####"), "-f", "1"]
+    env = blender_environment(_user_scripts(tmp_path), None)
+    completed = subprocess.run(command, env=env, stdout=subprocess.PIPE,
+                               stderr=subprocess.STDOUT, text=True, timeout=600)
+    assert completed.returncode == 0, completed.stdout[-3000:]
+    assert "pass hand-over" in completed.stdout, completed.stdout[-3000:]
+    setup = tmp_path / "setup"
+    (setup / "camera_0001.json").write_text(json.dumps(_camera_of(blend, tmp_path)))
+    ao = node_outputs(setup, 1)["ao"]
+    depth, normal = frame_passes(out, 1)
+    expected = native.compute_ao(depth, normal, params=node_params(radius=0.6,
+                                                                    integration="HBAO"),
+                                 camera=camera(setup, 1))
+    assert np.abs(ao - expected).max() <= EXACT
+
+
+def _user_scripts(tmp_path):
+    root = tmp_path / "user_scripts"
+    (root / "addons").mkdir(parents=True, exist_ok=True)
+    link = root / "addons" / "hbao"
+    if not link.exists():
+        link.symlink_to(REPO / "addon" / "hbao")
+    return root
+
+
+def _camera_of(blend, tmp_path):
+    script = tmp_path / "camera.py"
+    script.write_text(
+        "import bpy, json, sys\n"
+        f"sys.path.insert(0, {str(REPO / 'scripts')!r})\n"
+        "import blender_scenes\n"
+        "print('CAMERA', json.dumps(blender_scenes.camera_description(bpy.context.scene)))\n")
+    completed = subprocess.run(
+        [BLENDER, "-b", str(blend), "--factory-startup", "--python", str(script)],
+        env=blender_environment(_user_scripts(tmp_path), None), stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT, text=True, timeout=600)
+    line = next(l for l in completed.stdout.splitlines() if l.startswith("CAMERA "))
+    return json.loads(line[len("CAMERA "):])
+
+
+def test_f12_render_in_the_ui_job_thread(run_blender, tmp_path, native):
+    out = tmp_path / "f12"
+    completed = run_blender(SCRIPTS / "addon_f12.py", out, ui=True)
+    assert "F12: RENDERED" in completed.stdout, completed.stdout[-3000:]
+    assert "pass hand-over" in completed.stdout
+    ao = node_outputs(out, 1)["ao"]
+    expected = library_ao(native, out, 1, node_params(radius=0.9))
+    assert ao.min() < 0.9
+    assert np.abs(ao - expected).max() <= EXACT
+
+
+def test_eevee_main_engine(run_blender, tmp_path, native):
+    spec = {"engine": "BLENDER_EEVEE", "resolution": [64, 48], "samples": 1,
+            "nodes": [{"radius": 0.8}]}
+    out, _ = render(run_blender, tmp_path, spec)
+    ao = node_outputs(out, 1)["ao"]
+    assert ao.min() < 0.9
+    expected = library_ao(native, out, 1, node_params(radius=0.8))
+    assert np.abs(ao - expected).max() <= EXACT
+
+
+def test_hook_lifecycle(run_blender, tmp_path):
+    completed = run_blender(SCRIPTS / "addon_lifecycle.py", tmp_path)
+    assert "LIFECYCLE OK" in completed.stdout, completed.stdout[-3000:]
+
+
+def test_package_and_install(tmp_path):
+    """package_addon.sh makes an installable zip; install_addon.sh installs
+    and enables the add-on for a (temporary) Blender user."""
+    import zipfile
+    completed = subprocess.run([str(REPO / "scripts" / "package_addon.sh")],
+                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    assert completed.returncode == 0, completed.stdout
+    archive = completed.stdout.strip().splitlines()[-1]
+    names = zipfile.ZipFile(archive).namelist()
+    for expected in ("hbao/__init__.py", "hbao/native.py", "hbao/blender_manifest.toml",
+                     "hbao/lib/libhbao.so"):
+        assert expected in names
+    env = blender_environment(tmp_path / "scripts")
+    env["BLENDER_USER_CONFIG"] = str(tmp_path / "config")  # never the real user's prefs
+    env.pop("HBAO_LIBRARY")  # the installed copy must find its own lib/libhbao.so
+    completed = subprocess.run([str(REPO / "scripts" / "install_addon.sh")], env=env,
+                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    assert completed.returncode == 0, completed.stdout
+    assert (tmp_path / "scripts" / "addons" / "hbao" / "lib" / "libhbao.so").exists()
+    assert (tmp_path / "config" / "userpref.blend").exists()
+    check = subprocess.run(
+        [BLENDER, "-b", "--python-expr",
+         "import bpy, hbao.native as n; print('ENABLED', 'hbao' in "
+         "bpy.context.preferences.addons, n.library_version())"],
+        env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    assert "ENABLED True 0." in check.stdout, check.stdout[-2000:]

@@ -1,0 +1,576 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The `hbao` command-line tool on real EXR files written by Blender.
+
+How outputs are checked without a hand-written EXR parser:
+- `hbao --info --json FILE` reports what OpenEXRCore decodes (layout, channel
+  types, per-channel min/max/mean and non-finite counts); it is the tool's own
+  reader, so it is used for layout and statistics only.
+- Per-pixel checks go through Blender, an independent EXR implementation: a
+  Blender process exports the input's Depth pass (compositor Image node ->
+  File Output as a single-layer EXR) and loads the AO, written a second time
+  with `--ao-channel Y` (a channel Blender shows as grayscale), and the PNG
+  preview, then saves the pixels as .npy files for numpy.
+"""
+import json
+import os
+import random
+import shutil
+import struct
+import subprocess
+import zlib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from conftest import FIXTURES, REPO
+
+# Every fixture that holds a Depth pass, with the view layer the tool picks.
+DEPTH_FIXTURES = ["cycles_float_zip", "cycles_half_piz", "cycles_float_none", "eevee_half",
+                  "ortho_float", "two_layers"]
+# Fixtures read back pixel by pixel through Blender (one per engine and projection,
+# plus the half-float twin of cycles_float_zip).
+READBACK_FIXTURES = ["cycles_float_zip", "cycles_half_piz", "eevee_half", "ortho_float"]
+
+TOOL_TIMEOUT_S = 120
+EXIT_RUNTIME = 1
+EXIT_USAGE = 2
+# libhbao's contract: depths at or beyond this (and <= 0, non-finite) are
+# background and get AO = 1 exactly (HBAO_DEFAULT_BACKGROUND_DEPTH in hbao.h).
+BACKGROUND_DEPTH = 65504.0
+# The PNG preview maps AO in [0, 1] to round(AO * 255): it differs from the
+# EXR's AO by at most half a step, plus float32 rounding in the scaling.
+PNG_TOLERANCE = 0.5 / 255.0 + 1e-6
+# Statistics of the same float32 pixels computed by the tool (double sums in
+# C) and by numpy (pairwise float64 sums) agree to double rounding; 1e-9
+# relative is far above that and far below any real difference.
+MEAN_RELATIVE_TOLERANCE = 1e-9
+# Two renders of one scene (float and half colour depth) hold the same Depth,
+# but their Normal passes may differ in the last float bits (Cycles sums
+# samples across threads; the Normal.X means differed by 1e-10 relative in
+# our renders). AO is continuous in the normal, so a few float32 ulps of AO
+# may differ; 1e-5 bounds that with margin and is 400x below one 8-bit step.
+# (Measured: identical AO, difference 0.)
+HALF_FLOAT_AO_TOLERANCE = 1e-5
+# How many mutated files the fuzz test feeds the tool (the issue asks for 200).
+FUZZ_CASES = 200
+
+
+# --- helpers -----------------------------------------------------------------
+
+def fixture_path(name):
+    path = FIXTURES / f"{name}.exr"
+    if not path.is_file():
+        pytest.fail(f"{path} missing: see tests/fixtures/README.md to render it")
+    return path
+
+
+def camera_path(name):
+    path = FIXTURES / f"{name}.camera.json"
+    if not path.is_file():
+        pytest.fail(f"{path} missing: see tests/fixtures/README.md to render it")
+    return path
+
+
+def run_tool(tool, *arguments, env=None):
+    return subprocess.run([str(tool)] + [str(a) for a in arguments], stdout=subprocess.PIPE,
+                          stderr=subprocess.PIPE, text=True, errors="replace",
+                          timeout=TOOL_TIMEOUT_S, env=env)
+
+
+def run_ok(tool, *arguments):
+    completed = run_tool(tool, *arguments)
+    assert completed.returncode == 0, completed.stderr
+    return completed
+
+
+def info(tool, path):
+    completed = run_ok(tool, "--info", "--json", path)
+    return json.loads(completed.stdout)
+
+
+def channels_by_name(description):
+    return {channel["name"]: channel for channel in description["channels"]}
+
+
+def compute_ao(tool, name, output, *extra):
+    """Runs the tool on fixture `name` with its camera; returns the CompletedProcess."""
+    return run_ok(tool, fixture_path(name), "-o", output, "--camera", camera_path(name), *extra)
+
+
+def assert_clean_error(completed, status, *fragments):
+    assert completed.returncode == status, (completed.returncode, completed.stderr)
+    assert "hbao: error: " in completed.stderr
+    for fragment in fragments:
+        assert fragment in completed.stderr, completed.stderr
+
+
+def leftover_temporary_files(folder):
+    return [p.name for p in Path(folder).iterdir() if ".hbao-tmp-" in p.name]
+
+
+def png_header(path):
+    """(width, height, bit depth, colour type) from the PNG signature and IHDR chunk."""
+    data = Path(path).read_bytes()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n"
+    length, chunk_type = struct.unpack(">I4s", data[8:16])
+    assert chunk_type == b"IHDR" and length == 13
+    width, height, bit_depth, colour_type = struct.unpack(">IIBB", data[16:26])
+    assert struct.unpack(">I", data[29:33])[0] == zlib.crc32(data[12:29])
+    return width, height, bit_depth, colour_type
+
+
+# --- Blender as an independent reader ----------------------------------------
+
+READBACK_SCRIPT = r'''
+import json
+import os
+import sys
+
+import bpy
+import numpy as np
+
+job = json.load(open(sys.argv[sys.argv.index("--") + 1]))
+scene = bpy.context.scene
+
+
+def top_first(image, channel=0):
+    width, height = image.size
+    pixels = np.array(image.pixels[:], dtype=np.float32).reshape(height, width, -1)
+    return np.ascontiguousarray(pixels[::-1, :, channel])
+
+
+for item in job["depth"]:
+    # The multilayer file's Depth pass through the compositor into a plain EXR.
+    scene.render.resolution_x, scene.render.resolution_y = item["size"]
+    scene.render.resolution_percentage = 100
+    scene.use_nodes = True
+    tree = scene.node_tree
+    for node in list(tree.nodes):
+        tree.nodes.remove(node)
+    source = tree.nodes.new("CompositorNodeImage")
+    source.image = bpy.data.images.load(item["exr"])
+    source.layer = item["layer"]
+    sink = tree.nodes.new("CompositorNodeOutputFile")
+    sink.base_path = item["folder"]
+    sink.format.file_format = "OPEN_EXR"
+    sink.format.color_depth = "32"
+    sink.format.color_mode = "RGB"
+    sink.file_slots[0].path = "depth_"
+    tree.links.new(source.outputs["Depth"], sink.inputs[0])
+    composite = tree.nodes.new("CompositorNodeComposite")
+    tree.links.new(source.outputs["Depth"], composite.inputs[0])
+    scene.render.filepath = os.path.join(item["folder"], "composite_")
+    bpy.ops.render.render(write_still=False)
+    written = os.path.join(item["folder"], "depth_%04d.exr" % scene.frame_current)
+    np.save(item["npy"], top_first(bpy.data.images.load(written)))
+
+for item in job["images"]:
+    np.save(item["npy"], top_first(bpy.data.images.load(item["path"])))
+'''
+
+
+@pytest.fixture(scope="module")
+def readback(hbao_tool, run_blender, tmp_path_factory):
+    """Per fixture of READBACK_FIXTURES: depth (from the input, via Blender),
+    ao (the tool's EXR, via Blender), preview (the tool's PNG, via Blender)
+    and the tool's --info of the same AO written with its default name."""
+    folder = tmp_path_factory.mktemp("readback")
+    job = {"depth": [], "images": []}
+    tool_info = {}
+    for name in READBACK_FIXTURES:
+        description = info(hbao_tool, fixture_path(name))
+        layer = description["layers"][0]
+        compute_ao(hbao_tool, name, folder / f"{name}_ao.exr")
+        compute_ao(hbao_tool, name, folder / f"{name}_y.exr", "--ao-channel", "Y",
+                   "--preview", folder / f"{name}.png")
+        tool_info[name] = info(hbao_tool, folder / f"{name}_ao.exr")
+        (folder / name).mkdir()
+        job["depth"].append({"exr": str(fixture_path(name)), "layer": layer,
+                             "size": [description["width"], description["height"]],
+                             "folder": str(folder / name),
+                             "npy": str(folder / f"{name}_depth.npy")})
+        job["images"].append({"path": str(folder / f"{name}_y.exr"),
+                              "npy": str(folder / f"{name}_ao.npy")})
+        job["images"].append({"path": str(folder / f"{name}.png"),
+                              "npy": str(folder / f"{name}_png.npy")})
+    (folder / "job.json").write_text(json.dumps(job))
+    (folder / "readback.py").write_text(READBACK_SCRIPT)
+    run_blender(folder / "readback.py", folder / "job.json", addon=False)
+    return {name: {"depth": np.load(folder / f"{name}_depth.npy"),
+                   "ao": np.load(folder / f"{name}_ao.npy"),
+                   "preview": np.load(folder / f"{name}_png.npy"),
+                   "info": tool_info[name],
+                   "png_path": folder / f"{name}.png"}
+            for name in READBACK_FIXTURES}
+
+
+# --- reading Blender's files -------------------------------------------------
+
+@pytest.mark.parametrize("name", DEPTH_FIXTURES)
+def test_each_fixture_gives_an_ao_channel_in_unit_range(hbao_tool, tmp_path, name):
+    output = tmp_path / "ao.exr"
+    compute_ao(hbao_tool, name, output)
+    source, result = info(hbao_tool, fixture_path(name)), info(hbao_tool, output)
+    assert [c["name"] for c in result["channels"]] == ["AO"]
+    ao = result["channels"][0]
+    assert ao["type"] == "float"
+    assert ao["nonfinite"] == 0
+    assert ao["finite"] == source["width"] * source["height"]
+    assert 0.0 <= ao["min"] and ao["max"] <= 1.0
+    # Every fixture shows objects in contact with a floor and walls: some
+    # pixel must be occluded, and the sky (or the far wall) must not be.
+    assert ao["min"] < 0.9 and ao["max"] == 1.0
+    for key in ("width", "height", "data_window", "display_window", "pixel_aspect_ratio"):
+        assert result[key] == source[key]
+    assert result["compression"] == "zip"
+
+
+@pytest.mark.parametrize("name", READBACK_FIXTURES)
+def test_background_is_one_and_blender_reads_the_same_ao(readback, name):
+    depth, ao = readback[name]["depth"], readback[name]["ao"]
+    assert depth.shape == ao.shape
+    assert np.all(np.isfinite(ao)) and ao.min() >= 0.0 and ao.max() <= 1.0
+    background = ~np.isfinite(depth) | (depth <= 0.0) | (depth >= BACKGROUND_DEPTH)
+    # Each scene has sky above the far wall or around the props.
+    assert background.sum() > 0 and (~background).sum() > 0
+    # Exact: the library gives background exactly 1, and both files store float32.
+    assert np.all(ao[background] == 1.0)
+    # The tool's own reader and Blender agree on the AO it wrote.
+    stats = channels_by_name(readback[name]["info"])["AO"]
+    # cJSON prints 15 significant digits: enough to recover any float32 exactly.
+    assert np.float32(stats["min"]) == ao.min() and np.float32(stats["max"]) == ao.max()
+    assert stats["mean"] == pytest.approx(float(ao.astype(np.float64).mean()),
+                                          rel=MEAN_RELATIVE_TOLERANCE)
+
+
+def test_rows_are_not_flipped(readback):
+    """Background pixels line up with the input's background, row by row: a
+    flipped or shifted image would put AO < 1 on sky pixels."""
+    depth, ao = readback["cycles_float_zip"]["depth"], readback["cycles_float_zip"]["ao"]
+    background = depth >= BACKGROUND_DEPTH
+    rows_with_sky = np.flatnonzero(background.any(axis=1))
+    # The demo scene's sky is at the top, above the back wall.
+    assert rows_with_sky.size > 0 and rows_with_sky[0] == 0
+    assert np.all(ao[background] == 1.0)
+    assert ao[~background].min() < 1.0
+
+
+def test_half_float_input_gives_the_same_ao_as_float(hbao_tool, readback):
+    """cycles_half_piz is the scene of cycles_float_zip saved with half colour
+    depth and PIZ. Blender keeps Depth and Normal as 32-bit float even then
+    (checked below), so the AO may differ only through the two renders' own
+    float noise."""
+    half = channels_by_name(info(hbao_tool, fixture_path("cycles_half_piz")))
+    full = channels_by_name(info(hbao_tool, fixture_path("cycles_float_zip")))
+    assert {c["type"] for n, c in half.items() if ".Combined." in n} == {"half"}
+    for name in ("ViewLayer.Depth.Z", "ViewLayer.Normal.X", "ViewLayer.Normal.Y",
+                 "ViewLayer.Normal.Z"):
+        assert half[name]["type"] == full[name]["type"] == "float"
+    assert half["ViewLayer.Depth.Z"] == full["ViewLayer.Depth.Z"]
+    difference = np.abs(readback["cycles_half_piz"]["ao"] - readback["cycles_float_zip"]["ao"])
+    assert difference.max() <= HALF_FLOAT_AO_TOLERANCE
+
+
+def test_preview_png_matches_the_ao(readback):
+    for name in READBACK_FIXTURES:
+        ao, preview = readback[name]["ao"], readback[name]["preview"]
+        height, width = ao.shape
+        assert png_header(readback[name]["png_path"]) == (width, height, 8, 0)
+        assert preview.shape == ao.shape
+        assert np.abs(preview - ao).max() <= PNG_TOLERANCE
+
+
+def test_keep_input_copies_every_channel_with_its_type(hbao_tool, tmp_path):
+    for name in ("cycles_half_piz", "eevee_half", "cycles_float_zip", "cycles_float_none"):
+        output = tmp_path / f"{name}.exr"
+        compute_ao(hbao_tool, name, output, "--keep-input")
+        source = channels_by_name(info(hbao_tool, fixture_path(name)))
+        result = channels_by_name(info(hbao_tool, output))
+        assert set(result) == set(source) | {"AO"}
+        for channel, stats in source.items():
+            # Same type, same decoded values: the copy is lossless.
+            assert result[channel] == stats, channel
+        assert result["AO"]["type"] == "float"
+
+
+def test_keep_input_output_is_valid_for_the_reference_openexr(hbao_tool, tmp_path):
+    """exrheader (OpenEXR's C++ library) accepts the file and sees its channels."""
+    exrheader = shutil.which("exrheader")
+    if exrheader is None:
+        pytest.fail("exrheader missing: apt-get install openexr")
+    output = tmp_path / "kept.exr"
+    compute_ao(hbao_tool, "cycles_half_piz", output, "--keep-input", "--compression", "piz")
+    header = subprocess.run([exrheader, str(output)], stdout=subprocess.PIPE, text=True,
+                            check=True, timeout=TOOL_TIMEOUT_S).stdout
+    assert "AO, 32-bit floating-point" in header
+    assert "ViewLayer.Combined.R, 16-bit floating-point" in header
+    assert "compression (type compression): piz" in header
+    assert "BlenderMultiChannel" in header
+
+
+def test_layer_selection(hbao_tool, tmp_path):
+    layers = info(hbao_tool, fixture_path("two_layers"))["layers"]
+    assert layers == ["Back", "Front"]
+    means = {}
+    for layer in layers:
+        output = tmp_path / f"{layer}.exr"
+        compute_ao(hbao_tool, "two_layers", output, "--layer", layer)
+        means[layer] = channels_by_name(info(hbao_tool, output))["AO"]["mean"]
+    # "Front" holds props that "Back" excludes: more occlusion in front.
+    assert means["Front"] < means["Back"]
+    # Without --layer: the first layer in channel-name order.
+    compute_ao(hbao_tool, "two_layers", tmp_path / "default.exr")
+    assert channels_by_name(info(hbao_tool, tmp_path / "default.exr"))["AO"]["mean"] == \
+        means["Back"]
+    missing = run_tool(hbao_tool, fixture_path("two_layers"), "-o", tmp_path / "x.exr",
+                       "--layer", "Nope")
+    assert_clean_error(missing, EXIT_RUNTIME, "Nope", '"Back"', '"Front"')
+    assert not (tmp_path / "x.exr").exists()
+
+
+def test_missing_depth_pass_is_an_error(hbao_tool, tmp_path):
+    output = tmp_path / "ao.exr"
+    completed = run_tool(hbao_tool, fixture_path("no_depth"), "-o", output)
+    assert_clean_error(completed, EXIT_RUNTIME, "no Depth pass")
+    assert not output.exists() and leftover_temporary_files(tmp_path) == []
+
+
+# --- camera ------------------------------------------------------------------
+
+def test_camera_flags_override_the_file(hbao_tool, tmp_path):
+    name = "cycles_float_zip"
+    compute_ao(hbao_tool, name, tmp_path / "file.exr")
+    camera = json.loads(camera_path(name).read_text())
+    compute_ao(hbao_tool, name, tmp_path / "longer.exr", "--lens", str(camera["lens"] * 4))
+    matrix = ",".join(str(v) for row in camera["world_to_camera"] for v in row)
+    compute_ao(hbao_tool, name, tmp_path / "same.exr", "--lens", str(camera["lens"]),
+               "--world-to-camera", matrix)
+    stats = {key: channels_by_name(info(hbao_tool, tmp_path / f"{key}.exr"))["AO"]
+             for key in ("file", "longer", "same")}
+    # Restating the file's own values changes nothing; a 4x longer lens makes
+    # the same radius cover 4x more pixels, which changes the AO.
+    assert stats["same"] == stats["file"]
+    assert stats["longer"]["mean"] != stats["file"]["mean"]
+
+
+def test_normals_without_a_matrix_warn(hbao_tool, tmp_path):
+    source = fixture_path("cycles_float_zip")
+    warned = run_ok(hbao_tool, source, "-o", tmp_path / "a.exr")
+    assert "hbao: warning: " in warned.stderr and "identity" in warned.stderr
+    for extra in (["--no-normals"], ["--camera", camera_path("cycles_float_zip")]):
+        quiet = run_ok(hbao_tool, source, "-o", tmp_path / "b.exr", *extra)
+        assert quiet.stderr == ""
+
+
+@pytest.mark.parametrize("content, fragment", [
+    ("{", "not valid JSON"),
+    ('{"type": "PANO"}', '"type"'),
+    ('{"lens": -1}', '"lens"'),
+    ('{"world_to_camera": [[1, 0, 0, 0]]}', "world_to_camera"),
+    ('{"sensor_fit": 3}', "sensor_fit"),
+])
+def test_bad_camera_file_is_an_error(hbao_tool, tmp_path, content, fragment):
+    bad = tmp_path / "camera.json"
+    bad.write_text(content)
+    completed = run_tool(hbao_tool, fixture_path("cycles_float_zip"), "-o", tmp_path / "o.exr",
+                         "--camera", bad)
+    assert_clean_error(completed, EXIT_RUNTIME, fragment)
+
+
+# --- bad input files ---------------------------------------------------------
+
+def test_corrupt_truncated_empty_and_missing_inputs(hbao_tool, tmp_path):
+    data = fixture_path("cycles_float_zip").read_bytes()
+    rng = random.Random(1)
+    cases = {f"truncated_{n}.exr": data[:n] for n in (4, 100, 400, len(data) // 2, len(data) - 1)}
+    cases["garbage.exr"] = bytes(rng.randrange(256) for _ in range(4096))
+    cases["empty.exr"] = b""
+    cases["text.exr"] = b"not an exr file\n"
+    for file_name, content in cases.items():
+        (tmp_path / file_name).write_bytes(content)
+    cases["missing.exr"] = None
+    for file_name in cases:
+        output = tmp_path / f"out_{file_name}"
+        for arguments in ([tmp_path / file_name, "-o", output], ["--info", tmp_path / file_name]):
+            completed = run_tool(hbao_tool, *arguments)
+            assert_clean_error(completed, EXIT_RUNTIME, str(tmp_path / file_name))
+        assert not output.exists()
+    assert leftover_temporary_files(tmp_path) == []
+
+
+def test_fuzzed_inputs_never_crash(hbao_tool, tmp_path):
+    """Random truncations and byte changes: always exit 0 or 1, never a signal
+    or a sanitizer report. Uses the AddressSanitizer build when it exists
+    (cmake -S . -B build-sanitize -DHBAO_SANITIZE=ON), else the normal one;
+    scripts/fuzz_cli.sh runs longer campaigns."""
+    sanitized = REPO / "build-sanitize" / "hbao"
+    tool = sanitized if sanitized.exists() else hbao_tool
+    env = dict(os.environ, ASAN_OPTIONS="allocator_may_return_null=1:detect_leaks=1",
+               UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1")
+    data = fixture_path("cycles_half_piz").read_bytes()
+    rng = random.Random(2024)
+    mutated = tmp_path / "fuzz.exr"
+    for case in range(FUZZ_CASES):
+        content = bytearray(data)
+        if case % 3 == 0:
+            content = content[:rng.randrange(len(content))]
+        else:
+            # Flips in the header (first 400 bytes) or anywhere in the file.
+            span = 400 if case % 3 == 1 else len(content)
+            for _ in range(rng.randrange(1, 16)):
+                content[rng.randrange(min(span, len(content)))] = rng.randrange(256)
+        mutated.write_bytes(bytes(content))
+        completed = run_tool(tool, mutated, "-o", tmp_path / "out.exr", "--keep-input",
+                             "--preview", tmp_path / "out.png", env=env)
+        assert completed.returncode in (0, EXIT_RUNTIME), (case, completed.stderr[-3000:])
+        assert "Sanitizer" not in completed.stderr and "runtime error" not in completed.stderr
+        if completed.returncode == EXIT_RUNTIME:
+            assert "hbao: error: " in completed.stderr
+    assert leftover_temporary_files(tmp_path) == []
+
+
+# --- never overwrite the input; atomic outputs --------------------------------
+
+def test_output_equal_to_input_is_refused(hbao_tool, tmp_path):
+    source = tmp_path / "in.exr"
+    shutil.copyfile(fixture_path("cycles_float_zip"), source)
+    original = source.read_bytes()
+    (tmp_path / "hard.exr").hardlink_to(source)
+    (tmp_path / "soft.exr").symlink_to(source)
+    for target in (source, tmp_path / "." / "in.exr", tmp_path / "hard.exr",
+                   tmp_path / "soft.exr"):
+        for flag in ("-o", "--preview"):
+            arguments = [source, "-o", tmp_path / "ok.exr", flag, target] if flag != "-o" \
+                else [source, "-o", target]
+            completed = run_tool(hbao_tool, *arguments)
+            assert_clean_error(completed, EXIT_USAGE, "refusing to overwrite")
+            assert source.read_bytes() == original
+    assert not (tmp_path / "ok.exr").exists()
+
+
+def test_existing_output_is_replaced_only_on_success(hbao_tool, tmp_path):
+    output = tmp_path / "ao.exr"
+    preview = tmp_path / "ao.png"
+    output.write_bytes(b"previous result")
+    preview.write_bytes(b"previous preview")
+    truncated = tmp_path / "truncated.exr"
+    truncated.write_bytes(fixture_path("cycles_float_zip").read_bytes()[:2000])
+    for source in (truncated, tmp_path / "missing.exr", fixture_path("no_depth")):
+        completed = run_tool(hbao_tool, source, "-o", output, "--preview", preview)
+        assert completed.returncode == EXIT_RUNTIME
+        assert output.read_bytes() == b"previous result"
+        assert preview.read_bytes() == b"previous preview"
+    compute_ao(hbao_tool, "cycles_float_zip", output, "--preview", preview)
+    description = info(hbao_tool, output)
+    assert [c["name"] for c in description["channels"]] == ["AO"]
+    assert png_header(preview) == (description["width"], description["height"], 8, 0)
+    assert leftover_temporary_files(tmp_path) == []
+
+
+def test_unwritable_output_folder_is_an_error(hbao_tool, tmp_path):
+    completed = run_tool(hbao_tool, fixture_path("cycles_float_zip"), "-o",
+                         tmp_path / "no_such_folder" / "ao.exr")
+    assert_clean_error(completed, EXIT_RUNTIME, "no_such_folder")
+
+
+# --- command line --------------------------------------------------------------
+
+@pytest.mark.parametrize("arguments, fragment", [
+    (["--radius", "nan"], "--radius"),
+    (["--radius", "inf"], "--radius"),
+    (["--radius", "1e999"], "--radius"),
+    (["--radius", "-1"], "--radius"),
+    (["--radius", ""], "--radius"),
+    (["--radius=2x"], "--radius"),
+    (["--directions", "abc"], "--directions"),
+    (["--directions", "1.5"], "--directions"),
+    (["--directions", "0"], "--directions"),
+    (["--steps", "99999999999"], "--steps"),
+    (["--angle-bias", "90"], "--angle-bias"),
+    (["--lens", "0"], "--lens"),
+    (["--falloff", "linear"], "--falloff"),
+    (["--integration", "ssao"], "--integration"),
+    (["--sensor-fit", "auto"], "--sensor-fit"),
+    (["--compression", "dwaa"], "--compression"),
+    (["--world-to-camera", "1,0,0,0"], "--world-to-camera"),
+    (["--world-to-camera", "1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 nan"], "--world-to-camera"),
+    (["--bogus"], "unknown option --bogus"),
+    (["-x"], "unknown option -x"),
+    (["--half-res=1"], "takes no value"),
+    (["--radius"], "needs a value"),
+    (["second.exr"], "more than one input"),
+    (["--preview", ""], "empty"),
+    (["--ao-channel", ""], "empty"),
+])
+def test_bad_flags_are_usage_errors(hbao_tool, tmp_path, arguments, fragment):
+    completed = run_tool(hbao_tool, fixture_path("cycles_float_zip"), "-o", tmp_path / "o.exr",
+                         *arguments)
+    assert_clean_error(completed, EXIT_USAGE, fragment)
+    assert not (tmp_path / "o.exr").exists()
+
+
+def test_missing_input_or_output_are_usage_errors(hbao_tool, tmp_path):
+    assert_clean_error(run_tool(hbao_tool), EXIT_USAGE, "no input file")
+    assert_clean_error(run_tool(hbao_tool, fixture_path("cycles_float_zip")), EXIT_USAGE,
+                       "no output file")
+
+
+def test_all_parameters_are_accepted(hbao_tool, tmp_path):
+    output = tmp_path / "ao.exr"
+    compute_ao(hbao_tool, "cycles_float_zip", output, "--radius=0.5", "--angle-bias", "5",
+               "--directions", "4", "--steps", "3", "--blur", "0", "--blur-sharpness", "2",
+               "--half-res", "--falloff", "none", "--integration", "hbao", "--strength", "2",
+               "--threads", "1", "--compression", "none", "--sensor-fit", "HORIZONTAL",
+               "--shift-x", "0", "--shift-y", "0", "--pixel-aspect-x", "1",
+               "--pixel-aspect-y", "1", "--sensor-width", "36", "--sensor-height", "24")
+    ao = channels_by_name(info(hbao_tool, output))["AO"]
+    assert ao["nonfinite"] == 0 and 0.0 <= ao["min"] <= ao["max"] <= 1.0
+    assert info(hbao_tool, output)["compression"] == "none"
+
+
+def test_radius_zero_gives_no_occlusion(hbao_tool, tmp_path):
+    output = tmp_path / "ao.exr"
+    compute_ao(hbao_tool, "cycles_float_zip", output, "--radius", "0")
+    ao = channels_by_name(info(hbao_tool, output))["AO"]
+    assert ao["min"] == ao["max"] == 1.0
+
+
+def test_ortho_scale_flag_means_orthographic(hbao_tool, tmp_path):
+    """ortho_float's JSON says ORTHO; --ortho-scale alone (no JSON) must give the
+    same AO as the JSON when the other values match."""
+    camera = json.loads(camera_path("ortho_float").read_text())
+    assert camera["type"] == "ORTHO"
+    matrix = " ".join(str(v) for row in camera["world_to_camera"] for v in row)
+    compute_ao(hbao_tool, "ortho_float", tmp_path / "json.exr")
+    run_ok(hbao_tool, fixture_path("ortho_float"), "-o", tmp_path / "flags.exr",
+           "--ortho-scale", repr(camera["ortho_scale"]), "--world-to-camera", matrix,
+           "--sensor-width", repr(camera["sensor_width"]),
+           "--sensor-height", repr(camera["sensor_height"]),
+           "--sensor-fit", camera["sensor_fit"],
+           "--shift-x", repr(camera["shift_x"]), "--shift-y", repr(camera["shift_y"]))
+    assert channels_by_name(info(hbao_tool, tmp_path / "json.exr"))["AO"] == \
+        channels_by_name(info(hbao_tool, tmp_path / "flags.exr"))["AO"]
+
+
+def test_help_and_version(hbao_tool):
+    shown = run_ok(hbao_tool, "--help")
+    for flag in ("--radius", "--angle-bias", "--directions", "--steps", "--blur",
+                 "--blur-sharpness", "--half-res", "--falloff", "--integration", "--strength",
+                 "--threads", "--lens", "--sensor-width", "--sensor-height", "--sensor-fit",
+                 "--shift-x", "--shift-y", "--ortho-scale", "--world-to-camera", "--camera",
+                 "--keep-input", "--layer", "--preview", "--info", "identity"):
+        assert flag in shown.stdout
+    version = run_ok(hbao_tool, "--version").stdout
+    assert version.startswith("hbao 0.1.0") and "libhbao 0.1.0" in version
+
+
+def test_info_lists_layers_and_types(hbao_tool):
+    description = info(hbao_tool, fixture_path("eevee_half"))
+    assert description["layers"] == ["ViewLayer"]
+    channels = channels_by_name(description)
+    assert channels["ViewLayer.Combined.R"]["type"] == "half"
+    # EEVEE stores the sky's depth as the largest half float.
+    assert channels["ViewLayer.Depth.Z"]["max"] == BACKGROUND_DEPTH
+    text = run_ok(hbao_tool, "--info", fixture_path("eevee_half")).stdout
+    assert "ViewLayer.Depth.Z" in text and "compression:" in text

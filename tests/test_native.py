@@ -1,0 +1,196 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The ctypes binding addon/hbao/native.py against the built libhbao (plain
+pytest, no Blender)."""
+import ctypes
+import importlib.util
+import re
+import subprocess
+
+import numpy as np
+import pytest
+
+from conftest import REPO
+
+HEADER = REPO / "csrc" / "include" / "hbao.h"
+# Every image in these tests is small: the library's cost is irrelevant here.
+HEIGHT, WIDTH = 48, 64
+# The library promises bit-identical output whatever the thread count and
+# memory layout, so orientation and layout comparisons are exact.
+EXACT = 0.0
+# A flat plane facing the camera has its horizon exactly on the tangent plane;
+# with the default 10 degree angle bias, float rounding in the horizon angles
+# cannot reach the bias, so the result is 1 up to float32 rounding.
+FLAT_PLANE_TOLERANCE = 1e-6
+# Without the bias, the cosine integration around the view vector leaves about
+# 1e-4 of rounding on the plane (measured 1.1e-4 at 64x48); 1e-3 bounds it.
+FLAT_PLANE_NO_BIAS_TOLERANCE = 1e-3
+
+
+def _load_native():
+    spec = importlib.util.spec_from_file_location(
+        "hbao_native_under_test", REPO / "addon" / "hbao" / "native.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.fixture()
+def native(built_library, monkeypatch):
+    monkeypatch.setenv("HBAO_LIBRARY", str(built_library))
+    module = _load_native()
+    yield module
+    module.unload_library()
+
+
+def _header_defines():
+    """#define NAME value pairs of the public header (numbers only)."""
+    pattern = re.compile(r"^#define (HBAO_\w+) (-?[0-9.]+)f?$", re.M)
+    return {name: float(value) for name, value in pattern.findall(HEADER.read_text())}
+
+
+def _bumpy_depth():
+    """A sloped floor with a box on it: depth with occluders everywhere."""
+    rows, cols = np.mgrid[0:HEIGHT, 0:WIDTH].astype(np.float32)
+    depth = 4.0 + 0.02 * rows + 0.01 * cols
+    depth[10:30, 20:40] -= 0.8
+    depth[5:8, 50:60] = 1e10  # background
+    return depth.astype(np.float32)
+
+
+def test_defaults_match_header(native):
+    defines = _header_defines()
+    defaults = native.default_params()
+    assert defaults["radius"] == defines["HBAO_DEFAULT_RADIUS"]
+    assert defaults["angle_bias_degrees"] == defines["HBAO_DEFAULT_ANGLE_BIAS_DEGREES"]
+    assert defaults["directions"] == defines["HBAO_DEFAULT_DIRECTIONS"]
+    assert defaults["steps"] == defines["HBAO_DEFAULT_STEPS"]
+    assert defaults["blur_size"] == defines["HBAO_DEFAULT_BLUR_SIZE"]
+    assert defaults["blur_sharpness"] == defines["HBAO_DEFAULT_BLUR_SHARPNESS"]
+    assert defaults["strength"] == defines["HBAO_DEFAULT_STRENGTH"]
+    assert defaults["background_depth"] == defines["HBAO_DEFAULT_BACKGROUND_DEPTH"]
+    assert defaults["falloff"] == "QUADRATIC"
+    assert defaults["integration"] == "COSINE"
+    assert defaults["half_resolution"] is False
+    assert defaults["threads"] == 0
+    assert native.library_version() == "{:.0f}.{:.0f}.{:.0f}".format(
+        defines["HBAO_VERSION_MAJOR"], defines["HBAO_VERSION_MINOR"],
+        defines["HBAO_VERSION_PATCH"])
+
+
+def test_struct_sizes_match_library(native):
+    library = native.load_library()
+    assert library.hbao_params_size() == ctypes.sizeof(native.HBAOParams)
+    assert library.hbao_camera_size() == ctypes.sizeof(native.HBAOCamera)
+
+
+@pytest.mark.parametrize("params, camera, expected_fragment", [
+    ({"radius": -1.0}, None, "a parameter is not a number"),
+    ({"radius": float("nan")}, None, "a parameter is not a number"),
+    ({}, {"lens": 0.0}, "the camera is invalid"),
+    ({}, {"world_to_camera": [[0.0] * 4] * 4}, "the camera is invalid"),
+])
+def test_library_errors_become_exceptions_with_its_message(native, params, camera,
+                                                           expected_fragment):
+    with pytest.raises(native.HBAOError) as caught:
+        native.compute_ao(_bumpy_depth(), params=params, camera=camera)
+    library = native.load_library()
+    assert caught.value.code != 0
+    assert caught.value.library_message == library.hbao_result_message(
+        caught.value.code).decode()
+    assert expected_fragment in str(caught.value)
+
+
+def test_bad_arguments_raise_value_error(native):
+    with pytest.raises(ValueError, match="unknown HBAO parameter"):
+        native.compute_ao(_bumpy_depth(), params={"raduis": 1.0})
+    with pytest.raises(ValueError, match="falloff must be one of"):
+        native.compute_ao(_bumpy_depth(), params={"falloff": "LINEAR"})
+    with pytest.raises(ValueError, match="camera type"):
+        native.compute_ao(_bumpy_depth(), camera={"type": "PANO"})
+    with pytest.raises(ValueError, match="normal must be"):
+        native.compute_ao(_bumpy_depth(), np.zeros((HEIGHT, WIDTH, 2), np.float32))
+    with pytest.raises(ValueError, match="out must be"):
+        native.compute_ao(_bumpy_depth(), out=np.zeros((HEIGHT, WIDTH), np.float64))
+    with pytest.raises(ValueError, match="needs shape"):
+        native.compute_ao(np.ones(HEIGHT * WIDTH, np.float32))
+
+
+@pytest.mark.parametrize("integration", ["HBAO", "COSINE"])
+@pytest.mark.parametrize("with_normals", [False, True])
+def test_flat_plane_facing_camera_is_unoccluded(native, integration, with_normals):
+    depth = np.full((HEIGHT, WIDTH), 3.0, np.float32)
+    normal = None
+    if with_normals:
+        # Identity world_to_camera: world = camera space; the camera looks down -Z.
+        normal = np.zeros((HEIGHT, WIDTH, 3), np.float32)
+        normal[..., 2] = 1.0
+    ao = native.compute_ao(depth, normal, params={"radius": 2.0, "integration": integration})
+    assert ao.shape == (HEIGHT, WIDTH) and ao.dtype == np.float32
+    assert np.all(np.abs(ao - 1.0) <= FLAT_PLANE_TOLERANCE)
+    unbiased = native.compute_ao(depth, normal, params={
+        "radius": 2.0, "integration": integration, "angle_bias_degrees": 0.0})
+    assert np.all(np.abs(unbiased - 1.0) <= FLAT_PLANE_NO_BIAS_TOLERANCE)
+
+
+def test_occluders_darken(native):
+    ao = native.compute_ao(_bumpy_depth(), params={"radius": 1.0, "blur_size": 0})
+    assert np.all(np.isfinite(ao)) and ao.min() >= 0.0 and ao.max() <= 1.0
+    # The floor pixels next to the box's left edge see it as a wall.
+    assert ao[20, 17:20].max() < 0.95
+    assert np.all(ao[5:8, 50:60] == 1.0)  # background
+
+
+def test_bottom_up_flips_consistently(native):
+    depth = _bumpy_depth()
+    normal = np.zeros((HEIGHT, WIDTH, 4), np.float32)
+    normal[..., 1] = 0.3
+    normal[..., 2] = 0.95
+    top_down = native.compute_ao(depth, normal)
+    bottom_up = native.compute_ao(depth[::-1].copy(), normal[::-1].copy(), bottom_up=True)
+    assert np.abs(bottom_up[::-1] - top_down).max() <= EXACT
+    # And not symmetric, so the comparison above means something.
+    assert np.abs(top_down[::-1] - top_down).max() > 0.01
+
+
+def test_layouts_need_no_copy_and_agree(native):
+    depth = _bumpy_depth()
+    reference = native.compute_ao(depth)
+    flat = native.compute_ao(depth.reshape(-1), shape=(HEIGHT, WIDTH))
+    assert np.abs(flat - reference).max() <= EXACT
+    # A depth channel inside an RGBA-like buffer is passed with a pixel stride.
+    packed = np.zeros((HEIGHT, WIDTH, 4), np.float32)
+    packed[..., 2] = depth
+    strided = native.compute_ao(packed[..., 2])
+    assert np.abs(strided - reference).max() <= EXACT
+    out = np.full((HEIGHT, WIDTH), -1.0, np.float32)
+    returned = native.compute_ao(depth.astype(np.float64), out=out)
+    assert returned is out
+    assert np.abs(out - reference).max() <= EXACT
+
+
+def test_missing_library_names_the_path(monkeypatch, tmp_path):
+    missing = tmp_path / "nowhere" / "libhbao.so"
+    monkeypatch.setenv("HBAO_LIBRARY", str(missing))
+    module = _load_native()
+    with pytest.raises(module.HBAOLibraryError, match=re.escape(str(missing))):
+        module.compute_ao(np.ones((4, 4), np.float32))
+
+
+def test_incompatible_library_is_refused(monkeypatch, tmp_path):
+    """A library with the right symbols but another major version: refused on load."""
+    source = tmp_path / "fake.c"
+    source.write_text(
+        "#include <stddef.h>\n#include <stdint.h>\n"
+        "int32_t hbao_version(void) { return 10000; }\n"
+        "const char *hbao_result_message(int32_t r) { (void)r; return \"x\"; }\n"
+        "void hbao_params_default(void *p) { (void)p; }\n"
+        "void hbao_camera_default(void *c) { (void)c; }\n"
+        "size_t hbao_params_size(void) { return 48; }\n"
+        "size_t hbao_camera_size(void) { return 104; }\n"
+        "int32_t hbao_compute(void) { return 0; }\n")
+    fake = tmp_path / "libfake.so"
+    subprocess.run(["cc", "-shared", "-fPIC", "-o", str(fake), str(source)], check=True)
+    monkeypatch.setenv("HBAO_LIBRARY", str(fake))
+    module = _load_native()
+    with pytest.raises(module.HBAOLibraryError, match="version 1.0.0"):
+        module.load_library()

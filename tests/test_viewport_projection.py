@@ -1,0 +1,120 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The viewport preview's camera model and parameters without Blender: the
+frame from a projection matrix equals the library's camera model, and the
+depth-buffer linearisation inverts the projection."""
+import importlib.util
+import math
+import sys
+
+import pytest
+
+from conftest import REPO
+
+VIEWPORT = REPO / "addon" / "hbao" / "viewport"
+# float64 throughout: only rounding separates the two derivations.
+TOLERANCE = 1e-9
+
+
+def _load(name):
+    spec = importlib.util.spec_from_file_location(f"viewport_{name}_under_test",
+                                                  VIEWPORT / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+projection = _load("projection")
+parameters = _load("parameters")
+
+
+def _camera_matrix(frame, near=0.1, far=100.0):
+    """The OpenGL projection of `frame` (Blender's perspective_m4 / orthographic_m4
+    of the view plane), built independently of projection.py."""
+    left = frame.origin_x
+    right = frame.origin_x + frame.width * frame.pixel_size_x
+    bottom = frame.origin_y
+    top = frame.origin_y + frame.height * frame.pixel_size_y
+    if frame.perspective:
+        # View plane at unit depth scaled to the near plane.
+        left, right, bottom, top = (v * near for v in (left, right, bottom, top))
+        return [[2 * near / (right - left), 0, (right + left) / (right - left), 0],
+                [0, 2 * near / (top - bottom), (top + bottom) / (top - bottom), 0],
+                [0, 0, -(far + near) / (far - near), -2 * far * near / (far - near)],
+                [0, 0, -1, 0]]
+    return [[2 / (right - left), 0, 0, -(right + left) / (right - left)],
+            [0, 2 / (top - bottom), 0, -(top + bottom) / (top - bottom)],
+            [0, 0, -2 / (far - near), -(far + near) / (far - near)],
+            [0, 0, 0, 1]]
+
+
+CAMERAS = [
+    {"type": "PERSP", "lens": 50.0},
+    {"type": "PERSP", "lens": 24.0, "sensor_fit": "VERTICAL", "shift_x": 0.2, "shift_y": -0.1},
+    {"type": "PERSP", "lens": 35.0, "pixel_aspect_x": 1.0, "pixel_aspect_y": 2.0},
+    {"type": "ORTHO", "ortho_scale": 4.0, "shift_y": 0.3},
+]
+
+
+@pytest.mark.parametrize("camera", CAMERAS)
+@pytest.mark.parametrize("size", [(64, 48), (30, 90)])
+def test_frame_from_matrix_equals_camera_model(camera, size):
+    frame = projection.frame_from_camera(camera, *size)
+    again = projection.frame_from_projection_matrix(_camera_matrix(frame), *size)
+    assert again.perspective == frame.perspective
+    for name in ("pixel_size_x", "pixel_size_y", "origin_x", "origin_y"):
+        assert getattr(again, name) == pytest.approx(getattr(frame, name), abs=TOLERANCE)
+
+
+def test_camera_model_follows_blender_fit():
+    # 36 mm sensor over 64 px at 50 mm: pixel size 36 / 50 / 64 per unit depth.
+    wide = projection.frame_from_camera({"lens": 50.0}, 64, 48)
+    assert wide.pixel_size_x == pytest.approx(36.0 / 50.0 / 64.0, abs=TOLERANCE)
+    assert wide.origin_x == pytest.approx(-32 * wide.pixel_size_x, abs=TOLERANCE)
+    # AUTO on a tall image spans the height with sensor_width.
+    tall = projection.frame_from_camera({"lens": 50.0}, 48, 64)
+    assert tall.pixel_size_y == pytest.approx(36.0 / 50.0 / 64.0, abs=TOLERANCE)
+
+
+@pytest.mark.parametrize("perspective", [True, False])
+def test_depth_coefficients_invert_projection(perspective):
+    camera = {"type": "PERSP" if perspective else "ORTHO", "ortho_scale": 5.0}
+    matrix = _camera_matrix(projection.frame_from_camera(camera, 40, 30), near=0.5, far=80.0)
+    a, b, c, d = projection.depth_coefficients(matrix)
+    for depth in (0.5, 1.0, 7.25, 80.0):
+        z = -depth
+        clip_z = matrix[2][2] * z + matrix[2][3]
+        clip_w = matrix[3][2] * z + matrix[3][3]
+        ndc = clip_z / clip_w
+        assert (a * ndc + b) / (c * ndc + d) == pytest.approx(depth, rel=1e-9)
+
+
+def test_parameters_clamp_like_the_library():
+    resolved = parameters.resolved({"directions": 100, "steps": 0, "blur_size": 99,
+                                    "angle_bias_degrees": 75.0, "strength": -1.0})
+    assert resolved["directions"] == parameters.MAX_DIRECTIONS
+    assert resolved["steps"] == 1
+    assert resolved["blur_size"] == parameters.MAX_BLUR_SIZE
+    assert resolved["angle_bias_degrees"] == parameters.MAX_ANGLE_BIAS_DEGREES
+    assert resolved["strength"] == 0.0
+    assert parameters.blur_kernel_radius(9) == 4
+    assert parameters.blur_kernel_radius(8) == 3  # even sizes round down
+    assert parameters.blur_kernel_radius(1) == 0
+    for bad in ({"radius": -1.0}, {"radius": math.nan}, {"falloff": "LINEAR"},
+                {"colour": 1}):
+        with pytest.raises(ValueError):
+            parameters.resolved(bad)
+
+
+def test_defaults_match_header():
+    header = (REPO / "csrc" / "include" / "hbao.h").read_text()
+    for name, define in (("radius", "HBAO_DEFAULT_RADIUS"),
+                         ("angle_bias_degrees", "HBAO_DEFAULT_ANGLE_BIAS_DEGREES"),
+                         ("directions", "HBAO_DEFAULT_DIRECTIONS"),
+                         ("steps", "HBAO_DEFAULT_STEPS"),
+                         ("blur_size", "HBAO_DEFAULT_BLUR_SIZE"),
+                         ("blur_sharpness", "HBAO_DEFAULT_BLUR_SHARPNESS"),
+                         ("strength", "HBAO_DEFAULT_STRENGTH"),
+                         ("background_depth", "HBAO_DEFAULT_BACKGROUND_DEPTH")):
+        line = next(l for l in header.splitlines() if l.startswith(f"#define {define} "))
+        assert float(line.split()[2].rstrip("f")) == parameters.DEFAULTS[name]
