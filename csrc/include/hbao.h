@@ -237,6 +237,9 @@ HBAO_EXPORT void hbao_params_default(hbao_params *params);
 /** Fill *camera with Blender's default camera. */
 HBAO_EXPORT void hbao_camera_default(hbao_camera *camera);
 
+/** The hbao_implementation that HBAO_IMPLEMENTATION_AUTO runs on this CPU. */
+HBAO_EXPORT int32_t hbao_best_implementation(void);
+
 /** sizeof(hbao_params) and sizeof(hbao_camera) as compiled into the library,
  *  so that bindings (ctypes) can check their struct layouts on load. */
 HBAO_EXPORT size_t hbao_params_size(void);

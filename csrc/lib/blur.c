@@ -22,7 +22,7 @@ typedef struct blur_job {
 /* One output row. Taps run in the outer loop and pixels in the inner one,
  * so the inner loop reads contiguous memory and vectorizes; each pixel still
  * sums its taps in the same order. Taps on background get weight 0. */
-static void blur_row(void *context, int j) {
+HBAO_VECTOR_CLONES static void blur_row(void *context, int j) {
     const blur_job *job = context;
     const int radius = job->settings->blur_radius;
     const float sharpness = job->settings->blur_sharpness;
@@ -60,9 +60,10 @@ static void blur_row(void *context, int j) {
         const float *ao = job->source + offset;
         for (int i = first; i < last; i++) {
             const float difference = (z[i] - zc[i]) * inv_zc[i];
-            const float weight = z[i] > 0.0f
-                                     ? spatial * hbao_exp_negative(difference * difference)
-                                     : 0.0f;
+            /* A 0/1 factor rather than a branch keeps the loop vectorized;
+             * the weight is finite, so the product is exact. */
+            const float valid = (float)(z[i] > 0.0f);
+            const float weight = spatial * hbao_exp_negative(difference * difference) * valid;
             sum[i] += weight * ao[i];
             weight_sum[i] += weight;
         }

@@ -320,6 +320,12 @@ static hbao_horizon_span choose_kernel(int implementation) {
     return NULL;
 }
 
+int32_t hbao_best_implementation(void) {
+    if (hbao_horizon_avx512_available()) return HBAO_IMPLEMENTATION_AVX512;
+    if (hbao_horizon_avx2_available()) return HBAO_IMPLEMENTATION_AVX2;
+    return HBAO_IMPLEMENTATION_SCALAR;
+}
+
 void hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *grid, float *ao) {
     horizon_job job;
     job.settings = settings;

@@ -59,6 +59,17 @@ typedef struct hbao_grid {
     float ycor;       /* pixel height / pixel width */
 } hbao_grid;
 
+/* Loops written to auto-vectorize get one compiled copy per vector width,
+ * chosen when the library loads (GCC's target_clones). Their operations are
+ * element-wise and never contracted into FMAs (ISO C mode), so every copy
+ * computes the same floats. */
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
+    !defined(__SANITIZE_ADDRESS__)
+#define HBAO_VECTOR_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
+#else
+#define HBAO_VECTOR_CLONES
+#endif
+
 /* camera.c */
 hbao_result hbao_validate_camera(const hbao_camera *camera);
 /* Fill the grid's view-plane mapping, pixel_size, ycor, orthographic for a grid whose
@@ -137,12 +148,18 @@ void hbao_blur(const hbao_settings *settings, const float *depth, int width, int
 /* exp(-x) for x >= 0, to 3e-5 relative error (a degree-6 Taylor polynomial of 2^-f), without libm: the blur
  * and the upsample evaluate it for every tap. */
 static inline float hbao_exp_negative(float x) {
-    /* Branch-free so that loops calling it vectorize. Beyond 87 the result
-     * is below FLT_MIN: 0. NaN compares false and gives 0 too. */
-    const int in_range = x < 87.0f;
-    const float clamped = in_range ? x : 0.0f;
+    /* Branch-free (selects are integer masks) so that loops calling it
+     * vectorize for any vector width. Beyond 87 the result is below FLT_MIN:
+     * 0. NaN compares false and gives 0 too. */
+    const uint32_t keep = 0u - (uint32_t)(x < 87.0f); /* all ones or zero */
+    union {
+        float f;
+        uint32_t u;
+    } in, scale, out;
+    in.f = x;
+    in.u &= keep; /* out of range: compute with 0, mask the result below */
     /* 2^(-x * log2 e) = 2^-n * 2^-f with n integer, f in [0, 1). */
-    const float y = clamped * 1.44269504088896341f;
+    const float y = in.f * 1.44269504088896341f;
     const int n = (int)y;
     const float f = y - (float)n;
     /* 2^-f on [0, 1): degree-6 Taylor polynomial of exp(-f ln 2). */
@@ -153,12 +170,10 @@ static inline float hbao_exp_negative(float x) {
     p = p * f - 2.4022651e-1f;
     p = p * f + 6.9314718e-1f;
     p = 1.0f - p * f;
-    union {
-        float f;
-        uint32_t u;
-    } scale;
     scale.u = (uint32_t)(127 - n) << 23; /* 2^-n, 0 <= n <= 125 */
-    return in_range ? p * scale.f : 0.0f;
+    out.f = p * scale.f;
+    out.u &= keep;
+    return out.f;
 }
 
 /* acos(x) for x in [-1, 1] to 2e-8 absolute (Abramowitz & Stegun 4.4.46):

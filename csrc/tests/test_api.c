@@ -174,6 +174,8 @@ TEST_CASE(messages_version_and_sizes) {
     CHECK(strcmp(hbao_result_message(-5), "unknown result code") == 0);
     CHECK(strcmp(hbao_result_message(HBAO_RESULT_COUNT), "unknown result code") == 0);
     CHECK(hbao_version() == HBAO_VERSION);
+    const int32_t best = hbao_best_implementation();
+    CHECK(best >= HBAO_IMPLEMENTATION_SCALAR && best <= HBAO_IMPLEMENTATION_AVX512);
     CHECK(hbao_params_size() == sizeof(hbao_params));
     CHECK(hbao_camera_size() == sizeof(hbao_camera));
     hbao_params p;

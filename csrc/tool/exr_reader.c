@@ -7,9 +7,10 @@
 #include "hbao.h"
 
 /* OpenEXRCore reports details (which attribute is bad, which chunk is
- * corrupt) through a callback rather than the result code. The tool is
- * single-threaded around OpenEXRCore, so one static buffer is enough. */
-static char last_error_message[512];
+ * corrupt) through a callback rather than the result code. The callback runs
+ * in the thread that made the failing call, so one buffer per thread keeps
+ * libhbao_exr (which shares this reader) safe for callers in several threads. */
+static _Thread_local char last_error_message[512];
 
 static void keep_error_message(exr_const_context_t context, exr_result_t code,
                                const char *message)
