@@ -1,16 +1,17 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: GPL-2.0-or-later
-# Builds libhbao if needed, copies the add-on (with lib/libhbao.so) into the
-# current user's Blender add-ons folder, enables it and saves the preferences.
+# Builds libhbao and libhbao_exr if needed, copies the add-on (with
+# lib/libhbao.so and lib/libhbao_exr.so) into the current user's Blender
+# add-ons folder, enables it and saves the preferences.
 #   scripts/install_addon.sh            (BLENDER=/path/to/blender to choose one)
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="${HBAO_BUILD_DIR:-$REPO/build}"
 BLENDER="${BLENDER:-blender}"
 
-if [ ! -f "$BUILD/libhbao.so" ]; then
+if [ ! -f "$BUILD/libhbao.so" ] || [ ! -f "$BUILD/libhbao_exr.so" ]; then
     cmake -S "$REPO" -B "$BUILD" -DCMAKE_BUILD_TYPE=Release
-    cmake --build "$BUILD" -j2 --target hbao
+    cmake --build "$BUILD" -j2 --target hbao hbao_exr
 fi
 
 # Blender's own idea of the user add-ons folder (honours BLENDER_USER_SCRIPTS).
@@ -32,6 +33,7 @@ mkdir -p "$TARGET/lib"
         cp "$file" "$TARGET/$file"
     done)
 cp "$BUILD/libhbao.so" "$TARGET/lib/libhbao.so"
+cp "$BUILD/libhbao_exr.so" "$TARGET/lib/libhbao_exr.so"
 
 "$BLENDER" -b --python-expr '
 import addon_utils, bpy, sys

@@ -1,15 +1,16 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: GPL-2.0-or-later
-# Makes dist/hbao-<version>.zip: the add-on folder hbao/ with lib/libhbao.so
-# inside, for Edit > Preferences > Add-ons > Install (3.x-4.1) or Install
-# from Disk (4.2+ extensions, via blender_manifest.toml).
+# Makes dist/hbao-<version>.zip: the add-on folder hbao/ with lib/libhbao.so,
+# lib/libhbao_exr.so and the OpenEXRCore library it needs inside, for Edit >
+# Preferences > Add-ons > Install (3.x-4.1) or Install from Disk (4.2+
+# extensions, via blender_manifest.toml).
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="${HBAO_BUILD_DIR:-$REPO/build}"
 
-if [ ! -f "$BUILD/libhbao.so" ]; then
+if [ ! -f "$BUILD/libhbao.so" ] || [ ! -f "$BUILD/libhbao_exr.so" ]; then
     cmake -S "$REPO" -B "$BUILD" -DCMAKE_BUILD_TYPE=Release
-    cmake --build "$BUILD" -j2 --target hbao
+    cmake --build "$BUILD" -j2 --target hbao hbao_exr
 fi
 VERSION="$(sed -n 's/^version = "\(.*\)"/\1/p' "$REPO/addon/hbao/blender_manifest.toml")"
 STAGE="$(mktemp -d)"
@@ -21,6 +22,22 @@ mkdir -p "$STAGE/hbao/lib" "$REPO/dist"
         cp "$file" "$STAGE/hbao/$file"
     done)
 cp "$BUILD/libhbao.so" "$STAGE/hbao/lib/libhbao.so"
+cp "$BUILD/libhbao_exr.so" "$STAGE/hbao/lib/libhbao_exr.so"
+# Official Blender builds link OpenEXR statically and install no shared
+# copy: ship the OpenEXRCore that libhbao_exr.so was linked against next to
+# it (its RUNPATH is $ORIGIN), with its licence.
+OPENEXR_CORE="$(ldd "$BUILD/libhbao_exr.so" | awk '/libOpenEXRCore/ { print $3 }')"
+if [ -z "$OPENEXR_CORE" ] || [ ! -f "$OPENEXR_CORE" ]; then
+    echo "package_addon.sh: cannot find the OpenEXRCore library libhbao_exr.so uses" >&2
+    exit 1
+fi
+cp "$OPENEXR_CORE" "$STAGE/hbao/lib/$(basename "$OPENEXR_CORE")"
+for licence in /usr/share/doc/libopenexr*/copyright; do
+    if [ -f "$licence" ]; then
+        cp "$licence" "$STAGE/hbao/lib/OpenEXR-COPYRIGHT"
+        break
+    fi
+done
 ZIP="$REPO/dist/hbao-$VERSION.zip"
 rm -f "$ZIP"
 (cd "$STAGE" && python3 -c '

@@ -12,10 +12,16 @@ import pytest
 REPO = Path(__file__).resolve().parents[1]
 BUILD = Path(os.environ.get("HBAO_BUILD_DIR", REPO / "build"))
 LIBRARY = BUILD / "libhbao.so"
+# The add-on's EXR reader (csrc/exr): the add-on and the tests read EXRs with it.
+EXR_LIBRARY = BUILD / "libhbao_exr.so"
 TOOL = BUILD / "hbao"
 FIXTURES = REPO / "tests" / "fixtures"
 SCRIPTS = REPO / "scripts"
 BLENDER = shutil.which(os.environ.get("BLENDER", "blender"))
+
+# Tests read Blender's EXRs in this process too, through the add-on's binding
+# (addon/hbao/exr_passes.py), which finds the library through this variable.
+os.environ["HBAO_EXR_LIBRARY"] = str(EXR_LIBRARY)
 
 # Generous: Cycles renders of test scenes take seconds, EEVEE on llvmpipe
 # tens of seconds; a hang must still end the test rather than the CI run.
@@ -49,6 +55,7 @@ def blender_environment(user_scripts, extra=None):
     env = dict(os.environ)
     env["BLENDER_USER_SCRIPTS"] = str(user_scripts)
     env["HBAO_LIBRARY"] = str(LIBRARY)
+    env["HBAO_EXR_LIBRARY"] = str(EXR_LIBRARY)
     env["PYTHONUNBUFFERED"] = "1"
     env.pop("PYTHONPATH", None)
     if extra:

@@ -188,6 +188,20 @@ def test_missing_library_renders_without_ao_and_says_so(run_blender, tmp_path):
     assert np.abs(outputs["image"] - outputs["render"]).max() <= EXACT
 
 
+def test_missing_exr_library_renders_without_ao_and_says_so(run_blender, tmp_path):
+    missing = tmp_path / "no" / "libhbao_exr.so"
+    out, log = render(run_blender, tmp_path, {"nodes": [{"radius": 1.0}]},
+                      env={"HBAO_EXR_LIBRARY": str(missing)})
+    # The message reaches Blender's UI through RenderEngine.report (a
+    # WARNING, printed in -b) and says how to fix it.
+    assert f"libhbao_exr not found at {missing}" in log
+    assert "Rendering without AO" in log
+    assert "install_addon.sh" in log
+    outputs = node_outputs(out, 1)
+    assert np.all(outputs["ao"] == 1.0)
+    assert np.abs(outputs["image"] - outputs["render"]).max() <= EXACT
+
+
 def test_saved_file_renders_from_the_command_line(run_blender, tmp_path, native):
     blend = tmp_path / "hbao.blend"
     out = tmp_path / "cli"

@@ -116,5 +116,6 @@ def test_defaults_match_header():
                          ("blur_sharpness", "HBAO_DEFAULT_BLUR_SHARPNESS"),
                          ("strength", "HBAO_DEFAULT_STRENGTH"),
                          ("background_depth", "HBAO_DEFAULT_BACKGROUND_DEPTH")):
-        line = next(l for l in header.splitlines() if l.startswith(f"#define {define} "))
+        line = next(text for text in header.splitlines()
+                    if text.startswith(f"#define {define} "))
         assert float(line.split()[2].rstrip("f")) == parameters.DEFAULTS[name]

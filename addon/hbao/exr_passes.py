@@ -1,179 +1,256 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
-"""Channels of the uncompressed multilayer EXR that the render hook itself
-writes (Render Result saved with exr_codec 'NONE', 32-bit float). Needs numpy,
-not bpy.
+"""Channels of an OpenEXR file (the multilayer EXR the render hook writes)
+as numpy arrays, read by libhbao_exr through ctypes. Needs numpy, not bpy.
 
-Why this reads the file itself instead of going through OpenEXR: Blender's
-Python has no OpenEXR or OpenImageIO module, `bpy.data.images.load` gives no
-pixels for multilayer EXRs, and a C reader would make the shipped libhbao.so
-depend on OpenEXR's shared libraries, which official Blender builds do not
-install (they link OpenEXR statically). The add-on writes this file itself a
-few milliseconds earlier, uncompressed, so only the uncompressed scanline
-layout needs to be understood: a header of attributes, a table of row
-offsets, then one row per chunk holding each channel's row in name order.
-numpy then sees each channel as a strided (height, width) view of the file's
-bytes: no per-pixel work in Python, no copy. Anything else (compression,
-tiles, several parts, deep data, subsampling) is refused with a message.
+Why a library of its own: Blender's Python has no OpenEXR or OpenImageIO
+module and `bpy.data.images.load` gives no pixels for multilayer EXRs, so the
+add-on ships the `hbao` tool's OpenEXRCore reader as libhbao_exr.so
+(csrc/exr/hbao_exr.h). It is separate from libhbao.so so that the AO library
+itself never depends on OpenEXR. The library decodes every requested channel
+in one pass straight into numpy arrays: no per-pixel work in Python.
+
+The library is loaded once, lazily; the load checks its interface version and
+struct size, so a stale or foreign library fails with a message instead of
+corrupting memory.
+
+    channels = read_channels("passes.exr", ["ViewLayer.Depth.Z"])
 """
-import struct
+import ctypes
+import os
+import threading
+from pathlib import Path
 
 import numpy as np
 
-__all__ = ["EXRFormatError", "read_channels", "channel_names"]
+__all__ = ["EXRFormatError", "EXRFileError", "EXRLibraryError", "read_channels",
+           "read_channel_groups", "channel_names", "image_size", "load_library",
+           "unload_library", "library_path"]
 
-_MAGIC = 20000630
-_FLAG_TILED = 0x200
-_FLAG_LONG_NAMES = 0x400
-_FLAG_DEEP = 0x800
-_FLAG_MULTIPART = 0x1000
-_COMPRESSION_NONE = 0
-_LINE_ORDER_INCREASING_Y = 0
-# OpenEXR pixel types and their sizes in bytes.
-_PIXEL_UINT, _PIXEL_HALF, _PIXEL_FLOAT = 0, 1, 2
-_PIXEL_DTYPES = {_PIXEL_UINT: np.dtype("<u4"), _PIXEL_HALF: np.dtype("<f2"),
-                 _PIXEL_FLOAT: np.dtype("<f4")}
-# Bytes before each row's pixel data: its y coordinate and its data size (int32 each).
-_CHUNK_PREFIX_SIZE = 8
-_FLOAT_ALIGNMENT = 4
+#: The header's HBAO_EXR_INTERFACE_VERSION this binding mirrors.
+BINDING_INTERFACE_VERSION = 1
+#: Environment variable that names the library to load instead of lib/libhbao_exr.so.
+LIBRARY_ENVIRONMENT_VARIABLE = "HBAO_EXR_LIBRARY"
+LIBRARY_FILE_NAME = "libhbao_exr.so"
+_DEFAULT_LIBRARY_PATH = Path(__file__).resolve().parent / "lib" / LIBRARY_FILE_NAME
+# hbao_exr.h: HBAO_EXR_MESSAGE_SIZE holds every message the library writes.
+_MESSAGE_SIZE = 1024
+_FLOAT = np.dtype(np.float32)
+
+# Result codes of hbao_exr.h.
+_SUCCESS = 0
+_ERROR_FILE_ACCESS = 3
+_ERROR_MISSING_CHANNEL = 5
 
 
 class EXRFormatError(ValueError):
-    """The file is not an uncompressed single-part scanline EXR."""
+    """The file is not an EXR the library can read (or it is corrupt); carries
+    the library's result code and message."""
+
+    def __init__(self, message, code=None):
+        super().__init__(message)
+        self.code = code
 
 
-def _read_string(data, offset, path):
-    end = data.find(b"\0", offset)
-    if end < 0:
-        raise EXRFormatError(f"{path}: truncated EXR header")
-    return data[offset:end].decode("latin-1"), end + 1
+class EXRFileError(OSError):
+    """The file cannot be opened (missing, unreadable)."""
 
 
-def _parse_header(data, path):
-    if len(data) < 8:
-        raise EXRFormatError(f"{path}: not an EXR file (too short)")
-    magic, version = struct.unpack_from("<ii", data, 0)
-    if magic != _MAGIC:
-        raise EXRFormatError(f"{path}: not an EXR file")
-    flags = version & ~0xFF
-    if flags & (_FLAG_TILED | _FLAG_DEEP | _FLAG_MULTIPART):
-        raise EXRFormatError(f"{path}: tiled, deep or multi-part EXRs are not supported")
-    attributes = {}
-    offset = 8
-    while True:
-        name, offset = _read_string(data, offset, path)
-        if not name:
-            break
-        type_name, offset = _read_string(data, offset, path)
-        if offset + 4 > len(data):
-            raise EXRFormatError(f"{path}: truncated EXR header")
-        (size,) = struct.unpack_from("<i", data, offset)
-        offset += 4
-        if size < 0 or offset + size > len(data):
-            raise EXRFormatError(f"{path}: truncated EXR header")
-        attributes[name] = (type_name, data[offset:offset + size])
-        offset += size
-    return attributes, offset
+class EXRLibraryError(RuntimeError):
+    """libhbao_exr could not be loaded, or it does not match this binding."""
 
 
-def _parse_channels(raw, path):
-    channels = []
-    offset = 0
-    while offset < len(raw) and raw[offset] != 0:
-        name, offset = _read_string(raw, offset, path)
-        pixel_type, _linear, x_sampling, y_sampling = struct.unpack_from("<iB3xii", raw, offset)
-        offset += 16
-        if pixel_type not in _PIXEL_DTYPES:
-            raise EXRFormatError(f"{path}: channel {name} has unknown pixel type {pixel_type}")
-        if x_sampling != 1 or y_sampling != 1:
-            raise EXRFormatError(f"{path}: channel {name} is subsampled")
-        channels.append((name, _PIXEL_DTYPES[pixel_type]))
-    return channels
+class _ChannelRequest(ctypes.Structure):
+    """hbao_exr_channel_request (keep in the header's field order)."""
+    _fields_ = [
+        ("name", ctypes.c_char_p),
+        ("data", ctypes.POINTER(ctypes.c_float)),
+        ("pixel_stride", ctypes.c_int32),
+        ("row_stride", ctypes.c_int64),
+    ]
 
 
-class _Layout:
-    """Header, channel list and row offsets of the EXR open in `stream`."""
+_FILE_P = ctypes.c_void_p
+_INT32_P = ctypes.POINTER(ctypes.c_int32)
+# Every exported function: name -> (restype, argtypes). The one place they are declared.
+_FUNCTIONS = {
+    "hbao_exr_interface_version": (ctypes.c_int32, []),
+    "hbao_exr_channel_request_size": (ctypes.c_int32, []),
+    "hbao_exr_result_message": (ctypes.c_char_p, [ctypes.c_int32]),
+    "hbao_exr_open": (ctypes.c_int32, [ctypes.c_char_p, ctypes.POINTER(_FILE_P),
+                                       ctypes.c_char_p, ctypes.c_int32]),
+    "hbao_exr_size": (None, [_FILE_P, _INT32_P, _INT32_P]),
+    "hbao_exr_channel_count": (ctypes.c_int32, [_FILE_P]),
+    "hbao_exr_channel_name": (ctypes.c_char_p, [_FILE_P, ctypes.c_int32]),
+    "hbao_exr_has_channel": (ctypes.c_int32, [_FILE_P, ctypes.c_char_p]),
+    "hbao_exr_read_channels": (ctypes.c_int32, [_FILE_P, ctypes.POINTER(_ChannelRequest),
+                                                ctypes.c_int32, ctypes.c_char_p,
+                                                ctypes.c_int32]),
+    "hbao_exr_close": (None, [ctypes.POINTER(_FILE_P)]),
+}
 
-    _HEADER_READ_SIZE = 1 << 16
+_library = None
+_library_lock = threading.Lock()
 
-    def __init__(self, path, stream):
-        data = stream.read(self._HEADER_READ_SIZE)
-        while True:
-            try:
-                attributes, header_end = _parse_header(data, path)
-                break
-            except EXRFormatError:
-                more = stream.read(self._HEADER_READ_SIZE)
-                if not more:
-                    raise
-                data += more
-        for required in ("channels", "compression", "dataWindow", "lineOrder"):
-            if required not in attributes:
-                raise EXRFormatError(f"{path}: EXR header lacks {required}")
-        if attributes["compression"][1][0] != _COMPRESSION_NONE:
-            raise EXRFormatError(f"{path}: compressed EXR; the hook writes it with exr_codec "
-                                 f"'NONE'")
-        if attributes["lineOrder"][1][0] != _LINE_ORDER_INCREASING_Y:
-            raise EXRFormatError(f"{path}: line order is not increasing y")
-        x_min, y_min, x_max, y_max = struct.unpack("<iiii", attributes["dataWindow"][1])
-        self.width = x_max - x_min + 1
-        self.height = y_max - y_min + 1
-        if self.width < 1 or self.height < 1:
-            raise EXRFormatError(f"{path}: empty data window")
-        self.y_min = y_min
-        self.channels = _parse_channels(attributes["channels"][1], path)
-        stream.seek(header_end)
-        table = stream.read(8 * self.height)
-        if len(table) != 8 * self.height:
-            raise EXRFormatError(f"{path}: truncated EXR offset table")
-        self.offsets = np.frombuffer(table, dtype="<u8")
-        self.row_bytes = sum(dtype.itemsize for _, dtype in self.channels) * self.width
-        self.chunk_bytes = _CHUNK_PREFIX_SIZE + self.row_bytes
+
+def library_path():
+    """The file that load_library() loads: $HBAO_EXR_LIBRARY, else lib/libhbao_exr.so here."""
+    override = os.environ.get(LIBRARY_ENVIRONMENT_VARIABLE)
+    return Path(override) if override else _DEFAULT_LIBRARY_PATH
+
+
+def _open_library(path):
+    if not path.is_file():
+        raise EXRLibraryError(
+            f"libhbao_exr not found at {path}. Build it with `cmake -S . -B build && cmake "
+            f"--build build` and copy build/{LIBRARY_FILE_NAME} to "
+            f"{_DEFAULT_LIBRARY_PATH.parent}/ (scripts/install_addon.sh does both), or set "
+            f"{LIBRARY_ENVIRONMENT_VARIABLE} to its path.")
+    try:
+        library = ctypes.CDLL(str(path))
+    except OSError as error:
+        raise EXRLibraryError(
+            f"libhbao_exr at {path} could not be loaded: {error}. It needs OpenEXRCore "
+            f"(libOpenEXRCore-3_1.so) installed or next to it; rebuild or reinstall the "
+            f"add-on with scripts/install_addon.sh.") from error
+    for name, (restype, argtypes) in _FUNCTIONS.items():
+        try:
+            function = getattr(library, name)
+        except AttributeError as error:
+            raise EXRLibraryError(f"libhbao_exr at {path} lacks {name}(): it is not a "
+                                  f"compatible libhbao_exr; rebuild it from this add-on's "
+                                  f"sources.") from error
+        function.restype = restype
+        function.argtypes = argtypes
+    version = library.hbao_exr_interface_version()
+    if version != BINDING_INTERFACE_VERSION:
+        raise EXRLibraryError(
+            f"libhbao_exr at {path} has interface version {version}, this add-on needs "
+            f"{BINDING_INTERFACE_VERSION}: install the library that came with the add-on.")
+    if library.hbao_exr_channel_request_size() != ctypes.sizeof(_ChannelRequest):
+        raise EXRLibraryError(
+            f"libhbao_exr at {path}: sizeof(hbao_exr_channel_request) is "
+            f"{library.hbao_exr_channel_request_size()} bytes, the add-on expects "
+            f"{ctypes.sizeof(_ChannelRequest)}: reinstall the library and add-on together.")
+    return library
+
+
+def load_library():
+    """The loaded library (loaded on the first call). Raises EXRLibraryError."""
+    global _library
+    with _library_lock:
+        if _library is None:
+            _library = _open_library(library_path())
+        return _library
+
+
+def unload_library():
+    """Forget the loaded library so that the next call loads library_path() again."""
+    global _library
+    with _library_lock:
+        _library = None
+
+
+def _text(raw):
+    return raw.decode("utf-8", "replace") if raw else ""
+
+
+class _OpenFile:
+    """An open hbao_exr_file; closes it on leaving the `with` block."""
+
+    def __init__(self, path):
+        self.library = load_library()
+        self.path = os.fspath(path)
+        self.handle = _FILE_P()
+        message = ctypes.create_string_buffer(_MESSAGE_SIZE)
+        result = self.library.hbao_exr_open(os.fsencode(self.path), ctypes.byref(self.handle),
+                                            message, _MESSAGE_SIZE)
+        if result != _SUCCESS:
+            text = _text(message.value) or _text(self.library.hbao_exr_result_message(result))
+            if result == _ERROR_FILE_ACCESS:
+                raise EXRFileError(text)
+            raise EXRFormatError(text, result)
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *_exception):
+        self.library.hbao_exr_close(ctypes.byref(self.handle))
+
+    def size(self):
+        width, height = ctypes.c_int32(), ctypes.c_int32()
+        self.library.hbao_exr_size(self.handle, ctypes.byref(width), ctypes.byref(height))
+        return width.value, height.value
+
+    def names(self):
+        return [_text(self.library.hbao_exr_channel_name(self.handle, index))
+                for index in range(self.library.hbao_exr_channel_count(self.handle))]
+
+    def read(self, requests):
+        """Run hbao_exr_read_channels for [(name, array, channel offset)]."""
+        table = (_ChannelRequest * len(requests))()
+        for entry, (name, array, offset) in zip(table, requests):
+            entry.name = name.encode("utf-8")
+            entry.data = ctypes.cast(array.ctypes.data + offset * _FLOAT.itemsize,
+                                     ctypes.POINTER(ctypes.c_float))
+            entry.pixel_stride = array.strides[1] // _FLOAT.itemsize
+            entry.row_stride = array.strides[0] // _FLOAT.itemsize
+        message = ctypes.create_string_buffer(_MESSAGE_SIZE)
+        result = self.library.hbao_exr_read_channels(self.handle, table, len(requests),
+                                                     message, _MESSAGE_SIZE)
+        if result == _ERROR_MISSING_CHANNEL:
+            missing = next(name for name, _, _ in requests
+                           if not self.library.hbao_exr_has_channel(self.handle,
+                                                                    name.encode("utf-8")))
+            raise KeyError(f"{self.path} has no channel {missing!r}; it has: "
+                           f"{', '.join(sorted(self.names()))}")
+        if result != _SUCCESS:
+            raise EXRFormatError(
+                _text(message.value) or _text(self.library.hbao_exr_result_message(result)),
+                result)
 
 
 def channel_names(path):
     """The channel names of an EXR file, in file order."""
-    with open(path, "rb") as stream:
-        return [name for name, _ in _Layout(path, stream).channels]
+    with _OpenFile(path) as exr_file:
+        return exr_file.names()
+
+
+def image_size(path):
+    """(width, height) of an EXR file's data window."""
+    with _OpenFile(path) as exr_file:
+        return exr_file.size()
+
+
+def read_channel_groups(path, groups):
+    """{key: float32 array, top row first} for `groups` {key: [channel names]}:
+    a group of one name gives a (height, width) array, a group of n names an
+    interleaved (height, width, n) array (Normal.X/Y/Z as one normal image),
+    all decoded in one pass over the file. Raises EXRFileError, EXRFormatError,
+    KeyError naming a missing channel and the channels the file has, or
+    EXRLibraryError when libhbao_exr cannot be loaded."""
+    groups = {key: [names] if isinstance(names, str) else list(names)
+              for key, names in groups.items()}
+    with _OpenFile(path) as exr_file:
+        width, height = exr_file.size()
+        result, requests = {}, []
+        for key, names in groups.items():
+            if not names:
+                raise ValueError(f"group {key!r} names no channels")
+            array = np.empty((height, width, len(names)), dtype=np.float32)
+            requests += [(name, array, offset) for offset, name in enumerate(names)]
+            result[key] = array[:, :, 0] if len(names) == 1 else array
+        duplicates = {name for name, _, _ in requests
+                      if sum(other == name for other, _, _ in requests) > 1}
+        if duplicates:
+            raise ValueError(f"channels requested twice: {', '.join(sorted(duplicates))}")
+        if requests:
+            exr_file.read(requests)
+    return result
 
 
 def read_channels(path, names):
     """{name: (height, width) float32 array, top row first} for the channels
-    `names` of the uncompressed EXR at `path`. Raises EXRFormatError, or
-    KeyError naming a missing channel and the channels the file has."""
-    with open(path, "rb") as stream:
-        layout = _Layout(path, stream)
-        size = stream.seek(0, 2)
-        first_row = int(layout.offsets[0])
-        # Read the file into a buffer shifted so that the pixel data of every
-        # row starts on a float boundary: the arrays handed to C are aligned.
-        shift = -(first_row + _CHUNK_PREFIX_SIZE) % _FLOAT_ALIGNMENT
-        buffer = np.empty(size + shift, dtype=np.uint8)
-        stream.seek(0)
-        if stream.readinto(memoryview(buffer)[shift:]) != size:
-            raise EXRFormatError(f"{path}: file changed while being read")
-    expected = first_row + np.arange(layout.height, dtype=np.uint64) * layout.chunk_bytes
-    if not np.array_equal(layout.offsets, expected):
-        raise EXRFormatError(f"{path}: rows are not stored one after another")
-    if first_row + layout.height * layout.chunk_bytes > size:
-        raise EXRFormatError(f"{path}: truncated EXR pixel data")
-    rows = buffer[shift + first_row: shift + first_row + layout.height * layout.chunk_bytes]
-    rows = rows.reshape(layout.height, layout.chunk_bytes)
-    row_y = rows[:, 0:4].copy().view("<i4").reshape(-1)
-    if not np.array_equal(row_y, layout.y_min + np.arange(layout.height)):
-        raise EXRFormatError(f"{path}: rows are out of order")
-
-    available = {}
-    column = _CHUNK_PREFIX_SIZE
-    for name, dtype in layout.channels:
-        available[name] = (column, dtype)
-        column += dtype.itemsize * layout.width
-    result = {}
-    for name in names:
-        if name not in available:
-            raise KeyError(f"{path} has no channel {name!r}; it has: "
-                           f"{', '.join(sorted(available))}")
-        column, dtype = available[name]
-        view = rows[:, column:column + dtype.itemsize * layout.width].view(dtype)
-        result[name] = view if dtype == np.float32 else view.astype(np.float32)
-    return result
-
+    `names` of the EXR at `path` (each channel once, whatever `names` repeats).
+    Raises EXRFileError, EXRFormatError, KeyError naming a missing channel and
+    the channels the file has, or EXRLibraryError."""
+    return read_channel_groups(path, {name: [name] for name in dict.fromkeys(names)})

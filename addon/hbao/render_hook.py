@@ -459,7 +459,9 @@ def compute_passes(engine, depsgraph, width, height):
     if not jobs:
         return {}
     timings = {}
-    native.load_library()  # fail early, before the save, if it is missing
+    # Fail early, before the save, if a library is missing.
+    native.load_library()
+    exr_passes.load_library()
     camera = camera_model.camera_for_render_result(main, _evaluated_camera(main, depsgraph))
 
     start = time.perf_counter()
@@ -467,13 +469,15 @@ def compute_passes(engine, depsgraph, width, height):
     try:
         save_main_passes(main, path)
         timings["save"] = time.perf_counter() - start
-        names = set()
+        # One decode pass: each layer's depth, and its normal as one
+        # interleaved (height, width, 3) image, as libhbao reads it.
+        groups = {}
         for job in jobs:
-            names.add(f"{job.layer}.Depth.Z")
+            groups[("depth", job.layer)] = [f"{job.layer}.Depth.Z"]
             if job.with_normal:
-                names.update(f"{job.layer}.Normal.{axis}" for axis in "XYZ")
+                groups[("normal", job.layer)] = [f"{job.layer}.Normal.{axis}" for axis in "XYZ"]
         read_start = time.perf_counter()
-        channels = exr_passes.read_channels(path, sorted(names))
+        channels = exr_passes.read_channel_groups(path, groups)
         timings["read"] = time.perf_counter() - read_start
     finally:
         if os.path.exists(path):
@@ -481,19 +485,13 @@ def compute_passes(engine, depsgraph, width, height):
 
     results = {}
     compute_time = 0.0
-    normals = {}
     for index, job in enumerate(jobs):
         engine.update_stats("HBAO", f"{job.node_name}: computing AO ({index + 1}/{len(jobs)})")
-        depth = channels[f"{job.layer}.Depth.Z"]
+        depth = channels[("depth", job.layer)]
         if depth.shape != (height, width):
             raise RuntimeError(f"the Render Result is {depth.shape[1]}x{depth.shape[0]}, the "
                                f"helper scene renders {width}x{height}")
-        normal = None
-        if job.with_normal:
-            if job.layer not in normals:
-                normals[job.layer] = np.stack(
-                    [channels[f"{job.layer}.Normal.{axis}"] for axis in "XYZ"], axis=-1)
-            normal = normals[job.layer]
+        normal = channels[("normal", job.layer)] if job.with_normal else None
         compute_start = time.perf_counter()
         # The EXR's rows run top-down, a render pass bottom-up: views flipped, no copy.
         results[job.pass_name] = native.compute_ao(
@@ -513,7 +511,7 @@ def render_helper(engine, depsgraph):
     engine.hbao_timings = {}
     try:
         results = compute_passes(engine, depsgraph, width, height)
-    except native.HBAOLibraryError as error:
+    except (native.HBAOLibraryError, exr_passes.EXRLibraryError) as error:
         results = {}
         _report_failure(engine, f"{error} Rendering without AO.")
     except Exception as error:  # the render must complete: AO = 1

@@ -1,0 +1,445 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""libhbao_exr (csrc/exr/hbao_exr.h), the add-on's EXR reader, called through
+ctypes on EXRs that Blender wrote: its pixels must be exactly what the `hbao`
+tool reads (the same OpenEXRCore reader, shared object files), and bad input
+must give a result code and a message, never a crash."""
+import ctypes
+import importlib.util
+import json
+import os
+import subprocess
+import threading
+
+import numpy as np
+import pytest
+
+from conftest import BLENDER, EXR_LIBRARY, FIXTURES, SCRIPTS, blender_environment
+
+# hbao_exr.h result codes.
+SUCCESS = 0
+ERROR_INVALID_ARGUMENT = 1
+ERROR_FILE_ACCESS = 3
+ERROR_FORMAT = 4
+ERROR_MISSING_CHANNEL = 5
+RESULT_CODES = (0, 1, 2, 3, 4, 5)
+MESSAGE_SIZE = 1024  # HBAO_EXR_MESSAGE_SIZE
+# Fixture renders: tiny and few samples; the pixel values do not matter, only
+# that Blender wrote them. One file as the render hook writes it (32-bit,
+# uncompressed), one as artists often save (half float, ZIP), two layers.
+RENDERS = {
+    "hook_like": ["--scene", "corner", "--width", "48", "--height", "32", "--samples", "1",
+                  "--codec", "NONE"],
+    "half_zip_two_layers": ["--scene", "two_layers", "--width", "40", "--height", "24",
+                            "--samples", "1", "--codec", "ZIP", "--half"],
+}
+THREADS = 4
+# cJSON prints a double with 15 significant digits when that reads back
+# within DBL_EPSILON relative (else with 17): twice DBL_EPSILON bounds it.
+JSON_RELATIVE_TOLERANCE = 2 * np.finfo(np.float64).eps
+
+
+def _load_binding():
+    spec = importlib.util.spec_from_file_location(
+        "hbao_exr_binding_under_test", SCRIPTS.parent / "addon" / "hbao" / "exr_passes.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+exr = _load_binding()
+
+
+class ChannelRequest(ctypes.Structure):
+    _fields_ = [("name", ctypes.c_char_p), ("data", ctypes.POINTER(ctypes.c_float)),
+                ("pixel_stride", ctypes.c_int32), ("row_stride", ctypes.c_int64)]
+
+
+@pytest.fixture(scope="module")
+def library():
+    """The raw C interface, declared here independently of the add-on's binding."""
+    if not EXR_LIBRARY.exists():
+        pytest.fail(f"{EXR_LIBRARY} missing: build with scripts/test.sh or cmake first")
+    lib = ctypes.CDLL(str(EXR_LIBRARY))
+    handle_p = ctypes.POINTER(ctypes.c_void_p)
+    lib.hbao_exr_open.argtypes = [ctypes.c_char_p, handle_p, ctypes.c_char_p, ctypes.c_int32]
+    lib.hbao_exr_size.argtypes = [ctypes.c_void_p, ctypes.POINTER(ctypes.c_int32),
+                                  ctypes.POINTER(ctypes.c_int32)]
+    lib.hbao_exr_size.restype = None
+    lib.hbao_exr_channel_count.argtypes = [ctypes.c_void_p]
+    lib.hbao_exr_channel_name.argtypes = [ctypes.c_void_p, ctypes.c_int32]
+    lib.hbao_exr_channel_name.restype = ctypes.c_char_p
+    lib.hbao_exr_has_channel.argtypes = [ctypes.c_void_p, ctypes.c_char_p]
+    lib.hbao_exr_read_channel.argtypes = [ctypes.c_void_p, ctypes.c_char_p,
+                                          ctypes.POINTER(ctypes.c_float), ctypes.c_int32,
+                                          ctypes.c_int64, ctypes.c_char_p, ctypes.c_int32]
+    lib.hbao_exr_read_channels.argtypes = [ctypes.c_void_p, ctypes.POINTER(ChannelRequest),
+                                           ctypes.c_int32, ctypes.c_char_p, ctypes.c_int32]
+    lib.hbao_exr_close.argtypes = [handle_p]
+    lib.hbao_exr_close.restype = None
+    lib.hbao_exr_result_message.argtypes = [ctypes.c_int32]
+    lib.hbao_exr_result_message.restype = ctypes.c_char_p
+    return lib
+
+
+@pytest.fixture(scope="session")
+def blender_exrs(tmp_path_factory, blender_user_scripts):
+    """Blender-written EXRs: tests/fixtures/*.exr when present, plus small
+    renders made here by scripts/render_passes.py."""
+    if BLENDER is None:
+        pytest.fail("blender not found: run scripts/setup.sh")
+    folder = tmp_path_factory.mktemp("blender_exrs")
+    paths = sorted(FIXTURES.glob("*.exr")) if FIXTURES.is_dir() else []
+    for name, arguments in RENDERS.items():
+        completed = subprocess.run(
+            [BLENDER, "-b", "--factory-startup", "-noaudio", "--python",
+             str(SCRIPTS / "render_passes.py"), "--", "--out", str(folder / name)] + arguments,
+            env=blender_environment(blender_user_scripts), stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT, text=True, timeout=600)
+        assert completed.returncode == 0, completed.stdout[-3000:]
+        paths.append(folder / f"{name}.exr")
+    return paths
+
+
+def cli_info(hbao_tool, path):
+    completed = subprocess.run([str(hbao_tool), "--info", "--json", str(path)],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert completed.returncode == 0, completed.stderr
+    return json.loads(completed.stdout)
+
+
+def statistics(values):
+    """min, max, mean, finite and non-finite counts as info_command.c computes
+    them: in double, the sum running over the finite values in row order
+    (np.cumsum adds sequentially, so the sum is bit-identical to the C loop)."""
+    values = values.astype(np.float64).reshape(-1)
+    finite = values[np.isfinite(values)]
+    if finite.size == 0:
+        return {"min": None, "max": None, "mean": None, "finite": 0,
+                "nonfinite": int(values.size)}
+    return {"min": float(finite.min()), "max": float(finite.max()),
+            "mean": float(np.cumsum(finite)[-1] / finite.size), "finite": int(finite.size),
+            "nonfinite": int(values.size - finite.size)}
+
+
+def open_file(library, path):
+    handle = ctypes.c_void_p()
+    message = ctypes.create_string_buffer(MESSAGE_SIZE)
+    result = library.hbao_exr_open(os.fsencode(path), ctypes.byref(handle), message,
+                                   MESSAGE_SIZE)
+    return result, handle, message.value.decode()
+
+
+def test_every_channel_matches_the_cli_exactly(blender_exrs, hbao_tool):
+    """Depth.Z, Normal.X/Y/Z and every other channel: the statistics of what
+    the binding returns equal `hbao --info`'s exactly (same reader, same
+    floats; the tool prints doubles that round-trip)."""
+    checked_passes = 0
+    for path in blender_exrs:
+        info = cli_info(hbao_tool, path)
+        names = exr.channel_names(path)
+        assert names == [channel["name"] for channel in info["channels"]]
+        assert exr.image_size(path) == (info["width"], info["height"])
+        channels = exr.read_channels(path, names)
+        for channel in info["channels"]:
+            values = channels[channel["name"]]
+            assert values.shape == (info["height"], info["width"])
+            assert values.dtype == np.float32
+            measured = statistics(values)
+            where = (path, channel["name"])
+            assert (measured["finite"], measured["nonfinite"]) == \
+                (channel["finite"], channel["nonfinite"]), where
+            if channel["min"] is None:
+                assert measured["min"] is None, where
+                continue
+            # min and max are pixel values: exactly the same float32.
+            assert np.float32(measured["min"]) == np.float32(channel["min"]), where
+            assert np.float32(measured["max"]) == np.float32(channel["max"]), where
+            # Same double sum in the same order; only cJSON's printing loses
+            # bits (it prints 15 digits when they read back within DBL_EPSILON).
+            assert measured["mean"] == pytest.approx(channel["mean"],
+                                                     rel=JSON_RELATIVE_TOLERANCE), where
+            if channel["name"].endswith((".Depth.Z", ".Normal.X", ".Normal.Y", ".Normal.Z")):
+                checked_passes += 1
+        # Not all constant: a reader that returned one value everywhere would fail.
+        for layer in info["layers"]:
+            depth = channels[f"{layer}.Depth.Z"]
+            assert depth.min() < depth.max()
+    # Both renders have Depth and Normal; the two-layer one in two layers.
+    assert checked_passes >= 4 * 3
+
+
+def test_rows_come_top_row_first(blender_exrs):
+    """Statistics cannot see a flipped image; the scene can. The renders look
+    at a back wall (world normal horizontal, Z = 0) above a floor (Z = 1): the
+    first row returned must be wall, the last floor. 0.1 is far from both."""
+    for path in blender_exrs[-len(RENDERS):]:
+        names = [name for name in exr.channel_names(path) if name.endswith(".Normal.Z")]
+        assert names
+        for name, normal_z in exr.read_channels(path, names).items():
+            assert abs(normal_z[0].mean()) < 0.1, (path, name)
+            assert abs(normal_z[-1].mean() - 1.0) < 0.1, (path, name)
+
+
+def test_interleaved_groups_equal_separate_planes(blender_exrs):
+    path = blender_exrs[-1]
+    layers = sorted({name.split(".")[0] for name in exr.channel_names(path)
+                     if name.endswith(".Depth.Z")})
+    assert len(layers) == 2
+    groups = {layer: [f"{layer}.Normal.{axis}" for axis in "XYZ"] for layer in layers}
+    groups["depth"] = f"{layers[0]}.Depth.Z"
+    interleaved = exr.read_channel_groups(path, groups)
+    planes = exr.read_channels(path, [name for layer in layers for name in groups[layer]])
+    for layer in layers:
+        assert interleaved[layer].shape[2] == 3
+        for index, axis in enumerate("XYZ"):
+            assert np.array_equal(interleaved[layer][:, :, index],
+                                  planes[f"{layer}.Normal.{axis}"])
+    assert np.array_equal(interleaved["depth"], exr.read_channels(
+        path, [groups["depth"]])[groups["depth"]])
+
+
+def test_strided_read_fills_only_its_pixels(library, blender_exrs):
+    """hbao_exr_read_channel with pixel stride 2 and padded rows writes every
+    second float of each row and leaves the rest as it was."""
+    path = blender_exrs[0]
+    result, handle, message = open_file(library, path)
+    assert result == SUCCESS, message
+    try:
+        width, height = ctypes.c_int32(), ctypes.c_int32()
+        library.hbao_exr_size(handle, ctypes.byref(width), ctypes.byref(height))
+        width, height = width.value, height.value
+        name = next(library.hbao_exr_channel_name(handle, i).decode()
+                    for i in range(library.hbao_exr_channel_count(handle))
+                    if library.hbao_exr_channel_name(handle, i).endswith(b".Depth.Z"))
+        row_stride = 2 * width + 3
+        buffer = np.full((height, row_stride), -7.0, dtype=np.float32)
+        error = ctypes.create_string_buffer(MESSAGE_SIZE)
+        assert library.hbao_exr_read_channel(
+            handle, name.encode(), buffer.ctypes.data_as(ctypes.POINTER(ctypes.c_float)), 2,
+            row_stride, error, MESSAGE_SIZE) == SUCCESS, error.value
+    finally:
+        library.hbao_exr_close(ctypes.byref(handle))
+    expected = exr.read_channels(path, [name])[name]
+    assert np.array_equal(buffer[:, 0:2 * width:2], expected)
+    untouched = np.ones(buffer.shape, bool)
+    untouched[:, 0:2 * width:2] = False
+    assert np.all(buffer[untouched] == -7.0)
+
+
+def test_missing_channel_is_a_clean_error(library, blender_exrs):
+    path = blender_exrs[0]
+    result, handle, message = open_file(library, path)
+    assert result == SUCCESS, message
+    try:
+        assert library.hbao_exr_has_channel(handle, b"ViewLayer.Depth.Z") == 1
+        assert library.hbao_exr_has_channel(handle, b"NoLayer.Depth.Z") == 0
+        assert library.hbao_exr_channel_name(handle, -1) is None
+        assert library.hbao_exr_channel_name(
+            handle, library.hbao_exr_channel_count(handle)) is None
+        out = np.zeros(1 << 16, np.float32)
+        requests = (ChannelRequest * 2)(
+            ChannelRequest(b"ViewLayer.Depth.Z", out.ctypes.data_as(ctypes.POINTER(
+                ctypes.c_float)), 1, 256),
+            ChannelRequest(b"NoLayer.Depth.Z", out.ctypes.data_as(ctypes.POINTER(
+                ctypes.c_float)), 1, 256))
+        error = ctypes.create_string_buffer(MESSAGE_SIZE)
+        assert library.hbao_exr_read_channels(handle, requests, 2, error,
+                                              MESSAGE_SIZE) == ERROR_MISSING_CHANNEL
+        assert b"no channel named NoLayer.Depth.Z" in error.value
+        assert not out.any()  # refused before decoding anything
+    finally:
+        library.hbao_exr_close(ctypes.byref(handle))
+    with pytest.raises(KeyError, match="has no channel 'NoLayer.Depth.Z'; it has: .*Depth.Z"):
+        exr.read_channels(path, ["ViewLayer.Depth.Z", "NoLayer.Depth.Z"])
+
+
+def test_bad_requests_are_refused(library, blender_exrs):
+    result, handle, message = open_file(library, blender_exrs[0])
+    assert result == SUCCESS, message
+    out = np.zeros(1 << 16, np.float32)
+    data = out.ctypes.data_as(ctypes.POINTER(ctypes.c_float))
+    error = ctypes.create_string_buffer(MESSAGE_SIZE)
+    name = b"ViewLayer.Depth.Z"
+    try:
+        for bad in (ChannelRequest(name, data, 0, 64), ChannelRequest(name, data, 1, 0),
+                    ChannelRequest(name, data, 1, -64), ChannelRequest(name, None, 1, 64),
+                    ChannelRequest(None, data, 1, 64), ChannelRequest(name, data, 1, 1 << 40)):
+            assert library.hbao_exr_read_channels(handle, ctypes.byref(bad), 1, error,
+                                                  MESSAGE_SIZE) == ERROR_INVALID_ARGUMENT
+            assert error.value
+        twice = (ChannelRequest * 2)(ChannelRequest(name, data, 1, 64),
+                                     ChannelRequest(name, data, 1, 64))
+        assert library.hbao_exr_read_channels(handle, twice, 2, error,
+                                              MESSAGE_SIZE) == ERROR_INVALID_ARGUMENT
+        assert b"requested twice" in error.value
+        assert library.hbao_exr_read_channels(None, twice, 1, error,
+                                              MESSAGE_SIZE) == ERROR_INVALID_ARGUMENT
+        # No message buffer at all is allowed: only the code comes back.
+        assert library.hbao_exr_read_channels(handle, twice, 2, None, 0) == \
+            ERROR_INVALID_ARGUMENT
+    finally:
+        library.hbao_exr_close(ctypes.byref(handle))
+    assert not out.any()
+
+
+def _expect_failure(library, path, codes):
+    """Opening and reading every channel of `path` fails with one of `codes`
+    and a message naming the file; the process survives (no crash)."""
+    result, handle, message = open_file(library, path)
+    if result == SUCCESS:
+        try:
+            width, height = ctypes.c_int32(), ctypes.c_int32()
+            library.hbao_exr_size(handle, ctypes.byref(width), ctypes.byref(height))
+            count = library.hbao_exr_channel_count(handle)
+            out = np.zeros((count, height.value, width.value), np.float32)
+            requests = (ChannelRequest * count)(*[
+                ChannelRequest(library.hbao_exr_channel_name(handle, c),
+                               out[c].ctypes.data_as(ctypes.POINTER(ctypes.c_float)), 1,
+                               width.value) for c in range(count)])
+            error = ctypes.create_string_buffer(MESSAGE_SIZE)
+            result = library.hbao_exr_read_channels(handle, requests, count, error,
+                                                    MESSAGE_SIZE)
+            message = error.value.decode()
+        finally:
+            library.hbao_exr_close(ctypes.byref(handle))
+    else:
+        assert handle.value is None  # a failed open hands back no handle
+    assert result in codes, (path, result, message)
+    assert str(path) in message
+
+
+def test_truncated_files_give_an_error(library, blender_exrs, tmp_path):
+    data = blender_exrs[0].read_bytes()
+    # Cut inside the magic number, the header, the offset table, the pixel
+    # data and just before the last byte.
+    for length in (3, 40, 400, len(data) // 2, len(data) - 1):
+        path = tmp_path / f"truncated_{length}.exr"
+        path.write_bytes(data[:length])
+        _expect_failure(library, path, (ERROR_FORMAT,))
+        with pytest.raises(exr.EXRFormatError, match=str(path)):
+            exr.read_channels(path, exr.channel_names(blender_exrs[0]))
+
+
+def test_garbage_and_missing_files_give_an_error(library, blender_exrs, tmp_path):
+    rng = np.random.default_rng(2024)
+    data = blender_exrs[0].read_bytes()
+    cases = {
+        "random.exr": rng.integers(0, 256, 4096, dtype=np.uint8).tobytes(),
+        "magic_then_random.exr": data[:8] + rng.integers(0, 256, 4096, dtype=np.uint8).tobytes(),
+        "empty.exr": b"",
+        "text.exr": b"this is not an image\n" * 50,
+    }
+    for name, content in cases.items():
+        path = tmp_path / name
+        path.write_bytes(content)
+        _expect_failure(library, path, (ERROR_FORMAT,))
+    missing = tmp_path / "does_not_exist.exr"
+    _expect_failure(library, missing, (ERROR_FILE_ACCESS,))
+    with pytest.raises(exr.EXRFileError, match="does_not_exist.exr: cannot open"):
+        exr.channel_names(missing)
+    _expect_failure(library, tmp_path, (ERROR_FORMAT, ERROR_FILE_ACCESS))  # a folder
+
+
+def test_invalid_open_arguments_and_double_close(library, blender_exrs):
+    message = ctypes.create_string_buffer(MESSAGE_SIZE)
+    assert library.hbao_exr_open(os.fsencode(blender_exrs[0]), None, message,
+                                 MESSAGE_SIZE) == ERROR_INVALID_ARGUMENT
+    handle = ctypes.c_void_p(1234)
+    assert library.hbao_exr_open(None, ctypes.byref(handle), message,
+                                 MESSAGE_SIZE) == ERROR_INVALID_ARGUMENT
+    assert handle.value is None
+    result, handle, text = open_file(library, blender_exrs[0])
+    assert result == SUCCESS, text
+    library.hbao_exr_close(ctypes.byref(handle))
+    assert handle.value is None  # the close set the handle back to NULL
+    library.hbao_exr_close(ctypes.byref(handle))  # closing twice is harmless
+    library.hbao_exr_close(None)
+    assert library.hbao_exr_channel_count(None) == 0
+    width, height = ctypes.c_int32(5), ctypes.c_int32(5)
+    library.hbao_exr_size(None, ctypes.byref(width), ctypes.byref(height))
+    assert (width.value, height.value) == (0, 0)
+
+
+def test_result_messages(library):
+    messages = [library.hbao_exr_result_message(code) for code in RESULT_CODES]
+    assert all(messages) and len(set(messages)) == len(RESULT_CODES)
+    assert library.hbao_exr_result_message(99) == b"unknown result"
+
+
+def test_reads_in_parallel_threads_agree(blender_exrs):
+    """Each thread opens its own handle; errors and pixels stay per thread."""
+    path = blender_exrs[-1]
+    names = exr.channel_names(path)
+    reference = exr.read_channels(path, names)
+    failures, results = [], []
+
+    def work(index):
+        try:
+            for _ in range(5):
+                results.append(exr.read_channels(path, names))
+                with pytest.raises(KeyError):
+                    exr.read_channels(path, [f"Missing{index}.Z"])
+        except Exception as error:  # reported below, in the test's thread
+            failures.append(error)
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(THREADS)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert not failures
+    assert len(results) == THREADS * 5
+    for result in results:
+        assert all(np.array_equal(result[name], reference[name], equal_nan=True)
+                   for name in names)
+
+
+def test_binding_says_what_to_do_when_the_library_is_missing(tmp_path, monkeypatch):
+    monkeypatch.setenv(exr.LIBRARY_ENVIRONMENT_VARIABLE, str(tmp_path / "libhbao_exr.so"))
+    exr.unload_library()
+    try:
+        with pytest.raises(exr.EXRLibraryError, match="libhbao_exr not found at .*"
+                                                      "install_addon.sh"):
+            exr.read_channels(tmp_path / "any.exr", ["Z"])
+        (tmp_path / "libhbao_exr.so").write_bytes(b"not a library")
+        with pytest.raises(exr.EXRLibraryError, match="could not be loaded"):
+            exr.load_library()
+    finally:
+        exr.unload_library()
+
+
+def _offset_table_start(data, rows):
+    """Byte position of the offset table of an uncompressed single-part
+    scanline EXR (one row per chunk): its first entry points just past it."""
+    for position in range(8, len(data) - 8):
+        if int.from_bytes(data[position:position + 8], "little") == position + 8 * rows:
+            return position
+    raise AssertionError("no offset table found")
+
+
+def test_corrupt_offset_tables_never_give_wrong_pixels(library, blender_exrs, tmp_path):
+    """Offsets past the end of the file, or every row pointing at the first
+    chunk: an error, or (when OpenEXRCore rebuilds the table from the chunks
+    themselves) exactly the original pixels; never other data, never a crash."""
+    original = blender_exrs[0]
+    names = exr.channel_names(original)
+    reference = exr.read_channels(original, names)
+    _, rows = exr.image_size(original)
+    data = original.read_bytes()
+    table = _offset_table_start(data, rows)
+    first_chunk = data[table:table + 8]
+    variants = {"past_the_end": (1 << 62).to_bytes(8, "little") * rows,
+                "all_first_chunk": first_chunk * rows,
+                "reversed": b"".join(data[table + 8 * r:table + 8 * r + 8]
+                                     for r in reversed(range(rows)))}
+    for name, new_table in variants.items():
+        path = tmp_path / f"{name}.exr"
+        path.write_bytes(data[:table] + new_table + data[table + 8 * rows:])
+        try:
+            channels = exr.read_channels(path, names)
+        except exr.EXRFormatError as error:
+            assert str(path) in str(error)
+            assert error.code == ERROR_FORMAT
+            continue
+        for channel in names:
+            assert np.array_equal(channels[channel], reference[channel], equal_nan=True), name
