@@ -20,15 +20,20 @@ PYTHON="${PYTHON:-/usr/bin/python3}"
 "$REPO/scripts/setup.sh"
 
 echo "== build (Release) and C tests"
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
+# Options are given explicitly: a build folder configured earlier (e.g. by
+# fuzz_cli.sh, which turns the tests off) keeps its cached values otherwise.
+OPTIONS=(-DHBAO_BUILD_TOOL=ON -DHBAO_BUILD_TESTS=ON)
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DHBAO_SANITIZE=OFF -DHBAO_BUILD_BENCHMARKS=ON \
+    "${OPTIONS[@]}" >/dev/null
 cmake --build build -j"$JOBS"
-ctest --test-dir build --output-on-failure -j"$JOBS"
+ctest --test-dir build --output-on-failure --no-tests=error -j"$JOBS"
 
 echo "== build with AddressSanitizer + UndefinedBehaviorSanitizer and C tests"
 cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=Debug -DHBAO_SANITIZE=ON \
-    -DHBAO_BUILD_BENCHMARKS=OFF >/dev/null
+    -DHBAO_BUILD_BENCHMARKS=OFF "${OPTIONS[@]}" >/dev/null
 cmake --build build-sanitize -j"$JOBS"
-ASAN_OPTIONS=detect_leaks=1 ctest --test-dir build-sanitize --output-on-failure -j"$JOBS"
+ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
+    ctest --test-dir build-sanitize --output-on-failure --no-tests=error -j"$JOBS"
 if [ -x scripts/fuzz_cli.sh ]; then
     # 100 mutations per fixture keep this step short; the script defaults to 500
     scripts/fuzz_cli.sh 100 1

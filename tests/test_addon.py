@@ -222,8 +222,8 @@ def test_saved_file_renders_from_the_command_line(run_blender, tmp_path, native)
     (setup / "camera_0001.json").write_text(json.dumps(_camera_of(blend, tmp_path)))
     ao = node_outputs(setup, 1)["ao"]
     depth, normal = frame_passes(out, 1)
-    expected = native.compute_ao(depth, normal, params=node_params(radius=0.6,
-                                                                    integration="HBAO"),
+    expected = native.compute_ao(depth, normal,
+                                 params=node_params(radius=0.6, integration="HBAO"),
                                  camera=camera(setup, 1))
     assert np.abs(ao - expected).max() <= EXACT
 
@@ -248,7 +248,7 @@ def _camera_of(blend, tmp_path):
         [BLENDER, "-b", str(blend), "--factory-startup", "--python", str(script)],
         env=blender_environment(_user_scripts(tmp_path), None), stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT, text=True, timeout=600)
-    line = next(l for l in completed.stdout.splitlines() if l.startswith("CAMERA "))
+    line = next(text for text in completed.stdout.splitlines() if text.startswith("CAMERA "))
     return json.loads(line[len("CAMERA "):])
 
 
