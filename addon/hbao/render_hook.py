@@ -507,26 +507,27 @@ def compute_passes(engine, depsgraph, width, height):
 def render_helper(engine, depsgraph):
     """HBAOPassEngine.render(): fill every registered AO pass, 1 where it failed."""
     start = time.perf_counter()
-    width, height = engine.resolution_x, engine.resolution_y
     engine.hbao_timings = {}
+    # The result's own size: a border render cropped to its region is
+    # smaller than engine.resolution_x/y (the full frame).
+    result = engine.begin_result(0, 0, engine.resolution_x, engine.resolution_y)
+    width, height = result.resolution_x, result.resolution_y
     try:
-        results = compute_passes(engine, depsgraph, width, height)
-    except (native.HBAOLibraryError, exr_passes.EXRLibraryError) as error:
-        results = {}
-        _report_failure(engine, f"{error} Rendering without AO.")
-    except Exception as error:  # the render must complete: AO = 1
-        results = {}
-        _report_failure(engine, f"{type(error).__name__}: {error}. Rendering without AO.")
-
-    write_start = time.perf_counter()
-    result = engine.begin_result(0, 0, width, height)
-    try:
+        try:
+            results = compute_passes(engine, depsgraph, width, height)
+        except (native.HBAOLibraryError, exr_passes.EXRLibraryError) as error:
+            results = {}
+            _report_failure(engine, f"{error} Rendering without AO.")
+        except Exception as error:  # the render must complete: AO = 1
+            results = {}
+            _report_failure(engine, f"{type(error).__name__}: {error}. Rendering without AO.")
+        write_start = time.perf_counter()
         for layer in result.layers:
             for render_pass in layer.passes:
                 if not render_pass.name.startswith("HBAO "):
                     continue
                 ao = results.get(render_pass.name)
-                if ao is None:
+                if ao is None or ao.size != width * height:
                     ao = np.ones((height, width), np.float32)
                 render_pass.rect.foreach_set(ao.reshape(-1))
     finally:

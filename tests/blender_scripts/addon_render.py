@@ -12,7 +12,8 @@ both uncompressed 32-bit float. Usage:
 
 Spec keys (all optional): resolution [w, h], samples, engine, scene
 ("corner" | "two_layers"), frames [..], ao_reference (distance: adds Cycles'
-AO pass), orthographic, save_blend (path: saved after the setup, before
+AO pass), orthographic, border [min_x, max_x, min_y, max_y] (a border render
+cropped to it), save_blend (path: saved after the setup, before
 rendering), nodes: [{name, layer, normal (bool), radius, keyframes [[frame,
 radius], ..], radius_from_value_node, falloff, integration, blur_size,
 angle_bias, directions, steps, mute}], disable_normal_pass, disable_depth_pass.
@@ -43,6 +44,12 @@ if spec.get("ao_reference"):
     blender_scenes.configure_ao_reference(scene, spec["ao_reference"])
 if spec.get("orthographic"):
     blender_scenes.make_orthographic(scene)
+if spec.get("border"):
+    render_settings = scene.render
+    (render_settings.border_min_x, render_settings.border_max_x,
+     render_settings.border_min_y, render_settings.border_max_y) = spec["border"]
+    render_settings.use_border = True
+    render_settings.use_crop_to_border = True
 
 scene.use_nodes = True
 tree = scene.node_tree
