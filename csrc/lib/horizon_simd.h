@@ -77,27 +77,51 @@ typedef struct SIMD_NAME(block) {
     int j;
 } SIMD_NAME(block);
 
-/* One step of the march for all lanes: the sample vector, its squared
- * length and which lanes have a usable sample (returned); lanes whose step
- * left the image are removed from *alive. */
-static inline VM SIMD_NAME(march_step)(const SIMD_NAME(block) * b, int step, VF dc, VF ds,
-                                       VM *alive, VF delta[3], VF *dist2) {
+/* The depth fetches of a direction's steps. They depend only on the steps'
+ * positions, so all of them are issued first (one gather per step, back to
+ * back, their latencies overlapping) and the horizon logic runs afterwards. */
+typedef struct SIMD_NAME(fetch) {
+    VF zs;
+    VI si, sj;
+    VM candidate; /* inside the image, on another pixel */
+} SIMD_NAME(fetch);
+
+/* Fills fetches[0..n) and returns n, the steps before every lane has left
+ * the image. */
+static inline int SIMD_NAME(fetch_steps)(const SIMD_NAME(block) * b, int steps, VF dc, VF ds,
+                                         VM active, SIMD_NAME(fetch) * fetches) {
     const hbao_grid *g = b->grid;
-    const VF t = V_ADD(V_SET(1.0f), V_MUL(V_ADD(V_SET((float)step), b->jitter), b->step_px));
-    const VF x = V_ADD(b->base_x, V_MUL(dc, t));
-    const VF y = V_SUB(b->base_y, V_MUL(V_MUL(ds, t), b->inv_ycor));
-    const VM inside = M_AND(M_AND(V_GE(x, V_SET(0.0f)), V_GE(y, V_SET(0.0f))),
-                            M_AND(V_LT(x, V_SET((float)g->width)), V_LT(y, V_SET((float)g->height))));
-    *alive = M_AND(*alive, inside);
-    const VI si = I_ZERO_UNLESS(*alive, I_CVTT(x));
-    const VI sj = I_ZERO_UNLESS(*alive, I_CVTT(y));
-    const VM same = M_AND(I_CMPEQ(si, b->lane_i), I_CMPEQ(sj, I_SET(b->j)));
-    const VM candidate = M_ANDNOT(same, *alive);
-    const VI index = I_ZERO_UNLESS(candidate, I_ADD(I_MULLO(sj, I_SET(g->width)), si));
-    const VF zs = V_ZERO_UNLESS(candidate, V_GATHER(g->depth, index, candidate));
-    const VM valid = M_AND(candidate, V_GT(zs, V_SET(0.0f)));
-    const VF column = V_MUL(V_ADD(I_TO_F(si), V_SET(g->x_offset)), V_SET(g->x_step));
-    const VF row = V_MUL(V_ADD(I_TO_F(sj), V_SET(g->y_offset)), V_SET(g->y_step));
+    VM alive = active;
+    int step = 0;
+    for (; step < steps && M_ANY(alive); step++) {
+        const VF t = V_ADD(V_SET(1.0f), V_MUL(V_ADD(V_SET((float)step), b->jitter), b->step_px));
+        const VF x = V_ADD(b->base_x, V_MUL(dc, t));
+        const VF y = V_SUB(b->base_y, V_MUL(V_MUL(ds, t), b->inv_ycor));
+        const VM inside = M_AND(M_AND(V_GE(x, V_SET(0.0f)), V_GE(y, V_SET(0.0f))),
+                                M_AND(V_LT(x, V_SET((float)g->width)), V_LT(y, V_SET((float)g->height))));
+        alive = M_AND(alive, inside);
+        const VI si = I_ZERO_UNLESS(alive, I_CVTT(x));
+        const VI sj = I_ZERO_UNLESS(alive, I_CVTT(y));
+        const VM same = M_AND(I_CMPEQ(si, b->lane_i), I_CMPEQ(sj, I_SET(b->j)));
+        const VM candidate = M_ANDNOT(same, alive);
+        const VI index = I_ZERO_UNLESS(candidate, I_ADD(I_MULLO(sj, I_SET(g->width)), si));
+        fetches[step].zs = V_ZERO_UNLESS(candidate, V_GATHER(g->depth, index, candidate));
+        fetches[step].si = si;
+        fetches[step].sj = sj;
+        fetches[step].candidate = candidate;
+    }
+    return step;
+}
+
+/* A fetched step's sample vector and squared length, and which lanes have a
+ * usable sample (returned), among the lanes in `live`. */
+static inline VM SIMD_NAME(sample)(const SIMD_NAME(block) * b, const SIMD_NAME(fetch) * f, VM live,
+                                   VF delta[3], VF *dist2) {
+    const hbao_grid *g = b->grid;
+    const VF zs = f->zs;
+    const VM valid = M_AND(M_AND(f->candidate, live), V_GT(zs, V_SET(0.0f)));
+    const VF column = V_MUL(V_ADD(I_TO_F(f->si), V_SET(g->x_offset)), V_SET(g->x_step));
+    const VF row = V_MUL(V_ADD(I_TO_F(f->sj), V_SET(g->y_offset)), V_SET(g->y_step));
     const VF q0 = g->orthographic ? column : V_MUL(column, zs);
     const VF q1 = g->orthographic ? row : V_MUL(row, zs);
     delta[0] = V_SUB(q0, b->p[0]);
@@ -116,10 +140,12 @@ static VF SIMD_NAME(direction_occlusion_hbao)(const hbao_settings *s, const SIMD
     const int any_check = M_ANY(M_AND(check_past_normal, active));
     VF sin_max = V_SET(s->sin_bias);
     VF occlusion = V_SET(0.0f);
-    VM alive = active;
-    for (int step = 0; step < s->steps && M_ANY(alive); step++) {
+    SIMD_NAME(fetch) fetches[HBAO_MAX_STEPS];
+    const int fetched = SIMD_NAME(fetch_steps)(b, s->steps, dc, ds, active, fetches);
+    VM alive = active; /* lanes that have not stopped past the normal */
+    for (int step = 0; step < fetched && M_ANY(alive); step++) {
         VF delta[3], dist2;
-        const VM ok = SIMD_NAME(march_step)(b, step, dc, ds, &alive, delta, &dist2);
+        const VM ok = SIMD_NAME(sample)(b, &fetches[step], alive, delta, &dist2);
         if (!M_ANY(ok)) continue;
         const VF inv_dist = V_DIV(V_SET(1.0f), V_SQRT(dist2));
         VM rest = ok;
@@ -187,10 +213,11 @@ static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SI
         SIMD_NAME(horizon_visibility)(past_normal, cos_past_max, elevation_max, gamma, sl);
     VF visibility_at_max = visibility_start;
     VF occlusion = V_SET(0.0f);
-    VM alive = active;
-    for (int step = 0; step < s->steps && M_ANY(alive); step++) {
+    SIMD_NAME(fetch) fetches[HBAO_MAX_STEPS];
+    const int fetched = SIMD_NAME(fetch_steps)(b, s->steps, dc, ds, active, fetches);
+    for (int step = 0; step < fetched; step++) {
         VF delta[3], dist2;
-        const VM ok = SIMD_NAME(march_step)(b, step, dc, ds, &alive, delta, &dist2);
+        const VM ok = SIMD_NAME(sample)(b, &fetches[step], active, delta, &dist2);
         if (!M_ANY(ok)) continue;
         const VF inv_dist = V_DIV(V_SET(1.0f), V_SQRT(dist2));
         VM raised = M_ANDNOT(ok, ok); /* no lane */
