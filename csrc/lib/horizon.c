@@ -56,6 +56,7 @@ static inline int march_sample(const march *m, int step, float delta[3], float *
 typedef struct slice {
     float e[3];          /* in-slice axis perpendicular to V, marching side */
     float np_length;     /* |normal projected into the slice| */
+    float inv_np;        /* 1 / np_length */
     float cos_gamma;     /* angle of the projected normal from V towards e */
     float sin_gamma;
     int usable;
@@ -72,9 +73,10 @@ static inline void slice_setup(const float v[3], const float n[3], float dc, flo
     const float np[3] = {n[0] - m[0] * n_dot_m, n[1] - m[1] * n_dot_m, n[2] - m[2] * n_dot_m};
     sl->np_length = sqrtf(np[0] * np[0] + np[1] * np[1] + np[2] * np[2]);
     sl->usable = sl->np_length > 1e-6f;
+    sl->inv_np = 1.0f / sl->np_length;
     if (sl->usable) {
-        sl->cos_gamma = (np[0] * v[0] + np[1] * v[1] + np[2] * v[2]) / sl->np_length;
-        sl->sin_gamma = (np[0] * sl->e[0] + np[1] * sl->e[1] + np[2] * sl->e[2]) / sl->np_length;
+        sl->cos_gamma = (np[0] * v[0] + np[1] * v[1] + np[2] * v[2]) * sl->inv_np;
+        sl->sin_gamma = (np[0] * sl->e[0] + np[1] * sl->e[1] + np[2] * sl->e[2]) * sl->inv_np;
     } else {
         sl->cos_gamma = 1.0f;
         sl->sin_gamma = 0.0f;
@@ -166,7 +168,7 @@ static float direction_occlusion_cosine(const hbao_settings *s, const march *m, 
                                         const float v[3], const slice *sl, float *open_part) {
     const float gamma = HALF_PI - hbao_acos(sl->sin_gamma); /* asin; cos_gamma >= 0 */
     *open_part = 0.25f * (2.0f * sl->cos_gamma + (2.0f * gamma + HBAO_PI) * sl->sin_gamma);
-    const float inv_np = 1.0f / sl->np_length;
+    const float inv_np = sl->inv_np;
     const int check_past_normal = sl->sin_gamma > 0.0f;
     const int quadratic = s->falloff == HBAO_FALLOFF_QUADRATIC;
     const float inv_radius2 = 1.0f / m->radius2;

@@ -38,7 +38,7 @@ static inline VF SIMD_NAME(acos)(VF x) {
 }
 
 typedef struct SIMD_NAME(slice) {
-    VF np_length, cos_gamma, sin_gamma;
+    VF np_length, inv_np, cos_gamma, sin_gamma;
     VM usable;
 } SIMD_NAME(slice);
 
@@ -61,10 +61,11 @@ static inline void SIMD_NAME(slice_setup)(const VF v[3], const VF n[3], VF dc, V
     const VF np2 = V_SUB(n[2], V_MUL(m2, n_dot_m));
     sl->np_length = V_SQRT(SIMD_NAME(dot3)(np0, np1, np2, np0, np1, np2));
     sl->usable = V_GT(sl->np_length, V_SET(1e-6f));
+    sl->inv_np = V_DIV(V_SET(1.0f), sl->np_length);
     sl->cos_gamma = V_SELECT(sl->usable, V_SET(1.0f),
-                             V_DIV(SIMD_NAME(dot3)(np0, np1, np2, v[0], v[1], v[2]), sl->np_length));
+                             V_MUL(SIMD_NAME(dot3)(np0, np1, np2, v[0], v[1], v[2]), sl->inv_np));
     sl->sin_gamma = V_SELECT(sl->usable, V_SET(0.0f),
-                             V_DIV(SIMD_NAME(dot3)(np0, np1, np2, e0, e1, e2), sl->np_length));
+                             V_MUL(SIMD_NAME(dot3)(np0, np1, np2, e0, e1, e2), sl->inv_np));
 }
 
 /* The block of pixels and what does not change between directions. */
@@ -201,7 +202,7 @@ static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SI
     *open_part = V_MUL(V_SET(0.25f), V_ADD(V_MUL(V_SET(2.0f), sl->cos_gamma),
                                            V_MUL(V_ADD(V_MUL(V_SET(2.0f), gamma), V_SET(HBAO_PI)),
                                                  sl->sin_gamma)));
-    const VF inv_np = V_DIV(V_SET(1.0f), sl->np_length);
+    const VF inv_np = sl->inv_np;
     const VM check_past_normal = V_GT(sl->sin_gamma, V_SET(0.0f));
     const int any_check = M_ANY(M_AND(check_past_normal, active));
     const int quadratic = s->falloff == HBAO_FALLOFF_QUADRATIC;
