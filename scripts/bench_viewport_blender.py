@@ -55,7 +55,7 @@ def _median_ms(function, repeats):
 def run(options):
     draw = sys.modules["hbao.viewport.draw"]
     pipeline = sys.modules["hbao.viewport.pipeline"]
-    parameters = sys.modules["hbao.viewport.parameters"]
+    parameters = sys.modules["hbao.parameters"]
     print(f"renderer: {gpu.platform.renderer_get()} | {gpu.platform.vendor_get()} | "
           f"{gpu.platform.version_get()}")
     if options["backend_check"]:

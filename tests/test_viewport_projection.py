@@ -15,9 +15,9 @@ VIEWPORT = REPO / "addon" / "hbao" / "viewport"
 TOLERANCE = 1e-9
 
 
-def _load(name):
+def _load(name, folder=VIEWPORT):
     spec = importlib.util.spec_from_file_location(f"viewport_{name}_under_test",
-                                                  VIEWPORT / f"{name}.py")
+                                                  folder / f"{name}.py")
     module = importlib.util.module_from_spec(spec)
     sys.modules[spec.name] = module
     spec.loader.exec_module(module)
@@ -25,7 +25,7 @@ def _load(name):
 
 
 projection = _load("projection")
-parameters = _load("parameters")
+parameters = _load("parameters", VIEWPORT.parent)
 
 
 def _camera_matrix(frame, near=0.1, far=100.0):

@@ -17,10 +17,18 @@ corrupting memory.
 """
 import ctypes
 import os
-import threading
 from pathlib import Path
 
 import numpy as np
+
+try:
+    from . import library_loading
+except ImportError:  # loaded as a file of its own (tests, benchmarks): load the sibling
+    import importlib.util as _importlib_util
+    _spec = _importlib_util.spec_from_file_location(
+        "hbao_library_loading", Path(__file__).with_name("library_loading.py"))
+    library_loading = _importlib_util.module_from_spec(_spec)
+    _spec.loader.exec_module(library_loading)
 
 __all__ = ["EXRFormatError", "EXRFileError", "EXRLibraryError", "read_channels",
            "read_channel_groups", "channel_names", "image_size", "load_library",
@@ -31,7 +39,6 @@ BINDING_INTERFACE_VERSION = 1
 #: Environment variable that names the library to load instead of lib/libhbao_exr.so.
 LIBRARY_ENVIRONMENT_VARIABLE = "HBAO_EXR_LIBRARY"
 LIBRARY_FILE_NAME = "libhbao_exr.so"
-_DEFAULT_LIBRARY_PATH = Path(__file__).resolve().parent / "lib" / LIBRARY_FILE_NAME
 # hbao_exr.h: HBAO_EXR_MESSAGE_SIZE holds every message the library writes.
 _MESSAGE_SIZE = 1024
 _FLOAT = np.dtype(np.float32)
@@ -88,39 +95,9 @@ _FUNCTIONS = {
     "hbao_exr_close": (None, [ctypes.POINTER(_FILE_P)]),
 }
 
-_library = None
-_library_lock = threading.Lock()
 
-
-def library_path():
-    """The file that load_library() loads: $HBAO_EXR_LIBRARY, else lib/libhbao_exr.so here."""
-    override = os.environ.get(LIBRARY_ENVIRONMENT_VARIABLE)
-    return Path(override) if override else _DEFAULT_LIBRARY_PATH
-
-
-def _open_library(path):
-    if not path.is_file():
-        raise EXRLibraryError(
-            f"libhbao_exr not found at {path}. Build it with `cmake -S . -B build && cmake "
-            f"--build build` and copy build/{LIBRARY_FILE_NAME} to "
-            f"{_DEFAULT_LIBRARY_PATH.parent}/ (scripts/install_addon.sh does both), or set "
-            f"{LIBRARY_ENVIRONMENT_VARIABLE} to its path.")
-    try:
-        library = ctypes.CDLL(str(path))
-    except OSError as error:
-        raise EXRLibraryError(
-            f"libhbao_exr at {path} could not be loaded: {error}. It needs OpenEXRCore "
-            f"(libOpenEXRCore-3_1.so) installed or next to it; rebuild or reinstall the "
-            f"add-on with scripts/install_addon.sh.") from error
-    for name, (restype, argtypes) in _FUNCTIONS.items():
-        try:
-            function = getattr(library, name)
-        except AttributeError as error:
-            raise EXRLibraryError(f"libhbao_exr at {path} lacks {name}(): it is not a "
-                                  f"compatible libhbao_exr; rebuild it from this add-on's "
-                                  f"sources.") from error
-        function.restype = restype
-        function.argtypes = argtypes
+def _check_compatible(library, path):
+    """Raise EXRLibraryError unless the library matches this binding."""
     version = library.hbao_exr_interface_version()
     if version != BINDING_INTERFACE_VERSION:
         raise EXRLibraryError(
@@ -131,23 +108,30 @@ def _open_library(path):
             f"libhbao_exr at {path}: sizeof(hbao_exr_channel_request) is "
             f"{library.hbao_exr_channel_request_size()} bytes, the add-on expects "
             f"{ctypes.sizeof(_ChannelRequest)}: reinstall the library and add-on together.")
-    return library
+
+
+_LIBRARY = library_loading.NativeLibrary(
+    LIBRARY_FILE_NAME, LIBRARY_ENVIRONMENT_VARIABLE, Path(__file__).resolve().parent / "lib",
+    _FUNCTIONS,
+    EXRLibraryError, check=_check_compatible,
+    load_hint="It needs OpenEXRCore (libOpenEXRCore-3_1.so) installed or next to it; "
+              "rebuild or reinstall the add-on with scripts/install_addon.sh.")
+
+
+def library_path():
+    """The file that load_library() loads: the environment variable
+    LIBRARY_ENVIRONMENT_VARIABLE names, else lib/LIBRARY_FILE_NAME here."""
+    return _LIBRARY.path()
 
 
 def load_library():
     """The loaded library (loaded on the first call). Raises EXRLibraryError."""
-    global _library
-    with _library_lock:
-        if _library is None:
-            _library = _open_library(library_path())
-        return _library
+    return _LIBRARY.load()
 
 
 def unload_library():
-    """Forget the loaded library so that the next call loads library_path() again."""
-    global _library
-    with _library_lock:
-        _library = None
+    """Forget the loaded library; the next call loads library_path() again."""
+    _LIBRARY.unload()
 
 
 def _text(raw):

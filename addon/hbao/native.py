@@ -8,11 +8,18 @@ or foreign libhbao.so fails with a message instead of corrupting memory.
     ao = compute_ao(depth, normal, params={"radius": 0.5}, camera=camera_dict)
 """
 import ctypes
-import os
-import threading
 from pathlib import Path
 
 import numpy as np
+
+try:
+    from . import library_loading
+except ImportError:  # loaded as a file of its own (tests, benchmarks): load the sibling
+    import importlib.util as _importlib_util
+    _spec = _importlib_util.spec_from_file_location(
+        "hbao_library_loading", Path(__file__).with_name("library_loading.py"))
+    library_loading = _importlib_util.module_from_spec(_spec)
+    _spec.loader.exec_module(library_loading)
 
 __all__ = [
     "HBAOError", "HBAOLibraryError", "compute_ao", "default_params",
@@ -25,7 +32,6 @@ BINDING_VERSION_MAJOR = 0
 #: Environment variable that names the library to load instead of lib/libhbao.so.
 LIBRARY_ENVIRONMENT_VARIABLE = "HBAO_LIBRARY"
 LIBRARY_FILE_NAME = "libhbao.so"
-_DEFAULT_LIBRARY_PATH = Path(__file__).resolve().parent / "lib" / LIBRARY_FILE_NAME
 _FLOAT_SIZE = ctypes.sizeof(ctypes.c_float)
 _HBAO_SUCCESS = 0
 
@@ -113,37 +119,9 @@ _FUNCTIONS = {
                                       ctypes.c_int64]),
 }
 
-_library = None
-_library_lock = threading.Lock()
 
-
-def library_path():
-    """The file that load_library() loads: $HBAO_LIBRARY, else lib/libhbao.so here."""
-    override = os.environ.get(LIBRARY_ENVIRONMENT_VARIABLE)
-    return Path(override) if override else _DEFAULT_LIBRARY_PATH
-
-
-def _open_library(path):
-    if not path.is_file():
-        raise HBAOLibraryError(
-            f"libhbao not found at {path}. Build it with `cmake -S . -B build && cmake --build "
-            f"build` and copy build/{LIBRARY_FILE_NAME} to {_DEFAULT_LIBRARY_PATH.parent}/ "
-            f"(scripts/install_addon.sh does both), or set {LIBRARY_ENVIRONMENT_VARIABLE} "
-            f"to its path.")
-    try:
-        library = ctypes.CDLL(str(path))
-    except OSError as error:
-        raise HBAOLibraryError(f"libhbao at {path} could not be loaded: {error}. "
-                               f"Rebuild it for this machine.") from error
-    for name, (restype, argtypes) in _FUNCTIONS.items():
-        try:
-            function = getattr(library, name)
-        except AttributeError as error:
-            raise HBAOLibraryError(f"libhbao at {path} lacks {name}(): it is not a "
-                                   f"compatible libhbao; rebuild it from this add-on's "
-                                   f"sources.") from error
-        function.restype = restype
-        function.argtypes = argtypes
+def _check_compatible(library, path):
+    """Raise HBAOLibraryError unless the library matches this binding."""
     version = library.hbao_version()
     major = version // 10000
     if major != BINDING_VERSION_MAJOR:
@@ -157,23 +135,29 @@ def _open_library(path):
                 f"libhbao at {path}: sizeof({what}) is {size_function()} bytes, the add-on "
                 f"expects {ctypes.sizeof(structure)}: the library and add-on come from "
                 f"different versions; reinstall both together.")
-    return library
+
+
+_LIBRARY = library_loading.NativeLibrary(
+    LIBRARY_FILE_NAME, LIBRARY_ENVIRONMENT_VARIABLE, Path(__file__).resolve().parent / "lib",
+    _FUNCTIONS,
+    HBAOLibraryError, check=_check_compatible,
+    load_hint='Rebuild it for this machine.')
+
+
+def library_path():
+    """The file that load_library() loads: the environment variable
+    LIBRARY_ENVIRONMENT_VARIABLE names, else lib/LIBRARY_FILE_NAME here."""
+    return _LIBRARY.path()
 
 
 def load_library():
     """The loaded library (loaded on the first call). Raises HBAOLibraryError."""
-    global _library
-    with _library_lock:
-        if _library is None:
-            _library = _open_library(library_path())
-        return _library
+    return _LIBRARY.load()
 
 
 def unload_library():
-    """Forget the loaded library so that the next call loads library_path() again."""
-    global _library
-    with _library_lock:
-        _library = None
+    """Forget the loaded library; the next call loads library_path() again."""
+    _LIBRARY.unload()
 
 
 def _version_text(packed):

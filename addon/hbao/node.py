@@ -8,7 +8,8 @@ the artist's values; the hook reads them."""
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 
-from . import compat
+from . import compat, parameters
+from .parameters import FALLOFF_ITEMS, INTEGRATION_ITEMS
 
 NODE_IDNAME = "CompositorNodeHBAO"
 # One group tree shared by every HBAO node (the values live on each node's
@@ -27,25 +28,23 @@ AO_PASS_INPUT = "HBAO Pass"
 IMAGE_OUTPUT = "Image"
 AO_OUTPUT = "AO"
 
-# name -> (params key, default, min, max, integer). Defaults and limits are
-# the library's (csrc/include/hbao.h).
-VALUE_INPUTS = {
-    "Radius": ("radius", 1.0, 0.0, 1.0e4, False),
-    "Angle Bias": ("angle_bias_degrees", 10.0, 0.0, 60.0, False),
-    "Directions": ("directions", 8.0, 1.0, 64.0, True),
-    "Steps": ("steps", 6.0, 1.0, 64.0, True),
-    "Blur Size": ("blur_size", 9.0, 0.0, 65.0, True),
-    "Strength": ("strength", 1.0, 0.0, 16.0, False),
-}
+# The radius socket's upper end: far beyond any scene, but finite.
+MAX_RADIUS = 1.0e4
 
-FALLOFF_ITEMS = [
-    ("QUADRATIC", "Quadratic", "Occluders count less with distance: 1 - (d/radius)^2"),
-    ("NONE", "None", "Every occluder inside the radius counts fully"),
-]
-INTEGRATION_ITEMS = [
-    ("COSINE", "Cosine", "Cosine-weighted visibility, as Cycles' AO pass measures it"),
-    ("HBAO", "HBAO", "Bavoil & Sainz: the occluded fraction of the hemisphere"),
-]
+# name -> (params key, default, min, max, integer): the library's defaults and
+# limits (csrc/include/hbao.h, mirrored in parameters.py).
+_D = parameters.DEFAULTS
+VALUE_INPUTS = {
+    "Radius": ("radius", _D["radius"], 0.0, MAX_RADIUS, False),
+    "Angle Bias": ("angle_bias_degrees", _D["angle_bias_degrees"], 0.0,
+                   parameters.MAX_ANGLE_BIAS_DEGREES, False),
+    "Directions": ("directions", float(_D["directions"]), 1.0,
+                   float(parameters.MAX_DIRECTIONS), True),
+    "Steps": ("steps", float(_D["steps"]), 1.0, float(parameters.MAX_STEPS), True),
+    "Blur Size": ("blur_size", float(_D["blur_size"]), 0.0, float(parameters.MAX_BLUR_SIZE),
+                  True),
+    "Strength": ("strength", _D["strength"], 0.0, parameters.MAX_STRENGTH, False),
+}
 
 
 def _new_input(tree, socket_type, name, default=None, minimum=None, maximum=None):
@@ -131,15 +130,16 @@ class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
     bl_icon = "SHADING_RENDERED"
     bl_width_default = 180
 
-    falloff: EnumProperty(name="Falloff", items=FALLOFF_ITEMS, default="QUADRATIC",
+    falloff: EnumProperty(name="Falloff", items=FALLOFF_ITEMS, default=_D["falloff"],
                           update=_settings_changed)
-    integration: EnumProperty(name="Integration", items=INTEGRATION_ITEMS, default="COSINE",
-                              update=_settings_changed)
+    integration: EnumProperty(name="Integration", items=INTEGRATION_ITEMS,
+                              default=_D["integration"], update=_settings_changed)
     half_resolution: BoolProperty(
         name="Half Resolution", default=False, update=_settings_changed,
         description="Compute AO at half resolution and upsample it, depth-aware (faster)")
     blur_sharpness: FloatProperty(
-        name="Blur Sharpness", default=8.0, min=0.0, max=1000.0, soft_max=64.0,
+        name="Blur Sharpness", default=_D["blur_sharpness"], min=0.0,
+        max=parameters.MAX_BLUR_SHARPNESS, soft_max=64.0,
         update=_settings_changed,
         description="How strongly the blur stops at depth edges; 0 = plain Gaussian")
     pass_index: IntProperty(name="Pass Index", default=0, min=0,

@@ -25,23 +25,6 @@ static int compare_doubles(const void *a, const void *b) {
     return (x > y) - (x < y);
 }
 
-static scene_plane plane(double px, double py, double pz, double nx, double ny, double nz) {
-    scene_plane p;
-    memset(&p, 0, sizeof p);
-    p.point[0] = px; p.point[1] = py; p.point[2] = pz;
-    const double l = sqrt(nx * nx + ny * ny + nz * nz);
-    p.normal[0] = nx / l; p.normal[1] = ny / l; p.normal[2] = nz / l;
-    return p;
-}
-
-static void clip(scene_plane *p, double nx, double ny, double nz, double offset) {
-    p->clip_normal[p->clips][0] = nx;
-    p->clip_normal[p->clips][1] = ny;
-    p->clip_normal[p->clips][2] = nz;
-    p->clip_offset[p->clips] = offset;
-    p->clips++;
-}
-
 int main(int argc, char **argv) {
     int width = 1920, height = 1080, runs = 3, quick = 0;
     float radius = 0.5f;
@@ -63,18 +46,18 @@ int main(int argc, char **argv) {
     /* floor, back wall, side wall and a box: every pixel is geometry */
     scene s;
     memset(&s, 0, sizeof s);
-    s.plane[s.planes] = plane(0, 0, 0, 0, 0, 1);
-    clip(&s.plane[s.planes++], 1, 0, 0, 0);
-    s.plane[s.planes] = plane(0, 0, 0, -1, 0, 0);
-    clip(&s.plane[s.planes++], 0, 0, -1, 0);
-    s.plane[s.planes++] = plane(0, 4, 0, 0, -1, 0);
-    scene_plane front = plane(-1.5, 0, 0, -1, 0, 0);
-    clip(&front, 0, 0, 1, 0.6);
-    clip(&front, 0, 1, 0, 0.5);
+    s.plane[s.planes] = scene_plane_make(0, 0, 0, 0, 0, 1);
+    scene_plane_clip(&s.plane[s.planes++], 1, 0, 0, 0);
+    s.plane[s.planes] = scene_plane_make(0, 0, 0, -1, 0, 0);
+    scene_plane_clip(&s.plane[s.planes++], 0, 0, -1, 0);
+    s.plane[s.planes++] = scene_plane_make(0, 4, 0, 0, -1, 0);
+    scene_plane front = scene_plane_make(-1.5, 0, 0, -1, 0, 0);
+    scene_plane_clip(&front, 0, 0, 1, 0.6);
+    scene_plane_clip(&front, 0, 1, 0, 0.5);
     s.plane[s.planes++] = front;
-    scene_plane top = plane(0, 0, 0.6, 0, 0, 1);
-    clip(&top, -1, 0, 0, 1.5);
-    clip(&top, 0, 1, 0, 0.5);
+    scene_plane top = scene_plane_make(0, 0, 0.6, 0, 0, 1);
+    scene_plane_clip(&top, -1, 0, 0, 1.5);
+    scene_plane_clip(&top, 0, 1, 0, 0.5);
     s.plane[s.planes++] = top;
     scene_view view;
     memset(&view, 0, sizeof view);

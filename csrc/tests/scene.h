@@ -7,6 +7,7 @@
 
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "hbao.h"
 
@@ -30,6 +31,30 @@ typedef struct scene_view {
     hbao_camera camera;
     double camera_to_world[16]; /* row-major, rigid */
 } scene_view;
+
+/* An unbounded plane through (px, py, pz) with normal (nx, ny, nz). */
+static inline scene_plane scene_plane_make(double px, double py, double pz, double nx, double ny,
+                                           double nz) {
+    scene_plane p;
+    memset(&p, 0, sizeof p);
+    p.point[0] = px;
+    p.point[1] = py;
+    p.point[2] = pz;
+    const double l = sqrt(nx * nx + ny * ny + nz * nz);
+    p.normal[0] = nx / l;
+    p.normal[1] = ny / l;
+    p.normal[2] = nz / l;
+    return p;
+}
+
+/* Keep only the part of the plane where dot((nx, ny, nz), x) <= offset. */
+static inline void scene_plane_clip(scene_plane *p, double nx, double ny, double nz, double offset) {
+    p->clip_normal[p->clips][0] = nx;
+    p->clip_normal[p->clips][1] = ny;
+    p->clip_normal[p->clips][2] = nz;
+    p->clip_offset[p->clips] = offset;
+    p->clips++;
+}
 
 static inline void mat_mul_point(const double m[16], const double p[3], double out[3]) {
     for (int r = 0; r < 3; r++) out[r] = m[4 * r] * p[0] + m[4 * r + 1] * p[1] + m[4 * r + 2] * p[2] + m[4 * r + 3];

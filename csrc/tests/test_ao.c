@@ -43,32 +43,15 @@ static scene_view make_view(int width, int height, const double eye[3], const do
     return view;
 }
 
-static scene_plane infinite_plane(double px, double py, double pz, double nx, double ny, double nz) {
-    scene_plane p;
-    memset(&p, 0, sizeof p);
-    p.point[0] = px; p.point[1] = py; p.point[2] = pz;
-    double l = sqrt(nx * nx + ny * ny + nz * nz);
-    p.normal[0] = nx / l; p.normal[1] = ny / l; p.normal[2] = nz / l;
-    return p;
-}
-
-static void add_clip(scene_plane *p, double nx, double ny, double nz, double offset) {
-    p->clip_normal[p->clips][0] = nx;
-    p->clip_normal[p->clips][1] = ny;
-    p->clip_normal[p->clips][2] = nz;
-    p->clip_offset[p->clips] = offset;
-    p->clips++;
-}
-
 /* The floor z = 0 for x <= 0 and the wall x = 0 for z >= 0, facing -x. */
 static scene corner_scene(void) {
     scene s;
     memset(&s, 0, sizeof s);
     s.planes = 2;
-    s.plane[0] = infinite_plane(0, 0, 0, 0, 0, 1);
-    add_clip(&s.plane[0], 1, 0, 0, 0);
-    s.plane[1] = infinite_plane(0, 0, 0, -1, 0, 0);
-    add_clip(&s.plane[1], 0, 0, -1, 0);
+    s.plane[0] = scene_plane_make(0, 0, 0, 0, 0, 1);
+    scene_plane_clip(&s.plane[0], 1, 0, 0, 0);
+    s.plane[1] = scene_plane_make(0, 0, 0, -1, 0, 0);
+    scene_plane_clip(&s.plane[1], 0, 0, -1, 0);
     return s;
 }
 
@@ -105,12 +88,12 @@ TEST_CASE(plane_facing_camera_is_unoccluded) {
     /* looking straight down at the floor */
     const double eye_down[3] = {0, -1e-3, 5};
     (void)eye;
-    check_plane_is_unoccluded(eye_down, target, infinite_plane(0, 0, 0, 0, 0, 1));
+    check_plane_is_unoccluded(eye_down, target, scene_plane_make(0, 0, 0, 0, 0, 1));
 }
 
 TEST_CASE(tilted_plane_is_unoccluded) {
     const double eye[3] = {0, -6, 3}, target[3] = {0, 0, 0};
-    check_plane_is_unoccluded(eye, target, infinite_plane(0, 0, 0, 0.3, -0.2, 1));
+    check_plane_is_unoccluded(eye, target, scene_plane_make(0, 0, 0, 0.3, -0.2, 1));
 }
 
 /* --- the corner ---------------------------------------------------------- */
@@ -249,12 +232,12 @@ TEST_CASE(corner_value_at_the_crease_is_one_half) {
 static scene boxes_scene(void) {
     scene s = corner_scene();
     /* a box standing on the floor: two visible faces and the top */
-    scene_plane front = infinite_plane(-1.5, 0, 0, -1, 0, 0);
-    add_clip(&front, 0, 0, 1, 0.6);
-    add_clip(&front, 0, 1, 0, 0.5);
-    scene_plane side = infinite_plane(0, -0.5, 0, 0, -1, 0);
-    add_clip(&side, 0, 0, 1, 0.6);
-    add_clip(&side, -1, 0, 0, 1.5);
+    scene_plane front = scene_plane_make(-1.5, 0, 0, -1, 0, 0);
+    scene_plane_clip(&front, 0, 0, 1, 0.6);
+    scene_plane_clip(&front, 0, 1, 0, 0.5);
+    scene_plane side = scene_plane_make(0, -0.5, 0, 0, -1, 0);
+    scene_plane_clip(&side, 0, 0, 1, 0.6);
+    scene_plane_clip(&side, -1, 0, 0, 1.5);
     s.plane[s.planes++] = front;
     s.plane[s.planes++] = side;
     return s;
@@ -606,7 +589,7 @@ TEST_CASE(background_never_occludes) {
     scene s;
     memset(&s, 0, sizeof s);
     s.planes = 1;
-    s.plane[0] = infinite_plane(0, 0, 0, 0, 0, 1);
+    s.plane[0] = scene_plane_make(0, 0, 0, 0, 0, 1);
     scene_view view = make_view(64, 64, eye, target);
     float *depth, *normal;
     scene_render(&s, &view, &depth, &normal);

@@ -19,7 +19,8 @@ if str(REPO / "addon") not in sys.path:
     sys.path.insert(0, str(REPO / "addon"))
 
 from hbao import native  # noqa: E402
-from hbao.viewport import parameters, pipeline, projection  # noqa: E402
+from hbao import parameters  # noqa: E402
+from hbao.viewport import pipeline, projection  # noqa: E402
 
 WIDTH, HEIGHT = 200, 150
 PERSPECTIVE_CAMERA = {"type": "PERSP", "lens": 35.0, "sensor_width": 36.0,

@@ -7,7 +7,8 @@ import math
 import gpu
 from gpu_extras.batch import batch_for_shader
 
-from . import parameters, shaders
+from .. import parameters
+from . import shaders
 
 # Two triangles covering normalised device coordinates.
 _QUAD = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]

@@ -18,18 +18,10 @@ from bpy.app.handlers import persistent
 from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty,
                        IntProperty)
 
-from . import parameters
+from .. import parameters
+from ..parameters import FALLOFF_ITEMS, INTEGRATION_ITEMS
 
 COLLECTION_NAME = "hbao_viewport_views"
-
-FALLOFF_ITEMS = [
-    ("QUADRATIC", "Quadratic", "Occluders count less with distance: 1 - (d/radius)^2"),
-    ("NONE", "None", "Every occluder inside the radius counts fully"),
-]
-INTEGRATION_ITEMS = [
-    ("COSINE", "Cosine", "Cosine-weighted visibility, as Cycles' AO pass measures it"),
-    ("HBAO", "HBAO", "Bavoil & Sainz: the occluded fraction of the hemisphere"),
-]
 
 # (screen pointer, area pointer) -> entry name, for the areas seen this session.
 _entry_by_area = {}

@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
-"""The preview's parameters: the C library's hbao_params (csrc/include/hbao.h)
-by the names addon/hbao/native.py uses, with the header's defaults and limits.
-No bpy: the panel, the shaders and the tests share it."""
+"""The HBAO parameters as artists set them: the C library's hbao_params
+(csrc/include/hbao.h) by the names addon/hbao/native.py uses, with the
+header's defaults and limits and the menus' items. No bpy: the compositor
+node, the viewport preview and the tests share it."""
 import math
 
 # csrc/include/hbao.h, HBAO_DEFAULT_* and HBAO_MAX_*.
@@ -25,6 +26,16 @@ MAX_ANGLE_BIAS_DEGREES = 60.0
 MAX_STRENGTH = 16.0
 FALLOFF_VALUES = {"QUADRATIC": 0, "NONE": 1}
 INTEGRATION_VALUES = {"HBAO": 0, "COSINE": 1}
+
+# The menus of the node and of the viewport panel: (identifier, name, tip).
+FALLOFF_ITEMS = [
+    ("QUADRATIC", "Quadratic", "Occluders count less with distance: 1 - (d/radius)^2"),
+    ("NONE", "None", "Every occluder inside the radius counts fully"),
+]
+INTEGRATION_ITEMS = [
+    ("COSINE", "Cosine", "Cosine-weighted visibility, as Cycles' AO pass measures it"),
+    ("HBAO", "HBAO", "Bavoil & Sainz: the occluded fraction of the hemisphere"),
+]
 
 
 def _clamp(value, low, high):
