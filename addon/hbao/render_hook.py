@@ -36,6 +36,8 @@ MAIN_SCENE_KEY = "hbao_main_scene"
 # ID property on the Render Layers node the add-on manages.
 MANAGED_NODE_KEY = "hbao_managed"
 MANAGED_NODE_NAME = "HBAO Passes"
+# How far below the first HBAO node the managed node goes (node editor units).
+HBAO_NODE_CLEARANCE = 480
 LOG_PREFIX = "HBAO:"
 # Render settings copied from the main scene so that the helper's result has
 # the main Render Result's size.
@@ -205,7 +207,9 @@ def sync(scene):
         rlayers[MANAGED_NODE_KEY] = True
         rlayers.name = MANAGED_NODE_NAME
         rlayers.label = "HBAO passes (managed by the HBAO add-on)"
-        rlayers.location = (nodes[0].location.x - 220, nodes[0].location.y - 260)
+        # Below the first HBAO node (about 420 units tall with its options),
+        # clear of the artist's Render Layers node on its left.
+        rlayers.location = (nodes[0].location.x, nodes[0].location.y - HBAO_NODE_CLEARANCE)
         rlayers.hide = True
     if rlayers.scene != helper:
         rlayers.scene = helper
