@@ -28,7 +28,11 @@ PROPS_COLLECTION = "Props"
 # Soft grey world: lights the scene a little from everywhere, so shadowed
 # parts still show their colour and the AO pass has something to darken.
 WORLD_COLOUR = (0.45, 0.5, 0.58, 1.0)
-WORLD_STRENGTH = 0.6
+WORLD_STRENGTH = 0.35
+# Filmic's "Medium High Contrast" look and a little less exposure keep the
+# pale floor and wall from washing out the colours of the objects.
+VIEW_LOOK = "Medium High Contrast"
+VIEW_EXPOSURE = -0.3
 
 ENGINES = ("CYCLES", "BLENDER_EEVEE")
 
@@ -155,6 +159,15 @@ def configure_render(scene, resolution=DEFAULT_RESOLUTION, engine="CYCLES",
     # Same seed each run: fixtures stay the same when re-rendered.
     scene.cycles.seed = 0
     scene.eevee.taa_render_samples = samples
+    scene.view_settings.view_transform = "Filmic"
+    # 3.x names the look "Medium High Contrast", 4.x "Filmic - Medium High Contrast".
+    for look in (VIEW_LOOK, f"Filmic - {VIEW_LOOK}"):
+        try:
+            scene.view_settings.look = look
+            break
+        except TypeError:
+            continue
+    scene.view_settings.exposure = VIEW_EXPOSURE
     return scene
 
 
@@ -231,10 +244,10 @@ def camera_description(scene):
 def _room(scene, floor_size=12.0, wall_height=4.0, wall_y=2.0):
     """A floor at z = 0 and a back wall at y = wall_y: a concave corner."""
     room = _collection(scene, ROOM_COLLECTION)
-    floor_material = _material("Floor", (0.72, 0.70, 0.66), roughness=0.8)
-    wall_material = _material("Wall", (0.78, 0.76, 0.72), roughness=0.9)
-    floor = _add(bpy.ops.mesh.primitive_plane_add, room, floor_material, "Floor",
-                 size=floor_size, location=(0.0, 0.0, 0.0))
+    floor_material = _material("Floor", (0.55, 0.53, 0.50), roughness=0.8)
+    wall_material = _material("Wall", (0.62, 0.60, 0.57), roughness=0.9)
+    _add(bpy.ops.mesh.primitive_plane_add, room, floor_material, "Floor",
+         size=floor_size, location=(0.0, 0.0, 0.0))
     wall = _add(bpy.ops.mesh.primitive_plane_add, room, wall_material, "Wall",
                 size=1.0, location=(0.0, wall_y, wall_height / 2.0),
                 rotation=(math.radians(90.0), 0.0, 0.0))
@@ -298,7 +311,7 @@ def build_demo_scene(scene=None, resolution=DEFAULT_RESOLUTION, engine="CYCLES",
          (0.9, 0.9, 0.9), (-1.9, 0.2, 0.45), rotation=(0.0, 0.0, math.radians(25.0)))
 
     # Three steps against the wall: inner and outer edges at each riser.
-    steps_material = _material("Steps", (0.85, 0.78, 0.55))
+    steps_material = _material("Steps", (0.80, 0.62, 0.30))
     step_depth, step_height, step_width = 0.35, 0.25, 1.2
     for index in range(3):
         depth = step_depth * (3 - index)
@@ -366,7 +379,7 @@ def build_demo_scene(scene=None, resolution=DEFAULT_RESOLUTION, engine="CYCLES",
     camera_location, target = (4.6, -6.2, 3.4), (0.0, 0.0, 0.5)
     _camera(scene, room, location=camera_location, target=target, lens=32.0)
     scene["hbao_target_distance"] = (Vector(camera_location) - Vector(target)).length
-    _sun(room, rotation_deg=(48.0, 0.0, 28.0), strength=3.5)
+    _sun(room, rotation_deg=(48.0, 0.0, 28.0), strength=2.5)
     configure_render(scene, resolution, engine, samples)
     for view_layer in scene.view_layers:
         enable_passes(view_layer)

@@ -89,11 +89,16 @@ def library_ao(native, out, frame, params, with_normal=True, layer="ViewLayer"):
                              camera=camera(out, frame))
 
 
+PARAMETERS = _load("hbao_parameters_under_test", REPO / "addon" / "hbao" / "parameters.py")
+
+
 def node_params(**overrides):
-    """The node's defaults (node.py) as library params, with overrides."""
-    params = {"radius": 1.0, "angle_bias_degrees": 10.0, "directions": 8, "steps": 6,
-              "blur_size": 9, "strength": 1.0, "falloff": "QUADRATIC",
-              "integration": "COSINE", "half_resolution": 0, "blur_sharpness": 8.0}
+    """The node's defaults (node.py takes them from parameters.py) as library
+    params, with overrides."""
+    params = {key: PARAMETERS.DEFAULTS[key]
+              for key in ("radius", "angle_bias_degrees", "directions", "steps", "blur_size",
+                          "strength", "falloff", "integration", "blur_sharpness")}
+    params["half_resolution"] = 0
     params.update(overrides)
     return params
 

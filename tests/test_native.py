@@ -68,7 +68,7 @@ def test_defaults_match_header(native):
     assert defaults["blur_sharpness"] == defines["HBAO_DEFAULT_BLUR_SHARPNESS"]
     assert defaults["strength"] == defines["HBAO_DEFAULT_STRENGTH"]
     assert defaults["background_depth"] == defines["HBAO_DEFAULT_BACKGROUND_DEPTH"]
-    assert defaults["falloff"] == "QUADRATIC"
+    assert defaults["falloff"] == "NONE"
     assert defaults["integration"] == "COSINE"
     assert defaults["half_resolution"] is False
     assert defaults["threads"] == 0

@@ -8,13 +8,13 @@ import math
 # csrc/include/hbao.h, HBAO_DEFAULT_* and HBAO_MAX_*.
 DEFAULTS = {
     "radius": 1.0,
-    "angle_bias_degrees": 10.0,
+    "angle_bias_degrees": 5.0,
     "directions": 8,
     "steps": 6,
-    "falloff": "QUADRATIC",
+    "falloff": "NONE",
     "integration": "COSINE",
-    "blur_size": 9,
-    "blur_sharpness": 8.0,
+    "blur_size": 5,
+    "blur_sharpness": 32.0,
     "strength": 1.0,
     "background_depth": 65504.0,
 }

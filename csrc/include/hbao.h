@@ -122,9 +122,9 @@ typedef struct hbao_params {
     int32_t directions;
     /** Steps per direction, clamped to [1, 64]. */
     int32_t steps;
-    /** hbao_falloff. */
+    /** hbao_falloff; default NONE. */
     int32_t falloff;
-    /** hbao_integration. */
+    /** hbao_integration; default COSINE. */
     int32_t integration;
     /** Width in pixels of the cross-bilateral blur kernel; 0 or 1 = no blur.
      *  Even sizes round down to the odd size below. Clamped to [0, 65]. */
@@ -157,12 +157,15 @@ typedef enum hbao_implementation {
     HBAO_IMPLEMENTATION_AVX512 = 3  /**< 16 pixels at a time (x86-64) */
 } hbao_implementation;
 
+/* The defaults were chosen with the accuracy benchmark (docs/benchmark.md):
+ * cosine integration with no falloff is what Cycles' AO pass measures; 8 x 6
+ * samples; a 5-pixel blur hides the 4x4 sampling pattern at little cost. */
 #define HBAO_DEFAULT_RADIUS 1.0f
-#define HBAO_DEFAULT_ANGLE_BIAS_DEGREES 10.0f
+#define HBAO_DEFAULT_ANGLE_BIAS_DEGREES 5.0f
 #define HBAO_DEFAULT_DIRECTIONS 8
 #define HBAO_DEFAULT_STEPS 6
-#define HBAO_DEFAULT_BLUR_SIZE 9
-#define HBAO_DEFAULT_BLUR_SHARPNESS 8.0f
+#define HBAO_DEFAULT_BLUR_SIZE 5
+#define HBAO_DEFAULT_BLUR_SHARPNESS 32.0f
 #define HBAO_DEFAULT_STRENGTH 1.0f
 /** EEVEE's half-float Depth pass stores background as 65504, Cycles as 1e10. */
 #define HBAO_DEFAULT_BACKGROUND_DEPTH 65504.0f
@@ -170,7 +173,7 @@ typedef enum hbao_implementation {
 #define HBAO_PARAMS_DEFAULT_INITIALIZER                                         \
     {                                                                           \
         HBAO_DEFAULT_RADIUS, HBAO_DEFAULT_ANGLE_BIAS_DEGREES,                   \
-            HBAO_DEFAULT_DIRECTIONS, HBAO_DEFAULT_STEPS, HBAO_FALLOFF_QUADRATIC, \
+            HBAO_DEFAULT_DIRECTIONS, HBAO_DEFAULT_STEPS, HBAO_FALLOFF_NONE,     \
             HBAO_INTEGRATION_COSINE, HBAO_DEFAULT_BLUR_SIZE,                    \
             HBAO_DEFAULT_BLUR_SHARPNESS, 0, HBAO_DEFAULT_STRENGTH, 0,           \
             HBAO_DEFAULT_BACKGROUND_DEPTH, 0                                    \
