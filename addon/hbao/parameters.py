@@ -9,8 +9,8 @@ import math
 DEFAULTS = {
     "radius": 1.0,
     "angle_bias_degrees": 5.0,
-    "directions": 8,
-    "steps": 6,
+    "directions": 4,
+    "steps": 16,
     "falloff": "NONE",
     "integration": "COSINE",
     "blur_size": 5,

@@ -1,0 +1,93 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Times the add-on's render path inside Blender: the same Cycles render with
+and without an HBAO compositor node. Run by run_benchmark.py:
+
+    blender -b --factory-startup --addons hbao --python bench/addon_timing.py -- \\
+        '<json spec>'
+
+Spec: scene, width, height, samples, repeats, node (the HBAO node's settings:
+radius, directions, steps, blur_size, falloff, integration, half_resolution).
+Prints one line `bench-addon: {json}` with the render times in seconds; the
+add-on's own console line ("... pass hand-over N ms ...") is parsed by the
+driver from the same output.
+"""
+import json
+import os
+import statistics
+import sys
+import time
+
+import bpy
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import scene_library  # noqa: E402  (needs the path above)
+
+SOCKETS = {"radius": "Radius", "directions": "Directions", "steps": "Steps",
+           "blur_size": "Blur Size", "angle_bias_degrees": "Angle Bias"}
+PROPERTIES = ("falloff", "integration", "half_resolution")
+
+
+def configure(scene, spec):
+    scene.render.engine = "CYCLES"
+    scene.cycles.device = "CPU"
+    scene.cycles.samples = spec["samples"]
+    scene.cycles.use_denoising = False  # Debian's Blender has no OpenImageDenoise
+    scene.cycles.use_adaptive_sampling = False
+    scene.render.resolution_x = spec["width"]
+    scene.render.resolution_y = spec["height"]
+    scene.render.resolution_percentage = 100
+    scene.render.threads_mode = "FIXED"
+    scene.render.threads = spec.get("threads", 2)
+    layer = scene.view_layers[0]
+    layer.use_pass_z = True
+    layer.use_pass_normal = True
+    scene.use_nodes = True
+
+
+def build_tree(scene, node_settings):
+    """Render Layers -> (HBAO ->) Composite."""
+    tree = scene.node_tree
+    tree.nodes.clear()
+    layers = tree.nodes.new("CompositorNodeRLayers")
+    composite = tree.nodes.new("CompositorNodeComposite")
+    if node_settings is None:
+        tree.links.new(layers.outputs["Image"], composite.inputs["Image"])
+        return
+    hbao = tree.nodes.new("CompositorNodeHBAO")
+    for output in ("Image", "Depth", "Normal"):
+        tree.links.new(layers.outputs[output], hbao.inputs[output])
+    for key, socket in SOCKETS.items():
+        if key in node_settings:
+            hbao.inputs[socket].default_value = node_settings[key]
+    for key in PROPERTIES:
+        if key in node_settings:
+            setattr(hbao, key, node_settings[key])
+    tree.links.new(hbao.outputs["Image"], composite.inputs["Image"])
+
+
+def timed_renders(scene, node_settings, repeats):
+    build_tree(scene, node_settings)
+    bpy.ops.render.render()  # warm-up: kernels, and the add-on's helper scene
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        bpy.ops.render.render()
+        times.append(time.perf_counter() - start)
+    return times
+
+
+def main():
+    spec = json.loads(sys.argv[sys.argv.index("--") + 1])
+    scene = bpy.context.scene
+    spec_scene = scene_library.build(spec["scene"], spec.get("inputs", {}))
+    configure(scene, spec)
+    node = dict(spec["node"], radius=spec_scene.radius)
+    without = timed_renders(scene, None, spec["repeats"])
+    with_node = timed_renders(scene, node, spec["repeats"])
+    print("bench-addon: " + json.dumps({
+        "without_node_s": without, "with_node_s": with_node,
+        "without_node_median_s": statistics.median(without),
+        "with_node_median_s": statistics.median(with_node)}), flush=True)
+
+
+main()
