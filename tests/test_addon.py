@@ -12,6 +12,7 @@ import pytest
 from conftest import BLENDER, REPO, blender_environment
 
 SCRIPTS = REPO / "tests" / "blender_scripts"
+APPEND_SCRIPT = REPO / "tests" / "blender_scripts" / "addon_append.py"
 RENDER_SCRIPT = SCRIPTS / "addon_render.py"
 # The node computes from the same 32-bit float passes, camera and parameters
 # as a direct library call on the written EXR, and the library is
@@ -286,6 +287,30 @@ def test_border_crop_render_matches_the_full_frame(run_blender, tmp_path):
     # the shifted camera (1e-7 relative), far below a misplaced camera's
     # error (several hundredths).
     assert np.abs(inner_crop - inner_full).max() <= 1e-3
+
+
+@pytest.mark.parametrize("how", ["append", "link"])
+def test_appended_or_linked_scene_renders_with_ao(run_blender, tmp_path, native, how):
+    """A scene with an HBAO node, appended or linked into another file, still
+    renders its AO: the hook's helper scene comes along and is found again."""
+    blend = tmp_path / "source.blend"
+    render(run_blender, tmp_path, {"save_blend": str(blend),
+                                   "nodes": [{"radius": 0.6, "blur_size": 0}]}, name="setup")
+    out = tmp_path / how
+    out.mkdir()
+    completed = run_blender(APPEND_SCRIPT, blend, how, out)
+    assert "APPEND_RENDERED" in completed.stdout, completed.stdout[-3000:]
+    assert "without AO" not in completed.stdout, completed.stdout[-3000:]
+    setup = tmp_path / "setup"
+    ao = node_outputs(setup, 1)["ao"]
+    assert np.isfinite(ao).all() and ao.min() < 0.8  # the corner is occluded
+    if how == "append":
+        (setup / "camera_0001.json").write_text(json.dumps(_camera_of(blend, tmp_path)))
+        depth, normal = frame_passes(out, 1)
+        expected = native.compute_ao(depth, normal,
+                                     params=node_params(radius=0.6, blur_size=0),
+                                     camera=camera(setup, 1))
+        assert np.abs(ao - expected).max() <= EXACT
 
 
 def _user_scripts(tmp_path):
