@@ -118,20 +118,12 @@ _LIBRARY = library_loading.NativeLibrary(
               "rebuild or reinstall the add-on with scripts/install_addon.sh.")
 
 
-def library_path():
-    """The file that load_library() loads: the environment variable
-    LIBRARY_ENVIRONMENT_VARIABLE names, else lib/LIBRARY_FILE_NAME here."""
-    return _LIBRARY.path()
-
-
-def load_library():
-    """The loaded library (loaded on the first call). Raises EXRLibraryError."""
-    return _LIBRARY.load()
-
-
-def unload_library():
-    """Forget the loaded library; the next call loads library_path() again."""
-    _LIBRARY.unload()
+# The file that load_library() loads: $LIBRARY_ENVIRONMENT_VARIABLE, else
+# lib/LIBRARY_FILE_NAME here; load_library() loads it once (raises EXRLibraryError);
+# unload_library() forgets it, so that the next call loads library_path() again.
+library_path = _LIBRARY.path
+load_library = _LIBRARY.load
+unload_library = _LIBRARY.unload
 
 
 def _text(raw):
