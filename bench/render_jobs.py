@@ -30,7 +30,10 @@ import bpy
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import scene_library  # noqa: E402  (needs the path above)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                                "scripts"))
+import blender_scenes  # noqa: E402  (needs the paths above)
+import scene_library  # noqa: E402
 
 # Cycles' pixel filter, in pixels. Nearly 0 so that every sample hits the
 # pixel centre: the references then see the same surface as the Depth and
@@ -126,24 +129,6 @@ def read_exr(path, channels):
         bpy.data.images.remove(image)
 
 
-def camera_dict(scene):
-    camera = scene.camera
-    data = camera.data
-    return {
-        "type": data.type,
-        "lens": data.lens,
-        "sensor_width": data.sensor_width,
-        "sensor_height": data.sensor_height,
-        "sensor_fit": data.sensor_fit,
-        "shift_x": data.shift_x,
-        "shift_y": data.shift_y,
-        "ortho_scale": data.ortho_scale,
-        "pixel_aspect_x": scene.render.pixel_aspect_x,
-        "pixel_aspect_y": scene.render.pixel_aspect_y,
-        "world_to_camera": [list(row) for row in camera.matrix_world.inverted()],
-    }
-
-
 def run_job(scene, spec, job, cache):
     scratch = cache / f"scratch-{job['id']}"
     shutil.rmtree(scratch, ignore_errors=True)
@@ -167,7 +152,7 @@ def run_job(scene, spec, job, cache):
     np.savez(cache / f"{job['id']}.npz", **arrays)
     meta = dict(job)
     meta.update(scene=spec.name, radius=spec.radius, description=spec.description,
-                camera=camera_dict(scene), times_s=times,
+                camera=blender_scenes.camera_description(scene), times_s=times,
                 time_s=statistics.median(times), blender=bpy.app.version_string)
     # The .json is written last: its presence marks the job as done.
     (cache / f"{job['id']}.json").write_text(json.dumps(meta, indent=1))

@@ -10,7 +10,9 @@ Importable inside Blender only:
 Every builder empties the scene it is given (objects, not other scenes), so the
 repository holds no binary .blend file. Units are metres.
 """
+import importlib.util
 import math
+from pathlib import Path
 
 import bpy
 from mathutils import Vector
@@ -216,27 +218,14 @@ def make_orthographic(scene, ortho_scale=None):
 def camera_description(scene):
     """The scene camera as the JSON object the `hbao` CLI reads with --camera.
 
-    Keys are Blender's own property names; world_to_camera is row-major."""
-    camera_object = scene.camera
-    if camera_object is None:
-        raise ValueError(f"scene {scene.name!r} has no camera")
-    camera = camera_object.data
-    if camera.type not in ("PERSP", "ORTHO"):
-        raise ValueError(f"camera type {camera.type} is not supported (PERSP or ORTHO)")
-    world_to_camera = camera_object.matrix_world.inverted()
-    return {
-        "type": camera.type,
-        "lens": float(camera.lens),
-        "sensor_width": float(camera.sensor_width),
-        "sensor_height": float(camera.sensor_height),
-        "sensor_fit": camera.sensor_fit,
-        "shift_x": float(camera.shift_x),
-        "shift_y": float(camera.shift_y),
-        "ortho_scale": float(camera.ortho_scale),
-        "pixel_aspect_x": float(scene.render.pixel_aspect_x),
-        "pixel_aspect_y": float(scene.render.pixel_aspect_y),
-        "world_to_camera": [[float(v) for v in row] for row in world_to_camera],
-    }
+    Keys are Blender's own property names; world_to_camera is row-major. The
+    add-on's own reading of the camera (addon/hbao/camera.py, which needs no
+    add-on package around it) makes it, so tests and the add-on agree."""
+    path = Path(__file__).resolve().parents[1] / "addon" / "hbao" / "camera.py"
+    spec = importlib.util.spec_from_file_location("hbao_camera_model", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.camera_from_blender(scene)
 
 
 # --- scenes -----------------------------------------------------------------
