@@ -313,6 +313,17 @@ def test_appended_or_linked_scene_renders_with_ao(run_blender, tmp_path, native,
         assert np.abs(ao - expected).max() <= EXACT
 
 
+def test_a_value_that_is_not_a_number_renders_without_ao_and_says_so(run_blender, tmp_path):
+    """A Value node feeding NaN into Radius: the render completes, that
+    node's AO is 1 and the console names the node and the socket."""
+    out, stdout = render(run_blender, tmp_path, {"nodes": [
+        {"name": "Bad", "radius_from_value_node": float("nan")}]})
+    outputs = node_outputs(out, 1, "Bad")
+    assert np.all(outputs["ao"] == 1.0)
+    assert np.abs(outputs["image"] - outputs["render"]).max() <= EXACT
+    assert "Bad: Radius is not a number" in stdout, stdout[-3000:]
+
+
 def _user_scripts(tmp_path):
     root = tmp_path / "user_scripts"
     (root / "addons").mkdir(parents=True, exist_ok=True)
