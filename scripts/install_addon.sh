@@ -8,6 +8,8 @@ set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="${HBAO_BUILD_DIR:-$REPO/build}"
 BLENDER="${BLENDER:-blender}"
+# shellcheck source=addon_files.sh
+. "$REPO/scripts/addon_files.sh"
 
 if [ ! -f "$BUILD/libhbao.so" ] || [ ! -f "$BUILD/libhbao_exr.so" ]; then
     cmake -S "$REPO" -B "$BUILD" -DCMAKE_BUILD_TYPE=Release
@@ -25,15 +27,8 @@ fi
 
 TARGET="$ADDONS_DIR/hbao"
 rm -rf "$TARGET"
-mkdir -p "$TARGET/lib"
-# Copy the package without caches; the viewport subpackage comes along.
-(cd "$REPO/addon/hbao" && find . -name '__pycache__' -prune -o -name 'lib' -prune -o \
-    -type f -print | while read -r file; do
-        mkdir -p "$TARGET/$(dirname "$file")"
-        cp "$file" "$TARGET/$file"
-    done)
-cp "$BUILD/libhbao.so" "$TARGET/lib/libhbao.so"
-cp "$BUILD/libhbao_exr.so" "$TARGET/lib/libhbao_exr.so"
+# The package (the viewport subpackage too) and its libraries.
+copy_addon "$TARGET" "$BUILD"
 
 "$BLENDER" -b --python-expr '
 import addon_utils, bpy, sys

@@ -15,14 +15,10 @@ fi
 VERSION="$(sed -n 's/^version = "\(.*\)"/\1/p' "$REPO/addon/hbao/blender_manifest.toml")"
 STAGE="$(mktemp -d)"
 trap 'rm -rf "$STAGE"' EXIT
-mkdir -p "$STAGE/hbao/lib" "$REPO/dist"
-(cd "$REPO/addon/hbao" && find . -name '__pycache__' -prune -o -name 'lib' -prune -o \
-    -type f -print | while read -r file; do
-        mkdir -p "$STAGE/hbao/$(dirname "$file")"
-        cp "$file" "$STAGE/hbao/$file"
-    done)
-cp "$BUILD/libhbao.so" "$STAGE/hbao/lib/libhbao.so"
-cp "$BUILD/libhbao_exr.so" "$STAGE/hbao/lib/libhbao_exr.so"
+# shellcheck source=addon_files.sh
+. "$REPO/scripts/addon_files.sh"
+mkdir -p "$REPO/dist"
+copy_addon "$STAGE/hbao" "$BUILD"
 # Official Blender builds link OpenEXR statically and install no shared
 # copy: ship the OpenEXRCore that libhbao_exr.so was linked against next to
 # it (its RUNPATH is $ORIGIN), with its licence.
