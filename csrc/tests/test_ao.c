@@ -55,6 +55,15 @@ static scene corner_scene(void) {
     return s;
 }
 
+/* The view most tests use: the corner (and boxes) seen from above and to the
+ * side, so that floor, wall and box faces are all visible at an angle. */
+static void render_standard_view(scene s, int width, int height, scene_view *view, float **depth,
+                                 float **normal) {
+    const double eye[3] = {-5.0, -2.5, 3.5}, target[3] = {-0.8, 0, 0.3};
+    *view = make_view(width, height, eye, target);
+    scene_render(&s, view, depth, normal);
+}
+
 /* --- planes -------------------------------------------------------------- */
 
 /* A single plane occludes nothing: AO = 1. Tolerance 1e-4: samples on the
@@ -170,11 +179,9 @@ static double corner_hbao_occlusion(const scene_view *view, int i, int j, double
 /* Floor pixels of the corner, away from the image border by more than the
  * projected radius (no sampling outside the image). */
 static void check_corner(int integration) {
-    const double eye[3] = {-5.0, -2.5, 3.5}, target[3] = {-0.8, 0, 0.3};
-    scene s = corner_scene();
-    scene_view view = make_view(200, 150, eye, target);
+    scene_view view;
     float *depth, *normal;
-    scene_render(&s, &view, &depth, &normal);
+    render_standard_view(corner_scene(), 200, 150, &view, &depth, &normal);
     hbao_params p = exact_params(integration);
     p.radius = 1.0f;
     p.directions = 32;
@@ -244,11 +251,9 @@ static scene boxes_scene(void) {
 }
 
 TEST_CASE(scaling_depth_and_radius_keeps_ao) {
-    const double eye[3] = {-5.0, -2.5, 3.5}, target[3] = {-0.8, 0, 0.3};
-    scene s = boxes_scene();
-    scene_view view = make_view(128, 96, eye, target);
+    scene_view view;
     float *depth, *normal;
-    scene_render(&s, &view, &depth, &normal);
+    render_standard_view(boxes_scene(), 128, 96, &view, &depth, &normal);
     const size_t pixels = (size_t)view.width * view.height;
     float *scaled = malloc(pixels * sizeof(float));
     const float factor = 7.5f;
@@ -344,11 +349,9 @@ static double brute_force_cosine(const scene_view *view, const float *depth, con
 }
 
 TEST_CASE(more_samples_converge_to_brute_force) {
-    const double eye[3] = {-5.0, -2.5, 3.5}, target[3] = {-0.8, 0, 0.3};
-    scene s = boxes_scene();
-    scene_view view = make_view(120, 90, eye, target);
+    scene_view view;
     float *depth, *normal;
-    scene_render(&s, &view, &depth, &normal);
+    render_standard_view(boxes_scene(), 120, 90, &view, &depth, &normal);
     const double radius = 0.7;
     /* reference on a sparse grid of pixels */
     int count = 0;
@@ -445,11 +448,9 @@ TEST_CASE(random_and_degenerate_inputs_give_finite_ao_in_range) {
 }
 
 TEST_CASE(identical_output_for_any_thread_count) {
-    const double eye[3] = {-5.0, -2.5, 3.5}, target[3] = {-0.8, 0, 0.3};
-    scene s = boxes_scene();
-    scene_view view = make_view(161, 117, eye, target);
+    scene_view view;
     float *depth, *normal;
-    scene_render(&s, &view, &depth, &normal);
+    render_standard_view(boxes_scene(), 161, 117, &view, &depth, &normal);
     const size_t bytes = (size_t)view.width * view.height * sizeof(float);
     for (int variant = 0; variant < 4; variant++) {
         hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
@@ -472,11 +473,9 @@ TEST_CASE(identical_output_for_any_thread_count) {
 }
 
 TEST_CASE(bottom_up_rows_with_negative_stride) {
-    const double eye[3] = {-5.0, -2.5, 3.5}, target[3] = {-0.8, 0, 0.3};
-    scene s = boxes_scene();
-    scene_view view = make_view(64, 48, eye, target);
+    scene_view view;
     float *depth, *normal;
-    scene_render(&s, &view, &depth, &normal);
+    render_standard_view(boxes_scene(), 64, 48, &view, &depth, &normal);
     const int w = view.width, h = view.height;
     /* The same image stored bottom-up, as Blender's render passes are, with
      * depth in an RGBA-like 4-float pixel. */
@@ -505,11 +504,9 @@ TEST_CASE(bottom_up_rows_with_negative_stride) {
 /* --- stages ---------------------------------------------------------------- */
 
 TEST_CASE(half_resolution_is_close_to_full) {
-    const double eye[3] = {-5.0, -2.5, 3.5}, target[3] = {-0.8, 0, 0.3};
-    scene s = boxes_scene();
-    scene_view view = make_view(160, 120, eye, target);
+    scene_view view;
     float *depth, *normal;
-    scene_render(&s, &view, &depth, &normal);
+    render_standard_view(boxes_scene(), 160, 120, &view, &depth, &normal);
     hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
     p.directions = 16;
     p.steps = 12;
@@ -557,11 +554,9 @@ TEST_CASE(blur_keeps_depth_edges) {
 }
 
 TEST_CASE(strength_is_a_power) {
-    const double eye[3] = {-5.0, -2.5, 3.5}, target[3] = {-0.8, 0, 0.3};
-    scene s = corner_scene();
-    scene_view view = make_view(64, 48, eye, target);
+    scene_view view;
     float *depth, *normal;
-    scene_render(&s, &view, &depth, &normal);
+    render_standard_view(corner_scene(), 64, 48, &view, &depth, &normal);
     hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
     float *base = run(&p, &view, depth, normal);
     p.strength = 2.0f;
@@ -612,11 +607,9 @@ TEST_CASE(background_never_occludes) {
 }
 
 TEST_CASE(tiny_projected_radius_gives_one) {
-    const double eye[3] = {-5.0, -2.5, 3.5}, target[3] = {-0.8, 0, 0.3};
-    scene s = corner_scene();
-    scene_view view = make_view(64, 48, eye, target);
+    scene_view view;
     float *depth, *normal;
-    scene_render(&s, &view, &depth, &normal);
+    render_standard_view(corner_scene(), 64, 48, &view, &depth, &normal);
     hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
     /* under one pixel: 1e-3 units at depth ~6 with 64 px over a 36/50 view */
     p.radius = 1e-3f;
@@ -631,11 +624,10 @@ TEST_CASE(simd_paths_match_scalar_reference_bit_for_bit) {
     /* Every SIMD kernel must give exactly the scalar reference's floats: they
      * perform the same operations in the same order. A kernel this CPU lacks
      * falls back to the one below it, so the comparison still runs. */
-    const double eye[3] = {-5.0, -2.5, 3.5}, target[3] = {-0.8, 0, 0.3};
-    scene s = boxes_scene();
-    scene_view view = make_view(203, 157, eye, target); /* odd sizes: row tails */
+    scene_view view;
     float *depth, *normal;
-    scene_render(&s, &view, &depth, &normal);
+    /* odd sizes: row tails that the SIMD kernels leave to scalar code */
+    render_standard_view(boxes_scene(), 203, 157, &view, &depth, &normal);
     for (int k = 0; k < 300; k++) depth[(k * 7919) % (view.width * view.height)] = 1e10f; /* holes */
     const size_t bytes = (size_t)view.width * view.height * sizeof(float);
     const int kernels[] = {HBAO_IMPLEMENTATION_AVX2, HBAO_IMPLEMENTATION_AVX512, HBAO_IMPLEMENTATION_AUTO};
