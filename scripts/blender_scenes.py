@@ -10,12 +10,19 @@ Importable inside Blender only:
 Every builder empties the scene it is given (objects, not other scenes), so the
 repository holds no binary .blend file. Units are metres.
 """
-import importlib.util
 import math
+import sys
 from pathlib import Path
 
 import bpy
 from mathutils import Vector
+
+try:
+    import hbao  # noqa: F401  (the enabled add-on, or this checkout's below)
+except ImportError:
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "addon"))
+from hbao import camera as camera_model  # noqa: E402
+from hbao import compat  # noqa: E402
 
 # Debian's Blender has no OpenImageDenoise; renders with denoising on fail.
 # Small sample counts keep test renders at a few seconds on 2 CPU cores.
@@ -147,7 +154,7 @@ def configure_render(scene, resolution=DEFAULT_RESOLUTION, engine="CYCLES",
     if engine not in ENGINES:
         raise ValueError(f"unknown engine {engine!r}: use one of {', '.join(ENGINES)}")
     render = scene.render
-    render.engine = engine
+    render.engine = compat.engine_identifier(engine)
     render.resolution_x, render.resolution_y = resolution
     render.resolution_percentage = 100
     render.pixel_aspect_x = render.pixel_aspect_y = 1.0
@@ -219,13 +226,80 @@ def camera_description(scene):
     """The scene camera as the JSON object the `hbao` CLI reads with --camera.
 
     Keys are Blender's own property names; world_to_camera is row-major. The
-    add-on's own reading of the camera (addon/hbao/camera.py, which needs no
-    add-on package around it) makes it, so tests and the add-on agree."""
-    path = Path(__file__).resolve().parents[1] / "addon" / "hbao" / "camera.py"
-    spec = importlib.util.spec_from_file_location("hbao_camera_model", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module.camera_from_blender(scene)
+    add-on's own reading of the camera makes it, so tests and the add-on agree."""
+    return camera_model.camera_from_blender(scene)
+
+
+# --- compositor wiring (every Blender version, through the add-on's compat) ---
+
+class Compositor:
+    """The scene's compositor tree, emptied, with helpers that hide what
+    changed between Blender versions (5.0: a node group instead of
+    scene.node_tree, Group Output instead of Composite, the File Output
+    node's items, ShaderNodeValue)."""
+
+    def __init__(self, scene):
+        self.scene = scene
+        self.tree = compat.ensure_compositor_tree(scene)
+        for node in list(self.tree.nodes):
+            self.tree.nodes.remove(node)
+
+    def node(self, idname, location=(0, 0), **settings):
+        node = self.tree.nodes.new(idname)
+        node.location = location
+        for name, value in settings.items():
+            setattr(node, name, value)
+        return node
+
+    def link(self, from_socket, to_socket):
+        return self.tree.links.new(from_socket, to_socket)
+
+    def render_layers(self, view_layer=None, location=(-400, 0)):
+        node = self.node("CompositorNodeRLayers", location)
+        if view_layer is not None:
+            node.layer = view_layer
+        return node
+
+    def composite(self, socket, location=(900, 0)):
+        """The final image: Composite (<5.0) or the group's output."""
+        node = compat.new_composite_output(self.tree)
+        node.location = location
+        self.link(socket, node.inputs[0])
+        return node
+
+    def value(self, value, location=(0, -300)):
+        """A Value node (CompositorNodeValue <5.0, ShaderNodeValue 5.0+)."""
+        node = compat.new_value_node(self.tree)
+        node.location = location
+        node.outputs[0].default_value = value
+        return node
+
+    def file_output(self, folder, prefix, location=(900, -300), multilayer=True):
+        """A File Output node writing FOLDER/PREFIX<frame>.exr (multilayer,
+        32-bit float, uncompressed) or one PNG per input."""
+        node = self.node("CompositorNodeOutputFile", location)
+        compat.set_file_output_path(node, folder, prefix)
+        image_format = node.format
+        if multilayer:
+            compat.set_image_format(image_format, "OPEN_EXR_MULTILAYER")
+            image_format.color_depth = "32"
+            image_format.exr_codec = "NONE"
+        else:
+            compat.set_image_format(image_format, "PNG")
+        compat.clear_file_output_inputs(node)
+        return FileOutput(self, node)
+
+
+class FileOutput:
+    def __init__(self, compositor, node):
+        self.compositor = compositor
+        self.node = node
+
+    def add(self, name, socket):
+        """A new input called `name`, fed by `socket`."""
+        target = compat.new_file_output_input(self.node, name, socket)
+        self.compositor.link(socket, target)
+        return target
 
 
 # --- scenes -----------------------------------------------------------------

@@ -18,6 +18,9 @@ JOBS="${JOBS:-2}"
 PYTHON="${PYTHON:-/usr/bin/python3}"
 
 "$REPO/scripts/setup.sh"
+# PyPI's bpy 4.5 LTS, 5.0 and the newest 5.x for the Blender matrix (reused
+# from ~/.cache/hbao/bpy between runs).
+"$REPO/scripts/setup_bpy.sh"
 
 echo "== build (Release) and C tests"
 # Options are given explicitly: a build folder configured earlier (e.g. by
@@ -42,5 +45,6 @@ fi
 echo "== PEP 8"
 "$PYTHON" -m pycodestyle addon scripts tests $( [ -d bench ] && echo bench )
 
-echo "== Python tests (real Blender)"
-"$PYTHON" -m pytest tests -q -p no:cacheprovider
+echo "== Python tests (real Blender: Debian's blender and bpy 4.5, 5.0, newest 5.x)"
+# Debian's blender + the three bpy builds: a missing one fails the run.
+HBAO_EXPECTED_BLENDERS=4 "$PYTHON" -m pytest tests -q -p no:cacheprovider

@@ -1,15 +1,27 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """Shared pytest fixtures: where the built library, the tool and Blender are,
 and one way to run a Python script inside a real (headless or Xvfb) Blender
-with the add-on from this checkout enabled."""
+with the add-on from this checkout enabled.
+
+The Blender matrix: a test that takes the `blender` fixture and is marked
+`matrix` (test_addon.py marks all of its tests) runs once in every Blender
+scripts/blenders.py finds: Debian's blender and the bpy builds that
+scripts/setup_bpy.sh installs. Marked `ui` as well, it runs only where
+Blender has a user interface (Debian's, under Xvfb). Other tests get Debian's
+blender. The summary at the end counts the results per Blender."""
+import collections
 import os
 import shutil
 import subprocess
+import sys
 from pathlib import Path
 
 import pytest
 
 REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO / "scripts"))
+sys.path.insert(0, str(REPO / "addon"))  # the add-on's bpy-free modules
+import blenders  # noqa: E402
 BUILD = Path(os.environ.get("HBAO_BUILD_DIR", REPO / "build"))
 LIBRARY = BUILD / "libhbao.so"
 # The add-on's EXR reader (csrc/exr): the add-on and the tests read EXRs with it.
@@ -18,6 +30,11 @@ TOOL = BUILD / "hbao"
 FIXTURES = REPO / "tests" / "fixtures"
 SCRIPTS = REPO / "scripts"
 BLENDER = shutil.which(os.environ.get("BLENDER", "blender"))
+BLENDERS = blenders.all_blenders()
+DEBIAN_BLENDER = next((b for b in BLENDERS if b.kind == "app"), blenders.debian_blender())
+# Set by scripts/test.sh: every Blender of the matrix must be there (a missing
+# one fails the run instead of shrinking the matrix).
+EXPECTED_BLENDERS = int(os.environ.get("HBAO_EXPECTED_BLENDERS", "0"))
 
 # Tests read Blender's EXRs in this process too, through the add-on's binding
 # (addon/hbao/exr_passes.py), which finds the library through this variable.
@@ -54,6 +71,8 @@ def blender_user_scripts(tmp_path_factory):
 def blender_environment(user_scripts, extra=None):
     env = dict(os.environ)
     env["BLENDER_USER_SCRIPTS"] = str(user_scripts)
+    # Preferences beside the scripts folder: never the real user's.
+    env["BLENDER_USER_CONFIG"] = str(Path(user_scripts) / "config")
     env["HBAO_LIBRARY"] = str(LIBRARY)
     env["HBAO_EXR_LIBRARY"] = str(EXR_LIBRARY)
     env["PYTHONUNBUFFERED"] = "1"
@@ -63,39 +82,95 @@ def blender_environment(user_scripts, extra=None):
     return env
 
 
+def pytest_configure(config):
+    config.addinivalue_line("markers", "matrix: runs once in every Blender of the matrix")
+    config.addinivalue_line("markers", "ui: needs Blender's user interface (Xvfb)")
+
+
+def pytest_sessionstart(session):
+    if EXPECTED_BLENDERS and len(BLENDERS) < EXPECTED_BLENDERS:
+        names = ", ".join(b.name for b in BLENDERS) or "none"
+        raise pytest.UsageError(
+            f"the Blender matrix needs {EXPECTED_BLENDERS} Blenders, found {names}: "
+            f"run scripts/setup.sh and scripts/setup_bpy.sh")
+
+
+def pytest_generate_tests(metafunc):
+    if "blender" not in metafunc.fixturenames:
+        return
+    if metafunc.definition.get_closest_marker("matrix") is None:
+        candidates = [DEBIAN_BLENDER] if DEBIAN_BLENDER else []
+    elif metafunc.definition.get_closest_marker("ui") is not None:
+        candidates = [b for b in BLENDERS if b.has_ui]
+    else:
+        candidates = BLENDERS
+    metafunc.parametrize("blender", candidates, ids=[b.name for b in candidates])
+
+
+_OUTCOMES = collections.defaultdict(collections.Counter)
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item, call):
+    outcome = yield
+    report = outcome.get_result()
+    blender = getattr(item, "callspec", None) and item.callspec.params.get("blender")
+    if blender is None:
+        return
+    if report.when == "call" or (report.when == "setup" and report.outcome != "passed"):
+        _OUTCOMES[blender.name][report.outcome] += 1
+
+
+def pytest_terminal_summary(terminalreporter):
+    if not _OUTCOMES:
+        return
+    terminalreporter.section("tests per Blender")
+    for blender in BLENDERS:
+        counts = _OUTCOMES.get(blender.name)
+        if counts:
+            how = "application, headless and under Xvfb" if blender.has_ui \
+                else "Python module, headless"
+            terminalreporter.write_line(
+                f"{blender.name:16} ({how}): {counts['passed']} passed, "
+                f"{counts['failed']} failed, {counts['skipped']} skipped")
+
+
+def _runner(blender, user_scripts):
+    def run(script, *args, blend=None, ui=False, addon=True, env=None, check=True,
+            timeout=BLENDER_TIMEOUT_S):
+        command = blender.command(script, args, blend=blend, ui=ui,
+                                  addons=("hbao",) if addon else ())
+        return run_command(command, user_scripts, env, check, timeout)
+    return run
+
+
 @pytest.fixture(scope="session")
 def run_blender(blender_user_scripts):
     """run_blender(script, *args, blend=None, ui=False, addon=True, env=None)
 
-    Runs `script` (a path) in Blender 3.4 (factory settings, this checkout's
-    add-on enabled unless addon=False). Headless with -b, or with ui=True in a
-    real window under xvfb-run. Arguments after `--` reach the script via
+    Runs `script` (a path) in Debian's Blender, factory settings, this
+    checkout's add-on enabled unless addon=False. Headless, or with ui=True in
+    a real window under xvfb-run. Arguments after `--` reach the script via
     sys.argv. Returns the CompletedProcess; fails the test on a non-zero exit,
     showing Blender's output."""
-    if BLENDER is None:
+    if DEBIAN_BLENDER is None:
         pytest.fail("blender not found: run scripts/setup.sh")
+    return _runner(DEBIAN_BLENDER, blender_user_scripts)
 
-    def run(script, *args, blend=None, ui=False, addon=True, env=None, check=True,
-            timeout=BLENDER_TIMEOUT_S):
-        command = [BLENDER]
-        if not ui:
-            command.append("-b")
-        if blend is not None:
-            command.append(str(blend))
-        command += ["--factory-startup", "-noaudio"]
-        if addon:
-            command += ["--addons", "hbao"]
-        command += ["--python-exit-code", "1", "--python", str(script), "--"]
-        command += [str(a) for a in args]
-        if ui:
-            command = ["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24"] + command
-        completed = subprocess.run(
-            command, env=blender_environment(blender_user_scripts, env),
-            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-            timeout=timeout)
-        if check and completed.returncode != 0:
-            pytest.fail(f"Blender exited with {completed.returncode}:\n"
-                        f"{' '.join(command)}\n{completed.stdout[-6000:]}")
-        return completed
 
-    return run
+@pytest.fixture
+def run_in_blender(blender, blender_user_scripts):
+    """run_blender for the test's own Blender: a matrix test's `blender`
+    parameter (the bpy builds too), else Debian's."""
+    return _runner(blender, blender_user_scripts)
+
+
+def run_command(command, user_scripts, env=None, check=True, timeout=BLENDER_TIMEOUT_S):
+    """Run a Blender command line with this checkout's add-on and libraries."""
+    completed = subprocess.run(
+        command, env=blender_environment(user_scripts, env),
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=timeout)
+    if check and completed.returncode != 0:
+        pytest.fail(f"Blender exited with {completed.returncode}:\n"
+                    f"{' '.join(command)}\n{completed.stdout[-6000:]}")
+    return completed

@@ -9,7 +9,7 @@ import subprocess
 import numpy as np
 import pytest
 
-from conftest import BLENDER, REPO, blender_environment
+from conftest import BLENDER, REPO, blender_environment, run_command
 
 SCRIPTS = REPO / "tests" / "blender_scripts"
 APPEND_SCRIPT = REPO / "tests" / "blender_scripts" / "addon_append.py"
@@ -31,6 +31,9 @@ CYCLES_MEAN_ERROR_TOLERANCE = 0.08
 # Background depth in Cycles' Depth pass.
 CYCLES_BACKGROUND_DEPTH = 1e9
 
+# Every test here runs in each Blender of the matrix (tests/conftest.py).
+pytestmark = pytest.mark.matrix
+
 
 def _load(name, path):
     spec = importlib.util.spec_from_file_location(name, path)
@@ -50,9 +53,9 @@ def native(built_library):
     return module
 
 
-def render(run_blender, tmp_path, spec, env=None, name="render"):
+def render(run_in_blender, tmp_path, spec, env=None, name="render"):
     out = tmp_path / name
-    completed = run_blender(RENDER_SCRIPT, json.dumps(spec), out, env=env)
+    completed = run_in_blender(RENDER_SCRIPT, json.dumps(spec), out, env=env)
     assert "RENDERED" in completed.stdout or "SAVED" in completed.stdout, completed.stdout[-3000:]
     return out, completed.stdout
 
@@ -105,10 +108,10 @@ def node_params(**overrides):
 
 
 def test_node_ao_matches_library_cycles_and_composites_image_times_ao(
-        run_blender, tmp_path, native):
+        run_in_blender, tmp_path, native):
     spec = {"samples": 64, "ao_reference": 1.0,
             "nodes": [{"radius": 1.0, "integration": "COSINE", "falloff": "NONE"}]}
-    out, log = render(run_blender, tmp_path, spec)
+    out, log = render(run_in_blender, tmp_path, spec)
     assert "pass hand-over" in log  # the timing line is printed
     outputs = node_outputs(out, 1)
     ao = outputs["ao"]
@@ -129,10 +132,10 @@ def test_node_ao_matches_library_cycles_and_composites_image_times_ao(
     assert error <= CYCLES_MEAN_ERROR_TOLERANCE
 
 
-def test_node_ao_matches_cli(run_blender, tmp_path, hbao_tool):
+def test_node_ao_matches_cli(run_in_blender, tmp_path, hbao_tool):
     """The same passes through the command-line tool (its own OpenEXR reader)."""
     spec = {"nodes": [{"radius": 0.7, "blur_size": 0}]}
-    out, _ = render(run_blender, tmp_path, spec)
+    out, _ = render(run_in_blender, tmp_path, spec)
     cli_out = out / "cli_ao.exr"
     completed = subprocess.run(
         [str(hbao_tool), str(out / "frame_0001.exr"), "-o", str(cli_out), "--layer",
@@ -144,11 +147,11 @@ def test_node_ao_matches_cli(run_blender, tmp_path, hbao_tool):
     assert np.abs(node_outputs(out, 1)["ao"] - cli_ao).max() <= EXACT
 
 
-def test_keyframed_radius_and_value_node(run_blender, tmp_path, native):
+def test_keyframed_radius_and_value_node(run_in_blender, tmp_path, native):
     spec = {"frames": [1, 2], "orthographic": True, "nodes": [
         {"name": "Keyed", "keyframes": [[1, 0.15], [2, 1.2]], "blur_size": 0},
         {"name": "Valued", "radius_from_value_node": 0.5, "normal": False}]}
-    out, _ = render(run_blender, tmp_path, spec)
+    out, _ = render(run_in_blender, tmp_path, spec)
     ao = {frame: node_outputs(out, frame, "Keyed")["ao"] for frame in (1, 2)}
     for frame, radius in ((1, 0.15), (2, 1.2)):
         expected = library_ao(native, out, frame, node_params(radius=radius, blur_size=0))
@@ -160,12 +163,12 @@ def test_keyframed_radius_and_value_node(run_blender, tmp_path, native):
     assert np.abs(valued - expected).max() <= EXACT
 
 
-def test_two_nodes_two_view_layers_and_muted_node(run_blender, tmp_path, native):
+def test_two_nodes_two_view_layers_and_muted_node(run_in_blender, tmp_path, native):
     spec = {"scene": "two_layers", "nodes": [
         {"name": "Small", "layer": "Front", "radius": 0.2},
         {"name": "Large", "layer": "Back", "radius": 1.5},
         {"name": "Muted", "layer": "Front", "radius": 1.0, "mute": True}]}
-    out, log = render(run_blender, tmp_path, spec)
+    out, log = render(run_in_blender, tmp_path, spec)
     small = node_outputs(out, 1, "Small")["ao"]
     large = node_outputs(out, 1, "Large")["ao"]
     assert np.abs(small - large).max() > 0.1
@@ -176,17 +179,17 @@ def test_two_nodes_two_view_layers_and_muted_node(run_blender, tmp_path, native)
     assert "2 AO pass(es)" in log  # the muted node was not computed
 
 
-def test_missing_normal_pass_is_enabled_with_a_message(run_blender, tmp_path, native):
+def test_missing_normal_pass_is_enabled_with_a_message(run_in_blender, tmp_path, native):
     spec = {"disable_normal_pass": True, "nodes": [{"radius": 0.8}]}
-    out, log = render(run_blender, tmp_path, spec)
+    out, log = render(run_in_blender, tmp_path, spec)
     assert "enabled the Normal pass of view layer 'ViewLayer'" in log
     expected = library_ao(native, out, 1, node_params(radius=0.8))
     assert np.abs(node_outputs(out, 1)["ao"] - expected).max() <= EXACT
 
 
-def test_missing_library_renders_without_ao_and_says_so(run_blender, tmp_path):
+def test_missing_library_renders_without_ao_and_says_so(run_in_blender, tmp_path):
     missing = tmp_path / "no" / "libhbao.so"
-    out, log = render(run_blender, tmp_path, {"nodes": [{"radius": 1.0}]},
+    out, log = render(run_in_blender, tmp_path, {"nodes": [{"radius": 1.0}]},
                       env={"HBAO_LIBRARY": str(missing)})
     assert f"libhbao not found at {missing}" in log
     outputs = node_outputs(out, 1)
@@ -194,9 +197,9 @@ def test_missing_library_renders_without_ao_and_says_so(run_blender, tmp_path):
     assert np.abs(outputs["image"] - outputs["render"]).max() <= EXACT
 
 
-def test_missing_exr_library_renders_without_ao_and_says_so(run_blender, tmp_path):
+def test_missing_exr_library_renders_without_ao_and_says_so(run_in_blender, tmp_path):
     missing = tmp_path / "no" / "libhbao_exr.so"
-    out, log = render(run_blender, tmp_path, {"nodes": [{"radius": 1.0}]},
+    out, log = render(run_in_blender, tmp_path, {"nodes": [{"radius": 1.0}]},
                       env={"HBAO_EXR_LIBRARY": str(missing)})
     # The message reaches Blender's UI through RenderEngine.report (a
     # WARNING, printed in -b) and says how to fix it.
@@ -208,24 +211,22 @@ def test_missing_exr_library_renders_without_ao_and_says_so(run_blender, tmp_pat
     assert np.abs(outputs["image"] - outputs["render"]).max() <= EXACT
 
 
-def test_saved_file_renders_from_the_command_line(run_blender, tmp_path, native):
+def test_saved_file_renders_from_the_command_line(run_in_blender, blender,
+                                                  blender_user_scripts, tmp_path, native):
     blend = tmp_path / "hbao.blend"
     out = tmp_path / "cli"
-    render(run_blender, tmp_path, {"save_blend": str(blend),
-                                   "nodes": [{"radius": 0.6, "integration": "HBAO"}]},
+    render(run_in_blender, tmp_path, {"save_blend": str(blend),
+                                      "nodes": [{"radius": 0.6, "integration": "HBAO"}]},
            name="setup")
     # The file was saved before any render: the command line must render the
     # node as an artist's `blender -b file.blend -f 1` does, add-on enabled.
     # The script saved its outputs under the setup folder; redirect them.
-    command = [BLENDER, "-b", str(blend), "--factory-startup", "-noaudio", "--addons", "hbao",
-               "-o", str(out / "frame_####"), "-f", "1"]
-    env = blender_environment(_user_scripts(tmp_path), None)
-    completed = subprocess.run(command, env=env, stdout=subprocess.PIPE,
-                               stderr=subprocess.STDOUT, text=True, timeout=600)
-    assert completed.returncode == 0, completed.stdout[-3000:]
+    command = blender.command(blend=blend, output=out / "frame_####", frame=1)
+    completed = run_command(command, blender_user_scripts)
     assert "pass hand-over" in completed.stdout, completed.stdout[-3000:]
     setup = tmp_path / "setup"
-    (setup / "camera_0001.json").write_text(json.dumps(_camera_of(blend, tmp_path)))
+    (setup / "camera_0001.json").write_text(json.dumps(
+            _camera_of(blender, blender_user_scripts, blend, tmp_path)))
     ao = node_outputs(setup, 1)["ao"]
     depth, normal = frame_passes(out, 1)
     expected = native.compute_ao(depth, normal,
@@ -234,24 +235,22 @@ def test_saved_file_renders_from_the_command_line(run_blender, tmp_path, native)
     assert np.abs(ao - expected).max() <= EXACT
 
 
-def test_animation_renders_every_frame_at_its_keyframed_radius(run_blender, tmp_path, native):
+def test_animation_renders_every_frame_at_its_keyframed_radius(
+        run_in_blender, blender, blender_user_scripts, tmp_path, native):
     """`blender -b file.blend -s 1 -e 2 -a`: each frame's node AO is the
     library's AO of that frame's passes at that frame's keyframed radius."""
     blend = tmp_path / "animated.blend"
     out = tmp_path / "animation"
-    render(run_blender, tmp_path, {
+    render(run_in_blender, tmp_path, {
         "save_blend": str(blend), "frames": [1, 2],
         "nodes": [{"keyframes": [[1, 0.15], [2, 1.2]], "blur_size": 0}]}, name="setup")
-    command = [BLENDER, "-b", str(blend), "--factory-startup", "-noaudio", "--addons", "hbao",
-               "-o", str(out / "frame_####"), "-s", "1", "-e", "2", "-a"]
-    env = blender_environment(_user_scripts(tmp_path), None)
-    completed = subprocess.run(command, env=env, stdout=subprocess.PIPE,
-                               stderr=subprocess.STDOUT, text=True, timeout=600)
-    assert completed.returncode == 0, completed.stdout[-3000:]
+    command = blender.command(blend=blend, output=out / "frame_####", animation=(1, 2))
+    completed = run_command(command, blender_user_scripts)
     setup = tmp_path / "setup"
     ao = {}
     for frame, radius in ((1, 0.15), (2, 1.2)):
-        (setup / f"camera_{frame:04d}.json").write_text(json.dumps(_camera_of(blend, tmp_path)))
+        (setup / f"camera_{frame:04d}.json").write_text(json.dumps(
+            _camera_of(blender, blender_user_scripts, blend, tmp_path)))
         ao[frame] = node_outputs(setup, frame)["ao"]
         depth, normal = frame_passes(out, frame)
         expected = native.compute_ao(depth, normal,
@@ -262,7 +261,7 @@ def test_animation_renders_every_frame_at_its_keyframed_radius(run_blender, tmp_
     assert ao[2].mean() < ao[1].mean() - 0.02
 
 
-def test_border_crop_render_matches_the_full_frame(run_blender, tmp_path):
+def test_border_crop_render_matches_the_full_frame(run_in_blender, tmp_path):
     """A render cropped to a border region gives the same AO as the full
     frame at the same pixels, away from the crop edge by more than the
     projected radius (there the crop has no samples beyond its edge). The
@@ -270,8 +269,8 @@ def test_border_crop_render_matches_the_full_frame(run_blender, tmp_path):
     ignored the crop would misplace every position."""
     width, height = 192, 128
     common = {"resolution": [width, height], "nodes": [{"radius": 0.15, "blur_size": 0}]}
-    full_out, _ = render(run_blender, tmp_path, common, name="full")
-    crop_out, _ = render(run_blender, tmp_path, dict(common, border=[0.25, 0.75, 0.25, 0.75]),
+    full_out, _ = render(run_in_blender, tmp_path, common, name="full")
+    crop_out, _ = render(run_in_blender, tmp_path, dict(common, border=[0.25, 0.75, 0.25, 0.75]),
                          name="crop")
     full = node_outputs(full_out, 1)["ao"]
     crop = node_outputs(crop_out, 1)["ao"]
@@ -290,22 +289,24 @@ def test_border_crop_render_matches_the_full_frame(run_blender, tmp_path):
 
 
 @pytest.mark.parametrize("how", ["append", "link"])
-def test_appended_or_linked_scene_renders_with_ao(run_blender, tmp_path, native, how):
+def test_appended_or_linked_scene_renders_with_ao(run_in_blender, blender,
+                                                  blender_user_scripts, tmp_path, native, how):
     """A scene with an HBAO node, appended or linked into another file, still
     renders its AO: the hook's helper scene comes along and is found again."""
     blend = tmp_path / "source.blend"
-    render(run_blender, tmp_path, {"save_blend": str(blend),
-                                   "nodes": [{"radius": 0.6, "blur_size": 0}]}, name="setup")
+    render(run_in_blender, tmp_path, {"save_blend": str(blend),
+                                      "nodes": [{"radius": 0.6, "blur_size": 0}]}, name="setup")
     out = tmp_path / how
     out.mkdir()
-    completed = run_blender(APPEND_SCRIPT, blend, how, out)
+    completed = run_in_blender(APPEND_SCRIPT, blend, how, out)
     assert "APPEND_RENDERED" in completed.stdout, completed.stdout[-3000:]
     assert "without AO" not in completed.stdout, completed.stdout[-3000:]
     setup = tmp_path / "setup"
     ao = node_outputs(setup, 1)["ao"]
     assert np.isfinite(ao).all() and ao.min() < 0.8  # the corner is occluded
     if how == "append":
-        (setup / "camera_0001.json").write_text(json.dumps(_camera_of(blend, tmp_path)))
+        (setup / "camera_0001.json").write_text(json.dumps(
+            _camera_of(blender, blender_user_scripts, blend, tmp_path)))
         depth, normal = frame_passes(out, 1)
         expected = native.compute_ao(depth, normal,
                                      params=node_params(radius=0.6, blur_size=0),
@@ -313,10 +314,10 @@ def test_appended_or_linked_scene_renders_with_ao(run_blender, tmp_path, native,
         assert np.abs(ao - expected).max() <= EXACT
 
 
-def test_a_value_that_is_not_a_number_renders_without_ao_and_says_so(run_blender, tmp_path):
+def test_a_value_that_is_not_a_number_renders_without_ao_and_says_so(run_in_blender, tmp_path):
     """A Value node feeding NaN into Radius: the render completes, that
     node's AO is 1 and the console names the node and the socket."""
-    out, stdout = render(run_blender, tmp_path, {"nodes": [
+    out, stdout = render(run_in_blender, tmp_path, {"nodes": [
         {"name": "Bad", "radius_from_value_node": float("nan")}]})
     outputs = node_outputs(out, 1, "Bad")
     assert np.all(outputs["ao"] == 1.0)
@@ -324,33 +325,22 @@ def test_a_value_that_is_not_a_number_renders_without_ao_and_says_so(run_blender
     assert "Bad: Radius is not a number" in stdout, stdout[-3000:]
 
 
-def _user_scripts(tmp_path):
-    root = tmp_path / "user_scripts"
-    (root / "addons").mkdir(parents=True, exist_ok=True)
-    link = root / "addons" / "hbao"
-    if not link.exists():
-        link.symlink_to(REPO / "addon" / "hbao")
-    return root
-
-
-def _camera_of(blend, tmp_path):
+def _camera_of(blender, user_scripts, blend, tmp_path):
     script = tmp_path / "camera.py"
     script.write_text(
         "import bpy, json, sys\n"
         f"sys.path.insert(0, {str(REPO / 'scripts')!r})\n"
         "import blender_scenes\n"
         "print('CAMERA', json.dumps(blender_scenes.camera_description(bpy.context.scene)))\n")
-    completed = subprocess.run(
-        [BLENDER, "-b", str(blend), "--factory-startup", "--python", str(script)],
-        env=blender_environment(_user_scripts(tmp_path), None), stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT, text=True, timeout=600)
+    completed = run_command(blender.command(script, blend=blend, addons=()), user_scripts)
     line = next(text for text in completed.stdout.splitlines() if text.startswith("CAMERA "))
     return json.loads(line[len("CAMERA "):])
 
 
-def test_f12_render_in_the_ui_job_thread(run_blender, tmp_path, native):
+@pytest.mark.ui
+def test_f12_render_in_the_ui_job_thread(run_in_blender, tmp_path, native):
     out = tmp_path / "f12"
-    completed = run_blender(SCRIPTS / "addon_f12.py", out, ui=True)
+    completed = run_in_blender(SCRIPTS / "addon_f12.py", out, ui=True)
     assert "F12: RENDERED" in completed.stdout, completed.stdout[-3000:]
     assert "pass hand-over" in completed.stdout
     ao = node_outputs(out, 1)["ao"]
@@ -359,18 +349,18 @@ def test_f12_render_in_the_ui_job_thread(run_blender, tmp_path, native):
     assert np.abs(ao - expected).max() <= EXACT
 
 
-def test_eevee_main_engine(run_blender, tmp_path, native):
+def test_eevee_main_engine(run_in_blender, tmp_path, native):
     spec = {"engine": "BLENDER_EEVEE", "resolution": [64, 48], "samples": 1,
             "nodes": [{"radius": 0.8}]}
-    out, _ = render(run_blender, tmp_path, spec)
+    out, _ = render(run_in_blender, tmp_path, spec)
     ao = node_outputs(out, 1)["ao"]
     assert ao.min() < 0.9
     expected = library_ao(native, out, 1, node_params(radius=0.8))
     assert np.abs(ao - expected).max() <= EXACT
 
 
-def test_hook_lifecycle(run_blender, tmp_path):
-    completed = run_blender(SCRIPTS / "addon_lifecycle.py", tmp_path)
+def test_hook_lifecycle(run_in_blender, tmp_path):
+    completed = run_in_blender(SCRIPTS / "addon_lifecycle.py", tmp_path)
     assert "LIFECYCLE OK" in completed.stdout, completed.stdout[-3000:]
 
 

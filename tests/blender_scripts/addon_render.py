@@ -51,47 +51,27 @@ if spec.get("border"):
     render_settings.use_border = True
     render_settings.use_crop_to_border = True
 
-scene.use_nodes = True
-tree = scene.node_tree
-for node in list(tree.nodes):
-    tree.nodes.remove(node)
-composite = tree.nodes.new("CompositorNodeComposite")
-composite.location = (900, 0)
+compositor = blender_scenes.Compositor(scene)
+tree = compositor.tree
 render_layers = {}
 for index, view_layer in enumerate(scene.view_layers):
-    node = tree.nodes.new("CompositorNodeRLayers")
-    node.layer = view_layer.name
-    node.location = (-400, -400 * index)
-    render_layers[view_layer.name] = node
-
-file_output = tree.nodes.new("CompositorNodeOutputFile")
-file_output.location = (900, -300)
-file_output.base_path = os.path.join(out_dir, "nodes_")
-file_output.format.file_format = "OPEN_EXR_MULTILAYER"
-file_output.format.color_depth = "32"
-file_output.format.exr_codec = "NONE"
-file_output.file_slots.clear()
-
-
-def output_slot(name, socket):
-    file_output.file_slots.new(name)
-    tree.links.new(socket, file_output.inputs[name])
-
+    render_layers[view_layer.name] = compositor.render_layers(view_layer.name,
+                                                              (-400, -400 * index))
+file_output = compositor.file_output(out_dir, "nodes_")
 
 first_layer = scene.view_layers[0].name
-output_slot("Render", render_layers[first_layer].outputs["Image"])
+file_output.add("Render", render_layers[first_layer].outputs["Image"])
 if spec.get("ao_reference"):
-    output_slot("CyclesAO", render_layers[first_layer].outputs["AO"])
+    file_output.add("CyclesAO", render_layers[first_layer].outputs["AO"])
 
 for index, node_spec in enumerate(spec.get("nodes", [{}])):
-    hbao = tree.nodes.new("CompositorNodeHBAO")
+    hbao = compositor.node("CompositorNodeHBAO", (300, -400 * index))
     hbao.name = node_spec.get("name", f"HBAO{index}")
-    hbao.location = (300, -400 * index)
     source = render_layers[node_spec.get("layer", first_layer)]
-    tree.links.new(source.outputs["Image"], hbao.inputs["Image"])
-    tree.links.new(source.outputs["Depth"], hbao.inputs["Depth"])
+    compositor.link(source.outputs["Image"], hbao.inputs["Image"])
+    compositor.link(source.outputs["Depth"], hbao.inputs["Depth"])
     if node_spec.get("normal", True):
-        tree.links.new(source.outputs["Normal"], hbao.inputs["Normal"])
+        compositor.link(source.outputs["Normal"], hbao.inputs["Normal"])
     for key, socket_name in (("radius", "Radius"), ("angle_bias", "Angle Bias"),
                              ("directions", "Directions"), ("steps", "Steps"),
                              ("blur_size", "Blur Size"), ("strength", "Strength")):
@@ -101,17 +81,16 @@ for index, node_spec in enumerate(spec.get("nodes", [{}])):
         if key in node_spec:
             setattr(hbao, key, node_spec[key])
     if node_spec.get("radius_from_value_node") is not None:
-        value = tree.nodes.new("CompositorNodeValue")
-        value.outputs[0].default_value = node_spec["radius_from_value_node"]
-        tree.links.new(value.outputs[0], hbao.inputs["Radius"])
+        value = compositor.value(node_spec["radius_from_value_node"])
+        compositor.link(value.outputs[0], hbao.inputs["Radius"])
     for frame, radius in node_spec.get("keyframes", []):
         hbao.inputs["Radius"].default_value = radius
         hbao.inputs["Radius"].keyframe_insert("default_value", frame=frame)
     hbao.mute = node_spec.get("mute", False)
     if index == 0:
-        tree.links.new(hbao.outputs["Image"], composite.inputs["Image"])
-    output_slot(f"{hbao.name}_Image", hbao.outputs["Image"])
-    output_slot(f"{hbao.name}_AO", hbao.outputs["AO"])
+        compositor.composite(hbao.outputs["Image"])
+    file_output.add(f"{hbao.name}_Image", hbao.outputs["Image"])
+    file_output.add(f"{hbao.name}_AO", hbao.outputs["AO"])
 
 # Passes switched off after linking: the add-on must turn them back on.
 for view_layer in scene.view_layers:
@@ -120,7 +99,7 @@ for view_layer in scene.view_layers:
     if spec.get("disable_depth_pass"):
         view_layer.use_pass_z = False
 
-scene.render.image_settings.file_format = "OPEN_EXR_MULTILAYER"
+blender_scenes.compat.set_image_format(scene.render.image_settings, "OPEN_EXR_MULTILAYER")
 scene.render.image_settings.color_depth = "32"
 scene.render.image_settings.exr_codec = "NONE"
 scene.render.use_file_extension = True

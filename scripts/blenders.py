@@ -1,0 +1,117 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The Blenders this project runs in, and one way to start each (no bpy).
+
+- Debian's `blender` (the application: headless with -b, and with a window
+  under Xvfb for the UI),
+- PyPI's `bpy` (Blender as a Python module, headless only) in the virtual
+  environments scripts/setup_bpy.sh makes under BPY_ROOT.
+
+The tests, the demo and the benchmark start Blender through `command()`, so a
+script written for `blender -b` runs unchanged in either."""
+import os
+import shutil
+import subprocess
+from dataclasses import dataclass
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+BPY_RUNNER = REPO / "scripts" / "bpy_blender.py"
+# Where scripts/setup_bpy.sh keeps its virtual environments: outside the
+# checkout, so that every clone (and CI's fresh clone) reuses one download.
+BPY_ROOT = Path(os.environ.get("HBAO_BPY_ROOT", Path.home() / ".cache" / "hbao" / "bpy"))
+# The bpy environments setup_bpy.sh makes, by folder name, oldest first.
+BPY_ENVIRONMENTS = ("bpy-4.5", "bpy-5.0", "bpy-5-latest")
+
+
+@dataclass(frozen=True)
+class Blender:
+    """One Blender: `kind` is 'app' (the blender executable) or 'bpy' (a
+    Python with the bpy module). `name` is short and stable (test ids)."""
+    name: str
+    kind: str
+    executable: str
+    version: str = ""
+
+    @property
+    def has_ui(self):
+        return self.kind == "app"
+
+    def command(self, script=None, args=(), blend=None, addons=("hbao",), ui=False,
+                output=None, frame=None, animation=None):
+        """The command line that opens `blend` (or factory settings), enables
+        `addons`, then renders `frame` or the `animation` (start, end) to
+        `output`, or runs `script` with `args` after `--`."""
+        if ui and not self.has_ui:
+            raise ValueError(f"{self.name} has no user interface")
+        if self.kind == "app":
+            command = [self.executable]
+            if not ui:
+                command.append("-b")
+            if blend is not None:
+                command.append(str(blend))
+            command += ["--factory-startup", "-noaudio"]
+        else:
+            command = [self.executable, str(BPY_RUNNER)]
+            if blend is not None:
+                command.append(str(blend))
+        if addons:
+            command += ["--addons", ",".join(addons)]
+        if output is not None:
+            command += ["-o", str(output)]
+        if frame is not None:
+            command += ["-f", str(frame)]
+        if animation is not None:
+            command += ["-s", str(animation[0]), "-e", str(animation[1]), "-a"]
+        if script is not None:
+            if self.kind == "app":
+                command += ["--python-exit-code", "1"]
+            command += ["--python", str(script), "--"] + [str(a) for a in args]
+        if ui:
+            command = ["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24"] + command
+        return command
+
+
+def _version_of(command):
+    try:
+        completed = subprocess.run(command, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+                                   text=True, timeout=120)
+    except (OSError, subprocess.TimeoutExpired):
+        return ""
+    for line in completed.stdout.splitlines():
+        if line.startswith("Blender ") or line.startswith("VERSION "):
+            return line.split()[1]
+    return ""
+
+
+def debian_blender():
+    """Debian's blender (or $BLENDER), or None when it is not installed."""
+    path = shutil.which(os.environ.get("BLENDER", "blender"))
+    if path is None:
+        return None
+    version = _version_of([path, "--version"]) or "?"
+    return Blender(f"blender-{version}", "app", path, version)
+
+
+def bpy_blenders():
+    """The bpy environments setup_bpy.sh made, oldest first."""
+    found = []
+    for folder in BPY_ENVIRONMENTS:
+        python = BPY_ROOT / folder / "bin" / "python"
+        if not python.exists():
+            continue
+        version = _version_of([str(python), "-c",
+                               "import bpy; print('VERSION', bpy.app.version_string.split()[0])"])
+        if version:
+            found.append(Blender(f"bpy-{version}", "bpy", str(python), version))
+    return found
+
+
+def all_blenders():
+    """Every Blender here: Debian's first, then the bpy environments. The
+    selection $HBAO_BLENDERS (comma-separated names or prefixes, e.g.
+    'blender,bpy-5') keeps only the matching ones."""
+    blenders = [b for b in [debian_blender()] if b is not None] + bpy_blenders()
+    wanted = [w.strip() for w in os.environ.get("HBAO_BLENDERS", "").split(",") if w.strip()]
+    if wanted:
+        blenders = [b for b in blenders if any(b.name.startswith(w) for w in wanted)]
+    return blenders
