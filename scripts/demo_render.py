@@ -9,7 +9,9 @@ to the folder given after `--` (default out/demo):
 
   blender -b --factory-startup --addons hbao --python scripts/demo_render.py -- out/demo
 """
+import glob
 import os
+import shutil
 import sys
 import time
 
@@ -32,35 +34,33 @@ def parse_out_dir():
     return os.path.abspath(out)
 
 
+# The demo's panels, left to right: (file name, what feeds it).
+PANELS = ("without_ao", "ao", "with_ao")
+
+
 def build_tree(scene, out_dir):
-    scene.use_nodes = True
-    tree = scene.node_tree
-    tree.nodes.clear()
-    layers = tree.nodes.new("CompositorNodeRLayers")
-    layers.location = (-500, 0)
-    hbao = tree.nodes.new("CompositorNodeHBAO")
-    hbao.location = (-100, 0)
+    """Render Layers -> HBAO -> the final image, and one PNG File Output per
+    panel, each into a folder of its own (Blender versions name the files
+    differently; the folder finds it)."""
+    compositor = blender_scenes.Compositor(scene)
+    layers = compositor.render_layers(location=(-500, 0))
+    hbao = compositor.node("CompositorNodeHBAO", (-100, 0))
     hbao.inputs["Radius"].default_value = DEMO_RADIUS
     hbao.inputs["Strength"].default_value = DEMO_STRENGTH
-    composite = tree.nodes.new("CompositorNodeComposite")
-    composite.location = (300, 100)
-    tree.links.new(layers.outputs["Image"], hbao.inputs["Image"])
-    tree.links.new(layers.outputs["Depth"], hbao.inputs["Depth"])
-    tree.links.new(layers.outputs["Normal"], hbao.inputs["Normal"])
-    tree.links.new(hbao.outputs["Image"], composite.inputs["Image"])
-
-    files = tree.nodes.new("CompositorNodeOutputFile")
-    files.location = (300, -200)
-    files.base_path = out_dir + os.sep
-    files.format.file_format = "PNG"
-    files.format.color_mode = "RGB"
-    files.file_slots.clear()
-    for name, socket in (("without_ao_", layers.outputs["Image"]),
-                         ("ao_", hbao.outputs["AO"]),
-                         ("with_ao_", hbao.outputs["Image"])):
-        files.file_slots.new(name)
-        tree.links.new(socket, files.inputs[name])
-    return files
+    for name in ("Image", "Depth", "Normal"):
+        compositor.link(layers.outputs[name], hbao.inputs[name])
+    compositor.composite(hbao.outputs["Image"], (300, 100))
+    sources = {"without_ao": layers.outputs["Image"], "ao": hbao.outputs["AO"],
+               "with_ao": hbao.outputs["Image"]}
+    folders = {}
+    for index, name in enumerate(PANELS):
+        folders[name] = os.path.join(out_dir, f".{name}")
+        shutil.rmtree(folders[name], ignore_errors=True)
+        files = compositor.file_output(folders[name], name, (300, -200 * (index + 1)),
+                                       multilayer=False)
+        files.node.format.color_mode = "RGB"
+        files.add("Image", sources[name])
+    return folders
 
 
 def load_pixels(path):
@@ -88,20 +88,22 @@ def main():
     # Standard view: the AO image shows the AO values, not a film curve of them.
     scene.view_settings.view_transform = "Standard"
     scene.render.use_file_extension = True
-    files = build_tree(scene, out_dir)
+    folders = build_tree(scene, out_dir)
     scene.render.filepath = os.path.join(out_dir, "render")
-    scene.render.image_settings.file_format = "PNG"
+    blender_scenes.compat.set_image_format(scene.render.image_settings, "PNG")
 
     start = time.perf_counter()
     bpy.ops.render.render(write_still=False)
     print(f"demo: rendered in {time.perf_counter() - start:.1f} s")
 
-    frame = scene.frame_current
     panels = []
-    for slot in files.file_slots:
-        written = os.path.join(out_dir, f"{slot.path}{frame:04d}.png")
-        final = os.path.join(out_dir, slot.path.rstrip("_") + ".png")
-        os.replace(written, final)
+    for name in PANELS:
+        written = glob.glob(os.path.join(folders[name], "**", "*.png"), recursive=True)
+        if len(written) != 1:
+            sys.exit(f"demo: expected one PNG in {folders[name]}, found {written}")
+        final = os.path.join(out_dir, name + ".png")
+        os.replace(written[0], final)
+        shutil.rmtree(folders[name])
         panels.append(load_pixels(final))
     side_by_side = np.concatenate(panels, axis=1)
     save_pixels(side_by_side, os.path.join(out_dir, "side_by_side.png"))

@@ -20,28 +20,18 @@ import blender_scenes  # noqa: E402
 RENDER_TIMEOUT_S = 240.0
 
 scene = blender_scenes.build_corner_scene(bpy.context.scene, (96, 64), "CYCLES", 4)
-scene.use_nodes = True
-tree = scene.node_tree
-tree.nodes.clear()
-layers = tree.nodes.new("CompositorNodeRLayers")
-hbao = tree.nodes.new("CompositorNodeHBAO")
+compositor = blender_scenes.Compositor(scene)
+layers = compositor.render_layers()
+hbao = compositor.node("CompositorNodeHBAO")
 hbao.name = "HBAO0"
 hbao.inputs["Radius"].default_value = 0.9
-composite = tree.nodes.new("CompositorNodeComposite")
-tree.links.new(layers.outputs["Image"], hbao.inputs["Image"])
-tree.links.new(layers.outputs["Depth"], hbao.inputs["Depth"])
-tree.links.new(layers.outputs["Normal"], hbao.inputs["Normal"])
-tree.links.new(hbao.outputs["Image"], composite.inputs["Image"])
-files = tree.nodes.new("CompositorNodeOutputFile")
-files.base_path = os.path.join(out_dir, "nodes_")
-files.format.file_format = "OPEN_EXR_MULTILAYER"
-files.format.color_depth = "32"
-files.format.exr_codec = "NONE"
-files.file_slots.clear()
+for name in ("Image", "Depth", "Normal"):
+    compositor.link(layers.outputs[name], hbao.inputs[name])
+compositor.composite(hbao.outputs["Image"])
+files = compositor.file_output(out_dir, "nodes_")
 for name, socket in (("Render", layers.outputs["Image"]), ("HBAO0_AO", hbao.outputs["AO"]),
                      ("HBAO0_Image", hbao.outputs["Image"])):
-    files.file_slots.new(name)
-    tree.links.new(socket, files.inputs[name])
+    files.add(name, socket)
 os.makedirs(out_dir, exist_ok=True)
 bpy.context.view_layer.update()  # matrix_world of the new camera
 with open(os.path.join(out_dir, "camera_0001.json"), "w") as stream:

@@ -9,11 +9,11 @@ import sys
 import bpy
 
 import hbao
+from hbao import compat
 
 out_dir = sys.argv[sys.argv.index("--") + 1]
 scene = bpy.context.scene
-scene.use_nodes = True
-tree = scene.node_tree
+tree = compat.ensure_compositor_tree(scene)
 
 
 def check(condition, what):
@@ -48,7 +48,7 @@ path = os.path.join(out_dir, "lifecycle.blend")
 bpy.ops.wm.save_as_mainfile(filepath=path)
 bpy.ops.wm.open_mainfile(filepath=path)
 scene = bpy.context.scene
-tree = scene.node_tree
+tree = compat.compositor_tree(scene)
 hbao.sync(scene)
 nodes = [n for n in tree.nodes if n.bl_idname == "CompositorNodeHBAO"]
 check(len(nodes) == 2, "both nodes survive save and reload")
