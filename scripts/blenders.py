@@ -36,6 +36,15 @@ class Blender:
     def has_ui(self):
         return self.kind == "app"
 
+    @property
+    def version_tuple(self):
+        return tuple(int(part) for part in self.version.split(".")[:3] if part.isdigit())
+
+    @property
+    def supports_extensions(self):
+        """Blender 4.2+ installs add-ons as extensions (blender_manifest.toml)."""
+        return self.version_tuple >= (4, 2)
+
     def command(self, script=None, args=(), blend=None, addons=("hbao",), ui=False,
                 output=None, frame=None, animation=None):
         """The command line that opens `blend` (or factory settings), enables
@@ -115,3 +124,27 @@ def all_blenders():
     if wanted:
         blenders = [b for b in blenders if any(b.name.startswith(w) for w in wanted)]
     return blenders
+
+
+def extension_tool():
+    """(python, blender_ext.py) of the newest bpy here: Blender's own
+    extension tool (validate, build), which runs without Blender. None when
+    no bpy 4.2+ is installed."""
+    for blender in reversed(bpy_blenders()):
+        found = sorted(Path(blender.executable).parents[1].glob(
+            "lib/python3*/site-packages/bpy/*/scripts/addons_core/bl_pkg/cli/blender_ext.py"))
+        if found:
+            return blender.executable, str(found[-1])
+    return None
+
+
+if __name__ == "__main__":
+    import sys
+    if sys.argv[1:] == ["extension-tool"]:
+        tool = extension_tool()
+        if tool is None:
+            sys.exit(1)
+        print(*tool)
+    else:
+        for blender in all_blenders():
+            print(blender.name, blender.kind, blender.executable)

@@ -1,9 +1,15 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: GPL-2.0-or-later
-# Makes dist/hbao-<version>.zip: the add-on folder hbao/ with lib/libhbao.so,
-# lib/libhbao_exr.so and the OpenEXRCore library it needs inside, for Edit >
-# Preferences > Add-ons > Install (3.x-4.1) or Install from Disk (4.2+
-# extensions, via blender_manifest.toml).
+# Makes, in dist/:
+#   hbao-<version>.zip            the add-on folder hbao/ with lib/libhbao.so,
+#                                 lib/libhbao_exr.so and the OpenEXRCore library
+#                                 it needs, for Edit > Preferences > Add-ons >
+#                                 Install (Blender 3.4-4.1)
+#   hbao-<version>-extension.zip  the same files as a Blender 4.2+ extension,
+#                                 validated and built by Blender's own extension
+#                                 tool (from a bpy that scripts/setup_bpy.sh
+#                                 installed), for Install from Disk
+# Prints the paths of the zips it made, one a line.
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 BUILD="${HBAO_BUILD_DIR:-$REPO/build}"
@@ -44,3 +50,17 @@ with zipfile.ZipFile(sys.argv[1], "w", zipfile.ZIP_DEFLATED) as archive:
             archive.write(os.path.join(root, name))
 ' "$ZIP")
 echo "$ZIP"
+
+# Blender's extension tool runs without Blender; the newest bpy here has it.
+if ! TOOL="$(python3 "$REPO/scripts/blenders.py" extension-tool)"; then
+    echo "package_addon.sh: no bpy with Blender's extension tool (scripts/setup_bpy.sh);" \
+         "the 4.2+ extension zip is not built" >&2
+    exit 0
+fi
+read -r TOOL_PYTHON TOOL_SCRIPT <<<"$TOOL"
+"$TOOL_PYTHON" "$TOOL_SCRIPT" validate "$STAGE/hbao" >&2
+EXTENSION_ZIP="$REPO/dist/hbao-$VERSION-extension.zip"
+rm -f "$EXTENSION_ZIP"
+"$TOOL_PYTHON" "$TOOL_SCRIPT" build --source-dir "$STAGE/hbao" \
+    --output-filepath "$EXTENSION_ZIP" >&2
+echo "$EXTENSION_ZIP"

@@ -85,6 +85,7 @@ def blender_environment(user_scripts, extra=None):
 def pytest_configure(config):
     config.addinivalue_line("markers", "matrix: runs once in every Blender of the matrix")
     config.addinivalue_line("markers", "ui: needs Blender's user interface (Xvfb)")
+    config.addinivalue_line("markers", "extension: needs Blender 4.2+ (extensions)")
 
 
 def pytest_sessionstart(session):
@@ -102,6 +103,8 @@ def pytest_generate_tests(metafunc):
         candidates = [DEBIAN_BLENDER] if DEBIAN_BLENDER else []
     elif metafunc.definition.get_closest_marker("ui") is not None:
         candidates = [b for b in BLENDERS if b.has_ui]
+    elif metafunc.definition.get_closest_marker("extension") is not None:
+        candidates = [b for b in BLENDERS if b.supports_extensions]
     else:
         candidates = BLENDERS
     metafunc.parametrize("blender", candidates, ids=[b.name for b in candidates])
