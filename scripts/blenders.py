@@ -41,6 +41,11 @@ class Blender:
         return tuple(int(part) for part in self.version.split(".")[:3] if part.isdigit())
 
     @property
+    def draws_headless(self):
+        """bpy 5.2+ draws with the gpu module without a window (gpu.init())."""
+        return self.kind == "bpy" and self.version_tuple >= (5, 2)
+
+    @property
     def supports_extensions(self):
         """Blender 4.2+ installs add-ons as extensions (blender_manifest.toml)."""
         return self.version_tuple >= (4, 2)

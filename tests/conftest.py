@@ -117,7 +117,8 @@ _OUTCOMES = collections.defaultdict(collections.Counter)
 def pytest_runtest_makereport(item, call):
     outcome = yield
     report = outcome.get_result()
-    blender = getattr(item, "callspec", None) and item.callspec.params.get("blender")
+    params = item.callspec.params.values() if hasattr(item, "callspec") else ()
+    blender = next((p for p in params if isinstance(p, blenders.Blender)), None)
     if blender is None:
         return
     if report.when == "call" or (report.when == "setup" and report.outcome != "passed"):

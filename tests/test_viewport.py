@@ -6,7 +6,7 @@ import json
 
 import pytest
 
-from conftest import REPO
+from conftest import BLENDERS, REPO, _runner
 
 SCRIPTS = REPO / "tests" / "blender_scripts"
 ARTIFACTS = REPO / "out" / "test-artifacts"
@@ -42,10 +42,21 @@ MIN_DARKENED_FRACTION = 0.05
 MIN_MEAN_DARKENING = 0.002
 
 
+# The Blenders that can draw the preview's GLSL: Debian's in a window under
+# Xvfb, and bpy builds that draw headless (gpu.init(), 5.2+).
+DRAWING_BLENDERS = [b for b in BLENDERS if b.has_ui or b.draws_headless]
+
+
+@pytest.fixture(scope="module", params=DRAWING_BLENDERS, ids=lambda b: b.name)
+def blender_that_draws(request):
+    return request.param
+
+
 @pytest.fixture(scope="module")
-def match_report(run_blender, built_library, tmp_path_factory):
+def match_report(blender_that_draws, blender_user_scripts, built_library, tmp_path_factory):
     out = tmp_path_factory.mktemp("viewport_match") / "match.json"
-    run_blender(SCRIPTS / "viewport_match.py", out, ui=True)
+    run = _runner(blender_that_draws, blender_user_scripts)
+    run(SCRIPTS / "viewport_match.py", out, ui=blender_that_draws.has_ui)
     return json.loads(out.read_text())
 
 

@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
-"""Runs inside Blender with a window (xvfb): renders the viewport preview's GLSL
-AO of synthetic depth images offscreen and the C library's AO of the same
+"""Runs inside Blender with a window (xvfb), or headless where Blender can
+draw without one (bpy 5.2+, after gpu.init()): renders the viewport preview's
+GLSL AO of synthetic depth images offscreen and the C library's AO of the same
 images, and writes the per-case differences as JSON for
 tests/test_viewport.py to judge.
 
@@ -21,6 +22,9 @@ if str(REPO / "addon") not in sys.path:
 from hbao import native  # noqa: E402
 from hbao import parameters  # noqa: E402
 from hbao.viewport import pipeline, projection  # noqa: E402
+
+if bpy.app.background and hasattr(gpu, "init"):
+    gpu.init()  # 5.2+: an offscreen GPU context without a window
 
 WIDTH, HEIGHT = 200, 150
 PERSPECTIVE_CAMERA = {"type": "PERSP", "lens": 35.0, "sensor_width": 36.0,
@@ -187,4 +191,6 @@ try:
     main()
 finally:
     # --python-exit-code makes an exception exit Blender with an error code.
-    bpy.ops.wm.quit_blender()
+    # (Headless, the script's end ends Blender.)
+    if not bpy.app.background:
+        bpy.ops.wm.quit_blender()
