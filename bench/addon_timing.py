@@ -20,7 +20,10 @@ import time
 import bpy
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import scene_library  # noqa: E402  (needs the path above)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                                "scripts"))
+import blender_scenes  # noqa: E402  (needs the paths above)
+import scene_library  # noqa: E402
 
 SOCKETS = {"radius": "Radius", "directions": "Directions", "steps": "Steps",
            "blur_size": "Blur Size", "angle_bias_degrees": "Angle Bias"}
@@ -41,28 +44,25 @@ def configure(scene, spec):
     layer = scene.view_layers[0]
     layer.use_pass_z = True
     layer.use_pass_normal = True
-    scene.use_nodes = True
 
 
 def build_tree(scene, node_settings):
-    """Render Layers -> (HBAO ->) Composite."""
-    tree = scene.node_tree
-    tree.nodes.clear()
-    layers = tree.nodes.new("CompositorNodeRLayers")
-    composite = tree.nodes.new("CompositorNodeComposite")
+    """Render Layers -> (HBAO ->) the final image."""
+    compositor = blender_scenes.Compositor(scene)
+    layers = compositor.render_layers()
     if node_settings is None:
-        tree.links.new(layers.outputs["Image"], composite.inputs["Image"])
+        compositor.composite(layers.outputs["Image"])
         return
-    hbao = tree.nodes.new("CompositorNodeHBAO")
+    hbao = compositor.node("CompositorNodeHBAO")
     for output in ("Image", "Depth", "Normal"):
-        tree.links.new(layers.outputs[output], hbao.inputs[output])
+        compositor.link(layers.outputs[output], hbao.inputs[output])
     for key, socket in SOCKETS.items():
         if key in node_settings:
             hbao.inputs[socket].default_value = node_settings[key]
     for key in PROPERTIES:
         if key in node_settings:
             setattr(hbao, key, node_settings[key])
-    tree.links.new(hbao.outputs["Image"], composite.inputs["Image"])
+    compositor.composite(hbao.outputs["Image"])
 
 
 def timed_renders(scene, node_settings, repeats):

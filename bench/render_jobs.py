@@ -97,23 +97,15 @@ def configure_output(scene, job, scratch):
     layer.use_pass_z = "depth" in job["passes"]
     layer.use_pass_normal = "normal" in job["passes"]
     layer.use_pass_ambient_occlusion = "ao" in job["passes"]
-    scene.use_nodes = True
-    tree = scene.node_tree
-    tree.nodes.clear()
-    layers = tree.nodes.new("CompositorNodeRLayers")
+    compositor = blender_scenes.Compositor(scene)
+    layers = compositor.render_layers()
     layers.scene = scene
-    output = tree.nodes.new("CompositorNodeOutputFile")
-    output.base_path = str(scratch)
-    output.format.file_format = "OPEN_EXR"
-    output.format.color_depth = "32"
-    output.format.color_mode = "RGB"
-    output.format.exr_codec = "NONE"
-    output.file_slots.clear()
+    # One folder per pass: Blender versions name single-image outputs differently.
     for name in job["passes"]:
-        output.file_slots.new(name)
-        tree.links.new(layers.outputs[PASS_SOCKETS[name]], output.inputs[name])
-    composite = tree.nodes.new("CompositorNodeComposite")
-    tree.links.new(layers.outputs["Image"], composite.inputs["Image"])
+        output = compositor.file_output(str(scratch / name), name, file_format="OPEN_EXR")
+        output.node.format.color_mode = "RGB"
+        output.add(name, blender_scenes.compat.pass_output(layers, PASS_SOCKETS[name]))
+    compositor.composite(layers.outputs["Image"])
 
 
 def read_exr(path, channels):
@@ -145,7 +137,7 @@ def run_job(scene, spec, job, cache):
         times.append(time.perf_counter() - start)
     arrays = {}
     for name in job["passes"]:
-        files = sorted(scratch.glob(f"{name}*.exr"))
+        files = sorted((scratch / name).glob("**/*.exr"))
         if not files:
             raise RuntimeError(f"job {job['id']}: no {name} pass written in {scratch}")
         arrays[name] = read_exr(files[-1], 3 if name == "normal" else 1)

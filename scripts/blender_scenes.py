@@ -274,18 +274,18 @@ class Compositor:
         node.outputs[0].default_value = value
         return node
 
-    def file_output(self, folder, prefix, location=(900, -300), multilayer=True):
-        """A File Output node writing FOLDER/PREFIX<frame>.exr (multilayer,
-        32-bit float, uncompressed) or one PNG per input."""
+    def file_output(self, folder, prefix, location=(900, -300),
+                    file_format="OPEN_EXR_MULTILAYER"):
+        """A File Output node writing into FOLDER: one multilayer EXR
+        PREFIX<frame>.exr, or (OPEN_EXR, PNG) one image per input, named as
+        the Blender version names them (find them in the folder). EXRs are
+        32-bit float, uncompressed."""
         node = self.node("CompositorNodeOutputFile", location)
         compat.set_file_output_path(node, folder, prefix)
-        image_format = node.format
-        if multilayer:
-            compat.set_image_format(image_format, "OPEN_EXR_MULTILAYER")
-            image_format.color_depth = "32"
-            image_format.exr_codec = "NONE"
-        else:
-            compat.set_image_format(image_format, "PNG")
+        compat.set_image_format(node.format, file_format)
+        if file_format.startswith("OPEN_EXR"):
+            node.format.color_depth = "32"
+            node.format.exr_codec = "NONE"
         compat.clear_file_output_inputs(node)
         return FileOutput(self, node)
 

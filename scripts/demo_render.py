@@ -57,7 +57,7 @@ def build_tree(scene, out_dir):
         folders[name] = os.path.join(out_dir, f".{name}")
         shutil.rmtree(folders[name], ignore_errors=True)
         files = compositor.file_output(folders[name], name, (300, -200 * (index + 1)),
-                                       multilayer=False)
+                                       file_format="PNG")
         files.node.format.color_mode = "RGB"
         files.add("Image", sources[name])
     return folders

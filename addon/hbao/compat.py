@@ -126,6 +126,21 @@ def new_value_node(tree):
                           else "CompositorNodeValue")
 
 
+# Render Layers outputs 5.0 renamed: old name -> new name.
+_RENAMED_PASS_OUTPUTS = {"AO": "Ambient Occlusion"}
+
+
+def pass_output(render_layers, name):
+    """A Render Layers node's output by its pre-5.0 name (AO is
+    "Ambient Occlusion" since 5.0)."""
+    output = render_layers.outputs.get(name)
+    if output is None and name in _RENAMED_PASS_OUTPUTS:
+        output = render_layers.outputs.get(_RENAMED_PASS_OUTPUTS[name])
+    if output is None:
+        raise KeyError(f"{render_layers.name} has no {name} output")
+    return output
+
+
 def set_image_format(image_format, file_format):
     """Set an ImageFormatSettings' file format. 5.0 filters the formats by
     media_type, so the media type goes first."""

@@ -62,7 +62,7 @@ file_output = compositor.file_output(out_dir, "nodes_")
 first_layer = scene.view_layers[0].name
 file_output.add("Render", render_layers[first_layer].outputs["Image"])
 if spec.get("ao_reference"):
-    file_output.add("CyclesAO", render_layers[first_layer].outputs["AO"])
+    file_output.add("CyclesAO", blender_scenes.compat.pass_output(render_layers[first_layer], "AO"))
 
 for index, node_spec in enumerate(spec.get("nodes", [{}])):
     hbao = compositor.node("CompositorNodeHBAO", (300, -400 * index))
