@@ -86,6 +86,7 @@ def pytest_configure(config):
     config.addinivalue_line("markers", "matrix: runs once in every Blender of the matrix")
     config.addinivalue_line("markers", "ui: needs Blender's user interface (Xvfb)")
     config.addinivalue_line("markers", "extension: needs Blender 4.2+ (extensions)")
+    config.addinivalue_line("markers", "min_blender(major, minor): needs that Blender or newer")
 
 
 def pytest_sessionstart(session):
@@ -107,6 +108,9 @@ def pytest_generate_tests(metafunc):
         candidates = [b for b in BLENDERS if b.supports_extensions]
     else:
         candidates = BLENDERS
+    minimum = metafunc.definition.get_closest_marker("min_blender")
+    if minimum is not None:
+        candidates = [b for b in candidates if b.version_tuple >= tuple(minimum.args)]
     metafunc.parametrize("blender", candidates, ids=[b.name for b in candidates])
 
 

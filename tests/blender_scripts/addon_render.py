@@ -16,7 +16,11 @@ AO pass), orthographic, border [min_x, max_x, min_y, max_y] (a border render
 cropped to it), save_blend (path: saved after the setup, before
 rendering), nodes: [{name, layer, normal (bool), radius, keyframes [[frame,
 radius], ..], radius_from_value_node, falloff, integration, blur_size,
-angle_bias, directions, steps, mute}], disable_normal_pass, disable_depth_pass.
+angle_bias, directions, steps, mute}], disable_normal_pass, disable_depth_pass,
+output_format (the main output's file format, default OPEN_EXR_MULTILAYER),
+prepare [actions before rendering: sync, delete_helper, rename_helper,
+rename_node, second_scene_shares_the_tree]. Prints OUTPUT SETTINGS {json}
+(the main output's settings after the renders) and RENDERED.
 """
 import json
 import os
@@ -99,15 +103,48 @@ for view_layer in scene.view_layers:
     if spec.get("disable_depth_pass"):
         view_layer.use_pass_z = False
 
-blender_scenes.compat.set_image_format(scene.render.image_settings, "OPEN_EXR_MULTILAYER")
-scene.render.image_settings.color_depth = "32"
-scene.render.image_settings.exr_codec = "NONE"
+# The main output: what the tests read back, or (output_format) an artist's
+# own choice, which the add-on must leave as it found it.
+output_format = spec.get("output_format", "OPEN_EXR_MULTILAYER")
+blender_scenes.compat.set_image_format(scene.render.image_settings, output_format)
+if output_format.startswith("OPEN_EXR"):
+    scene.render.image_settings.color_depth = "32"
+    scene.render.image_settings.exr_codec = "NONE"
 scene.render.use_file_extension = True
+
+
+def helper_scenes():
+    return [s for s in bpy.data.scenes if s.name.startswith(".HBAO") or s.get("hbao_main_scene")]
+
+
+# Faults and edits an artist may make before rendering (tests/test_faults.py).
+for action in spec.get("prepare", []):
+    if action == "sync":  # what the UI does on its own after an edit
+        import hbao
+        hbao.sync(scene)
+    elif action == "delete_helper":
+        for helper in helper_scenes():
+            bpy.data.scenes.remove(helper)
+    elif action == "rename_helper":
+        for helper in helper_scenes():
+            helper.name = "Renamed by the artist"
+    elif action == "rename_node":
+        for node in tree.nodes:
+            if node.bl_idname == "CompositorNodeHBAO":
+                node.name = node.label = "Renamed " + node.name
+    elif action == "second_scene_shares_the_tree":  # 5.0+: one node group, two scenes
+        other = scene.copy()
+        other.name = "Second"
+        other.compositing_node_group = tree
+    else:
+        raise ValueError(f"unknown prepare action {action!r}")
+    print("PREPARED", action, flush=True)
 
 if spec.get("save_blend"):
     bpy.ops.wm.save_as_mainfile(filepath=spec["save_blend"])
     print("SAVED", spec["save_blend"])
     sys.exit(0)
+
 
 for frame in spec.get("frames", [1]):
     scene.frame_set(frame)
@@ -116,4 +153,9 @@ for frame in spec.get("frames", [1]):
     # Still renders do not replace '#' in the path: name the frame here.
     scene.render.filepath = os.path.join(out_dir, f"frame_{frame:04d}")
     bpy.ops.render.render(write_still=True)
+settings = scene.render.image_settings
+print("OUTPUT SETTINGS", json.dumps({
+    "file_format": settings.file_format, "color_depth": settings.color_depth,
+    "exr_codec": settings.exr_codec, "media_type": getattr(settings, "media_type", None),
+    "use_exr_interleave": getattr(settings, "use_exr_interleave", None)}))
 print("RENDERED", json.dumps({"frames": spec.get("frames", [1])}))

@@ -1,0 +1,160 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Blender under faults: each failure the render hook can meet, injected into a
+real render in every Blender of the matrix. In each case the render
+completes (exit 0, the image written), the console says why AO is missing
+(the same text reaches the render window's report), no temporary file is
+left, and the user's output settings are as they were."""
+import json
+import os
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from conftest import EXR_LIBRARY, REPO, run_command
+from test_addon import (EXACT, exr, library_ao, native, node_outputs,  # noqa: F401
+                        node_params, render)
+
+pytestmark = pytest.mark.matrix
+RENDER_SCRIPT = REPO / "tests" / "blender_scripts" / "addon_render.py"
+# Where the add-on writes the Render Result for its own reading, and what it
+# calls the file: nothing of it may remain after a render.
+SCRATCH_FOLDERS = [Path("/dev/shm"), Path(os.environ.get("TMPDIR", "/tmp"))]
+SCRATCH_PATTERN = "hbao-passes-*"
+
+
+def scratch_files():
+    return sorted(str(p) for folder in SCRATCH_FOLDERS if folder.is_dir()
+                  for p in folder.glob(SCRATCH_PATTERN))
+
+
+@pytest.fixture
+def no_leftovers():
+    before = set(scratch_files())
+    yield
+    left = set(scratch_files()) - before
+    assert not left, f"temporary files left behind: {sorted(left)}"
+
+
+def output_settings(log):
+    line = next(text for text in log.splitlines() if text.startswith("OUTPUT SETTINGS "))
+    return json.loads(line[len("OUTPUT SETTINGS "):])
+
+
+def assert_no_ao_and_image_unchanged(out, node="HBAO0"):
+    outputs = node_outputs(out, 1, node)
+    assert np.all(outputs["ao"] == 1.0)
+    assert np.abs(outputs["image"] - outputs["render"]).max() <= EXACT
+
+
+def test_library_of_another_kind_renders_without_ao_and_says_so(
+        run_in_blender, tmp_path, no_leftovers):
+    # libhbao_exr in place of libhbao: a real shared library without libhbao's API.
+    out, log = render(run_in_blender, tmp_path, {"nodes": [{"radius": 1.0}]},
+                      env={"HBAO_LIBRARY": str(EXR_LIBRARY)})
+    assert "is not a compatible libhbao" in log, log[-3000:]
+    assert "Rendering without AO" in log
+    assert_no_ao_and_image_unchanged(out)
+
+
+def test_users_png_output_is_restored_after_the_pass_hand_over(run_in_blender, tmp_path,
+                                                               no_leftovers):
+    out, log = render(run_in_blender, tmp_path,
+                      {"output_format": "PNG", "nodes": [{"radius": 1.0}]})
+    settings = output_settings(log)
+    assert settings["file_format"] == "PNG", settings
+    if settings["media_type"] is not None:  # 5.0+
+        assert settings["media_type"] == "IMAGE", settings
+    assert (out / "frame_0001.png").is_file()
+    assert node_outputs(out, 1)["ao"].min() < 0.9  # the AO itself was computed
+
+
+@pytest.mark.parametrize("edit", ["rename_node", "rename_helper"])
+def test_renamed_node_or_helper_scene_still_renders_ao(run_in_blender, tmp_path, native,
+                                                       no_leftovers, edit):
+    out, log = render(run_in_blender, tmp_path, {
+        "prepare": ["sync", edit], "nodes": [{"radius": 0.8, "blur_size": 0}]})
+    assert "without AO" not in log, log[-3000:]
+    ao = node_outputs(out, 1)["ao"]
+    expected = library_ao(native, out, 1, node_params(radius=0.8, blur_size=0))
+    assert np.abs(ao - expected).max() <= EXACT
+
+
+def test_deleted_helper_scene_is_rebuilt_or_explained(run_in_blender, tmp_path, native,
+                                                      no_leftovers):
+    out, log = render(run_in_blender, tmp_path, {
+        "prepare": ["sync", "delete_helper"], "nodes": [{"radius": 0.8, "blur_size": 0}]})
+    ao = node_outputs(out, 1)["ao"]
+    if np.all(ao == 1.0):
+        # Where Blender forbids creating the helper during a render, the
+        # artist is told what to do instead.
+        assert "HBAO" in log and "helper" in log.lower(), log[-3000:]
+    else:
+        expected = library_ao(native, out, 1, node_params(radius=0.8, blur_size=0))
+        assert np.abs(ao - expected).max() <= EXACT
+
+
+def test_file_reopened_without_the_add_on_renders_without_ao(
+        blender, blender_user_scripts, run_in_blender, tmp_path, no_leftovers):
+    blend = tmp_path / "hbao.blend"
+    render(run_in_blender, tmp_path, {"save_blend": str(blend), "prepare": ["sync"],
+                                      "nodes": [{"radius": 0.6}]}, name="setup")
+    out = tmp_path / "without"
+    command = blender.command(blend=blend, output=out / "frame_####", frame=1, addons=())
+    completed = run_command(command, blender_user_scripts)
+    written = out / "frame_0001.exr"
+    assert written.is_file(), completed.stdout[-3000:]
+    channels = exr.channel_names(written)
+    assert "ViewLayer.Combined.R" in channels
+    nodes_file = tmp_path / "setup" / "nodes_0001.exr"
+    if nodes_file.exists():
+        # 3.4 composites the tree: the node group multiplies by its pass
+        # input's default, 1, so the image is the render.
+        nodes = node_outputs(tmp_path / "setup", 1)
+        assert np.all(nodes["ao"] == 1.0)
+        assert np.abs(nodes["image"] - nodes["render"]).max() <= EXACT
+    else:
+        # 4.x/5.x skip compositing a tree with a node type nobody registered:
+        # the file holds the render itself, without a Composite layer.
+        assert blender.version_tuple >= (4, 0), completed.stdout[-3000:]
+        assert not any(name.startswith("Composite.") for name in channels)
+
+
+@pytest.fixture
+def full_disk(tmp_path):
+    """A 64 KiB tmpfs as the add-on's scratch folder: the Render Result of the
+    test scene (about 200 KiB uncompressed) does not fit."""
+    folder = tmp_path / "full"
+    folder.mkdir()
+    mounted = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs", str(folder)],
+                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    assert mounted.returncode == 0, f"cannot mount a tmpfs (root needed): {mounted.stdout}"
+    try:
+        yield folder
+    finally:
+        subprocess.run(["umount", str(folder)], check=False)
+
+
+def test_full_disk_renders_without_ao_leaves_nothing_and_restores_settings(
+        run_in_blender, tmp_path, full_disk):
+    out, log = render(run_in_blender, tmp_path,
+                      {"output_format": "PNG", "nodes": [{"radius": 1.0}]},
+                      env={"HBAO_TEMP_DIR": str(full_disk)})
+    assert "Rendering without AO" in log, log[-3000:]
+    assert list(full_disk.iterdir()) == []
+    settings = output_settings(log)
+    assert settings["file_format"] == "PNG", settings
+    assert_no_ao_and_image_unchanged(out)
+
+
+@pytest.mark.min_blender(5, 0)
+def test_two_scenes_sharing_one_compositing_group(run_in_blender, tmp_path, native,
+                                                  no_leftovers):
+    out, log = render(run_in_blender, tmp_path, {
+        "prepare": ["sync", "second_scene_shares_the_tree"],
+        "nodes": [{"radius": 0.8, "blur_size": 0}]})
+    assert "without AO" not in log, log[-3000:]
+    ao = node_outputs(out, 1)["ao"]
+    expected = library_ao(native, out, 1, node_params(radius=0.8, blur_size=0))
+    assert np.abs(ao - expected).max() <= EXACT
