@@ -1,17 +1,31 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: GPL-2.0-or-later
-# Installs what building, testing and running the demo need on Debian 12
-# (Blender 3.4 from Debian, the C toolchain, OpenEXR, libpng, cJSON, numpy,
-# pytest, Xvfb). Idempotent: does nothing when everything is installed.
+# Installs what building, testing and running the demo need on Debian 12 or 13
+# (Debian's Blender, the C toolchain, clang with its sanitizer and libFuzzer
+# runtime, OpenEXR, libpng, cJSON, numpy, pytest, Xvfb). PyPI's bpy builds come
+# from scripts/setup_bpy.sh. Idempotent: does nothing when everything is there.
 set -euo pipefail
 
+# clang's runtime libraries (ASan, UBSan, libFuzzer) are packaged per LLVM
+# version: 14 on Debian 12, 19 on Debian 13.
+case "$(cut -d. -f1 /etc/debian_version 2>/dev/null)" in
+    12) LLVM=14 ;;
+    13) LLVM=19 ;;
+    *)  LLVM="$(apt-cache search --names-only '^libclang-rt-[0-9]+-dev$' 2>/dev/null |
+               sed -n 's/^libclang-rt-\([0-9]*\)-dev.*/\1/p' | sort -n | tail -n 1)"
+        LLVM="${LLVM:-14}" ;;
+esac
+
 PACKAGES=(
-    blender            # the renderer the add-on runs in (3.4.1 on Debian 12)
+    blender            # the add-on's UI tests (3.4.1 on Debian 12, 4.3 on 13)
     cmake gcc make pkg-config
+    clang "libclang-rt-$LLVM-dev"  # fuzz targets (libFuzzer, ASan, UBSan); clang is LLVM $LLVM
+    clang-format                 # the C style check (.clang-format)
     libopenexr-dev     # OpenEXRCore, the EXR reader/writer of the CLI
+    openexr            # exrheader: the reference reader our written EXRs are checked with
     libpng-dev         # --preview PNGs
     libcjson-dev       # --camera FILE.json
-    python3 python3-numpy python3-pytest
+    python3 python3-numpy python3-pytest python3-venv
     python3-pycodestyle  # the PEP 8 check of the test suite
     xvfb xauth         # F12 and viewport tests in a real window
 )
