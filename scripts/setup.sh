@@ -9,6 +9,7 @@ PACKAGES=(
     blender            # the renderer the add-on runs in (3.4.1 on Debian 12)
     cmake gcc make pkg-config
     libopenexr-dev     # OpenEXRCore, the EXR reader/writer of the CLI
+    openexr            # exrheader, exrmultipart, exrmaketiled: tests check and make EXRs with them
     libpng-dev         # --preview PNGs
     libcjson-dev       # --camera FILE.json
     python3 python3-numpy python3-pytest
