@@ -11,6 +11,8 @@ here.
 """
 import importlib.util
 import json
+import os
+import random
 import re
 import shutil
 import subprocess
@@ -18,7 +20,7 @@ import subprocess
 import numpy as np
 import pytest
 
-from conftest import FIXTURES, SCRIPTS
+from conftest import FIXTURES, REPO, SCRIPTS
 
 MULTIPART = "blender5_cycles_multipart"
 INTERLEAVED = "blender5_cycles_multipart_interleaved"
@@ -34,6 +36,12 @@ TOOL_TIMEOUT_S = 120
 # Half floats have an 11-bit significand: a float rounded to half is within
 # 2**-11 relative of it (values here are far from half's subnormal range).
 HALF_RELATIVE_TOLERANCE = 2.0 ** -11
+# Mutated copies of the multi-part fixture fed to the tool (as test_cli.py's
+# fuzz test does for a single-part one; scripts/fuzz_cli.sh runs longer).
+FUZZ_CASES = 200
+# The three part headers of the fixture end before this byte: byte flips
+# below it hit part names, windows, channel lists and chunk counts.
+HEADER_BYTES = 1500
 
 
 def _load_binding():
@@ -329,3 +337,40 @@ def test_a_tiled_part_is_refused(hbao_tool, tmp_path):
     path = combine(tmp_path, "with_tiled", f"{fixture(MULTIPART)}:0", tiled)
     assert_refused(hbao_tool, path, tmp_path / "out.exr",
                    "only scanline images are supported (part 1", "is tiled")
+
+
+def test_fuzzed_multipart_inputs_never_crash(hbao_tool, tmp_path):
+    """Truncations and byte flips in the three part headers or anywhere:
+    always exit 0 or 1, never a signal or a sanitizer report. Uses the
+    AddressSanitizer build when it exists, else the normal one."""
+    sanitized = REPO / "build-sanitize" / "hbao"
+    tool = sanitized if sanitized.exists() else hbao_tool
+    env = dict(os.environ, ASAN_OPTIONS="allocator_may_return_null=1:detect_leaks=1",
+               UBSAN_OPTIONS="halt_on_error=1:print_stacktrace=1")
+    data = fixture(HALF_PIZ).read_bytes()
+    assert data.find(b"ViewLayer.Normal.Z") < HEADER_BYTES < len(data)
+    rng = random.Random(5)
+    mutated = tmp_path / "fuzz.exr"
+    outcomes = {0: 0, EXIT_RUNTIME: 0}
+    for case in range(FUZZ_CASES):
+        content = bytearray(data)
+        if case % 3 == 0:
+            content = content[:rng.randrange(len(content))]
+        else:
+            span = HEADER_BYTES if case % 3 == 1 else len(content)
+            for _ in range(rng.randrange(1, 16)):
+                content[rng.randrange(span)] = rng.randrange(256)
+        mutated.write_bytes(bytes(content))
+        for arguments in ([mutated, "-o", tmp_path / "out.exr", "--keep-input"],
+                          ["--info", mutated]):
+            completed = subprocess.run([str(tool)] + [str(a) for a in arguments],
+                                       stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                                       text=True, errors="replace", timeout=TOOL_TIMEOUT_S,
+                                       env=env)
+            assert completed.returncode in outcomes, (case, completed.stderr[-3000:])
+            assert "Sanitizer" not in completed.stderr and "runtime error" not in completed.stderr
+            if completed.returncode == EXIT_RUNTIME:
+                assert "hbao: error: " in completed.stderr
+            outcomes[completed.returncode] += 1
+    # Both outcomes happen: the mutations neither all break nor all miss the file.
+    assert outcomes[0] > 0 and outcomes[EXIT_RUNTIME] > 0, outcomes
