@@ -322,6 +322,24 @@ def test_parts_with_different_data_windows_are_refused(hbao_tool, tmp_path):
                    "parts with different data windows are not supported")
 
 
+def test_parts_with_different_display_windows_are_refused(hbao_tool, tmp_path):
+    """exrmultipart will not make this (the display window is an attribute
+    every part must share), so the Normal part's display window is patched
+    in place: its max.x, the third int32 of the box2i value, 47 -> 63."""
+    data = bytearray(fixture(MULTIPART).read_bytes())
+    key = b"displayWindow\x00box2i\x00" + (16).to_bytes(4, "little")
+    positions = [m.start() for m in re.finditer(re.escape(key), data)]
+    assert len(positions) == 3
+    max_x = positions[2] + len(key) + 8
+    assert int.from_bytes(data[max_x:max_x + 4], "little", signed=True) == 47
+    data[max_x:max_x + 4] = (63).to_bytes(4, "little", signed=True)
+    path = tmp_path / "display_mismatch.exr"
+    path.write_bytes(bytes(data))
+    assert_refused(hbao_tool, path, tmp_path / "out.exr",
+                   f'part 2 ("{LAYER}.Normal") has display window (0, 0) - (63, 31) but part 0 '
+                   f"has (0, 0) - (47, 31)", "parts with different display windows")
+
+
 def test_a_channel_name_in_two_parts_is_refused(hbao_tool, tmp_path):
     path = combine(tmp_path, "duplicate", f"{fixture(MULTIPART)}:1", fixture(INTERLEAVED))
     assert_refused(hbao_tool, path, tmp_path / "out.exr",
