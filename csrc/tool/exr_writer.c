@@ -77,9 +77,11 @@ static int32_t lines_per_chunk_for(exr_compression_t compression)
 
 /* A multi-part input's part header (Blender 5) carries chunkCount, the number
  * of chunks of that part at its compression. OpenEXRCore writes a copied one
- * unchanged into a single-part file, where a reader that trusts it (OpenEXR's
- * C++ library) would find too few or too many chunks: it must count this
- * file's chunks. A header without one is left without one. */
+ * unchanged into a single-part file, whose header would then contradict its
+ * own offset table (OpenEXR 3.1's readers recompute the count for single-part
+ * files, but the file layout says the attribute is the count, and other
+ * readers may trust it): it must count this file's chunks. A header without
+ * one is left without one. */
 static exr_result_t fix_copied_chunk_count(exr_context_t context, int part,
                                            const exr_output_layout *layout)
 {
