@@ -26,6 +26,14 @@ render eevee_half --scene demo --engine BLENDER_EEVEE --half --codec ZIP
 render ortho_float --scene demo --ortho --codec ZIP
 render two_layers --scene two_layers --codec ZIP
 render no_depth --scene demo --no-depth --codec ZIP
+# Blender 5's multi-part EXRs need Blender 5, which Debian does not ship: a
+# Python with PyPI's bpy 5.x (pip install bpy==5.0.1) renders them.
+if [ -n "${BPY5_PYTHON:-}" ]; then
+    "$BPY5_PYTHON" "$REPO/scripts/render_blender5_multipart.py" --out "$OUT" >/dev/null
+    echo "wrote $OUT/blender5_*.exr"
+else
+    echo "BPY5_PYTHON not set: kept the Blender 5 multi-part fixtures as they are"
+fi
 blender_version="$("$BLENDER" --version 2>/dev/null | head -n 1)"
 cat > "$OUT/README.md" <<README
 # Test fixtures
@@ -45,4 +53,15 @@ Each NAME.exr has a NAME.camera.json (Blender's camera properties, the format of
 | ortho_float | orthographic camera |
 | two_layers | two view layers with different content |
 | no_depth | no Depth pass (the error path) |
+
+Blender 5 multi-part files, written by Blender 5.0.1 (PyPI's \`bpy\` 5.0.1) through
+\`scripts/render_blender5_multipart.py\`, 48x32, 2 samples: one render of a cube on a
+floor, saved three ways. \`make_fixtures.sh\` renders them when \`BPY5_PYTHON\` names a
+Python that has that \`bpy\`.
+
+| file | what |
+|---|---|
+| blender5_cycles_multipart | Blender 5's default multilayer layout: 3 parts (Combined, Depth, Normal), 32-bit float, ZIP |
+| blender5_cycles_multipart_interleaved | the same pixels in one part (\`use_exr_interleave\`) |
+| blender5_half_piz_multipart | the same render, 3 parts, half-float Combined (Depth and Normal stay float), PIZ |
 README

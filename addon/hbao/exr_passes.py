@@ -186,7 +186,7 @@ class _OpenFile:
 
 
 def channel_names(path):
-    """The channel names of an EXR file, in file order."""
+    """The channel names of an EXR file, over all its parts, sorted by name."""
     with _OpenFile(path) as exr_file:
         return exr_file.names()
 

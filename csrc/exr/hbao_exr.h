@@ -84,9 +84,10 @@ HBAO_EXR_EXPORT const char *hbao_exr_result_message(int32_t result);
 
 /**
  * Open the EXR at `path` and read its header. The file must have one
- * scanline part whose channels are not subsampled, with a data window of at
- * most HBAO_MAX_IMAGE_SIZE (hbao.h) pixels on each side; any compression
- * OpenEXRCore decodes is accepted. On success *file is a new handle; on
+ * scanline part, or several (Blender 5's multi-part multilayer EXRs) that
+ * share one data and display window and no channel name; channels must not be
+ * subsampled, and the data window must be at most HBAO_MAX_IMAGE_SIZE (hbao.h)
+ * pixels on each side; any compression OpenEXRCore decodes is accepted. On success *file is a new handle; on
  * failure *file is NULL and `message` (when not NULL, `message_size` > 0)
  * holds a sentence naming the file and the problem, truncated to fit.
  */
@@ -96,12 +97,12 @@ HBAO_EXR_EXPORT int32_t hbao_exr_open(const char *path, hbao_exr_file **file, ch
 /** The data window's size in pixels (0 x 0 for a NULL file). */
 HBAO_EXR_EXPORT void hbao_exr_size(const hbao_exr_file *file, int32_t *width, int32_t *height);
 
-/** Number of channels in the file (0 for a NULL file). */
+/** Number of channels in the file, over all its parts (0 for a NULL file). */
 HBAO_EXR_EXPORT int32_t hbao_exr_channel_count(const hbao_exr_file *file);
 
-/** Name of channel `index` in [0, hbao_exr_channel_count), in the file's
- *  (alphabetical) order; owned by `file`, valid until it is closed. NULL when
- *  `index` is out of range. */
+/** Name of channel `index` in [0, hbao_exr_channel_count), in alphabetical
+ *  (strcmp) order over all parts; owned by `file`, valid until it is closed.
+ *  NULL when `index` is out of range. */
 HBAO_EXR_EXPORT const char *hbao_exr_channel_name(const hbao_exr_file *file, int32_t index);
 
 /** 1 when the file has a channel called `name`, else 0. */

@@ -1,7 +1,9 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
 #include "exr_reader.h"
 
+#include <limits.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "hbao.h"
@@ -77,6 +79,135 @@ static pixel_rect rect_from_box(const exr_attr_box2i_t *box)
     return rect;
 }
 
+/* A part's name for messages: Blender names each part after its pass
+ * ("ViewLayer.Depth"); a single-part file usually has none. */
+static const char *part_name(const exr_input *input, int part)
+{
+    const char *name = NULL;
+    if (exr_get_name(input->context, part, &name) != EXR_ERR_SUCCESS || name == NULL)
+        return "unnamed";
+    return name;
+}
+
+static bool same_box(const exr_attr_box2i_t *a, const exr_attr_box2i_t *b)
+{
+    return a->min.x == b->min.x && a->min.y == b->min.y && a->max.x == b->max.x &&
+           a->max.y == b->max.y;
+}
+
+/* The image is one rectangle of pixels: every part must cover exactly the
+ * same one (Blender 5 writes all passes with the render's windows), or the
+ * passes would not line up pixel for pixel. */
+static int check_part_windows(exr_input *input, const exr_attr_box2i_t *data_window,
+                              const exr_attr_box2i_t *display_window, tool_error *error)
+{
+    int status = TOOL_EXIT_SUCCESS;
+    for (int part = 1; part < input->part_count; ++part) {
+        exr_attr_box2i_t part_data, part_display;
+        CHECK_EXR(exr_get_data_window(input->context, part, &part_data), "no data window");
+        CHECK_EXR(exr_get_display_window(input->context, part, &part_display),
+                  "no display window");
+        const bool data_differs = !same_box(&part_data, data_window);
+        if (data_differs || !same_box(&part_display, display_window)) {
+            const exr_attr_box2i_t *theirs = data_differs ? &part_data : &part_display;
+            const exr_attr_box2i_t *first = data_differs ? data_window : display_window;
+            const char *which = data_differs ? "data" : "display";
+            return tool_fail(error, TOOL_EXIT_RUNTIME,
+                             "%s: part %d (\"%s\") has %s window (%d, %d) - (%d, %d) but part "
+                             "0 has (%d, %d) - (%d, %d); parts with different %s windows are "
+                             "not supported",
+                             input->path, part, part_name(input, part), which, theirs->min.x,
+                             theirs->min.y, theirs->max.x, theirs->max.y, first->min.x,
+                             first->min.y, first->max.x, first->max.y, which);
+        }
+    }
+fail:
+    return status;
+}
+
+/* A channel and the part that holds it, while the parts' lists are merged. */
+typedef struct part_channel {
+    exr_attr_chlist_entry_t entry;
+    int part;
+} part_channel;
+
+/* Several parts' lists, each sorted, merge into one list sorted the same way
+ * (OpenEXRCore orders a part's channels by strcmp), so that the first layer
+ * "in channel-name order" is the same whatever the file's part layout. */
+static int compare_channel_names(const void *a, const void *b)
+{
+    return strcmp(((const part_channel *)a)->entry.name.str,
+                  ((const part_channel *)b)->entry.name.str);
+}
+
+static int fail_no_channels(const exr_input *input, int part, tool_error *error)
+{
+    if (input->part_count == 1)
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: has no channels", input->path);
+    return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: part %d (\"%s\") has no channels",
+                     input->path, part, part_name(input, part));
+}
+
+/* input->channels: the union of every part's channels, each with its part.
+ * What it allocates, exr_input_close() frees. */
+static int collect_channels(exr_input *input, tool_error *error)
+{
+    int status = TOOL_EXIT_SUCCESS;
+    int64_t total = 0;
+    const exr_attr_chlist_t *list = NULL;
+    part_channel *merged = NULL;
+    for (int part = 0; part < input->part_count; ++part) {
+        CHECK_EXR(exr_get_channels(input->context, part, &list), "no channel list");
+        if (list == NULL || list->num_channels < 1) return fail_no_channels(input, part, error);
+        total += list->num_channels;
+    }
+    if (total > INT_MAX / (int64_t)sizeof(part_channel))
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: too many channels (%lld)", input->path,
+                         (long long)total);
+    merged = malloc((size_t)total * sizeof *merged);
+    exr_attr_chlist_entry_t *entries = malloc((size_t)total * sizeof *entries);
+    input->channel_union.entries = entries;
+    input->channel_parts = malloc((size_t)total * sizeof *input->channel_parts);
+    if (merged == NULL || entries == NULL || input->channel_parts == NULL) {
+        status = tool_fail(error, TOOL_EXIT_RUNTIME, "%s: out of memory for %lld channels",
+                           input->path, (long long)total);
+        goto fail;
+    }
+    int count = 0;
+    for (int part = 0; part < input->part_count; ++part) {
+        CHECK_EXR(exr_get_channels(input->context, part, &list), "no channel list");
+        for (int c = 0; c < list->num_channels; ++c) {
+            merged[count].entry = list->entries[c];
+            merged[count].part = part;
+            ++count;
+        }
+    }
+    qsort(merged, (size_t)count, sizeof *merged, compare_channel_names);
+    for (int c = 0; c < count; ++c) {
+        entries[c] = merged[c].entry;
+        input->channel_parts[c] = merged[c].part;
+    }
+    input->channel_union.num_channels = count;
+    input->channel_union.num_alloced = count;
+    input->channels = &input->channel_union;
+    /* A name in two parts would make a request ambiguous (which part's
+     * pixels?); sorted, duplicates are neighbours. */
+    for (int c = 1; c < count; ++c) {
+        if (strcmp(entries[c - 1].name.str, entries[c].name.str) == 0) {
+            const int first = input->channel_parts[c - 1], second = input->channel_parts[c];
+            status = tool_fail(error, TOOL_EXIT_RUNTIME,
+                               "%s: channel %s is in part %d (\"%s\") and in part %d (\"%s\"); "
+                               "channel names must be unique across parts",
+                               input->path, entries[c].name.str, first,
+                               part_name(input, first), second, part_name(input, second));
+            break;
+        }
+    }
+fail:
+    free(merged);
+    return status;
+}
+
 int exr_input_open(exr_input *input, const char *path, tool_error *error)
 {
     memset(input, 0, sizeof *input);
@@ -91,22 +222,23 @@ int exr_input_open(exr_input *input, const char *path, tool_error *error)
         goto fail;
     }
 
-    int part_count = 0;
-    CHECK_EXR(exr_get_count(input->context, &part_count), "cannot count parts");
-    if (part_count != 1) {
-        status = tool_fail(error, TOOL_EXIT_RUNTIME,
-                           "%s: has %d parts; only single-part EXR files (as Blender writes) "
-                           "are supported",
-                           path, part_count);
+    CHECK_EXR(exr_get_count(input->context, &input->part_count), "cannot count parts");
+    if (input->part_count < 1) {
+        status = tool_fail(error, TOOL_EXIT_RUNTIME, "%s: has no parts", path);
         goto fail;
     }
-    exr_storage_t storage;
-    CHECK_EXR(exr_get_storage(input->context, 0, &storage), "cannot read the storage type");
-    if (storage != EXR_STORAGE_SCANLINE) {
-        status = tool_fail(error, TOOL_EXIT_RUNTIME,
-                           "%s: only scanline images are supported (this one is %s)", path,
-                           storage == EXR_STORAGE_TILED ? "tiled" : "deep");
-        goto fail;
+    for (int part = 0; part < input->part_count; ++part) {
+        exr_storage_t storage;
+        CHECK_EXR(exr_get_storage(input->context, part, &storage),
+                  "cannot read the storage type");
+        if (storage != EXR_STORAGE_SCANLINE) {
+            status = tool_fail(error, TOOL_EXIT_RUNTIME,
+                               "%s: only scanline images are supported (part %d, \"%s\", is "
+                               "%s)",
+                               path, part, part_name(input, part),
+                               storage == EXR_STORAGE_TILED ? "tiled" : "deep");
+            goto fail;
+        }
     }
 
     exr_attr_box2i_t data_window, display_window;
@@ -124,6 +256,8 @@ int exr_input_open(exr_input *input, const char *path, tool_error *error)
     }
     input->width = (int32_t)width;
     input->height = (int32_t)height;
+    status = check_part_windows(input, &data_window, &display_window, error);
+    if (status != TOOL_EXIT_SUCCESS) goto fail;
 
     CHECK_EXR(exr_get_compression(input->context, 0, &input->compression), "no compression");
     CHECK_EXR(exr_get_lineorder(input->context, 0, &input->line_order), "no line order");
@@ -141,11 +275,8 @@ int exr_input_open(exr_input *input, const char *path, tool_error *error)
         EXR_ERR_SUCCESS)
         input->screen_window_width = 1.0f;
 
-    CHECK_EXR(exr_get_channels(input->context, 0, &input->channels), "no channel list");
-    if (input->channels == NULL || input->channels->num_channels < 1) {
-        status = tool_fail(error, TOOL_EXIT_RUNTIME, "%s: has no channels", path);
-        goto fail;
-    }
+    status = collect_channels(input, error);
+    if (status != TOOL_EXIT_SUCCESS) goto fail;
     for (int c = 0; c < input->channels->num_channels; ++c) {
         const exr_attr_chlist_entry_t *channel = &input->channels->entries[c];
         if (channel->x_sampling != 1 || channel->y_sampling != 1) {
@@ -178,21 +309,17 @@ static const exr_channel_request *find_request(const exr_channel_request *reques
     return NULL;
 }
 
-int exr_input_read(exr_input *input, const exr_channel_request *requests, int count,
-                   tool_error *error)
+/* Decode the requests that name channels of `part`; the others are left to
+ * the other parts (a name is in one part only). */
+static int read_part(exr_input *input, int part, const exr_channel_request *requests, int count,
+                     tool_error *error)
 {
     int status = TOOL_EXIT_SUCCESS;
     exr_decode_pipeline_t decoder = EXR_DECODE_PIPELINE_INITIALIZER;
     bool decoder_ready = false;
-    exr_clear_last_error();
-    for (int r = 0; r < count; ++r) {
-        if (exr_input_find_channel(input, requests[r].name) < 0)
-            return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: no channel named %s", input->path,
-                             requests[r].name);
-    }
 
     int32_t lines_per_chunk = 0;
-    CHECK_EXR(exr_get_scanlines_per_chunk(input->context, 0, &lines_per_chunk),
+    CHECK_EXR(exr_get_scanlines_per_chunk(input->context, part, &lines_per_chunk),
               "cannot read the chunk layout");
     if (lines_per_chunk < 1) {
         status = tool_fail(error, TOOL_EXIT_RUNTIME, "%s: invalid scanlines per chunk (%d)",
@@ -203,7 +330,7 @@ int exr_input_read(exr_input *input, const exr_channel_request *requests, int co
     const pixel_rect *window = &input->data_window;
     for (int64_t y = window->min_y; y <= window->max_y; y += lines_per_chunk) {
         exr_chunk_info_t chunk;
-        CHECK_EXR(exr_read_scanline_chunk_info(input->context, 0, (int)y, &chunk),
+        CHECK_EXR(exr_read_scanline_chunk_info(input->context, part, (int)y, &chunk),
                   "cannot read a chunk (file truncated or corrupt?)");
         /* Chunks start at the data window's top and follow each other; one
          * that does not (a corrupt offset table) would send the copy below
@@ -216,11 +343,11 @@ int exr_input_read(exr_input *input, const exr_channel_request *requests, int co
             goto fail;
         }
         if (!decoder_ready) {
-            CHECK_EXR(exr_decoding_initialize(input->context, 0, &chunk, &decoder),
+            CHECK_EXR(exr_decoding_initialize(input->context, part, &chunk, &decoder),
                       "cannot start decoding");
             decoder_ready = true;
         } else {
-            CHECK_EXR(exr_decoding_update(input->context, 0, &chunk, &decoder),
+            CHECK_EXR(exr_decoding_update(input->context, part, &chunk, &decoder),
                       "cannot decode a chunk");
         }
         const int64_t first_row = chunk.start_y - window->min_y;
@@ -238,15 +365,17 @@ int exr_input_read(exr_input *input, const exr_channel_request *requests, int co
             channel->user_data_type = (uint16_t)request->type;
             channel->user_bytes_per_element = (int16_t)exr_pixel_type_size(request->type);
         }
-        CHECK_EXR(exr_decoding_choose_default_routines(input->context, 0, &decoder),
+        CHECK_EXR(exr_decoding_choose_default_routines(input->context, part, &decoder),
                   "cannot decode this channel layout");
-        exr_result_t decoded = exr_decoding_run(input->context, 0, &decoder);
+        exr_result_t decoded = exr_decoding_run(input->context, part, &decoder);
         if (decoded == EXR_ERR_FEATURE_NOT_IMPLEMENTED) {
             /* OpenEXRCore 3.1 cannot decompress DWAA/DWAB. */
+            exr_compression_t compression = input->compression;
+            exr_get_compression(input->context, part, &compression);
             status = tool_fail(error, TOOL_EXIT_RUNTIME,
                                "%s: this OpenEXR library cannot decode %s compression; save "
                                "the EXR with ZIP, PIZ or no compression",
-                               input->path, exr_compression_name(input->compression));
+                               input->path, exr_compression_name(compression));
             goto fail;
         }
         CHECK_EXR(decoded, "cannot decode a chunk (file truncated or corrupt?)");
@@ -257,9 +386,37 @@ fail:
     return status;
 }
 
+int exr_input_read(exr_input *input, const exr_channel_request *requests, int count,
+                   tool_error *error)
+{
+    exr_clear_last_error();
+    /* Only parts that hold a requested channel are decoded: reading Depth
+     * from Blender 5's one-part-per-pass files skips Combined and the rest. */
+    bool *wanted = calloc((size_t)input->part_count, sizeof *wanted);
+    if (wanted == NULL) return tool_fail(error, TOOL_EXIT_RUNTIME, "out of memory");
+    for (int r = 0; r < count; ++r) {
+        const int channel = exr_input_find_channel(input, requests[r].name);
+        if (channel < 0) {
+            free(wanted);
+            return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: no channel named %s", input->path,
+                             requests[r].name);
+        }
+        wanted[input->channel_parts[channel]] = true;
+    }
+    int status = TOOL_EXIT_SUCCESS;
+    for (int part = 0; part < input->part_count && status == TOOL_EXIT_SUCCESS; ++part)
+        if (wanted[part]) status = read_part(input, part, requests, count, error);
+    free(wanted);
+    return status;
+}
+
 void exr_input_close(exr_input *input)
 {
     if (input->context != NULL) exr_finish(&input->context);
     input->context = NULL;
     input->channels = NULL;
+    free((void *)input->channel_union.entries);
+    input->channel_union.entries = NULL;
+    free(input->channel_parts);
+    input->channel_parts = NULL;
 }

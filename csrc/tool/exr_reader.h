@@ -1,8 +1,10 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
 /*
- * Reading single-part scanline EXR files (what Blender writes) through
- * OpenEXRCore. The image is the part's data window; rows are stored top row
- * first, whatever the file's line order.
+ * Reading scanline EXR files (what Blender writes) through OpenEXRCore:
+ * single-part (Blender before 5.0, or 5.x with "interleave") or multi-part
+ * with one data window (Blender 5.x's default, one part per pass). The image
+ * is the data window; rows are stored top row first, whatever the file's line
+ * order. The header fields below come from part 0.
  */
 #ifndef HBAO_TOOL_EXR_READER_H
 #define HBAO_TOOL_EXR_READER_H
@@ -26,7 +28,11 @@ typedef struct exr_input {
     float screen_window_width;
     exr_compression_t compression;
     exr_lineorder_t line_order;
-    const exr_attr_chlist_t *channels; /**< sorted by name; owned by the context */
+    int part_count;
+    /** Every part's channels, sorted by name; names are unique across parts. */
+    const exr_attr_chlist_t *channels;
+    int *channel_parts; /**< the part that holds channels->entries[c] */
+    exr_attr_chlist_t channel_union; /* storage behind `channels`; names owned by the context */
 } exr_input;
 
 /** Where one channel's pixels go. Strides are in bytes. */
@@ -39,13 +45,15 @@ typedef struct exr_channel_request {
 } exr_channel_request;
 
 /**
- * Open `path`, check that it is an image the tool can read (one scanline
- * part, channels not subsampled, size within hbao's limits) and fill *input.
+ * Open `path`, check that it is an image the tool can read (scanline parts
+ * that share one data and display window, no channel name in two parts,
+ * channels not subsampled, size within hbao's limits) and fill *input.
  * On failure *input needs no exr_input_close().
  */
 int exr_input_open(exr_input *input, const char *path, tool_error *error);
 
-/** Decode the requested channels (each must exist) for the whole data window. */
+/** Decode the requested channels (each must exist) for the whole data window,
+ *  from whichever parts hold them. */
 int exr_input_read(exr_input *input, const exr_channel_request *requests, int count,
                    tool_error *error);
 

@@ -58,6 +58,41 @@ static exr_attr_box2i_t box_from_rect(const pixel_rect *rect)
     return box;
 }
 
+/* Scanlines per chunk for each compression, as the OpenEXR file layout
+ * defines them. OpenEXRCore 3.1 computes this only when it writes the header,
+ * too late for fix_copied_chunk_count(); exr_write_image() checks the two agree. */
+static int32_t lines_per_chunk_for(exr_compression_t compression)
+{
+    switch (compression) {
+    case EXR_COMPRESSION_ZIP:
+    case EXR_COMPRESSION_PXR24: return 16;
+    case EXR_COMPRESSION_PIZ:
+    case EXR_COMPRESSION_B44:
+    case EXR_COMPRESSION_B44A:
+    case EXR_COMPRESSION_DWAA: return 32;
+    case EXR_COMPRESSION_DWAB: return 256;
+    default: return 1; /* none, RLE, ZIPS */
+    }
+}
+
+/* A multi-part input's part header (Blender 5) carries chunkCount, the number
+ * of chunks of that part at its compression. OpenEXRCore writes a copied one
+ * unchanged into a single-part file, whose header would then contradict its
+ * own offset table (OpenEXR 3.1's readers recompute the count for single-part
+ * files, but the file layout says the attribute is the count, and other
+ * readers may trust it): it must count this file's chunks. A header without
+ * one is left without one. */
+static exr_result_t fix_copied_chunk_count(exr_context_t context, int part,
+                                           const exr_output_layout *layout)
+{
+    const exr_attribute_t *copied = NULL;
+    if (exr_get_attribute_by_name(context, part, "chunkCount", &copied) != EXR_ERR_SUCCESS)
+        return EXR_ERR_SUCCESS;
+    const int64_t lines = lines_per_chunk_for(layout->compression);
+    const int64_t height = (int64_t)layout->data_window.max_y - layout->data_window.min_y + 1;
+    return exr_set_chunk_count(context, part, (int32_t)((height + lines - 1) / lines));
+}
+
 int exr_write_image(int fd, const char *name, const exr_output_layout *layout,
                     const exr_output_channel *channels, int count, tool_error *error)
 {
@@ -91,13 +126,23 @@ int exr_write_image(int fd, const char *name, const exr_output_layout *layout,
                                   channels[c].perceptual, 1, 1),
                   "cannot add a channel");
     }
-    if (layout->copy_attributes_from != NULL)
+    if (layout->copy_attributes_from != NULL) {
         CHECK_EXR(exr_copy_unset_attributes(context, part, layout->copy_attributes_from, 0),
                   "cannot copy the input's header attributes");
+        CHECK_EXR(fix_copied_chunk_count(context, part, layout), "cannot set the chunk count");
+    }
     CHECK_EXR(exr_write_header(context), "cannot write the header");
 
     int32_t lines_per_chunk = 0;
     CHECK_EXR(exr_get_scanlines_per_chunk(context, part, &lines_per_chunk), "no chunk layout");
+    if (lines_per_chunk != lines_per_chunk_for(layout->compression)) {
+        status = tool_fail(error, TOOL_EXIT_RUNTIME,
+                           "cannot write %s: internal: %s compression has %d scanlines per "
+                           "chunk, not %d",
+                           name, exr_compression_name(layout->compression), lines_per_chunk,
+                           lines_per_chunk_for(layout->compression));
+        goto fail;
+    }
     const pixel_rect *window = &layout->data_window;
     for (int64_t y = window->min_y; y <= window->max_y; y += lines_per_chunk) {
         exr_chunk_info_t chunk;

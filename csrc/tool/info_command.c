@@ -51,6 +51,7 @@ static void print_text(const exr_input *input, const channel_statistics *stats,
            data->max_y);
     printf("  display window: (%d, %d) - (%d, %d)\n", display->min_x, display->min_y,
            display->max_x, display->max_y);
+    printf("  parts: %d\n", input->part_count);
     printf("  compression: %s\n", exr_compression_name(input->compression));
     printf("  pixel aspect ratio: %g%s\n", (double)input->pixel_aspect_ratio,
            input->has_pixel_aspect_ratio ? "" : " (not in header)");
@@ -85,6 +86,7 @@ static int print_json(const exr_input *input, const channel_statistics *stats,
     cJSON_AddNumberToObject(root, "height", input->height);
     cJSON_AddItemToObject(root, "data_window", rect_json(&input->data_window));
     cJSON_AddItemToObject(root, "display_window", rect_json(&input->display_window));
+    cJSON_AddNumberToObject(root, "parts", input->part_count);
     cJSON_AddStringToObject(root, "compression", exr_compression_name(input->compression));
     cJSON_AddNumberToObject(root, "pixel_aspect_ratio", input->pixel_aspect_ratio);
     for (int l = 0; l < layer_count; ++l) {
@@ -102,6 +104,7 @@ static int print_json(const exr_input *input, const channel_statistics *stats,
         cJSON_AddItemToArray(channel_list, item);
         cJSON_AddStringToObject(item, "name", channel->name.str);
         cJSON_AddStringToObject(item, "type", exr_pixel_type_name(channel->pixel_type));
+        cJSON_AddNumberToObject(item, "part", input->channel_parts[c]);
         if (stats[c].finite_count > 0) {
             cJSON_AddNumberToObject(item, "min", stats[c].minimum);
             cJSON_AddNumberToObject(item, "max", stats[c].maximum);
