@@ -195,12 +195,13 @@ def configure_ao_reference(scene, distance=DEFAULT_AO_DISTANCE):
     """Makes the AO pass of every view layer a reference with rays `distance` long.
 
     Cycles traces the AO pass with world.light_settings.distance as ray length;
-    EEVEE uses scene.eevee.gtao_distance."""
+    EEVEE uses scene.eevee.gtao_distance before 5.0 and the world's since."""
     if distance <= 0.0 or not math.isfinite(distance):
         raise ValueError(f"AO distance must be a positive number of metres, got {distance}")
     world = scene.world or _world(scene)
     world.light_settings.distance = distance
-    scene.eevee.gtao_distance = distance
+    if hasattr(scene.eevee, "gtao_distance"):  # before 5.0; since, EEVEE uses the world's
+        scene.eevee.gtao_distance = distance
     for view_layer in scene.view_layers:
         view_layer.use_pass_ambient_occlusion = True
     return scene

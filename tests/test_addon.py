@@ -369,9 +369,9 @@ def test_package_and_install(tmp_path):
     and enables the add-on for a (temporary) Blender user."""
     import zipfile
     completed = subprocess.run([str(REPO / "scripts" / "package_addon.sh")],
-                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    assert completed.returncode == 0, completed.stdout
-    archive = completed.stdout.strip().splitlines()[-1]
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    assert completed.returncode == 0, completed.stderr
+    archive = completed.stdout.strip().splitlines()[0]  # the legacy zip; then the extension
     names = zipfile.ZipFile(archive).namelist()
     for expected in ("hbao/__init__.py", "hbao/native.py", "hbao/blender_manifest.toml",
                      "hbao/lib/libhbao.so"):
