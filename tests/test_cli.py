@@ -14,9 +14,15 @@ How outputs are checked without a hand-written EXR parser:
 import json
 import os
 import random
+import resource
 import shutil
+import signal
+import socket
+import stat
 import struct
 import subprocess
+import threading
+import time
 import zlib
 from pathlib import Path
 
@@ -107,6 +113,43 @@ def assert_clean_error(completed, status, *fragments):
 
 def leftover_temporary_files(folder):
     return [p.name for p in Path(folder).iterdir() if ".hbao-tmp-" in p.name]
+
+
+def exr_attribute(name, kind, payload):
+    return name.encode() + b"\0" + kind.encode() + b"\0" + struct.pack("<i", len(payload)) + payload
+
+
+def scanline_exr(channels, width, height, claimed_size=None):
+    """A single-part, uncompressed scanline EXR of float channels (name ->
+    float32 array of shape (height, width)), written from the OpenEXR file
+    layout so that tests can make inputs of any size, or a header whose
+    claimed size (claimed_size=(w, h)) the file does not hold: then no chunk
+    table and no chunks follow."""
+    claimed_width, claimed_height = claimed_size or (width, height)
+    names = sorted(channels)
+    # chlist: name, pixel type 2 (float), pLinear, 3 reserved, x/y sampling.
+    chlist = b"".join(n.encode() + b"\0" + struct.pack("<iB3xii", 2, 0, 1, 1)
+                      for n in names) + b"\0"
+    box = struct.pack("<4i", 0, 0, claimed_width - 1, claimed_height - 1)
+    header = (struct.pack("<ii", 20000630, 2)
+              + exr_attribute("channels", "chlist", chlist)
+              + exr_attribute("compression", "compression", b"\0")
+              + exr_attribute("dataWindow", "box2i", box)
+              + exr_attribute("displayWindow", "box2i", box)
+              + exr_attribute("lineOrder", "lineOrder", b"\0")
+              + exr_attribute("pixelAspectRatio", "float", struct.pack("<f", 1.0))
+              + exr_attribute("screenWindowCenter", "v2f", struct.pack("<ff", 0.0, 0.0))
+              + exr_attribute("screenWindowWidth", "float", struct.pack("<f", 1.0)) + b"\0")
+    if claimed_size is not None:
+        return header
+    rows = [b"".join(np.ascontiguousarray(channels[n][y], dtype="<f4").tobytes()
+                     for n in names) for y in range(height)]
+    chunks = [struct.pack("<ii", y, len(row)) + row for y, row in enumerate(rows)]
+    offsets, position = [], len(header) + 8 * height
+    for chunk in chunks:
+        offsets.append(position)
+        position += len(chunk)
+    return header + struct.pack(f"<{height}Q", *offsets) + b"".join(chunks)
 
 
 def png_header(path):
@@ -466,6 +509,143 @@ def test_existing_output_is_replaced_only_on_success(hbao_tool, tmp_path):
     assert [c["name"] for c in description["channels"]] == ["AO"]
     assert png_header(preview) == (description["width"], description["height"], 8, 0)
     assert leftover_temporary_files(tmp_path) == []
+
+
+def test_symbolic_link_output_replaces_its_target_and_keeps_the_link(hbao_tool, tmp_path):
+    """A link is followed, as a shell's `>` would: the target gets the image
+    (atomically), the link stays a link; a dangling link creates its target."""
+    reference = tmp_path / "reference.exr"
+    compute_ao(hbao_tool, "cycles_float_zip", reference)
+    (tmp_path / "real").mkdir()
+    target = tmp_path / "real" / "target.exr"
+    target.write_bytes(b"previous result")
+    links = {tmp_path / "link.exr": Path("real") / "target.exr",
+             tmp_path / "dangling.exr": Path("real") / "new.exr"}
+    for link, points_to in links.items():
+        link.symlink_to(points_to)
+        compute_ao(hbao_tool, "cycles_float_zip", link)
+        assert link.is_symlink() and os.readlink(link) == str(points_to)
+        assert (tmp_path / points_to).read_bytes() == reference.read_bytes()
+    assert leftover_temporary_files(tmp_path) == []
+    assert leftover_temporary_files(tmp_path / "real") == []
+
+
+def test_fifo_output_is_written_through(hbao_tool, tmp_path):
+    """A FIFO is not replaced by a file: its reader gets the whole EXR."""
+    reference = tmp_path / "reference.exr"
+    compute_ao(hbao_tool, "cycles_float_zip", reference)
+    fifo = tmp_path / "pipe.exr"
+    os.mkfifo(fifo)
+    received = []
+    reader = threading.Thread(target=lambda: received.append(fifo.read_bytes()))
+    reader.start()
+    compute_ao(hbao_tool, "cycles_float_zip", fifo)
+    reader.join(TOOL_TIMEOUT_S)
+    assert received == [reference.read_bytes()]
+    assert stat.S_ISFIFO(os.lstat(fifo).st_mode)
+    assert leftover_temporary_files(tmp_path) == []
+
+
+def test_character_device_output_is_written_through(hbao_tool, tmp_path):
+    """As root, a replaced /dev/null would break the system (issue 13, D3)."""
+    before = os.lstat("/dev/null")
+    compute_ao(hbao_tool, "cycles_float_zip", "/dev/null")
+    after = os.lstat("/dev/null")
+    assert stat.S_ISCHR(after.st_mode) and after.st_rdev == before.st_rdev
+    assert leftover_temporary_files("/dev") == []
+
+
+def test_block_device_socket_and_directory_outputs_are_refused(hbao_tool, tmp_path):
+    server = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    server.bind(str(tmp_path / "socket.exr"))
+    targets = {tmp_path / "socket.exr": "socket", tmp_path: "directory"}
+    if os.geteuid() == 0:
+        # A device node of the loop driver (major 7); nothing opens it.
+        os.mknod(tmp_path / "block.exr", 0o600 | stat.S_IFBLK, os.makedev(7, 200))
+        targets[tmp_path / "block.exr"] = "block device"
+    try:
+        for target, kind in targets.items():
+            for flag in ("-o", "--preview"):
+                arguments = [fixture_path("cycles_float_zip"), "-o", tmp_path / "ok.exr",
+                             flag, target] if flag != "-o" else \
+                    [fixture_path("cycles_float_zip"), "-o", target]
+                completed = run_tool(hbao_tool, *arguments)
+                assert_clean_error(completed, EXIT_USAGE, str(target), kind)
+        assert stat.S_ISSOCK(os.lstat(tmp_path / "socket.exr").st_mode)
+        if os.geteuid() == 0:
+            assert stat.S_ISBLK(os.lstat(tmp_path / "block.exr").st_mode)
+    finally:
+        server.close()
+    assert not (tmp_path / "ok.exr").exists() and leftover_temporary_files(tmp_path) == []
+
+
+def test_longest_legal_output_name_works(hbao_tool, tmp_path):
+    """NAME_MAX (255 bytes) is the file system's limit on one name; the
+    temporary name must not push a legal name over it (issue 13, D5)."""
+    name_max = os.pathconf(tmp_path, "PC_NAME_MAX")
+    output = tmp_path / ("a" * (name_max - len(".exr")) + ".exr")
+    preview = tmp_path / ("p" * (name_max - len(".png")) + ".png")
+    compute_ao(hbao_tool, "cycles_float_zip", output, "--preview", preview)
+    assert [c["name"] for c in info(hbao_tool, output)["channels"]] == ["AO"]
+    assert png_header(preview)[:2] == (64, 48)
+
+
+# The slow run for the signal test: 512x512 pixels, 64 directions x 64 steps
+# on one thread take about 1 s on this project's machine, far longer than the
+# few milliseconds between the temporary file appearing and the signal.
+SLOW_SIZE = 512
+SLOW_RUN = ["--directions", "64", "--steps", "64", "--threads", "1"]
+
+
+@pytest.mark.parametrize("signal_number", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP])
+def test_signal_removes_the_temporary_files(hbao_tool, tmp_path, signal_number):
+    y, x = np.mgrid[0:SLOW_SIZE, 0:SLOW_SIZE].astype(np.float32)
+    source = tmp_path / "big.exr"
+    source.write_bytes(scanline_exr({"Depth.Z": 5.0 + 0.01 * x + np.sin(y / 7.0)},
+                                    SLOW_SIZE, SLOW_SIZE))
+    outputs = tmp_path / "out"
+    outputs.mkdir()
+    command = [str(hbao_tool), str(source), "-o", str(outputs / "ao.exr"),
+               "--preview", str(outputs / "ao.png")] + SLOW_RUN
+    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    try:
+        deadline = time.monotonic() + TOOL_TIMEOUT_S
+        while len(leftover_temporary_files(outputs)) < 2 and process.poll() is None:
+            assert time.monotonic() < deadline
+            time.sleep(0.005)
+        # Both temporary files existed while the tool was still running:
+        # otherwise the signal below would test nothing.
+        assert process.poll() is None, "the run ended before it could be interrupted"
+        process.send_signal(signal_number)
+        process.wait(TOOL_TIMEOUT_S)
+    finally:
+        process.kill()
+        process.wait()
+    # The exit status says the signal ended the run.
+    assert process.returncode == -signal_number, process.stderr.read()
+    assert list(outputs.iterdir()) == []
+
+
+def test_size_claim_is_checked_against_the_file_before_allocating(hbao_tool, tmp_path):
+    """A ~500-byte header claiming 65536x65536 pixels (16 GiB per float
+    channel) is refused for what the file holds, not by a failed allocation:
+    the address space is limited to 1 GiB, so a reservation for the claimed
+    size fails ("out of memory") instead of silently succeeding through
+    overcommit (issue 13, D6)."""
+    claim = tmp_path / "claim.exr"
+    claim.write_bytes(scanline_exr({"Depth.Z": None}, 0, 0, claimed_size=(65536, 65536)))
+    address_space = 1 << 30
+
+    def limit_memory():
+        resource.setrlimit(resource.RLIMIT_AS, (address_space, address_space))
+
+    for arguments in ([claim, "-o", tmp_path / "ao.exr"], ["--info", claim]):
+        completed = subprocess.run([str(hbao_tool)] + [str(a) for a in arguments],
+                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                   timeout=TOOL_TIMEOUT_S, preexec_fn=limit_memory)
+        assert_clean_error(completed, EXIT_RUNTIME, "claims a 65536x65536 image")
+        assert "out of memory" not in completed.stderr
+    assert not (tmp_path / "ao.exr").exists() and leftover_temporary_files(tmp_path) == []
 
 
 def test_unwritable_output_folder_is_an_error(hbao_tool, tmp_path):

@@ -15,7 +15,8 @@
 #include "png_writer.h"
 
 /* Refuse an output path that is the input file itself, through any name
- * (hard link, symbolic link, "./x" vs "x"): stat() identity, not strings. */
+ * (hard link, symbolic link, "./x" vs "x"): stat() identity, not strings.
+ * What else may be written is atomic_file_begin()'s rule. */
 static int refuse_overwriting_input(const char *output, const char *flag,
                                     const struct stat *input_status, tool_error *error)
 {
@@ -25,8 +26,6 @@ static int refuse_overwriting_input(const char *output, const char *flag,
         output_status.st_ino == input_status->st_ino)
         return tool_fail(error, TOOL_EXIT_USAGE,
                          "%s %s is the input file; refusing to overwrite it", flag, output);
-    if (S_ISDIR(output_status.st_mode))
-        return tool_fail(error, TOOL_EXIT_USAGE, "%s %s is a directory", flag, output);
     return TOOL_EXIT_SUCCESS;
 }
 
@@ -140,13 +139,31 @@ static int read_copies(exr_input *input, const char *ao_channel, pass_buffers *b
     return status;
 }
 
+/* The outputs' temporary files exist from before the computation to the
+ * end: an unwritable folder fails before any work, and an interruption at
+ * any point is cleaned up (atomic_file.h). */
+typedef struct output_files {
+    atomic_file exr, png;
+} output_files;
+
+static int begin_outputs(const cli_options *options, output_files *files, tool_error *error)
+{
+    int status = atomic_file_begin(&files->exr, options->output_path, error);
+    if (status == TOOL_EXIT_SUCCESS && options->preview_path != NULL)
+        status = atomic_file_begin(&files->png, options->preview_path, error);
+    return status;
+}
+
+static void abort_outputs(output_files *files)
+{
+    atomic_file_abort(&files->exr);
+    atomic_file_abort(&files->png);
+}
+
 static int write_outputs(const cli_options *options, const exr_input *input,
                          const exr_output_channel *channels, int channel_count, const float *ao,
-                         tool_error *error)
+                         output_files *files, tool_error *error)
 {
-    atomic_file exr_file, png_file;
-    int status = atomic_file_begin(&exr_file, options->output_path, error);
-    if (status != TOOL_EXIT_SUCCESS) return status;
     exr_output_layout layout = {input->data_window,
                                 input->display_window,
                                 input->pixel_aspect_ratio,
@@ -154,32 +171,15 @@ static int write_outputs(const cli_options *options, const exr_input *input,
                                 input->screen_window_width,
                                 options->compression,
                                 options->keep_input ? input->context : NULL};
-    status = exr_write_image(exr_file.fd, options->output_path, &layout, channels, channel_count,
-                             error);
-    if (status != TOOL_EXIT_SUCCESS) {
-        atomic_file_abort(&exr_file);
-        return status;
-    }
-    bool with_preview = options->preview_path != NULL;
-    if (with_preview) {
-        status = atomic_file_begin(&png_file, options->preview_path, error);
-        if (status == TOOL_EXIT_SUCCESS) {
-            status = png_write_gray(png_file.fd, options->preview_path, ao, input->width,
-                                    input->height, input->width, error);
-            if (status != TOOL_EXIT_SUCCESS) atomic_file_abort(&png_file);
-        }
-        if (status != TOOL_EXIT_SUCCESS) {
-            atomic_file_abort(&exr_file);
-            return status;
-        }
-    }
+    int status = exr_write_image(files->exr.fd, options->output_path, &layout, channels,
+                                 channel_count, error);
+    if (status == TOOL_EXIT_SUCCESS && options->preview_path != NULL)
+        status = png_write_gray(files->png.fd, options->preview_path, ao, input->width,
+                                input->height, input->width, error);
     /* Both files are complete: only now replace the destinations. */
-    status = atomic_file_commit(&exr_file, error);
-    if (status != TOOL_EXIT_SUCCESS) {
-        if (with_preview) atomic_file_abort(&png_file);
-        return status;
-    }
-    if (with_preview) status = atomic_file_commit(&png_file, error);
+    if (status == TOOL_EXIT_SUCCESS) status = atomic_file_commit(&files->exr, error);
+    if (status == TOOL_EXIT_SUCCESS && options->preview_path != NULL)
+        status = atomic_file_commit(&files->png, error);
     return status;
 }
 
@@ -204,6 +204,7 @@ int ao_command(const cli_options *options, tool_error *error)
 
     pass_buffers buffers = {0};
     exr_output_channel *outputs = NULL;
+    output_files files = {ATOMIC_FILE_IDLE, ATOMIC_FILE_IDLE};
     blender_passes passes;
     status = blender_find_passes(&input, options->layer, &passes, error);
     if (status != TOOL_EXIT_SUCCESS) goto done;
@@ -215,6 +216,8 @@ int ao_command(const cli_options *options, tool_error *error)
     const hbao_camera cropped =
         camera_for_data_window(&camera.camera, &input.display_window, &input.data_window);
 
+    status = begin_outputs(options, &files, error);
+    if (status != TOOL_EXIT_SUCCESS) goto done;
     status = read_passes(&input, &passes, use_normals, &buffers, error);
     if (status != TOOL_EXIT_SUCCESS) goto done;
     if (use_normals && !(camera.fields_set & CAMERA_FIELD_WORLD_TO_CAMERA))
@@ -250,9 +253,10 @@ int ao_command(const cli_options *options, tool_error *error)
         status = read_copies(&input, options->ao_channel, &buffers, outputs, &output_count, error);
         if (status != TOOL_EXIT_SUCCESS) goto done;
     }
-    status = write_outputs(options, &input, outputs, output_count, buffers.ao, error);
+    status = write_outputs(options, &input, outputs, output_count, buffers.ao, &files, error);
 
 done:
+    abort_outputs(&files);
     free(outputs);
     free_buffers(&buffers);
     exr_input_close(&input);

@@ -3,6 +3,7 @@
 
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "hbao.h"
 
@@ -75,6 +76,62 @@ static pixel_rect rect_from_box(const exr_attr_box2i_t *box)
 {
     pixel_rect rect = {box->min.x, box->min.y, box->max.x, box->max.y};
     return rect;
+}
+
+/* The chunk that holds scanline y, checked against the data window: chunks
+ * start at the window's top and follow each other; one that does not (a
+ * corrupt offset table) would send the decoder's copy outside the buffers.
+ * Its bytes must lie inside the file, whose size is file_size. */
+static int read_chunk_info(exr_input *input, int64_t y, int64_t file_size,
+                           exr_chunk_info_t *chunk, tool_error *error)
+{
+    int status = TOOL_EXIT_SUCCESS;
+    CHECK_EXR(exr_read_scanline_chunk_info(input->context, 0, (int)y, chunk),
+              "cannot read a chunk (file truncated or corrupt?)");
+    const pixel_rect *window = &input->data_window;
+    if (chunk->start_y != y || chunk->height < 1 || chunk->height > input->lines_per_chunk ||
+        chunk->width != input->width ||
+        (int64_t)chunk->start_y + chunk->height - 1 > window->max_y ||
+        chunk->data_offset > (uint64_t)file_size ||
+        chunk->packed_size > (uint64_t)file_size - chunk->data_offset)
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: corrupt chunk at scanline %lld",
+                         input->path, (long long)y);
+fail:
+    return status;
+}
+
+/* Every chunk the data window needs, read before anything is allocated for
+ * the image: a header claiming a huge image in a small file fails here (its
+ * chunk table or its chunks do not fit in the file). The chunk table itself
+ * is 8 bytes per chunk, which OpenEXRCore checks against the file size. */
+static int check_chunks(exr_input *input, tool_error *error)
+{
+    int status = TOOL_EXIT_SUCCESS;
+    struct stat file_status;
+    if (stat(input->path, &file_status) != 0)
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: cannot read its size", input->path);
+    CHECK_EXR(exr_get_scanlines_per_chunk(input->context, 0, &input->lines_per_chunk),
+              "cannot read the chunk layout");
+    if (input->lines_per_chunk < 1)
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: invalid scanlines per chunk (%d)",
+                         input->path, input->lines_per_chunk);
+    const pixel_rect *window = &input->data_window;
+    for (int64_t y = window->min_y; y <= window->max_y; y += input->lines_per_chunk) {
+        exr_chunk_info_t chunk;
+        status = read_chunk_info(input, y, (int64_t)file_status.st_size, &chunk, error);
+        if (status != TOOL_EXIT_SUCCESS) {
+            char detail[TOOL_ERROR_MESSAGE_SIZE];
+            snprintf(detail, sizeof detail, "%s", error->message);
+            return tool_fail(error, status,
+                             "%s: the header claims a %dx%d image, which this %lld-byte file "
+                             "does not hold (%s)",
+                             input->path, input->width, input->height,
+                             (long long)file_status.st_size, detail);
+        }
+    }
+    input->file_size = (int64_t)file_status.st_size;
+fail:
+    return status;
 }
 
 int exr_input_open(exr_input *input, const char *path, tool_error *error)
@@ -156,6 +213,8 @@ int exr_input_open(exr_input *input, const char *path, tool_error *error)
             goto fail;
         }
     }
+    status = check_chunks(input, error);
+    if (status != TOOL_EXIT_SUCCESS) goto fail;
     return TOOL_EXIT_SUCCESS;
 
 fail:
@@ -191,30 +250,11 @@ int exr_input_read(exr_input *input, const exr_channel_request *requests, int co
                              requests[r].name);
     }
 
-    int32_t lines_per_chunk = 0;
-    CHECK_EXR(exr_get_scanlines_per_chunk(input->context, 0, &lines_per_chunk),
-              "cannot read the chunk layout");
-    if (lines_per_chunk < 1) {
-        status = tool_fail(error, TOOL_EXIT_RUNTIME, "%s: invalid scanlines per chunk (%d)",
-                           input->path, lines_per_chunk);
-        goto fail;
-    }
-
     const pixel_rect *window = &input->data_window;
-    for (int64_t y = window->min_y; y <= window->max_y; y += lines_per_chunk) {
+    for (int64_t y = window->min_y; y <= window->max_y; y += input->lines_per_chunk) {
         exr_chunk_info_t chunk;
-        CHECK_EXR(exr_read_scanline_chunk_info(input->context, 0, (int)y, &chunk),
-                  "cannot read a chunk (file truncated or corrupt?)");
-        /* Chunks start at the data window's top and follow each other; one
-         * that does not (a corrupt offset table) would send the copy below
-         * outside the buffers. */
-        if (chunk.start_y != y || chunk.height < 1 || chunk.height > lines_per_chunk ||
-            chunk.width != input->width ||
-            (int64_t)chunk.start_y + chunk.height - 1 > window->max_y) {
-            status = tool_fail(error, TOOL_EXIT_RUNTIME, "%s: corrupt chunk at scanline %lld",
-                               input->path, (long long)y);
-            goto fail;
-        }
+        status = read_chunk_info(input, y, input->file_size, &chunk, error);
+        if (status != TOOL_EXIT_SUCCESS) goto fail;
         if (!decoder_ready) {
             CHECK_EXR(exr_decoding_initialize(input->context, 0, &chunk, &decoder),
                       "cannot start decoding");
