@@ -52,15 +52,7 @@ static int resolve_camera(const cli_options *options, const exr_input *input,
     return TOOL_EXIT_SUCCESS;
 }
 
-typedef struct pass_buffers {
-    float *depth;
-    float *normal; /* X Y Z interleaved; NULL when not used */
-    float *ao;
-    uint8_t **copies; /* --keep-input: one native-type buffer per input channel */
-    int copy_count;
-} pass_buffers;
-
-static void free_buffers(pass_buffers *buffers)
+void ao_buffers_free(ao_buffers *buffers)
 {
     free(buffers->depth);
     free(buffers->normal);
@@ -80,7 +72,7 @@ static exr_channel_request float_request(const char *name, float *data, int comp
 }
 
 static int read_passes(exr_input *input, const blender_passes *passes, bool use_normals,
-                       pass_buffers *buffers, tool_error *error)
+                       ao_buffers *buffers, tool_error *error)
 {
     const size_t pixel_count = (size_t)input->width * (size_t)input->height;
     buffers->depth = malloc(pixel_count * sizeof(float));
@@ -99,7 +91,7 @@ static int read_passes(exr_input *input, const blender_passes *passes, bool use_
 }
 
 /* --keep-input: every channel but a previous AO, decoded in its own type. */
-static int read_copies(exr_input *input, const char *ao_channel, pass_buffers *buffers,
+static int read_copies(exr_input *input, const char *ao_channel, ao_buffers *buffers,
                        exr_output_channel *outputs, int *output_count, tool_error *error)
 {
     const int channel_count = input->channels->num_channels;
@@ -183,6 +175,40 @@ static int write_outputs(const cli_options *options, const exr_input *input,
     return status;
 }
 
+int ao_compute_input(const cli_options *options, exr_input *input, ao_buffers *buffers,
+                     tool_error *error)
+{
+    blender_passes passes;
+    int status = blender_find_passes(input, options->layer, &passes, error);
+    if (status != TOOL_EXIT_SUCCESS) return status;
+
+    camera_settings camera;
+    status = resolve_camera(options, input, &camera, error);
+    if (status != TOOL_EXIT_SUCCESS) return status;
+    const bool use_normals = passes.has_normal && !options->ignore_normals;
+    const hbao_camera cropped =
+        camera_for_data_window(&camera.camera, &input->display_window, &input->data_window);
+
+    status = read_passes(input, &passes, use_normals, buffers, error);
+    if (status != TOOL_EXIT_SUCCESS) return status;
+    if (use_normals && !(camera.fields_set & CAMERA_FIELD_WORLD_TO_CAMERA))
+        tool_warn("the Normal pass (%s) is in world space but no world-to-camera matrix was "
+                  "given; using the identity, which is right only for a camera at the origin "
+                  "looking down -Z. Give --camera FILE.json or --world-to-camera, or "
+                  "--no-normals to reconstruct normals from depth",
+                  passes.normal[0]);
+
+    hbao_channel depth = {buffers->depth, 1, input->width};
+    hbao_channel normal = {buffers->normal, 3, (int64_t)input->width * 3};
+    hbao_result result = hbao_compute(&options->params, &cropped, input->width, input->height,
+                                      &depth, use_normals ? &normal : NULL, buffers->ao,
+                                      input->width);
+    if (result != HBAO_SUCCESS)
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: cannot compute AO: %s",
+                         options->input_path, hbao_result_message(result));
+    return TOOL_EXIT_SUCCESS;
+}
+
 int ao_command(const cli_options *options, tool_error *error)
 {
     struct stat input_status;
@@ -202,41 +228,13 @@ int ao_command(const cli_options *options, tool_error *error)
     status = exr_input_open(&input, options->input_path, error);
     if (status != TOOL_EXIT_SUCCESS) return status;
 
-    pass_buffers buffers = {0};
+    ao_buffers buffers = {0};
     exr_output_channel *outputs = NULL;
     output_files files = {ATOMIC_FILE_IDLE, ATOMIC_FILE_IDLE};
-    blender_passes passes;
-    status = blender_find_passes(&input, options->layer, &passes, error);
-    if (status != TOOL_EXIT_SUCCESS) goto done;
-
-    camera_settings camera;
-    status = resolve_camera(options, &input, &camera, error);
-    if (status != TOOL_EXIT_SUCCESS) goto done;
-    const bool use_normals = passes.has_normal && !options->ignore_normals;
-    const hbao_camera cropped =
-        camera_for_data_window(&camera.camera, &input.display_window, &input.data_window);
-
     status = begin_outputs(options, &files, error);
     if (status != TOOL_EXIT_SUCCESS) goto done;
-    status = read_passes(&input, &passes, use_normals, &buffers, error);
+    status = ao_compute_input(options, &input, &buffers, error);
     if (status != TOOL_EXIT_SUCCESS) goto done;
-    if (use_normals && !(camera.fields_set & CAMERA_FIELD_WORLD_TO_CAMERA))
-        tool_warn("the Normal pass (%s) is in world space but no world-to-camera matrix was "
-                  "given; using the identity, which is right only for a camera at the origin "
-                  "looking down -Z. Give --camera FILE.json or --world-to-camera, or "
-                  "--no-normals to reconstruct normals from depth",
-                  passes.normal[0]);
-
-    hbao_channel depth = {buffers.depth, 1, input.width};
-    hbao_channel normal = {buffers.normal, 3, (int64_t)input.width * 3};
-    hbao_result result = hbao_compute(&options->params, &cropped, input.width, input.height,
-                                      &depth, use_normals ? &normal : NULL, buffers.ao,
-                                      input.width);
-    if (result != HBAO_SUCCESS) {
-        status = tool_fail(error, TOOL_EXIT_RUNTIME, "%s: cannot compute AO: %s",
-                           options->input_path, hbao_result_message(result));
-        goto done;
-    }
 
     outputs = calloc((size_t)input.channels->num_channels + 1, sizeof *outputs);
     if (outputs == NULL) {
@@ -258,7 +256,7 @@ int ao_command(const cli_options *options, tool_error *error)
 done:
     abort_outputs(&files);
     free(outputs);
-    free_buffers(&buffers);
+    ao_buffers_free(&buffers);
     exr_input_close(&input);
     return status;
 }
