@@ -132,6 +132,59 @@ TEST_CASE(invalid_cameras_are_rejected) {
     CHECK_RESULT(compute_with(&p, &c), HBAO_SUCCESS);
 }
 
+/* AO of the W x H test plane with given normals (all tilted, so that the
+ * matrix matters) under camera c. */
+static hbao_result compute_with_normals(const hbao_camera *c, float *out) {
+    hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+    p.threads = 1;
+    hbao_channel d = {depth, 1, W};
+    hbao_channel n = {normal, 3, 3 * W};
+    for (int k = 0; k < W * H; k++) {
+        normal[3 * k] = 0.6f;
+        normal[3 * k + 1] = 0.0f;
+        normal[3 * k + 2] = 0.8f;
+    }
+    return hbao_compute(&p, c, W, H, &d, &n, out, W);
+}
+
+/* Issue 13: a rotation scaled by 1e-5 is invertible and must be accepted;
+ * only the matrix's direction matters, so the AO is that of the unscaled
+ * rotation up to the float rounding of the renormalised normals. */
+TEST_CASE(world_to_camera_check_is_scale_free) {
+    fill_inputs();
+    /* A rotation by 30 degrees about Y. */
+    const float cosine = 0.8660254f, sine = 0.5f;
+    const float rotation[16] = {cosine, 0, sine, 0, 0, 1, 0, 0, -sine, 0, cosine, 0, 0, 0, 0, 1};
+    hbao_camera c = HBAO_CAMERA_DEFAULT_INITIALIZER;
+    static float reference[W * H], scaled_ao[W * H];
+    memcpy(c.world_to_camera, rotation, sizeof rotation);
+    CHECK_RESULT(compute_with_normals(&c, reference), HBAO_SUCCESS);
+    const float scales[] = {1e-5f, 1e-12f, 1e5f, 1e12f};
+    for (size_t s = 0; s < sizeof scales / sizeof scales[0]; s++) {
+        for (int k = 0; k < 12; k++) c.world_to_camera[k] = rotation[k] * scales[s];
+        CHECK_RESULT(compute_with_normals(&c, scaled_ao), HBAO_SUCCESS);
+        /* Scaling changes each normal by a few float ulps (2^-24 relative)
+         * before renormalising; AO moves by a small multiple of that. 1e-5
+         * is far above it and far below an 8-bit step (3.9e-3). */
+        double worst = 0.0;
+        for (int k = 0; k < W * H; k++) worst = fmax(worst, fabs(scaled_ao[k] - reference[k]));
+        CHECK_NEAR(worst, 0.0, 1e-5);
+    }
+    /* Singular: two equal rows, a zero row, the zero matrix; at any scale. */
+    const float singular_rows[3][12] = {
+        {1, 0, 0, 0, 1, 0, 0, 0, 0, 0, 1, 0},
+        {1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0},
+        {1e-5f, 0, 0, 0, 0, 1e-5f, 0, 0, 1e-5f, 1e-5f, 0, 0},
+    };
+    for (int m = 0; m < 3; m++) {
+        memcpy(c.world_to_camera, singular_rows[m], sizeof singular_rows[m]);
+        CHECK_RESULT(compute_with_normals(&c, scaled_ao), HBAO_ERROR_INVALID_CAMERA);
+    }
+    /* Beyond float's range for the normal transform (camera.c's row limits). */
+    for (int k = 0; k < 12; k++) c.world_to_camera[k] = rotation[k] * 1e-20f;
+    CHECK_RESULT(compute_with_normals(&c, scaled_ao), HBAO_ERROR_INVALID_CAMERA);
+}
+
 TEST_CASE(out_of_range_counts_are_clamped) {
     fill_inputs();
     hbao_camera c = HBAO_CAMERA_DEFAULT_INITIALIZER;
@@ -225,5 +278,6 @@ TEST_CASE(concurrent_calls_agree) {
 
 TEST_MAIN(TEST_ENTRY(null_arguments_are_rejected), TEST_ENTRY(sizes_and_strides_are_checked),
           TEST_ENTRY(invalid_parameters_are_rejected), TEST_ENTRY(invalid_cameras_are_rejected),
+          TEST_ENTRY(world_to_camera_check_is_scale_free),
           TEST_ENTRY(out_of_range_counts_are_clamped), TEST_ENTRY(zero_radius_gives_ones),
           TEST_ENTRY(messages_version_and_sizes), TEST_ENTRY(concurrent_calls_agree))
