@@ -656,9 +656,7 @@ def test_unwritable_output_folder_is_an_error(hbao_tool, tmp_path):
     (["--radius=2x"], "--radius"),
     (["--directions", "abc"], "--directions"),
     (["--directions", "1.5"], "--directions"),
-    (["--directions", "0"], "--directions"),
     (["--steps", "99999999999"], "--steps"),
-    (["--angle-bias", "90"], "--angle-bias"),
     (["--lens", "0"], "--lens"),
     (["--falloff", "linear"], "--falloff"),
     (["--integration", "ssao"], "--integration"),
@@ -679,6 +677,28 @@ def test_bad_flags_are_usage_errors(hbao_tool, tmp_path, arguments, fragment):
                          *arguments)
     assert_clean_error(completed, EXIT_USAGE, fragment)
     assert not (tmp_path / "o.exr").exists()
+
+
+def test_out_of_range_parameters_are_clamped_with_a_warning(hbao_tool, tmp_path):
+    """libhbao's hbao_params_resolve decides, for the CLI as for the add-on:
+    one warning per clamped value, exit 0, and the AO of the limit values."""
+    clamped = compute_ao(hbao_tool, "cycles_float_zip", tmp_path / "clamped.exr",
+                         "--steps", "500", "--directions", "0", "--angle-bias", "90",
+                         "--blur", "-3", "--strength", "20")
+    warnings = [line for line in clamped.stderr.splitlines() if line.startswith("hbao: warning:")]
+    assert sorted(warnings) == sorted([
+        "hbao: warning: --steps 500 is above the limit 64; using 64",
+        "hbao: warning: --directions 0 is below the limit 1; using 1",
+        "hbao: warning: --angle-bias 90 is above the limit 60; using 60",
+        "hbao: warning: --blur -3 is below the limit 0; using 0",
+        "hbao: warning: --strength 20 is above the limit 16; using 16"]), clamped.stderr
+    limits = compute_ao(hbao_tool, "cycles_float_zip", tmp_path / "limits.exr",
+                        "--steps", "64", "--directions", "1", "--angle-bias", "60",
+                        "--blur", "0", "--strength", "16")
+    assert limits.stderr == ""
+    # Same parameters after clamping, deterministic library: identical AO.
+    assert channels_by_name(info(hbao_tool, tmp_path / "clamped.exr"))["AO"] == \
+        channels_by_name(info(hbao_tool, tmp_path / "limits.exr"))["AO"]
 
 
 def test_missing_input_or_output_are_usage_errors(hbao_tool, tmp_path):

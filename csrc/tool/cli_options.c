@@ -2,6 +2,8 @@
 #include "cli_options.h"
 
 #include <float.h>
+#include <math.h>
+#include <stdint.h>
 #include <string.h>
 
 #include "number_parsing.h"
@@ -199,25 +201,27 @@ static int apply_option(const option_spec *spec, const char *value, cli_options 
         options->compression = (exr_compression_t)compression;
         break;
     }
+    /* AO parameters: only the syntax here; their limits are libhbao's
+     * (hbao_params_resolve, in resolve_params below). */
     case OPTION_RADIUS:
-        status = parse_float_flag(flag, value, 0.0f, FLT_MAX, false, &params->radius, error);
+        status = parse_float_flag(flag, value, -FLT_MAX, FLT_MAX, false, &params->radius, error);
         break;
     case OPTION_ANGLE_BIAS:
-        status = parse_float_flag(flag, value, 0.0f, HBAO_MAX_ANGLE_BIAS_DEGREES, false,
+        status = parse_float_flag(flag, value, -FLT_MAX, FLT_MAX, false,
                                   &params->angle_bias_degrees, error);
         break;
     case OPTION_DIRECTIONS:
-        status = parse_int_flag(flag, value, 1, HBAO_MAX_DIRECTIONS, &params->directions, error);
+        status = parse_int_flag(flag, value, INT32_MIN, INT32_MAX, &params->directions, error);
         break;
     case OPTION_STEPS:
-        status = parse_int_flag(flag, value, 1, HBAO_MAX_STEPS, &params->steps, error);
+        status = parse_int_flag(flag, value, INT32_MIN, INT32_MAX, &params->steps, error);
         break;
     case OPTION_BLUR:
-        status = parse_int_flag(flag, value, 0, HBAO_MAX_BLUR_SIZE, &params->blur_size, error);
+        status = parse_int_flag(flag, value, INT32_MIN, INT32_MAX, &params->blur_size, error);
         break;
     case OPTION_BLUR_SHARPNESS:
-        status = parse_float_flag(flag, value, 0.0f, HBAO_MAX_BLUR_SHARPNESS, false,
-                                  &params->blur_sharpness, error);
+        status = parse_float_flag(flag, value, -FLT_MAX, FLT_MAX, false, &params->blur_sharpness,
+                                  error);
         break;
     case OPTION_HALF_RES: params->half_resolution = 1; break;
     case OPTION_FALLOFF:
@@ -227,11 +231,11 @@ static int apply_option(const option_spec *spec, const char *value, cli_options 
         status = parse_choice(flag, value, integration_choices, &params->integration, error);
         break;
     case OPTION_STRENGTH:
-        status = parse_float_flag(flag, value, 0.0f, HBAO_MAX_STRENGTH, false, &params->strength,
+        status = parse_float_flag(flag, value, -FLT_MAX, FLT_MAX, false, &params->strength,
                                   error);
         break;
     case OPTION_THREADS:
-        status = parse_int_flag(flag, value, 0, HBAO_MAX_THREADS, &params->threads, error);
+        status = parse_int_flag(flag, value, INT32_MIN, INT32_MAX, &params->threads, error);
         break;
     case OPTION_CAMERA: options->camera_path = value; break;
     case OPTION_CAMERA_TYPE:
@@ -293,6 +297,63 @@ static int apply_option(const option_spec *spec, const char *value, cli_options 
     case OPTION_VERSION: break;
     }
     return status;
+}
+
+/* The flag of each hbao_params field the command line sets. */
+static const struct {
+    uint32_t field;
+    const char *flag;
+} param_flags[] = {
+    {HBAO_PARAM_FIELD_RADIUS, "radius"},
+    {HBAO_PARAM_FIELD_ANGLE_BIAS_DEGREES, "angle-bias"},
+    {HBAO_PARAM_FIELD_DIRECTIONS, "directions"},
+    {HBAO_PARAM_FIELD_STEPS, "steps"},
+    {HBAO_PARAM_FIELD_FALLOFF, "falloff"},
+    {HBAO_PARAM_FIELD_INTEGRATION, "integration"},
+    {HBAO_PARAM_FIELD_BLUR_SIZE, "blur"},
+    {HBAO_PARAM_FIELD_BLUR_SHARPNESS, "blur-sharpness"},
+    {HBAO_PARAM_FIELD_STRENGTH, "strength"},
+    {HBAO_PARAM_FIELD_THREADS, "threads"},
+};
+
+static double param_value(const hbao_params *params, uint32_t field)
+{
+    switch (field) {
+    case HBAO_PARAM_FIELD_RADIUS: return params->radius;
+    case HBAO_PARAM_FIELD_ANGLE_BIAS_DEGREES: return params->angle_bias_degrees;
+    case HBAO_PARAM_FIELD_DIRECTIONS: return params->directions;
+    case HBAO_PARAM_FIELD_STEPS: return params->steps;
+    case HBAO_PARAM_FIELD_BLUR_SIZE: return params->blur_size;
+    case HBAO_PARAM_FIELD_BLUR_SHARPNESS: return params->blur_sharpness;
+    case HBAO_PARAM_FIELD_STRENGTH: return params->strength;
+    case HBAO_PARAM_FIELD_THREADS: return params->threads;
+    default: return NAN;
+    }
+}
+
+/* The library decides (hbao_params_resolve): like the add-on, the tool
+ * clamps out-of-range values with one warning per value and goes on; only
+ * values with no nearest legal value (a negative radius) are refused. */
+static int resolve_params(hbao_params *params, tool_error *error)
+{
+    hbao_params resolved;
+    uint32_t fields = 0;
+    hbao_result result = hbao_params_resolve(params, &resolved, &fields);
+    for (size_t i = 0; i < sizeof param_flags / sizeof param_flags[0]; ++i) {
+        if (!(fields & param_flags[i].field)) continue;
+        const double given = param_value(params, param_flags[i].field);
+        if (result != HBAO_SUCCESS)
+            return tool_fail(error, TOOL_EXIT_USAGE, "--%s %g is not valid: %s",
+                             param_flags[i].flag, given, hbao_result_message(result));
+        const double limit = param_value(&resolved, param_flags[i].field);
+        tool_warn("--%s %g is %s the limit %g; using %g", param_flags[i].flag, given,
+                  given > limit ? "above" : "below", limit, limit);
+    }
+    if (result != HBAO_SUCCESS)
+        return tool_fail(error, TOOL_EXIT_USAGE, "invalid parameters: %s",
+                         hbao_result_message(result));
+    *params = resolved;
+    return TOOL_EXIT_SUCCESS;
 }
 
 static void options_init(cli_options *options)
@@ -381,7 +442,7 @@ int cli_parse(int argc, char **argv, cli_options *options, tool_error *error)
         return tool_fail(error, TOOL_EXIT_USAGE, "a file name is empty");
     if (options->preview_path != NULL && strcmp(options->preview_path, options->output_path) == 0)
         return tool_fail(error, TOOL_EXIT_USAGE, "--preview and -o name the same file");
-    return TOOL_EXIT_SUCCESS;
+    return resolve_params(&options->params, error);
 }
 
 void cli_print_help(FILE *stream)
@@ -422,8 +483,10 @@ void cli_print_help(FILE *stream)
 "                          the finite values and the count of non-finite ones.\n"
 "  --json                  with --info: print it as JSON.\n"
 "\n"
-"AO parameters (defaults from libhbao):\n"
-"  --radius R              AO radius in scene units (>= 0; default %g)\n"
+"AO parameters (defaults and limits from libhbao; a value outside its range is\n"
+"clamped to it, with a warning, as the Blender add-on does):\n"
+"  --radius R              AO radius in scene units (>= 0, else an error;\n"
+"                          default %g)\n"
 "  --angle-bias DEG        ignore occluders this far above the tangent plane\n"
 "                          [0, %g] (default %g)\n"
 "  --directions N          directions per pixel [1, %d] (default %d)\n"
@@ -437,7 +500,8 @@ void cli_print_help(FILE *stream)
 "                          quadratic (HBAO's 1 - (d/radius)^2 attenuation)\n"
 "  --integration I         cosine (default: what Cycles' AO pass measures) or hbao\n"
 "  --strength S            ao = ao^S, [0, %g] (default %g)\n"
-"  --threads N             worker threads [0, %d]; 0 = one per core (default)\n"
+"  --threads N             worker threads, at most %d; 0 (or less) = one per\n"
+"                          core (default)\n"
 "\n"
 "Camera (Blender's camera model and names; flags override --camera):\n"
 "  --camera FILE.json      JSON object with Blender's property names: type\n"
