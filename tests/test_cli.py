@@ -588,23 +588,36 @@ SLOW_SIZE = 512
 SLOW_RUN = ["--directions", "64", "--steps", "64", "--threads", "1"]
 
 
-@pytest.mark.parametrize("signal_number", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP])
-def test_signal_removes_the_temporary_files(hbao_tool, tmp_path, signal_number):
+def slow_input(path):
     y, x = np.mgrid[0:SLOW_SIZE, 0:SLOW_SIZE].astype(np.float32)
-    source = tmp_path / "big.exr"
-    source.write_bytes(scanline_exr({"Depth.Z": 5.0 + 0.01 * x + np.sin(y / 7.0)},
-                                    SLOW_SIZE, SLOW_SIZE))
+    path.write_bytes(scanline_exr({"Depth.Z": 5.0 + 0.01 * x + np.sin(y / 7.0)},
+                                  SLOW_SIZE, SLOW_SIZE))
+
+
+@pytest.mark.parametrize("signal_number, frames", [
+    (signal.SIGINT, 1), (signal.SIGTERM, 1), (signal.SIGHUP, 1),
+    # Two frames at once (--jobs 2): four temporary files, from two threads.
+    (signal.SIGTERM, 2)])
+def test_signal_removes_the_temporary_files(hbao_tool, tmp_path, signal_number, frames):
     outputs = tmp_path / "out"
     outputs.mkdir()
-    command = [str(hbao_tool), str(source), "-o", str(outputs / "ao.exr"),
-               "--preview", str(outputs / "ao.png")] + SLOW_RUN
+    if frames == 1:
+        slow_input(tmp_path / "big.exr")
+        command = [str(hbao_tool), str(tmp_path / "big.exr"), "-o", str(outputs / "ao.exr"),
+                   "--preview", str(outputs / "ao.png")] + SLOW_RUN
+    else:
+        for frame in range(1, frames + 1):
+            slow_input(tmp_path / f"big_{frame}.exr")
+        command = [str(hbao_tool), str(tmp_path / "big_#.exr"), "-o", str(outputs / "ao_#.exr"),
+                   "--preview", str(outputs / "ao_#.png"), "--frames", f"1-{frames}",
+                   "--jobs", str(frames)] + SLOW_RUN
     process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     try:
         deadline = time.monotonic() + TOOL_TIMEOUT_S
-        while len(leftover_temporary_files(outputs)) < 2 and process.poll() is None:
+        while len(leftover_temporary_files(outputs)) < 2 * frames and process.poll() is None:
             assert time.monotonic() < deadline
             time.sleep(0.005)
-        # Both temporary files existed while the tool was still running:
+        # All temporary files existed while the tool was still running:
         # otherwise the signal below would test nothing.
         assert process.poll() is None, "the run ended before it could be interrupted"
         process.send_signal(signal_number)
@@ -643,6 +656,83 @@ def test_unwritable_output_folder_is_an_error(hbao_tool, tmp_path):
     completed = run_tool(hbao_tool, fixture_path("cycles_float_zip"), "-o",
                          tmp_path / "no_such_folder" / "ao.exr")
     assert_clean_error(completed, EXIT_RUNTIME, "no_such_folder")
+
+
+# --- sequences -------------------------------------------------------------------
+
+def sequence_folder(tmp_path):
+    """Frames 1, 2, 4 are fixtures, 3 is truncated, 5 is missing."""
+    folder = tmp_path / "sequence"
+    folder.mkdir()
+    sources = {1: "cycles_float_zip", 2: "eevee_half", 4: "ortho_float"}
+    for frame, name in sources.items():
+        shutil.copyfile(fixture_path(name), folder / f"render_{frame:04d}.exr")
+    (folder / "render_0003.exr").write_bytes(fixture_path("cycles_float_zip").read_bytes()[:3000])
+    return folder, sources
+
+
+def run_sequence(tool, folder, *extra):
+    return run_tool(tool, folder / "render_####.exr", "-o", folder / "ao_####.exr",
+                    "--preview", folder / "ao_####.png", "--frames", "1-5", "--no-normals",
+                    *extra)
+
+
+def test_sequence_computes_every_frame_and_lists_the_failed_ones(hbao_tool, tmp_path):
+    folder, sources = sequence_folder(tmp_path)
+    completed = run_sequence(hbao_tool, folder, "--jobs", "2")
+    assert_clean_error(completed, EXIT_RUNTIME, "2 of 5 frames failed: 3, 5")
+    progress = [line for line in completed.stderr.splitlines() if line.startswith("hbao: [")]
+    assert len(progress) == 5 and all(f"[{k}/5]" in progress[k - 1] for k in range(1, 6))
+    assert sum("failed" in line for line in progress) == 2
+    # Each frame's output is what a single run on that frame writes, byte for
+    # byte (the library's result does not depend on the thread count).
+    for frame, name in sources.items():
+        single = tmp_path / f"single_{frame}.exr"
+        run_ok(hbao_tool, fixture_path(name), "-o", single, "--no-normals")
+        assert (folder / f"ao_{frame:04d}.exr").read_bytes() == single.read_bytes()
+        assert png_header(folder / f"ao_{frame:04d}.png")[2:] == (8, 0)
+    for frame in (3, 5):
+        assert not (folder / f"ao_{frame:04d}.exr").exists()
+        assert not (folder / f"ao_{frame:04d}.png").exists()
+    assert leftover_temporary_files(folder) == []
+
+
+def test_sequence_skips_up_to_date_frames(hbao_tool, tmp_path):
+    folder, sources = sequence_folder(tmp_path)
+    run_sequence(hbao_tool, folder)
+    written = {frame: os.stat(folder / f"ao_{frame:04d}.exr").st_mtime_ns for frame in sources}
+    again = run_sequence(hbao_tool, folder)
+    assert again.returncode == EXIT_RUNTIME  # frames 3 and 5 still fail
+    assert again.stderr.count("is up to date, skipped") == 3
+    assert {f: os.stat(folder / f"ao_{f:04d}.exr").st_mtime_ns for f in sources} == written
+    # A newer input makes its frame out of date; --force redoes them all.
+    later = written[2] + 10**9
+    os.utime(folder / "render_0002.exr", ns=(later, later))
+    touched = run_sequence(hbao_tool, folder)
+    assert touched.stderr.count("is up to date, skipped") == 2
+    assert "frame 2: " in touched.stderr and os.stat(folder / "ao_0002.exr").st_mtime_ns != \
+        written[2]
+    forced = run_sequence(hbao_tool, folder, "--force")
+    assert "is up to date" not in forced.stderr
+    assert leftover_temporary_files(folder) == []
+
+
+@pytest.mark.parametrize("arguments, fragment", [
+    (["in_####.exr", "-o", "ao.exr", "--frames", "1-3"], "-o (ao.exr) needs a '#'"),
+    (["in.exr", "-o", "ao_#.exr", "--frames", "1-3"], "the input (in.exr) needs a '#'"),
+    (["in_#.exr", "-o", "ao_#.exr", "--preview", "p.png", "--frames", "1"], "--preview"),
+    (["in_#.exr", "-o", "ao_#.exr", "--frames", "3-1"], "--frames"),
+    (["in_#.exr", "-o", "ao_#.exr", "--frames", "-1"], "--frames"),
+    (["in_#.exr", "-o", "ao_#.exr", "--frames", "1-2,"], "--frames"),
+    (["in_#.exr", "-o", "ao_#.exr", "--frames", "1-5,5-7"], "none twice"),
+    (["in_#.exr", "-o", "ao_#.exr", "--frames", "1-2", "--jobs", "0"], "--jobs"),
+    (["in.exr", "-o", "ao.exr", "--jobs", "2"], "go with --frames"),
+    (["in.exr", "-o", "ao.exr", "--force"], "go with --frames"),
+    (["--info", "in_#.exr", "--frames", "1"], "drop --frames"),
+])
+def test_bad_sequence_flags_are_usage_errors(hbao_tool, tmp_path, arguments, fragment):
+    completed = run_tool(hbao_tool, *arguments)
+    assert_clean_error(completed, EXIT_USAGE, fragment)
 
 
 # --- command line --------------------------------------------------------------

@@ -3,6 +3,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <pthread.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -18,7 +19,7 @@
  * before their flag was set (with the signals blocked), unlinks them and
  * re-raises the signal with its default action. */
 
-#define CLEANUP_SLOTS 4 /* the tool has at most two outputs open at once */
+#define CLEANUP_SLOTS ATOMIC_FILE_MAX_OPEN
 
 static const int cleanup_signals[] = {SIGINT, SIGTERM, SIGHUP};
 #define CLEANUP_SIGNAL_COUNT (int)(sizeof cleanup_signals / sizeof cleanup_signals[0])
@@ -26,6 +27,9 @@ static const int cleanup_signals[] = {SIGINT, SIGTERM, SIGHUP};
 static char cleanup_paths[CLEANUP_SLOTS][PATH_MAX];
 static volatile sig_atomic_t cleanup_active[CLEANUP_SLOTS];
 static bool handlers_installed;
+/* Frames of a sequence write their outputs from several threads: the slots,
+ * the handler installation and the umask() probe take turns. */
+static pthread_mutex_t slots_lock = PTHREAD_MUTEX_INITIALIZER;
 
 static void remove_temporary_files(int signal_number)
 {
@@ -38,9 +42,13 @@ static void remove_temporary_files(int signal_number)
     raise(signal_number);
 }
 
-static void install_handlers(void)
+void atomic_file_install_signal_handlers(void)
 {
-    if (handlers_installed) return;
+    pthread_mutex_lock(&slots_lock);
+    if (handlers_installed) {
+        pthread_mutex_unlock(&slots_lock);
+        return;
+    }
     handlers_installed = true;
     for (int i = 0; i < CLEANUP_SIGNAL_COUNT; ++i) {
         struct sigaction previous;
@@ -54,21 +62,40 @@ static void install_handlers(void)
         sigfillset(&action.sa_mask); /* one handler at a time */
         sigaction(cleanup_signals[i], &action, NULL);
     }
+    pthread_mutex_unlock(&slots_lock);
 }
 
 /* Creating, renaming and unlinking a temporary file happen with the cleanup
  * signals blocked, so that the handler never misses a file that exists nor
  * sees a half-written path. */
-static void block_cleanup_signals(sigset_t *previous)
+void atomic_file_block_signals(sigset_t *previous)
 {
     sigset_t blocked;
     sigemptyset(&blocked);
     for (int i = 0; i < CLEANUP_SIGNAL_COUNT; ++i) sigaddset(&blocked, cleanup_signals[i]);
-    sigprocmask(SIG_BLOCK, &blocked, previous);
+    pthread_sigmask(SIG_BLOCK, &blocked, previous);
 }
 
-static void restore_signals(const sigset_t *previous) { sigprocmask(SIG_SETMASK, previous, NULL); }
+void atomic_file_restore_signals(const sigset_t *previous)
+{
+    pthread_sigmask(SIG_SETMASK, previous, NULL);
+}
 
+static void block_cleanup_signals(sigset_t *previous)
+{
+    atomic_file_block_signals(previous);
+    pthread_mutex_lock(&slots_lock);
+}
+
+static void restore_signals(const sigset_t *previous)
+{
+    pthread_mutex_unlock(&slots_lock);
+    atomic_file_restore_signals(previous);
+}
+
+/* Called with the slots locked. With no free slot the file is still
+ * written, only not removed by a signal; ATOMIC_FILE_MAX_OPEN is sized so
+ * that this does not happen. */
 static int claim_cleanup_slot(const char *path)
 {
     for (int s = 0; s < CLEANUP_SLOTS; ++s) {
@@ -170,7 +197,7 @@ int atomic_file_begin(atomic_file *file, const char *destination, tool_error *er
     file->fd = -1;
     file->cleanup_slot = -1;
     file->name = destination;
-    install_handlers();
+    atomic_file_install_signal_handlers();
 
     /* What the name finally points to decides how it is written. stat()
      * follows links as open() would, also the kernel's magic ones
@@ -203,9 +230,13 @@ int atomic_file_begin(atomic_file *file, const char *destination, tool_error *er
     file->active = true;
     if (file->write_through) return TOOL_EXIT_SUCCESS;
     /* mkstemp creates 0600; give the result the permissions a plain
-     * open(O_CREAT, 0666) would have. */
+     * open(O_CREAT, 0666) would have. umask() can only be read by setting
+     * it, so other threads must not create files meanwhile. */
+    sigset_t previous;
+    block_cleanup_signals(&previous);
     mode_t mask = umask(0);
     umask(mask);
+    restore_signals(&previous);
     if (fchmod(file->fd, 0666 & ~mask) != 0) {
         int saved = errno;
         atomic_file_abort(file);

@@ -18,12 +18,16 @@
  * - a directory, a block device or a socket: refused (TOOL_EXIT_USAGE).
  *
  * SIGINT, SIGTERM and SIGHUP while a temporary file exists remove it, then
- * end the process by the same signal (so its exit status says so).
+ * end the process by the same signal (so its exit status says so). Several
+ * threads may write files at once (the frames of a sequence): then only the
+ * main thread should take the signals (atomic_file_block_signals() in the
+ * others).
  */
 #ifndef HBAO_TOOL_ATOMIC_FILE_H
 #define HBAO_TOOL_ATOMIC_FILE_H
 
 #include <limits.h>
+#include <signal.h>
 #include <stdbool.h>
 
 #include "tool_error.h"
@@ -31,6 +35,10 @@
 #ifndef PATH_MAX
 #define PATH_MAX 4096
 #endif
+
+/** How many temporary files may exist at once and still be removed by a
+ *  signal: two outputs (EXR, PNG) for each frame being computed. */
+#define ATOMIC_FILE_MAX_OPEN 64
 
 typedef struct atomic_file {
     int fd;                          /**< open on the temporary file; -1 once closed */
@@ -56,5 +64,14 @@ int atomic_file_commit(atomic_file *file, tool_error *error);
 
 /** Remove the temporary file (no-op when nothing is pending). */
 void atomic_file_abort(atomic_file *file);
+
+/** Install the signal handlers now (atomic_file_begin() does it too): call
+ *  before starting threads that write files. */
+void atomic_file_install_signal_handlers(void);
+
+/** Block (and restore) the signals that remove temporary files, in the
+ *  calling thread: threads started in between inherit the block. */
+void atomic_file_block_signals(sigset_t *previous);
+void atomic_file_restore_signals(const sigset_t *previous);
 
 #endif /* HBAO_TOOL_ATOMIC_FILE_H */

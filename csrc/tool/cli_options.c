@@ -39,6 +39,9 @@ typedef enum option_id {
     OPTION_PIXEL_ASPECT_X,
     OPTION_PIXEL_ASPECT_Y,
     OPTION_WORLD_TO_CAMERA,
+    OPTION_FRAMES,
+    OPTION_JOBS,
+    OPTION_FORCE,
     OPTION_INFO,
     OPTION_JSON,
     OPTION_HELP,
@@ -83,6 +86,9 @@ static const option_spec option_specs[] = {
     {"pixel-aspect-x", 0, OPTION_PIXEL_ASPECT_X, true},
     {"pixel-aspect-y", 0, OPTION_PIXEL_ASPECT_Y, true},
     {"world-to-camera", 0, OPTION_WORLD_TO_CAMERA, true},
+    {"frames", 0, OPTION_FRAMES, true},
+    {"jobs", 'j', OPTION_JOBS, true},
+    {"force", 0, OPTION_FORCE, false},
     {"info", 0, OPTION_INFO, false},
     {"json", 0, OPTION_JSON, false},
     {"help", 'h', OPTION_HELP, false},
@@ -291,6 +297,17 @@ static int apply_option(const option_spec *spec, const char *value, cli_options 
                              value);
         flags->fields_set |= CAMERA_FIELD_WORLD_TO_CAMERA;
         break;
+    case OPTION_FRAMES:
+        if (!frame_list_parse(value, &options->frames))
+            return tool_fail(error, TOOL_EXIT_USAGE,
+                             "--frames: \"%s\" is not a frame list like 1-250 or 1-10,20 "
+                             "(frames in [0, %d], at most %d ranges, none twice)",
+                             value, FRAME_MAX, FRAME_RANGES_MAX);
+        break;
+    case OPTION_JOBS:
+        status = parse_int_flag(flag, value, 1, CLI_MAX_JOBS, &options->jobs, error);
+        break;
+    case OPTION_FORCE: options->force = true; break;
     case OPTION_INFO: options->mode = TOOL_MODE_INFO; break;
     case OPTION_JSON: options->info_json = true; break;
     case OPTION_HELP: /* handled after parsing */ break;
@@ -362,6 +379,7 @@ static void options_init(cli_options *options)
     options->mode = TOOL_MODE_COMPUTE;
     options->compression = EXR_COMPRESSION_ZIP;
     options->ao_channel = "AO";
+    options->jobs = 1;
     hbao_params defaults = HBAO_PARAMS_DEFAULT_INITIALIZER;
     options->params = defaults;
     camera_settings_init(&options->camera_flags);
@@ -427,11 +445,15 @@ int cli_parse(int argc, char **argv, cli_options *options, tool_error *error)
     if (options->input_path == NULL)
         return tool_fail(error, TOOL_EXIT_USAGE, "no input file (usage: hbao INPUT.exr -o "
                                                  "OUTPUT.exr [options]; see hbao --help)");
+    const bool sequence = options->frames.range_count > 0;
     if (options->mode == TOOL_MODE_INFO) {
         if (options->output_path != NULL || options->preview_path != NULL)
             return tool_fail(error, TOOL_EXIT_USAGE, "--info writes nothing: drop -o/--preview");
+        if (sequence) return tool_fail(error, TOOL_EXIT_USAGE, "--info reads one file: drop --frames");
         return TOOL_EXIT_SUCCESS;
     }
+    if (!sequence && (options->jobs != 1 || options->force))
+        return tool_fail(error, TOOL_EXIT_USAGE, "--jobs and --force go with --frames");
     if (options->info_json)
         return tool_fail(error, TOOL_EXIT_USAGE, "--json only goes with --info");
     if (options->output_path == NULL)
@@ -442,6 +464,19 @@ int cli_parse(int argc, char **argv, cli_options *options, tool_error *error)
         return tool_fail(error, TOOL_EXIT_USAGE, "a file name is empty");
     if (options->preview_path != NULL && strcmp(options->preview_path, options->output_path) == 0)
         return tool_fail(error, TOOL_EXIT_USAGE, "--preview and -o name the same file");
+    if (sequence) {
+        /* Each frame needs its own files: a name without '#' would be
+         * read (or overwritten) by every frame. */
+        const char *paths[] = {options->input_path, options->output_path, options->preview_path};
+        const char *flags[] = {"the input", "-o", "--preview"};
+        for (int p = 0; p < 3; ++p)
+            if (paths[p] != NULL && !frame_pattern_has_frame(paths[p]))
+                return tool_fail(error, TOOL_EXIT_USAGE,
+                                 "with --frames, %s (%s) needs a '#' run for the frame number, "
+                                 "e.g. render_####.exr",
+                                 flags[p], paths[p]);
+        options->mode = TOOL_MODE_SEQUENCE;
+    }
     return resolve_params(&options->params, error);
 }
 
@@ -530,6 +565,22 @@ void cli_print_help(FILE *stream)
 "                          unless the camera sits at the origin looking down -Z, so\n"
 "                          the tool warns; pass the matrix or --no-normals.\n"
 "\n"
+"Sequences:\n"
+"  --frames LIST           compute every frame of LIST (1-250, or 1-10,20,30-40;\n"
+"                          frames in [0, %d]). The input, -o and --preview names\n"
+"                          must hold a run of '#', replaced by the frame number\n"
+"                          zero-padded to the run's length, as Blender names\n"
+"                          frames: hbao 'render_####.exr' -o 'ao_####.exr'\n"
+"                          --frames 1-250. An output at least as new as its input\n"
+"                          (and --camera file) is up to date and skipped. One\n"
+"                          progress line per frame; every frame is attempted, and\n"
+"                          the exit status is 1 (2 for a usage error in a frame)\n"
+"                          when any failed, with the list of failed frames.\n"
+"  -j, --jobs N            frames computed at once [1, %d] (default 1); without\n"
+"                          --threads, each frame gets cores / N threads\n"
+"  --force                 recompute frames that are up to date (changed flags\n"
+"                          are not detected)\n"
+"\n"
 "Data window: the tool works on the EXR's data window and writes the output with\n"
 "the same data and display windows; when the data window is a part of the\n"
 "display window, the camera is adjusted to that part (same view rays). Blender\n"
@@ -547,5 +598,5 @@ void cli_print_help(FILE *stream)
             HBAO_DEFAULT_DIRECTIONS, HBAO_MAX_STEPS, HBAO_DEFAULT_STEPS, HBAO_MAX_BLUR_SIZE,
             HBAO_DEFAULT_BLUR_SIZE, (double)HBAO_MAX_BLUR_SHARPNESS,
             (double)HBAO_DEFAULT_BLUR_SHARPNESS, (double)HBAO_MAX_STRENGTH,
-            (double)HBAO_DEFAULT_STRENGTH, HBAO_MAX_THREADS);
+            (double)HBAO_DEFAULT_STRENGTH, HBAO_MAX_THREADS, FRAME_MAX, CLI_MAX_JOBS);
 }
