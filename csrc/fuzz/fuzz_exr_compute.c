@@ -15,16 +15,18 @@
 
 /* Small settings keep an execution short; the size of the input picks one
  * of four variants so that each of the library's paths (half resolution,
- * blur, both integrations and falloffs) gets inputs. */
+ * blur, both integrations and falloffs) gets inputs. The blur is small and
+ * in two variants only: instrumented for coverage, its per-tap comparisons
+ * took a third of the time. */
 static char *variants[4][20] = {
     {"hbao", "IN", "-o", "unused.exr", "--directions", "2", "--steps", "3", "--threads", "1",
-     NULL},
+     "--blur", "0", NULL},
     {"hbao", "IN", "-o", "unused.exr", "--directions", "3", "--steps", "2", "--threads", "1",
-     "--half-res", "--integration", "hbao", NULL},
+     "--half-res", "--integration", "hbao", "--blur", "3", NULL},
     {"hbao", "IN", "-o", "unused.exr", "--directions", "1", "--steps", "4", "--threads", "1",
      "--falloff", "quadratic", "--blur", "0", "--no-normals", NULL},
     {"hbao", "IN", "-o", "unused.exr", "--directions", "2", "--steps", "2", "--threads", "1",
-     "--blur", "9", "--strength", "3", "--angle-bias", "0", NULL},
+     "--blur", "3", "--strength", "3", "--angle-bias", "0", NULL},
 };
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
