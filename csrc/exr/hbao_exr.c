@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
 /*
- * libhbao_exr: the hbao tool's OpenEXRCore reader (csrc/tool/exr_reader.c,
- * compiled once into an object library both targets link) behind a small
+ * libhbao_exr: the OpenEXRCore reader that the hbao tool also uses
+ * (exr_reader.c, compiled once into an object library both targets link) behind a small
  * interface that ctypes can call: plain C types, caller-owned buffers, a
  * result code and a message in the caller's buffer.
  */

@@ -98,7 +98,8 @@ typedef enum hbao_falloff {
 } hbao_falloff;
 
 /** Documented limits. Values outside them are clamped (counts, sizes) or
- *  rejected with HBAO_ERROR_INVALID_PARAMETER (NaN, negative radius). */
+ *  rejected with HBAO_ERROR_INVALID_PARAMETER (NaN, negative radius); see
+ *  hbao_params_resolve(), the one place that applies them. */
 #define HBAO_MAX_DIRECTIONS 64
 #define HBAO_MAX_STEPS 64
 #define HBAO_MAX_BLUR_SIZE 65
@@ -138,7 +139,8 @@ typedef struct hbao_params {
     /** Applied last: ao = ao^strength. 0 = no AO, 1 = as computed, larger =
      *  darker. Clamped to [0, 16]. */
     float strength;
-    /** Worker threads; 0 = one per available core. Clamped to [1, 256]. */
+    /** Worker threads; 0 (or less) = one per available core. Clamped to at
+     *  most 256. */
     int32_t threads;
     /** Depths at or beyond this are background. Must be > 0. */
     float background_depth;
@@ -228,6 +230,49 @@ typedef struct hbao_channel {
                                (>= 3 for normals) */
     int64_t row_stride;   /**< floats from one row to the row below it */
 } hbao_channel;
+
+/** The fields of hbao_params in struct order, each with its bit in
+ *  hbao_params_resolve()'s report and its name (the struct member's). */
+#define HBAO_PARAM_FIELD_LIST(X)                                               \
+    X(HBAO_PARAM_FIELD_RADIUS, 0, "radius")                                    \
+    X(HBAO_PARAM_FIELD_ANGLE_BIAS_DEGREES, 1, "angle_bias_degrees")            \
+    X(HBAO_PARAM_FIELD_DIRECTIONS, 2, "directions")                            \
+    X(HBAO_PARAM_FIELD_STEPS, 3, "steps")                                      \
+    X(HBAO_PARAM_FIELD_FALLOFF, 4, "falloff")                                  \
+    X(HBAO_PARAM_FIELD_INTEGRATION, 5, "integration")                          \
+    X(HBAO_PARAM_FIELD_BLUR_SIZE, 6, "blur_size")                              \
+    X(HBAO_PARAM_FIELD_BLUR_SHARPNESS, 7, "blur_sharpness")                    \
+    X(HBAO_PARAM_FIELD_HALF_RESOLUTION, 8, "half_resolution")                  \
+    X(HBAO_PARAM_FIELD_STRENGTH, 9, "strength")                                \
+    X(HBAO_PARAM_FIELD_THREADS, 10, "threads")                                 \
+    X(HBAO_PARAM_FIELD_BACKGROUND_DEPTH, 11, "background_depth")               \
+    X(HBAO_PARAM_FIELD_IMPLEMENTATION, 12, "implementation")
+
+typedef enum hbao_param_field {
+#define HBAO_PARAM_FIELD_ENUM_ENTRY(name, bit, text) name = 1u << (bit),
+    HBAO_PARAM_FIELD_LIST(HBAO_PARAM_FIELD_ENUM_ENTRY)
+#undef HBAO_PARAM_FIELD_ENUM_ENTRY
+} hbao_param_field;
+
+/**
+ * The parameters hbao_compute() will use for `in`: every limit above
+ * applied in one place, which every front end (the CLI, the add-on) calls so
+ * that they agree with the library. Out-of-range values are clamped to the
+ * nearest limit and their bits (hbao_param_field) set in *clamped_fields, so
+ * the caller can warn; negative threads become 0 (one per core) and a
+ * non-zero half_resolution becomes 1, without a bit. Values that have no
+ * nearest legal value (NaN or infinite floats, a negative radius, a
+ * background_depth <= 0, unknown enum values) give
+ * HBAO_ERROR_INVALID_PARAMETER, and then *clamped_fields holds the bits of
+ * those invalid fields instead and *out is unchanged. `out` may be `in`;
+ * clamped_fields may be NULL.
+ */
+HBAO_EXPORT hbao_result hbao_params_resolve(const hbao_params *in, hbao_params *out,
+                                            uint32_t *clamped_fields);
+
+/** The name of one hbao_param_field bit ("steps", ...), or NULL for a value
+ *  that is not exactly one field's bit. */
+HBAO_EXPORT const char *hbao_param_field_name(uint32_t bit);
 
 /** Packed HBAO_VERSION of the library that is loaded. */
 HBAO_EXPORT int32_t hbao_version(void);

@@ -7,6 +7,34 @@
 
 static int finite_positive(float value) { return isfinite(value) && value > 0.0f; }
 
+/* The rotation part (upper-left 3x3) maps normals into the camera; only its
+ * direction matters, the normals are renormalised after it. So the test is
+ * scale-free: |det| / (product of the row lengths) is 1 for orthogonal rows
+ * (any rotation, at any uniform scale) and 0 for a singular matrix (Hadamard's
+ * inequality). Below MIN_HADAMARD_RATIO the rows are dependent to within
+ * float precision (1.2e-7) and the normals they give are noise. */
+#define MIN_HADAMARD_RATIO 1e-6
+/* The normal transform runs in float: a row length outside these bounds
+ * makes the squared length of a transformed unit normal underflow to zero
+ * or overflow (float's range is 1.2e-38 .. 3.4e38, squares double the
+ * exponent), so such matrices are refused rather than silently ignored. */
+#define MIN_ROW_LENGTH 1e-15
+#define MAX_ROW_LENGTH 1e15
+
+static int rotation_part_is_invertible(const float *m) {
+    double row_length_product = 1.0;
+    for (int r = 0; r < 3; r++) {
+        const double length = sqrt((double)m[4 * r] * m[4 * r] + (double)m[4 * r + 1] * m[4 * r + 1] +
+                                   (double)m[4 * r + 2] * m[4 * r + 2]);
+        if (!(length >= MIN_ROW_LENGTH && length <= MAX_ROW_LENGTH)) return 0;
+        row_length_product *= length;
+    }
+    const double determinant = (double)m[0] * ((double)m[5] * m[10] - (double)m[6] * m[9]) -
+                               (double)m[1] * ((double)m[4] * m[10] - (double)m[6] * m[8]) +
+                               (double)m[2] * ((double)m[4] * m[9] - (double)m[5] * m[8]);
+    return fabs(determinant) / row_length_product >= MIN_HADAMARD_RATIO;
+}
+
 hbao_result hbao_validate_camera(const hbao_camera *camera) {
     if (camera->projection != HBAO_PROJECTION_PERSPECTIVE &&
         camera->projection != HBAO_PROJECTION_ORTHOGRAPHIC)
@@ -26,12 +54,7 @@ hbao_result hbao_validate_camera(const hbao_camera *camera) {
     const float *m = camera->world_to_camera;
     for (int k = 0; k < 16; k++)
         if (!isfinite(m[k])) return HBAO_ERROR_INVALID_CAMERA;
-    /* The rotation part maps normals; a singular one would turn every normal
-     * into nothing. */
-    const double determinant = (double)m[0] * ((double)m[5] * m[10] - (double)m[6] * m[9]) -
-                               (double)m[1] * ((double)m[4] * m[10] - (double)m[6] * m[8]) +
-                               (double)m[2] * ((double)m[4] * m[9] - (double)m[5] * m[8]);
-    if (!(fabs(determinant) > 1e-12)) return HBAO_ERROR_INVALID_CAMERA;
+    if (!rotation_part_is_invertible(m)) return HBAO_ERROR_INVALID_CAMERA;
     return HBAO_SUCCESS;
 }
 

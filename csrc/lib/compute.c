@@ -1,51 +1,32 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
-/* hbao_compute(): argument checks, parameter clamping and the pipeline. */
+/* hbao_compute(): argument checks and the pipeline. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "internal_hbao.h"
 
-static int clamp_int(int value, int low, int high) {
-    return value < low ? low : (value > high ? high : value);
-}
-
-static float clamp_float(float value, float low, float high) {
-    return value < low ? low : (value > high ? high : value);
-}
-
+/* The limits are hbao_params_resolve()'s (params.c); this only derives the
+ * pipeline's settings from the resolved values. */
 static hbao_result make_settings(const hbao_params *params, hbao_settings *s) {
-    if (!isfinite(params->radius) || params->radius < 0.0f || !isfinite(params->angle_bias_degrees) ||
-        !isfinite(params->blur_sharpness) || !isfinite(params->strength) ||
-        isnan(params->background_depth) || !(params->background_depth > 0.0f))
-        return HBAO_ERROR_INVALID_PARAMETER;
-    if (params->falloff != HBAO_FALLOFF_QUADRATIC && params->falloff != HBAO_FALLOFF_NONE)
-        return HBAO_ERROR_INVALID_PARAMETER;
-    if (params->integration != HBAO_INTEGRATION_HBAO &&
-        params->integration != HBAO_INTEGRATION_COSINE)
-        return HBAO_ERROR_INVALID_PARAMETER;
-    if (params->implementation < HBAO_IMPLEMENTATION_AUTO ||
-        params->implementation > HBAO_IMPLEMENTATION_AVX512)
-        return HBAO_ERROR_INVALID_PARAMETER;
-    s->radius = params->radius;
-    const float bias_degrees =
-        clamp_float(params->angle_bias_degrees, 0.0f, HBAO_MAX_ANGLE_BIAS_DEGREES);
-    s->bias_rad = bias_degrees * (HBAO_PI / 180.0f);
+    hbao_params p;
+    const hbao_result resolved = hbao_params_resolve(params, &p, NULL);
+    if (resolved != HBAO_SUCCESS) return resolved;
+    s->radius = p.radius;
+    s->bias_rad = p.angle_bias_degrees * (HBAO_PI / 180.0f);
     s->sin_bias = sinf(s->bias_rad);
     s->cos_bias = cosf(s->bias_rad);
-    s->directions = clamp_int(params->directions, 1, HBAO_MAX_DIRECTIONS);
-    s->steps = clamp_int(params->steps, 1, HBAO_MAX_STEPS);
-    s->falloff = params->falloff;
-    s->integration = params->integration;
-    const int blur_size = clamp_int(params->blur_size, 0, HBAO_MAX_BLUR_SIZE);
-    s->blur_radius = blur_size >= 2 ? (blur_size - 1) / 2 : 0;
-    s->blur_sharpness = clamp_float(params->blur_sharpness, 0.0f, HBAO_MAX_BLUR_SHARPNESS);
-    s->half_resolution = params->half_resolution != 0;
-    s->strength = clamp_float(params->strength, 0.0f, HBAO_MAX_STRENGTH);
-    s->threads = params->threads <= 0 ? hbao_available_cores()
-                                      : clamp_int(params->threads, 1, HBAO_MAX_THREADS);
-    s->background_depth = params->background_depth;
-    s->implementation = params->implementation;
+    s->directions = p.directions;
+    s->steps = p.steps;
+    s->falloff = p.falloff;
+    s->integration = p.integration;
+    s->blur_radius = p.blur_size >= 2 ? (p.blur_size - 1) / 2 : 0;
+    s->blur_sharpness = p.blur_sharpness;
+    s->half_resolution = p.half_resolution;
+    s->strength = p.strength;
+    s->threads = p.threads == 0 ? hbao_available_cores() : p.threads;
+    s->background_depth = p.background_depth;
+    s->implementation = p.implementation;
     return HBAO_SUCCESS;
 }
 

@@ -24,6 +24,26 @@ static void fill_inputs(void) {
     }
 }
 
+/* One clampable field: set below (high = 0) or above (high = 1) its range,
+ * and read back. */
+#define FIELD_CASES(X)                                                                        \
+    X(HBAO_PARAM_FIELD_ANGLE_BIAS_DEGREES, angle_bias_degrees, -5.0f, 90.0f, 0.0,              \
+      HBAO_MAX_ANGLE_BIAS_DEGREES)                                                            \
+    X(HBAO_PARAM_FIELD_DIRECTIONS, directions, 0, 1000, 1, HBAO_MAX_DIRECTIONS)               \
+    X(HBAO_PARAM_FIELD_STEPS, steps, -7, 500, 1, HBAO_MAX_STEPS)                              \
+    X(HBAO_PARAM_FIELD_BLUR_SIZE, blur_size, -1, 99, 0, HBAO_MAX_BLUR_SIZE)                   \
+    X(HBAO_PARAM_FIELD_BLUR_SHARPNESS, blur_sharpness, -1.0f, 1e6f, 0.0,                      \
+      HBAO_MAX_BLUR_SHARPNESS)                                                                \
+    X(HBAO_PARAM_FIELD_STRENGTH, strength, -0.5f, 17.0f, 0.0, HBAO_MAX_STRENGTH)
+
+#define FIELD_ACCESSORS(bit, member, low_value, high_value, low_limit, high_limit)            \
+    static void set_##member(hbao_params *p, int high) {                                      \
+        p->member = high ? (high_value) : (low_value);                                        \
+    }                                                                                         \
+    static double get_##member(const hbao_params *p) { return (double)p->member; }
+FIELD_CASES(FIELD_ACCESSORS)
+#undef FIELD_ACCESSORS
+
 static hbao_result compute_with(const hbao_params *p, const hbao_camera *c) {
     hbao_channel d = {depth, 1, W};
     return hbao_compute(p, c, W, H, &d, NULL, ao, W);
@@ -132,6 +152,157 @@ TEST_CASE(invalid_cameras_are_rejected) {
     CHECK_RESULT(compute_with(&p, &c), HBAO_SUCCESS);
 }
 
+/* AO of the W x H test plane with given normals (all tilted, so that the
+ * matrix matters) under camera c. */
+static hbao_result compute_with_normals(const hbao_camera *c, float *out) {
+    hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+    p.threads = 1;
+    hbao_channel d = {depth, 1, W};
+    hbao_channel n = {normal, 3, 3 * W};
+    for (int k = 0; k < W * H; k++) {
+        normal[3 * k] = 0.6f;
+        normal[3 * k + 1] = 0.0f;
+        normal[3 * k + 2] = 0.8f;
+    }
+    return hbao_compute(&p, c, W, H, &d, &n, out, W);
+}
+
+/* Issue 13: a rotation scaled by 1e-5 is invertible and must be accepted;
+ * only the matrix's direction matters, so the AO is that of the unscaled
+ * rotation up to the float rounding of the renormalised normals. */
+TEST_CASE(world_to_camera_check_is_scale_free) {
+    fill_inputs();
+    /* A rotation by 30 degrees about Y. */
+    const float cosine = 0.8660254f, sine = 0.5f;
+    const float rotation[16] = {cosine, 0, sine, 0, 0, 1, 0, 0, -sine, 0, cosine, 0, 0, 0, 0, 1};
+    hbao_camera c = HBAO_CAMERA_DEFAULT_INITIALIZER;
+    static float reference[W * H], scaled_ao[W * H];
+    memcpy(c.world_to_camera, rotation, sizeof rotation);
+    CHECK_RESULT(compute_with_normals(&c, reference), HBAO_SUCCESS);
+    const float scales[] = {1e-5f, 1e-12f, 1e5f, 1e12f};
+    for (size_t s = 0; s < sizeof scales / sizeof scales[0]; s++) {
+        for (int k = 0; k < 12; k++) c.world_to_camera[k] = rotation[k] * scales[s];
+        CHECK_RESULT(compute_with_normals(&c, scaled_ao), HBAO_SUCCESS);
+        /* Scaling changes each normal by a few float ulps (2^-24 relative)
+         * before renormalising; AO moves by a small multiple of that. 1e-5
+         * is far above it and far below an 8-bit step (3.9e-3). */
+        double worst = 0.0;
+        for (int k = 0; k < W * H; k++) worst = fmax(worst, fabs(scaled_ao[k] - reference[k]));
+        CHECK_NEAR(worst, 0.0, 1e-5);
+    }
+    /* Singular: two equal rows, a zero row, the zero matrix; at any scale. */
+    const float singular_rows[3][12] = {
+        {1, 0, 0, 0, 1, 0, 0, 0, 0, 0, 1, 0},
+        {1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 0},
+        {1e-5f, 0, 0, 0, 0, 1e-5f, 0, 0, 1e-5f, 1e-5f, 0, 0},
+    };
+    for (int m = 0; m < 3; m++) {
+        memcpy(c.world_to_camera, singular_rows[m], sizeof singular_rows[m]);
+        CHECK_RESULT(compute_with_normals(&c, scaled_ao), HBAO_ERROR_INVALID_CAMERA);
+    }
+    /* Beyond float's range for the normal transform (camera.c's row limits). */
+    for (int k = 0; k < 12; k++) c.world_to_camera[k] = rotation[k] * 1e-20f;
+    CHECK_RESULT(compute_with_normals(&c, scaled_ao), HBAO_ERROR_INVALID_CAMERA);
+}
+
+/* hbao_params_resolve(): each out-of-range field comes back at its limit,
+ * with its bit and no other; exact, the limits are constants. */
+TEST_CASE(params_resolve_clamps_each_field_and_names_it) {
+    const hbao_params defaults = HBAO_PARAMS_DEFAULT_INITIALIZER;
+    hbao_params in = defaults, out;
+    uint32_t fields = 0xffffffffu;
+    CHECK_RESULT(hbao_params_resolve(&in, &out, &fields), HBAO_SUCCESS);
+    CHECK(fields == 0);
+    CHECK(memcmp(&in, &out, sizeof in) == 0);
+
+    struct {
+        uint32_t field;
+        void (*set)(hbao_params *, int high);
+        double (*get)(const hbao_params *);
+        double low_limit, high_limit;
+    } cases[] = {
+#define FIELD_CASE(bit, member, low_value, high_value, low_limit, high_limit)                  \
+    {bit, set_##member, get_##member, low_limit, high_limit},
+        FIELD_CASES(FIELD_CASE)
+#undef FIELD_CASE
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        for (int high = 0; high <= 1; high++) {
+            in = defaults;
+            cases[k].set(&in, high);
+            fields = 0;
+            CHECK_RESULT(hbao_params_resolve(&in, &out, &fields), HBAO_SUCCESS);
+            CHECK(fields == cases[k].field);
+            CHECK(cases[k].get(&out) == (high ? cases[k].high_limit : cases[k].low_limit));
+            /* the other fields are untouched */
+            cases[k].set(&out, high);
+            CHECK(memcmp(&in, &out, sizeof in) == 0);
+        }
+        CHECK(hbao_param_field_name(cases[k].field) != NULL);
+    }
+    /* Several at once; `out` may be `in`. */
+    in = defaults;
+    in.steps = 500;
+    in.blur_size = -3;
+    CHECK_RESULT(hbao_params_resolve(&in, &in, &fields), HBAO_SUCCESS);
+    CHECK(fields == (HBAO_PARAM_FIELD_STEPS | HBAO_PARAM_FIELD_BLUR_SIZE));
+    CHECK(in.steps == HBAO_MAX_STEPS && in.blur_size == 0);
+    /* Threads have only an upper limit: negative means "one per core", like
+     * 0, and needs no warning. */
+    in = defaults;
+    in.threads = 100000;
+    CHECK_RESULT(hbao_params_resolve(&in, &out, &fields), HBAO_SUCCESS);
+    CHECK(fields == HBAO_PARAM_FIELD_THREADS && out.threads == HBAO_MAX_THREADS);
+    in = defaults;
+    in.threads = -4;
+    in.half_resolution = 7;
+    CHECK_RESULT(hbao_params_resolve(&in, &out, &fields), HBAO_SUCCESS);
+    CHECK(fields == 0 && out.threads == 0 && out.half_resolution == 1);
+
+    CHECK(strcmp(hbao_param_field_name(HBAO_PARAM_FIELD_STEPS), "steps") == 0);
+    CHECK(strcmp(hbao_param_field_name(HBAO_PARAM_FIELD_RADIUS), "radius") == 0);
+    CHECK(strcmp(hbao_param_field_name(HBAO_PARAM_FIELD_IMPLEMENTATION), "implementation") == 0);
+    CHECK(hbao_param_field_name(0) == NULL);
+    CHECK(hbao_param_field_name(HBAO_PARAM_FIELD_STEPS | HBAO_PARAM_FIELD_RADIUS) == NULL);
+    CHECK(hbao_param_field_name(1u << 31) == NULL);
+}
+
+/* Values with no nearest legal value are refused, their bits reported, and
+ * *out left alone. */
+TEST_CASE(params_resolve_rejects_what_cannot_be_clamped) {
+    const hbao_params defaults = HBAO_PARAMS_DEFAULT_INITIALIZER;
+    hbao_params in = defaults, out, untouched;
+    memset(&untouched, 0x5a, sizeof untouched);
+    uint32_t fields;
+    struct {
+        uint32_t field;
+        hbao_params params;
+    } cases[8];
+    for (int k = 0; k < 8; k++) cases[k].params = defaults;
+    cases[0].field = HBAO_PARAM_FIELD_RADIUS, cases[0].params.radius = -1.0f;
+    cases[1].field = HBAO_PARAM_FIELD_RADIUS, cases[1].params.radius = NAN;
+    cases[2].field = HBAO_PARAM_FIELD_ANGLE_BIAS_DEGREES,
+    cases[2].params.angle_bias_degrees = INFINITY;
+    cases[3].field = HBAO_PARAM_FIELD_BLUR_SHARPNESS, cases[3].params.blur_sharpness = NAN;
+    cases[4].field = HBAO_PARAM_FIELD_STRENGTH, cases[4].params.strength = -INFINITY;
+    cases[5].field = HBAO_PARAM_FIELD_BACKGROUND_DEPTH, cases[5].params.background_depth = 0.0f;
+    cases[6].field = HBAO_PARAM_FIELD_FALLOFF | HBAO_PARAM_FIELD_INTEGRATION;
+    cases[6].params.falloff = 9, cases[6].params.integration = -1;
+    cases[7].field = HBAO_PARAM_FIELD_IMPLEMENTATION, cases[7].params.implementation = 4;
+    for (int k = 0; k < 8; k++) {
+        out = untouched;
+        CHECK_RESULT(hbao_params_resolve(&cases[k].params, &out, &fields),
+                     HBAO_ERROR_INVALID_PARAMETER);
+        CHECK(fields == cases[k].field);
+        CHECK(memcmp(&out, &untouched, sizeof out) == 0);
+    }
+    CHECK_RESULT(hbao_params_resolve(NULL, &out, &fields), HBAO_ERROR_NULL_ARGUMENT);
+    CHECK_RESULT(hbao_params_resolve(&in, NULL, NULL), HBAO_ERROR_NULL_ARGUMENT);
+    /* infinity is a legal background depth */
+    in.background_depth = INFINITY;
+    CHECK_RESULT(hbao_params_resolve(&in, &out, NULL), HBAO_SUCCESS);
+}
+
 TEST_CASE(out_of_range_counts_are_clamped) {
     fill_inputs();
     hbao_camera c = HBAO_CAMERA_DEFAULT_INITIALIZER;
@@ -225,5 +396,8 @@ TEST_CASE(concurrent_calls_agree) {
 
 TEST_MAIN(TEST_ENTRY(null_arguments_are_rejected), TEST_ENTRY(sizes_and_strides_are_checked),
           TEST_ENTRY(invalid_parameters_are_rejected), TEST_ENTRY(invalid_cameras_are_rejected),
+          TEST_ENTRY(world_to_camera_check_is_scale_free),
+          TEST_ENTRY(params_resolve_clamps_each_field_and_names_it),
+          TEST_ENTRY(params_resolve_rejects_what_cannot_be_clamped),
           TEST_ENTRY(out_of_range_counts_are_clamped), TEST_ENTRY(zero_radius_gives_ones),
           TEST_ENTRY(messages_version_and_sizes), TEST_ENTRY(concurrent_calls_agree))

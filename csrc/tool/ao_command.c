@@ -15,7 +15,8 @@
 #include "png_writer.h"
 
 /* Refuse an output path that is the input file itself, through any name
- * (hard link, symbolic link, "./x" vs "x"): stat() identity, not strings. */
+ * (hard link, symbolic link, "./x" vs "x"): stat() identity, not strings.
+ * What else may be written is atomic_file_begin()'s rule. */
 static int refuse_overwriting_input(const char *output, const char *flag,
                                     const struct stat *input_status, tool_error *error)
 {
@@ -25,8 +26,6 @@ static int refuse_overwriting_input(const char *output, const char *flag,
         output_status.st_ino == input_status->st_ino)
         return tool_fail(error, TOOL_EXIT_USAGE,
                          "%s %s is the input file; refusing to overwrite it", flag, output);
-    if (S_ISDIR(output_status.st_mode))
-        return tool_fail(error, TOOL_EXIT_USAGE, "%s %s is a directory", flag, output);
     return TOOL_EXIT_SUCCESS;
 }
 
@@ -53,15 +52,7 @@ static int resolve_camera(const cli_options *options, const exr_input *input,
     return TOOL_EXIT_SUCCESS;
 }
 
-typedef struct pass_buffers {
-    float *depth;
-    float *normal; /* X Y Z interleaved; NULL when not used */
-    float *ao;
-    uint8_t **copies; /* --keep-input: one native-type buffer per input channel */
-    int copy_count;
-} pass_buffers;
-
-static void free_buffers(pass_buffers *buffers)
+void ao_buffers_free(ao_buffers *buffers)
 {
     free(buffers->depth);
     free(buffers->normal);
@@ -81,7 +72,7 @@ static exr_channel_request float_request(const char *name, float *data, int comp
 }
 
 static int read_passes(exr_input *input, const blender_passes *passes, bool use_normals,
-                       pass_buffers *buffers, tool_error *error)
+                       ao_buffers *buffers, tool_error *error)
 {
     const size_t pixel_count = (size_t)input->width * (size_t)input->height;
     buffers->depth = malloc(pixel_count * sizeof(float));
@@ -100,7 +91,7 @@ static int read_passes(exr_input *input, const blender_passes *passes, bool use_
 }
 
 /* --keep-input: every channel but a previous AO, decoded in its own type. */
-static int read_copies(exr_input *input, const char *ao_channel, pass_buffers *buffers,
+static int read_copies(exr_input *input, const char *ao_channel, ao_buffers *buffers,
                        exr_output_channel *outputs, int *output_count, tool_error *error)
 {
     const int channel_count = input->channels->num_channels;
@@ -140,13 +131,31 @@ static int read_copies(exr_input *input, const char *ao_channel, pass_buffers *b
     return status;
 }
 
+/* The outputs' temporary files exist from before the computation to the
+ * end: an unwritable folder fails before any work, and an interruption at
+ * any point is cleaned up (atomic_file.h). */
+typedef struct output_files {
+    atomic_file exr, png;
+} output_files;
+
+static int begin_outputs(const cli_options *options, output_files *files, tool_error *error)
+{
+    int status = atomic_file_begin(&files->exr, options->output_path, error);
+    if (status == TOOL_EXIT_SUCCESS && options->preview_path != NULL)
+        status = atomic_file_begin(&files->png, options->preview_path, error);
+    return status;
+}
+
+static void abort_outputs(output_files *files)
+{
+    atomic_file_abort(&files->exr);
+    atomic_file_abort(&files->png);
+}
+
 static int write_outputs(const cli_options *options, const exr_input *input,
                          const exr_output_channel *channels, int channel_count, const float *ao,
-                         tool_error *error)
+                         output_files *files, tool_error *error)
 {
-    atomic_file exr_file, png_file;
-    int status = atomic_file_begin(&exr_file, options->output_path, error);
-    if (status != TOOL_EXIT_SUCCESS) return status;
     exr_output_layout layout = {input->data_window,
                                 input->display_window,
                                 input->pixel_aspect_ratio,
@@ -154,33 +163,50 @@ static int write_outputs(const cli_options *options, const exr_input *input,
                                 input->screen_window_width,
                                 options->compression,
                                 options->keep_input ? input->context : NULL};
-    status = exr_write_image(exr_file.fd, options->output_path, &layout, channels, channel_count,
-                             error);
-    if (status != TOOL_EXIT_SUCCESS) {
-        atomic_file_abort(&exr_file);
-        return status;
-    }
-    bool with_preview = options->preview_path != NULL;
-    if (with_preview) {
-        status = atomic_file_begin(&png_file, options->preview_path, error);
-        if (status == TOOL_EXIT_SUCCESS) {
-            status = png_write_gray(png_file.fd, options->preview_path, ao, input->width,
-                                    input->height, input->width, error);
-            if (status != TOOL_EXIT_SUCCESS) atomic_file_abort(&png_file);
-        }
-        if (status != TOOL_EXIT_SUCCESS) {
-            atomic_file_abort(&exr_file);
-            return status;
-        }
-    }
+    int status = exr_write_image(files->exr.fd, options->output_path, &layout, channels,
+                                 channel_count, error);
+    if (status == TOOL_EXIT_SUCCESS && options->preview_path != NULL)
+        status = png_write_gray(files->png.fd, options->preview_path, ao, input->width,
+                                input->height, input->width, error);
     /* Both files are complete: only now replace the destinations. */
-    status = atomic_file_commit(&exr_file, error);
-    if (status != TOOL_EXIT_SUCCESS) {
-        if (with_preview) atomic_file_abort(&png_file);
-        return status;
-    }
-    if (with_preview) status = atomic_file_commit(&png_file, error);
+    if (status == TOOL_EXIT_SUCCESS) status = atomic_file_commit(&files->exr, error);
+    if (status == TOOL_EXIT_SUCCESS && options->preview_path != NULL)
+        status = atomic_file_commit(&files->png, error);
     return status;
+}
+
+int ao_compute_input(const cli_options *options, exr_input *input, ao_buffers *buffers,
+                     tool_error *error)
+{
+    blender_passes passes;
+    int status = blender_find_passes(input, options->layer, &passes, error);
+    if (status != TOOL_EXIT_SUCCESS) return status;
+
+    camera_settings camera;
+    status = resolve_camera(options, input, &camera, error);
+    if (status != TOOL_EXIT_SUCCESS) return status;
+    const bool use_normals = passes.has_normal && !options->ignore_normals;
+    const hbao_camera cropped =
+        camera_for_data_window(&camera.camera, &input->display_window, &input->data_window);
+
+    status = read_passes(input, &passes, use_normals, buffers, error);
+    if (status != TOOL_EXIT_SUCCESS) return status;
+    if (use_normals && !(camera.fields_set & CAMERA_FIELD_WORLD_TO_CAMERA))
+        tool_warn("the Normal pass (%s) is in world space but no world-to-camera matrix was "
+                  "given; using the identity, which is right only for a camera at the origin "
+                  "looking down -Z. Give --camera FILE.json or --world-to-camera, or "
+                  "--no-normals to reconstruct normals from depth",
+                  passes.normal[0]);
+
+    hbao_channel depth = {buffers->depth, 1, input->width};
+    hbao_channel normal = {buffers->normal, 3, (int64_t)input->width * 3};
+    hbao_result result = hbao_compute(&options->params, &cropped, input->width, input->height,
+                                      &depth, use_normals ? &normal : NULL, buffers->ao,
+                                      input->width);
+    if (result != HBAO_SUCCESS)
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: cannot compute AO: %s",
+                         options->input_path, hbao_result_message(result));
+    return TOOL_EXIT_SUCCESS;
 }
 
 int ao_command(const cli_options *options, tool_error *error)
@@ -202,38 +228,13 @@ int ao_command(const cli_options *options, tool_error *error)
     status = exr_input_open(&input, options->input_path, error);
     if (status != TOOL_EXIT_SUCCESS) return status;
 
-    pass_buffers buffers = {0};
+    ao_buffers buffers = {0};
     exr_output_channel *outputs = NULL;
-    blender_passes passes;
-    status = blender_find_passes(&input, options->layer, &passes, error);
+    output_files files = {ATOMIC_FILE_IDLE, ATOMIC_FILE_IDLE};
+    status = begin_outputs(options, &files, error);
     if (status != TOOL_EXIT_SUCCESS) goto done;
-
-    camera_settings camera;
-    status = resolve_camera(options, &input, &camera, error);
+    status = ao_compute_input(options, &input, &buffers, error);
     if (status != TOOL_EXIT_SUCCESS) goto done;
-    const bool use_normals = passes.has_normal && !options->ignore_normals;
-    const hbao_camera cropped =
-        camera_for_data_window(&camera.camera, &input.display_window, &input.data_window);
-
-    status = read_passes(&input, &passes, use_normals, &buffers, error);
-    if (status != TOOL_EXIT_SUCCESS) goto done;
-    if (use_normals && !(camera.fields_set & CAMERA_FIELD_WORLD_TO_CAMERA))
-        tool_warn("the Normal pass (%s) is in world space but no world-to-camera matrix was "
-                  "given; using the identity, which is right only for a camera at the origin "
-                  "looking down -Z. Give --camera FILE.json or --world-to-camera, or "
-                  "--no-normals to reconstruct normals from depth",
-                  passes.normal[0]);
-
-    hbao_channel depth = {buffers.depth, 1, input.width};
-    hbao_channel normal = {buffers.normal, 3, (int64_t)input.width * 3};
-    hbao_result result = hbao_compute(&options->params, &cropped, input.width, input.height,
-                                      &depth, use_normals ? &normal : NULL, buffers.ao,
-                                      input.width);
-    if (result != HBAO_SUCCESS) {
-        status = tool_fail(error, TOOL_EXIT_RUNTIME, "%s: cannot compute AO: %s",
-                           options->input_path, hbao_result_message(result));
-        goto done;
-    }
 
     outputs = calloc((size_t)input.channels->num_channels + 1, sizeof *outputs);
     if (outputs == NULL) {
@@ -250,11 +251,12 @@ int ao_command(const cli_options *options, tool_error *error)
         status = read_copies(&input, options->ao_channel, &buffers, outputs, &output_count, error);
         if (status != TOOL_EXIT_SUCCESS) goto done;
     }
-    status = write_outputs(options, &input, outputs, output_count, buffers.ao, error);
+    status = write_outputs(options, &input, outputs, output_count, buffers.ao, &files, error);
 
 done:
+    abort_outputs(&files);
     free(outputs);
-    free_buffers(&buffers);
+    ao_buffers_free(&buffers);
     exr_input_close(&input);
     return status;
 }

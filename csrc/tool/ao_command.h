@@ -4,8 +4,26 @@
 #define HBAO_TOOL_AO_COMMAND_H
 
 #include "cli_options.h"
+#include "exr_reader.h"
 #include "tool_error.h"
 
+/** The images of one run; any pointer may be NULL. */
+typedef struct ao_buffers {
+    float *depth;
+    float *normal;    /**< X Y Z interleaved; NULL when not used */
+    float *ao;        /**< width x height, rows top first */
+    uint8_t **copies; /**< --keep-input: one native-type buffer per input channel */
+    int copy_count;
+} ao_buffers;
+
+void ao_buffers_free(ao_buffers *buffers);
+
+/** Everything between an opened input and its AO: find the passes, resolve
+ *  the camera, read Depth (and Normal), run hbao_compute into buffers->ao. */
+int ao_compute_input(const cli_options *options, exr_input *input, ao_buffers *buffers,
+                     tool_error *error);
+
+/** The whole command: checks, ao_compute_input(), outputs written atomically. */
 int ao_command(const cli_options *options, tool_error *error);
 
 #endif /* HBAO_TOOL_AO_COMMAND_H */

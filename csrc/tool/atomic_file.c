@@ -2,39 +2,241 @@
 #include "atomic_file.h"
 
 #include <errno.h>
+#include <fcntl.h>
+#include <pthread.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+/* Linux's limit on symbolic links followed in one lookup (MAXSYMLINKS). */
+#define SYMLINK_HOPS_MAX 40
+
+/* --- removing temporary files when a signal ends the run -------------------
+ * The handler may only use async-signal-safe calls: it reads paths written
+ * before their flag was set (with the signals blocked), unlinks them and
+ * re-raises the signal with its default action. */
+
+#define CLEANUP_SLOTS ATOMIC_FILE_MAX_OPEN
+
+static const int cleanup_signals[] = {SIGINT, SIGTERM, SIGHUP};
+#define CLEANUP_SIGNAL_COUNT (int)(sizeof cleanup_signals / sizeof cleanup_signals[0])
+
+static char cleanup_paths[CLEANUP_SLOTS][PATH_MAX];
+static volatile sig_atomic_t cleanup_active[CLEANUP_SLOTS];
+static bool handlers_installed;
+/* Frames of a sequence write their outputs from several threads: the slots,
+ * the handler installation and the umask() probe take turns. */
+static pthread_mutex_t slots_lock = PTHREAD_MUTEX_INITIALIZER;
+
+static void remove_temporary_files(int signal_number)
+{
+    for (int s = 0; s < CLEANUP_SLOTS; ++s)
+        if (cleanup_active[s]) unlink(cleanup_paths[s]);
+    /* Die of the same signal, so that the parent (a shell, a render farm)
+     * sees that the run was interrupted rather than a normal exit. The signal
+     * is blocked while its handler runs, so it is delivered on return. */
+    signal(signal_number, SIG_DFL);
+    raise(signal_number);
+}
+
+void atomic_file_install_signal_handlers(void)
+{
+    pthread_mutex_lock(&slots_lock);
+    if (handlers_installed) {
+        pthread_mutex_unlock(&slots_lock);
+        return;
+    }
+    handlers_installed = true;
+    for (int i = 0; i < CLEANUP_SIGNAL_COUNT; ++i) {
+        struct sigaction previous;
+        /* A signal the caller chose to ignore (nohup) stays ignored. */
+        if (sigaction(cleanup_signals[i], NULL, &previous) != 0 ||
+            previous.sa_handler == SIG_IGN)
+            continue;
+        struct sigaction action;
+        memset(&action, 0, sizeof action);
+        action.sa_handler = remove_temporary_files;
+        sigfillset(&action.sa_mask); /* one handler at a time */
+        sigaction(cleanup_signals[i], &action, NULL);
+    }
+    pthread_mutex_unlock(&slots_lock);
+}
+
+/* Creating, renaming and unlinking a temporary file happen with the cleanup
+ * signals blocked, so that the handler never misses a file that exists nor
+ * sees a half-written path. */
+void atomic_file_block_signals(sigset_t *previous)
+{
+    sigset_t blocked;
+    sigemptyset(&blocked);
+    for (int i = 0; i < CLEANUP_SIGNAL_COUNT; ++i) sigaddset(&blocked, cleanup_signals[i]);
+    pthread_sigmask(SIG_BLOCK, &blocked, previous);
+}
+
+void atomic_file_restore_signals(const sigset_t *previous)
+{
+    pthread_sigmask(SIG_SETMASK, previous, NULL);
+}
+
+static void block_cleanup_signals(sigset_t *previous)
+{
+    atomic_file_block_signals(previous);
+    pthread_mutex_lock(&slots_lock);
+}
+
+static void restore_signals(const sigset_t *previous)
+{
+    pthread_mutex_unlock(&slots_lock);
+    atomic_file_restore_signals(previous);
+}
+
+/* Called with the slots locked. With no free slot the file is still
+ * written, only not removed by a signal; ATOMIC_FILE_MAX_OPEN is sized so
+ * that this does not happen. */
+static int claim_cleanup_slot(const char *path)
+{
+    for (int s = 0; s < CLEANUP_SLOTS; ++s) {
+        if (cleanup_active[s]) continue;
+        strcpy(cleanup_paths[s], path); /* both are PATH_MAX buffers */
+        cleanup_active[s] = 1;
+        return s;
+    }
+    return -1;
+}
+
+static void release_cleanup_slot(atomic_file *file)
+{
+    if (file->cleanup_slot >= 0) cleanup_active[file->cleanup_slot] = 0;
+    file->cleanup_slot = -1;
+}
+
+/* --- where to write -------------------------------------------------------- */
+
+/* Follow `path` while it is a symbolic link (a dangling one too: writing
+ * through it creates its target, as `echo > link` does). */
+static int follow_symbolic_links(const char *path, char resolved[PATH_MAX], tool_error *error)
+{
+    if (strlen(path) >= PATH_MAX)
+        return tool_fail(error, TOOL_EXIT_USAGE, "output path too long: %s", path);
+    strcpy(resolved, path);
+    for (int hops = 0;; ++hops) {
+        struct stat status;
+        if (lstat(resolved, &status) != 0 || !S_ISLNK(status.st_mode)) return TOOL_EXIT_SUCCESS;
+        if (hops == SYMLINK_HOPS_MAX)
+            return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: too many levels of symbolic links",
+                             path);
+        char target[PATH_MAX];
+        ssize_t length = readlink(resolved, target, sizeof target - 1);
+        if (length < 0)
+            return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot read the link %s: %s", resolved,
+                             strerror(errno));
+        target[length] = '\0';
+        /* A relative target is relative to the link's own directory. */
+        const char *slash = strrchr(resolved, '/');
+        int directory_length = target[0] == '/' || slash == NULL ? 0 : (int)(slash - resolved + 1);
+        char next[PATH_MAX];
+        int written = snprintf(next, sizeof next, "%.*s%s", directory_length, resolved, target);
+        if (written < 0 || written >= PATH_MAX)
+            return tool_fail(error, TOOL_EXIT_USAGE, "output path too long: %s", path);
+        strcpy(resolved, next);
+    }
+}
+
+/* A temporary file in the destination's directory, so that rename() stays
+ * on one file system; the leading dot keeps it out of casual listings. The
+ * name has a fixed length, whatever the destination's. */
+static int create_named_temporary(atomic_file *file, tool_error *error)
+{
+    const char *slash = strrchr(file->destination, '/');
+    int directory_length = slash ? (int)(slash - file->destination + 1) : 0;
+    int written = snprintf(file->temporary_path, sizeof file->temporary_path,
+                           "%.*s.hbao-tmp-XXXXXX", directory_length, file->destination);
+    if (written < 0 || (size_t)written >= sizeof file->temporary_path)
+        return tool_fail(error, TOOL_EXIT_USAGE, "output path too long: %s", file->name);
+    sigset_t previous;
+    block_cleanup_signals(&previous);
+    file->fd = mkstemp(file->temporary_path);
+    int saved = errno;
+    if (file->fd >= 0) file->cleanup_slot = claim_cleanup_slot(file->temporary_path);
+    restore_signals(&previous);
+    if (file->fd < 0)
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot create a file next to %s: %s",
+                         file->name, strerror(saved));
+    return TOOL_EXIT_SUCCESS;
+}
+
+/* For a FIFO or a device: an unnamed file in $TMPDIR (unlinked at once, so
+ * nothing can be left behind) that holds the data until commit. */
+static int create_unnamed_temporary(atomic_file *file, tool_error *error)
+{
+    const char *folder = getenv("TMPDIR");
+    if (folder == NULL || folder[0] == '\0') folder = "/tmp";
+    char path[PATH_MAX];
+    int written = snprintf(path, sizeof path, "%s/.hbao-tmp-XXXXXX", folder);
+    if (written < 0 || (size_t)written >= sizeof path)
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "TMPDIR too long: %s", folder);
+    sigset_t previous;
+    block_cleanup_signals(&previous);
+    file->fd = mkstemp(path);
+    int saved = errno;
+    if (file->fd >= 0) unlink(path);
+    restore_signals(&previous);
+    file->temporary_path[0] = '\0';
+    if (file->fd < 0)
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot create a temporary file in %s: %s",
+                         folder, strerror(saved));
+    return TOOL_EXIT_SUCCESS;
+}
+
 int atomic_file_begin(atomic_file *file, const char *destination, tool_error *error)
 {
     memset(file, 0, sizeof *file);
     file->fd = -1;
-    if (strlen(destination) >= sizeof file->destination)
-        return tool_fail(error, TOOL_EXIT_USAGE, "output path too long: %s", destination);
-    strcpy(file->destination, destination);
+    file->cleanup_slot = -1;
+    file->name = destination;
+    atomic_file_install_signal_handlers();
 
-    /* Same directory as the destination, so that rename() stays on one file
-     * system; a leading dot keeps it out of casual directory listings. */
-    const char *slash = strrchr(destination, '/');
-    int directory_length = slash ? (int)(slash - destination + 1) : 0;
-    const char *base = destination + directory_length;
-    int written = snprintf(file->temporary_path, sizeof file->temporary_path,
-                           "%.*s.%s.hbao-tmp-XXXXXX", directory_length, destination, base);
-    if (written < 0 || (size_t)written >= sizeof file->temporary_path)
-        return tool_fail(error, TOOL_EXIT_USAGE, "output path too long: %s", destination);
+    /* What the name finally points to decides how it is written. stat()
+     * follows links as open() would, also the kernel's magic ones
+     * (/dev/stdout -> /proc/self/fd/1 -> "pipe:[...]") that readlink()
+     * cannot turn into a path. */
+    struct stat existing;
+    bool exists = stat(destination, &existing) == 0;
+    if (exists && S_ISDIR(existing.st_mode))
+        return tool_fail(error, TOOL_EXIT_USAGE, "%s is a directory", destination);
+    if (exists && (S_ISBLK(existing.st_mode) || S_ISSOCK(existing.st_mode)))
+        return tool_fail(error, TOOL_EXIT_USAGE,
+                         "%s is a %s; hbao writes only regular files, FIFOs and character "
+                         "devices",
+                         destination, S_ISBLK(existing.st_mode) ? "block device" : "socket");
+    file->write_through = exists && (S_ISFIFO(existing.st_mode) || S_ISCHR(existing.st_mode));
+    int status = TOOL_EXIT_SUCCESS;
+    if (file->write_through) {
+        if (strlen(destination) >= sizeof file->destination)
+            return tool_fail(error, TOOL_EXIT_USAGE, "output path too long: %s", destination);
+        strcpy(file->destination, destination);
+    } else {
+        /* The rename must replace the link's target, not the link. */
+        status = follow_symbolic_links(destination, file->destination, error);
+        if (status != TOOL_EXIT_SUCCESS) return status;
+    }
 
-    file->fd = mkstemp(file->temporary_path);
-    if (file->fd < 0)
-        return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot create a file next to %s: %s",
-                         destination, strerror(errno));
+    status = file->write_through ? create_unnamed_temporary(file, error)
+                                 : create_named_temporary(file, error);
+    if (status != TOOL_EXIT_SUCCESS) return status;
     file->active = true;
+    if (file->write_through) return TOOL_EXIT_SUCCESS;
     /* mkstemp creates 0600; give the result the permissions a plain
-     * open(O_CREAT, 0666) would have. */
+     * open(O_CREAT, 0666) would have. umask() can only be read by setting
+     * it, so other threads must not create files meanwhile. */
+    sigset_t previous;
+    block_cleanup_signals(&previous);
     mode_t mask = umask(0);
     umask(mask);
+    restore_signals(&previous);
     if (fchmod(file->fd, 0666 & ~mask) != 0) {
         int saved = errno;
         atomic_file_abort(file);
@@ -44,24 +246,77 @@ int atomic_file_begin(atomic_file *file, const char *destination, tool_error *er
     return TOOL_EXIT_SUCCESS;
 }
 
+/* Copy the whole temporary file to the FIFO or device, in order. */
+static int copy_through(atomic_file *file, tool_error *error)
+{
+    if (lseek(file->fd, 0, SEEK_SET) != 0)
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot reread the data for %s: %s",
+                         file->name, strerror(errno));
+    /* No O_CREAT: the destination exists; no O_TRUNC: a device or FIFO has
+     * nothing to truncate. Opening a FIFO waits for its reader. */
+    int sink = open(file->destination, O_WRONLY | O_NOCTTY | O_CLOEXEC);
+    if (sink < 0)
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot open %s: %s", file->name,
+                         strerror(errno));
+    char buffer[1 << 16];
+    int status = TOOL_EXIT_SUCCESS;
+    for (;;) {
+        ssize_t got = read(file->fd, buffer, sizeof buffer);
+        if (got < 0 && errno == EINTR) continue;
+        if (got < 0) {
+            status = tool_fail(error, TOOL_EXIT_RUNTIME, "cannot reread the data for %s: %s",
+                               file->name, strerror(errno));
+            break;
+        }
+        if (got == 0) break;
+        for (ssize_t done = 0; done < got;) {
+            ssize_t put = write(sink, buffer + done, (size_t)(got - done));
+            if (put < 0 && errno == EINTR) continue;
+            if (put <= 0) {
+                status = tool_fail(error, TOOL_EXIT_RUNTIME, "cannot write %s: %s", file->name,
+                                   put < 0 ? strerror(errno) : "nothing written");
+                break;
+            }
+            done += put;
+        }
+        if (status != TOOL_EXIT_SUCCESS) break;
+    }
+    if (close(sink) != 0 && status == TOOL_EXIT_SUCCESS)
+        status = tool_fail(error, TOOL_EXIT_RUNTIME, "cannot write %s: %s", file->name,
+                           strerror(errno));
+    return status;
+}
+
 int atomic_file_commit(atomic_file *file, tool_error *error)
 {
     if (!file->active) return tool_fail(error, TOOL_EXIT_RUNTIME, "internal: nothing to commit");
+    if (file->write_through) {
+        int status = copy_through(file, error);
+        atomic_file_abort(file);
+        return status;
+    }
     if (fsync(file->fd) != 0 || close(file->fd) != 0) {
         int saved = errno;
         file->fd = -1;
         atomic_file_abort(file);
-        return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot write %s: %s", file->destination,
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot write %s: %s", file->name,
                          strerror(saved));
     }
     file->fd = -1;
-    if (rename(file->temporary_path, file->destination) != 0) {
-        int saved = errno;
+    sigset_t previous;
+    block_cleanup_signals(&previous);
+    int renamed = rename(file->temporary_path, file->destination);
+    int saved = errno;
+    if (renamed == 0) {
+        release_cleanup_slot(file);
+        file->active = false;
+    }
+    restore_signals(&previous);
+    if (renamed != 0) {
         atomic_file_abort(file);
-        return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot create %s: %s", file->destination,
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot create %s: %s", file->name,
                          strerror(saved));
     }
-    file->active = false;
     return TOOL_EXIT_SUCCESS;
 }
 
@@ -69,6 +324,10 @@ void atomic_file_abort(atomic_file *file)
 {
     if (file->fd >= 0) close(file->fd);
     file->fd = -1;
-    if (file->active) unlink(file->temporary_path);
+    sigset_t previous;
+    block_cleanup_signals(&previous);
+    if (file->active && file->temporary_path[0] != '\0') unlink(file->temporary_path);
+    release_cleanup_slot(file);
     file->active = false;
+    restore_signals(&previous);
 }

@@ -1,15 +1,33 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
 /*
- * Output files that appear complete or not at all: the data goes to a
- * temporary file in the destination's directory, which is renamed over the
- * destination only once everything has been written and flushed. A failed
- * run removes its temporary file and leaves any existing destination as it
- * was.
+ * Output files that appear complete or not at all, and that never replace
+ * something that is not a regular file:
+ *
+ * - a regular file (or a name that does not exist yet): the data goes to a
+ *   temporary file `.hbao-tmp-XXXXXX` in the destination's directory, which
+ *   is renamed over the destination only once everything has been written
+ *   and flushed. A failed run removes its temporary file and leaves any
+ *   existing destination as it was. The temporary name has a fixed length,
+ *   so that any legal destination name (up to NAME_MAX) works.
+ * - a symbolic link: followed (also a dangling one); its final target is
+ *   replaced as above and the link itself is kept.
+ * - a FIFO or a character device (/dev/null, a terminal): written through,
+ *   never replaced. The data goes to an unnamed temporary file first and is
+ *   copied to the destination at commit, so a reader sees the whole image or
+ *   nothing.
+ * - a directory, a block device or a socket: refused (TOOL_EXIT_USAGE).
+ *
+ * SIGINT, SIGTERM and SIGHUP while a temporary file exists remove it, then
+ * end the process by the same signal (so its exit status says so). Several
+ * threads may write files at once (the frames of a sequence): then only the
+ * main thread should take the signals (atomic_file_block_signals() in the
+ * others).
  */
 #ifndef HBAO_TOOL_ATOMIC_FILE_H
 #define HBAO_TOOL_ATOMIC_FILE_H
 
 #include <limits.h>
+#include <signal.h>
 #include <stdbool.h>
 
 #include "tool_error.h"
@@ -18,21 +36,42 @@
 #define PATH_MAX 4096
 #endif
 
+/** How many temporary files may exist at once and still be removed by a
+ *  signal: two outputs (EXR, PNG) for each frame being computed. */
+#define ATOMIC_FILE_MAX_OPEN 64
+
 typedef struct atomic_file {
     int fd;                          /**< open on the temporary file; -1 once closed */
-    char destination[PATH_MAX];
-    char temporary_path[PATH_MAX];
-    bool active;                     /**< the temporary file exists */
+    const char *name;                /**< the destination as the user gave it, for messages */
+    char destination[PATH_MAX];      /**< symbolic links followed */
+    char temporary_path[PATH_MAX];   /**< empty when the temporary file is unnamed */
+    bool active;                     /**< begun, not yet committed or aborted */
+    bool write_through;              /**< FIFO or character device: copy, do not rename */
+    int cleanup_slot;                /**< the signal handler's record of temporary_path, or -1 */
 } atomic_file;
 
-/** Create the temporary file for `destination` (mode 0666 & ~umask). */
+/** A file on which atomic_file_abort() is a no-op, before atomic_file_begin(). */
+#define ATOMIC_FILE_IDLE {.fd = -1, .cleanup_slot = -1}
+
+/** Prepare writing `destination` (kept by pointer for messages): create the
+ *  temporary file (mode 0666 & ~umask) or refuse a destination that must not
+ *  be written. */
 int atomic_file_begin(atomic_file *file, const char *destination, tool_error *error);
 
-/** Flush, close and rename the temporary file over the destination. On
- *  failure the temporary file is removed. */
+/** Flush the temporary file and put it in place (rename or copy through).
+ *  On failure the temporary file is removed. */
 int atomic_file_commit(atomic_file *file, tool_error *error);
 
 /** Remove the temporary file (no-op when nothing is pending). */
 void atomic_file_abort(atomic_file *file);
+
+/** Install the signal handlers now (atomic_file_begin() does it too): call
+ *  before starting threads that write files. */
+void atomic_file_install_signal_handlers(void);
+
+/** Block (and restore) the signals that remove temporary files, in the
+ *  calling thread: threads started in between inherit the block. */
+void atomic_file_block_signals(sigset_t *previous);
+void atomic_file_restore_signals(const sigset_t *previous);
 
 #endif /* HBAO_TOOL_ATOMIC_FILE_H */

@@ -11,6 +11,7 @@
 #include <stdint.h>
 
 #include "hbao.h"
+#include "pixel_rect.h"
 
 /** Bits of camera_settings.fields_set, one per hbao_camera field. */
 enum {
@@ -37,11 +38,6 @@ void camera_settings_init(camera_settings *settings);
 
 /** Copy into `base` every field that `override` sets. */
 void camera_settings_apply(camera_settings *base, const camera_settings *override);
-
-/** Image rectangle in pixels, y growing downwards (EXR convention). */
-typedef struct pixel_rect {
-    int32_t min_x, min_y, max_x, max_y; /* inclusive */
-} pixel_rect;
 
 /**
  * The camera for the sub-rectangle `data` of the full frame `display`

@@ -2,6 +2,8 @@
 #include "cli_options.h"
 
 #include <float.h>
+#include <math.h>
+#include <stdint.h>
 #include <string.h>
 
 #include "number_parsing.h"
@@ -37,6 +39,9 @@ typedef enum option_id {
     OPTION_PIXEL_ASPECT_X,
     OPTION_PIXEL_ASPECT_Y,
     OPTION_WORLD_TO_CAMERA,
+    OPTION_FRAMES,
+    OPTION_JOBS,
+    OPTION_FORCE,
     OPTION_INFO,
     OPTION_JSON,
     OPTION_HELP,
@@ -81,6 +86,9 @@ static const option_spec option_specs[] = {
     {"pixel-aspect-x", 0, OPTION_PIXEL_ASPECT_X, true},
     {"pixel-aspect-y", 0, OPTION_PIXEL_ASPECT_Y, true},
     {"world-to-camera", 0, OPTION_WORLD_TO_CAMERA, true},
+    {"frames", 0, OPTION_FRAMES, true},
+    {"jobs", 'j', OPTION_JOBS, true},
+    {"force", 0, OPTION_FORCE, false},
     {"info", 0, OPTION_INFO, false},
     {"json", 0, OPTION_JSON, false},
     {"help", 'h', OPTION_HELP, false},
@@ -199,25 +207,27 @@ static int apply_option(const option_spec *spec, const char *value, cli_options 
         options->compression = (exr_compression_t)compression;
         break;
     }
+    /* AO parameters: only the syntax here; their limits are libhbao's
+     * (hbao_params_resolve, in resolve_params below). */
     case OPTION_RADIUS:
-        status = parse_float_flag(flag, value, 0.0f, FLT_MAX, false, &params->radius, error);
+        status = parse_float_flag(flag, value, -FLT_MAX, FLT_MAX, false, &params->radius, error);
         break;
     case OPTION_ANGLE_BIAS:
-        status = parse_float_flag(flag, value, 0.0f, HBAO_MAX_ANGLE_BIAS_DEGREES, false,
+        status = parse_float_flag(flag, value, -FLT_MAX, FLT_MAX, false,
                                   &params->angle_bias_degrees, error);
         break;
     case OPTION_DIRECTIONS:
-        status = parse_int_flag(flag, value, 1, HBAO_MAX_DIRECTIONS, &params->directions, error);
+        status = parse_int_flag(flag, value, INT32_MIN, INT32_MAX, &params->directions, error);
         break;
     case OPTION_STEPS:
-        status = parse_int_flag(flag, value, 1, HBAO_MAX_STEPS, &params->steps, error);
+        status = parse_int_flag(flag, value, INT32_MIN, INT32_MAX, &params->steps, error);
         break;
     case OPTION_BLUR:
-        status = parse_int_flag(flag, value, 0, HBAO_MAX_BLUR_SIZE, &params->blur_size, error);
+        status = parse_int_flag(flag, value, INT32_MIN, INT32_MAX, &params->blur_size, error);
         break;
     case OPTION_BLUR_SHARPNESS:
-        status = parse_float_flag(flag, value, 0.0f, HBAO_MAX_BLUR_SHARPNESS, false,
-                                  &params->blur_sharpness, error);
+        status = parse_float_flag(flag, value, -FLT_MAX, FLT_MAX, false, &params->blur_sharpness,
+                                  error);
         break;
     case OPTION_HALF_RES: params->half_resolution = 1; break;
     case OPTION_FALLOFF:
@@ -227,11 +237,11 @@ static int apply_option(const option_spec *spec, const char *value, cli_options 
         status = parse_choice(flag, value, integration_choices, &params->integration, error);
         break;
     case OPTION_STRENGTH:
-        status = parse_float_flag(flag, value, 0.0f, HBAO_MAX_STRENGTH, false, &params->strength,
+        status = parse_float_flag(flag, value, -FLT_MAX, FLT_MAX, false, &params->strength,
                                   error);
         break;
     case OPTION_THREADS:
-        status = parse_int_flag(flag, value, 0, HBAO_MAX_THREADS, &params->threads, error);
+        status = parse_int_flag(flag, value, INT32_MIN, INT32_MAX, &params->threads, error);
         break;
     case OPTION_CAMERA: options->camera_path = value; break;
     case OPTION_CAMERA_TYPE:
@@ -287,6 +297,17 @@ static int apply_option(const option_spec *spec, const char *value, cli_options 
                              value);
         flags->fields_set |= CAMERA_FIELD_WORLD_TO_CAMERA;
         break;
+    case OPTION_FRAMES:
+        if (!frame_list_parse(value, &options->frames))
+            return tool_fail(error, TOOL_EXIT_USAGE,
+                             "--frames: \"%s\" is not a frame list like 1-250 or 1-10,20 "
+                             "(frames in [0, %d], at most %d ranges, none twice)",
+                             value, FRAME_MAX, FRAME_RANGES_MAX);
+        break;
+    case OPTION_JOBS:
+        status = parse_int_flag(flag, value, 1, CLI_MAX_JOBS, &options->jobs, error);
+        break;
+    case OPTION_FORCE: options->force = true; break;
     case OPTION_INFO: options->mode = TOOL_MODE_INFO; break;
     case OPTION_JSON: options->info_json = true; break;
     case OPTION_HELP: /* handled after parsing */ break;
@@ -295,12 +316,70 @@ static int apply_option(const option_spec *spec, const char *value, cli_options 
     return status;
 }
 
+/* The flag of each hbao_params field the command line sets. */
+static const struct {
+    uint32_t field;
+    const char *flag;
+} param_flags[] = {
+    {HBAO_PARAM_FIELD_RADIUS, "radius"},
+    {HBAO_PARAM_FIELD_ANGLE_BIAS_DEGREES, "angle-bias"},
+    {HBAO_PARAM_FIELD_DIRECTIONS, "directions"},
+    {HBAO_PARAM_FIELD_STEPS, "steps"},
+    {HBAO_PARAM_FIELD_FALLOFF, "falloff"},
+    {HBAO_PARAM_FIELD_INTEGRATION, "integration"},
+    {HBAO_PARAM_FIELD_BLUR_SIZE, "blur"},
+    {HBAO_PARAM_FIELD_BLUR_SHARPNESS, "blur-sharpness"},
+    {HBAO_PARAM_FIELD_STRENGTH, "strength"},
+    {HBAO_PARAM_FIELD_THREADS, "threads"},
+};
+
+static double param_value(const hbao_params *params, uint32_t field)
+{
+    switch (field) {
+    case HBAO_PARAM_FIELD_RADIUS: return params->radius;
+    case HBAO_PARAM_FIELD_ANGLE_BIAS_DEGREES: return params->angle_bias_degrees;
+    case HBAO_PARAM_FIELD_DIRECTIONS: return params->directions;
+    case HBAO_PARAM_FIELD_STEPS: return params->steps;
+    case HBAO_PARAM_FIELD_BLUR_SIZE: return params->blur_size;
+    case HBAO_PARAM_FIELD_BLUR_SHARPNESS: return params->blur_sharpness;
+    case HBAO_PARAM_FIELD_STRENGTH: return params->strength;
+    case HBAO_PARAM_FIELD_THREADS: return params->threads;
+    default: return NAN;
+    }
+}
+
+/* The library decides (hbao_params_resolve): like the add-on, the tool
+ * clamps out-of-range values with one warning per value and goes on; only
+ * values with no nearest legal value (a negative radius) are refused. */
+static int resolve_params(hbao_params *params, tool_error *error)
+{
+    hbao_params resolved;
+    uint32_t fields = 0;
+    hbao_result result = hbao_params_resolve(params, &resolved, &fields);
+    for (size_t i = 0; i < sizeof param_flags / sizeof param_flags[0]; ++i) {
+        if (!(fields & param_flags[i].field)) continue;
+        const double given = param_value(params, param_flags[i].field);
+        if (result != HBAO_SUCCESS)
+            return tool_fail(error, TOOL_EXIT_USAGE, "--%s %g is not valid: %s",
+                             param_flags[i].flag, given, hbao_result_message(result));
+        const double limit = param_value(&resolved, param_flags[i].field);
+        tool_warn("--%s %g is %s the limit %g; using %g", param_flags[i].flag, given,
+                  given > limit ? "above" : "below", limit, limit);
+    }
+    if (result != HBAO_SUCCESS)
+        return tool_fail(error, TOOL_EXIT_USAGE, "invalid parameters: %s",
+                         hbao_result_message(result));
+    *params = resolved;
+    return TOOL_EXIT_SUCCESS;
+}
+
 static void options_init(cli_options *options)
 {
     memset(options, 0, sizeof *options);
     options->mode = TOOL_MODE_COMPUTE;
     options->compression = EXR_COMPRESSION_ZIP;
     options->ao_channel = "AO";
+    options->jobs = 1;
     hbao_params defaults = HBAO_PARAMS_DEFAULT_INITIALIZER;
     options->params = defaults;
     camera_settings_init(&options->camera_flags);
@@ -366,11 +445,15 @@ int cli_parse(int argc, char **argv, cli_options *options, tool_error *error)
     if (options->input_path == NULL)
         return tool_fail(error, TOOL_EXIT_USAGE, "no input file (usage: hbao INPUT.exr -o "
                                                  "OUTPUT.exr [options]; see hbao --help)");
+    const bool sequence = options->frames.range_count > 0;
     if (options->mode == TOOL_MODE_INFO) {
         if (options->output_path != NULL || options->preview_path != NULL)
             return tool_fail(error, TOOL_EXIT_USAGE, "--info writes nothing: drop -o/--preview");
+        if (sequence) return tool_fail(error, TOOL_EXIT_USAGE, "--info reads one file: drop --frames");
         return TOOL_EXIT_SUCCESS;
     }
+    if (!sequence && (options->jobs != 1 || options->force))
+        return tool_fail(error, TOOL_EXIT_USAGE, "--jobs and --force go with --frames");
     if (options->info_json)
         return tool_fail(error, TOOL_EXIT_USAGE, "--json only goes with --info");
     if (options->output_path == NULL)
@@ -381,7 +464,20 @@ int cli_parse(int argc, char **argv, cli_options *options, tool_error *error)
         return tool_fail(error, TOOL_EXIT_USAGE, "a file name is empty");
     if (options->preview_path != NULL && strcmp(options->preview_path, options->output_path) == 0)
         return tool_fail(error, TOOL_EXIT_USAGE, "--preview and -o name the same file");
-    return TOOL_EXIT_SUCCESS;
+    if (sequence) {
+        /* Each frame needs its own files: a name without '#' would be
+         * read (or overwritten) by every frame. */
+        const char *paths[] = {options->input_path, options->output_path, options->preview_path};
+        const char *flags[] = {"the input", "-o", "--preview"};
+        for (int p = 0; p < 3; ++p)
+            if (paths[p] != NULL && !frame_pattern_has_frame(paths[p]))
+                return tool_fail(error, TOOL_EXIT_USAGE,
+                                 "with --frames, %s (%s) needs a '#' run for the frame number, "
+                                 "e.g. render_####.exr",
+                                 flags[p], paths[p]);
+        options->mode = TOOL_MODE_SEQUENCE;
+    }
+    return resolve_params(&options->params, error);
 }
 
 void cli_print_help(FILE *stream)
@@ -396,7 +492,14 @@ void cli_print_help(FILE *stream)
 "\n"
 "Input and output:\n"
 "  -o, --output FILE       output EXR (required). Written to a temporary file\n"
-"                          next to it and renamed when complete; never the input.\n"
+"                          .hbao-tmp-XXXXXX next to it and renamed over it when\n"
+"                          complete, so it appears whole or not at all; never the\n"
+"                          input. A symbolic link is followed: its target is\n"
+"                          replaced, the link kept. A FIFO or character device\n"
+"                          (/dev/null, /dev/stdout) is written through, never\n"
+"                          replaced. A directory, block device or socket is\n"
+"                          refused (exit 2). Ctrl-C, SIGTERM and SIGHUP remove\n"
+"                          the temporary files. The same holds for --preview.\n"
 "  --layer NAME            view layer to use (channels NAME.Depth.Z and, if\n"
 "                          present, NAME.Normal.X/Y/Z). Default: the first layer,\n"
 "                          in channel-name order, that has a Depth pass; a plain\n"
@@ -415,8 +518,10 @@ void cli_print_help(FILE *stream)
 "                          the finite values and the count of non-finite ones.\n"
 "  --json                  with --info: print it as JSON.\n"
 "\n"
-"AO parameters (defaults from libhbao):\n"
-"  --radius R              AO radius in scene units (>= 0; default %g)\n"
+"AO parameters (defaults and limits from libhbao; a value outside its range is\n"
+"clamped to it, with a warning, as the Blender add-on does):\n"
+"  --radius R              AO radius in scene units (>= 0, else an error;\n"
+"                          default %g)\n"
 "  --angle-bias DEG        ignore occluders this far above the tangent plane\n"
 "                          [0, %g] (default %g)\n"
 "  --directions N          directions per pixel [1, %d] (default %d)\n"
@@ -430,7 +535,8 @@ void cli_print_help(FILE *stream)
 "                          quadratic (HBAO's 1 - (d/radius)^2 attenuation)\n"
 "  --integration I         cosine (default: what Cycles' AO pass measures) or hbao\n"
 "  --strength S            ao = ao^S, [0, %g] (default %g)\n"
-"  --threads N             worker threads [0, %d]; 0 = one per core (default)\n"
+"  --threads N             worker threads, at most %d; 0 (or less) = one per\n"
+"                          core (default)\n"
 "\n"
 "Camera (Blender's camera model and names; flags override --camera):\n"
 "  --camera FILE.json      JSON object with Blender's property names: type\n"
@@ -459,6 +565,22 @@ void cli_print_help(FILE *stream)
 "                          unless the camera sits at the origin looking down -Z, so\n"
 "                          the tool warns; pass the matrix or --no-normals.\n"
 "\n"
+"Sequences:\n"
+"  --frames LIST           compute every frame of LIST (1-250, or 1-10,20,30-40;\n"
+"                          frames in [0, %d]). The input, -o and --preview\n"
+"                          names must hold a run of '#', replaced by the frame\n"
+"                          number zero-padded to the run's length, as Blender\n"
+"                          names frames: hbao 'render_####.exr' -o 'ao_####.exr'\n"
+"                          --frames 1-250. An output at least as new as its input\n"
+"                          (and --camera file) is up to date and skipped. One\n"
+"                          progress line per frame; every frame is attempted, and\n"
+"                          the exit status is 1 (2 for a usage error in a frame)\n"
+"                          when any failed, with the list of failed frames.\n"
+"  -j, --jobs N            frames computed at once [1, %d] (default 1); without\n"
+"                          --threads, each frame gets cores / N threads\n"
+"  --force                 recompute frames that are up to date (changed flags\n"
+"                          are not detected)\n"
+"\n"
 "Data window: the tool works on the EXR's data window and writes the output with\n"
 "the same data and display windows; when the data window is a part of the\n"
 "display window, the camera is adjusted to that part (same view rays). Blender\n"
@@ -476,5 +598,5 @@ void cli_print_help(FILE *stream)
             HBAO_DEFAULT_DIRECTIONS, HBAO_MAX_STEPS, HBAO_DEFAULT_STEPS, HBAO_MAX_BLUR_SIZE,
             HBAO_DEFAULT_BLUR_SIZE, (double)HBAO_MAX_BLUR_SHARPNESS,
             (double)HBAO_DEFAULT_BLUR_SHARPNESS, (double)HBAO_MAX_STRENGTH,
-            (double)HBAO_DEFAULT_STRENGTH, HBAO_MAX_THREADS);
+            (double)HBAO_DEFAULT_STRENGTH, HBAO_MAX_THREADS, FRAME_MAX, CLI_MAX_JOBS);
 }

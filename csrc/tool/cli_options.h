@@ -7,16 +7,23 @@
 #include <stdbool.h>
 #include <stdio.h>
 
+#include "atomic_file.h"
 #include "camera_settings.h"
+#include "frame_pattern.h"
 #include "hbao.h"
 #include "tool_error.h"
 
 typedef enum tool_mode {
     TOOL_MODE_COMPUTE, /**< hbao INPUT.exr -o OUTPUT.exr */
+    TOOL_MODE_SEQUENCE, /**< hbao IN_####.exr -o OUT_####.exr --frames 1-250 */
     TOOL_MODE_INFO,    /**< hbao --info FILE.exr */
     TOOL_MODE_HELP,
     TOOL_MODE_VERSION
 } tool_mode;
+
+/** The most frames computed at once (--jobs): each holds up to two
+ *  temporary files that a signal must be able to remove. */
+#define CLI_MAX_JOBS (ATOMIC_FILE_MAX_OPEN / 2)
 
 typedef struct cli_options {
     tool_mode mode;
@@ -32,6 +39,9 @@ typedef struct cli_options {
     exr_compression_t compression;
     hbao_params params;
     camera_settings camera_flags; /**< camera fields given as flags */
+    frame_list frames;            /**< --frames (TOOL_MODE_SEQUENCE) */
+    int32_t jobs;                 /**< frames computed at once */
+    bool force;                   /**< recompute up-to-date frames */
 } cli_options;
 
 /** Fill *options from argv; TOOL_EXIT_USAGE with a message on a bad command line. */

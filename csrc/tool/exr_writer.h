@@ -6,7 +6,7 @@
 #include <openexr.h>
 #include <stdint.h>
 
-#include "camera_settings.h"
+#include "pixel_rect.h"
 #include "tool_error.h"
 
 typedef struct exr_output_layout {

@@ -9,6 +9,7 @@
 #include "cli_options.h"
 #include "hbao.h"
 #include "info_command.h"
+#include "sequence_command.h"
 #include "tool_error.h"
 
 static void print_version(void)
@@ -31,6 +32,7 @@ int main(int argc, char **argv)
             status = info_command(options.input_path, options.info_json, &error);
             break;
         case TOOL_MODE_COMPUTE: status = ao_command(&options, &error); break;
+        case TOOL_MODE_SEQUENCE: status = sequence_command(&options, &error); break;
         }
     }
     if (status != TOOL_EXIT_SUCCESS) fprintf(stderr, "hbao: error: %s\n", error.message);

@@ -41,7 +41,7 @@ static void write_bytes(png_structp png, png_bytep data, size_t length)
 static void flush_nothing(png_structp png) { (void)png; }
 
 /* libpng reports errors by longjmp; this keeps the message for our error. */
-static char png_message[256];
+static _Thread_local char png_message[256];
 
 static void on_png_error(png_structp png, png_const_charp message)
 {

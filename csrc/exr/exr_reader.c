@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "hbao.h"
 
@@ -125,6 +126,41 @@ fail:
     return status;
 }
 
+/* Scanlines per chunk of `part` (1, 16 or 32 by compression). */
+static int part_lines_per_chunk(exr_input *input, int part, int32_t *lines, tool_error *error)
+{
+    int status = TOOL_EXIT_SUCCESS;
+    CHECK_EXR(exr_get_scanlines_per_chunk(input->context, part, lines),
+              "cannot read the chunk layout");
+    if (*lines < 1)
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: invalid scanlines per chunk (%d)",
+                         input->path, *lines);
+fail:
+    return status;
+}
+
+/* The chunk of `part` that holds scanline y, checked against the data window:
+ * chunks start at the window's top and follow each other; one that does not
+ * (a corrupt offset table) would send the decoder's copy outside the buffers.
+ * Its bytes must lie inside the file, whose size is file_size. */
+static int read_chunk_info(exr_input *input, int part, int32_t lines_per_chunk, int64_t y,
+                           int64_t file_size, exr_chunk_info_t *chunk, tool_error *error)
+{
+    int status = TOOL_EXIT_SUCCESS;
+    CHECK_EXR(exr_read_scanline_chunk_info(input->context, part, (int)y, chunk),
+              "cannot read a chunk (file truncated or corrupt?)");
+    const pixel_rect *window = &input->data_window;
+    if (chunk->start_y != y || chunk->height < 1 || chunk->height > lines_per_chunk ||
+        chunk->width != input->width ||
+        (int64_t)chunk->start_y + chunk->height - 1 > window->max_y ||
+        chunk->data_offset > (uint64_t)file_size ||
+        chunk->packed_size > (uint64_t)file_size - chunk->data_offset)
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: corrupt chunk at scanline %lld",
+                         input->path, (long long)y);
+fail:
+    return status;
+}
+
 /* A channel and the part that holds it, while the parts' lists are merged. */
 typedef struct part_channel {
     exr_attr_chlist_entry_t entry;
@@ -208,6 +244,42 @@ fail:
     return status;
 }
 
+/* Every chunk of every part that the data window needs, read before
+ * anything is allocated for the image: a header claiming a huge image in a
+ * small file fails here (its chunk table or its chunks do not fit in the
+ * file). The chunk table itself is 8 bytes per chunk, which OpenEXRCore
+ * checks against the file size. */
+static int check_chunks(exr_input *input, tool_error *error)
+{
+    int status = TOOL_EXIT_SUCCESS;
+    struct stat file_status;
+    if (stat(input->path, &file_status) != 0)
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: cannot read its size", input->path);
+    const pixel_rect *window = &input->data_window;
+    for (int part = 0; part < input->part_count; ++part) {
+        int32_t lines_per_chunk = 0;
+        status = part_lines_per_chunk(input, part, &lines_per_chunk, error);
+        if (status != TOOL_EXIT_SUCCESS) return status;
+        for (int64_t y = window->min_y; y <= window->max_y; y += lines_per_chunk) {
+            exr_chunk_info_t chunk;
+            status = read_chunk_info(input, part, lines_per_chunk, y,
+                                     (int64_t)file_status.st_size, &chunk, error);
+            if (status != TOOL_EXIT_SUCCESS) {
+                char detail[TOOL_ERROR_MESSAGE_SIZE];
+                snprintf(detail, sizeof detail, "%s", error->message);
+                return tool_fail(error, status,
+                                 "%s: the header claims a %dx%d image, which this %lld-byte "
+                                 "file does not hold (%s)",
+                                 input->path, input->width, input->height,
+                                 (long long)file_status.st_size, detail);
+            }
+        }
+    }
+    input->file_size = (int64_t)file_status.st_size;
+    return status;
+}
+
+
 int exr_input_open(exr_input *input, const char *path, tool_error *error)
 {
     memset(input, 0, sizeof *input);
@@ -287,6 +359,8 @@ int exr_input_open(exr_input *input, const char *path, tool_error *error)
             goto fail;
         }
     }
+    status = check_chunks(input, error);
+    if (status != TOOL_EXIT_SUCCESS) goto fail;
     return TOOL_EXIT_SUCCESS;
 
 fail:
@@ -319,29 +393,15 @@ static int read_part(exr_input *input, int part, const exr_channel_request *requ
     bool decoder_ready = false;
 
     int32_t lines_per_chunk = 0;
-    CHECK_EXR(exr_get_scanlines_per_chunk(input->context, part, &lines_per_chunk),
-              "cannot read the chunk layout");
-    if (lines_per_chunk < 1) {
-        status = tool_fail(error, TOOL_EXIT_RUNTIME, "%s: invalid scanlines per chunk (%d)",
-                           input->path, lines_per_chunk);
-        goto fail;
-    }
+    status = part_lines_per_chunk(input, part, &lines_per_chunk, error);
+    if (status != TOOL_EXIT_SUCCESS) goto fail;
 
     const pixel_rect *window = &input->data_window;
     for (int64_t y = window->min_y; y <= window->max_y; y += lines_per_chunk) {
         exr_chunk_info_t chunk;
-        CHECK_EXR(exr_read_scanline_chunk_info(input->context, part, (int)y, &chunk),
-                  "cannot read a chunk (file truncated or corrupt?)");
-        /* Chunks start at the data window's top and follow each other; one
-         * that does not (a corrupt offset table) would send the copy below
-         * outside the buffers. */
-        if (chunk.start_y != y || chunk.height < 1 || chunk.height > lines_per_chunk ||
-            chunk.width != input->width ||
-            (int64_t)chunk.start_y + chunk.height - 1 > window->max_y) {
-            status = tool_fail(error, TOOL_EXIT_RUNTIME, "%s: corrupt chunk at scanline %lld",
-                               input->path, (long long)y);
-            goto fail;
-        }
+        status = read_chunk_info(input, part, lines_per_chunk, y, input->file_size, &chunk,
+                                 error);
+        if (status != TOOL_EXIT_SUCCESS) goto fail;
         if (!decoder_ready) {
             CHECK_EXR(exr_decoding_initialize(input->context, part, &chunk, &decoder),
                       "cannot start decoding");

@@ -6,14 +6,14 @@
  * is the data window; rows are stored top row first, whatever the file's line
  * order. The header fields below come from part 0.
  */
-#ifndef HBAO_TOOL_EXR_READER_H
-#define HBAO_TOOL_EXR_READER_H
+#ifndef HBAO_EXR_READER_H
+#define HBAO_EXR_READER_H
 
 #include <openexr.h>
 #include <stdbool.h>
 #include <stdint.h>
 
-#include "camera_settings.h"
+#include "pixel_rect.h"
 #include "tool_error.h"
 
 typedef struct exr_input {
@@ -28,6 +28,7 @@ typedef struct exr_input {
     float screen_window_width;
     exr_compression_t compression;
     exr_lineorder_t line_order;
+    int64_t file_size; /**< in bytes, when opened */
     int part_count;
     /** Every part's channels, sorted by name; names are unique across parts. */
     const exr_attr_chlist_t *channels;
@@ -47,7 +48,11 @@ typedef struct exr_channel_request {
 /**
  * Open `path`, check that it is an image the tool can read (scanline parts
  * that share one data and display window, no channel name in two parts,
- * channels not subsampled, size within hbao's limits) and fill *input.
+ * channels not subsampled, size within hbao's limits, every chunk of every
+ * part that the data window needs listed and inside the file) and fill
+ * *input. So a caller may allocate for width x height once this succeeds: a
+ * corrupt header's size claim is refused here, before anyone reserves memory
+ * for it.
  * On failure *input needs no exr_input_close().
  */
 int exr_input_open(exr_input *input, const char *path, tool_error *error);
@@ -80,4 +85,4 @@ exr_context_initializer_t exr_quiet_initializer(void);
 const char *exr_error_text(exr_result_t result);
 void exr_clear_last_error(void);
 
-#endif /* HBAO_TOOL_EXR_READER_H */
+#endif /* HBAO_EXR_READER_H */

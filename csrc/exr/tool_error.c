@@ -16,9 +16,12 @@ int tool_fail(tool_error *error, int status, const char *format, ...)
 void tool_warn(const char *format, ...)
 {
     va_list arguments;
+    /* One line at a time when several frames run at once. */
+    flockfile(stderr);
     fputs("hbao: warning: ", stderr);
     va_start(arguments, format);
     vfprintf(stderr, format, arguments);
     va_end(arguments);
     fputc('\n', stderr);
+    funlockfile(stderr);
 }

@@ -1,8 +1,10 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
 /*
- * Error reporting for the hbao tool: each step fills a tool_error with a
- * message and returns the exit status the failure deserves, so that main()
- * prints one line (`hbao: error: ...`) and exits with it.
+ * Error reporting for the hbao tool and the EXR reader below it (which
+ * libhbao_exr shares): each step fills a tool_error with a message and
+ * returns the exit status the failure deserves, so that the tool's main()
+ * prints one line (`hbao: error: ...`) and exits with it, and libhbao_exr
+ * hands the message to its caller.
  */
 #ifndef HBAO_TOOL_ERROR_H
 #define HBAO_TOOL_ERROR_H

@@ -1,0 +1,180 @@
+/* SPDX-License-Identifier: GPL-2.0-or-later */
+#include "sequence_command.h"
+
+#include <limits.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "ao_command.h"
+#include "atomic_file.h"
+#include "frame_pattern.h"
+
+typedef struct frame_outcome {
+    int32_t frame;
+    int status;   /* TOOL_EXIT_* */
+    bool skipped; /* up to date */
+} frame_outcome;
+
+typedef struct sequence_run {
+    const cli_options *options;
+    frame_outcome *outcomes;
+    int64_t count;
+    int64_t next;     /* the next frame to start */
+    int64_t finished; /* for the progress count */
+    pthread_mutex_t lock;
+} sequence_run;
+
+static bool newer_or_equal(const struct stat *a, const struct stat *b)
+{
+    if (a->st_mtim.tv_sec != b->st_mtim.tv_sec) return a->st_mtim.tv_sec > b->st_mtim.tv_sec;
+    return a->st_mtim.tv_nsec >= b->st_mtim.tv_nsec;
+}
+
+/* Up to date, as make decides: every output exists and is at least as new
+ * as the input and the camera file. Changed flags are not detected, hence
+ * --force. */
+static bool up_to_date(const cli_options *frame)
+{
+    struct stat input, output, other;
+    if (stat(frame->input_path, &input) != 0 || stat(frame->output_path, &output) != 0 ||
+        !S_ISREG(output.st_mode) || !newer_or_equal(&output, &input))
+        return false;
+    if (frame->camera_path != NULL &&
+        (stat(frame->camera_path, &other) != 0 || !newer_or_equal(&output, &other)))
+        return false;
+    if (frame->preview_path != NULL &&
+        (stat(frame->preview_path, &other) != 0 || !newer_or_equal(&other, &input)))
+        return false;
+    return true;
+}
+
+static void report(sequence_run *run, const frame_outcome *outcome, const char *output,
+                   const char *message)
+{
+    pthread_mutex_lock(&run->lock);
+    const int64_t done = ++run->finished;
+    flockfile(stderr);
+    if (outcome->status != TOOL_EXIT_SUCCESS)
+        fprintf(stderr, "hbao: [%lld/%lld] frame %d failed: %s\n", (long long)done,
+                (long long)run->count, outcome->frame, message);
+    else
+        fprintf(stderr, "hbao: [%lld/%lld] frame %d: %s%s\n", (long long)done,
+                (long long)run->count, outcome->frame, output,
+                outcome->skipped ? " is up to date, skipped" : "");
+    funlockfile(stderr);
+    pthread_mutex_unlock(&run->lock);
+}
+
+static void run_frame(sequence_run *run, frame_outcome *outcome)
+{
+    const cli_options *options = run->options;
+    char input[PATH_MAX], output[PATH_MAX], preview[PATH_MAX];
+    cli_options frame = *options;
+    tool_error error = {{0}};
+    frame.mode = TOOL_MODE_COMPUTE;
+    frame.input_path = input;
+    frame.output_path = output;
+    frame.preview_path = options->preview_path ? preview : NULL;
+    if (!frame_pattern_path(options->input_path, outcome->frame, input, sizeof input) ||
+        !frame_pattern_path(options->output_path, outcome->frame, output, sizeof output) ||
+        (options->preview_path != NULL &&
+         !frame_pattern_path(options->preview_path, outcome->frame, preview, sizeof preview))) {
+        outcome->status = tool_fail(&error, TOOL_EXIT_USAGE, "a path is too long");
+    } else if (!options->force && up_to_date(&frame)) {
+        outcome->skipped = true;
+        outcome->status = TOOL_EXIT_SUCCESS;
+    } else {
+        outcome->status = ao_command(&frame, &error);
+    }
+    report(run, outcome, output, error.message);
+}
+
+static void *worker(void *context)
+{
+    sequence_run *run = context;
+    for (;;) {
+        pthread_mutex_lock(&run->lock);
+        const int64_t index = run->next++;
+        pthread_mutex_unlock(&run->lock);
+        if (index >= run->count) return NULL;
+        run_frame(run, &run->outcomes[index]);
+    }
+}
+
+/* "3 of 250 frames failed: 4, 17, 200" (the list shortened to fit). */
+static int summarize(const sequence_run *run, tool_error *error)
+{
+    static const char ellipsis[] = ", ...";
+    int status = TOOL_EXIT_SUCCESS;
+    int64_t failed = 0;
+    char list[512] = "";
+    bool shortened = false;
+    for (int64_t i = 0; i < run->count; ++i) {
+        const frame_outcome *outcome = &run->outcomes[i];
+        if (outcome->status == TOOL_EXIT_SUCCESS) continue;
+        if (outcome->status > status) status = outcome->status;
+        char item[24];
+        snprintf(item, sizeof item, "%s%d", failed > 0 ? ", " : "", outcome->frame);
+        ++failed;
+        if (shortened) continue;
+        if (strlen(list) + strlen(item) + sizeof ellipsis > sizeof list) {
+            strcat(list, ellipsis);
+            shortened = true;
+        } else {
+            strcat(list, item);
+        }
+    }
+    if (failed == 0) return TOOL_EXIT_SUCCESS;
+    return tool_fail(error, status, "%lld of %lld frames failed: %s", (long long)failed,
+                     (long long)run->count, list);
+}
+
+static int available_cores(void)
+{
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    return cores < 1 ? 1 : (int)cores;
+}
+
+int sequence_command(const cli_options *options, tool_error *error)
+{
+    sequence_run run = {0};
+    run.count = frame_list_count(&options->frames);
+    run.outcomes = calloc((size_t)run.count, sizeof *run.outcomes);
+    if (run.outcomes == NULL) return tool_fail(error, TOOL_EXIT_RUNTIME, "out of memory");
+    for (int64_t i = 0; i < run.count; ++i) run.outcomes[i].frame = frame_list_at(&options->frames, i);
+
+    cli_options shared = *options;
+    int jobs = options->jobs < 1 ? 1 : options->jobs;
+    if (jobs > run.count) jobs = (int)run.count;
+    /* Frames at once share the cores: each frame's computation gets its
+     * part, unless --threads says otherwise. */
+    if (shared.params.threads == 0 && jobs > 1) {
+        shared.params.threads = available_cores() / jobs;
+        if (shared.params.threads < 1) shared.params.threads = 1;
+    }
+    run.options = &shared;
+    pthread_mutex_init(&run.lock, NULL);
+
+    /* The workers run with the cleanup signals blocked, so that the main
+     * thread (waiting below) takes them and removes every frame's
+     * temporary files. */
+    atomic_file_install_signal_handlers();
+    sigset_t previous;
+    atomic_file_block_signals(&previous);
+    pthread_t threads[ATOMIC_FILE_MAX_OPEN / 2];
+    int started = 0;
+    for (; started < jobs; ++started)
+        if (pthread_create(&threads[started], NULL, worker, &run) != 0) break;
+    atomic_file_restore_signals(&previous);
+    if (started == 0) worker(&run); /* no thread could start: this one does the work */
+    for (int t = 0; t < started; ++t) pthread_join(threads[t], NULL);
+
+    int status = summarize(&run, error);
+    pthread_mutex_destroy(&run.lock);
+    free(run.outcomes);
+    return status;
+}
