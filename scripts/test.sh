@@ -4,7 +4,8 @@
 #   1. install what is missing (scripts/setup.sh),
 #   2. build (Release) and run the C tests (ctest),
 #   3. build again with AddressSanitizer + UndefinedBehaviorSanitizer and run
-#      the C tests and a fuzz pass of the CLI under it,
+#      the C tests and a mutation pass of the CLI under it, then 60 s of the
+#      libFuzzer targets (scripts/fuzz.sh),
 #   4. check PEP 8 of all Python code,
 #   5. run the Python tests (pytest): the ctypes binding, the CLI on EXRs
 #      written by Blender, the add-on in real headless and Xvfb Blender renders,
@@ -37,10 +38,11 @@ cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=Debug -DHBAO_SANITIZE=ON \
 cmake --build build-sanitize -j"$JOBS"
 ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
     ctest --test-dir build-sanitize --output-on-failure --no-tests=error -j"$JOBS"
-if [ -x scripts/fuzz_cli.sh ]; then
-    # 100 mutations per fixture keep this step short; the script defaults to 500
-    scripts/fuzz_cli.sh 100 1
-fi
+# 100 mutations per fixture keep this step short; the script defaults to 500
+scripts/fuzz_cli.sh 100 1
+
+echo "== coverage-guided fuzzing (libFuzzer + ASan + UBSan), 60 s"
+scripts/fuzz.sh 60
 
 echo "== PEP 8"
 "$PYTHON" -m pycodestyle addon scripts tests $( [ -d bench ] && echo bench )
