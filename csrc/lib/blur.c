@@ -2,6 +2,7 @@
 /* Cross-bilateral (depth-aware) blur, applied separably: rows, then columns
  * (Bavoil & Sainz; the filter is not separable, but the separable version is
  * close and costs 2r+1 taps instead of (2r+1)^2). */
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 
@@ -40,7 +41,11 @@ HBAO_VECTOR_CLONES static void blur_row(void *context, int j) {
     for (int i = 0; i < width; i++) {
         sum[i] = 0.0f;
         weight_sum[i] = 0.0f;
-        inv_zc[i] = zc[i] > 0.0f ? sharpness / zc[i] : 0.0f;
+        /* sharpness / z overflows for tiny depths (1e-40, or 1e-37 at the
+         * largest sharpness); an infinite factor would turn the centre tap's
+         * 0 difference into NaN. Capped at FLT_MAX the product stays a number:
+         * the centre weighs 1, and other taps 0 or their usual weight. */
+        inv_zc[i] = zc[i] > 0.0f ? fminf(sharpness / zc[i], FLT_MAX) : 0.0f;
     }
     for (int k = -radius; k <= radius; k++) {
         const float spatial = job->spatial[k < 0 ? -k : k];

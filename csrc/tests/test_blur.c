@@ -1,0 +1,129 @@
+/* SPDX-License-Identifier: GPL-2.0-or-later */
+/* The stages after the horizon search: the cross-bilateral blur (depth and
+ * normal weights), the half-resolution upsample and the output, on inputs at
+ * the ends of the float range and on a thin fin the blur must not wash out. */
+#include <float.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "hbao.h"
+#include "scene.h"
+#include "test_harness.h"
+
+/* --- helpers ------------------------------------------------------------- */
+
+static int count_outside_unit_range(const float *ao, size_t pixels) {
+    int bad = 0;
+    for (size_t k = 0; k < pixels; k++) bad += !(ao[k] >= 0.0f && ao[k] <= 1.0f);
+    return bad;
+}
+
+static float minimum(const float *ao, size_t pixels) {
+    float low = 1.0f;
+    for (size_t k = 0; k < pixels; k++) low = ao[k] < low ? ao[k] : low;
+    return low;
+}
+
+/* --- depths at the ends of the float range (issue 13) --------------------- */
+
+/* A plane facing the camera (every pixel at the same planar depth) occludes
+ * nothing, at any scale: AO = 1 up to the 1e-4 that float rounding of
+ * positions allows (test_ao.c's plane tests), for every depth from a
+ * denormal to near FLT_MAX and with the blur at any sharpness. Before the
+ * fix, 1e-40 gave AO = 0: sharpness / depth overflowed to infinity and the
+ * centre tap's weight became 0 * inf = NaN. */
+TEST_CASE(flat_plane_at_extreme_depths_is_unoccluded) {
+    static const float depths[] = {1e-45f, 1e-40f, 1e-38f, 1e-36f, 1e-30f, 1.0f, 1e30f, 3e38f};
+    static const float sharpness[] = {0.0f, HBAO_DEFAULT_BLUR_SHARPNESS, HBAO_MAX_BLUR_SHARPNESS};
+    enum { w = 48, h = 32 };
+    static float depth[w * h], ao[w * h];
+    hbao_camera camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
+    for (size_t d = 0; d < sizeof depths / sizeof depths[0]; d++) {
+        for (int k = 0; k < w * h; k++) depth[k] = depths[d];
+        for (int variant = 0; variant < 12; variant++) {
+            hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+            p.background_depth = INFINITY; /* 3e38 is geometry here */
+            p.blur_size = variant & 1 ? 15 : HBAO_DEFAULT_BLUR_SIZE;
+            p.half_resolution = (variant >> 1) & 1;
+            p.blur_sharpness = sharpness[variant >> 2];
+            p.threads = 1 + (variant & 1);
+            hbao_channel channel = {depth, 1, w};
+            CHECK_RESULT(hbao_compute(&p, &camera, w, h, &channel, NULL, ao, w), HBAO_SUCCESS);
+            const float low = minimum(ao, w * h);
+            if (low < 1.0f - 1e-4f) printf("  depth %g, variant %d: min AO %g\n", depths[d], variant, low);
+            CHECK_NEAR(low, 1.0f, 1e-4);
+            CHECK(count_outside_unit_range(ao, w * h) == 0);
+        }
+    }
+}
+
+/* Two planes facing the camera side by side, one at a denormal depth and one
+ * at 1e30: each is flat and further than the radius from the other, so AO is
+ * 1 on both. The blur meets relative depth differences of 1e70 (infinite in
+ * float) between them: their taps must get weight 0 (or, at sharpness 0, the
+ * plain Gaussian's), never NaN. */
+TEST_CASE(planes_at_denormal_and_huge_depth_side_by_side) {
+    enum { w = 40, h = 24 };
+    static float depth[w * h], ao[w * h];
+    for (int j = 0; j < h; j++)
+        for (int i = 0; i < w; i++) depth[j * w + i] = (i < w / 2) != (j < h / 2) ? 1e-40f : 1e30f;
+    hbao_camera camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
+    for (int variant = 0; variant < 8; variant++) {
+        hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+        p.background_depth = INFINITY;
+        p.blur_size = variant & 1 ? 9 : HBAO_DEFAULT_BLUR_SIZE;
+        p.half_resolution = (variant >> 1) & 1;
+        p.blur_sharpness = variant & 4 ? 0.0f : HBAO_DEFAULT_BLUR_SHARPNESS;
+        hbao_channel channel = {depth, 1, w};
+        CHECK_RESULT(hbao_compute(&p, &camera, w, h, &channel, NULL, ao, w), HBAO_SUCCESS);
+        const float low = minimum(ao, w * h);
+        if (low < 1.0f - 1e-4f) printf("  variant %d: min AO %g\n", variant, low);
+        CHECK_NEAR(low, 1.0f, 1e-4);
+        CHECK(count_outside_unit_range(ao, w * h) == 0);
+    }
+}
+
+/* Random depths spread over the whole positive float range, denormals
+ * included, with and without normals: the output is in [0, 1] and, as for
+ * ordinary scenes, bit-identical for the scalar reference on 1 thread and
+ * the fastest code on 3 threads (overflows must not depend on the path). */
+TEST_CASE(random_depths_over_the_float_range_stay_in_range) {
+    enum { w = 37, h = 29 };
+    static float depth[w * h], normal[3 * w * h], ao[w * h], reference[w * h];
+    uint32_t state = 12345u;
+    for (int trial = 0; trial < 16; trial++) {
+        for (int k = 0; k < w * h; k++) {
+            state = state * 1664525u + 1013904223u;
+            /* exponent bits 0..254: every finite magnitude from denormals up */
+            union {
+                uint32_t u;
+                float f;
+            } bits;
+            bits.u = state >> 1;
+            if ((bits.u >> 23) == 255u) bits.u &= ~(1u << 30);
+            depth[k] = bits.f;
+            for (int c = 0; c < 3; c++) normal[3 * k + c] = (float)((state >> (8 * c)) & 255u) - 127.5f;
+        }
+        hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+        p.background_depth = INFINITY;
+        p.radius = trial & 1 ? 1e-30f : 1e30f;
+        p.blur_size = 1 + 2 * (trial % 8);
+        p.half_resolution = (trial >> 1) & 1;
+        p.blur_sharpness = (trial >> 2) & 1 ? HBAO_MAX_BLUR_SHARPNESS : 0.0f;
+        hbao_camera camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
+        hbao_channel d = {depth, 1, w};
+        hbao_channel n = {normal, 3, 3 * (int64_t)w};
+        const hbao_channel *given = (trial >> 3) & 1 ? &n : NULL;
+        p.threads = 3;
+        CHECK_RESULT(hbao_compute(&p, &camera, w, h, &d, given, ao, w), HBAO_SUCCESS);
+        CHECK(count_outside_unit_range(ao, w * h) == 0);
+        p.threads = 1;
+        p.implementation = HBAO_IMPLEMENTATION_SCALAR;
+        CHECK_RESULT(hbao_compute(&p, &camera, w, h, &d, given, reference, w), HBAO_SUCCESS);
+        CHECK(memcmp(ao, reference, sizeof ao) == 0);
+    }
+}
+
+TEST_MAIN(TEST_ENTRY(flat_plane_at_extreme_depths_is_unoccluded),
+          TEST_ENTRY(planes_at_denormal_and_huge_depth_side_by_side),
+          TEST_ENTRY(random_depths_over_the_float_range_stay_in_range))
