@@ -51,10 +51,11 @@ typedef struct ring_row {
     float *ao, *nx, *ny, *nz;
 } ring_row;
 
-/* The taps of one pass for one row of centres: tap t of pixel i reads
- * z[t][i + offset[t]] (and likewise ao and the normal); along a row every
- * tap reads the centre row shifted by offset t - r, down a column every tap
- * reads its own row unshifted. Taps outside the image are left out. */
+/* The taps of one pass for one row of centres, the centre itself left out
+ * (it weighs 1): tap t of pixel i reads z[t][i + offset[t]] (and likewise ao
+ * and the normal); along a row every tap reads the centre row shifted by
+ * its offset k, down a column every tap reads its own row unshifted. Taps
+ * outside the image are left out. */
 typedef struct tap_set {
     int count;
     int along_row; /* 1: offsets shift along the row, so edge pixels lose taps */
@@ -65,17 +66,17 @@ typedef struct tap_set {
     float spatial[2 * MAX_BLUR_RADIUS + 1];
 } tap_set;
 
-/* The centre row of a pass: its depth and guide normals. */
+/* The centre row of a pass: its depth, AO and guide normals. */
 typedef struct centre_row {
-    const float *z, *nx, *ny, *nz;
+    const float *z, *ao, *nx, *ny, *nz;
 } centre_row;
 
-/* One pixel, taps in order; the weight of a tap is
- * spatial * exp(-(factor * (z - zc))^2 - NS * max(0, 1 - n.c)), 0 on
- * background, with factor = min(sharpness / zc, FLT_MAX): sharpness / zc
+/* One pixel: the centre with weight 1, then the taps in order; the weight
+ * of a tap is spatial * exp(-(factor * (z - zc))^2 - NS * max(0, 1 - n.c)),
+ * 0 on background, with factor = min(sharpness / zc, FLT_MAX): sharpness / zc
  * overflows for tiny depths (below ~1e-37, denormals), and an infinite
- * factor would make the centre tap's 0 * inf a NaN; capped, the centre tap
- * weighs ~1 and a tap whose scaled difference overflows weighs 0. A 0/1
+ * factor would turn a tap at the same depth into 0 * inf = NaN; capped, a
+ * tap whose scaled difference overflows weighs 0. A 0/1
  * factor rather than a branch marks background; the weight is finite, so
  * the product is exact. The vector loop below performs exactly these
  * operations lane by lane. Background centres give 1. */
@@ -84,7 +85,7 @@ static HBAO_ALWAYS_INLINE float blur_pixel(const tap_set *taps, const centre_row
     const float zc = c->z[i];
     const float scaled = zc > 0.0f ? sharpness / zc : 0.0f;
     const float factor = scaled < FLT_MAX ? scaled : FLT_MAX;
-    float sum = 0.0f, weight_sum = 0.0f;
+    float sum = c->ao[i], weight_sum = 1.0f;
     for (int t = 0; t < taps->count; t++) {
         const int at = i + taps->offset[t];
         if (taps->along_row && (at < 0 || at >= width)) continue;
@@ -100,8 +101,6 @@ static HBAO_ALWAYS_INLINE float blur_pixel(const tap_set *taps, const centre_row
         sum += weight * taps->ao[t][at];
         weight_sum += weight;
     }
-    /* The centre tap always counts (weight > 0) unless the pixel is
-     * background. */
     return zc > 0.0f ? sum / weight_sum : 1.0f;
 }
 
@@ -153,7 +152,7 @@ static HBAO_ALWAYS_INLINE void blur_lanes(const tap_set *taps, const centre_row 
     const vfloat factor = select_lanes(scaled < FLT_MAX, scaled, zero + FLT_MAX);
     const vfloat cx = load_lanes(c->nx + i), cy = load_lanes(c->ny + i),
                  cz = load_lanes(c->nz + i);
-    vfloat sum = zero, weight_sum = zero;
+    vfloat sum = load_lanes(c->ao + i), weight_sum = one;
     for (int t = 0; t < taps->count; t++) {
         const int at = i + taps->offset[t];
         const vfloat z = load_lanes(taps->z[t] + at);
@@ -169,7 +168,7 @@ static HBAO_ALWAYS_INLINE void blur_lanes(const tap_set *taps, const centre_row 
         sum += weight * load_lanes(taps->ao[t] + at);
         weight_sum += weight;
     }
-    const vfloat blurred = select_lanes(geometry, sum / select_lanes(geometry, weight_sum, one), one);
+    const vfloat blurred = select_lanes(geometry, sum / weight_sum, one);
     memcpy(target + i, &blurred, sizeof blurred);
 }
 
@@ -234,18 +233,20 @@ static HBAO_ALWAYS_INLINE void make_row(const finish_job *job, band_memory *m, i
     }
     const float *z = job->depth + (size_t)j * width;
     tap_set taps;
-    taps.count = 2 * radius + 1;
+    taps.count = 0;
     taps.along_row = 1;
-    for (int t = 0; t < taps.count; t++) {
-        taps.z[t] = z;
-        taps.ao[t] = raw;
-        taps.nx[t] = slot->nx;
-        taps.ny[t] = slot->ny;
-        taps.nz[t] = slot->nz;
-        taps.offset[t] = t - radius;
-        taps.spatial[t] = job->spatial[t < radius ? radius - t : t - radius];
+    for (int k = -radius; k <= radius; k++) {
+        if (k == 0) continue;
+        taps.z[taps.count] = z;
+        taps.ao[taps.count] = raw;
+        taps.nx[taps.count] = slot->nx;
+        taps.ny[taps.count] = slot->ny;
+        taps.nz[taps.count] = slot->nz;
+        taps.offset[taps.count] = k;
+        taps.spatial[taps.count] = job->spatial[k < 0 ? -k : k];
+        taps.count++;
     }
-    const centre_row centre = {z, slot->nx, slot->ny, slot->nz};
+    const centre_row centre = {z, raw, slot->nx, slot->ny, slot->nz};
     blur_pass(&taps, &centre, job->sharpness, width, radius, slot->ao);
 }
 
@@ -261,7 +262,7 @@ static HBAO_ALWAYS_INLINE void finish_row(const finish_job *job, band_memory *m,
         taps.count = 0;
         taps.along_row = 0;
         for (int k = -radius; k <= radius; k++) {
-            if (j + k < 0 || j + k >= job->height) continue;
+            if (k == 0 || j + k < 0 || j + k >= job->height) continue;
             const ring_row *tap = &m->ring[(j + k) % slots];
             taps.z[taps.count] = job->depth + (size_t)(j + k) * width;
             taps.ao[taps.count] = tap->ao;
@@ -272,7 +273,7 @@ static HBAO_ALWAYS_INLINE void finish_row(const finish_job *job, band_memory *m,
             taps.spatial[taps.count] = job->spatial[k < 0 ? -k : k];
             taps.count++;
         }
-        const centre_row c = {zc, centre->nx, centre->ny, centre->nz};
+        const centre_row c = {zc, centre->ao, centre->nx, centre->ny, centre->nz};
         blur_pass(&taps, &c, job->sharpness, width, radius, m->finished);
         blurred = m->finished;
     }
