@@ -56,14 +56,15 @@ static HBAO_ALWAYS_INLINE void finish_pixel(float z, float sum, float weight_sum
     *nz = averaged ? normal_sum[2] * inverse : nearest_normal[2];
 }
 
-static HBAO_ALWAYS_INLINE void upsample_row(const hbao_grid *half, const float *half_ao,
-                                            const float *full_depth, int width, int j,
-                                            float *restrict out, float *restrict nx,
-                                            float *restrict ny, float *restrict nz) {
+static HBAO_ALWAYS_INLINE void upsample_rows(const hbao_grid *half, const float *half_ao,
+                                             const float *full_depth, int width, int j,
+                                             int two_rows, float *restrict out,
+                                             float *restrict nx, float *restrict ny,
+                                             float *restrict nz) {
     const int half_width = half->width;
     const int r0 = j / 2;
-    const int r1 = (j & 1) && r0 + 1 < half->height ? r0 + 1 : r0;
-    const float top_weight = r1 != r0 ? 0.5f : 1.0f, bottom_weight = 1.0f - top_weight;
+    const int r1 = two_rows ? r0 + 1 : r0;
+    const float top_weight = two_rows ? 0.5f : 1.0f, bottom_weight = 1.0f - top_weight;
     const float *z_top = half->depth + (size_t)r0 * half_width;
     const float *z_bottom = half->depth + (size_t)r1 * half_width;
     const float *ao_top = half_ao + (size_t)r0 * half_width;
@@ -80,8 +81,9 @@ static HBAO_ALWAYS_INLINE void upsample_row(const hbao_grid *half, const float *
         float normal_sum[3] = {0.0f, 0.0f, 0.0f};
         add_candidate(top_weight, z_top[k], ao_top[k], n_top + 3 * k, z, &sum, &weight_sum,
                       &nearest_ao, &nearest_difference, normal_sum, normal);
-        add_candidate(bottom_weight, z_bottom[k], ao_bottom[k], n_bottom + 3 * k, z, &sum,
-                      &weight_sum, &nearest_ao, &nearest_difference, normal_sum, normal);
+        if (two_rows)
+            add_candidate(bottom_weight, z_bottom[k], ao_bottom[k], n_bottom + 3 * k, z, &sum,
+                          &weight_sum, &nearest_ao, &nearest_difference, normal_sum, normal);
         finish_pixel(z, sum, weight_sum, nearest_ao, normal_sum, normal, out + 2 * k, nx + 2 * k,
                      ny + 2 * k, nz + 2 * k);
     }
@@ -100,14 +102,30 @@ static HBAO_ALWAYS_INLINE void upsample_row(const hbao_grid *half, const float *
                       &weight_sum, &nearest_ao, &nearest_difference, normal_sum, normal);
         add_candidate(right_weight * top_weight, z_top[right], ao_top[right], n_top + 3 * right, z,
                       &sum, &weight_sum, &nearest_ao, &nearest_difference, normal_sum, normal);
-        add_candidate(left_weight * bottom_weight, z_bottom[k], ao_bottom[k], n_bottom + 3 * k, z,
-                      &sum, &weight_sum, &nearest_ao, &nearest_difference, normal_sum, normal);
-        add_candidate(right_weight * bottom_weight, z_bottom[right], ao_bottom[right],
-                      n_bottom + 3 * right, z, &sum, &weight_sum, &nearest_ao,
-                      &nearest_difference, normal_sum, normal);
+        if (two_rows) {
+            add_candidate(left_weight * bottom_weight, z_bottom[k], ao_bottom[k], n_bottom + 3 * k,
+                          z, &sum, &weight_sum, &nearest_ao, &nearest_difference, normal_sum,
+                          normal);
+            add_candidate(right_weight * bottom_weight, z_bottom[right], ao_bottom[right],
+                          n_bottom + 3 * right, z, &sum, &weight_sum, &nearest_ao,
+                          &nearest_difference, normal_sum, normal);
+        }
         finish_pixel(z, sum, weight_sum, nearest_ao, normal_sum, normal, out + 2 * k + 1,
                      nx + 2 * k + 1, ny + 2 * k + 1, nz + 2 * k + 1);
     }
+}
+
+/* Rows that lie on a half-grid row (and the last odd row, which has no row
+ * below) have bilinear weight 0 on the row below: a candidate of weight 0
+ * adds exactly nothing, so those rows skip it. */
+static HBAO_ALWAYS_INLINE void upsample_row(const hbao_grid *half, const float *half_ao,
+                                            const float *full_depth, int width, int j,
+                                            float *restrict out, float *restrict nx,
+                                            float *restrict ny, float *restrict nz) {
+    if ((j & 1) && j / 2 + 1 < half->height)
+        upsample_rows(half, half_ao, full_depth, width, j, 1, out, nx, ny, nz);
+    else
+        upsample_rows(half, half_ao, full_depth, width, j, 0, out, nx, ny, nz);
 }
 
 static void upsample_row_portable(const hbao_grid *half, const float *half_ao,
