@@ -211,7 +211,8 @@ int main(int argc, char **argv) {
     printf("Cosine integration; 'defaults' = %d directions x %d steps, blur %d. Best implementation on "
            "this CPU: %s. The scalar column is the portable reference code (horizon search and blur) on "
            "1 thread. Cells: median wall-clock ms (median process CPU ms, all threads together). Blur "
-           "share: (time - time without blur) / time, on the last column, wall (CPU).\n",
+           "share: (time - time without blur) / time, on the last column, wall (CPU; the blur's own CPU "
+           "ms).\n",
            HBAO_DEFAULT_DIRECTIONS, HBAO_DEFAULT_STEPS, HBAO_DEFAULT_BLUR_SIZE, kernel_names[best]);
     print_load("before");
     printf("\n| settings | size |");
@@ -283,8 +284,9 @@ int main(int argc, char **argv) {
         timing unblurred;
         if (!time_compute(&p, &b, runs, ao, &unblurred)) return 1;
         const timing with_blur = measured_times[r][last_column];
-        printf(" %.0f %% (%.0f %%) |\n", 100.0 * (with_blur.wall - unblurred.wall) / with_blur.wall,
-               100.0 * (with_blur.cpu - unblurred.cpu) / with_blur.cpu);
+        printf(" %.0f %% (%.0f %%; %.1f ms) |\n", 100.0 * (with_blur.wall - unblurred.wall) / with_blur.wall,
+               100.0 * (with_blur.cpu - unblurred.cpu) / with_blur.cpu,
+               1e3 * (with_blur.cpu - unblurred.cpu));
         fflush(stdout);
         free(ao);
         free(reference);

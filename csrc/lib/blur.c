@@ -126,21 +126,15 @@ static HBAO_ALWAYS_INLINE vfloat select_lanes(vint mask, vfloat a, vfloat b) {
     return (vfloat)((mask & (vint)a) | (~mask & (vint)b));
 }
 
-/* hbao_exp_negative, lane by lane */
+/* hbao_exp_negative, lane by lane: a loop of LANES iterations that the
+ * compiler vectorizes, so that the polynomial is written once. */
 static HBAO_ALWAYS_INLINE vfloat exp_negative_lanes(vfloat x) {
-    const vint keep = x < 87.0f;
-    const vfloat in = (vfloat)((vint)x & keep);
-    const vfloat y = in * 1.44269504088896341f;
-    const vint n = __builtin_convertvector(y, vint);
-    const vfloat f = y - __builtin_convertvector(n, vfloat);
-    vfloat p = f * -1.530163e-4f + 1.3333558e-3f;
-    p = p * f - 9.6181291e-3f;
-    p = p * f + 5.5504109e-2f;
-    p = p * f - 2.4022651e-1f;
-    p = p * f + 6.9314718e-1f;
-    p = 1.0f - p * f;
-    const vfloat scale = (vfloat)((127 - n) << 23);
-    return (vfloat)((vint)(p * scale) & keep);
+    float in[LANES], out[LANES];
+    memcpy(in, &x, sizeof in);
+    for (int l = 0; l < LANES; l++) out[l] = hbao_exp_negative(in[l]);
+    vfloat result;
+    memcpy(&result, out, sizeof result);
+    return result;
 }
 
 static HBAO_ALWAYS_INLINE void blur_lanes(const tap_set *taps, const centre_row *c, float sharpness,
