@@ -5,10 +5,10 @@
  * at 1920x1080 full and half resolution, 8 x 6 with a 15-pixel blur, and the
  * defaults at 3840x2160. Each row is timed for every implementation the CPU
  * has (the scalar reference on 1 thread, AVX2 and AVX-512 on 1 and 2
- * threads; --implementations picks which), median of --runs runs after one
- * warm-up run, all in the same process so that ratios compare like with
- * like on a loaded machine. The blur's share is the row's time minus the
- * same row without blur, over the row's time, on the fastest column. Prints
+ * threads; --implementations picks which), median of --runs rounds after a
+ * warm-up round; a round times every column once, so that ratios compare
+ * like with like on a loaded machine. The blur's share is the row's time
+ * minus the same row without blur, over the row's time, on the last column. Prints
  * Markdown tables. Not a test: it asserts nothing, but says when a column's
  * output is not bit-identical to the scalar column's. */
 #include <stdio.h>
@@ -103,41 +103,25 @@ static void bench_scene_make(bench_scene *b, int width, int height) {
     scene_render(&s, &b->view, &b->depth, &b->normal);
 }
 
-/* Median wall-clock and process CPU seconds per frame of `runs` runs after
- * a warm-up run; the output of the last run stays in ao. On a loaded
- * machine the CPU time (all threads together) is the steadier of the two.
- * Returns 0 on error. */
+/* One call's wall-clock and process CPU seconds (all threads together; on
+ * a loaded machine the steadier of the two). Returns 0 on error. */
 typedef struct timing {
     double wall, cpu;
 } timing;
 
-static int time_compute(const hbao_params *p, const bench_scene *b, int runs, float *ao,
-                        timing *median) {
+static int time_call(const hbao_params *p, const bench_scene *b, float *ao, timing *t) {
     const int w = b->view.width, h = b->view.height;
     hbao_channel d = {b->depth, 1, w};
     hbao_channel n = {b->normal, 3, 3 * (int64_t)w};
-    double *wall = malloc(2 * (size_t)runs * sizeof(double));
-    if (wall == NULL) return 0;
-    double *cpu = wall + runs;
-    for (int r = -1; r < runs; r++) {
-        const double start = clock_seconds(CLOCK_MONOTONIC);
-        const double cpu_start = clock_seconds(CLOCK_PROCESS_CPUTIME_ID);
-        const hbao_result result = hbao_compute(p, &b->view.camera, w, h, &d, &n, ao, w);
-        const double cpu_elapsed = clock_seconds(CLOCK_PROCESS_CPUTIME_ID) - cpu_start;
-        const double elapsed = clock_seconds(CLOCK_MONOTONIC) - start;
-        if (result != HBAO_SUCCESS) {
-            fprintf(stderr, "bench_speed: %s\n", hbao_result_message(result));
-            free(wall);
-            return 0;
-        }
-        if (r >= 0) {
-            wall[r] = elapsed;
-            cpu[r] = cpu_elapsed;
-        }
+    const double start = clock_seconds(CLOCK_MONOTONIC);
+    const double cpu_start = clock_seconds(CLOCK_PROCESS_CPUTIME_ID);
+    const hbao_result result = hbao_compute(p, &b->view.camera, w, h, &d, &n, ao, w);
+    t->cpu = clock_seconds(CLOCK_PROCESS_CPUTIME_ID) - cpu_start;
+    t->wall = clock_seconds(CLOCK_MONOTONIC) - start;
+    if (result != HBAO_SUCCESS) {
+        fprintf(stderr, "bench_speed: %s\n", hbao_result_message(result));
+        return 0;
     }
-    median->wall = median_of(wall, runs);
-    median->cpu = median_of(cpu, runs);
-    free(wall);
     return 1;
 }
 
@@ -205,14 +189,15 @@ int main(int argc, char **argv) {
     const int row_count = (int)(sizeof rows / sizeof rows[0]) - (with_4k ? 0 : 1);
 
     static const char *const kernel_names[] = {"auto", "scalar", "AVX2", "AVX-512"};
-    printf("# hbao_compute speed: radius %g (scene ~3-7 units deep), median of %d runs after a warm-up, "
-           "ms per frame\n\n",
+    printf("# hbao_compute speed: radius %g (scene ~3-7 units deep), median of %d rounds after a "
+           "warm-up round, ms per frame\n\n",
            radius, runs);
     printf("Cosine integration; 'defaults' = %d directions x %d steps, blur %d. Best implementation on "
            "this CPU: %s. The scalar column is the portable reference code (horizon search and blur) on "
-           "1 thread. Cells: median wall-clock ms (median process CPU ms, all threads together). Blur "
-           "share: (time - time without blur) / time, on the last column, wall (CPU; the blur's own CPU "
-           "ms).\n",
+           "1 thread. A round times every column once (and the last one without blur). Cells: median "
+           "wall-clock ms (median process CPU ms, all threads together). Speed-up and blur share "
+           "((time - time without blur) / time, on the last column; wall (CPU; the blur's own CPU ms)) "
+           "are medians of the per-round values.\n",
            HBAO_DEFAULT_DIRECTIONS, HBAO_DEFAULT_STEPS, HBAO_DEFAULT_BLUR_SIZE, kernel_names[best]);
     print_load("before");
     printf("\n| settings | size |");
@@ -233,9 +218,19 @@ int main(int argc, char **argv) {
     printf("---|---|\n");
     fflush(stdout);
 
-    timing measured_times[8][COLUMN_COUNT];
-    double measured[8][COLUMN_COUNT];
+    /* Rounds: every variant (each column, and the last column without blur)
+     * is timed once per round, so that a change of load during the run
+     * affects them alike; ratios are taken within a round, then the median
+     * over rounds. */
+    enum { VARIANTS = COLUMN_COUNT + 1, UNBLURRED = COLUMN_COUNT };
+    double measured[8][COLUMN_COUNT], speedup[8];
     int mismatched = 0;
+    timing *times = malloc((size_t)VARIANTS * runs * sizeof(timing));
+    double *scratch = malloc(2 * (size_t)runs * sizeof(double));
+    if (times == NULL || scratch == NULL) {
+        fprintf(stderr, "bench_speed: out of memory\n");
+        return 1;
+    }
     for (int r = 0; r < row_count; r++) {
         const bench_row *row = &rows[r];
         bench_scene b;
@@ -246,53 +241,74 @@ int main(int argc, char **argv) {
             fprintf(stderr, "bench_speed: out of memory\n");
             return 1;
         }
-        hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
-        p.radius = radius;
-        p.directions = row->directions;
-        p.steps = row->steps;
-        p.blur_size = row->blur_size;
-        p.half_resolution = row->half_resolution;
-        printf("| %s | %dx%d |", row->name, row->width, row->height);
         int have_reference = 0;
+        for (int round = -1; round < runs; round++) { /* round -1: warm-up */
+            for (int v = 0; v < VARIANTS; v++) {
+                const int c = v == UNBLURRED ? last_column : v;
+                if (!wanted[c]) continue;
+                hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+                p.radius = radius;
+                p.directions = row->directions;
+                p.steps = row->steps;
+                p.blur_size = v == UNBLURRED ? 0 : row->blur_size;
+                p.half_resolution = row->half_resolution;
+                p.implementation = all_columns[c].implementation;
+                p.threads = all_columns[c].threads;
+                timing t;
+                if (!time_call(&p, &b, ao, &t)) return 1;
+                if (round >= 0) times[v * runs + round] = t;
+                if (round != -1 || v == UNBLURRED) continue;
+                if (!have_reference) {
+                    memcpy(reference, ao, pixels * sizeof(float));
+                    have_reference = 1;
+                } else if (memcmp(reference, ao, pixels * sizeof(float)) != 0) {
+                    mismatched = 1;
+                    fprintf(stderr, "bench_speed: %s, %s: output differs from the first column's\n",
+                                    row->name, all_columns[c].name);
+                }
+            }
+        }
+        printf("| %s | %dx%d |", row->name, row->width, row->height);
         for (int c = 0; c < COLUMN_COUNT; c++) {
             measured[r][c] = 0.0;
             if (!wanted[c]) continue;
-            p.implementation = all_columns[c].implementation;
-            p.threads = all_columns[c].threads;
-            timing t;
-            if (!time_compute(&p, &b, runs, ao, &t)) return 1;
-            measured_times[r][c] = t;
-            measured[r][c] = t.wall;
-            printf(" %.1f (%.1f) |", 1e3 * t.wall, 1e3 * t.cpu);
-            fflush(stdout);
-            if (!have_reference) {
-                memcpy(reference, ao, pixels * sizeof(float));
-                have_reference = 1;
-            } else if (memcmp(reference, ao, pixels * sizeof(float)) != 0) {
-                mismatched = 1;
-                fprintf(stderr, "bench_speed: %s, %s: output differs from the first column's\n",
-                        row->name, all_columns[c].name);
+            for (int k = 0; k < runs; k++) {
+                scratch[k] = times[c * runs + k].wall;
+                scratch[runs + k] = times[c * runs + k].cpu;
             }
+            measured[r][c] = median_of(scratch, runs);
+            printf(" %.1f (%.1f) |", 1e3 * measured[r][c], 1e3 * median_of(scratch + runs, runs));
         }
-        if (scalar_column >= 0 && scalar_column != last_column)
-            printf(" %.1fx |", measured[r][scalar_column] / measured[r][last_column]);
-        else
+        speedup[r] = 0.0;
+        if (scalar_column >= 0 && scalar_column != last_column) {
+            for (int k = 0; k < runs; k++)
+                scratch[k] = times[scalar_column * runs + k].wall / times[last_column * runs + k].wall;
+            speedup[r] = median_of(scratch, runs);
+            printf(" %.1fx |", speedup[r]);
+        } else {
             printf(" - |");
-        p.implementation = all_columns[last_column].implementation;
-        p.threads = all_columns[last_column].threads;
-        p.blur_size = 0;
-        timing unblurred;
-        if (!time_compute(&p, &b, runs, ao, &unblurred)) return 1;
-        const timing with_blur = measured_times[r][last_column];
-        printf(" %.0f %% (%.0f %%; %.1f ms) |\n", 100.0 * (with_blur.wall - unblurred.wall) / with_blur.wall,
-               100.0 * (with_blur.cpu - unblurred.cpu) / with_blur.cpu,
-               1e3 * (with_blur.cpu - unblurred.cpu));
+        }
+        /* The blur's share, wall and CPU, and its own CPU time, per round. */
+        double share_wall, share_cpu, blur_cpu;
+        for (int k = 0; k < runs; k++) {
+            const timing with = times[last_column * runs + k], without = times[UNBLURRED * runs + k];
+            scratch[k] = (with.wall - without.wall) / with.wall;
+            scratch[runs + k] = (with.cpu - without.cpu) / with.cpu;
+        }
+        share_wall = median_of(scratch, runs);
+        share_cpu = median_of(scratch + runs, runs);
+        for (int k = 0; k < runs; k++)
+            scratch[k] = times[last_column * runs + k].cpu - times[UNBLURRED * runs + k].cpu;
+        blur_cpu = median_of(scratch, runs);
+        printf(" %.0f %% (%.0f %%; %.1f ms) |\n", 100.0 * share_wall, 100.0 * share_cpu, 1e3 * blur_cpu);
         fflush(stdout);
         free(ao);
         free(reference);
         free(b.depth);
         free(b.normal);
     }
+    free(times);
+    free(scratch);
     print_load("after");
 
     /* The targets beside the measurements of this run. */
@@ -304,17 +320,15 @@ int main(int argc, char **argv) {
         const double ms = 1e3 * measured[r][last_column];
         printf("| %s, %dx%d | <= %.0f ms | %.1f ms | %s |", rows[r].name, rows[r].width,
                rows[r].height, rows[r].target_ms, ms, ms <= rows[r].target_ms ? "yes" : "no");
-        if (scalar_column >= 0 && scalar_column != last_column)
-            printf(" %.1fx |\n", measured[r][scalar_column] / measured[r][last_column]);
+        if (speedup[r] > 0.0)
+            printf(" %.1fx |\n", speedup[r]);
         else
             printf(" - |\n");
     }
-    if (scalar_column >= 0 && scalar_column != last_column) {
-        const double speedup = measured[0][scalar_column] / measured[0][last_column];
+    if (speedup[0] > 0.0)
         printf("| speed-up over the scalar reference on 1 thread (defaults, full) | >= %.0fx | %.1fx | "
                "%s | |\n",
-               TARGET_SPEEDUP, speedup, speedup >= TARGET_SPEEDUP ? "yes" : "no");
-    }
+               TARGET_SPEEDUP, speedup[0], speedup[0] >= TARGET_SPEEDUP ? "yes" : "no");
     if (mismatched) printf("\nWARNING: some columns' output was not bit-identical (see stderr).\n");
     return 0;
 }
