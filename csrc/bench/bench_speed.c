@@ -311,6 +311,49 @@ int main(int argc, char **argv) {
     free(scratch);
     print_load("after");
 
+    /* The stages around the horizon search alone: with a radius far under a
+     * pixel no horizon is searched, so the time is depth conversion,
+     * normals, upsample, blur and output. One thread, CPU time, the best
+     * implementation: the steadiest measure of the blur's own cost. */
+    {
+        bench_scene b;
+        bench_scene_make(&b, 1920, 1080);
+        float *ao = malloc((size_t)1920 * 1080 * sizeof(float));
+        double *cpu = malloc((size_t)runs * sizeof(double));
+        if (ao == NULL || cpu == NULL) return 1;
+        printf("\n## Stages around the horizon search, 1920x1080, %s, 1 thread, median CPU ms\n\n",
+               kernel_names[best]);
+        printf("Radius 1e-4 (under a pixel everywhere, so no horizon is searched): depth conversion, "
+               "normals, [upsample], blur, output.\n\n");
+        printf("| resolution | blur 0 | blur %d | blur 15 | blur %d alone | blur 15 alone |\n",
+               HBAO_DEFAULT_BLUR_SIZE, HBAO_DEFAULT_BLUR_SIZE);
+        printf("|---|---|---|---|---|---|\n");
+        for (int half = 0; half <= 1; half++) {
+            const int sizes[3] = {0, HBAO_DEFAULT_BLUR_SIZE, 15};
+            double stage[3];
+            for (int k = 0; k < 3; k++) {
+                hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+                p.radius = 1e-4f;
+                p.blur_size = sizes[k];
+                p.half_resolution = half;
+                p.threads = 1;
+                for (int round = -1; round < runs; round++) {
+                    timing t;
+                    if (!time_call(&p, &b, ao, &t)) return 1;
+                    if (round >= 0) cpu[round] = t.cpu;
+                }
+                stage[k] = median_of(cpu, runs);
+            }
+            printf("| %s | %.1f | %.1f | %.1f | %.1f | %.1f |\n", half ? "half" : "full", 1e3 * stage[0],
+                   1e3 * stage[1], 1e3 * stage[2], 1e3 * (stage[1] - stage[0]),
+                   1e3 * (stage[2] - stage[0]));
+        }
+        free(ao);
+        free(cpu);
+        free(b.depth);
+        free(b.normal);
+    }
+
     /* The targets beside the measurements of this run. */
     printf("\n## Issue 11 targets (%s)\n\n", all_columns[last_column].name);
     printf("| target | limit | measured median | met | speed-up over scalar, 1 thread |\n");

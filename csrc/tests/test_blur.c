@@ -124,6 +124,54 @@ TEST_CASE(random_depths_over_the_float_range_stay_in_range) {
     }
 }
 
+/* --- bands ---------------------------------------------------------------- */
+
+/* The blur runs per band of rows whose height follows the thread count
+ * (blur.c), each band remaking the r rows above and below it. A tall image
+ * makes 1, 2 and 5 threads cut it into bands of 38, 19 and 16 rows; blur
+ * radii 2, 7 and 32 (wider than a band) must give the same bits, at full
+ * and half resolution, as must every implementation. */
+TEST_CASE(identical_output_for_any_band_height) {
+    enum { w = 75, h = 300 };
+    static float depth[w * h], normal[3 * w * h], one[w * h], many[w * h];
+    for (int j = 0; j < h; j++) {
+        for (int i = 0; i < w; i++) {
+            const int k = j * w + i;
+            /* a sloped floor with steps and holes: depth edges, creases, background */
+            depth[k] = (i * 7 + j * 3) % 101 == 0 ? 1e10f : 2.0f + 0.01f * (float)j + 0.3f * (float)((i / 9) % 3);
+            normal[3 * k] = (float)((i / 9) % 3) - 1.0f;
+            normal[3 * k + 1] = 0.2f;
+            normal[3 * k + 2] = 1.0f;
+        }
+    }
+    hbao_camera camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
+    hbao_channel d = {depth, 1, w};
+    hbao_channel n = {normal, 3, 3 * (int64_t)w};
+    const int sizes[] = {5, 15, 65};
+    for (int variant = 0; variant < 6; variant++) {
+        hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+        p.radius = 0.3f;
+        p.blur_size = sizes[variant % 3];
+        p.half_resolution = variant / 3;
+        p.threads = 1;
+        p.implementation = HBAO_IMPLEMENTATION_SCALAR;
+        CHECK_RESULT(hbao_compute(&p, &camera, w, h, &d, &n, one, w), HBAO_SUCCESS);
+        const int threads[] = {2, 5};
+        for (int t = 0; t < 2; t++) {
+            for (int implementation = HBAO_IMPLEMENTATION_AUTO; implementation <= HBAO_IMPLEMENTATION_AVX512;
+                 implementation++) {
+                p.threads = threads[t];
+                p.implementation = implementation;
+                CHECK_RESULT(hbao_compute(&p, &camera, w, h, &d, &n, many, w), HBAO_SUCCESS);
+                if (memcmp(one, many, sizeof one) != 0)
+                    printf("  blur %d, half %d, %d threads, implementation %d differ\n", p.blur_size,
+                           p.half_resolution, threads[t], implementation);
+                CHECK(memcmp(one, many, sizeof one) == 0);
+            }
+        }
+    }
+}
+
 /* --- a thin fin: the normal weight ----------------------------------------- */
 
 /* A floor (z = 0) with a long thin wall standing on it: front face x = -0.05
@@ -235,4 +283,4 @@ TEST_CASE(blur_keeps_a_thin_fin) {
 TEST_MAIN(TEST_ENTRY(flat_plane_at_extreme_depths_is_unoccluded),
           TEST_ENTRY(planes_at_denormal_and_huge_depth_side_by_side),
           TEST_ENTRY(random_depths_over_the_float_range_stay_in_range),
-          TEST_ENTRY(blur_keeps_a_thin_fin))
+          TEST_ENTRY(identical_output_for_any_band_height), TEST_ENTRY(blur_keeps_a_thin_fin))
