@@ -1,98 +1,356 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
-/* Cross-bilateral (depth-aware) blur, applied separably: rows, then columns
- * (Bavoil & Sainz; the filter is not separable, but the separable version is
- * close and costs 2r+1 taps instead of (2r+1)^2). */
+/* Everything after the horizon search: [half-resolution upsample] ->
+ * cross-bilateral blur weighted by depth and normal, applied separably (rows,
+ * then columns; Bavoil & Sainz: the filter is not separable, but the
+ * separable version is close and costs 2r+1 taps instead of (2r+1)^2) ->
+ * strength -> the caller's output.
+ *
+ * The stages are fused per band of rows: a thread walks down its band,
+ * makes each row (upsampled AO, guide normals, blurred along the row) into a
+ * ring of the last 2r+1 rows, and as soon as the rows a column tap needs are
+ * there, blurs down the column and writes the finished output row. Each row
+ * of the image is thus read from memory once and no full-size intermediate
+ * image is written. A band recomputes the r rows above and below it that its
+ * neighbours also make; every row's values depend only on the input, so the
+ * result is the same for any number of threads and any band height. */
+#include <float.h>
 #include <math.h>
+#include <stdatomic.h>
 #include <stdlib.h>
+#include <string.h>
 
-#include "internal_hbao.h"
+#include "internal_finish.h"
 
 #define MAX_BLUR_RADIUS ((HBAO_MAX_BLUR_SIZE - 1) / 2)
 
-typedef struct blur_job {
-    const hbao_settings *settings;
-    const float *depth;
-    int width, height;
-    const float *source;
-    float *target;
-    float spatial[MAX_BLUR_RADIUS + 1]; /* Gaussian weight by tap distance */
-    int along_row; /* 1: taps along the row, 0: along the column */
-} blur_job;
+/* Bands per thread: enough that a thread that falls behind (background rows
+ * are cheap, geometry is not) is evened out by the row queue (parallel.c);
+ * few enough that the 2r rows a band recomputes stay a small share. */
+#define BANDS_PER_THREAD 8
+#define MIN_BAND_ROWS 16
 
-/* One output row. Taps run in the outer loop and pixels in the inner one,
- * so the inner loop reads contiguous memory and vectorizes; each pixel still
- * sums its taps in the same order. Taps on background get weight 0. */
-HBAO_VECTOR_CLONES static void blur_row(void *context, int j) {
-    const blur_job *job = context;
-    const int radius = job->settings->blur_radius;
-    const float sharpness = job->settings->blur_sharpness;
-    const int width = job->width;
-    const size_t row_start = (size_t)j * width;
-    const float *zc = job->depth + row_start;
-    float *target = job->target + row_start;
-    float *sums = malloc(3 * (size_t)width * sizeof(float));
-    if (sums == NULL) {
-        /* Without scratch memory, leave the row unblurred rather than fail. */
-        for (int i = 0; i < width; i++) target[i] = zc[i] > 0.0f ? job->source[row_start + i] : 1.0f;
-        return;
+typedef struct finish_job {
+    const hbao_grid *grid; /* the horizon grid: its normals guide the blur */
+    const float *grid_ao;  /* raw AO on the grid */
+    const float *depth;    /* full resolution, 0 = background */
+    int width, height;
+    int half_resolution;
+    int radius;         /* taps on each side; 0 = no blur */
+    int band_rows;
+    int implementation; /* resolved: which compiled copy runs */
+    float sharpness;
+    float strength;
+    float spatial[MAX_BLUR_RADIUS + 1]; /* Gaussian weight by tap distance */
+    float *out;
+    int64_t out_row_stride;
+    atomic_int out_of_memory;
+} finish_job;
+
+/* One ring slot: a row blurred along itself, and its guide normals. */
+typedef struct ring_row {
+    float *ao, *nx, *ny, *nz;
+} ring_row;
+
+/* The taps of one pass for one row of centres, the centre itself left out
+ * (it weighs 1): tap t of pixel i reads z[t][i + offset[t]] (and likewise ao
+ * and the normal); along a row every tap reads the centre row shifted by
+ * its offset k, down a column every tap reads its own row unshifted. Taps
+ * outside the image are left out. */
+typedef struct tap_set {
+    int count;
+    int along_row; /* 1: offsets shift along the row, so edge pixels lose taps */
+    const float *z[2 * MAX_BLUR_RADIUS + 1], *ao[2 * MAX_BLUR_RADIUS + 1];
+    const float *nx[2 * MAX_BLUR_RADIUS + 1], *ny[2 * MAX_BLUR_RADIUS + 1],
+        *nz[2 * MAX_BLUR_RADIUS + 1];
+    int offset[2 * MAX_BLUR_RADIUS + 1];
+    float spatial[2 * MAX_BLUR_RADIUS + 1];
+} tap_set;
+
+/* The centre row of a pass: its depth, AO and guide normals. */
+typedef struct centre_row {
+    const float *z, *ao, *nx, *ny, *nz;
+} centre_row;
+
+/* One pixel: the centre with weight 1, then the taps in order; the weight
+ * of a tap is spatial * exp(-(factor * (z - zc))^2 - NS * max(0, 1 - n.c)),
+ * 0 on background, with factor = min(sharpness / zc, FLT_MAX): sharpness / zc
+ * overflows for tiny depths (below ~1e-37, denormals), and an infinite
+ * factor would turn a tap at the same depth into 0 * inf = NaN; capped, a
+ * tap whose scaled difference overflows weighs 0. A 0/1
+ * factor rather than a branch marks background; the weight is finite, so
+ * the product is exact. The vector loop below performs exactly these
+ * operations lane by lane. Background centres give 1. */
+static HBAO_ALWAYS_INLINE float blur_pixel(const tap_set *taps, const centre_row *c, float sharpness,
+                                           int width, int i) {
+    const float zc = c->z[i];
+    const float scaled = zc > 0.0f ? sharpness / zc : 0.0f;
+    const float factor = scaled < FLT_MAX ? scaled : FLT_MAX;
+    float sum = c->ao[i], weight_sum = 1.0f;
+    for (int t = 0; t < taps->count; t++) {
+        const int at = i + taps->offset[t];
+        if (taps->along_row && (at < 0 || at >= width)) continue;
+        const float z = taps->z[t][at];
+        const float difference = (z - zc) * factor;
+        const float facing = taps->nx[t][at] * c->nx[i] + taps->ny[t][at] * c->ny[i] +
+                             taps->nz[t][at] * c->nz[i];
+        const float bend = 1.0f - facing;
+        const float exponent =
+            difference * difference + HBAO_BLUR_NORMAL_SHARPNESS * (bend > 0.0f ? bend : 0.0f);
+        const float valid = (float)(z > 0.0f);
+        const float weight = taps->spatial[t] * hbao_exp_negative(exponent) * valid;
+        sum += weight * taps->ao[t][at];
+        weight_sum += weight;
     }
-    float *sum = sums, *weight_sum = sums + width, *inv_zc = sums + 2 * (size_t)width;
-    for (int i = 0; i < width; i++) {
-        sum[i] = 0.0f;
-        weight_sum[i] = 0.0f;
-        inv_zc[i] = zc[i] > 0.0f ? sharpness / zc[i] : 0.0f;
-    }
-    for (int k = -radius; k <= radius; k++) {
-        const float spatial = job->spatial[k < 0 ? -k : k];
-        int first, last; /* pixels i whose tap i + k (or row j + k) exists */
-        ptrdiff_t offset;
-        if (job->along_row) {
-            first = k < 0 ? -k : 0;
-            last = k > 0 ? width - k : width;
-            offset = (ptrdiff_t)row_start + k;
-        } else {
-            if (j + k < 0 || j + k >= job->height) continue;
-            first = 0;
-            last = width;
-            offset = (ptrdiff_t)(j + k) * width;
-        }
-        const float *z = job->depth + offset;
-        const float *ao = job->source + offset;
-        for (int i = first; i < last; i++) {
-            const float difference = (z[i] - zc[i]) * inv_zc[i];
-            /* A 0/1 factor rather than a branch keeps the loop vectorized;
-             * the weight is finite, so the product is exact. */
-            const float valid = (float)(z[i] > 0.0f);
-            const float weight = spatial * hbao_exp_negative(difference * difference) * valid;
-            sum[i] += weight * ao[i];
-            weight_sum[i] += weight;
-        }
-    }
-    /* The centre tap always counts (weight > 0) unless the pixel is
-     * background, which stays 1. */
-    for (int i = 0; i < width; i++) target[i] = zc[i] > 0.0f ? sum[i] / weight_sum[i] : 1.0f;
-    free(sums);
+    return zc > 0.0f ? sum / weight_sum : 1.0f;
 }
 
-void hbao_blur(const hbao_settings *settings, const float *depth, int width, int height, float *ao,
-               float *scratch) {
-    const int radius = settings->blur_radius;
-    if (radius <= 0) return;
-    blur_job job;
-    job.settings = settings;
-    job.depth = depth;
+/* 16 pixels at once in GCC vector types: each function that inlines this
+ * is compiled for its instruction set (one AVX-512 register, two AVX2 or
+ * four SSE2 ones per vector), and every operation is blur_pixel's, lane by
+ * lane, so all copies give the same floats. */
+#define LANES 16
+/* GCC and clang warn that passing these vectors by value differs between
+ * instruction sets; the helpers are always inlined, so no call passes one. */
+#pragma GCC diagnostic ignored "-Wpsabi"
+typedef float vfloat __attribute__((vector_size(4 * LANES)));
+typedef int32_t vint __attribute__((vector_size(4 * LANES)));
+
+static HBAO_ALWAYS_INLINE vfloat load_lanes(const float *p) {
+    vfloat v;
+    memcpy(&v, p, sizeof v);
+    return v;
+}
+
+/* mask ? a : b, mask lanes all ones or zero */
+static HBAO_ALWAYS_INLINE vfloat select_lanes(vint mask, vfloat a, vfloat b) {
+    return (vfloat)((mask & (vint)a) | (~mask & (vint)b));
+}
+
+/* hbao_exp_negative, lane by lane: a loop of LANES iterations that the
+ * compiler vectorizes, so that the polynomial is written once. */
+static HBAO_ALWAYS_INLINE vfloat exp_negative_lanes(vfloat x) {
+    float in[LANES], out[LANES];
+    memcpy(in, &x, sizeof in);
+    for (int l = 0; l < LANES; l++) out[l] = hbao_exp_negative(in[l]);
+    vfloat result;
+    memcpy(&result, out, sizeof result);
+    return result;
+}
+
+static HBAO_ALWAYS_INLINE void blur_lanes(const tap_set *taps, const centre_row *c, float sharpness,
+                                          int i, float *target) {
+    const vfloat zero = {0.0f}, one = zero + 1.0f;
+    const vfloat zc = load_lanes(c->z + i);
+    const vint geometry = zc > 0.0f;
+    const vfloat scaled = select_lanes(geometry, sharpness / zc, zero);
+    const vfloat factor = select_lanes(scaled < FLT_MAX, scaled, zero + FLT_MAX);
+    const vfloat cx = load_lanes(c->nx + i), cy = load_lanes(c->ny + i),
+                 cz = load_lanes(c->nz + i);
+    vfloat sum = load_lanes(c->ao + i), weight_sum = one;
+    for (int t = 0; t < taps->count; t++) {
+        const int at = i + taps->offset[t];
+        const vfloat z = load_lanes(taps->z[t] + at);
+        const vfloat difference = (z - zc) * factor;
+        const vfloat facing = load_lanes(taps->nx[t] + at) * cx +
+                              load_lanes(taps->ny[t] + at) * cy +
+                              load_lanes(taps->nz[t] + at) * cz;
+        const vfloat bend = 1.0f - facing;
+        const vfloat exponent = difference * difference +
+                                HBAO_BLUR_NORMAL_SHARPNESS * (vfloat)((vint)bend & (bend > 0.0f));
+        const vfloat valid = (vfloat)((vint)one & (z > 0.0f));
+        const vfloat weight = taps->spatial[t] * exp_negative_lanes(exponent) * valid;
+        sum += weight * load_lanes(taps->ao[t] + at);
+        weight_sum += weight;
+    }
+    const vfloat blurred = select_lanes(geometry, sum / weight_sum, one);
+    memcpy(target + i, &blurred, sizeof blurred);
+}
+
+/* One pass over a row of centres: the vector loop where every tap lies
+ * inside the row, blur_pixel at the ends. */
+static HBAO_ALWAYS_INLINE void blur_pass(const tap_set *taps, const centre_row *c, float sharpness,
+                                         int width, int radius, float *target) {
+    const int first = taps->along_row ? radius : 0;
+    const int last = taps->along_row ? width - radius : width; /* vector lanes in [first, last) */
+    int i = 0;
+    for (; i < first && i < width; i++) target[i] = blur_pixel(taps, c, sharpness, width, i);
+    for (; i + LANES <= last; i += LANES) blur_lanes(taps, c, sharpness, i, target);
+    for (; i < width; i++) target[i] = blur_pixel(taps, c, sharpness, width, i);
+}
+
+/* Scratch of one band: the ring, the raw (upsampled) row and the finished
+ * row, width floats each. */
+typedef struct band_memory {
+    float *block;
+    float *raw, *finished;
+    ring_row ring[2 * MAX_BLUR_RADIUS + 1];
+} band_memory;
+
+static int band_memory_make(band_memory *m, int width, int slots) {
+    const size_t row = (size_t)width;
+    m->block = malloc((2 + 4 * (size_t)slots) * row * sizeof(float));
+    if (m->block == NULL) return 0;
+    m->raw = m->block;
+    m->finished = m->raw + row;
+    for (int s = 0; s < slots; s++) {
+        float *base = m->finished + row + 4 * (size_t)s * row;
+        m->ring[s] = (ring_row){base, base + row, base + 2 * row, base + 3 * row};
+    }
+    return 1;
+}
+
+/* Row j into its ring slot: its raw AO (upsampled if need be) and guide
+ * normals, then blurred along the row. */
+static HBAO_ALWAYS_INLINE void make_row(const finish_job *job, band_memory *m, int j) {
+    const int width = job->width, radius = job->radius;
+    const ring_row *slot = &m->ring[j % (2 * radius + 1)];
+    const float *raw;
+    if (job->half_resolution) {
+        hbao_upsample_row(job->implementation, job->grid, job->grid_ao, job->depth, width, j, m->raw,
+                          slot->nx, slot->ny, slot->nz);
+        raw = m->raw;
+    } else {
+        raw = job->grid_ao + (size_t)j * width;
+        if (radius > 0) {
+            const float *n = job->grid->normal + 3 * (size_t)j * width;
+            float *restrict nx = slot->nx, *restrict ny = slot->ny, *restrict nz = slot->nz;
+            for (int i = 0; i < width; i++) {
+                nx[i] = n[3 * i];
+                ny[i] = n[3 * i + 1];
+                nz[i] = n[3 * i + 2];
+            }
+        }
+    }
+    if (radius == 0) {
+        memcpy(slot->ao, raw, (size_t)width * sizeof(float));
+        return;
+    }
+    const float *z = job->depth + (size_t)j * width;
+    tap_set taps;
+    taps.count = 0;
+    taps.along_row = 1;
+    for (int k = -radius; k <= radius; k++) {
+        if (k == 0) continue;
+        taps.z[taps.count] = z;
+        taps.ao[taps.count] = raw;
+        taps.nx[taps.count] = slot->nx;
+        taps.ny[taps.count] = slot->ny;
+        taps.nz[taps.count] = slot->nz;
+        taps.offset[taps.count] = k;
+        taps.spatial[taps.count] = job->spatial[k < 0 ? -k : k];
+        taps.count++;
+    }
+    const centre_row centre = {z, raw, slot->nx, slot->ny, slot->nz};
+    blur_pass(&taps, &centre, job->sharpness, width, radius, slot->ao);
+}
+
+/* Output row j: rows j - r .. j + r of the ring blurred down the column,
+ * then strength and the clamp to [0, 1]. */
+static HBAO_ALWAYS_INLINE void finish_row(const finish_job *job, band_memory *m, int j) {
+    const int width = job->width, radius = job->radius, slots = 2 * radius + 1;
+    const float *zc = job->depth + (size_t)j * width;
+    const ring_row *centre = &m->ring[j % slots];
+    const float *blurred = centre->ao;
+    if (radius > 0) {
+        tap_set taps;
+        taps.count = 0;
+        taps.along_row = 0;
+        for (int k = -radius; k <= radius; k++) {
+            if (k == 0 || j + k < 0 || j + k >= job->height) continue;
+            const ring_row *tap = &m->ring[(j + k) % slots];
+            taps.z[taps.count] = job->depth + (size_t)(j + k) * width;
+            taps.ao[taps.count] = tap->ao;
+            taps.nx[taps.count] = tap->nx;
+            taps.ny[taps.count] = tap->ny;
+            taps.nz[taps.count] = tap->nz;
+            taps.offset[taps.count] = 0;
+            taps.spatial[taps.count] = job->spatial[k < 0 ? -k : k];
+            taps.count++;
+        }
+        const centre_row c = {zc, centre->ao, centre->nx, centre->ny, centre->nz};
+        blur_pass(&taps, &c, job->sharpness, width, radius, m->finished);
+        blurred = m->finished;
+    }
+    float *out = job->out + (int64_t)j * job->out_row_stride;
+    const float strength = job->strength;
+    if (strength != 1.0f) {
+        for (int i = 0; i < width; i++) {
+            const float ao = powf(zc[i] > 0.0f ? blurred[i] : 1.0f, strength);
+            /* Written so that a NaN could never pass through. */
+            out[i] = ao > 0.0f ? (ao < 1.0f ? ao : 1.0f) : 0.0f;
+        }
+        return;
+    }
+    for (int i = 0; i < width; i++) {
+        const float ao = zc[i] > 0.0f ? blurred[i] : 1.0f;
+        out[i] = ao > 0.0f ? (ao < 1.0f ? ao : 1.0f) : 0.0f;
+    }
+}
+
+/* One band of output rows, each row made once it is needed. */
+static HBAO_ALWAYS_INLINE void finish_band(void *context, int band) {
+    finish_job *job = context;
+    const int radius = job->radius, height = job->height;
+    const int first = band * job->band_rows;
+    const int last = first + job->band_rows < height ? first + job->band_rows : height;
+    band_memory m;
+    if (!band_memory_make(&m, job->width, 2 * radius + 1)) {
+        atomic_store(&job->out_of_memory, 1);
+        return;
+    }
+    int next = first - radius > 0 ? first - radius : 0; /* the next row to make */
+    for (int j = first; j < last; j++) {
+        const int needed = j + radius < height ? j + radius : height - 1;
+        for (; next <= needed; next++) make_row(job, &m, next);
+        finish_row(job, &m, j);
+    }
+    free(m.block);
+}
+
+static void finish_band_portable(void *context, int band) { finish_band(context, band); }
+
+#ifdef HBAO_FINISH_X86
+HBAO_TARGET_AVX2 static void finish_band_avx2(void *context, int band) {
+    finish_band(context, band);
+}
+
+HBAO_TARGET_AVX512 static void finish_band_avx512(void *context, int band) {
+    finish_band(context, band);
+}
+#endif
+
+hbao_result hbao_finish(const hbao_settings *settings, const hbao_grid *grid, const float *grid_ao,
+                        const float *full_depth, int width, int height, float *out,
+                        int64_t out_row_stride) {
+    finish_job job;
+    job.grid = grid;
+    job.grid_ao = grid_ao;
+    job.depth = full_depth;
     job.width = width;
     job.height = height;
-    const float sigma = 0.5f * (float)(radius + 1);
-    for (int k = 0; k <= radius; k++) job.spatial[k] = expf(-(float)(k * k) / (2.0f * sigma * sigma));
+    job.half_resolution = settings->half_resolution;
+    job.radius = settings->blur_radius;
+    job.implementation = hbao_finish_implementation(settings->implementation);
+    job.sharpness = settings->blur_sharpness;
+    job.strength = settings->strength;
+    job.out = out;
+    job.out_row_stride = out_row_stride;
+    atomic_init(&job.out_of_memory, 0);
+    const float sigma = 0.5f * (float)(job.radius + 1);
+    for (int k = 0; k <= job.radius; k++)
+        job.spatial[k] = expf(-(float)(k * k) / (2.0f * sigma * sigma));
 
-    job.source = ao;
-    job.target = scratch;
-    job.along_row = 1;
-    hbao_parallel_rows(settings->threads, height, blur_row, &job);
+    const int bands_wanted = BANDS_PER_THREAD * settings->threads;
+    int band_rows = (height + bands_wanted - 1) / bands_wanted;
+    if (band_rows < MIN_BAND_ROWS) band_rows = MIN_BAND_ROWS;
+    job.band_rows = band_rows;
+    const int bands = (height + band_rows - 1) / band_rows;
 
-    job.source = scratch;
-    job.target = ao;
-    job.along_row = 0;
-    hbao_parallel_rows(settings->threads, height, blur_row, &job);
+    hbao_row_job run = finish_band_portable;
+#ifdef HBAO_FINISH_X86
+    if (job.implementation == HBAO_IMPLEMENTATION_AVX512) run = finish_band_avx512;
+    if (job.implementation == HBAO_IMPLEMENTATION_AVX2) run = finish_band_avx2;
+#endif
+    hbao_parallel_rows(settings->threads, bands, run, &job);
+    return atomic_load(&job.out_of_memory) ? HBAO_ERROR_OUT_OF_MEMORY : HBAO_SUCCESS;
 }

@@ -4,7 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "internal_hbao.h"
+#include "internal_finish.h"
 
 /* The limits are hbao_params_resolve()'s (params.c); this only derives the
  * pipeline's settings from the resolved values. */
@@ -58,27 +58,6 @@ static void convert_depth_row(void *context, int j) {
     }
 }
 
-typedef struct output_job {
-    const float *ao;
-    const float *depth;
-    int width;
-    float strength;
-    float *out;
-    int64_t out_row_stride;
-} output_job;
-
-static void write_output_row(void *context, int j) {
-    const output_job *job = context;
-    float *out = job->out + (int64_t)j * job->out_row_stride;
-    for (int i = 0; i < job->width; i++) {
-        const size_t index = (size_t)j * job->width + i;
-        float ao = job->depth[index] > 0.0f ? job->ao[index] : 1.0f;
-        if (job->strength != 1.0f) ao = powf(ao, job->strength);
-        /* Written so that a NaN could never pass through. */
-        out[i] = ao > 0.0f ? (ao < 1.0f ? ao : 1.0f) : 0.0f;
-    }
-}
-
 typedef struct half_depth_job {
     const float *full;
     int full_width;
@@ -129,14 +108,14 @@ hbao_result hbao_compute(const hbao_params *params, const hbao_camera *camera, i
     grid.height = (height + scale - 1) / scale;
     const size_t grid_pixels = (size_t)grid.width * grid.height;
 
+    /* The raw AO on the grid; the later stages (blur.c) turn it into the
+     * output row by row, with no other full-size buffer. */
     float *full_depth = malloc(pixels * sizeof(float));
-    float *full_ao = malloc(pixels * sizeof(float));
-    float *scratch = malloc(pixels * sizeof(float));
+    float *grid_ao = malloc(grid_pixels * sizeof(float));
     float *half_depth = s.half_resolution ? malloc(grid_pixels * sizeof(float)) : NULL;
-    float *half_ao = s.half_resolution ? malloc(grid_pixels * sizeof(float)) : NULL;
     grid.normal = malloc(grid_pixels * 3 * sizeof(float));
-    if (full_depth == NULL || full_ao == NULL || scratch == NULL || grid.normal == NULL ||
-        (s.half_resolution && (half_depth == NULL || half_ao == NULL))) {
+    if (full_depth == NULL || grid_ao == NULL || grid.normal == NULL ||
+        (s.half_resolution && half_depth == NULL)) {
         result = HBAO_ERROR_OUT_OF_MEMORY;
         goto done;
     }
@@ -154,23 +133,13 @@ hbao_result hbao_compute(const hbao_params *params, const hbao_camera *camera, i
     }
     hbao_compute_normals(&s, camera, &grid, normal, scale);
 
-    if (s.half_resolution) {
-        hbao_compute_horizons(&s, &grid, half_ao);
-        hbao_upsample(&s, &grid, half_ao, full_depth, width, height, full_ao);
-    } else {
-        hbao_compute_horizons(&s, &grid, full_ao);
-    }
-    hbao_blur(&s, full_depth, width, height, full_ao, scratch);
-
-    output_job output = {full_ao, full_depth, width, s.strength, ao, ao_row_stride};
-    hbao_parallel_rows(s.threads, height, write_output_row, &output);
+    hbao_compute_horizons(&s, &grid, grid_ao);
+    result = hbao_finish(&s, &grid, grid_ao, full_depth, width, height, ao, ao_row_stride);
 
 done:
     free(full_depth);
-    free(full_ao);
-    free(scratch);
+    free(grid_ao);
     free(half_depth);
-    free(half_ao);
     free(grid.normal);
     return result;
 }

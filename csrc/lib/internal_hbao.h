@@ -137,13 +137,7 @@ void hbao_horizon_span_avx2(const hbao_horizon_job *job, int x0, int x1, int j);
 int hbao_horizon_avx512_available(void);
 void hbao_horizon_span_avx512(const hbao_horizon_job *job, int x0, int x1, int j);
 
-/* upsample.c: half-resolution AO to full resolution, guided by full depth. */
-void hbao_upsample(const hbao_settings *settings, const hbao_grid *half, const float *half_ao,
-                   const float *full_depth, int width, int height, float *full_ao);
-
-/* blur.c: separable cross-bilateral blur, in place on ao (uses scratch). */
-void hbao_blur(const hbao_settings *settings, const float *depth, int width, int height, float *ao,
-               float *scratch);
+/* blur.c, upsample.c: the stages after the horizon search (internal_finish.h). */
 
 /* exp(-x) for x >= 0, to 3e-5 relative error (a degree-6 Taylor polynomial of 2^-f), without libm: the blur
  * and the upsample evaluate it for every tap. */

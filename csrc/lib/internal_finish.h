@@ -1,0 +1,64 @@
+/* SPDX-License-Identifier: GPL-2.0-or-later */
+/* Private declarations of the stages after the horizon search (blur.c,
+ * upsample.c): the half-resolution upsample, the cross-bilateral blur, the
+ * strength and the write to the caller's output, fused per band of rows. */
+#ifndef HBAO_INTERNAL_FINISH_H
+#define HBAO_INTERNAL_FINISH_H
+
+/* Before internal_hbao.h, so that its inline helpers (hbao_exp_negative)
+ * are not contracted into FMAs either where the AVX-512 copies inline them:
+ * clang contracts by default, GCC does not in ISO C mode. Include this
+ * header before internal_hbao.h. */
+#ifdef __clang__
+#pragma STDC FP_CONTRACT OFF
+#endif
+#include "internal_hbao.h"
+
+/* How strongly the blur stops where the normal turns, in units of
+ * 1 - cos(angle between the two normals) (docs/algorithm.md, "After
+ * sampling"): a tap on a face at 90 degrees weighs exp(-16) ~ 1e-7, at 20
+ * degrees exp(-0.96) ~ 0.38, at 5 degrees 0.94. */
+#define HBAO_BLUR_NORMAL_SHARPNESS 16.0f
+
+/* The loops of these stages are plain C written to auto-vectorize; each is
+ * compiled three times (baseline, AVX2, AVX-512) and the copy matching
+ * params.implementation runs, so that the scalar column of the benchmark is
+ * the portable code and the tests compare every copy. Their operations are
+ * element-wise and never contracted into FMAs (ISO C mode; clang is told
+ * above), so every copy computes the same floats. */
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define HBAO_FINISH_X86 1
+#define HBAO_TARGET_AVX2 __attribute__((target("avx2")))
+#define HBAO_TARGET_AVX512 __attribute__((target("avx512f")))
+#endif
+#define HBAO_ALWAYS_INLINE inline __attribute__((always_inline))
+
+/* The copy to run for a requested hbao_implementation: AUTO and anything the
+ * CPU lacks fall back to the best one it has (as the horizon kernels do). */
+static inline int hbao_finish_implementation(int requested) {
+#ifdef HBAO_FINISH_X86
+    const int best = hbao_best_implementation();
+    return requested == HBAO_IMPLEMENTATION_AUTO || requested > best ? best : requested;
+#else
+    (void)requested;
+    return HBAO_IMPLEMENTATION_SCALAR;
+#endif
+}
+
+/* blur.c: AO on the full image from the raw AO on the grid (grid_ao, dense,
+ * grid->width wide): [upsample] -> cross-bilateral blur on depth and normals
+ * (rows, then columns) -> strength -> clamp to [0, 1], written to out.
+ * HBAO_ERROR_OUT_OF_MEMORY if its row buffers cannot be allocated. */
+hbao_result hbao_finish(const hbao_settings *settings, const hbao_grid *grid, const float *grid_ao,
+                        const float *full_depth, int width, int height, float *out,
+                        int64_t out_row_stride);
+
+/* upsample.c: full-resolution row j of the half-resolution AO (ao, width
+ * floats) and the blur's guide normal of each pixel (normal_x/_y/_z): the
+ * normal of the half-grid sample nearest in depth. implementation: as
+ * resolved by hbao_finish_implementation(). */
+void hbao_upsample_row(int implementation, const hbao_grid *half, const float *half_ao,
+                       const float *full_depth, int width, int j, float *ao, float *normal_x,
+                       float *normal_y, float *normal_z);
+
+#endif /* HBAO_INTERNAL_FINISH_H */
