@@ -24,6 +24,11 @@ typedef struct march {
     float jitter;
     float step_px;
     float radius2;
+    /* What every sample is compared with: the depth's rounding tolerance
+     * along the normal (docs/algorithm.md, "Depth precision"), and the sine
+     * of V's elevation above the tangent plane, dot(n, V). */
+    float height_tolerance;
+    float n_dot_v;
 } march;
 
 enum { SAMPLE_END = -1, SAMPLE_SKIP = 0, SAMPLE_OK = 1 };
@@ -83,6 +88,27 @@ static inline void slice_setup(const float v[3], const float n[3], float dc, flo
     }
 }
 
+/* The sine of a sample's elevation above the tangent plane, its height
+ * lowered by what the depth's rounding could have raised it. */
+static inline float sample_elevation(const march *m, const float n[3], const float delta[3],
+                                     float inv_dist) {
+    return (delta[0] * n[0] + delta[1] * n[1] + delta[2] * n[2] - m->height_tolerance) * inv_dist;
+}
+
+/* Whether a sample lies past the normal. In the slice that means an angle
+ * from V below gamma; but samples are snapped to pixel centres, off the
+ * slice, and near a plane seen at a grazing angle (V nearly in the tangent
+ * plane) a sample on the plane itself can lie within gamma of V. A sample
+ * past the normal inside the slice also rises above the tangent plane at
+ * least as steeply as V does (its elevation is cos(h - gamma) >= cos(gamma),
+ * i.e. sin_s >= dot(n, V)), which no sample on or near the plane does, so
+ * both are required. */
+static inline int past_the_normal(const march *m, const slice *sl, const float v[3],
+                                  const float delta[3], float inv_dist, float sin_s) {
+    const float cos_v = (delta[0] * v[0] + delta[1] * v[1] + delta[2] * v[2]) * inv_dist;
+    return cos_v > sl->cos_gamma && sin_s > m->n_dot_v;
+}
+
 /* HBAO integration of one direction: sum of W * (increase of the sine of the
  * elevation above the tangent plane), Bavoil & Sainz with seed 003's rule. */
 static float direction_occlusion_hbao(const hbao_settings *s, const march *m, const float n[3],
@@ -99,16 +125,13 @@ static float direction_occlusion_hbao(const hbao_settings *s, const march *m, co
         if (status == SAMPLE_END) break;
         if (status == SAMPLE_SKIP) continue;
         const float inv_dist = 1.0f / sqrtf(dist2);
-        if (check_past_normal) {
-            const float cos_h = (delta[0] * v[0] + delta[1] * v[1] + delta[2] * v[2]) * inv_dist;
-            if (cos_h > sl->cos_gamma) {
-                /* Beyond the normal inside the slice: the screen-space march
-                 * has no proper data here; count the direction half occluded. */
-                if (occlusion < half_occluded) occlusion = half_occluded;
-                break;
-            }
+        const float sin_s = sample_elevation(m, n, delta, inv_dist);
+        if (check_past_normal && past_the_normal(m, sl, v, delta, inv_dist, sin_s)) {
+            /* Beyond the normal inside the slice: the screen-space march
+             * has no proper data here; count the direction half occluded. */
+            if (occlusion < half_occluded) occlusion = half_occluded;
+            break;
         }
-        const float sin_s = (delta[0] * n[0] + delta[1] * n[1] + delta[2] * n[2]) * inv_dist;
         if (sin_s > sin_max) {
             const float weight = quadratic ? 1.0f - dist2 * inv_radius2 : 1.0f;
             occlusion += weight * (sin_s - sin_max);
@@ -159,11 +182,11 @@ static inline void horizon_state(int past_normal, float cos_past_max, float elev
  * attenuated per sample. Returns the occluded part; *open_part receives the
  * visibility of the unoccluded half slice.
  * A sample's angle h from V is measured through its elevation above the
- * tangent plane, sin(phi) = dot(n, D) / (|D| |np|), h = gamma + pi/2 - phi:
- * exact for samples in the slice, and, unlike the angle to V, still exact
+ * tangent plane, sin(phi) = sin_s / |np| (sample_elevation),
+ * h = gamma + pi/2 - phi: exact for samples in the slice, and, unlike the angle to V, still exact
  * (0) for snapped samples that lie on the tangent plane but off the slice.
- * Past the normal (h < gamma) the elevation turns back, so there the angle
- * to V is used. */
+ * Past the normal (past_the_normal) the elevation turns back, so there the
+ * angle to V is used. */
 static float direction_occlusion_cosine(const hbao_settings *s, const march *m, const float n[3],
                                         const float v[3], const slice *sl, float *open_part) {
     const float gamma = HALF_PI - hbao_acos(sl->sin_gamma); /* asin; cos_gamma >= 0 */
@@ -191,21 +214,19 @@ static float direction_occlusion_cosine(const hbao_settings *s, const march *m, 
         if (status == SAMPLE_END) break;
         if (status == SAMPLE_SKIP) continue;
         const float inv_dist = 1.0f / sqrtf(dist2);
+        const float sin_s = sample_elevation(m, n, delta, inv_dist);
         int raised = 0;
-        if (check_past_normal) {
+        if (check_past_normal && past_the_normal(m, sl, v, delta, inv_dist, sin_s)) {
             const float cos_v = (delta[0] * v[0] + delta[1] * v[1] + delta[2] * v[2]) * inv_dist;
-            if (cos_v > sl->cos_gamma) {
-                if (cos_v > cos_past_max) {
-                    past_normal = 1;
-                    cos_past_max = cos_v > 1.0f ? 1.0f : cos_v;
-                    raised = 1;
-                }
+            if (cos_v > cos_past_max) {
+                past_normal = 1;
+                cos_past_max = cos_v > 1.0f ? 1.0f : cos_v;
+                raised = 1;
             }
         }
         if (!raised) {
             if (past_normal) continue; /* nothing below the normal can raise it now */
-            const float elevation =
-                (delta[0] * n[0] + delta[1] * n[1] + delta[2] * n[2]) * inv_dist * inv_np;
+            const float elevation = sin_s * inv_np;
             if (elevation <= elevation_max) continue;
             elevation_max = elevation > 1.0f ? 1.0f : elevation;
             raised = 1;
@@ -252,6 +273,8 @@ float hbao_horizon_pixel(const horizon_job *job, int i, int j) {
         for (int c = 0; c < 3; c++) v[c] = -m.p[c] * inv;
     }
     const float *n = g->normal + 3 * ((size_t)j * g->width + i);
+    m.n_dot_v = n[0] * v[0] + n[1] * v[1] + n[2] * v[2];
+    m.height_tolerance = g->depth_precision * hbao_rounding_along_normal(g, n, m.p);
     const int cosine = s->integration == HBAO_INTEGRATION_COSINE;
 
     float occlusion_sum = 0.0f;                /* HBAO */

@@ -4,8 +4,8 @@
  * the vector vocabulary below (horizon_avx2.c, horizon_avx512.c). The kernel
  * performs the same float operations in the same order as the scalar
  * reference in horizon.c (no FMA contraction), so every instance gives
- * bit-identical results (tested in test_ao.c); where the scalar code leaves
- * a loop with break or continue, lanes are masked instead.
+ * bit-identical results (tested in test_ao.c and test_planes.c); where the
+ * scalar code leaves a loop with break or continue, lanes are masked instead.
  *
  * Vocabulary: VF float vector, VI int32 vector, VM lane mask;
  * V_ADD V_SUB V_MUL V_DIV V_SQRT V_SET V_LOADU V_STOREU V_NEG V_MAX0 (max
@@ -75,6 +75,7 @@ typedef struct SIMD_NAME(block) {
     VF base_x, base_y; /* pixel centre, in pixels */
     VF p[3], v[3], n[3];
     VF jitter, step_px, radius2, inv_radius2, inv_ycor;
+    VF height_tolerance, n_dot_v; /* as in horizon.c's march */
     int j;
 } SIMD_NAME(block);
 
@@ -132,6 +133,21 @@ static inline VM SIMD_NAME(sample)(const SIMD_NAME(block) * b, const SIMD_NAME(f
     return M_AND(valid, M_AND(V_LT(*dist2, b->radius2), V_GT(*dist2, V_SET(0.0f))));
 }
 
+/* horizon.c's sample_elevation and past_the_normal */
+static inline VF SIMD_NAME(sample_elevation)(const SIMD_NAME(block) * b, const VF delta[3], VF inv_dist) {
+    const VF height = SIMD_NAME(dot3)(delta[0], delta[1], delta[2], b->n[0], b->n[1], b->n[2]);
+    return V_MUL(V_SUB(height, b->height_tolerance), inv_dist);
+}
+
+static inline VF SIMD_NAME(cos_to_view)(const SIMD_NAME(block) * b, const VF delta[3], VF inv_dist) {
+    return V_MUL(SIMD_NAME(dot3)(delta[0], delta[1], delta[2], b->v[0], b->v[1], b->v[2]), inv_dist);
+}
+
+static inline VM SIMD_NAME(past_the_normal)(const SIMD_NAME(block) * b, const SIMD_NAME(slice) * sl,
+                                            const VF delta[3], VF inv_dist, VF sin_s) {
+    return M_AND(V_GT(SIMD_NAME(cos_to_view)(b, delta, inv_dist), sl->cos_gamma), V_GT(sin_s, b->n_dot_v));
+}
+
 static VF SIMD_NAME(direction_occlusion_hbao)(const hbao_settings *s, const SIMD_NAME(block) * b,
                                               VM active, VF dc, VF ds,
                                               const SIMD_NAME(slice) * sl) {
@@ -149,17 +165,15 @@ static VF SIMD_NAME(direction_occlusion_hbao)(const hbao_settings *s, const SIMD
         const VM ok = SIMD_NAME(sample)(b, &fetches[step], alive, delta, &dist2);
         if (!M_ANY(ok)) continue;
         const VF inv_dist = V_DIV(V_SET(1.0f), V_SQRT(dist2));
+        const VF sin_s = SIMD_NAME(sample_elevation)(b, delta, inv_dist);
         VM rest = ok;
         if (any_check) {
-            const VF cos_h = V_MUL(SIMD_NAME(dot3)(delta[0], delta[1], delta[2], b->v[0], b->v[1], b->v[2]),
-                                   inv_dist);
-            const VM past = M_AND(M_AND(ok, check_past_normal), V_GT(cos_h, sl->cos_gamma));
+            const VM past = M_AND(M_AND(ok, check_past_normal),
+                                  SIMD_NAME(past_the_normal)(b, sl, delta, inv_dist, sin_s));
             occlusion = V_SELECT(M_AND(past, V_LT(occlusion, half_occluded)), occlusion, half_occluded);
             alive = M_ANDNOT(past, alive);
             rest = M_ANDNOT(past, ok);
         }
-        const VF sin_s = V_MUL(SIMD_NAME(dot3)(delta[0], delta[1], delta[2], b->n[0], b->n[1], b->n[2]),
-                               inv_dist);
         const VM rise = M_AND(rest, V_GT(sin_s, sin_max));
         const VF weight = quadratic ? V_SUB(V_SET(1.0f), V_MUL(dist2, b->inv_radius2)) : V_SET(1.0f);
         occlusion = V_SELECT(rise, occlusion, V_ADD(occlusion, V_MUL(weight, V_SUB(sin_s, sin_max))));
@@ -221,19 +235,18 @@ static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SI
         const VM ok = SIMD_NAME(sample)(b, &fetches[step], active, delta, &dist2);
         if (!M_ANY(ok)) continue;
         const VF inv_dist = V_DIV(V_SET(1.0f), V_SQRT(dist2));
+        const VF sin_s = SIMD_NAME(sample_elevation)(b, delta, inv_dist);
         VM raised = M_ANDNOT(ok, ok); /* no lane */
         if (any_check) {
-            const VF cos_v = V_MUL(SIMD_NAME(dot3)(delta[0], delta[1], delta[2], b->v[0], b->v[1], b->v[2]),
-                                   inv_dist);
-            const VM newly = M_AND(M_AND(M_AND(ok, check_past_normal), V_GT(cos_v, sl->cos_gamma)),
-                                   V_GT(cos_v, cos_past_max));
+            const VF cos_v = SIMD_NAME(cos_to_view)(b, delta, inv_dist);
+            const VM past = M_AND(V_GT(cos_v, sl->cos_gamma), V_GT(sin_s, b->n_dot_v));
+            const VM newly = M_AND(M_AND(M_AND(ok, check_past_normal), past), V_GT(cos_v, cos_past_max));
             past_normal = M_OR(past_normal, newly);
             cos_past_max = V_SELECT(newly, cos_past_max, V_SELECT(V_GT(cos_v, V_SET(1.0f)), cos_v, V_SET(1.0f)));
             raised = newly;
         }
         const VM elevation_candidates = M_ANDNOT(past_normal, M_ANDNOT(raised, ok));
-        const VF elevation = V_MUL(
-            V_MUL(SIMD_NAME(dot3)(delta[0], delta[1], delta[2], b->n[0], b->n[1], b->n[2]), inv_dist), inv_np);
+        const VF elevation = V_MUL(sin_s, inv_np);
         const VM rise = M_AND(elevation_candidates, V_GT(elevation, elevation_max));
         elevation_max = V_SELECT(rise, elevation_max,
                                  V_SELECT(V_GT(elevation, V_SET(1.0f)), elevation, V_SET(1.0f)));
@@ -297,6 +310,12 @@ static void SIMD_NAME(block_ao)(const hbao_horizon_job *job, int i0, int j, floa
     for (int k = 0; k < SIMD_LANES; k++)
         for (int c = 0; c < 3; c++) normal_lanes[c][k] = normal[3 * k + c];
     for (int c = 0; c < 3; c++) b.n[c] = V_LOADU(normal_lanes[c]);
+    b.n_dot_v = SIMD_NAME(dot3)(b.n[0], b.n[1], b.n[2], b.v[0], b.v[1], b.v[2]);
+    /* hbao_rounding_along_normal */
+    const VF along = g->orthographic ? V_MUL(b.n[2], b.p[2])
+                                     : SIMD_NAME(dot3)(b.n[0], b.n[1], b.n[2], b.p[0], b.p[1], b.p[2]);
+    b.height_tolerance =
+        V_MUL(V_SET(g->depth_precision), V_SELECT(V_LT(along, V_SET(0.0f)), along, V_NEG(along)));
 
     const int cosine = s->integration == HBAO_INTEGRATION_COSINE;
     VF occlusion_sum = V_SET(0.0f), visible_sum = V_SET(0.0f), open_sum = V_SET(0.0f);

@@ -57,7 +57,30 @@ typedef struct hbao_grid {
     int orthographic;
     float pixel_size; /* view-plane width of one grid pixel (per unit depth if perspective) */
     float ycor;       /* pixel height / pixel width */
+    /* The spacing of representable depths relative to the depth: an upper
+     * bound on ulp(z) / z for the format the depth came in (set by
+     * hbao_compute_normals(), docs/algorithm.md "Depth precision"). */
+    float depth_precision;
 } hbao_grid;
+
+/* ulp(z) / z <= 2^-10 for half floats (10 mantissa bits), 2^-23 for floats. */
+#define HBAO_HALF_DEPTH_PRECISION 9.765625e-4f
+#define HBAO_FLOAT_DEPTH_PRECISION 1.1920929e-7f
+
+/* How far rounding the depth to a spacing of 1 (times z) moves the point at
+ * `position` along the normal n: |dot(n, P)| in perspective (the point moves
+ * along its ray, P / z per unit of depth; for every point of a plane this is
+ * the plane's distance from the eye), |n.z| z in orthographic views. Times
+ * depth_precision it bounds the height error of a sample relative to the
+ * centre's tangent plane when both depths are rounded (each by at most half
+ * a spacing). Written as the SIMD kernels compute it. */
+static inline float hbao_rounding_along_normal(const hbao_grid *grid, const float n[3],
+                                               const float position[3]) {
+    const float along = grid->orthographic
+                            ? n[2] * position[2]
+                            : n[0] * position[0] + n[1] * position[1] + n[2] * position[2];
+    return along < 0.0f ? -along : along;
+}
 
 /* Loops written to auto-vectorize get one compiled copy per vector width,
  * chosen when the library loads (GCC's target_clones). Their operations are
