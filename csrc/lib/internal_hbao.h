@@ -145,15 +145,55 @@ typedef struct hbao_horizon_job {
     float direction_cos[16][HBAO_MAX_DIRECTIONS];
     float direction_sin[16][HBAO_MAX_DIRECTIONS];
     float jitter[16];
+    /* The depth deinterleaved by column phase (SIMD kernels only; NULL for
+     * the scalar reference): phase_depth[(a * height + j) * phase_width + X]
+     * is grid depth (4 X + a, j), 0 beyond the row's end. */
+    const float *phase_depth;
+    int phase_width;
 } hbao_horizon_job;
 
-/* The scalar reference for one pixel (horizon.c). */
-float hbao_horizon_pixel(const hbao_horizon_job *job, int i, int j);
+/* The horizon search works on blocks: the HBAO_BLOCK_PIXELS pixels
+ * i = x0 + a + 4 k of one row (x0 a multiple of 4 * HBAO_BLOCK_PIXELS,
+ * phase a in 0..3, k in 0..HBAO_BLOCK_PIXELS-1) share a pattern cell, so
+ * they march the same directions with the same jitter; they also share one
+ * step length, from the largest projected radius among them, so every step
+ * is one pixel offset for all of them and their depths are one contiguous
+ * load from phase_depth (docs/algorithm.md, "Per-pixel sampling"). */
+#define HBAO_BLOCK_PIXELS 16
+#define HBAO_BLOCK_SPAN (4 * HBAO_BLOCK_PIXELS) /* columns a block spans */
+
+/* The step length in pixels, (R_block - 1) / steps, of the block of phase a
+ * that starts at column x0 of row j (pixels before x1 only); 0 when no pixel
+ * of it is sampled. */
+float hbao_block_step(const hbao_horizon_job *job, int x0, int x1, int j, int a);
+
+/* The pixel offset (ox, oy) of step `step` along direction (dc, ds) of a
+ * block: floor(0.5 + dc t), floor(0.5 - ds t / ycor), t = 1 + (step +
+ * jitter) * step_px. Returns 0 when it lies a whole image away, where every
+ * later step lies too. One function for every kernel, so all compute the
+ * same offsets. */
+static inline int hbao_step_offset(const hbao_grid *grid, float dc, float ds, float inv_ycor,
+                                   float jitter, float step_px, int step, int *ox, int *oy) {
+    const float t = 1.0f + ((float)step + jitter) * step_px;
+    const float x = floorf(0.5f + dc * t);
+    const float y = floorf(0.5f - ds * t * inv_ycor);
+    /* tested before converting: a huge projected radius must not overflow int */
+    if (!(x > -(float)grid->width && x < (float)grid->width && y > -(float)grid->height &&
+          y < (float)grid->height))
+        return 0;
+    *ox = (int)x;
+    *oy = (int)y;
+    return 1;
+}
+
+/* The scalar reference for one pixel (horizon.c), with its block's step. */
+float hbao_horizon_pixel(const hbao_horizon_job *job, int i, int j, float step_px);
 
 /* SIMD kernels (horizon_avx2.c, horizon_avx512.c, both made from
  * horizon_simd.h): whether this CPU and build can run each, and the kernel
  * that computes pixels [x0, x1) of row j bit-identically to
- * hbao_horizon_pixel(). */
+ * hbao_horizon_pixel(); x0 is a multiple of HBAO_BLOCK_SPAN and x1 - x0 at
+ * most HBAO_BLOCK_SPAN. */
 typedef void (*hbao_horizon_span)(const hbao_horizon_job *job, int x0, int x1, int j);
 int hbao_horizon_avx2_available(void);
 void hbao_horizon_span_avx2(const hbao_horizon_job *job, int x0, int x1, int j);
