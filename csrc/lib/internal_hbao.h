@@ -172,18 +172,21 @@ float hbao_block_step(const hbao_horizon_job *job, int x0, int x1, int j, int a)
  * jitter) * step_px. Returns 0 when it lies a whole image away, where every
  * later step lies too. One function for every kernel, so all compute the
  * same offsets. */
+static inline int hbao_floor_in_range(float x, int limit, int *floor_x) {
+    /* floor(x) in (-limit, limit), tested before converting so that a huge
+     * projected radius cannot overflow int; NaN fails. Floor by truncation
+     * and correction: no libm call in the scalar reference's inner loop. */
+    if (!(x >= (float)(1 - limit) && x < (float)limit)) return 0;
+    const int truncated = (int)x;
+    *floor_x = (float)truncated > x ? truncated - 1 : truncated;
+    return 1;
+}
+
 static inline int hbao_step_offset(const hbao_grid *grid, float dc, float ds, float inv_ycor,
                                    float jitter, float step_px, int step, int *ox, int *oy) {
     const float t = 1.0f + ((float)step + jitter) * step_px;
-    const float x = floorf(0.5f + dc * t);
-    const float y = floorf(0.5f - ds * t * inv_ycor);
-    /* tested before converting: a huge projected radius must not overflow int */
-    if (!(x > -(float)grid->width && x < (float)grid->width && y > -(float)grid->height &&
-          y < (float)grid->height))
-        return 0;
-    *ox = (int)x;
-    *oy = (int)y;
-    return 1;
+    return hbao_floor_in_range(0.5f + dc * t, grid->width, ox) &&
+           hbao_floor_in_range(0.5f - ds * t * inv_ycor, grid->height, oy);
 }
 
 /* The scalar reference for one pixel (horizon.c), with its block's step. */
