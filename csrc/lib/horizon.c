@@ -3,6 +3,7 @@
  * jittered steps inside the projected radius and integrate the occlusion of
  * the highest horizon found, per docs/algorithm.md. */
 #include <math.h>
+#include <stdlib.h>
 
 #include "internal_hbao.h"
 
@@ -24,6 +25,11 @@ typedef struct march {
     float jitter;
     float step_px;
     float radius2;
+    /* What every sample is compared with: the depth's rounding tolerance
+     * along the normal (docs/algorithm.md, "Depth precision"), and the sine
+     * of V's elevation above the tangent plane, dot(n, V). */
+    float height_tolerance;
+    float n_dot_v;
 } march;
 
 enum { SAMPLE_END = -1, SAMPLE_SKIP = 0, SAMPLE_OK = 1 };
@@ -31,15 +37,12 @@ enum { SAMPLE_END = -1, SAMPLE_SKIP = 0, SAMPLE_OK = 1 };
 /* The vector to the sample of a step and its squared length. */
 static inline int march_sample(const march *m, int step, float delta[3], float *dist2) {
     const hbao_grid *g = m->grid;
-    const float t = 1.0f + ((float)step + m->jitter) * m->step_px;
-    const float x = (float)m->i + 0.5f + m->dc * t;
-    const float y = (float)m->j + 0.5f - m->ds * t * m->inv_ycor;
-    /* Test before converting: a huge projected radius must not overflow int. */
-    if (!(x >= 0.0f && y >= 0.0f && x < (float)g->width && y < (float)g->height))
+    int ox, oy;
+    if (!hbao_step_offset(g, m->dc, m->ds, m->inv_ycor, m->jitter, m->step_px, step, &ox, &oy))
         return SAMPLE_END;
-    const int si = (int)x, sj = (int)y;
-    if (si >= g->width || sj >= g->height) return SAMPLE_END;
-    if (si == m->i && sj == m->j) return SAMPLE_SKIP;
+    const int si = m->i + ox, sj = m->j + oy;
+    if (si < 0 || sj < 0 || si >= g->width || sj >= g->height) return SAMPLE_END;
+    if (ox == 0 && oy == 0) return SAMPLE_SKIP;
     const float zs = g->depth[(size_t)sj * g->width + si];
     if (zs <= 0.0f) return SAMPLE_SKIP;
     float q[3];
@@ -83,6 +86,27 @@ static inline void slice_setup(const float v[3], const float n[3], float dc, flo
     }
 }
 
+/* The sine of a sample's elevation above the tangent plane, its height
+ * lowered by what the depth's rounding could have raised it. */
+static inline float sample_elevation(const march *m, const float n[3], const float delta[3],
+                                     float inv_dist) {
+    return (delta[0] * n[0] + delta[1] * n[1] + delta[2] * n[2] - m->height_tolerance) * inv_dist;
+}
+
+/* Whether a sample lies past the normal. In the slice that means an angle
+ * from V below gamma; but samples are snapped to pixel centres, off the
+ * slice, and near a plane seen at a grazing angle (V nearly in the tangent
+ * plane) a sample on the plane itself can lie within gamma of V. A sample
+ * past the normal inside the slice also rises above the tangent plane at
+ * least as steeply as V does (its elevation is cos(h - gamma) >= cos(gamma),
+ * i.e. sin_s >= dot(n, V)), which no sample on or near the plane does, so
+ * both are required. */
+static inline int past_the_normal(const march *m, const slice *sl, const float v[3],
+                                  const float delta[3], float inv_dist, float sin_s) {
+    const float cos_v = (delta[0] * v[0] + delta[1] * v[1] + delta[2] * v[2]) * inv_dist;
+    return cos_v > sl->cos_gamma && sin_s > m->n_dot_v;
+}
+
 /* HBAO integration of one direction: sum of W * (increase of the sine of the
  * elevation above the tangent plane), Bavoil & Sainz with seed 003's rule. */
 static float direction_occlusion_hbao(const hbao_settings *s, const march *m, const float n[3],
@@ -99,16 +123,13 @@ static float direction_occlusion_hbao(const hbao_settings *s, const march *m, co
         if (status == SAMPLE_END) break;
         if (status == SAMPLE_SKIP) continue;
         const float inv_dist = 1.0f / sqrtf(dist2);
-        if (check_past_normal) {
-            const float cos_h = (delta[0] * v[0] + delta[1] * v[1] + delta[2] * v[2]) * inv_dist;
-            if (cos_h > sl->cos_gamma) {
-                /* Beyond the normal inside the slice: the screen-space march
-                 * has no proper data here; count the direction half occluded. */
-                if (occlusion < half_occluded) occlusion = half_occluded;
-                break;
-            }
+        const float sin_s = sample_elevation(m, n, delta, inv_dist);
+        if (check_past_normal && past_the_normal(m, sl, v, delta, inv_dist, sin_s)) {
+            /* Beyond the normal inside the slice: the screen-space march
+             * has no proper data here; count the direction half occluded. */
+            if (occlusion < half_occluded) occlusion = half_occluded;
+            break;
         }
-        const float sin_s = (delta[0] * n[0] + delta[1] * n[1] + delta[2] * n[2]) * inv_dist;
         if (sin_s > sin_max) {
             const float weight = quadratic ? 1.0f - dist2 * inv_radius2 : 1.0f;
             occlusion += weight * (sin_s - sin_max);
@@ -159,11 +180,11 @@ static inline void horizon_state(int past_normal, float cos_past_max, float elev
  * attenuated per sample. Returns the occluded part; *open_part receives the
  * visibility of the unoccluded half slice.
  * A sample's angle h from V is measured through its elevation above the
- * tangent plane, sin(phi) = dot(n, D) / (|D| |np|), h = gamma + pi/2 - phi:
- * exact for samples in the slice, and, unlike the angle to V, still exact
+ * tangent plane, sin(phi) = sin_s / |np| (sample_elevation),
+ * h = gamma + pi/2 - phi: exact for samples in the slice, and, unlike the angle to V, still exact
  * (0) for snapped samples that lie on the tangent plane but off the slice.
- * Past the normal (h < gamma) the elevation turns back, so there the angle
- * to V is used. */
+ * Past the normal (past_the_normal) the elevation turns back, so there the
+ * angle to V is used. */
 static float direction_occlusion_cosine(const hbao_settings *s, const march *m, const float n[3],
                                         const float v[3], const slice *sl, float *open_part) {
     const float gamma = HALF_PI - hbao_acos(sl->sin_gamma); /* asin; cos_gamma >= 0 */
@@ -191,21 +212,19 @@ static float direction_occlusion_cosine(const hbao_settings *s, const march *m, 
         if (status == SAMPLE_END) break;
         if (status == SAMPLE_SKIP) continue;
         const float inv_dist = 1.0f / sqrtf(dist2);
+        const float sin_s = sample_elevation(m, n, delta, inv_dist);
         int raised = 0;
-        if (check_past_normal) {
+        if (check_past_normal && past_the_normal(m, sl, v, delta, inv_dist, sin_s)) {
             const float cos_v = (delta[0] * v[0] + delta[1] * v[1] + delta[2] * v[2]) * inv_dist;
-            if (cos_v > sl->cos_gamma) {
-                if (cos_v > cos_past_max) {
-                    past_normal = 1;
-                    cos_past_max = cos_v > 1.0f ? 1.0f : cos_v;
-                    raised = 1;
-                }
+            if (cos_v > cos_past_max) {
+                past_normal = 1;
+                cos_past_max = cos_v > 1.0f ? 1.0f : cos_v;
+                raised = 1;
             }
         }
         if (!raised) {
             if (past_normal) continue; /* nothing below the normal can raise it now */
-            const float elevation =
-                (delta[0] * n[0] + delta[1] * n[1] + delta[2] * n[2]) * inv_dist * inv_np;
+            const float elevation = sin_s * inv_np;
             if (elevation <= elevation_max) continue;
             elevation_max = elevation > 1.0f ? 1.0f : elevation;
             raised = 1;
@@ -226,7 +245,7 @@ static float direction_occlusion_cosine(const hbao_settings *s, const march *m, 
     return occlusion;
 }
 
-float hbao_horizon_pixel(const horizon_job *job, int i, int j) {
+float hbao_horizon_pixel(const horizon_job *job, int i, int j, float step_px) {
     const hbao_settings *s = job->settings;
     const hbao_grid *g = job->grid;
     const float z = g->depth[(size_t)j * g->width + i];
@@ -243,7 +262,7 @@ float hbao_horizon_pixel(const horizon_job *job, int i, int j) {
     const int cell = (i & 3) + 4 * (j & 3);
     m.inv_ycor = 1.0f / g->ycor;
     m.jitter = job->jitter[cell];
-    m.step_px = (radius_px - 1.0f) / (float)s->steps;
+    m.step_px = step_px;
     m.radius2 = s->radius * s->radius;
 
     float v[3] = {0.0f, 0.0f, 1.0f};
@@ -252,6 +271,8 @@ float hbao_horizon_pixel(const horizon_job *job, int i, int j) {
         for (int c = 0; c < 3; c++) v[c] = -m.p[c] * inv;
     }
     const float *n = g->normal + 3 * ((size_t)j * g->width + i);
+    m.n_dot_v = n[0] * v[0] + n[1] * v[1] + n[2] * v[2];
+    m.height_tolerance = g->depth_precision * hbao_rounding_along_normal(g, n, m.p);
     const int cosine = s->integration == HBAO_INTEGRATION_COSINE;
 
     float occlusion_sum = 0.0f;                /* HBAO */
@@ -281,11 +302,27 @@ float hbao_horizon_pixel(const horizon_job *job, int i, int j) {
     return ao < 1.0f ? ao : 1.0f;
 }
 
+float hbao_block_step(const horizon_job *job, int x0, int x1, int j, int a) {
+    const hbao_settings *s = job->settings;
+    const hbao_grid *g = job->grid;
+    float largest = 0.0f;
+    for (int i = x0 + a; i < x1; i += 4) {
+        const float z = g->depth[(size_t)j * g->width + i];
+        if (z <= 0.0f) continue;
+        /* as hbao_horizon_pixel and the SIMD kernels compute it */
+        const float radius_px =
+            g->orthographic ? s->radius / g->pixel_size : s->radius / (g->pixel_size * z);
+        if (radius_px >= 1.0f && radius_px > largest) largest = radius_px;
+    }
+    return largest >= 1.0f ? (largest - 1.0f) / (float)s->steps : 0.0f;
+}
+
 /* Pixels are visited tile by tile: a pixel's samples spread over the whole
  * projected radius, and the pixel below it samples nearly the same cache
- * lines, which are still cached when only a tile's width lies between them
- * (not a whole row). Measured with csrc/bench/bench_speed.c. */
-#define TILE_SIZE 64
+ * lines, which are still cached when only a tile's height lies between them
+ * (not a whole image). A tile is one block span wide. Measured with
+ * csrc/bench/bench_speed.c. */
+#define TILE_SIZE HBAO_BLOCK_SPAN
 
 typedef struct tiled_job {
     const horizon_job *job;
@@ -306,7 +343,30 @@ static void horizon_tile(void *context, int tile) {
             tiled->simd(job, x0, x1, j);
         } else {
             float *out = job->ao + (size_t)j * width;
-            for (int i = x0; i < x1; i++) out[i] = hbao_horizon_pixel(job, i, j);
+            for (int a = 0; a < 4; a++) {
+                const float step_px = hbao_block_step(job, x0, x1, j, a);
+                for (int i = x0 + a; i < x1; i += 4) out[i] = hbao_horizon_pixel(job, i, j, step_px);
+            }
+        }
+    }
+}
+
+/* hbao_horizon_job.phase_depth, row by row. */
+typedef struct deinterleave_job {
+    const hbao_grid *grid;
+    int phase_width;
+    float *phase_depth;
+} deinterleave_job;
+
+static void deinterleave_row(void *context, int j) {
+    const deinterleave_job *job = context;
+    const hbao_grid *g = job->grid;
+    const float *row = g->depth + (size_t)j * g->width;
+    for (int a = 0; a < 4; a++) {
+        float *out = job->phase_depth + ((size_t)a * g->height + j) * job->phase_width;
+        for (int x = 0; x < job->phase_width; x++) {
+            const int i = 4 * x + a;
+            out[x] = i < g->width ? row[i] : 0.0f;
         }
     }
 }
@@ -347,6 +407,22 @@ void hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *grid,
     tiled.job = &job;
     tiled.tiles_across = (grid->width + TILE_SIZE - 1) / TILE_SIZE;
     tiled.simd = choose_kernel(settings->implementation);
+    float *phase_depth = NULL;
+    job.phase_depth = NULL;
+    /* whole blocks, so that a block's depths are always one full load */
+    job.phase_width = ((grid->width + 3) / 4 + HBAO_BLOCK_PIXELS - 1) / HBAO_BLOCK_PIXELS * HBAO_BLOCK_PIXELS;
+    if (tiled.simd != NULL) {
+        phase_depth = malloc((size_t)4 * grid->height * job.phase_width * sizeof(float));
+        /* Without memory for the copy the scalar reference computes the same
+         * result, only slower. */
+        if (phase_depth == NULL) tiled.simd = NULL;
+    }
+    if (phase_depth != NULL) {
+        deinterleave_job deinterleave = {grid, job.phase_width, phase_depth};
+        hbao_parallel_rows(settings->threads, grid->height, deinterleave_row, &deinterleave);
+        job.phase_depth = phase_depth;
+    }
     const int tiles_down = (grid->height + TILE_SIZE - 1) / TILE_SIZE;
     hbao_parallel_rows(settings->threads, tiled.tiles_across * tiles_down, horizon_tile, &tiled);
+    free(phase_depth);
 }

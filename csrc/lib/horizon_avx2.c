@@ -36,20 +36,7 @@
 #define I_ADD _mm256_add_epi32
 #define I_MULLO _mm256_mullo_epi32
 #define I_LANES _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)
-#define I_CVTT _mm256_cvttps_epi32
 #define I_TO_F _mm256_cvtepi32_ps
-#define I_CMPEQ(a, b) _mm256_castsi256_ps(_mm256_cmpeq_epi32((a), (b)))
-#define I_ZERO_UNLESS(m, v) _mm256_and_si256(_mm256_castps_si256(m), (v))
-
-/* Eight scalar loads: faster than vgatherdps on the CPUs measured
- * (csrc/bench/bench_speed.c). Masked-off lanes carry index 0. */
-static inline __m256 gather_avx2(const float *base, __m256i index) {
-    int32_t lane[8];
-    _mm256_storeu_si256((__m256i *)lane, index);
-    return _mm256_setr_ps(base[lane[0]], base[lane[1]], base[lane[2]], base[lane[3]], base[lane[4]],
-                          base[lane[5]], base[lane[6]], base[lane[7]]);
-}
-#define V_GATHER(base, index, mask) gather_avx2((base), (index))
 
 #include "horizon_simd.h"
 
@@ -68,7 +55,10 @@ int hbao_horizon_avx2_available(void) { return 0; }
 
 void hbao_horizon_span_avx2(const hbao_horizon_job *job, int x0, int x1, int j) {
     float *out = job->ao + (size_t)j * job->grid->width;
-    for (int i = x0; i < x1; i++) out[i] = hbao_horizon_pixel(job, i, j);
+    for (int a = 0; a < 4; a++) {
+        const float step_px = hbao_block_step(job, x0, x1, j, a);
+        for (int i = x0 + a; i < x1; i += 4) out[i] = hbao_horizon_pixel(job, i, j, step_px);
+    }
 }
 
 #endif

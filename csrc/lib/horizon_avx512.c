@@ -36,12 +36,7 @@
 #define I_ADD _mm512_add_epi32
 #define I_MULLO _mm512_mullo_epi32
 #define I_LANES _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15)
-#define I_CVTT _mm512_cvttps_epi32
 #define I_TO_F _mm512_cvtepi32_ps
-#define I_CMPEQ(a, b) _mm512_cmpeq_epi32_mask((a), (b))
-#define I_ZERO_UNLESS(m, v) _mm512_maskz_mov_epi32((m), (v))
-#define V_GATHER(base, index, mask) \
-    _mm512_mask_i32gather_ps(_mm512_setzero_ps(), (mask), (index), (base), 4)
 
 #include "horizon_simd.h"
 
@@ -60,7 +55,10 @@ int hbao_horizon_avx512_available(void) { return 0; }
 
 void hbao_horizon_span_avx512(const hbao_horizon_job *job, int x0, int x1, int j) {
     float *out = job->ao + (size_t)j * job->grid->width;
-    for (int i = x0; i < x1; i++) out[i] = hbao_horizon_pixel(job, i, j);
+    for (int a = 0; a < 4; a++) {
+        const float step_px = hbao_block_step(job, x0, x1, j, a);
+        for (int i = x0 + a; i < x1; i += 4) out[i] = hbao_horizon_pixel(job, i, j, step_px);
+    }
 }
 
 #endif

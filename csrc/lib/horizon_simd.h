@@ -4,15 +4,14 @@
  * the vector vocabulary below (horizon_avx2.c, horizon_avx512.c). The kernel
  * performs the same float operations in the same order as the scalar
  * reference in horizon.c (no FMA contraction), so every instance gives
- * bit-identical results (tested in test_ao.c); where the scalar code leaves
- * a loop with break or continue, lanes are masked instead.
+ * bit-identical results (tested in test_ao.c and test_planes.c); where the
+ * scalar code leaves a loop with break or continue, lanes are masked instead.
  *
  * Vocabulary: VF float vector, VI int32 vector, VM lane mask;
  * V_ADD V_SUB V_MUL V_DIV V_SQRT V_SET V_LOADU V_STOREU V_NEG V_MAX0 (max
  * with 0, NaN -> 0); comparisons V_GT V_GE V_LT V_LE -> VM; masks M_AND M_OR
  * M_ANDNOT(a, b) = ~a & b, M_ANY; V_SELECT(m, a, b) = m ? b : a;
- * V_ZERO_UNLESS(m, v); I_SET I_ADD I_MULLO I_LANES (0, 1, ...) I_CVTT
- * (truncate) I_TO_F I_CMPEQ -> VM, I_ZERO_UNLESS(m, v), I_STOREU;
+ * V_ZERO_UNLESS(m, v); I_SET I_ADD I_MULLO I_LANES (0, 1, ...) I_TO_F;
  * SIMD_NAME(x) gives the instance's function names. */
 
 static inline VF SIMD_NAME(dot3)(VF a0, VF a1, VF a2, VF b0, VF b1, VF b2) {
@@ -68,45 +67,65 @@ static inline void SIMD_NAME(slice_setup)(const VF v[3], const VF n[3], VF dc, V
                              V_MUL(SIMD_NAME(dot3)(np0, np1, np2, e0, e1, e2), sl->inv_np));
 }
 
-/* The block of pixels and what does not change between directions. */
+/* The lanes' pixels (SIMD_LANES of a block's HBAO_BLOCK_PIXELS, see
+ * internal_hbao.h) and what does not change between directions. */
 typedef struct SIMD_NAME(block) {
+    const hbao_horizon_job *job;
     const hbao_grid *grid;
-    VI lane_i;
-    VF base_x, base_y; /* pixel centre, in pixels */
-    VF p[3], v[3], n[3];
-    VF jitter, step_px, radius2, inv_radius2, inv_ycor;
+    VI lane_i;       /* the lanes' columns: first_i + 4 k */
+    int phase;       /* first_i & 3: the lanes' column phase */
+    int first_x;     /* lane 0's index in its phase_depth row: first_i / 4 */
     int j;
+    float jitter, step_px, inv_ycor; /* shared by the block */
+    VF p[3], v[3], n[3];
+    VF radius2, inv_radius2;
+    VF height_tolerance, n_dot_v; /* as in horizon.c's march */
 } SIMD_NAME(block);
 
 /* The depth fetches of a direction's steps. They depend only on the steps'
- * positions, so all of them are issued first (one gather per step, back to
- * back, their latencies overlapping) and the horizon logic runs afterwards. */
+ * positions, so all of them are issued first and the horizon logic runs
+ * afterwards. A step is one pixel offset for every lane, so its depths are
+ * one contiguous load from the phase_depth row of the lanes' new phase. */
 typedef struct SIMD_NAME(fetch) {
     VF zs;
-    VI si, sj;
+    VI si;        /* the samples' columns */
+    int sj;       /* and their row, the same for all lanes */
     VM candidate; /* inside the image, on another pixel */
 } SIMD_NAME(fetch);
 
 /* Fills fetches[0..n) and returns n, the steps before every lane has left
  * the image. */
-static inline int SIMD_NAME(fetch_steps)(const SIMD_NAME(block) * b, int steps, VF dc, VF ds,
+static inline int SIMD_NAME(fetch_steps)(const SIMD_NAME(block) * b, int steps, float dc, float ds,
                                          VM active, SIMD_NAME(fetch) * fetches) {
     const hbao_grid *g = b->grid;
+    const int phase_width = b->job->phase_width;
     VM alive = active;
     int step = 0;
     for (; step < steps && M_ANY(alive); step++) {
-        const VF t = V_ADD(V_SET(1.0f), V_MUL(V_ADD(V_SET((float)step), b->jitter), b->step_px));
-        const VF x = V_ADD(b->base_x, V_MUL(dc, t));
-        const VF y = V_SUB(b->base_y, V_MUL(V_MUL(ds, t), b->inv_ycor));
-        const VM inside = M_AND(M_AND(V_GE(x, V_SET(0.0f)), V_GE(y, V_SET(0.0f))),
-                                M_AND(V_LT(x, V_SET((float)g->width)), V_LT(y, V_SET((float)g->height))));
-        alive = M_AND(alive, inside);
-        const VI si = I_ZERO_UNLESS(alive, I_CVTT(x));
-        const VI sj = I_ZERO_UNLESS(alive, I_CVTT(y));
-        const VM same = M_AND(I_CMPEQ(si, b->lane_i), I_CMPEQ(sj, I_SET(b->j)));
-        const VM candidate = M_ANDNOT(same, alive);
-        const VI index = I_ZERO_UNLESS(candidate, I_ADD(I_MULLO(sj, I_SET(g->width)), si));
-        fetches[step].zs = V_ZERO_UNLESS(candidate, V_GATHER(g->depth, index, candidate));
+        int ox, oy;
+        if (!hbao_step_offset(g, dc, ds, b->inv_ycor, b->jitter, b->step_px, step, &ox, &oy)) break;
+        const int sj = b->j + oy;
+        if (sj < 0 || sj >= g->height) break; /* every lane's sample leaves the image */
+        const VI si = I_ADD(b->lane_i, I_SET(ox));
+        const VF column = I_TO_F(si); /* exact: |si| < 2^24 */
+        alive = M_AND(alive, M_AND(V_GE(column, V_SET(0.0f)), V_LT(column, V_SET((float)g->width))));
+        const VM candidate = (ox == 0 && oy == 0) ? M_ANDNOT(alive, alive) : alive;
+        /* lane k samples column first_i + 4 k + ox: phase (phase + ox) mod 4,
+         * index first_x + k + floor((phase + ox) / 4) of that phase's row */
+        const int moved = b->phase + ox;
+        const int new_phase = ((moved % 4) + 4) % 4;
+        const int first = b->first_x + (moved - new_phase) / 4;
+        const float *row = b->job->phase_depth + ((size_t)new_phase * g->height + sj) * phase_width;
+        VF zs;
+        if (first >= 0 && first + SIMD_LANES <= phase_width) {
+            zs = V_LOADU(row + first);
+        } else { /* at the image's side: only the lanes inside read */
+            float lanes[SIMD_LANES];
+            for (int k = 0; k < SIMD_LANES; k++)
+                lanes[k] = first + k >= 0 && first + k < phase_width ? row[first + k] : 0.0f;
+            zs = V_LOADU(lanes);
+        }
+        fetches[step].zs = V_ZERO_UNLESS(candidate, zs);
         fetches[step].si = si;
         fetches[step].sj = sj;
         fetches[step].candidate = candidate;
@@ -122,7 +141,7 @@ static inline VM SIMD_NAME(sample)(const SIMD_NAME(block) * b, const SIMD_NAME(f
     const VF zs = f->zs;
     const VM valid = M_AND(M_AND(f->candidate, live), V_GT(zs, V_SET(0.0f)));
     const VF column = V_MUL(V_ADD(I_TO_F(f->si), V_SET(g->x_offset)), V_SET(g->x_step));
-    const VF row = V_MUL(V_ADD(I_TO_F(f->sj), V_SET(g->y_offset)), V_SET(g->y_step));
+    const VF row = V_SET(hbao_grid_y(g, f->sj));
     const VF q0 = g->orthographic ? column : V_MUL(column, zs);
     const VF q1 = g->orthographic ? row : V_MUL(row, zs);
     delta[0] = V_SUB(q0, b->p[0]);
@@ -132,8 +151,23 @@ static inline VM SIMD_NAME(sample)(const SIMD_NAME(block) * b, const SIMD_NAME(f
     return M_AND(valid, M_AND(V_LT(*dist2, b->radius2), V_GT(*dist2, V_SET(0.0f))));
 }
 
+/* horizon.c's sample_elevation and past_the_normal */
+static inline VF SIMD_NAME(sample_elevation)(const SIMD_NAME(block) * b, const VF delta[3], VF inv_dist) {
+    const VF height = SIMD_NAME(dot3)(delta[0], delta[1], delta[2], b->n[0], b->n[1], b->n[2]);
+    return V_MUL(V_SUB(height, b->height_tolerance), inv_dist);
+}
+
+static inline VF SIMD_NAME(cos_to_view)(const SIMD_NAME(block) * b, const VF delta[3], VF inv_dist) {
+    return V_MUL(SIMD_NAME(dot3)(delta[0], delta[1], delta[2], b->v[0], b->v[1], b->v[2]), inv_dist);
+}
+
+static inline VM SIMD_NAME(past_the_normal)(const SIMD_NAME(block) * b, const SIMD_NAME(slice) * sl,
+                                            const VF delta[3], VF inv_dist, VF sin_s) {
+    return M_AND(V_GT(SIMD_NAME(cos_to_view)(b, delta, inv_dist), sl->cos_gamma), V_GT(sin_s, b->n_dot_v));
+}
+
 static VF SIMD_NAME(direction_occlusion_hbao)(const hbao_settings *s, const SIMD_NAME(block) * b,
-                                              VM active, VF dc, VF ds,
+                                              VM active, float dc, float ds,
                                               const SIMD_NAME(slice) * sl) {
     const int quadratic = s->falloff == HBAO_FALLOFF_QUADRATIC;
     const VF half_occluded = V_SET(0.5f * (1.0f - s->sin_bias));
@@ -149,17 +183,15 @@ static VF SIMD_NAME(direction_occlusion_hbao)(const hbao_settings *s, const SIMD
         const VM ok = SIMD_NAME(sample)(b, &fetches[step], alive, delta, &dist2);
         if (!M_ANY(ok)) continue;
         const VF inv_dist = V_DIV(V_SET(1.0f), V_SQRT(dist2));
+        const VF sin_s = SIMD_NAME(sample_elevation)(b, delta, inv_dist);
         VM rest = ok;
         if (any_check) {
-            const VF cos_h = V_MUL(SIMD_NAME(dot3)(delta[0], delta[1], delta[2], b->v[0], b->v[1], b->v[2]),
-                                   inv_dist);
-            const VM past = M_AND(M_AND(ok, check_past_normal), V_GT(cos_h, sl->cos_gamma));
+            const VM past = M_AND(M_AND(ok, check_past_normal),
+                                  SIMD_NAME(past_the_normal)(b, sl, delta, inv_dist, sin_s));
             occlusion = V_SELECT(M_AND(past, V_LT(occlusion, half_occluded)), occlusion, half_occluded);
             alive = M_ANDNOT(past, alive);
             rest = M_ANDNOT(past, ok);
         }
-        const VF sin_s = V_MUL(SIMD_NAME(dot3)(delta[0], delta[1], delta[2], b->n[0], b->n[1], b->n[2]),
-                               inv_dist);
         const VM rise = M_AND(rest, V_GT(sin_s, sin_max));
         const VF weight = quadratic ? V_SUB(V_SET(1.0f), V_MUL(dist2, b->inv_radius2)) : V_SET(1.0f);
         occlusion = V_SELECT(rise, occlusion, V_ADD(occlusion, V_MUL(weight, V_SUB(sin_s, sin_max))));
@@ -196,7 +228,7 @@ static inline VF SIMD_NAME(horizon_visibility)(VM past_normal, VF cos_past_max, 
 }
 
 static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SIMD_NAME(block) * b,
-                                                VM active, VF dc, VF ds,
+                                                VM active, float dc, float ds,
                                                 const SIMD_NAME(slice) * sl, VF *open_part) {
     const VF gamma = V_SUB(V_SET(0.5f * HBAO_PI), SIMD_NAME(acos)(sl->sin_gamma));
     *open_part = V_MUL(V_SET(0.25f), V_ADD(V_MUL(V_SET(2.0f), sl->cos_gamma),
@@ -221,19 +253,18 @@ static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SI
         const VM ok = SIMD_NAME(sample)(b, &fetches[step], active, delta, &dist2);
         if (!M_ANY(ok)) continue;
         const VF inv_dist = V_DIV(V_SET(1.0f), V_SQRT(dist2));
+        const VF sin_s = SIMD_NAME(sample_elevation)(b, delta, inv_dist);
         VM raised = M_ANDNOT(ok, ok); /* no lane */
         if (any_check) {
-            const VF cos_v = V_MUL(SIMD_NAME(dot3)(delta[0], delta[1], delta[2], b->v[0], b->v[1], b->v[2]),
-                                   inv_dist);
-            const VM newly = M_AND(M_AND(M_AND(ok, check_past_normal), V_GT(cos_v, sl->cos_gamma)),
-                                   V_GT(cos_v, cos_past_max));
+            const VF cos_v = SIMD_NAME(cos_to_view)(b, delta, inv_dist);
+            const VM past = M_AND(V_GT(cos_v, sl->cos_gamma), V_GT(sin_s, b->n_dot_v));
+            const VM newly = M_AND(M_AND(M_AND(ok, check_past_normal), past), V_GT(cos_v, cos_past_max));
             past_normal = M_OR(past_normal, newly);
             cos_past_max = V_SELECT(newly, cos_past_max, V_SELECT(V_GT(cos_v, V_SET(1.0f)), cos_v, V_SET(1.0f)));
             raised = newly;
         }
         const VM elevation_candidates = M_ANDNOT(past_normal, M_ANDNOT(raised, ok));
-        const VF elevation = V_MUL(
-            V_MUL(SIMD_NAME(dot3)(delta[0], delta[1], delta[2], b->n[0], b->n[1], b->n[2]), inv_dist), inv_np);
+        const VF elevation = V_MUL(sin_s, inv_np);
         const VM rise = M_AND(elevation_candidates, V_GT(elevation, elevation_max));
         elevation_max = V_SELECT(rise, elevation_max,
                                  V_SELECT(V_GT(elevation, V_SET(1.0f)), elevation, V_SET(1.0f)));
@@ -253,14 +284,22 @@ static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SI
     return occlusion;
 }
 
-static void SIMD_NAME(block_ao)(const hbao_horizon_job *job, int i0, int j, float *out) {
+/* Lanes first_lane .. first_lane + SIMD_LANES - 1 of the block of phase a
+ * at x0 in row j, with the block's step step_px. */
+static void SIMD_NAME(lanes_ao)(const hbao_horizon_job *job, int x0, int x1, int j, int a, int first_lane,
+                                float step_px) {
     const hbao_settings *s = job->settings;
     const hbao_grid *g = job->grid;
     SIMD_NAME(block) b;
+    b.job = job;
     b.grid = g;
     b.j = j;
-    const VF z = V_LOADU(g->depth + (size_t)j * g->width + i0);
-    b.lane_i = I_ADD(I_SET(i0), I_LANES);
+    const int first_i = x0 + a + 4 * first_lane;
+    b.phase = a;
+    b.first_x = first_i / 4;
+    /* phase_depth rows are padded to whole blocks with zeros: background */
+    const VF z = V_LOADU(job->phase_depth + ((size_t)a * g->height + j) * job->phase_width + b.first_x);
+    b.lane_i = I_ADD(I_SET(first_i), I_MULLO(I_LANES, I_SET(4)));
     const VF column = V_MUL(V_ADD(I_TO_F(b.lane_i), V_SET(g->x_offset)), V_SET(g->x_step));
     const VF row = V_SET(hbao_grid_y(g, j));
     b.p[0] = g->orthographic ? column : V_MUL(column, z);
@@ -269,71 +308,76 @@ static void SIMD_NAME(block_ao)(const hbao_horizon_job *job, int i0, int j, floa
     const VF radius_px = g->orthographic ? V_SET(s->radius / g->pixel_size)
                                          : V_DIV(V_SET(s->radius), V_MUL(V_SET(g->pixel_size), z));
     const VM active = M_AND(V_GT(z, V_SET(0.0f)), V_GE(radius_px, V_SET(1.0f)));
+    float result[SIMD_LANES];
     if (!M_ANY(active)) {
-        V_STOREU(out, V_SET(1.0f));
-        return;
-    }
-    b.base_x = V_ADD(I_TO_F(b.lane_i), V_SET(0.5f));
-    b.base_y = V_SET((float)j + 0.5f);
-    /* i0 is a multiple of 4, so lane k has pattern cell (k & 3) + cell0 */
-    const int cell0 = 4 * (j & 3);
-    float lane_values[SIMD_LANES];
-    for (int k = 0; k < SIMD_LANES; k++) lane_values[k] = job->jitter[cell0 + (k & 3)];
-    b.jitter = V_LOADU(lane_values);
-    b.step_px = V_DIV(V_SUB(radius_px, V_SET(1.0f)), V_SET((float)s->steps));
-    b.radius2 = V_SET(s->radius * s->radius);
-    b.inv_radius2 = V_SET(1.0f / (s->radius * s->radius));
-    b.inv_ycor = V_SET(1.0f / g->ycor);
-    if (g->orthographic) {
-        b.v[0] = V_SET(0.0f);
-        b.v[1] = V_SET(0.0f);
-        b.v[2] = V_SET(1.0f);
+        V_STOREU(result, V_SET(1.0f));
     } else {
-        const VF inv = V_DIV(V_SET(1.0f), V_SQRT(SIMD_NAME(dot3)(b.p[0], b.p[1], b.p[2], b.p[0], b.p[1], b.p[2])));
-        for (int c = 0; c < 3; c++) b.v[c] = V_MUL(V_NEG(b.p[c]), inv);
-    }
-    float normal_lanes[3][SIMD_LANES];
-    const float *normal = g->normal + 3 * ((size_t)j * g->width + i0);
-    for (int k = 0; k < SIMD_LANES; k++)
-        for (int c = 0; c < 3; c++) normal_lanes[c][k] = normal[3 * k + c];
-    for (int c = 0; c < 3; c++) b.n[c] = V_LOADU(normal_lanes[c]);
-
-    const int cosine = s->integration == HBAO_INTEGRATION_COSINE;
-    VF occlusion_sum = V_SET(0.0f), visible_sum = V_SET(0.0f), open_sum = V_SET(0.0f);
-    float dc_lanes[SIMD_LANES], ds_lanes[SIMD_LANES];
-    for (int d = 0; d < s->directions; d++) {
-        for (int k = 0; k < SIMD_LANES; k++) {
-            dc_lanes[k] = job->direction_cos[cell0 + (k & 3)][d];
-            ds_lanes[k] = job->direction_sin[cell0 + (k & 3)][d];
-        }
-        const VF dc = V_LOADU(dc_lanes), ds = V_LOADU(ds_lanes);
-        SIMD_NAME(slice) sl;
-        SIMD_NAME(slice_setup)(b.v, b.n, dc, ds, &sl);
-        if (cosine) {
-            const VM lanes = M_AND(active, sl.usable);
-            if (!M_ANY(lanes)) continue;
-            VF open;
-            const VF occlusion = SIMD_NAME(direction_occlusion_cosine)(s, &b, lanes, dc, ds, &sl, &open);
-            visible_sum = V_SELECT(lanes, visible_sum, V_ADD(visible_sum, V_MUL(sl.np_length, V_SUB(open, occlusion))));
-            open_sum = V_SELECT(lanes, open_sum, V_ADD(open_sum, V_MUL(sl.np_length, open)));
+        const int cell = a + 4 * (j & 3);
+        b.jitter = job->jitter[cell];
+        b.step_px = step_px;
+        b.inv_ycor = 1.0f / g->ycor;
+        b.radius2 = V_SET(s->radius * s->radius);
+        b.inv_radius2 = V_SET(1.0f / (s->radius * s->radius));
+        if (g->orthographic) {
+            b.v[0] = V_SET(0.0f);
+            b.v[1] = V_SET(0.0f);
+            b.v[2] = V_SET(1.0f);
         } else {
-            occlusion_sum = V_ADD(occlusion_sum, SIMD_NAME(direction_occlusion_hbao)(s, &b, active, dc, ds, &sl));
+            const VF inv = V_DIV(V_SET(1.0f), V_SQRT(SIMD_NAME(dot3)(b.p[0], b.p[1], b.p[2], b.p[0], b.p[1], b.p[2])));
+            for (int c = 0; c < 3; c++) b.v[c] = V_MUL(V_NEG(b.p[c]), inv);
         }
+        float normal_lanes[3][SIMD_LANES];
+        for (int k = 0; k < SIMD_LANES; k++) {
+            const int i = first_i + 4 * k;
+            const float *normal = g->normal + 3 * ((size_t)j * g->width + (i < x1 ? i : x0));
+            for (int c = 0; c < 3; c++) normal_lanes[c][k] = normal[c];
+        }
+        for (int c = 0; c < 3; c++) b.n[c] = V_LOADU(normal_lanes[c]);
+        b.n_dot_v = SIMD_NAME(dot3)(b.n[0], b.n[1], b.n[2], b.v[0], b.v[1], b.v[2]);
+        /* hbao_rounding_along_normal */
+        const VF along = g->orthographic ? V_MUL(b.n[2], b.p[2])
+                                         : SIMD_NAME(dot3)(b.n[0], b.n[1], b.n[2], b.p[0], b.p[1], b.p[2]);
+        b.height_tolerance =
+            V_MUL(V_SET(g->depth_precision), V_SELECT(V_LT(along, V_SET(0.0f)), along, V_NEG(along)));
+
+        const int cosine = s->integration == HBAO_INTEGRATION_COSINE;
+        VF occlusion_sum = V_SET(0.0f), visible_sum = V_SET(0.0f), open_sum = V_SET(0.0f);
+        for (int d = 0; d < s->directions; d++) {
+            const float dc = job->direction_cos[cell][d], ds = job->direction_sin[cell][d];
+            SIMD_NAME(slice) sl;
+            SIMD_NAME(slice_setup)(b.v, b.n, V_SET(dc), V_SET(ds), &sl);
+            if (cosine) {
+                const VM lanes = M_AND(active, sl.usable);
+                if (!M_ANY(lanes)) continue;
+                VF open;
+                const VF occlusion = SIMD_NAME(direction_occlusion_cosine)(s, &b, lanes, dc, ds, &sl, &open);
+                visible_sum = V_SELECT(lanes, visible_sum, V_ADD(visible_sum, V_MUL(sl.np_length, V_SUB(open, occlusion))));
+                open_sum = V_SELECT(lanes, open_sum, V_ADD(open_sum, V_MUL(sl.np_length, open)));
+            } else {
+                occlusion_sum = V_ADD(occlusion_sum, SIMD_NAME(direction_occlusion_hbao)(s, &b, active, dc, ds, &sl));
+            }
+        }
+        VF ao;
+        if (cosine)
+            ao = V_SELECT(V_GT(open_sum, V_SET(1e-12f)), V_SET(1.0f), V_DIV(visible_sum, open_sum));
+        else
+            ao = V_SUB(V_SET(1.0f), V_DIV(occlusion_sum, V_SET((float)s->directions * (1.0f - s->sin_bias))));
+        ao = V_ZERO_UNLESS(V_GT(ao, V_SET(0.0f)), ao); /* !(ao > 0) -> 0, NaN included */
+        ao = V_SELECT(V_LT(ao, V_SET(1.0f)), V_SET(1.0f), ao);
+        ao = V_SELECT(active, V_SET(1.0f), ao);
+        V_STOREU(result, ao);
     }
-    VF ao;
-    if (cosine)
-        ao = V_SELECT(V_GT(open_sum, V_SET(1e-12f)), V_SET(1.0f), V_DIV(visible_sum, open_sum));
-    else
-        ao = V_SUB(V_SET(1.0f), V_DIV(occlusion_sum, V_SET((float)s->directions * (1.0f - s->sin_bias))));
-    ao = V_ZERO_UNLESS(V_GT(ao, V_SET(0.0f)), ao); /* !(ao > 0) -> 0, NaN included */
-    ao = V_SELECT(V_LT(ao, V_SET(1.0f)), V_SET(1.0f), ao);
-    ao = V_SELECT(active, V_SET(1.0f), ao);
-    V_STOREU(out, ao);
+    float *out = job->ao + (size_t)j * g->width;
+    for (int k = 0; k < SIMD_LANES; k++) {
+        const int i = first_i + 4 * k;
+        if (i < x1) out[i] = result[k];
+    }
 }
 
 static void SIMD_NAME(span)(const hbao_horizon_job *job, int x0, int x1, int j) {
-    float *out = job->ao + (size_t)j * job->grid->width;
-    int i = x0;
-    for (; i + SIMD_LANES <= x1; i += SIMD_LANES) SIMD_NAME(block_ao)(job, i, j, out + i);
-    for (; i < x1; i++) out[i] = hbao_horizon_pixel(job, i, j);
+    for (int a = 0; a < 4; a++) {
+        const float step_px = hbao_block_step(job, x0, x1, j, a);
+        for (int first_lane = 0; first_lane < HBAO_BLOCK_PIXELS; first_lane += SIMD_LANES)
+            SIMD_NAME(lanes_ao)(job, x0, x1, j, a, first_lane, step_px);
+    }
 }

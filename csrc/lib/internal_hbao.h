@@ -57,7 +57,30 @@ typedef struct hbao_grid {
     int orthographic;
     float pixel_size; /* view-plane width of one grid pixel (per unit depth if perspective) */
     float ycor;       /* pixel height / pixel width */
+    /* The spacing of representable depths relative to the depth: an upper
+     * bound on ulp(z) / z for the format the depth came in (set by
+     * hbao_compute_normals(), docs/algorithm.md "Depth precision"). */
+    float depth_precision;
 } hbao_grid;
+
+/* ulp(z) / z <= 2^-10 for half floats (10 mantissa bits), 2^-23 for floats. */
+#define HBAO_HALF_DEPTH_PRECISION 9.765625e-4f
+#define HBAO_FLOAT_DEPTH_PRECISION 1.1920929e-7f
+
+/* How far rounding the depth to a spacing of 1 (times z) moves the point at
+ * `position` along the normal n: |dot(n, P)| in perspective (the point moves
+ * along its ray, P / z per unit of depth; for every point of a plane this is
+ * the plane's distance from the eye), |n.z| z in orthographic views. Times
+ * depth_precision it bounds the height error of a sample relative to the
+ * centre's tangent plane when both depths are rounded (each by at most half
+ * a spacing). Written as the SIMD kernels compute it. */
+static inline float hbao_rounding_along_normal(const hbao_grid *grid, const float n[3],
+                                               const float position[3]) {
+    const float along = grid->orthographic
+                            ? n[2] * position[2]
+                            : n[0] * position[0] + n[1] * position[1] + n[2] * position[2];
+    return along < 0.0f ? -along : along;
+}
 
 /* Loops written to auto-vectorize get one compiled copy per vector width,
  * chosen when the library loads (GCC's target_clones). Their operations are
@@ -122,15 +145,58 @@ typedef struct hbao_horizon_job {
     float direction_cos[16][HBAO_MAX_DIRECTIONS];
     float direction_sin[16][HBAO_MAX_DIRECTIONS];
     float jitter[16];
+    /* The depth deinterleaved by column phase (SIMD kernels only; NULL for
+     * the scalar reference): phase_depth[(a * height + j) * phase_width + X]
+     * is grid depth (4 X + a, j), 0 beyond the row's end. */
+    const float *phase_depth;
+    int phase_width;
 } hbao_horizon_job;
 
-/* The scalar reference for one pixel (horizon.c). */
-float hbao_horizon_pixel(const hbao_horizon_job *job, int i, int j);
+/* The horizon search works on blocks: the HBAO_BLOCK_PIXELS pixels
+ * i = x0 + a + 4 k of one row (x0 a multiple of 4 * HBAO_BLOCK_PIXELS,
+ * phase a in 0..3, k in 0..HBAO_BLOCK_PIXELS-1) share a pattern cell, so
+ * they march the same directions with the same jitter; they also share one
+ * step length, from the largest projected radius among them, so every step
+ * is one pixel offset for all of them and their depths are one contiguous
+ * load from phase_depth (docs/algorithm.md, "Per-pixel sampling"). */
+#define HBAO_BLOCK_PIXELS 16
+#define HBAO_BLOCK_SPAN (4 * HBAO_BLOCK_PIXELS) /* columns a block spans */
+
+/* The step length in pixels, (R_block - 1) / steps, of the block of phase a
+ * that starts at column x0 of row j (pixels before x1 only); 0 when no pixel
+ * of it is sampled. */
+float hbao_block_step(const hbao_horizon_job *job, int x0, int x1, int j, int a);
+
+/* The pixel offset (ox, oy) of step `step` along direction (dc, ds) of a
+ * block: floor(0.5 + dc t), floor(0.5 - ds t / ycor), t = 1 + (step +
+ * jitter) * step_px. Returns 0 when it lies a whole image away, where every
+ * later step lies too. One function for every kernel, so all compute the
+ * same offsets. */
+static inline int hbao_floor_in_range(float x, int limit, int *floor_x) {
+    /* floor(x) in (-limit, limit), tested before converting so that a huge
+     * projected radius cannot overflow int; NaN fails. Floor by truncation
+     * and correction: no libm call in the scalar reference's inner loop. */
+    if (!(x >= (float)(1 - limit) && x < (float)limit)) return 0;
+    const int truncated = (int)x;
+    *floor_x = (float)truncated > x ? truncated - 1 : truncated;
+    return 1;
+}
+
+static inline int hbao_step_offset(const hbao_grid *grid, float dc, float ds, float inv_ycor,
+                                   float jitter, float step_px, int step, int *ox, int *oy) {
+    const float t = 1.0f + ((float)step + jitter) * step_px;
+    return hbao_floor_in_range(0.5f + dc * t, grid->width, ox) &&
+           hbao_floor_in_range(0.5f - ds * t * inv_ycor, grid->height, oy);
+}
+
+/* The scalar reference for one pixel (horizon.c), with its block's step. */
+float hbao_horizon_pixel(const hbao_horizon_job *job, int i, int j, float step_px);
 
 /* SIMD kernels (horizon_avx2.c, horizon_avx512.c, both made from
  * horizon_simd.h): whether this CPU and build can run each, and the kernel
  * that computes pixels [x0, x1) of row j bit-identically to
- * hbao_horizon_pixel(). */
+ * hbao_horizon_pixel(); x0 is a multiple of HBAO_BLOCK_SPAN and x1 - x0 at
+ * most HBAO_BLOCK_SPAN. */
 typedef void (*hbao_horizon_span)(const hbao_horizon_job *job, int x0, int x1, int j);
 int hbao_horizon_avx2_available(void);
 void hbao_horizon_span_avx2(const hbao_horizon_job *job, int x0, int x1, int j);

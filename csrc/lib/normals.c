@@ -4,6 +4,8 @@
  * (Bavoil & Sainz: face normals avoid the false occlusion that interpolated
  * normals give). Every normal is turned to face the viewer. */
 #include <math.h>
+#include <stdatomic.h>
+#include <stdint.h>
 
 #include "internal_hbao.h"
 
@@ -52,18 +54,111 @@ static int pick_tangent(const hbao_grid *grid, int i, int j, int di, int dj, con
     return best_change < INFINITY;
 }
 
-static int reconstruct_normal(const hbao_grid *grid, int i, int j, const float center[3],
-                              float n[3]) {
-    float dx[3], dy[3];
-    if (!pick_tangent(grid, i, j, 1, 0, center, dx) || !pick_tangent(grid, i, j, 0, 1, center, dy))
-        return 0;
-    n[0] = dx[1] * dy[2] - dx[2] * dy[1];
-    n[1] = dx[2] * dy[0] - dx[0] * dy[2];
-    n[2] = dx[0] * dy[1] - dx[1] * dy[0];
+/* Depths rounded to half floats (EEVEE) step in stairs: on a plane tilted
+ * 30 degrees at 10 m, a 1-pixel difference is either 0 or one 8 mm step, so
+ * the normal from neighbours is off by tens of degrees. There the tangent
+ * along an axis is the least-squares line through the run of up to
+ * HALF_DEPTH_FIT_REACH pixels on each side that continues the surface:
+ * points of a plane along a row or column lie on one 3D line, so the fit
+ * keeps the exact direction, while the rounding errors average out
+ * (measured by the half-depth cases of test_planes.c). */
+#define HALF_DEPTH_FIT_REACH 8
+
+static int usable_depth(const hbao_grid *grid, int i, int j, float *z) {
+    if (i < 0 || j < 0 || i >= grid->width || j >= grid->height) return 0;
+    *z = grid->depth[(size_t)j * grid->width + i];
+    return *z > 0.0f;
+}
+
+static int fit_tangent(const hbao_grid *grid, int i, int j, int di, int dj, const float center[3],
+                       float tangent[3]) {
+    const float z0 = -center[2];
+    /* The surface's depth step per pixel: the smaller of the two first steps
+     * (the other may cross a silhouette). A tap continues the run while its
+     * step stays within twice that plus two rounding steps (staircase). */
+    float first_step = INFINITY;
+    for (int side = -1; side <= 1; side += 2) {
+        float z;
+        if (usable_depth(grid, i + side * di, j + side * dj, &z)) first_step = fminf(first_step, fabsf(z - z0));
+    }
+    if (first_step == INFINITY) return 0;
+    const float limit = 2.0f * first_step + 2.0f * grid->depth_precision * z0;
+    /* Walk the run outwards on both sides, summing what the least-squares
+     * slope needs: with offsets k and depths z(k), sum z, sum k z, sum k^2 z,
+     * sum k and sum k^2. */
+    float sum_z = z0, sum_kz = 0.0f, sum_kkz = 0.0f;
+    int sum_k = 0, sum_kk = 0, count = 1;
+    for (int sign = -1; sign <= 1; sign += 2) {
+        float previous = z0, z;
+        for (int k = sign; k * sign <= HALF_DEPTH_FIT_REACH; k += sign) {
+            if (!usable_depth(grid, i + k * di, j + k * dj, &z) || !(fabsf(z - previous) <= limit)) break;
+            previous = z;
+            sum_z += z;
+            sum_kz += (float)k * z;
+            sum_kkz += (float)(k * k) * z;
+            sum_k += k;
+            sum_kk += k * k;
+            count++;
+        }
+    }
+    if (count < 2) return 0;
+    /* The line through P(k) has direction sum (k - mean) P(k). The view-plane
+     * coordinates are linear in k (one step is (di x_step, dj y_step)); in
+     * perspective P(k) = z(k) (x(k), y(k), -1), in orthographic views
+     * P(k) = (x(k), y(k), -z(k)). */
+    const float mean = (float)sum_k / (float)count;
+    const float weighted_z = sum_kz - mean * sum_z;    /* sum (k - mean) z(k) */
+    const float weighted_kz = sum_kkz - mean * sum_kz; /* sum (k - mean) k z(k) */
+    const float step_x = (float)di * grid->x_step, step_y = (float)dj * grid->y_step;
+    if (grid->orthographic) {
+        const float weighted_k = (float)sum_kk - mean * (float)sum_k; /* sum (k - mean) k */
+        tangent[0] = step_x * weighted_k;
+        tangent[1] = step_y * weighted_k;
+    } else {
+        tangent[0] = hbao_grid_x(grid, i) * weighted_z + step_x * weighted_kz;
+        tangent[1] = hbao_grid_y(grid, j) * weighted_z + step_y * weighted_kz;
+    }
+    tangent[2] = -weighted_z;
+    return 1;
+}
+
+static int tangent_along(const hbao_grid *grid, int i, int j, int di, int dj, const float center[3],
+                         float tangent[3]) {
+    if (grid->depth_precision >= HBAO_HALF_DEPTH_PRECISION)
+        return fit_tangent(grid, i, j, di, dj, center, tangent);
+    return pick_tangent(grid, i, j, di, dj, center, tangent);
+}
+
+static int normalize3(float n[3]) {
     const float length = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     if (!(length > 0.0f) || !isfinite(length)) return 0;
     for (int c = 0; c < 3; c++) n[c] /= length;
     return 1;
+}
+
+static int reconstruct_normal(const hbao_grid *grid, int i, int j, const float center[3],
+                              const float v[3], float n[3]) {
+    float dx[3], dy[3];
+    const int have_x = tangent_along(grid, i, j, 1, 0, center, dx);
+    const int have_y = tangent_along(grid, i, j, 0, 1, center, dy);
+    if (have_x && have_y) {
+        n[0] = dx[1] * dy[2] - dx[2] * dy[1];
+        n[1] = dx[2] * dy[0] - dx[0] * dy[2];
+        n[2] = dx[0] * dy[1] - dx[1] * dy[0];
+        return normalize3(n);
+    }
+    if (!have_x && !have_y) return 0;
+    /* One axis only (an image or a strip one pixel wide or tall): the normal
+     * is perpendicular to that tangent; of those, the one nearest V, the
+     * guess that the unseen axis faces the camera. Every sample the march
+     * can take lies along that same axis, on the tangent's line for a plane,
+     * so it has elevation 0 whatever the unseen axis does. */
+    const float *t = have_x ? dx : dy;
+    const float t2 = t[0] * t[0] + t[1] * t[1] + t[2] * t[2];
+    if (!(t2 > 0.0f) || !isfinite(t2)) return 0;
+    const float along = (v[0] * t[0] + v[1] * t[1] + v[2] * t[2]) / t2;
+    for (int c = 0; c < 3; c++) n[c] = v[c] - along * t[c];
+    return normalize3(n);
 }
 
 static int transform_given_normal(const normal_job *job, int i, int j, float n[3]) {
@@ -100,7 +195,7 @@ static void normal_row(void *context, int j) {
         hbao_grid_position(grid, i, j, z, p);
         view_vector(grid, p, v);
         int have = job->given != NULL && transform_given_normal(job, i, j, n);
-        if (!have) have = reconstruct_normal(grid, i, j, p, n);
+        if (!have) have = reconstruct_normal(grid, i, j, p, v, n);
         if (!have) {
             for (int c = 0; c < 3; c++) n[c] = v[c];
         }
@@ -110,8 +205,53 @@ static void normal_row(void *context, int j) {
     }
 }
 
+/* Whether a depth is exactly a half float: a normal one, in [2^-14, 65504]
+ * with its 13 low mantissa bits zero, or a subnormal one, a multiple of
+ * 2^-24 below 2^-14 (a surface crossing the camera plane reaches those). */
+static int is_half_float(float z) {
+    union {
+        float f;
+        uint32_t u;
+    } bits;
+    bits.f = z;
+    if (z < 6.103515625e-5f) {
+        const float scaled = z * 16777216.0f; /* exact: a power of two, result < 1024 */
+        return scaled == (float)(int)scaled;
+    }
+    return z <= 65504.0f && (bits.u & 0x1FFFu) == 0;
+}
+
+typedef struct precision_job {
+    const hbao_grid *grid;
+    atomic_int not_half; /* set by any row that has a depth which is not a half float */
+} precision_job;
+
+static void precision_row(void *context, int j) {
+    precision_job *job = context;
+    const float *row = job->grid->depth + (size_t)j * job->grid->width;
+    int half = 1;
+    for (int i = 0; i < job->grid->width; i++)
+        half &= row[i] <= 0.0f || is_half_float(row[i]); /* background is 0 */
+    if (!half) atomic_store_explicit(&job->not_half, 1, memory_order_relaxed);
+}
+
+/* The depth's format, told from its values: half floats (EEVEE's Depth pass)
+ * if every depth is one, else floats. A float image whose every depth
+ * happens to be a half float (a plane facing the camera at an integer
+ * distance) gets the half tolerance, which then costs nothing as no sample
+ * rises above its plane. */
+static float detect_depth_precision(const hbao_settings *settings, const hbao_grid *grid) {
+    precision_job job;
+    job.grid = grid;
+    atomic_init(&job.not_half, 0);
+    /* the rows' threads have all finished when this returns */
+    hbao_parallel_rows(settings->threads, grid->height, precision_row, &job);
+    return atomic_load(&job.not_half) ? HBAO_FLOAT_DEPTH_PRECISION : HBAO_HALF_DEPTH_PRECISION;
+}
+
 void hbao_compute_normals(const hbao_settings *settings, const hbao_camera *camera,
                           hbao_grid *grid, const hbao_channel *normal, int scale) {
+    grid->depth_precision = detect_depth_precision(settings, grid);
     normal_job job = {camera, grid, normal, scale};
     hbao_parallel_rows(settings->threads, grid->height, normal_row, &job);
 }

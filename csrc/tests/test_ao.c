@@ -333,7 +333,10 @@ static double brute_force_cosine(const scene_view *view, const float *depth, con
              * tangent plane, or past the normal through its angle to V */
             const double cos_v = (q[0] * v[0] + q[1] * v[1] + q[2] * v[2]) / dist;
             double hs;
-            if (gamma > 0 && cos_v > cos(gamma))
+            /* past the normal: within gamma of V and rising above the
+             * tangent plane at least as steeply as V */
+            const double sin_s = (q[0] * n[0] + q[1] * n[1] + q[2] * n[2]) / dist;
+            if (gamma > 0 && cos_v > cos(gamma) && sin_s > n[0] * v[0] + n[1] * v[1] + n[2] * v[2])
                 hs = acos(fmin(1.0, cos_v));
             else
                 hs = gamma + acos(fmax(-1.0, fmin(1.0, (q[0] * n[0] + q[1] * n[1] + q[2] * n[2]) / dist / npl)));
