@@ -2,7 +2,6 @@
 """The viewport preview's camera model and parameters without Blender: the
 frame from a projection matrix equals the library's camera model, and the
 depth-buffer linearisation inverts the projection."""
-import importlib.util
 import math
 import sys
 
@@ -10,22 +9,13 @@ import pytest
 
 from conftest import REPO
 
-VIEWPORT = REPO / "addon" / "hbao" / "viewport"
+# The add-on imports as a package without Blender.
+sys.path.insert(0, str(REPO / "addon"))
+from hbao import parameters  # noqa: E402
+from hbao.viewport import projection  # noqa: E402
+
 # float64 throughout: only rounding separates the two derivations.
 TOLERANCE = 1e-9
-
-
-def _load(name, folder=VIEWPORT):
-    spec = importlib.util.spec_from_file_location(f"viewport_{name}_under_test",
-                                                  folder / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module
-    spec.loader.exec_module(module)
-    return module
-
-
-projection = _load("projection")
-parameters = _load("parameters", VIEWPORT.parent)
 
 
 def _camera_matrix(frame, near=0.1, far=100.0):
