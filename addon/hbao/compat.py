@@ -24,7 +24,7 @@ VALUE_NODE_IDNAMES = ("CompositorNodeValue", "ShaderNodeValue")
 # restored: 5.0's media_type decides which file formats are valid, so it
 # comes before file_format, and the format before its options.
 SAVED_IMAGE_SETTINGS = ("media_type", "file_format", "color_mode", "color_depth", "exr_codec",
-                        "use_preview", "use_zbuffer", "views_format")
+                        "use_exr_interleave", "use_preview", "use_zbuffer", "views_format")
 
 
 def _version_text(version):
@@ -48,10 +48,14 @@ def version_message():
 
 
 def set_multilayer_exr(settings):
-    """Make `settings` (ImageFormatSettings) save a multilayer OpenEXR."""
+    """Make `settings` (ImageFormatSettings) save a single-part multilayer
+    OpenEXR, the layout libhbao_exr reads."""
     if hasattr(settings, "media_type"):
         settings.media_type = "MULTI_LAYER_IMAGE"  # 5.0+: before file_format
     settings.file_format = "OPEN_EXR_MULTILAYER"
+    if hasattr(settings, "use_exr_interleave"):
+        # 5.0+ writes one part per pass unless told to interleave them.
+        settings.use_exr_interleave = True
 
 
 def compositor_tree(scene):
