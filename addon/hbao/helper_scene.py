@@ -144,10 +144,18 @@ def _ensure_helper_scene(scene):
         log(f"created helper scene {helper.name!r} for {scene.name!r}")
     if compat.TREES_SHARED_BETWEEN_SCENES and helper.get(MAIN_TREE_KEY) is None:
         helper[MAIN_TREE_KEY] = compat.compositor_tree(scene)
+    # Between renders the helper follows one scene, the one it was made for,
+    # so that syncing scenes that share its tree does not flip its settings
+    # back and forth (each change would trigger another sync). A render
+    # copies its own scene's settings (record_rendering).
+    owner = main_scene_of(helper)
+    if owner is None or not serves(helper, owner):
+        helper[MAIN_SCENE_KEY] = owner = scene
     set_if_different(helper.render, "engine", ENGINE_IDNAME)
     if not compat.HAS_COMPOSITING_NODE_GROUP and helper.use_nodes:
         helper.use_nodes = False
-    copy_render_settings(scene, helper)
+    if owner == scene:
+        copy_render_settings(scene, helper)
     # The helper's render needs a camera; the main cameras themselves, so that
     # their animation is evaluated at the frame being rendered in the helper's
     # depsgraph. Every scene sharing the tree brings its own.
@@ -155,8 +163,8 @@ def _ensure_helper_scene(scene):
     for camera in cameras:
         if helper.collection.objects.get(camera.name) != camera:
             helper.collection.objects.link(camera)
-    if scene.camera is not None:
-        set_if_different(helper, "camera", scene.camera)
+    if owner.camera is not None:
+        set_if_different(helper, "camera", owner.camera)
     for obj in list(helper.collection.objects):
         if obj not in cameras:
             helper.collection.objects.unlink(obj)
