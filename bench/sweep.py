@@ -1,11 +1,11 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """Runs libhbao (through the add-on's ctypes binding) over a grid of settings
 on one scene's cached passes: error against the references, and time."""
-import importlib.util
 import itertools
 import json
 import os
 import statistics
+import sys
 import time
 from pathlib import Path
 
@@ -20,14 +20,14 @@ BORDER_FRACTION = 0.125
 
 
 def load_native():
-    """The add-on's binding addon/hbao/native.py, imported from its file (the
-    package's __init__ needs bpy). Loads this checkout's build unless
-    HBAO_LIBRARY names another library."""
-    os.environ.setdefault("HBAO_LIBRARY", str(REPO / "build/libhbao.so"))
-    spec = importlib.util.spec_from_file_location("hbao_native", REPO / "addon/hbao/native.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    """The add-on's binding (the package imports without bpy). Loads this
+    checkout's build unless HBAO_LIBRARY names another library."""
+    if str(REPO / "addon") not in sys.path:
+        sys.path.insert(0, str(REPO / "addon"))
+    from hbao import library_loading, native
+    os.environ.setdefault("HBAO_LIBRARY",
+                          str(REPO / "build" / library_loading.library_file_name("hbao")))
+    return native
 
 
 def setting_key(setting):

@@ -5,6 +5,7 @@ this file checks the EXRs Blender wrote."""
 import importlib.util
 import json
 import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -42,14 +43,17 @@ def _load(name, path):
     return module
 
 
-exr = _load("hbao_exr_passes_under_test", REPO / "addon" / "hbao" / "exr_passes.py")
+# The add-on imports as a package without Blender (conftest could do this once).
+sys.path.insert(0, str(REPO / "addon"))
+from hbao import exr_passes as exr  # noqa: E402
 
 
 @pytest.fixture(scope="module")
 def native(built_library):
     import os
     os.environ["HBAO_LIBRARY"] = str(built_library)
-    module = _load("hbao_native_for_addon_tests", REPO / "addon" / "hbao" / "native.py")
+    from hbao import native as module
+    module.unload_library()
     return module
 
 

@@ -4,10 +4,10 @@ ctypes on EXRs that Blender wrote: its pixels must be exactly what the `hbao`
 tool reads (the same OpenEXRCore reader, shared object files), and bad input
 must give a result code and a message, never a crash."""
 import ctypes
-import importlib.util
 import json
 import os
 import subprocess
+import sys
 import threading
 
 import numpy as np
@@ -38,15 +38,9 @@ THREADS = 4
 JSON_RELATIVE_TOLERANCE = 2 * np.finfo(np.float64).eps
 
 
-def _load_binding():
-    spec = importlib.util.spec_from_file_location(
-        "hbao_exr_binding_under_test", SCRIPTS.parent / "addon" / "hbao" / "exr_passes.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-exr = _load_binding()
+# The add-on imports as a package without Blender.
+sys.path.insert(0, str(SCRIPTS.parent / "addon"))
+from hbao import exr_passes as exr  # noqa: E402
 
 
 class ChannelRequest(ctypes.Structure):

@@ -2,14 +2,19 @@
 """The ctypes binding addon/hbao/native.py against the built libhbao (plain
 pytest, no Blender)."""
 import ctypes
-import importlib.util
 import re
 import subprocess
+import sys
 
 import numpy as np
 import pytest
 
 from conftest import REPO
+
+# The add-on imports as a package without Blender (addon/hbao/__init__.py
+# imports bpy only in register()).
+sys.path.insert(0, str(REPO / "addon"))
+from hbao import native as native_module  # noqa: E402
 
 HEADER = REPO / "csrc" / "include" / "hbao.h"
 # Every image in these tests is small: the library's cost is irrelevant here.
@@ -27,11 +32,10 @@ FLAT_PLANE_NO_BIAS_TOLERANCE = 1e-3
 
 
 def _load_native():
-    spec = importlib.util.spec_from_file_location(
-        "hbao_native_under_test", REPO / "addon" / "hbao" / "native.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    """The binding, with the library loaded again on first use (each test
+    may point HBAO_LIBRARY elsewhere)."""
+    native_module.unload_library()
+    return native_module
 
 
 @pytest.fixture()

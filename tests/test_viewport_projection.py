@@ -2,7 +2,6 @@
 """The viewport preview's camera model and parameters without Blender: the
 frame from a projection matrix equals the library's camera model, and the
 depth-buffer linearisation inverts the projection."""
-import importlib.util
 import math
 import sys
 
@@ -10,22 +9,14 @@ import pytest
 
 from conftest import REPO
 
-VIEWPORT = REPO / "addon" / "hbao" / "viewport"
+# The add-on imports as a package without Blender.
+sys.path.insert(0, str(REPO / "addon"))
+from hbao import camera as camera_model  # noqa: E402
+from hbao import parameters  # noqa: E402
+from hbao.viewport import projection  # noqa: E402
+
 # float64 throughout: only rounding separates the two derivations.
 TOLERANCE = 1e-9
-
-
-def _load(name, folder=VIEWPORT):
-    spec = importlib.util.spec_from_file_location(f"viewport_{name}_under_test",
-                                                  folder / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module
-    spec.loader.exec_module(module)
-    return module
-
-
-projection = _load("projection")
-parameters = _load("parameters", VIEWPORT.parent)
 
 
 def _camera_matrix(frame, near=0.1, far=100.0):
@@ -64,6 +55,42 @@ def test_frame_from_matrix_equals_camera_model(camera, size):
     assert again.perspective == frame.perspective
     for name in ("pixel_size_x", "pixel_size_y", "origin_x", "origin_y"):
         assert getattr(again, name) == pytest.approx(getattr(frame, name), abs=TOLERANCE)
+
+
+# Borders (x0, x1, y0, y1 in pixels, y from the bottom) inside both test sizes.
+BORDERS = [(0, 30, 0, 48), (5, 21, 7, 40), (13, 29, 30, 47)]
+
+
+@pytest.mark.parametrize("camera", CAMERAS + [{"type": "PERSP", "sensor_fit": "AUTO",
+                                               "lens": 30.0, "shift_x": 0.1}])
+@pytest.mark.parametrize("size", [(64, 48), (30, 90)])
+@pytest.mark.parametrize("border", BORDERS)
+def test_a_cropped_border_sees_the_same_pixels(camera, size, border):
+    """The border's camera (camera.crop_camera, used by the render hook for
+    cropped border renders) puts each of its pixels where the full frame's
+    camera puts the same pixel: same pixel size, origin moved by the border's
+    corner. Portrait sizes cover AUTO fitting the vertical side with
+    sensor_width (one sensor_fit rule for both functions)."""
+    full = projection.frame_from_camera(camera, *size)
+    x0, x1, y0, y1 = border
+    cropped = projection.frame_from_camera(
+        camera_model.crop_camera(camera, *size, border), x1 - x0, y1 - y0)
+    assert cropped.perspective == full.perspective
+    assert cropped.pixel_size_x == pytest.approx(full.pixel_size_x, abs=TOLERANCE)
+    assert cropped.pixel_size_y == pytest.approx(full.pixel_size_y, abs=TOLERANCE)
+    assert cropped.origin_x == pytest.approx(full.origin_x + x0 * full.pixel_size_x,
+                                             abs=TOLERANCE)
+    assert cropped.origin_y == pytest.approx(full.origin_y + y0 * full.pixel_size_y,
+                                             abs=TOLERANCE)
+
+
+def test_auto_fit_spans_the_larger_side_with_sensor_width():
+    # Blender's BKE_camera_sensor_size: AUTO never uses sensor_height.
+    camera = {"sensor_width": 36.0, "sensor_height": 10.0}
+    assert camera_model.sensor_fit(camera, 30, 90) == ("VERTICAL", 36.0, 90.0)
+    assert camera_model.sensor_fit(camera, 90, 30) == ("HORIZONTAL", 36.0, 90.0)
+    vertical = dict(camera, sensor_fit="VERTICAL")
+    assert camera_model.sensor_fit(vertical, 90, 30) == ("VERTICAL", 10.0, 30.0)
 
 
 def test_camera_model_follows_blender_fit():

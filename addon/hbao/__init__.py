@@ -1,6 +1,17 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """HBAO: horizon-based ambient occlusion as a compositor node (Add > Filter >
-HBAO) and a viewport preview, computed by the native library libhbao."""
+HBAO) and a viewport preview, computed by the native library libhbao.
+
+Importing the package needs no bpy: the modules that touch Blender are
+imported by register(), so that parameters, native, exr_passes, camera and
+viewport.projection/shader_sources work in plain Python (tests, benchmarks).
+
+    bpy-free   parameters, library_loading, native, exr_passes, camera,
+               viewport.projection, viewport.shader_sources
+    Blender    compat (every version difference), preferences, node,
+               helper_scene, socket_values, planning, handover, engine, handlers,
+               viewport.*
+"""
 
 bl_info = {
     "name": "HBAO",
@@ -15,44 +26,52 @@ bl_info = {
     "support": "COMMUNITY",
 }
 
-import bpy  # noqa: E402  (bl_info must come first for Blender's add-on scanner)
-
-from . import node, render_hook  # noqa: E402
-
-_MODULES = (node, render_hook)
+# Modules registered in this order (unregistered in reverse); None until register().
+_registered = []
 
 
 def sync(scene=None):
     """Build or update the render hook of `scene` (default: every scene) now.
     Scripts that add HBAO nodes in background mode may call it; renders call
-    it themselves."""
+    it themselves. Returns the hook's messages."""
+    from . import helper_scene
     if scene is None:
-        render_hook.sync_all()
+        helper_scene.sync_all()
         return []
-    return render_hook.sync(scene)
-
-
-def _viewport():
-    from . import viewport
-    return viewport
+    return helper_scene.sync(scene)
 
 
 def register():
-    for module in _MODULES:
+    import bpy
+
+    from . import compat, preferences
+    preferences.register()
+    message = compat.version_message()
+    if message is not None:
+        preferences.show(message)
+        if not compat.version_is_new_enough():
+            return  # the message says why; a traceback would not
+    from . import engine, handlers, node
+    for module in (node, engine, handlers):
         module.register()
+        _registered.append(module)
     try:
-        _viewport().register()
+        from . import viewport
+        viewport.register()
+        _registered.append(viewport)
     except Exception as error:  # the compositor node works without the preview
         print(f"HBAO: the viewport preview could not be registered: {error}")
     if not isinstance(bpy.data, bpy.types.BlendData):
         return  # add-on enabled at startup: load_post syncs once a file is open
-    render_hook.sync_all()
+    sync()
 
 
 def unregister():
-    try:
-        _viewport().unregister()
-    except Exception as error:
-        print(f"HBAO: the viewport preview could not be unregistered: {error}")
-    for module in reversed(_MODULES):
-        module.unregister()
+    from . import preferences
+    while _registered:
+        module = _registered.pop()
+        try:
+            module.unregister()
+        except Exception as error:  # unregister the rest whatever one of them did
+            print(f"HBAO: {module.__name__} could not be unregistered: {error}")
+    preferences.unregister()

@@ -56,32 +56,56 @@ def _border_pixels(render, width, height):
     return x0, max(x1, x0 + 1), y0, max(y1, y0 + 1)
 
 
+def sensor_fit(camera, width, height):
+    """Blender's sensor-fit rule (BKE_camera_params_compute_viewplane) for a
+    camera dict on a `width` x `height` image: (fitted axis "HORIZONTAL" or
+    "VERTICAL", the sensor size in mm (or ortho scale's side) spanning it, and
+    that side's length in pixel widths). AUTO fits the larger side of the
+    aspect-corrected image, with sensor_width whichever side that is. The C
+    library (csrc/lib/camera.c) and this function are the rule's two
+    implementations; tests/test_viewport_projection.py ties the Python uses
+    of it together."""
+    aspect_x = float(camera.get("pixel_aspect_x", 1.0))
+    aspect_y = float(camera.get("pixel_aspect_y", 1.0))
+    requested = camera.get("sensor_fit", "AUTO")
+    fit = requested
+    if fit == "AUTO":
+        fit = "HORIZONTAL" if aspect_x * width >= aspect_y * height else "VERTICAL"
+    sensor = float(camera.get("sensor_height", 24.0)) if requested == "VERTICAL" \
+        else float(camera.get("sensor_width", 36.0))
+    fitted_side = width if fit == "HORIZONTAL" else aspect_y / aspect_x * height
+    return fit, sensor, fitted_side
+
+
+def crop_camera(description, width, height, border):
+    """The camera dict of the `border` (x0, x1, y0, y1 pixels, y from the
+    bottom) of a `width` x `height` image seen by camera dict `description`:
+    same focal length in pixels, the principal point moved by a lens shift,
+    the sensor fitted horizontally to the crop."""
+    x0, x1, y0, y1 = border
+    _fit, sensor, fitted_side = sensor_fit(description, width, height)
+    ycor = float(description.get("pixel_aspect_y", 1.0)) / \
+        float(description.get("pixel_aspect_x", 1.0))
+    crop_width = x1 - x0
+    # The crop's centre relative to the full frame's, in pixel widths.
+    dx = (x0 + x1) / 2.0 - width / 2.0
+    dy = ((y0 + y1) / 2.0 - height / 2.0) * ycor
+    cropped = dict(description)
+    cropped["sensor_fit"] = "HORIZONTAL"
+    cropped["sensor_width"] = sensor * crop_width / fitted_side
+    cropped["ortho_scale"] = float(description.get("ortho_scale", 6.0)) * crop_width / fitted_side
+    cropped["shift_x"] = (float(description.get("shift_x", 0.0)) * fitted_side + dx) / crop_width
+    cropped["shift_y"] = (float(description.get("shift_y", 0.0)) * fitted_side + dy) / crop_width
+    return cropped
+
+
 def camera_for_render_result(scene, camera_object=None):
-    """camera_from_blender(), turned into the camera of the cropped image when
-    the scene renders a cropped border: same focal length in pixels, the
-    principal point moved by a lens shift, the sensor fitted horizontally."""
+    """camera_from_blender(), turned into the camera of the cropped image
+    (crop_camera) when the scene renders a cropped border."""
     description = camera_from_blender(scene, camera_object)
     render = scene.render
     if not (render.use_border and render.use_crop_to_border):
         return description
     scale = render.resolution_percentage / 100.0
     width, height = int(render.resolution_x * scale), int(render.resolution_y * scale)
-    aspect_x, aspect_y = description["pixel_aspect_x"], description["pixel_aspect_y"]
-    full_w, full_h = width * aspect_x, height * aspect_y  # aspect-corrected pixels
-    fit = description["sensor_fit"]
-    if fit == "AUTO":
-        fit = "HORIZONTAL" if full_w >= full_h else "VERTICAL"
-    fitted_pixels = full_w if fit == "HORIZONTAL" else full_h
-    fitted_sensor = (description["sensor_width"] if fit == "HORIZONTAL"
-                     else description["sensor_height"])
-    x0, x1, y0, y1 = _border_pixels(render, width, height)
-    crop_w = (x1 - x0) * aspect_x
-    # Crop centre relative to the full frame's centre, aspect-corrected pixels.
-    dx = ((x0 + x1) / 2.0 - width / 2.0) * aspect_x
-    dy = ((y0 + y1) / 2.0 - height / 2.0) * aspect_y
-    description["sensor_fit"] = "HORIZONTAL"
-    description["sensor_width"] = fitted_sensor * crop_w / fitted_pixels
-    description["ortho_scale"] = description["ortho_scale"] * crop_w / fitted_pixels
-    description["shift_x"] = (description["shift_x"] * fitted_pixels + dx) / crop_w
-    description["shift_y"] = (description["shift_y"] * fitted_pixels + dy) / crop_w
-    return description
+    return crop_camera(description, width, height, _border_pixels(render, width, height))

@@ -5,11 +5,59 @@ import os
 import bpy
 
 VERSION = bpy.app.version
+# The oldest Blender the add-on runs on (its bl_info says the same), and the
+# newest it has been tested with; a newer one is tried, with a warning.
+MIN_SUPPORTED_VERSION = (3, 4, 0)
+NEWEST_KNOWN_VERSION = (5, 3)
 # 4.0 replaced tree.inputs/outputs with tree.interface.
 HAS_TREE_INTERFACE = VERSION >= (4, 0, 0)
 # 5.0 replaced scene.node_tree with scene.compositing_node_group and the
 # Composite node with the group's Group Output.
 HAS_COMPOSITING_NODE_GROUP = VERSION >= (5, 0, 0)
+
+
+# 5.0 lets several scenes use one compositing node group (an ID of its own);
+# before, each scene's tree was embedded in the scene.
+TREES_SHARED_BETWEEN_SCENES = HAS_COMPOSITING_NODE_GROUP
+# The Value node's idname: the compositor's own until 4.x, the shared
+# ShaderNodeValue in 5.x files and menus (old files may still hold either).
+VALUE_NODE_IDNAMES = ("CompositorNodeValue", "ShaderNodeValue")
+# Image settings that saving a Render Result reads, in the order they must be
+# restored: 5.0's media_type decides which file formats are valid, so it
+# comes before file_format, and the format before its options.
+SAVED_IMAGE_SETTINGS = ("media_type", "file_format", "color_mode", "color_depth", "exr_codec",
+                        "use_exr_interleave", "use_preview", "use_zbuffer", "views_format")
+
+
+def _version_text(version):
+    return ".".join(str(part) for part in version)
+
+
+def version_is_new_enough():
+    return tuple(VERSION) >= MIN_SUPPORTED_VERSION
+
+
+def version_message():
+    """Why this Blender may not run the add-on, or None when it is one we test."""
+    if not version_is_new_enough():
+        return (f"HBAO needs Blender {_version_text(MIN_SUPPORTED_VERSION)} or newer; this is "
+                f"{_version_text(VERSION)}. The add-on stays off.")
+    if tuple(VERSION[:2]) > NEWEST_KNOWN_VERSION:
+        return (f"HBAO is tested up to Blender {_version_text(NEWEST_KNOWN_VERSION)}; this is "
+                f"{_version_text(VERSION)}. Trying anyway: if renders show no AO, check the "
+                f"console for HBAO messages.")
+    return None
+
+
+def set_multilayer_exr(settings):
+    """Make `settings` (ImageFormatSettings) save a single-part multilayer
+    OpenEXR, the layout libhbao_exr reads."""
+    if hasattr(settings, "media_type"):
+        settings.media_type = "MULTI_LAYER_IMAGE"  # 5.0+: before file_format
+    settings.file_format = "OPEN_EXR_MULTILAYER"
+    if hasattr(settings, "use_exr_interleave"):
+        # 5.0+ writes one part per pass unless told to interleave them.
+        settings.use_exr_interleave = True
 
 
 def compositor_tree(scene):

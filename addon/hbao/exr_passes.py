@@ -21,14 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
-try:
-    from . import library_loading
-except ImportError:  # loaded as a file of its own (tests, benchmarks): load the sibling
-    import importlib.util as _importlib_util
-    _spec = _importlib_util.spec_from_file_location(
-        "hbao_library_loading", Path(__file__).with_name("library_loading.py"))
-    library_loading = _importlib_util.module_from_spec(_spec)
-    _spec.loader.exec_module(library_loading)
+from . import library_loading
 
 __all__ = ["EXRFormatError", "EXRFileError", "EXRLibraryError", "read_channels",
            "read_channel_groups", "channel_names", "image_size", "load_library",
@@ -38,7 +31,6 @@ __all__ = ["EXRFormatError", "EXRFileError", "EXRLibraryError", "read_channels",
 BINDING_INTERFACE_VERSION = 1
 #: Environment variable that names the library to load instead of lib/libhbao_exr.so.
 LIBRARY_ENVIRONMENT_VARIABLE = "HBAO_EXR_LIBRARY"
-LIBRARY_FILE_NAME = "libhbao_exr.so"
 # hbao_exr.h: HBAO_EXR_MESSAGE_SIZE holds every message the library writes.
 _MESSAGE_SIZE = 1024
 _FLOAT = np.dtype(np.float32)
@@ -96,26 +88,16 @@ _FUNCTIONS = {
 }
 
 
-def _check_compatible(library, path):
-    """Raise EXRLibraryError unless the library matches this binding."""
-    version = library.hbao_exr_interface_version()
-    if version != BINDING_INTERFACE_VERSION:
-        raise EXRLibraryError(
-            f"libhbao_exr at {path} has interface version {version}, this add-on needs "
-            f"{BINDING_INTERFACE_VERSION}: install the library that came with the add-on.")
-    if library.hbao_exr_channel_request_size() != ctypes.sizeof(_ChannelRequest):
-        raise EXRLibraryError(
-            f"libhbao_exr at {path}: sizeof(hbao_exr_channel_request) is "
-            f"{library.hbao_exr_channel_request_size()} bytes, the add-on expects "
-            f"{ctypes.sizeof(_ChannelRequest)}: reinstall the library and add-on together.")
-
-
 _LIBRARY = library_loading.NativeLibrary(
-    LIBRARY_FILE_NAME, LIBRARY_ENVIRONMENT_VARIABLE, Path(__file__).resolve().parent / "lib",
-    _FUNCTIONS,
-    EXRLibraryError, check=_check_compatible,
+    "hbao_exr", LIBRARY_ENVIRONMENT_VARIABLE, Path(__file__).resolve().parent / "lib",
+    _FUNCTIONS, EXRLibraryError,
+    handshake=library_loading.Handshake(
+        "hbao_exr_interface_version", BINDING_INTERFACE_VERSION,
+        [("hbao_exr_channel_request", "hbao_exr_channel_request_size", _ChannelRequest)]),
     load_hint="It needs OpenEXRCore (libOpenEXRCore-3_1.so) installed or next to it; "
               "rebuild or reinstall the add-on with scripts/install_addon.sh.")
+#: The platform's file name of the library (libhbao_exr.so on Linux).
+LIBRARY_FILE_NAME = _LIBRARY.file_name
 
 
 # The file that load_library() loads: $LIBRARY_ENVIRONMENT_VARIABLE, else

@@ -1,26 +1,72 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """Finding and loading the add-on's native libraries (libhbao, libhbao_exr):
 once, lazily and thread-safely, with every function's signature declared in
-one place and errors that say what to do. No bpy."""
+one place, one compatibility handshake, and errors that say what to do. No bpy."""
 import ctypes
 import os
+import sys
 import threading
 from pathlib import Path
 
 
+def library_file_name(stem, platform=None):
+    """The file CMake builds for shared library `stem` ("hbao") on `platform`
+    (default: this one): libhbao.so, libhbao.dylib, or hbao.dll (MSVC builds
+    have no "lib" prefix)."""
+    platform = sys.platform if platform is None else platform
+    if platform.startswith("win"):
+        return f"{stem}.dll"
+    if platform == "darwin":
+        return f"lib{stem}.dylib"
+    return f"lib{stem}.so"
+
+
+class Handshake:
+    """What a library must report to match its binding: `version_function()`
+    must give a value whose `version_key(value)` is `expected`, and each
+    (C type name, size function, ctypes structure) of `structures` must have
+    the structure's size, or the library and the binding disagree on memory
+    layout. `describe(value)` prints a version for messages."""
+
+    def __init__(self, version_function, expected, structures, version_key=None,
+                 describe=str, expected_text=None):
+        self.version_function = version_function
+        self.expected = expected
+        self.expected_text = expected_text or str(expected)
+        self.structures = structures
+        self.version_key = version_key or (lambda value: value)
+        self.describe = describe
+
+    def check(self, library, path, name, error_class):
+        version = getattr(library, self.version_function)()
+        if self.version_key(version) != self.expected:
+            raise error_class(
+                f"{name} at {path} is version {self.describe(version)}, this add-on needs "
+                f"{self.expected_text}: install the library that came with the add-on.")
+        for c_type, size_function, structure in self.structures:
+            size = getattr(library, size_function)()
+            if size != ctypes.sizeof(structure):
+                raise error_class(
+                    f"{name} at {path}: sizeof({c_type}) is {size} bytes, the add-on "
+                    f"expects {ctypes.sizeof(structure)}: the library and add-on come from "
+                    f"different versions; reinstall both together.")
+
+
 class NativeLibrary:
     """One shared library: $<environment_variable> if set, else
-    <folder>/<file_name>. `functions` maps names to (restype, argtypes);
-    `check(library, path)` may raise `error_class` for an incompatible one."""
+    <folder>/<platform file name of stem>. `functions` maps names to
+    (restype, argtypes); `handshake` (a Handshake) rejects an incompatible
+    library with `error_class`."""
 
-    def __init__(self, file_name, environment_variable, folder, functions, error_class,
-                 check=None, load_hint=""):
-        self.file_name = file_name
+    def __init__(self, stem, environment_variable, folder, functions, error_class,
+                 handshake=None, load_hint=""):
+        self.name = f"lib{stem}"
+        self.file_name = library_file_name(stem)
         self.environment_variable = environment_variable
-        self.default_path = Path(folder) / file_name
+        self.default_path = Path(folder) / self.file_name
         self.functions = functions
         self.error_class = error_class
-        self.check = check
+        self.handshake = handshake
         self.load_hint = load_hint
         self._library = None
         self._lock = threading.Lock()
@@ -43,7 +89,7 @@ class NativeLibrary:
             self._library = None
 
     def _open(self, path):
-        name = self.file_name.rsplit(".so", 1)[0]
+        name = self.name
         if not path.is_file():
             raise self.error_class(
                 f"{name} not found at {path}. Build it with `cmake -S . -B build && cmake "
@@ -64,6 +110,6 @@ class NativeLibrary:
                     f"{name}; rebuild it from this add-on's sources.") from error
             function.restype = restype
             function.argtypes = argtypes
-        if self.check is not None:
-            self.check(library, path)
+        if self.handshake is not None:
+            self.handshake.check(library, path, name, self.error_class)
         return library

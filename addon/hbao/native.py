@@ -12,14 +12,9 @@ from pathlib import Path
 
 import numpy as np
 
-try:
-    from . import library_loading
-except ImportError:  # loaded as a file of its own (tests, benchmarks): load the sibling
-    import importlib.util as _importlib_util
-    _spec = _importlib_util.spec_from_file_location(
-        "hbao_library_loading", Path(__file__).with_name("library_loading.py"))
-    library_loading = _importlib_util.module_from_spec(_spec)
-    _spec.loader.exec_module(library_loading)
+from . import library_loading
+from .parameters import (FALLOFF_VALUES, INTEGRATION_VALUES, PROJECTION_VALUES,
+                         SENSOR_FIT_VALUES)
 
 __all__ = [
     "HBAOError", "HBAOLibraryError", "compute_ao", "default_params",
@@ -31,7 +26,6 @@ __all__ = [
 BINDING_VERSION_MAJOR = 0
 #: Environment variable that names the library to load instead of lib/libhbao.so.
 LIBRARY_ENVIRONMENT_VARIABLE = "HBAO_LIBRARY"
-LIBRARY_FILE_NAME = "libhbao.so"
 _FLOAT_SIZE = ctypes.sizeof(ctypes.c_float)
 _HBAO_SUCCESS = 0
 
@@ -93,11 +87,11 @@ class HBAOChannel(ctypes.Structure):
     ]
 
 
-# Enum names as Blender spells them, mapped to the header's values.
-FALLOFF_NAMES = {"QUADRATIC": 0, "NONE": 1}
-INTEGRATION_NAMES = {"HBAO": 0, "COSINE": 1}
-PROJECTION_NAMES = {"PERSP": 0, "ORTHO": 1}
-SENSOR_FIT_NAMES = {"AUTO": 0, "HORIZONTAL": 1, "VERTICAL": 2}
+# Enum names as Blender spells them, mapped to the header's values (parameters.py).
+FALLOFF_NAMES = FALLOFF_VALUES
+INTEGRATION_NAMES = INTEGRATION_VALUES
+PROJECTION_NAMES = PROJECTION_VALUES
+SENSOR_FIT_NAMES = SENSOR_FIT_VALUES
 _ENUM_PARAMETERS = {"falloff": FALLOFF_NAMES, "integration": INTEGRATION_NAMES}
 PARAMETER_NAMES = tuple(name for name, _ in HBAOParams._fields_)
 _CAMERA_FLOAT_NAMES = ("lens", "sensor_width", "sensor_height", "shift_x", "shift_y",
@@ -120,28 +114,23 @@ _FUNCTIONS = {
 }
 
 
-def _check_compatible(library, path):
-    """Raise HBAOLibraryError unless the library matches this binding."""
-    version = library.hbao_version()
-    major = version // 10000
-    if major != BINDING_VERSION_MAJOR:
-        raise HBAOLibraryError(
-            f"libhbao at {path} is version {_version_text(version)}, this add-on needs "
-            f"{BINDING_VERSION_MAJOR}.x: install the library that came with the add-on.")
-    for what, size_function, structure in (("hbao_params", library.hbao_params_size, HBAOParams),
-                                           ("hbao_camera", library.hbao_camera_size, HBAOCamera)):
-        if size_function() != ctypes.sizeof(structure):
-            raise HBAOLibraryError(
-                f"libhbao at {path}: sizeof({what}) is {size_function()} bytes, the add-on "
-                f"expects {ctypes.sizeof(structure)}: the library and add-on come from "
-                f"different versions; reinstall both together.")
+def _version_text(packed):
+    return f"{packed // 10000}.{packed // 100 % 100}.{packed % 100}"
 
 
 _LIBRARY = library_loading.NativeLibrary(
-    LIBRARY_FILE_NAME, LIBRARY_ENVIRONMENT_VARIABLE, Path(__file__).resolve().parent / "lib",
-    _FUNCTIONS,
-    HBAOLibraryError, check=_check_compatible,
-    load_hint='Rebuild it for this machine.')
+    "hbao", LIBRARY_ENVIRONMENT_VARIABLE, Path(__file__).resolve().parent / "lib",
+    _FUNCTIONS, HBAOLibraryError,
+    handshake=library_loading.Handshake(
+        "hbao_version", BINDING_VERSION_MAJOR,
+        [("hbao_params", "hbao_params_size", HBAOParams),
+         ("hbao_camera", "hbao_camera_size", HBAOCamera)],
+        version_key=lambda packed: packed // 10000,
+        describe=_version_text,
+        expected_text=f"{BINDING_VERSION_MAJOR}.x"),
+    load_hint="Rebuild it for this machine.")
+#: The platform's file name of the library (libhbao.so on Linux).
+LIBRARY_FILE_NAME = _LIBRARY.file_name
 
 
 # The file that load_library() loads: $LIBRARY_ENVIRONMENT_VARIABLE, else
@@ -150,10 +139,6 @@ _LIBRARY = library_loading.NativeLibrary(
 library_path = _LIBRARY.path
 load_library = _LIBRARY.load
 unload_library = _LIBRARY.unload
-
-
-def _version_text(packed):
-    return f"{packed // 10000}.{packed // 100 % 100}.{packed % 100}"
 
 
 def library_version():

@@ -2,9 +2,11 @@
 """The HBAO compositor node (Add > Filter > HBAO).
 
 It is a custom group node: its group multiplies Image by the AO pass that the
-render hook (render_hook.py) computes with this node's settings and publishes
-through a Render Layers node. The group's inputs other than Image only carry
-the artist's values; the hook reads them."""
+render hook (helper_scene.py, engine.py) computes with this node's settings
+and publishes through a Render Layers node. The group's inputs other than
+Image only carry the artist's values; the hook reads them. The node knows
+nothing of the hook: it announces that nodes came or went through
+`changed_callbacks`, which the hook subscribes to."""
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 
@@ -31,20 +33,20 @@ AO_OUTPUT = "AO"
 # The radius socket's upper end: far beyond any scene, but finite.
 MAX_RADIUS = 1.0e4
 
-# name -> (params key, default, min, max, integer): the library's defaults and
-# limits (csrc/include/hbao.h, mirrored in parameters.py).
+# The parameters an artist can animate or drive with a Value node: one float
+# socket each, named as parameters.LABELS names it -> (params key, default,
+# socket min, socket max), the range the library's limits (parameters.LIMITS).
 _D = parameters.DEFAULTS
 VALUE_INPUTS = {
-    "Radius": ("radius", _D["radius"], 0.0, MAX_RADIUS, False),
-    "Angle Bias": ("angle_bias_degrees", _D["angle_bias_degrees"], 0.0,
-                   parameters.MAX_ANGLE_BIAS_DEGREES, False),
-    "Directions": ("directions", float(_D["directions"]), 1.0,
-                   float(parameters.MAX_DIRECTIONS), True),
-    "Steps": ("steps", float(_D["steps"]), 1.0, float(parameters.MAX_STEPS), True),
-    "Blur Size": ("blur_size", float(_D["blur_size"]), 0.0, float(parameters.MAX_BLUR_SIZE),
-                  True),
-    "Strength": ("strength", _D["strength"], 0.0, parameters.MAX_STRENGTH, False),
+    parameters.LABELS[key]: (key, float(_D[key]),
+                             *((0.0, MAX_RADIUS) if key == "radius"
+                               else (float(parameters.LIMITS[key][0]),
+                                     float(parameters.LIMITS[key][1]))))
+    for key in ("radius", "angle_bias_degrees", "directions", "steps", "blur_size", "strength")
 }
+# Called with no arguments when an HBAO node is added, copied or deleted
+# (the hook's handlers subscribe: node callbacks must not edit the tree).
+changed_callbacks = []
 
 
 def _new_input(tree, socket_type, name, default=None, minimum=None, maximum=None):
@@ -63,7 +65,7 @@ def _build_group_tree(tree):
     _new_input(tree, "NodeSocketColor", IMAGE_INPUT, (1.0, 1.0, 1.0, 1.0))
     _new_input(tree, "NodeSocketFloat", DEPTH_INPUT, 0.0)
     _new_input(tree, "NodeSocketVector", NORMAL_INPUT)
-    for name, (_key, default, minimum, maximum, _integer) in VALUE_INPUTS.items():
+    for name, (_key, default, minimum, maximum) in VALUE_INPUTS.items():
         _new_input(tree, "NodeSocketFloat", name, default, minimum, maximum)
     _new_input(tree, "NodeSocketFloat", AO_PASS_INPUT, 1.0, 0.0, 1.0)
     compat.new_group_socket(tree, "OUTPUT", "NodeSocketColor", IMAGE_OUTPUT)
@@ -117,6 +119,11 @@ def next_pass_index(tree, exclude=None):
     return index
 
 
+def _announce_change():
+    for callback in changed_callbacks:
+        callback()
+
+
 def _settings_changed(node, _context):
     # Nothing to rebuild: the hook reads the node at render time. Re-running
     # the compositor shows the new result in the backdrop.
@@ -156,20 +163,17 @@ class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
         self.node_tree = group_tree()
         self.pass_index = next_pass_index(self.id_data, exclude=self)
         self.width = self.bl_width_default
-        from . import render_hook
-        render_hook.schedule_sync()
+        _announce_change()
 
     def copy(self, node):
         self.node_tree = node.node_tree
         self.pass_index = next_pass_index(self.id_data, exclude=self)
-        from . import render_hook
-        render_hook.schedule_sync()
+        _announce_change()
 
     def free(self):
         # The shared group tree stays; the hook drops this node's pass and,
         # with the last HBAO node, its own Render Layers node, on its next sync.
-        from . import render_hook
-        render_hook.schedule_sync()
+        _announce_change()
 
     def draw_buttons(self, context, layout):
         layout.prop(self, "falloff")

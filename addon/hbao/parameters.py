@@ -1,11 +1,17 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """The HBAO parameters as artists set them: the C library's hbao_params
 (csrc/include/hbao.h) by the names addon/hbao/native.py uses, with the
-header's defaults and limits and the menus' items. No bpy: the compositor
-node, the viewport preview and the tests share it."""
+header's defaults, limits and enum values, the menus' items, and the one
+resolver every Python front end (node, viewport) passes its values through.
+No bpy and no imports from the package: the compositor node, the viewport
+preview, the tests and the benchmark share it.
+
+tests/test_parameter_contract.py checks every number here against the header
+and csrc/lib/, so a copy cannot drift from the library."""
 import math
 
-# csrc/include/hbao.h, HBAO_DEFAULT_* and HBAO_MAX_*.
+# csrc/include/hbao.h, HBAO_DEFAULT_* (falloff and integration: the
+# HBAO_PARAMS_DEFAULT_INITIALIZER's enum values).
 DEFAULTS = {
     "radius": 1.0,
     "angle_bias_degrees": 5.0,
@@ -18,14 +24,48 @@ DEFAULTS = {
     "strength": 1.0,
     "background_depth": 65504.0,
 }
+# csrc/include/hbao.h, HBAO_MAX_*.
 MAX_DIRECTIONS = 64
 MAX_STEPS = 64
 MAX_BLUR_SIZE = 65
 MAX_BLUR_SHARPNESS = 1000.0
 MAX_ANGLE_BIAS_DEGREES = 60.0
 MAX_STRENGTH = 16.0
+
+# The header's enums by the names Blender uses for them: hbao_falloff,
+# hbao_integration, hbao_projection (Camera.type), hbao_sensor_fit
+# (Camera.sensor_fit). The binding, the menus and the GLSL defines use these.
 FALLOFF_VALUES = {"QUADRATIC": 0, "NONE": 1}
 INTEGRATION_VALUES = {"HBAO": 0, "COSINE": 1}
+PROJECTION_VALUES = {"PERSP": 0, "ORTHO": 1}
+SENSOR_FIT_VALUES = {"AUTO": 0, "HORIZONTAL": 1, "VERTICAL": 2}
+
+# The limits the library clamps to (hbao.h documents each field's range):
+# key -> (lowest, highest, whole number).
+LIMITS = {
+    "angle_bias_degrees": (0.0, MAX_ANGLE_BIAS_DEGREES, False),
+    "directions": (1, MAX_DIRECTIONS, True),
+    "steps": (1, MAX_STEPS, True),
+    "blur_size": (0, MAX_BLUR_SIZE, True),
+    "blur_sharpness": (0.0, MAX_BLUR_SHARPNESS, False),
+    "strength": (0.0, MAX_STRENGTH, False),
+}
+# Keys passed through unchanged when given (not artist-facing parameters).
+PASS_THROUGH = ("half_resolution", "threads")
+
+# Each parameter as the node's sockets and the panel name it, for messages.
+LABELS = {
+    "radius": "Radius",
+    "angle_bias_degrees": "Angle Bias",
+    "directions": "Directions",
+    "steps": "Steps",
+    "falloff": "Falloff",
+    "integration": "Integration",
+    "blur_size": "Blur Size",
+    "blur_sharpness": "Blur Sharpness",
+    "strength": "Strength",
+    "background_depth": "Background Depth",
+}
 
 # The menus of the node and of the viewport panel: (identifier, name, tip).
 FALLOFF_ITEMS = [
@@ -37,46 +77,72 @@ INTEGRATION_ITEMS = [
     ("HBAO", "HBAO", "Bavoil & Sainz: the occluded fraction of the hemisphere"),
 ]
 
+# The blur (csrc/lib/compute.c and blur.c): a kernel of size b has radius
+# (b - 1) / 2 taps each side for b >= 2 (even sizes round down, 0 and 1 mean
+# no blur), and its Gaussian has sigma = BLUR_SIGMA_PER_TAP * (radius +
+# BLUR_SIGMA_TAP_OFFSET), so the outermost tap keeps a weight of about
+# exp(-2): wide enough to hide the 4x4 pattern, narrow enough to stay local.
+BLUR_SIGMA_PER_TAP = 0.5
+BLUR_SIGMA_TAP_OFFSET = 1
 
-def _clamp(value, low, high):
-    return min(max(value, low), high)
+
+def _number(value):
+    return f"{value:g}" if isinstance(value, float) else str(value)
 
 
-def resolved(params):
-    """`params` (any subset of DEFAULTS' keys) completed with the defaults and
-    clamped to the header's limits, as the C library clamps them. Raises
-    ValueError where the library returns HBAO_ERROR_INVALID_PARAMETER."""
-    unknown = set(params or {}) - set(DEFAULTS) - {"half_resolution", "threads"}
+def resolved(params, warnings=None):
+    """`params` (any subset of DEFAULTS' keys, plus half_resolution and
+    threads) completed with the defaults and clamped to the header's limits,
+    as the C library clamps them; whole-number parameters are rounded to the
+    nearest integer. Each clamped value appends a message to `warnings` (a
+    list) when given. Raises ValueError where the library returns
+    HBAO_ERROR_INVALID_PARAMETER (not finite, negative radius, background
+    depth not above 0) or for an unknown key or enum name."""
+    unknown = set(params or {}) - set(DEFAULTS) - set(PASS_THROUGH)
     if unknown:
         raise ValueError(f"unknown HBAO parameters: {', '.join(sorted(unknown))}")
     merged = dict(DEFAULTS)
-    merged.update({k: v for k, v in (params or {}).items() if k in DEFAULTS})
-    for name in ("radius", "angle_bias_degrees", "blur_sharpness", "strength",
-                 "background_depth"):
-        if not math.isfinite(float(merged[name])):
-            raise ValueError(f"{name} must be a finite number, not {merged[name]}")
-    if merged["radius"] < 0.0 or merged["background_depth"] <= 0.0:
-        raise ValueError("radius must be >= 0 and background_depth > 0")
-    if merged["falloff"] not in FALLOFF_VALUES:
-        raise ValueError(f"falloff must be one of {', '.join(FALLOFF_VALUES)}")
-    if merged["integration"] not in INTEGRATION_VALUES:
-        raise ValueError(f"integration must be one of {', '.join(INTEGRATION_VALUES)}")
-    blur_size = _clamp(int(merged["blur_size"]), 0, MAX_BLUR_SIZE)
-    return {
+    merged.update(params or {})
+    for key, value in merged.items():
+        if key in ("falloff", "integration") or key in PASS_THROUGH:
+            continue
+        if not math.isfinite(float(value)):
+            raise ValueError(f"{LABELS[key]} is not a number")
+    if float(merged["radius"]) < 0.0:
+        raise ValueError(f"Radius {float(merged['radius']):g} is negative")
+    if float(merged["background_depth"]) <= 0.0:
+        raise ValueError(f"Background Depth {float(merged['background_depth']):g} "
+                         f"is not above 0")
+    for key, values in (("falloff", FALLOFF_VALUES), ("integration", INTEGRATION_VALUES)):
+        if merged[key] not in values:
+            raise ValueError(f"{key} must be one of {', '.join(values)}, not {merged[key]!r}")
+    result = {
         "radius": float(merged["radius"]),
-        "angle_bias_degrees": _clamp(float(merged["angle_bias_degrees"]), 0.0,
-                                     MAX_ANGLE_BIAS_DEGREES),
-        "directions": _clamp(int(merged["directions"]), 1, MAX_DIRECTIONS),
-        "steps": _clamp(int(merged["steps"]), 1, MAX_STEPS),
         "falloff": merged["falloff"],
         "integration": merged["integration"],
-        "blur_size": blur_size,
-        "blur_sharpness": _clamp(float(merged["blur_sharpness"]), 0.0, MAX_BLUR_SHARPNESS),
-        "strength": _clamp(float(merged["strength"]), 0.0, MAX_STRENGTH),
         "background_depth": float(merged["background_depth"]),
     }
+    for key, (low, high, whole) in LIMITS.items():
+        value = float(merged[key])
+        if whole:
+            value = int(round(value))
+        clamped = min(max(value, low), high)
+        if clamped != value and warnings is not None:
+            side, limit = ("below", low) if value < low else ("above", high)
+            warnings.append(f"{LABELS[key]} {_number(value)} is {side} the limit "
+                            f"{_number(limit)}; using {_number(clamped)}")
+        result[key] = int(clamped) if whole else float(clamped)
+    for key in PASS_THROUGH:
+        if key in merged:
+            result[key] = int(merged[key])
+    return result
 
 
 def blur_kernel_radius(blur_size):
-    """docs/algorithm.md: r = (b - 1) / 2 for b >= 2 (even sizes round down), else no blur."""
+    """Taps each side of the blur kernel of size `blur_size` (0: no blur)."""
     return (blur_size - 1) // 2 if blur_size >= 2 else 0
+
+
+def blur_sigma(kernel_radius):
+    """The blur Gaussian's sigma, in pixels, for a kernel of `kernel_radius` taps each side."""
+    return BLUR_SIGMA_PER_TAP * (kernel_radius + BLUR_SIGMA_TAP_OFFSET)

@@ -3,24 +3,15 @@
 3D viewport in Solid and Material Preview shading, per 3D view, from the
 sidebar's "HBAO" tab. No native library needed: it runs on the GPU.
 
-    projection.py, parameters.py, shader_sources.py   no bpy (plain pytest)
+    projection.py, shader_sources.py                  no bpy (plain pytest)
     shaders.py, pipeline.py                           gpu passes
     settings.py                                       per-view settings on the Screen
     draw.py                                           the draw handler (only while on)
     panel.py                                          sidebar panel and operator
 """
-import bpy
-from bpy.app.handlers import persistent
-
-from . import draw, panel, settings
-
+# bpy and the gpu modules are imported by register(), so that projection and
+# shader_sources (and this package) import in plain Python.
 _registered = False
-
-
-@persistent
-def _sync_after_load(*_args):
-    # A file saved with the preview on turns it on; one without turns it off.
-    draw.sync_handler()
 
 
 def is_registered():
@@ -31,10 +22,13 @@ def register():
     global _registered
     if _registered:
         return
+    import bpy
+
+    from . import draw, panel, settings
     settings.register()
     panel.register()
     settings.enabled_change_callbacks.append(draw.sync_handler)
-    bpy.app.handlers.load_post.append(_sync_after_load)
+    bpy.app.handlers.load_post.append(draw.sync_after_load)
     _registered = True
     if isinstance(bpy.data, bpy.types.BlendData):
         draw.sync_handler()
@@ -44,8 +38,11 @@ def unregister():
     global _registered
     if not _registered:
         return
-    while _sync_after_load in bpy.app.handlers.load_post:
-        bpy.app.handlers.load_post.remove(_sync_after_load)
+    import bpy
+
+    from . import draw, panel, settings
+    while draw.sync_after_load in bpy.app.handlers.load_post:
+        bpy.app.handlers.load_post.remove(draw.sync_after_load)
     if draw.sync_handler in settings.enabled_change_callbacks:
         settings.enabled_change_callbacks.remove(draw.sync_handler)
     draw.unregister()

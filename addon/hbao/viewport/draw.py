@@ -9,6 +9,7 @@ linearised, turned into AO and multiplied over the view.
 """
 import bpy
 import gpu
+from bpy.app.handlers import persistent
 
 from . import pipeline, projection, settings
 
@@ -35,6 +36,12 @@ def sync_handler():
         _handler = None
         _pipelines.clear()
     _redraw_3d_views()
+
+
+@persistent
+def sync_after_load(*_args):
+    """load_post: a file saved with the preview on turns it on; one without turns it off."""
+    sync_handler()
 
 
 def _redraw_3d_views():

@@ -98,6 +98,7 @@ class AOPipeline:
                 shader.uniform_int("image_size", (width, height))
                 shader.uniform_int("blur_step", step)
                 shader.uniform_int("kernel_radius", kernel_radius)
+                shader.uniform_float("sigma", parameters.blur_sigma(kernel_radius))
                 shader.uniform_float("sharpness", params["blur_sharpness"])
                 shader.uniform_float("background_depth", params["background_depth"])
                 _draw_quad("blur")

@@ -17,6 +17,8 @@ tests/test_viewport_projection.py checks.
 """
 from dataclasses import dataclass
 
+from ..camera import sensor_fit
+
 
 @dataclass(frozen=True)
 class ViewFrame:
@@ -43,17 +45,8 @@ def frame_from_camera(camera, width, height):
     projection = camera.get("type", "PERSP")
     if projection not in ("PERSP", "ORTHO"):
         raise ValueError(f"camera type must be PERSP or ORTHO, not {projection!r}")
-    aspect_x = float(camera.get("pixel_aspect_x", 1.0))
-    aspect_y = float(camera.get("pixel_aspect_y", 1.0))
-    ycor = aspect_y / aspect_x
-    requested_fit = camera.get("sensor_fit", "AUTO")
-    fit = requested_fit
-    if fit == "AUTO":
-        fit = "HORIZONTAL" if aspect_x * width >= aspect_y * height else "VERTICAL"
-    # AUTO spans the larger side with sensor_width, even when that side is vertical.
-    sensor_size = float(camera.get("sensor_height", 24.0)) if requested_fit == "VERTICAL" \
-        else float(camera.get("sensor_width", 36.0))
-    viewfac = width if fit == "HORIZONTAL" else ycor * height
+    ycor = float(camera.get("pixel_aspect_y", 1.0)) / float(camera.get("pixel_aspect_x", 1.0))
+    _fit, sensor_size, viewfac = sensor_fit(camera, width, height)
     if projection == "PERSP":
         pixel_size = sensor_size / float(camera.get("lens", 50.0)) / viewfac
     else:

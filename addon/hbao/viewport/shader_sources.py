@@ -8,6 +8,7 @@ Textures are bottom-up (OpenGL rows); the algorithm's pixel (i, j) has j
 counted from the top, so j = H - 1 - row wherever the pattern or the
 camera model needs it.
 """
+from ..parameters import FALLOFF_VALUES, INTEGRATION_VALUES
 
 # A full-screen quad given in normalised device coordinates: no matrices, so it
 # draws the same in POST_VIEW (3D matrices bound) and into our own framebuffers.
@@ -230,8 +231,10 @@ void main()
 """
 
 # One separable pass of the cross-bilateral blur (docs/algorithm.md, "After
-# sampling", 2); `blur_step` is (1, 0) for rows, (0, 1) for columns. Direction along
-# the rows does not matter (the kernel is symmetric), so it works bottom-up.
+# sampling", 2); `blur_step` is (1, 0) for rows, (0, 1) for columns;
+# `kernel_radius` and `sigma` come from parameters.blur_kernel_radius and
+# blur_sigma, the library's rule. Direction along the rows does not matter
+# (the kernel is symmetric), so it works bottom-up.
 BLUR_FRAGMENT = COMMON + """
 void main()
 {
@@ -241,7 +244,6 @@ void main()
         frag_output = vec4(1.0, 0.0, 0.0, 1.0);
         return;
     }
-    float sigma = float(kernel_radius + 1) * 0.5;
     float sum = 0.0;
     float weight_sum = 0.0;
     for (int x = -kernel_radius; x <= kernel_radius; x++) {
@@ -278,12 +280,12 @@ void main()
 }
 """
 
-# Falloff and integration enum values as the shader sees them (the header's).
+# Falloff and integration enum values as the shader sees them (the header's,
+# through parameters.py).
 AO_DEFINES = {
-    "FALLOFF_QUADRATIC": 0,
-    "FALLOFF_NONE": 1,
-    "INTEGRATION_HBAO": 0,
-    "INTEGRATION_COSINE": 1,
-    # csrc/lib/horizon.c: a projected normal shorter than this has no slice angle.
+    **{f"FALLOFF_{name}": value for name, value in FALLOFF_VALUES.items()},
+    **{f"INTEGRATION_{name}": value for name, value in INTEGRATION_VALUES.items()},
+    # csrc/lib/horizon.c: a projected normal shorter than this has no slice
+    # angle (tests/test_parameter_contract.py compares the two).
     "NORMAL_IN_SLICE_EPSILON": 1e-6,
 }

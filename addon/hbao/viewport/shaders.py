@@ -39,7 +39,7 @@ _DEFINITIONS = {
     "blur": lambda: _create_info(
         shader_sources.BLUR_FRAGMENT,
         [("IVEC2", "image_size"), ("IVEC2", "blur_step"), ("INT", "kernel_radius"),
-         ("FLOAT", "sharpness"), ("FLOAT", "background_depth")],
+         ("FLOAT", "sigma"), ("FLOAT", "sharpness"), ("FLOAT", "background_depth")],
         ["depth_texture", "ao_texture"]),
     "composite": lambda: _create_info(
         shader_sources.COMPOSITE_FRAGMENT,

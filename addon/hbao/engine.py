@@ -1,0 +1,149 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The helper scene's render engine: renders nothing itself, but publishes
+one AO pass "HBAO <n>" per HBAO node of the tree it serves, computed by
+libhbao from the main Render Result's Depth and Normal passes.
+
+Anything that goes wrong leaves the pass at 1 (no AO) with a message: the
+render always completes."""
+import time
+
+import bpy
+import numpy as np
+
+from . import camera as camera_model
+from . import exr_passes, handover, native
+from .helper_scene import ENGINE_IDNAME, pass_names_for_helper, scene_for_render
+from .planning import plan
+from .report import log
+
+# The prefix of the passes this engine fills (node.pass_name's).
+PASS_PREFIX = "HBAO "
+
+
+def _evaluated_camera(main, depsgraph):
+    camera = main.camera
+    if camera is None:
+        return None
+    try:
+        return camera.evaluated_get(depsgraph)
+    except (RuntimeError, ReferenceError, TypeError):
+        return camera
+
+
+def _original(scene):
+    return scene.original if hasattr(scene, "original") else scene
+
+
+def compute_passes(engine, depsgraph, width, height):
+    """{pass name: bottom-up (height, width) AO} for the helper being rendered."""
+    helper = _original(depsgraph.scene)
+    main = scene_for_render(helper)
+    if main is None:
+        raise RuntimeError(f"scene {helper.name!r} is not an HBAO helper scene")
+    frame = main.frame_current + main.frame_subframe
+    jobs, warnings = plan(main, frame)
+    for warning in warnings:
+        engine.report({"WARNING"}, f"HBAO {warning}")
+        log(warning)
+    if not jobs:
+        return {}
+    # Fail early, before the save, if a library is missing.
+    native.load_library()
+    exr_passes.load_library()
+    camera = camera_model.camera_for_render_result(main, _evaluated_camera(main, depsgraph))
+    channels, timings = handover.read_main_passes(main, jobs)
+
+    results = {}
+    compute_time = 0.0
+    for index, job in enumerate(jobs):
+        engine.update_stats("HBAO", f"{job.node_name}: computing AO ({index + 1}/{len(jobs)})")
+        depth = channels[("depth", job.layer)]
+        if depth.shape != (height, width):
+            raise RuntimeError(f"the Render Result is {depth.shape[1]}x{depth.shape[0]}, the "
+                               f"helper scene renders {width}x{height}")
+        normal = channels[("normal", job.layer)] if job.with_normal else None
+        compute_start = time.perf_counter()
+        # The EXR's rows run top-down, a render pass bottom-up: views flipped, no copy.
+        results[job.pass_name] = native.compute_ao(
+            depth[::-1], None if normal is None else normal[::-1], params=job.params,
+            camera=camera, bottom_up=True)
+        compute_time += time.perf_counter() - compute_start
+        engine.update_progress((index + 1) / len(jobs))
+    timings["ao"] = compute_time
+    engine.hbao_timings = timings
+    return results
+
+
+def _timing_line(count, width, height, total, timings):
+    milliseconds = {name: timings.get(name, 0.0) * 1000 for name in ("save", "read", "write",
+                                                                     "ao")}
+    handover_ms = milliseconds["save"] + milliseconds["read"] + milliseconds["write"]
+    return (f"{count} AO pass(es) {width}x{height} in {total * 1000:.0f} ms: AO "
+            f"{milliseconds['ao']:.0f} ms, pass hand-over {handover_ms:.0f} ms "
+            f"(save {milliseconds['save']:.0f}, read {milliseconds['read']:.0f}, write "
+            f"{milliseconds['write']:.0f})")
+
+
+def _report_failure(engine, message):
+    log(message)
+    engine.report({"WARNING"}, f"HBAO: {message}")
+
+
+def render_helper(engine, depsgraph):
+    """HBAOPassEngine.render(): fill every registered AO pass, 1 where it failed."""
+    start = time.perf_counter()
+    engine.hbao_timings = {}
+    # The result's own size: a border render cropped to its region is
+    # smaller than engine.resolution_x/y (the full frame).
+    result = engine.begin_result(0, 0, engine.resolution_x, engine.resolution_y)
+    width, height = result.resolution_x, result.resolution_y
+    try:
+        try:
+            results = compute_passes(engine, depsgraph, width, height)
+        except (native.HBAOLibraryError, exr_passes.EXRLibraryError) as error:
+            results = {}
+            _report_failure(engine, f"{error} Rendering without AO.")
+        except Exception as error:  # the render must complete: AO = 1
+            results = {}
+            _report_failure(engine, f"{type(error).__name__}: {error}. Rendering without AO.")
+        write_start = time.perf_counter()
+        for layer in result.layers:
+            for render_pass in layer.passes:
+                if not render_pass.name.startswith(PASS_PREFIX):
+                    continue
+                ao = results.get(render_pass.name)
+                if ao is None or ao.size != width * height:
+                    ao = np.ones((height, width), np.float32)
+                render_pass.rect.foreach_set(ao.reshape(-1))
+    finally:
+        engine.end_result(result)
+    timings = dict(engine.hbao_timings)
+    timings["write"] = time.perf_counter() - write_start
+    if results:
+        line = _timing_line(len(results), width, height, time.perf_counter() - start, timings)
+        log(line)
+        engine.update_stats("HBAO", line)
+
+
+class HBAOPassEngine(bpy.types.RenderEngine):
+    """Renders nothing itself: publishes the AO of the main scene's HBAO nodes."""
+    bl_idname = ENGINE_IDNAME
+    bl_label = "HBAO Passes (internal)"
+    bl_use_postprocess = True
+    bl_use_preview = False
+
+    def update_render_passes(self, scene=None, renderlayer=None):
+        self.register_pass(scene, renderlayer, "Combined", 4, "RGBA", "COLOR")
+        for name in pass_names_for_helper(_original(scene)):
+            self.register_pass(scene, renderlayer, name, 1, "X", "VALUE")
+
+    def render(self, depsgraph):
+        render_helper(self, depsgraph)
+
+
+def register():
+    bpy.utils.register_class(HBAOPassEngine)
+
+
+def unregister():
+    bpy.utils.unregister_class(HBAOPassEngine)

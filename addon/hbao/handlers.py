@@ -1,0 +1,94 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""When the hook is kept in sync: Blender's application handlers and a
+timer, and the node's change callbacks.
+
+Structural changes (helper scene, managed node, links) need the main
+thread and must not happen inside node callbacks, so those only schedule a
+sync. F12 runs the render handlers in the render job's thread: there they
+copy plain settings only. `blender -b ... -f N` runs them in the main thread,
+the only chance such a render has to build the hook."""
+import bpy
+
+from . import compat, helper_scene, node
+from .report import in_main_thread, log
+
+_sync_scheduled = False
+
+
+def _timer_sync():
+    global _sync_scheduled
+    _sync_scheduled = False
+    helper_scene.sync_all()
+    return None  # run once
+
+
+def schedule_sync():
+    """Sync soon, from the main loop (node callbacks must not edit the tree)."""
+    global _sync_scheduled
+    if not _sync_scheduled and not bpy.app.background:
+        _sync_scheduled = True
+        bpy.app.timers.register(_timer_sync, first_interval=0.0)
+
+
+@bpy.app.handlers.persistent
+def _on_load_post(*_args):
+    helper_scene.sync_all()
+
+
+@bpy.app.handlers.persistent
+def _on_save_pre(*_args):
+    # Background scripts get no timer: the hook is built at the latest here, so
+    # that `blender -b file.blend -f N` finds it in the file.
+    helper_scene.sync_all()
+
+
+@bpy.app.handlers.persistent
+def _on_render_pre(scene, *_args):
+    if helper_scene.is_helper(scene):
+        return
+    tree = compat.compositor_tree(scene)
+    if not node.hbao_nodes(tree):
+        return
+    try:
+        if in_main_thread():
+            helper_scene.sync(scene)
+        else:
+            helper_scene.enable_needed_passes(scene, tree)
+        # The helper may serve several scenes (5.x): its engine computes for this one.
+        helper_scene.record_rendering(scene)
+    except Exception as error:
+        log(f"could not prepare the HBAO hook of {scene.name!r}: {error}")
+
+
+@bpy.app.handlers.persistent
+def _on_depsgraph_update_post(scene, *_args):
+    if helper_scene.is_helper(scene) or not in_main_thread():
+        return
+    tree = compat.compositor_tree(scene)
+    if node.hbao_nodes(tree) or helper_scene.managed_node(tree) is not None:
+        schedule_sync()
+
+
+_HANDLERS = (
+    (bpy.app.handlers.load_post, _on_load_post),
+    (bpy.app.handlers.save_pre, _on_save_pre),
+    (bpy.app.handlers.render_init, _on_render_pre),
+    (bpy.app.handlers.render_pre, _on_render_pre),
+    (bpy.app.handlers.depsgraph_update_post, _on_depsgraph_update_post),
+)
+
+
+def register():
+    for handlers, function in _HANDLERS:
+        if function not in handlers:
+            handlers.append(function)
+    if schedule_sync not in node.changed_callbacks:
+        node.changed_callbacks.append(schedule_sync)
+
+
+def unregister():
+    if schedule_sync in node.changed_callbacks:
+        node.changed_callbacks.remove(schedule_sync)
+    for handlers, function in _HANDLERS:
+        if function in handlers:
+            handlers.remove(function)

@@ -1,0 +1,79 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Handing the main Render Result's passes to Python: Blender gives a
+Python engine no access to another scene's Render Result pixels, but it can
+save the Render Result as a multilayer EXR, which libhbao_exr decodes
+straight into numpy arrays."""
+import os
+import tempfile
+import threading
+from time import perf_counter as _clock
+
+import bpy
+
+from . import compat, exr_passes
+
+
+def _render_result_image():
+    for image in bpy.data.images:
+        if image.type == "RENDER_RESULT":
+            return image
+    return None
+
+
+def _scratch_path():
+    # Memory-backed where there is one: the file lives for milliseconds.
+    folder = "/dev/shm" if os.path.isdir("/dev/shm") and os.access("/dev/shm", os.W_OK) \
+        else tempfile.gettempdir()
+    return os.path.join(folder, f"hbao-passes-{os.getpid()}-{threading.get_ident()}.exr")
+
+
+def save_main_passes(main, path):
+    """Write the main scene's current Render Result to `path`, uncompressed
+    32-bit multilayer EXR, leaving the user's output settings as they were."""
+    image = _render_result_image()
+    if image is None:
+        raise RuntimeError("Blender has no Render Result image to read the passes from")
+    settings = main.render.image_settings
+    saved = [(name, getattr(settings, name)) for name in compat.SAVED_IMAGE_SETTINGS
+             if hasattr(settings, name)]
+    try:
+        compat.set_multilayer_exr(settings)
+        settings.color_depth = "32"
+        settings.exr_codec = "NONE"
+        if hasattr(settings, "use_preview"):
+            settings.use_preview = False
+        image.save_render(path, scene=main)
+    finally:
+        # In compat.SAVED_IMAGE_SETTINGS' order: the media type and format
+        # first, so that their options are valid when they are set.
+        for name, value in saved:
+            try:
+                setattr(settings, name, value)
+            except (TypeError, ValueError):
+                pass  # an enum value not valid for the restored format is re-derived
+
+
+def read_main_passes(main, jobs):
+    """{("depth", layer): (H, W), ("normal", layer): (H, W, 3)} float32, top
+    row first, for the view layers `jobs` read, from the main Render Result;
+    and the seconds the save and the read took."""
+    path = _scratch_path()
+    timings = {}
+    try:
+        start = _clock()
+        save_main_passes(main, path)
+        timings["save"] = _clock() - start
+        # One decode pass: each layer's depth, and its normal as one
+        # interleaved (height, width, 3) image, as libhbao reads it.
+        groups = {}
+        for job in jobs:
+            groups[("depth", job.layer)] = [f"{job.layer}.Depth.Z"]
+            if job.with_normal:
+                groups[("normal", job.layer)] = [f"{job.layer}.Normal.{axis}" for axis in "XYZ"]
+        read_start = _clock()
+        channels = exr_passes.read_channel_groups(path, groups)
+        timings["read"] = _clock() - read_start
+    finally:
+        if os.path.exists(path):
+            os.remove(path)
+    return channels, timings

@@ -1,0 +1,282 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The helper scene and the managed Render Layers node: how AO computed in
+Python reaches Blender's compositor.
+
+Python cannot run per pixel inside the compositor, but Blender renders every
+scene that a Render Layers node of the compositor tree points at after the
+main scene's engine has finished and before compositing. So each compositor
+tree that holds HBAO nodes gets a helper scene (".HBAO passes <scene>")
+rendered by the add-on's engine (engine.py), and a managed, collapsed Render
+Layers node pointing at it, whose outputs "HBAO <n>" are linked to each
+node's hidden "HBAO Pass" input.
+
+The helper belongs to the tree, not to a scene: from Blender 5.0 one
+compositing node group may serve several scenes, and a managed node that
+pointed at each scene's helper in turn would flip with every sync. The
+scene being rendered is recorded by the render handlers (record_rendering)
+and read by the engine (scene_for_render)."""
+import bpy
+
+from . import compat
+from .node import (AO_PASS_INPUT, DEPTH_INPUT, NORMAL_INPUT, hbao_nodes, next_pass_index,
+                   pass_name)
+from .report import in_main_thread, log
+
+ENGINE_IDNAME = "HBAO_PASSES"
+HELPER_SCENE_PREFIX = ".HBAO passes "
+# ID property on the helper scene: the scene it was made for.
+MAIN_SCENE_KEY = "hbao_main_scene"
+# ID property on the helper scene (5.0+): the compositing node group it serves.
+MAIN_TREE_KEY = "hbao_main_tree"
+# ID property on the Render Layers node the add-on manages.
+MANAGED_NODE_KEY = "hbao_managed"
+MANAGED_NODE_NAME = "HBAO Passes"
+# How far below the first HBAO node the managed node goes (node editor units):
+# the HBAO node is about 420 units tall with its options.
+HBAO_NODE_CLEARANCE = 480
+# Render settings copied from the main scene so that the helper's result has
+# the main Render Result's size.
+SYNCED_RENDER_SETTINGS = (
+    "resolution_x", "resolution_y", "resolution_percentage", "pixel_aspect_x",
+    "pixel_aspect_y", "use_border", "use_crop_to_border", "border_min_x", "border_max_x",
+    "border_min_y", "border_max_y", "fps", "fps_base")
+
+# Helper scene name -> name of the scene whose render is using it now.
+_rendering = {}
+
+
+def set_if_different(owner, attribute, value):
+    """Assign only real changes: every assignment tags Blender data for update."""
+    if getattr(owner, attribute) != value:
+        setattr(owner, attribute, value)
+        return True
+    return False
+
+
+def managed_node(tree):
+    if tree is None:
+        return None
+    for node in tree.nodes:
+        if node.bl_idname == "CompositorNodeRLayers" and node.get(MANAGED_NODE_KEY):
+            return node
+    return None
+
+
+def is_helper(scene):
+    # The key stays when the scene it names is deleted (its value becomes None).
+    return MAIN_SCENE_KEY in scene.keys()
+
+
+def main_scene_of(helper):
+    """The scene `helper` was made for, or None (not a helper, or deleted)."""
+    main = helper.get(MAIN_SCENE_KEY)
+    return main if isinstance(main, bpy.types.Scene) else None
+
+
+def tree_of_helper(helper):
+    """The compositor tree whose HBAO nodes the helper serves."""
+    tree = helper.get(MAIN_TREE_KEY) if compat.TREES_SHARED_BETWEEN_SCENES else None
+    if isinstance(tree, bpy.types.NodeTree):
+        return tree
+    main = main_scene_of(helper)
+    return compat.compositor_tree(main) if main is not None else None
+
+
+def serves(helper, scene):
+    """Whether `helper` publishes the AO of `scene`'s compositor tree."""
+    if not is_helper(helper) or is_helper(scene):
+        return False
+    tree = compat.compositor_tree(scene)
+    return tree is not None and tree_of_helper(helper) == tree
+
+
+def helper_scene_of(scene):
+    node = managed_node(compat.compositor_tree(scene))
+    if node is not None and node.scene is not None and serves(node.scene, scene):
+        return node.scene
+    for candidate in bpy.data.scenes:
+        if serves(candidate, scene):
+            return candidate
+    return None
+
+
+def scenes_served_by(helper):
+    return [scene for scene in bpy.data.scenes if serves(helper, scene)]
+
+
+def pass_names_for_helper(helper):
+    """The AO passes the helper scene's engine publishes (one per HBAO node)."""
+    return [pass_name(node) for node in hbao_nodes(tree_of_helper(helper))]
+
+
+def copy_render_settings(scene, helper):
+    """Only plain values: allowed in the render job's thread too."""
+    for attribute in SYNCED_RENDER_SETTINGS:
+        set_if_different(helper.render, attribute, getattr(scene.render, attribute))
+
+
+def record_rendering(scene):
+    """Called when `scene` starts rendering: its helper computes for it."""
+    helper = helper_scene_of(scene)
+    if helper is not None:
+        _rendering[helper.name] = scene.name
+        copy_render_settings(scene, helper)
+
+
+def scene_for_render(helper):
+    """The scene whose render is rendering `helper` now (the last one that
+    started), else the scene it was made for."""
+    scene = bpy.data.scenes.get(_rendering.get(helper.name, ""))
+    if scene is not None and serves(helper, scene):
+        return scene
+    main = main_scene_of(helper)
+    if main is not None and serves(helper, main):
+        return main
+    served = scenes_served_by(helper)
+    return served[0] if served else None
+
+
+def _ensure_helper_scene(scene):
+    helper = helper_scene_of(scene)
+    if helper is None:
+        helper = bpy.data.scenes.new(HELPER_SCENE_PREFIX + scene.name)
+        helper[MAIN_SCENE_KEY] = scene
+        log(f"created helper scene {helper.name!r} for {scene.name!r}")
+    if compat.TREES_SHARED_BETWEEN_SCENES and helper.get(MAIN_TREE_KEY) is None:
+        helper[MAIN_TREE_KEY] = compat.compositor_tree(scene)
+    # Between renders the helper follows one scene, the one it was made for,
+    # so that syncing scenes that share its tree does not flip its settings
+    # back and forth (each change would trigger another sync). A render
+    # copies its own scene's settings (record_rendering).
+    owner = main_scene_of(helper)
+    if owner is None or not serves(helper, owner):
+        helper[MAIN_SCENE_KEY] = owner = scene
+    set_if_different(helper.render, "engine", ENGINE_IDNAME)
+    if not compat.HAS_COMPOSITING_NODE_GROUP and helper.use_nodes:
+        helper.use_nodes = False
+    if owner == scene:
+        copy_render_settings(scene, helper)
+    # The helper's render needs a camera; the main cameras themselves, so that
+    # their animation is evaluated at the frame being rendered in the helper's
+    # depsgraph. Every scene sharing the tree brings its own.
+    cameras = [s.camera for s in scenes_served_by(helper) if s.camera is not None]
+    for camera in cameras:
+        if helper.collection.objects.get(camera.name) != camera:
+            helper.collection.objects.link(camera)
+    if owner.camera is not None:
+        set_if_different(helper, "camera", owner.camera)
+    for obj in list(helper.collection.objects):
+        if obj not in cameras:
+            helper.collection.objects.unlink(obj)
+    return helper
+
+
+def enable_needed_passes(scene, tree):
+    """Turn on the Depth/Normal pass a linked HBAO node reads but the view
+    layer lacks. Plain settings only: allowed in the render job's thread."""
+    messages = []
+    for node in hbao_nodes(tree):
+        if node.mute:
+            continue
+        for input_name, attribute, label in ((DEPTH_INPUT, "use_pass_z", "Depth"),
+                                             (NORMAL_INPUT, "use_pass_normal", "Normal")):
+            socket = node.inputs.get(input_name)
+            if socket is None or not socket.is_linked:
+                continue
+            source = socket.links[0].from_node
+            while source.bl_idname == "NodeReroute" and source.inputs[0].is_linked:
+                source = source.inputs[0].links[0].from_node
+            if source.bl_idname != "CompositorNodeRLayers" or source.get(MANAGED_NODE_KEY):
+                continue
+            source_scene = source.scene or scene
+            view_layer = source_scene.view_layers.get(source.layer)
+            if view_layer is not None and not getattr(view_layer, attribute):
+                setattr(view_layer, attribute, True)
+                message = (f"enabled the {label} pass of view layer {view_layer.name!r} "
+                           f"for node {node.name!r}")
+                messages.append(message)
+                log(message)
+                if in_main_thread():
+                    node.status = f"{label} pass enabled on {view_layer.name}"
+    return messages
+
+
+def _ensure_managed_node(tree, nodes, helper):
+    rlayers = managed_node(tree)
+    if rlayers is None:
+        rlayers = tree.nodes.new("CompositorNodeRLayers")
+        rlayers[MANAGED_NODE_KEY] = True
+        rlayers.name = MANAGED_NODE_NAME
+        rlayers.label = "HBAO passes (managed by the HBAO add-on)"
+        # Below the first HBAO node, clear of the artist's Render Layers node
+        # on its left.
+        rlayers.location = (nodes[0].location.x, nodes[0].location.y - HBAO_NODE_CLEARANCE)
+        rlayers.hide = True
+    if rlayers.scene != helper:
+        rlayers.scene = helper
+    # Missing (new node) or unavailable (file loaded before the engine was
+    # registered): re-assigning the layer makes Blender ask the engine for
+    # its passes again.
+    if any(rlayers.outputs.get(pass_name(node)) is None
+           or not rlayers.outputs[pass_name(node)].enabled for node in nodes):
+        rlayers.layer = helper.view_layers[0].name
+    for output in rlayers.outputs:
+        if not output.is_linked:
+            set_if_different(output, "hide", True)
+    return rlayers
+
+
+def sync(scene):
+    """Create, update or remove the hook of `scene` to match its HBAO nodes.
+    Main thread only; returns a list of messages."""
+    tree = compat.compositor_tree(scene)
+    if tree is None or is_helper(scene):
+        return []
+    nodes = hbao_nodes(tree)
+    if not nodes:
+        rlayers = managed_node(tree)
+        if rlayers is not None:
+            tree.nodes.remove(rlayers)
+            log(f"removed the HBAO hook of {scene.name!r} (no HBAO node left)")
+        helper = helper_scene_of(scene)
+        if helper is not None:
+            bpy.data.scenes.remove(helper)
+        return []
+
+    messages = enable_needed_passes(scene, tree)
+    seen = set()
+    for node in nodes:
+        if node.pass_index == 0 or node.pass_index in seen:
+            node.pass_index = next_pass_index(tree, exclude=node)
+        seen.add(node.pass_index)
+
+    helper = _ensure_helper_scene(scene)
+    rlayers = _ensure_managed_node(tree, nodes, helper)
+    for node in nodes:
+        output = rlayers.outputs.get(pass_name(node))
+        target = node.inputs.get(AO_PASS_INPUT)
+        if output is None or target is None:
+            messages.append(f"node {node.name!r}: its AO pass socket is not available yet")
+            continue
+        # Blender unhides linked sockets and refuses to hide them, so this one
+        # link stays visible; the collapsed Render Layers node shows only it.
+        if not (target.is_linked and target.links[0].from_socket == output):
+            for link in list(output.links):
+                tree.links.remove(link)
+            tree.links.new(output, target)
+    return messages
+
+
+def sync_all():
+    """sync() every scene with HBAO nodes or a hook; drop helpers nobody uses."""
+    for scene in list(bpy.data.scenes):
+        if is_helper(scene):
+            if not scenes_served_by(scene):
+                bpy.data.scenes.remove(scene)
+            continue
+        tree = compat.compositor_tree(scene)
+        if hbao_nodes(tree) or managed_node(tree) is not None:
+            try:
+                sync(scene)
+            except Exception as error:  # never break the user's session
+                log(f"could not update the HBAO hook of {scene.name!r}: {error}")

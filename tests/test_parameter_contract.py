@@ -1,0 +1,201 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""One parameter contract: the C header (csrc/include/hbao.h) defines the
+defaults, limits and enums, csrc/lib/ the blur formulas; every Python table
+and GLSL constant that must repeat them is checked here against the C
+sources themselves, so a copy cannot drift. Plain pytest: no library, no
+Blender. Every comparison is exact: the values are decimal literals in both
+languages, and float32 literals compare equal to their float64 parse."""
+import ctypes
+import re
+import sys
+
+import pytest
+
+from conftest import REPO
+
+sys.path.insert(0, str(REPO / "addon"))
+from hbao import native, parameters  # noqa: E402
+from hbao.viewport import shader_sources  # noqa: E402
+
+HEADER = (REPO / "csrc" / "include" / "hbao.h").read_text()
+LIBRARY_SOURCES = {path.name: path.read_text()
+                   for path in sorted((REPO / "csrc" / "lib").glob("*.c"))}
+# Header limits with no Python copy: the binding passes threads and image
+# sizes through, and the library checks them itself.
+UNMIRRORED_MAXIMA = {"THREADS", "IMAGE_SIZE"}
+# Blender's names for the header's enumerators where they differ.
+BLENDER_ENUMERATOR_NAMES = {"PERSPECTIVE": "PERSP", "ORTHOGRAPHIC": "ORTHO"}
+PYTHON_ENUMS = {
+    "hbao_falloff": parameters.FALLOFF_VALUES,
+    "hbao_integration": parameters.INTEGRATION_VALUES,
+    "hbao_projection": parameters.PROJECTION_VALUES,
+    "hbao_sensor_fit": parameters.SENSOR_FIT_VALUES,
+}
+C_FIELD_TYPES = {"float": ctypes.c_float, "int32_t": ctypes.c_int32}
+
+
+def _number(literal):
+    return float(literal.rstrip("f"))
+
+
+def header_defines(prefix):
+    """{NAME: value} of `#define <prefix>NAME <number>` in the header."""
+    found = {name: _number(value) for name, value in re.findall(
+        rf"#define {prefix}(\w+) (-?[\d.]+(?:e-?\d+)?f?)\s", HEADER)}
+    assert found, f"no {prefix}* defines found in hbao.h: has the header changed form?"
+    return found
+
+
+def header_enum(name):
+    """{ENUMERATOR without the type's prefix: value} of `typedef enum name`."""
+    body = re.search(rf"typedef enum {name} \{{(.*?)\}} {name};", HEADER, re.S)
+    assert body, f"enum {name} not found in hbao.h"
+    prefix = name.upper() + "_"
+    values = {key[len(prefix):]: int(value) for key, value in
+              re.findall(rf"({prefix}\w+) = (\d+)", body.group(1))}
+    assert values, f"enum {name} has no enumerators with explicit values"
+    return values
+
+
+def header_struct(name):
+    """[(field, C type, doc comment)] of `typedef struct name` in field order."""
+    body = re.search(rf"typedef struct {name} \{{(.*?)\}} {name};", HEADER, re.S)
+    assert body, f"struct {name} not found in hbao.h"
+    fields = []
+    comment = ""
+    for match in re.finditer(r"(/\*\*.*?\*/)|(\w+) (\w+)(\[\d+\])?;(\s*/\*\*<.*?\*/)?",
+                             body.group(1), re.S):
+        if match.group(1):
+            comment = match.group(1)
+            continue
+        fields.append((match.group(3), match.group(2) + (match.group(4) or ""),
+                       comment + (match.group(5) or "")))
+        comment = ""
+    return fields
+
+
+def library_pattern(pattern, what):
+    """The first match of `pattern` in csrc/lib/*.c, or a failure naming `what`."""
+    for source in LIBRARY_SOURCES.values():
+        match = re.search(pattern, source)
+        if match:
+            return match
+    pytest.fail(f"{what} not found in csrc/lib/*.c: the library's form changed; update "
+                f"this test's pattern and check the Python copy")
+
+
+def test_every_default_matches_the_header():
+    defaults = header_defines("HBAO_DEFAULT_")
+    for name, value in defaults.items():
+        assert parameters.DEFAULTS[name.lower()] == value, name
+    initializer = re.search(r"#define HBAO_PARAMS_DEFAULT_INITIALIZER(.*?)\}", HEADER, re.S)
+    falloff = re.search(r"HBAO_FALLOFF_(\w+)", initializer.group(1)).group(1)
+    integration = re.search(r"HBAO_INTEGRATION_(\w+)", initializer.group(1)).group(1)
+    assert parameters.DEFAULTS["falloff"] == falloff
+    assert parameters.DEFAULTS["integration"] == integration
+    numeric = {key for key, value in parameters.DEFAULTS.items() if not isinstance(value, str)}
+    assert numeric == {name.lower() for name in defaults}, "a Python default has no header twin"
+
+
+def test_every_limit_matches_the_header():
+    maxima = header_defines("HBAO_MAX_")
+    for name, value in maxima.items():
+        if name in UNMIRRORED_MAXIMA:
+            continue
+        assert getattr(parameters, f"MAX_{name}") == value, name
+    # The header documents each clamped field's range as "clamped to [low, high]".
+    documented = {}
+    for field, _type, comment in header_struct("hbao_params"):
+        match = re.search(r"[Cc]lamped to \[([^,\]]+), ([^\]]+)\]", comment)
+        if match:
+            documented[field] = (_number(match.group(1)), _number(match.group(2)))
+    documented.pop("threads")
+    assert documented, "no 'clamped to [low, high]' found in hbao_params' comments"
+    assert set(documented) == set(parameters.LIMITS)
+    for field, (low, high) in documented.items():
+        assert parameters.LIMITS[field][:2] == (low, high), field
+
+
+def test_every_enum_matches_the_header():
+    for name, python_values in PYTHON_ENUMS.items():
+        expected = {BLENDER_ENUMERATOR_NAMES.get(key, key): value
+                    for key, value in header_enum(name).items()}
+        assert python_values == expected, name
+    assert native.FALLOFF_NAMES is parameters.FALLOFF_VALUES  # one table, not a copy
+    menus = {"falloff": parameters.FALLOFF_ITEMS, "integration": parameters.INTEGRATION_ITEMS}
+    for key, items in menus.items():
+        assert {item[0] for item in items} == set(PYTHON_ENUMS[f"hbao_{key}"])
+
+
+@pytest.mark.parametrize("struct_name, structure", [("hbao_params", native.HBAOParams),
+                                                    ("hbao_camera", native.HBAOCamera)])
+def test_the_bindings_structs_match_the_header(struct_name, structure):
+    fields = header_struct(struct_name)
+    assert [name for name, _, _ in fields] == [name for name, _ in structure._fields_]
+    for (name, c_type, _), (_, ctype) in zip(fields, structure._fields_):
+        if c_type.endswith("]"):
+            base, count = re.match(r"(\w+)\[(\d+)\]", c_type).groups()
+            assert ctype._type_ is C_FIELD_TYPES[base] and ctype._length_ == int(count), name
+        else:
+            assert ctype is C_FIELD_TYPES[c_type], name
+
+
+def test_the_blur_formulas_match_the_library():
+    radius = library_pattern(r">= (\d+) \? \((\w+) - (\d+)\) / (\d+) : 0",
+                             "the blur size -> radius rule (b >= 2 ? (b - 1) / 2 : 0)")
+    threshold, offset, divisor = (int(radius.group(i)) for i in (1, 3, 4))
+    for size in range(parameters.MAX_BLUR_SIZE + 2):
+        expected = (size - offset) // divisor if size >= threshold else 0
+        assert parameters.blur_kernel_radius(size) == expected, size
+    sigma = library_pattern(r"sigma = ([\d.]+)f? \* \(float\)\(radius \+ (\d+)\)",
+                            "the blur sigma rule (sigma = a * (radius + b))")
+    assert parameters.BLUR_SIGMA_PER_TAP == float(sigma.group(1))
+    assert parameters.BLUR_SIGMA_TAP_OFFSET == int(sigma.group(2))
+    for kernel_radius in range(1, 33):
+        assert parameters.blur_sigma(kernel_radius) == \
+            float(sigma.group(1)) * (kernel_radius + int(sigma.group(2)))
+    # The spatial weight has the same Gaussian form in C and GLSL; sigma itself
+    # comes into the shader as a uniform (parameters.blur_sigma), never recomputed.
+    library_pattern(r"expf\(-\(float\)\(k \* k\) / \(2\.0f \* sigma \* sigma\)\)",
+                    "the blur's Gaussian exp(-k^2 / (2 sigma^2))")
+    assert "exp(-float(x * x) / (2.0 * sigma * sigma)" in shader_sources.BLUR_FRAGMENT
+    assert "sigma =" not in shader_sources.BLUR_FRAGMENT
+
+
+def test_the_glsl_constants_match_the_library():
+    defines = shader_sources.AO_DEFINES
+    for enum_name in ("hbao_falloff", "hbao_integration"):
+        for key, value in header_enum(enum_name).items():
+            assert defines[f"{enum_name[5:].upper()}_{key}"] == value, key
+    epsilon = library_pattern(r"np_length > ([\d.e-]+)f;",
+                              "the normal-in-slice threshold (np_length > eps)")
+    assert defines["NORMAL_IN_SLICE_EPSILON"] == float(epsilon.group(1))
+
+
+def test_clamping_happens_once_and_says_so():
+    warnings = []
+    resolved = parameters.resolved({"steps": 500, "directions": 0, "blur_size": 7.6,
+                                    "strength": 20.0}, warnings)
+    assert resolved["steps"] == parameters.MAX_STEPS
+    assert resolved["directions"] == 1
+    assert resolved["blur_size"] == 8  # rounded, not clamped: no warning
+    assert resolved["strength"] == parameters.MAX_STRENGTH
+    assert sorted(warnings) == sorted([
+        "Steps 500 is above the limit 64; using 64",
+        "Directions 0 is below the limit 1; using 1",
+        "Strength 20 is above the limit 16; using 16"])
+    untouched = []
+    parameters.resolved(parameters.DEFAULTS, untouched)
+    assert untouched == []
+
+
+@pytest.mark.parametrize("params, message", [
+    ({"radius": float("nan")}, "Radius is not a number"),
+    ({"steps": float("inf")}, "Steps is not a number"),
+    ({"radius": -1.0}, "Radius -1 is negative"),
+    ({"falloff": "LINEAR"}, "falloff must be one of"),
+    ({"raduis": 1.0}, "unknown HBAO parameters: raduis"),
+])
+def test_unusable_values_are_rejected_with_their_name(params, message):
+    with pytest.raises(ValueError, match=message):
+        parameters.resolved(params)
