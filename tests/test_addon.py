@@ -271,7 +271,7 @@ def test_border_crop_render_matches_the_full_frame(run_in_blender, tmp_path):
     projected radius (there the crop has no samples beyond its edge). The
     add-on must describe the cropped view to the library; a camera that
     ignored the crop would misplace every position."""
-    width, height = 192, 128
+    width, height = 256, 128
     common = {"resolution": [width, height], "nodes": [{"radius": 0.15, "blur_size": 0}]}
     full_out, _ = render(run_in_blender, tmp_path, common, name="full")
     crop_out, _ = render(run_in_blender, tmp_path, dict(common, border=[0.25, 0.75, 0.25, 0.75]),
@@ -279,12 +279,14 @@ def test_border_crop_render_matches_the_full_frame(run_in_blender, tmp_path):
     full = node_outputs(full_out, 1)["ao"]
     crop = node_outputs(crop_out, 1)["ao"]
     assert crop.shape == (height // 2, width // 2)
-    # The border starts at pixel 48 from the left and row 32 from the top
-    # (multiples of 4: the 4x4 sampling pattern lines up). The radius
-    # projects to under 9 pixels here, so 12 pixels keep clear of the edge.
+    # The border starts at pixel 64 from the left and row 32 from the top and
+    # is 128 pixels wide: the library's sampling pattern repeats every 4 rows,
+    # and its blocks (16 pixels of a 64-pixel span share one step length, see
+    # docs/algorithm.md) line up with the full frame's. The radius projects to
+    # under 9 pixels here, so 12 pixels keep clear of the edge.
     margin = 12
     inner_crop = crop[margin:-margin, margin:-margin]
-    inner_full = full[32 + margin:32 + height // 2 - margin, 48 + margin:48 + width // 2 - margin]
+    inner_full = full[32 + margin:32 + height // 2 - margin, 64 + margin:64 + width // 2 - margin]
     assert inner_full.min() < 0.9  # there is occlusion to compare
     # Same depths, same pattern: equal up to float rounding of positions in
     # the shifted camera (1e-7 relative), far below a misplaced camera's
