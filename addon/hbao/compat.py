@@ -49,15 +49,55 @@ def version_message():
     return None
 
 
+def saved_image_settings(settings):
+    """[(name, value)] of the ImageFormatSettings `settings` that saving a
+    Render Result reads, as this version has them, in restoring order."""
+    return [(name, getattr(settings, name)) for name in SAVED_IMAGE_SETTINGS
+            if hasattr(settings, name)]
+
+
+def restore_image_settings(settings, saved):
+    """Put back what saved_image_settings() returned, in its order."""
+    for name, value in saved:
+        try:
+            setattr(settings, name, value)
+        except (TypeError, ValueError):
+            pass  # an enum value not valid for the restored format is re-derived
+
+
 def set_multilayer_exr(settings):
     """Make `settings` (ImageFormatSettings) save a single-part multilayer
-    OpenEXR, the layout libhbao_exr reads."""
+    OpenEXR, the layout libhbao_exr reads, with no preview image beside it."""
     if hasattr(settings, "media_type"):
         settings.media_type = "MULTI_LAYER_IMAGE"  # 5.0+: before file_format
     settings.file_format = "OPEN_EXR_MULTILAYER"
     if hasattr(settings, "use_exr_interleave"):
         # 5.0+ writes one part per pass unless told to interleave them.
         settings.use_exr_interleave = True
+    if hasattr(settings, "use_preview"):
+        settings.use_preview = False
+
+
+# The menu that lists the compositor's filter nodes: its name changed in 4.x.
+_FILTER_MENUS = ("NODE_MT_category_compositor_filter", "NODE_MT_category_CMP_FILTER")
+
+
+def compositor_filter_menu():
+    """The menu class Add > Filter of the compositor is, or None."""
+    for name in _FILTER_MENUS:
+        menu = getattr(bpy.types, name, None)
+        if menu is not None:
+            return menu
+    return None
+
+
+def settle_new_scene(scene):
+    """Bring a scene whose objects the add-on just linked up to date before a
+    render copies it: 5.3 crashes (BKE_view_layer_copy_data, in the render's
+    depsgraph) copying a scene made in a render handler whose view layer has
+    not yet been synced with its collection. Harmless before 5.3."""
+    for view_layer in scene.view_layers:
+        view_layer.update()
 
 
 def compositor_tree(scene):

@@ -20,10 +20,16 @@ def _render_result_image():
     return None
 
 
+# Environment variable naming the folder for the scratch EXR instead.
+SCRATCH_FOLDER_VARIABLE = "HBAO_TEMP_DIR"
+
+
 def _scratch_path():
     # Memory-backed where there is one: the file lives for milliseconds.
-    folder = "/dev/shm" if os.path.isdir("/dev/shm") and os.access("/dev/shm", os.W_OK) \
-        else tempfile.gettempdir()
+    folder = os.environ.get(SCRATCH_FOLDER_VARIABLE)
+    if not folder:
+        folder = "/dev/shm" if os.path.isdir("/dev/shm") and os.access("/dev/shm", os.W_OK) \
+            else tempfile.gettempdir()
     return os.path.join(folder, f"hbao-passes-{os.getpid()}-{threading.get_ident()}.exr")
 
 
@@ -34,23 +40,16 @@ def save_main_passes(main, path):
     if image is None:
         raise RuntimeError("Blender has no Render Result image to read the passes from")
     settings = main.render.image_settings
-    saved = [(name, getattr(settings, name)) for name in compat.SAVED_IMAGE_SETTINGS
-             if hasattr(settings, name)]
+    saved = compat.saved_image_settings(settings)
     try:
         compat.set_multilayer_exr(settings)
         settings.color_depth = "32"
         settings.exr_codec = "NONE"
-        if hasattr(settings, "use_preview"):
-            settings.use_preview = False
         image.save_render(path, scene=main)
     finally:
-        # In compat.SAVED_IMAGE_SETTINGS' order: the media type and format
-        # first, so that their options are valid when they are set.
-        for name, value in saved:
-            try:
-                setattr(settings, name, value)
-            except (TypeError, ValueError):
-                pass  # an enum value not valid for the restored format is re-derived
+        # The media type and format first, so that their options are valid
+        # when they are set; the user's PNG output stays PNG.
+        compat.restore_image_settings(settings, saved)
 
 
 def read_main_passes(main, jobs):

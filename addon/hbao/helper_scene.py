@@ -138,6 +138,8 @@ def scene_for_render(helper):
 
 def _ensure_helper_scene(scene):
     helper = helper_scene_of(scene)
+    # Objects linked or unlinked, or a new scene: it must settle before a render.
+    restructured = helper is None
     if helper is None:
         helper = bpy.data.scenes.new(HELPER_SCENE_PREFIX + scene.name)
         helper[MAIN_SCENE_KEY] = scene
@@ -163,11 +165,15 @@ def _ensure_helper_scene(scene):
     for camera in cameras:
         if helper.collection.objects.get(camera.name) != camera:
             helper.collection.objects.link(camera)
+            restructured = True
     if owner.camera is not None:
         set_if_different(helper, "camera", owner.camera)
     for obj in list(helper.collection.objects):
         if obj not in cameras:
             helper.collection.objects.unlink(obj)
+            restructured = True
+    if restructured:
+        compat.settle_new_scene(helper)
     return helper
 
 

@@ -200,22 +200,15 @@ def _draw_add_menu(menu, context):
     operator.use_transform = True
 
 
-# Menus that list the compositor's filter nodes, by Blender version.
-_FILTER_MENUS = ("NODE_MT_category_compositor_filter", "NODE_MT_category_CMP_FILTER")
-
-
 def register():
     bpy.utils.register_class(CompositorNodeHBAO)
-    for name in _FILTER_MENUS:
-        menu = getattr(bpy.types, name, None)
-        if menu is not None:
-            menu.append(_draw_add_menu)
-            break
+    menu = compat.compositor_filter_menu()
+    if menu is not None:
+        menu.append(_draw_add_menu)
 
 
 def unregister():
-    for name in _FILTER_MENUS:
-        menu = getattr(bpy.types, name, None)
-        if menu is not None:
-            menu.remove(_draw_add_menu)
+    menu = compat.compositor_filter_menu()
+    if menu is not None:
+        menu.remove(_draw_add_menu)
     bpy.utils.unregister_class(CompositorNodeHBAO)
