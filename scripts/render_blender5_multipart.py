@@ -17,7 +17,6 @@ Result, so both files hold the very same pixels:
 each with its NAME.camera.json, the camera as `hbao --camera` reads it.
 """
 import argparse
-import importlib.util
 import json
 import math
 import sys
@@ -38,13 +37,11 @@ FIXTURES = (
 
 
 def camera_from_blender(scene):
-    """The add-on's reading of the camera (addon/hbao/camera.py needs no
-    add-on package around it), so the JSON matches what the add-on uses."""
-    path = REPO / "addon" / "hbao" / "camera.py"
-    spec = importlib.util.spec_from_file_location("hbao_camera_model", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module.camera_from_blender(scene)
+    """The add-on's reading of the camera (the add-on's bpy-free camera
+    module), so the JSON matches what the add-on uses."""
+    sys.path.insert(0, str(REPO / "addon"))
+    from hbao import camera
+    return camera.camera_from_blender(scene)
 
 
 def build_scene():

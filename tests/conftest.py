@@ -53,6 +53,15 @@ def built_library():
 
 
 @pytest.fixture(scope="session")
+def native(built_library):
+    """The add-on's ctypes binding of libhbao, on this build's library."""
+    os.environ["HBAO_LIBRARY"] = str(built_library)
+    from hbao import native as module
+    module.unload_library()
+    return module
+
+
+@pytest.fixture(scope="session")
 def hbao_tool():
     if not TOOL.exists():
         pytest.fail(f"{TOOL} missing: build with scripts/test.sh or cmake first")

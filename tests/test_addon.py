@@ -2,10 +2,8 @@
 """The HBAO compositor node in real headless Blender renders (Cycles CPU,
 96x64, few samples): tests/blender_scripts/addon_render.py builds the scene,
 this file checks the EXRs Blender wrote."""
-import importlib.util
 import json
 import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -36,25 +34,8 @@ CYCLES_BACKGROUND_DEPTH = 1e9
 pytestmark = pytest.mark.matrix
 
 
-def _load(name, path):
-    spec = importlib.util.spec_from_file_location(name, path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-# The add-on imports as a package without Blender (conftest could do this once).
-sys.path.insert(0, str(REPO / "addon"))
-from hbao import exr_passes as exr  # noqa: E402
-
-
-@pytest.fixture(scope="module")
-def native(built_library):
-    import os
-    os.environ["HBAO_LIBRARY"] = str(built_library)
-    from hbao import native as module
-    module.unload_library()
-    return module
+from hbao import exr_passes as exr  # noqa: E402  (conftest puts addon/ on sys.path)
+from hbao import parameters as PARAMETERS  # noqa: E402
 
 
 def render(run_in_blender, tmp_path, spec, env=None, name="render"):
@@ -95,9 +76,6 @@ def library_ao(native, out, frame, params, with_normal=True, layer="ViewLayer"):
     depth, normal = frame_passes(out, frame, layer)
     return native.compute_ao(depth, normal if with_normal else None, params=params,
                              camera=camera(out, frame))
-
-
-PARAMETERS = _load("hbao_parameters_under_test", REPO / "addon" / "hbao" / "parameters.py")
 
 
 def node_params(**overrides):
@@ -249,7 +227,7 @@ def test_animation_renders_every_frame_at_its_keyframed_radius(
         "save_blend": str(blend), "frames": [1, 2],
         "nodes": [{"keyframes": [[1, 0.15], [2, 1.2]], "blur_size": 0}]}, name="setup")
     command = blender.command(blend=blend, output=out / "frame_####", animation=(1, 2))
-    completed = run_command(command, blender_user_scripts)
+    run_command(command, blender_user_scripts)
     setup = tmp_path / "setup"
     ao = {}
     for frame, radius in ((1, 0.15), (2, 1.2)):

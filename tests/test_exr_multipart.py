@@ -9,7 +9,6 @@ part (use_exr_interleave), and multi-part half-float PIZ. OpenEXR's own tools
 make the files the reader must refuse, so no EXR is parsed or written by hand
 here.
 """
-import importlib.util
 import json
 import os
 import random
@@ -20,7 +19,7 @@ import subprocess
 import numpy as np
 import pytest
 
-from conftest import FIXTURES, REPO, SCRIPTS
+from conftest import FIXTURES, REPO
 
 MULTIPART = "blender5_cycles_multipart"
 INTERLEAVED = "blender5_cycles_multipart_interleaved"
@@ -44,15 +43,7 @@ FUZZ_CASES = 200
 HEADER_BYTES = 1500
 
 
-def _load_binding():
-    spec = importlib.util.spec_from_file_location(
-        "hbao_exr_binding_multipart", SCRIPTS.parent / "addon" / "hbao" / "exr_passes.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-exr = _load_binding()
+from hbao import exr_passes as exr  # noqa: E402  (conftest puts addon/ on sys.path)
 
 
 # --- helpers -----------------------------------------------------------------

@@ -11,7 +11,7 @@ import zipfile
 import numpy as np
 import pytest
 
-from conftest import REPO, blenders, run_command
+from conftest import REPO, run_command
 
 pytestmark = pytest.mark.matrix
 SCRIPTS = REPO / "tests" / "blender_scripts"

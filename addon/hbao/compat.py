@@ -68,9 +68,7 @@ def restore_image_settings(settings, saved):
 def set_multilayer_exr(settings):
     """Make `settings` (ImageFormatSettings) save a single-part multilayer
     OpenEXR, the layout libhbao_exr reads, with no preview image beside it."""
-    if hasattr(settings, "media_type"):
-        settings.media_type = "MULTI_LAYER_IMAGE"  # 5.0+: before file_format
-    settings.file_format = "OPEN_EXR_MULTILAYER"
+    set_image_format(settings, "OPEN_EXR_MULTILAYER")
     if hasattr(settings, "use_exr_interleave"):
         # 5.0+ writes one part per pass unless told to interleave them.
         settings.use_exr_interleave = True
@@ -78,8 +76,11 @@ def set_multilayer_exr(settings):
         settings.use_preview = False
 
 
-# The menu that lists the compositor's filter nodes: its name changed in 4.x.
-_FILTER_MENUS = ("NODE_MT_category_compositor_filter", "NODE_MT_category_CMP_FILTER")
+# The menu that lists the compositor's filter nodes: 3.4 generates
+# NODE_MT_category_CMP_OP_FILTER from its node categories; 4.x/5.x name it
+# NODE_MT_category_compositor_filter.
+_FILTER_MENUS = ("NODE_MT_category_compositor_filter", "NODE_MT_category_CMP_OP_FILTER",
+                 "NODE_MT_category_CMP_FILTER")
 
 
 def compositor_filter_menu():
