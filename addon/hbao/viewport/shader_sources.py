@@ -42,10 +42,10 @@ bool is_background(float z)
 }
 """
 
-AO_FRAGMENT = COMMON + """
-/* The interleaved 4x4 pattern of docs/algorithm.md. */
-const int PATTERN[16] = int[16](0, 8, 2, 10, 12, 4, 14, 6, 3, 11, 1, 9, 15, 7, 13, 5);
-
+# Depth, position and reconstructed normal of pixel (i, j) (j from the top):
+# the AO pass and the blur's normal weight use the same normals
+# (docs/algorithm.md, "Normals" and "After sampling").
+NORMALS = """
 float depth_at(ivec2 p)
 {
     return texelFetch(depth_texture, ivec2(p.x, image_size.y - 1 - p.y), 0).r;
@@ -95,6 +95,12 @@ vec3 reconstructed_normal(ivec2 p, float z, vec3 position, vec3 view)
     n /= len;
     return dot(n, view) < 0.0 ? -n : n;
 }
+
+"""
+
+AO_FRAGMENT = COMMON + NORMALS + """
+/* The interleaved 4x4 pattern of docs/algorithm.md. */
+const int PATTERN[16] = int[16](0, 8, 2, 10, 12, 4, 14, 6, 3, 11, 1, 9, 15, 7, 13, 5);
 
 /* Cosine-weighted visibility of a half slice from V up to angle h. */
 float slice_visibility(float h, float gamma)
@@ -232,7 +238,16 @@ void main()
 # One separable pass of the cross-bilateral blur (docs/algorithm.md, "After
 # sampling", 2); `blur_step` is (1, 0) for rows, (0, 1) for columns. Direction along
 # the rows does not matter (the kernel is symmetric), so it works bottom-up.
-BLUR_FRAGMENT = COMMON + """
+BLUR_FRAGMENT = COMMON + NORMALS + """
+/* The normal the AO pass used at texel t (bottom-up rows). */
+vec3 guide_normal(ivec2 t, float z)
+{
+    ivec2 p = ivec2(t.x, image_size.y - 1 - t.y);
+    vec3 position = position_at(p, z);
+    vec3 view = perspective != 0 ? normalize(-position) : vec3(0.0, 0.0, 1.0);
+    return reconstructed_normal(p, z, position, view);
+}
+
 void main()
 {
     ivec2 p = ivec2(gl_FragCoord.xy);
@@ -241,24 +256,29 @@ void main()
         frag_output = vec4(1.0, 0.0, 0.0, 1.0);
         return;
     }
+    vec3 nc = guide_normal(p, zc);
+    float factor = min(sharpness / zc, 3.40282347e38);
     float sigma = float(kernel_radius + 1) * 0.5;
-    float sum = 0.0;
-    float weight_sum = 0.0;
+    /* The centre weighs 1. */
+    float sum = texelFetch(ao_texture, p, 0).r;
+    float weight_sum = 1.0;
     for (int x = -kernel_radius; x <= kernel_radius; x++) {
         ivec2 q = p + x * blur_step;
-        if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, image_size))) {
+        if (x == 0 || any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, image_size))) {
             continue;
         }
         float zq = texelFetch(depth_texture, q, 0).r;
         if (is_background(zq)) {
             continue;
         }
-        float edge = sharpness * abs(zq - zc) / zc;
-        float w = exp(-float(x * x) / (2.0 * sigma * sigma) - edge * edge);
+        float difference = (zq - zc) * factor;
+        float bend = max(1.0 - dot(guide_normal(q, zq), nc), 0.0);
+        float w = exp(-float(x * x) / (2.0 * sigma * sigma))
+                * exp(-(difference * difference) - NORMAL_SHARPNESS * bend);
         sum += w * texelFetch(ao_texture, q, 0).r;
         weight_sum += w;
     }
-    frag_output = vec4(weight_sum > 0.0 ? sum / weight_sum : 1.0, 0.0, 0.0, 1.0);
+    frag_output = vec4(sum / weight_sum, 0.0, 0.0, 1.0);
 }
 """
 
@@ -286,4 +306,9 @@ AO_DEFINES = {
     "INTEGRATION_COSINE": 1,
     # csrc/lib/horizon.c: a projected normal shorter than this has no slice angle.
     "NORMAL_IN_SLICE_EPSILON": 1e-6,
+}
+
+# csrc/lib/internal_finish.h: HBAO_BLUR_NORMAL_SHARPNESS, the blur's normal weight.
+BLUR_DEFINES = {
+    "NORMAL_SHARPNESS": 16.0,
 }

@@ -38,9 +38,11 @@ _DEFINITIONS = {
         shader_sources.AO_DEFINES),
     "blur": lambda: _create_info(
         shader_sources.BLUR_FRAGMENT,
-        [("IVEC2", "image_size"), ("IVEC2", "blur_step"), ("INT", "kernel_radius"),
+        [("IVEC2", "image_size"), ("VEC2", "pixel_size"), ("VEC2", "origin"),
+         ("INT", "perspective"), ("IVEC2", "blur_step"), ("INT", "kernel_radius"),
          ("FLOAT", "sharpness"), ("FLOAT", "background_depth")],
-        ["depth_texture", "ao_texture"]),
+        ["depth_texture", "ao_texture"],
+        shader_sources.BLUR_DEFINES),
     "composite": lambda: _create_info(
         shader_sources.COMPOSITE_FRAGMENT,
         [("IVEC2", "pixel_offset"), ("FLOAT", "strength")],
