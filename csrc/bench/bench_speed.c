@@ -143,8 +143,9 @@ static int parse_implementations(const char *list, int wanted[COLUMN_COUNT]) {
 
 static void usage(const char *program) {
     fprintf(stderr,
-            "usage: %s [--runs N] [--implementations LIST] [--no-4k] [--radius R]\n"
-            "  LIST: comma-separated scalar,avx2,avx512 (default: all this CPU has)\n",
+            "usage: %s [--runs N] [--implementations LIST] [--no-4k] [--quick] [--radius R]\n"
+            "  LIST: comma-separated scalar,avx2,avx512 (default: all this CPU has)\n"
+            "  --quick: --runs 3 --no-4k\n",
             program);
 }
 
@@ -157,6 +158,10 @@ int main(int argc, char **argv) {
         if (!strcmp(argv[a], "--runs") && a + 1 < argc) runs = atoi(argv[++a]);
         else if (!strcmp(argv[a], "--radius") && a + 1 < argc) radius = (float)atof(argv[++a]);
         else if (!strcmp(argv[a], "--no-4k")) with_4k = 0;
+        else if (!strcmp(argv[a], "--quick")) { /* the README's quick look */
+            runs = 3;
+            with_4k = 0;
+        }
         else if (!strcmp(argv[a], "--implementations") && a + 1 < argc) {
             if (!parse_implementations(argv[++a], wanted)) {
                 usage(argv[0]);
