@@ -310,5 +310,5 @@ AO_DEFINES = {
 
 # csrc/lib/internal_finish.h: HBAO_BLUR_NORMAL_SHARPNESS, the blur's normal weight.
 BLUR_DEFINES = {
-    "NORMAL_SHARPNESS": 16.0,
+    "NORMAL_SHARPNESS": 8.0,
 }
