@@ -24,7 +24,8 @@
 #define HBAO_BLUR_NORMAL_SHARPNESS 8.0f
 
 /* The loops of these stages are plain C written to auto-vectorize (the
- * blur's tap loop in GCC vector types, 16 lanes); each is compiled three times (baseline, AVX2, AVX-512) and the copy matching
+ * blur's tap loop in GCC vector types, 16 lanes); each is compiled three
+ * times (baseline, AVX2, AVX-512) and the copy matching
  * params.implementation runs, so that the scalar column of the benchmark is
  * the portable code and the tests compare every copy. Their operations are
  * element-wise and never contracted into FMAs (ISO C mode; clang is told
