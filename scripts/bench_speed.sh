@@ -7,7 +7,8 @@
 # (scalar on 1 thread, AVX2 and AVX-512 on 1 and 2 threads), the blur's share
 # and the targets beside the medians. With the default 5 runs it takes a few
 # minutes, most of it in the scalar column.
-#   scripts/bench_speed.sh [--runs N] [--implementations scalar,avx2,avx512] [--no-4k] [--radius R]
+#   scripts/bench_speed.sh [--runs N] [--implementations scalar,avx2,avx512] [--no-4k] [--quick]
+#                          [--radius R]      (--quick = --runs 3 --no-4k)
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 "$REPO/scripts/setup.sh"

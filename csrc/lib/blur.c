@@ -25,7 +25,9 @@
 
 /* Bands per thread: enough that a thread that falls behind (background rows
  * are cheap, geometry is not) is evened out by the row queue (parallel.c);
- * few enough that the 2r rows a band recomputes stay a small share. */
+ * few enough that the 2r rows a band recomputes stay a small share. A band
+ * is at least MIN_BAND_ROWS high, so that on small images or many threads it
+ * does not spend most of its time remaking its neighbours' rows. */
 #define BANDS_PER_THREAD 8
 #define MIN_BAND_ROWS 16
 
@@ -76,10 +78,10 @@ typedef struct centre_row {
  * 0 on background, with factor = min(sharpness / zc, FLT_MAX): sharpness / zc
  * overflows for tiny depths (below ~1e-37, denormals), and an infinite
  * factor would turn a tap at the same depth into 0 * inf = NaN; capped, a
- * tap whose scaled difference overflows weighs 0. A 0/1
- * factor rather than a branch marks background; the weight is finite, so
- * the product is exact. The vector loop below performs exactly these
- * operations lane by lane. Background centres give 1. */
+ * tap whose scaled difference overflows weighs 0. A 0/1 factor rather than a
+ * branch marks background; the weight is finite, so the product is exact.
+ * The vector loop below performs exactly these operations lane by lane.
+ * Background centres give 1. */
 static HBAO_ALWAYS_INLINE float blur_pixel(const tap_set *taps, const centre_row *c, float sharpness,
                                            int width, int i) {
     const float zc = c->z[i];

@@ -27,18 +27,13 @@ static HBAO_ALWAYS_INLINE void add_candidate(float bilinear, float zs, float ao,
     for (int c = 0; c < 3; c++) nearest_normal[c] = nearer ? normal[c] : nearest_normal[c];
 }
 
-/* One full-resolution row; candidates in the order (left, top), (right,
- * top), (left, bottom), (right, bottom). Even pixels sit on a half-grid
- * column and odd ones between two, so each gets its own loop over the half
- * columns k: every access to the half grid is then contiguous and both loops
- * vectorize. A candidate with bilinear weight 0 adds nothing, so even pixels
- * skip the right-hand column.
- * The guide normal is the candidates' normals averaged with the AO's weights
- * and normalised: a weighted mean rather than the nearest candidate's, so
- * that it does not jump where two candidates are about equally near in depth
- * (at a crease); there it lies between the faces and the blur leaves the
- * pixel nearly alone. Without weight it falls back like the AO: to the
- * candidate nearest in depth, or the top-left one's if none is usable. */
+/* One pixel's AO and guide normal from its candidates' sums. The guide
+ * normal is the candidates' normals averaged with the AO's weights and
+ * normalised: a weighted mean rather than the nearest candidate's, so that
+ * it does not jump where two candidates are about equally near in depth (at
+ * a crease); there it lies between the faces and the blur leaves the pixel
+ * nearly alone. Without weight it falls back like the AO: to the candidate
+ * nearest in depth, or the top-left one's if none is usable. */
 static HBAO_ALWAYS_INLINE void finish_pixel(float z, float sum, float weight_sum, float nearest_ao,
                                             const float normal_sum[3],
                                             const float nearest_normal[3], float *out, float *nx,
@@ -56,6 +51,13 @@ static HBAO_ALWAYS_INLINE void finish_pixel(float z, float sum, float weight_sum
     *nz = averaged ? normal_sum[2] * inverse : nearest_normal[2];
 }
 
+/* One full-resolution row; candidates in the order (left, top), (right,
+ * top), (left, bottom), (right, bottom). Even pixels sit on a half-grid
+ * column and odd ones between two, so each gets its own loop over the half
+ * columns k: every access to the half grid is then contiguous and both loops
+ * vectorize. A candidate with bilinear weight 0 adds nothing, so even pixels
+ * skip the right-hand column (and rows without a row below, see
+ * upsample_row, skip the bottom candidates). */
 static HBAO_ALWAYS_INLINE void upsample_rows(const hbao_grid *half, const float *half_ao,
                                              const float *full_depth, int width, int j,
                                              int two_rows, float *restrict out,
