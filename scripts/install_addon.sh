@@ -4,8 +4,14 @@
 # lib/libhbao.so and lib/libhbao_exr.so) into the current user's Blender
 # add-ons folder, enables it and saves the preferences.
 #   scripts/install_addon.sh            (BLENDER=/path/to/blender to choose one)
+# With BLENDER_USER_SCRIPTS set (an add-ons folder of your choosing), the
+# preferences go beside it, to $BLENDER_USER_SCRIPTS/config, unless
+# BLENDER_USER_CONFIG says where: never into the real user's preferences.
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+if [ -n "${BLENDER_USER_SCRIPTS:-}" ] && [ -z "${BLENDER_USER_CONFIG:-}" ]; then
+    export BLENDER_USER_CONFIG="$BLENDER_USER_SCRIPTS/config"
+fi
 BUILD="${HBAO_BUILD_DIR:-$REPO/build}"
 BLENDER="${BLENDER:-blender}"
 # shellcheck source=addon_files.sh

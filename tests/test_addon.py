@@ -361,13 +361,18 @@ def test_package_and_install(tmp_path):
                      "hbao/lib/libhbao.so"):
         assert expected in names
     env = blender_environment(tmp_path / "scripts")
-    env["BLENDER_USER_CONFIG"] = str(tmp_path / "config")  # never the real user's prefs
+    # Only the scripts folder is given: the preferences must go beside it, not
+    # into the user's (a HOME of its own shows anything written there).
+    env.pop("BLENDER_USER_CONFIG")
+    env["HOME"] = str(tmp_path / "home")
     env.pop("HBAO_LIBRARY")  # the installed copy must find its own lib/libhbao.so
     completed = subprocess.run([str(REPO / "scripts" / "install_addon.sh")], env=env,
                                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     assert completed.returncode == 0, completed.stdout
     assert (tmp_path / "scripts" / "addons" / "hbao" / "lib" / "libhbao.so").exists()
-    assert (tmp_path / "config" / "userpref.blend").exists()
+    assert (tmp_path / "scripts" / "config" / "userpref.blend").exists()
+    assert not any((tmp_path / "home").rglob("userpref.blend"))
+    env["BLENDER_USER_CONFIG"] = str(tmp_path / "scripts" / "config")
     check = subprocess.run(
         [BLENDER, "-b", "--python-expr",
          "import bpy, hbao.native as n; print('ENABLED', 'hbao' in "
