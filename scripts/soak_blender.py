@@ -54,6 +54,8 @@ RSS_BASELINE_FRAME = 10
 # frames is 0.2 MiB a frame; one 96x64 frame's passes are about 0.5 MiB, so a
 # leak of a frame's buffers every frame would exceed it within ~100 frames.
 RSS_GROWTH_LIMIT_MIB = 50.0
+# The report traces RSS at about this many evenly spaced frames.
+TRACE_POINTS = 5
 # Frames compared for steadiness of time (the first and the last this many).
 STEADY_WINDOW = 10
 # The last frames' median CPU time per frame may be at most this multiple of
@@ -63,6 +65,8 @@ CPU_SLOWDOWN_LIMIT = 2.0
 # Generous: a frame takes well under a second; a hang must still end the run.
 SECONDS_PER_FRAME_LIMIT = 30
 SCRATCH_GLOB = "hbao-passes-{pid}-*"
+# The report names the first few other things left in the temp folder.
+SHOWN_LEFTOVERS = 3
 PROBE_LINE = re.compile(r"^HBAO-SOAK frame=(\d+) (.*)$")
 HOOK_LINE = re.compile(r"^HBAO: (\d+) AO pass\(es\) \d+x\d+ in (\d+) ms: AO (\d+) ms")
 MIB = 1024.0
@@ -97,9 +101,12 @@ def environment(root):
     return env, temp
 
 
-def save_scene(blender, env, blend, frames, output):
+def save_scene(blender, env, blend, frames, output, control=False):
+    """The test scene; `control`: its HBAO node muted, so the render hook runs
+    but computes nothing (a scene without the node has no Composite node)."""
     spec = {"resolution": list(RESOLUTION), "samples": SAMPLES, "save_blend": str(blend),
-            "nodes": [{"keyframes": [[1, RADIUS_FIRST], [frames, RADIUS_LAST]]}]}
+            "nodes": [{"keyframes": [[1, RADIUS_FIRST], [frames, RADIUS_LAST]],
+                       "mute": control}]}
     command = blender.command(SCENE_SCRIPT, [json.dumps(spec), output])
     completed = subprocess.run(command, env=env, stdout=subprocess.PIPE,
                                stderr=subprocess.STDOUT, text=True, timeout=600)
@@ -137,6 +144,8 @@ def run_render(command, env, frames, log_path):
                 samples.append({"frame": int(match.group(1)),
                                 "rss_kib": int(fields["rss_kib"]),
                                 "hwm_kib": int(fields["hwm_kib"]),
+                                "anon_kib": int(fields["anon_kib"]),
+                                "swap_kib": int(fields["swap_kib"]),
                                 "cpu_s": float(fields["cpu_s"]),
                                 "pre_cpu_s": float(fields["pre_cpu_s"]),
                                 "pre_s": float(fields["pre_s"]),
@@ -195,6 +204,15 @@ def median(values):
     return statistics.median(values) if values else float("nan")
 
 
+def slope(xs, ys):
+    """Least-squares slope of ys over xs: growth per frame, robust to one odd sample."""
+    if len(xs) < 2:
+        return float("nan")
+    mean_x, mean_y = statistics.fmean(xs), statistics.fmean(ys)
+    spread = sum((x - mean_x) ** 2 for x in xs)
+    return sum((x - mean_x) * (y - mean_y) for x, y in zip(xs, ys)) / spread
+
+
 def figures(samples, frames):
     by_frame = {s["frame"]: s for s in samples}
     ordered = [by_frame[f] for f in sorted(by_frame)]
@@ -207,9 +225,28 @@ def figures(samples, frames):
         cpu.append(sample["cpu_s"] - (previous["cpu_s"] if previous else sample["pre_cpu_s"]))
     baseline = by_frame.get(RSS_BASELINE_FRAME)
     last = by_frame.get(frames)
-    growth = (last["rss_kib"] - baseline["rss_kib"]) / MIB if baseline and last else float("nan")
+
+    def growth_mib(key):
+        return (last[key] - baseline[key]) / MIB if baseline and last else float("nan")
+
+    growth = growth_mib("rss_kib")
     span = frames - RSS_BASELINE_FRAME
+    steady = [s for s in ordered if s["frame"] >= RSS_BASELINE_FRAME]
+    every = max(1, frames // TRACE_POINTS)
+    trace = [f for f in sorted(set([1, RSS_BASELINE_FRAME, frames]
+                                   + list(range(every, frames, every))))
+             if f in by_frame]
+    second_half = [s for s in ordered if s["frame"] > frames // 2]
     return {
+        "rss_trace": ", ".join(f"{f}: {by_frame[f]['rss_kib'] / MIB:.0f}" for f in trace),
+        "anon_baseline_mib": baseline["anon_kib"] / MIB if baseline else float("nan"),
+        "anon_last_mib": last["anon_kib"] / MIB if last else float("nan"),
+        "anon_growth_mib": growth_mib("anon_kib"),
+        "anon_slope_kib": slope([s["frame"] for s in steady], [s["anon_kib"] for s in steady]),
+        "rss_slope_kib": slope([s["frame"] for s in steady], [s["rss_kib"] for s in steady]),
+        "anon_slope_late_kib": slope([s["frame"] for s in second_half],
+                                     [s["anon_kib"] for s in second_half]),
+        "swap_max_mib": max(s["swap_kib"] for s in ordered) / MIB if ordered else float("nan"),
         "rss_first_mib": ordered[0]["rss_kib"] / MIB if ordered else float("nan"),
         "rss_baseline_mib": baseline["rss_kib"] / MIB if baseline else float("nan"),
         "rss_last_mib": last["rss_kib"] / MIB if last else float("nan"),
@@ -228,10 +265,14 @@ def figures(samples, frames):
 def leftovers(pid, temp):
     """Scratch files of the render's process, and anything else left in its temp folder."""
     scratch = []
-    for folder in (Path("/dev/shm"), temp):
+    folders = [Path("/dev/shm"), temp]
+    if os.environ.get("HBAO_TEMP_DIR"):  # the add-on's override of its scratch folder
+        folders.append(Path(os.environ["HBAO_TEMP_DIR"]))
+    for folder in folders:
         if folder.is_dir() and pid is not None:
             scratch += [str(p) for p in folder.glob(SCRATCH_GLOB.format(pid=pid))]
-    other = [str(p) for p in temp.rglob("*") if str(p) not in scratch]
+    other = [str(p.relative_to(temp)) + ("/" if p.is_dir() else "")
+             for p in temp.rglob("*") if str(p) not in scratch]
     return sorted(scratch), sorted(other)
 
 
@@ -242,13 +283,14 @@ def shown(command):
     return text.replace(str(REPO) + "/", "")
 
 
-def report(blender, frames, command, elapsed, returncode, fig, hook_ms, messages, missing, bad,
-           means, scratch, other, failures):
-    radius_trend = ""
+def report(blender, frames, control, command, elapsed, returncode, fig, hook_ms, messages,
+           missing, bad, means, scratch, other, failures):
+    radius_trend = "not checked"
     if 1 in means and frames in means:
         radius_trend = f"{means[1]:.4f} (frame 1) to {means[frames]:.4f} (frame {frames})"
     lines = [
-        f"### Animation render: {blender.name}, {frames} frames",
+        f"### Animation render: {blender.name}, {frames} frames"
+        + (" (control: HBAO node muted)" if control else ""),
         "",
         f"Command (WORK a fresh temp folder): `{shown(command)}`",
         "",
@@ -262,7 +304,14 @@ def report(blender, frames, command, elapsed, returncode, fig, hook_ms, messages
         f"(max {fig['rss_max_mib']:.1f}, peak VmHWM {fig['hwm_last_mib']:.1f}): growth "
         f"{fig['rss_growth_mib']:+.2f} MiB from frame {RSS_BASELINE_FRAME} to {frames}, "
         f"{fig['rss_growth_per_frame_kib']:+.1f} KiB per frame (limit "
-        f"{RSS_GROWTH_LIMIT_MIB:.0f} MiB).",
+        f"{RSS_GROWTH_LIMIT_MIB:.0f} MiB); least-squares slope from frame "
+        f"{RSS_BASELINE_FRAME} on {fig['rss_slope_kib']:+.1f} KiB per frame.",
+        f"- RSS by frame (MiB): {fig['rss_trace']}.",
+        f"- RssAnon (private memory, what a leak grows): {fig['anon_baseline_mib']:.1f} MiB at "
+        f"frame {RSS_BASELINE_FRAME}, {fig['anon_last_mib']:.1f} MiB at frame {frames}: growth "
+        f"{fig['anon_growth_mib']:+.2f} MiB (same limit), slope {fig['anon_slope_kib']:+.1f} KiB "
+        f"per frame, {fig['anon_slope_late_kib']:+.2f} KiB per frame over the second half; "
+        f"swap used at most {fig['swap_max_mib']:.1f} MiB.",
         f"- Wall time per frame: median {fig['wall_median_s'] * 1000:.0f} ms; first "
         f"{STEADY_WINDOW} {fig['wall_first_s'] * 1000:.0f} ms, last {STEADY_WINDOW} "
         f"{fig['wall_last_s'] * 1000:.0f} ms (medians).",
@@ -279,7 +328,8 @@ def report(blender, frames, command, elapsed, returncode, fig, hook_ms, messages
         f"nodes_NNNN.exr); {len(bad)} File Output AO invalid or not computed; mean AO "
         f"{radius_trend}.",
         f"- Left behind: {len(scratch)} hbao-passes scratch file(s) of the render's process; "
-        f"{len(other)} other file(s) in its private temp folder.",
+        f"{len(other)} other file(s) or folder(s) in its private temp folder"
+        + (f" ({', '.join(other[:SHOWN_LEFTOVERS])})." if other else "."),
         f"- Add-on messages other than its per-frame timing: {len(messages)}.",
         "",
         "**Result: " + ("PASS**" if not failures else "FAIL**: " + "; ".join(failures)),
@@ -296,6 +346,12 @@ def main(argv=None):
                              "e.g. bpy-5.0")
     parser.add_argument("--report", type=Path, help="write the Markdown section here")
     parser.add_argument("--keep", action="store_true", help="keep the work folder")
+    parser.add_argument("--control", action="store_true",
+                        help="the same render with the HBAO node muted: Blender's and the "
+                             "hook's own memory and time, without the AO computation")
+    parser.add_argument("--inject-leak-kib", type=int, default=0,
+                        help="self-test: leak this many KiB per frame in the render process "
+                             "(the memory check must then fail)")
     options = parser.parse_args(argv)
     if options.frames <= RSS_BASELINE_FRAME:
         parser.error(f"--frames must be more than {RSS_BASELINE_FRAME}")
@@ -308,17 +364,22 @@ def main(argv=None):
     root = Path(tempfile.mkdtemp(prefix="hbao-soak-blender-"))
     try:
         env, temp = environment(root)
+        env["HBAO_SOAK_INJECT_LEAK_KIB"] = str(options.inject_leak_kib)
         output = root / "frames"
         output.mkdir()
         blend = root / "soak.blend"
         print(f"soak: {blender.name}: saving the scene, then rendering {options.frames} frames "
               f"in {root}", flush=True)
-        save_scene(blender, env, blend, options.frames, output)
+        save_scene(blender, env, blend, options.frames, output, options.control)
         command = render_command(blender, blend, options.frames, output)
         returncode, samples, hook_ms, messages, pid, elapsed = run_render(
             command, env, options.frames, root / "render.log")
         scratch, other = leftovers(pid, temp)
         missing, bad, means = check_outputs(tool, output, options.frames)
+        expected_computations = options.frames
+        if options.control:
+            # A muted node passes its Image through and computes no AO.
+            bad, means, expected_computations = [], {}, 0
         fig = figures(samples, options.frames)
 
         failures = []
@@ -326,10 +387,14 @@ def main(argv=None):
             failures.append(f"exit status {returncode} (log: {root / 'render.log'})")
         if fig["frames_probed"] != options.frames:
             failures.append(f"{fig['frames_probed']} frames reported, {options.frames} expected")
-        if len(hook_ms) != options.frames:
-            failures.append(f"{len(hook_ms)} AO computations logged, {options.frames} expected")
+        if len(hook_ms) != expected_computations:
+            failures.append(f"{len(hook_ms)} AO computations logged, "
+                            f"{expected_computations} expected")
         if not fig["rss_growth_mib"] <= RSS_GROWTH_LIMIT_MIB:
             failures.append(f"RSS grew {fig['rss_growth_mib']:.1f} MiB "
+                            f"(limit {RSS_GROWTH_LIMIT_MIB:.0f})")
+        if not fig["anon_growth_mib"] <= RSS_GROWTH_LIMIT_MIB:
+            failures.append(f"RssAnon grew {fig['anon_growth_mib']:.1f} MiB "
                             f"(limit {RSS_GROWTH_LIMIT_MIB:.0f})")
         if not fig["cpu_last_s"] <= CPU_SLOWDOWN_LIMIT * fig["cpu_first_s"]:
             failures.append("CPU time per frame grew beyond "
@@ -346,9 +411,10 @@ def main(argv=None):
         if messages:
             failures.append(f"the add-on reported: {messages[0]}")
         # Blender's own files in the temp folder are shown, not failed: they
-        # are not the add-on's (none were seen in our runs).
-        text = report(blender, options.frames, command, elapsed, returncode, fig, hook_ms,
-                      messages, missing, bad, means, scratch, other, failures)
+        # are not the add-on's (bpy leaves its empty blender_XXXXXX session
+        # folders: bpy_blender.py ends with os._exit, skipping its clean-up).
+        text = report(blender, options.frames, options.control, command, elapsed, returncode,
+                      fig, hook_ms, messages, missing, bad, means, scratch, other, failures)
         print(text, flush=True)
         if options.report:
             options.report.parent.mkdir(parents=True, exist_ok=True)
