@@ -23,6 +23,7 @@ import argparse
 import json
 import os
 import re
+import shlex
 import shutil
 import statistics
 import subprocess
@@ -278,8 +279,8 @@ def leftovers(pid, temp):
 
 def shown(command):
     """The command line with the work folder as WORK and the checkout's paths relative."""
-    text = " ".join(str(c) for c in command)
-    text = re.sub(r"\S*/hbao-soak-blender-[^/\s]+", "WORK", text)
+    text = shlex.join(str(c) for c in command)
+    text = re.sub(r"[^\s']*/hbao-soak-blender-[^/\s']+", "WORK", text)
     return text.replace(str(REPO) + "/", "")
 
 
