@@ -22,15 +22,15 @@ RUNS=1000
 BLENDER_NAME=blender
 REPORT="$REPO/out/soak/report.md"
 
-usage() { sed -n '9,14p' "$0" | sed 's/^# \{0,1\}//'; exit 2; }
+usage() { sed -n '10,13p' "$0" | sed 's/^# \{0,1\}//'; exit "$1"; }
 while [ $# -gt 0 ]; do
     case "$1" in
         --frames) FRAMES="$2"; shift 2 ;;
         --runs) RUNS="$2"; shift 2 ;;
         --blender) BLENDER_NAME="$2"; shift 2 ;;
         --report) REPORT="$2"; shift 2 ;;
-        -h|--help) usage ;;
-        *) echo "soak.sh: unknown option $1" >&2; usage ;;
+        -h|--help) usage 0 ;;
+        *) echo "soak.sh: unknown option $1" >&2; usage 2 ;;
     esac
 done
 [ -x /usr/bin/time ] || { echo "soak.sh: GNU time missing: apt-get install time" >&2; exit 2; }
