@@ -61,15 +61,15 @@ class Blender:
             command = [self.executable]
             if not ui:
                 command.append("-b")
-            if blend is not None:
-                command.append(str(blend))
             command += ["--factory-startup", "-noaudio"]
         else:
             command = [self.executable, str(BPY_RUNNER)]
-            if blend is not None:
-                command.append(str(blend))
+        # Add-ons before the file, as an artist's preferences would have them:
+        # the file's helper scene then finds its render engine registered.
         if addons:
             command += ["--addons", ",".join(addons)]
+        if blend is not None:
+            command.append(str(blend))
         if output is not None:
             command += ["-o", str(output)]
         if frame is not None:

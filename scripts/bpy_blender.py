@@ -81,7 +81,4 @@ def main(argv):
 
 
 if __name__ == "__main__":
-    status = main(sys.argv[1:])
-    sys.stdout.flush()
-    # bpy's own atexit handlers can take seconds; nothing is left to write.
-    os._exit(status)
+    sys.exit(main(sys.argv[1:]))

@@ -47,6 +47,9 @@ scripts/fuzz.sh 60
 echo "== PEP 8"
 "$PYTHON" -m pycodestyle addon scripts tests $( [ -d bench ] && echo bench )
 
+echo "== soak: a 50-frame animation with the node and 200 CLI runs (memory, time, leftovers)"
+scripts/soak.sh --frames 50 --runs 200 --report out/soak/test-report.md
+
 echo "== Python tests (real Blender: Debian's blender and bpy 4.5, 5.0, newest 5.x)"
 # Debian's blender + the three bpy builds: a missing one fails the run.
 HBAO_EXPECTED_BLENDERS=4 "$PYTHON" -m pytest tests -q -p no:cacheprovider
