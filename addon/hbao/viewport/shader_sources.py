@@ -7,6 +7,11 @@ reads its inputs with texelFetch (no filtering, no normalised coordinates).
 Textures are bottom-up (OpenGL rows); the algorithm's pixel (i, j) has j
 counted from the top, so j = H - 1 - row wherever the pattern or the
 camera model needs it.
+
+The passes: linearize (planar depth) -> normals (camera space, as
+csrc/lib/normals.c) -> AO (csrc/lib/horizon.c) -> blur along rows, then
+columns (csrc/lib/blur.c). The normals are a texture of their own because
+both the AO pass and the blur read them, as the library's grid->normal.
 """
 from ..parameters import FALLOFF_VALUES, INTEGRATION_VALUES
 
@@ -32,7 +37,7 @@ void main()
 }
 """
 
-# Shared by the AO and blur passes: background test and the camera model.
+# Shared by every pass after linearize: the background test.
 COMMON = """
 #define PI 3.14159265358979323846
 
@@ -43,10 +48,9 @@ bool is_background(float z)
 }
 """
 
-AO_FRAGMENT = COMMON + """
-/* The interleaved 4x4 pattern of docs/algorithm.md. */
-const int PATTERN[16] = int[16](0, 8, 2, 10, 12, 4, 14, 6, 3, 11, 1, 9, 15, 7, 13, 5);
-
+# Shared by the normal and AO passes: depth and position of a pixel (i, j),
+# j from the top, through the camera model of docs/algorithm.md.
+CAMERA = COMMON + """
 float depth_at(ivec2 p)
 {
     return texelFetch(depth_texture, ivec2(p.x, image_size.y - 1 - p.y), 0).r;
@@ -59,6 +63,16 @@ vec3 position_at(ivec2 p, float z)
     return perspective != 0 ? vec3(x * z, y * z, -z) : vec3(x, y, -z);
 }
 
+vec3 view_vector(vec3 position)
+{
+    return perspective != 0 ? normalize(-position) : vec3(0.0, 0.0, 1.0);
+}
+"""
+
+# Camera-space normals reconstructed from depth (docs/algorithm.md, "Normals",
+# float depth: the preview's depth is float, see DEPTH_PRECISION), facing the
+# viewer; (0, 0, 1) on background, as csrc/lib/normals.c writes there.
+NORMAL_FRAGMENT = CAMERA + """
 /* One axis of the reconstructed tangent: the neighbour difference with the
  * smaller depth change (the one before wins a tie, as in csrc/lib/normals.c);
  * false when neither neighbour is usable. */
@@ -84,17 +98,80 @@ bool tangent_along(ivec2 p, ivec2 axis, float z, vec3 position, out vec3 tangent
 vec3 reconstructed_normal(ivec2 p, float z, vec3 position, vec3 view)
 {
     vec3 dx, dy;
-    if (!tangent_along(p, ivec2(1, 0), z, position, dx) ||
-        !tangent_along(p, ivec2(0, 1), z, position, dy)) {
+    bool have_x = tangent_along(p, ivec2(1, 0), z, position, dx);
+    bool have_y = tangent_along(p, ivec2(0, 1), z, position, dy);
+    vec3 n;
+    if (have_x && have_y) {
+        n = cross(dx, dy);
+    }
+    else if (have_x || have_y) {
+        /* One axis only (a strip one pixel wide or tall): V made
+         * perpendicular to that tangent, so that every sample, which lies
+         * along that axis, has elevation 0 on a plane. */
+        vec3 t = have_x ? dx : dy;
+        float t2 = dot(t, t);
+        if (!(t2 > 0.0) || isinf(t2)) {
+            return view;
+        }
+        n = view - t * (dot(view, t) / t2);
+    }
+    else {
         return view;
     }
-    vec3 n = cross(dx, dy);
     float len = length(n);
-    if (!(len > 0.0)) {
+    if (!(len > 0.0) || isinf(len)) {
         return view;
     }
     n /= len;
     return dot(n, view) < 0.0 ? -n : n;
+}
+
+void main()
+{
+    ivec2 row_up = ivec2(gl_FragCoord.xy);
+    ivec2 p = ivec2(row_up.x, image_size.y - 1 - row_up.y);
+    float z = depth_at(p);
+    if (is_background(z)) {
+        frag_output = vec4(0.0, 0.0, 1.0, 0.0);
+        return;
+    }
+    vec3 position = position_at(p, z);
+    frag_output = vec4(reconstructed_normal(p, z, position, view_vector(position)), 0.0);
+}
+"""
+
+AO_FRAGMENT = CAMERA + """
+/* The interleaved 4x4 pattern of docs/algorithm.md. */
+const int PATTERN[16] = int[16](0, 8, 2, 10, 12, 4, 14, 6, 3, 11, 1, 9, 15, 7, 13, 5);
+
+float radius_in_pixels(float z)
+{
+    return perspective != 0 ? radius / (pixel_size.x * z) : radius / pixel_size.x;
+}
+
+/* R_block: the largest R_px >= 1 among the BLOCK_PIXELS pixels x0 + a + 4 k
+ * of p's row (x0 a multiple of 4 BLOCK_PIXELS, a = p.x & 3), which march
+ * with one step length in the library (csrc/lib/horizon.c, hbao_block_step).
+ * p itself is one of them, with R_px >= 1. */
+float block_radius(ivec2 p, float own_radius)
+{
+    if (perspective == 0) {
+        return own_radius; /* the same for every pixel */
+    }
+    int first = (p.x / (4 * BLOCK_PIXELS)) * (4 * BLOCK_PIXELS) + (p.x & 3);
+    int last = min(first + 4 * BLOCK_PIXELS, image_size.x);
+    float largest = own_radius;
+    for (int i = first; i < last; i += 4) {
+        float z = depth_at(ivec2(i, p.y));
+        if (is_background(z)) {
+            continue;
+        }
+        float r = radius_in_pixels(z);
+        if (r >= 1.0 && r > largest) {
+            largest = r;
+        }
+    }
+    return largest;
 }
 
 /* Cosine-weighted visibility of a half slice from V up to angle h. */
@@ -109,19 +186,24 @@ float occlusion(ivec2 p)
     if (is_background(z)) {
         return 1.0;
     }
-    vec3 position = position_at(p, z);
-    vec3 view = perspective != 0 ? normalize(-position) : vec3(0.0, 0.0, 1.0);
-    vec3 normal = reconstructed_normal(p, z, position, view);
-
-    float radius_px = perspective != 0 ? radius / (pixel_size.x * z) : radius / pixel_size.x;
-    if (radius_px < 1.0) {
+    float radius_px = radius_in_pixels(z);
+    if (!(radius_px >= 1.0)) {
         return 1.0;
     }
+    vec3 position = position_at(p, z);
+    vec3 view = view_vector(position);
+    vec3 normal = texelFetch(normal_texture, ivec2(p.x, image_size.y - 1 - p.y), 0).xyz;
+    float n_dot_v = dot(normal, view);
+    /* docs/algorithm.md, "Depth precision": what rounding the depths can
+     * raise a sample above the tangent plane. */
+    float height_tolerance = depth_precision
+                           * abs(perspective != 0 ? dot(normal, position) : normal.z * position.z);
+
     float inv_ycor = pixel_size.x / pixel_size.y;
     float rotation = (float(PATTERN[(p.x & 3) + 4 * (p.y & 3)]) + 0.5) / 16.0;
     float jitter = (float(PATTERN[(p.y & 3) + 4 * (p.x & 3)]) + 0.5) / 16.0;
     float sin_bias = sin(angle_bias);
-    float step_px = (radius_px - 1.0) / float(steps);
+    float step_px = (block_radius(p, radius_px) - 1.0) / float(steps);
 
     float hbao_sum = 0.0;
     float cosine_open = 0.0;
@@ -141,7 +223,9 @@ float occlusion(ivec2 p)
         if (!usable && integration == INTEGRATION_COSINE) {
             continue;
         }
+        float cos_gamma = usable ? dot(np, view) / np_length : 1.0;
         float gamma = usable ? atan(dot(np, e), dot(np, view)) : 0.0;
+        bool check_past_normal = usable && gamma > 0.0;
 
         float sin_max = sin_bias;
         float h_open = gamma + 0.5 * PI;
@@ -149,9 +233,10 @@ float occlusion(ivec2 p)
         bool past_normal = false;
         float occ = 0.0;
         for (int s = 0; s < steps; s++) {
+            /* The block's offset, the same for its 16 pixels. */
             float t = 1.0 + (float(s) + jitter) * step_px;
-            ivec2 q = ivec2(floor(float(p.x) + 0.5 + cos_theta * t),
-                            floor(float(p.y) + 0.5 - sin_theta * t * inv_ycor));
+            ivec2 q = p + ivec2(floor(0.5 + cos_theta * t),
+                                floor(0.5 - sin_theta * t * inv_ycor));
             if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, image_size))) {
                 break;
             }
@@ -164,19 +249,24 @@ float occlusion(ivec2 p)
             }
             vec3 delta = position_at(q, zs) - position;
             float dist2 = dot(delta, delta);
+            /* Also what keeps a pixel to its own radius within the block's
+             * longer steps. */
             if (!(dist2 < radius * radius) || !(dist2 > 0.0)) {
                 continue;
             }
-            float dist = sqrt(dist2);
+            float inv_dist = 1.0 / sqrt(dist2);
             float weight = falloff == FALLOFF_QUADRATIC ? 1.0 - dist2 / (radius * radius) : 1.0;
-            float cos_v = dot(delta, view) / dist;
+            float cos_v = dot(delta, view) * inv_dist;
+            float sin_s = (dot(delta, normal) - height_tolerance) * inv_dist;
+            /* Past the normal: within gamma of V and rising at least as
+             * steeply as V (docs/algorithm.md, "The slice of a direction"). */
+            bool beyond = check_past_normal && cos_v > cos_gamma && sin_s > n_dot_v;
             if (integration == INTEGRATION_HBAO) {
-                if (usable && gamma > 0.0 && cos_v > cos(gamma)) {
+                if (beyond) {
                     /* Beyond the normal inside the slice: half occluded. */
                     occ = max(occ, 0.5 * (1.0 - sin_bias));
                     break;
                 }
-                float sin_s = dot(normal, delta) / dist;
                 if (sin_s > sin_max) {
                     occ += weight * (sin_s - sin_max);
                     sin_max = sin_s;
@@ -187,7 +277,7 @@ float occlusion(ivec2 p)
                  * tangent plane; past the normal through its angle to V
                  * (docs/algorithm.md, "Integration COSINE"). */
                 float h;
-                if (gamma > 0.0 && cos_v > cos(gamma)) {
+                if (beyond) {
                     h = acos(min(cos_v, 1.0));
                     past_normal = true;
                 }
@@ -195,7 +285,7 @@ float occlusion(ivec2 p)
                     if (past_normal) {
                         continue;
                     }
-                    float elevation = dot(normal, delta) / dist / np_length;
+                    float elevation = sin_s / np_length;
                     h = max(0.0, gamma + acos(clamp(elevation, -1.0, 1.0)));
                 }
                 if (h < h_max) {
@@ -233,9 +323,17 @@ void main()
 # One separable pass of the cross-bilateral blur (docs/algorithm.md, "After
 # sampling", 2); `blur_step` is (1, 0) for rows, (0, 1) for columns;
 # `kernel_radius` and `sigma` come from parameters.blur_kernel_radius and
-# blur_sigma, the library's rule. Direction along the rows does not matter
-# (the kernel is symmetric), so it works bottom-up.
+# blur_sigma, the library's rule. The centre weighs 1 and the taps are summed
+# after it, nearest first on the negative side, as csrc/lib/blur.c does; down
+# a column the order is mirrored (textures are bottom-up), which only changes
+# rounding. The library evaluates exp(-x) with its own polynomial
+# (hbao_exp_negative, 3e-5 relative error); the GPU's exp differs from it by
+# that much in a tap's weight, far below tests/test_viewport.py's tolerances.
 BLUR_FRAGMENT = COMMON + """
+/* FLT_MAX: sharpness / z overflows for tiny depths; capped, a tap at the
+ * same depth weighs 1 instead of 0 * inf (csrc/lib/blur.c). */
+#define LARGEST_FLOAT 3.402823466e38
+
 void main()
 {
     ivec2 p = ivec2(gl_FragCoord.xy);
@@ -244,23 +342,27 @@ void main()
         frag_output = vec4(1.0, 0.0, 0.0, 1.0);
         return;
     }
-    float sum = 0.0;
-    float weight_sum = 0.0;
+    float factor = min(sharpness / zc, LARGEST_FLOAT);
+    vec3 nc = texelFetch(normal_texture, p, 0).xyz;
+    float sum = texelFetch(ao_texture, p, 0).r;
+    float weight_sum = 1.0;
     for (int x = -kernel_radius; x <= kernel_radius; x++) {
         ivec2 q = p + x * blur_step;
-        if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, image_size))) {
+        if (x == 0 || any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, image_size))) {
             continue;
         }
         float zq = texelFetch(depth_texture, q, 0).r;
         if (is_background(zq)) {
             continue;
         }
-        float edge = sharpness * abs(zq - zc) / zc;
-        float w = exp(-float(x * x) / (2.0 * sigma * sigma) - edge * edge);
+        float difference = (zq - zc) * factor;
+        float bend = max(0.0, 1.0 - dot(texelFetch(normal_texture, q, 0).xyz, nc));
+        float spatial = exp(-float(x * x) / (2.0 * sigma * sigma));
+        float w = spatial * exp(-(difference * difference + NORMAL_SHARPNESS * bend));
         sum += w * texelFetch(ao_texture, q, 0).r;
         weight_sum += w;
     }
-    frag_output = vec4(weight_sum > 0.0 ? sum / weight_sum : 1.0, 0.0, 0.0, 1.0);
+    frag_output = vec4(sum / weight_sum, 0.0, 0.0, 1.0);
 }
 """
 
@@ -280,6 +382,13 @@ void main()
 }
 """
 
+# The depth's rounding relative to the depth (docs/algorithm.md, "Depth
+# precision"): the library's for float depth, 2^-23 (csrc/lib/internal_hbao.h,
+# HBAO_FLOAT_DEPTH_PRECISION). The preview's depth is float: linearised in
+# float from the viewport's depth buffer, never half floats, so the preview
+# neither tests for half floats nor fits half-float normals.
+FLOAT_DEPTH_PRECISION = 1.1920929e-7
+
 # Falloff and integration enum values as the shader sees them (the header's,
 # through parameters.py).
 AO_DEFINES = {
@@ -288,4 +397,13 @@ AO_DEFINES = {
     # csrc/lib/horizon.c: a projected normal shorter than this has no slice
     # angle (tests/test_parameter_contract.py compares the two).
     "NORMAL_IN_SLICE_EPSILON": 1e-6,
+    # csrc/lib/internal_hbao.h, HBAO_BLOCK_PIXELS: the pixels of a block,
+    # which share one step length (tests/test_viewport.py compares the two).
+    "BLOCK_PIXELS": 16,
+}
+
+BLUR_DEFINES = {
+    # csrc/lib/internal_finish.h, HBAO_BLUR_NORMAL_SHARPNESS
+    # (tests/test_viewport.py compares the two).
+    "NORMAL_SHARPNESS": 16.0,
 }
