@@ -34,8 +34,9 @@ SHIFTED_CAMERA = dict(PERSPECTIVE_CAMERA, shift_x=0.1, shift_y=-0.05,
                       pixel_aspect_x=1.0, pixel_aspect_y=1.5)
 ORTHOGRAPHIC_CAMERA = {"type": "ORTHO", "ortho_scale": 7.0, "sensor_fit": "AUTO"}
 
-# The compared cases: (name, camera, parameters[, floor height]). Blur off shows
-# the horizon search alone; blur on adds the two bilateral passes.
+# The compared cases: (name, camera, parameters[, scene]); scene may set the
+# floor's height ("floor_y", camera space) and the image's "size". Blur off
+# shows the horizon search alone; blur on adds the two bilateral passes.
 CASES = [
     ("persp_cosine", PERSPECTIVE_CAMERA, {"blur_size": 0}),
     ("persp_hbao", PERSPECTIVE_CAMERA, {"integration": "HBAO", "blur_size": 0}),
@@ -57,8 +58,12 @@ CASES = [
     # rule, radius 0.1 puts false occlusion on about 7 times as many pixels as
     # radius 1 (measured).
     ("grazing_hbao", PERSPECTIVE_CAMERA,
-     {"integration": "HBAO", "blur_size": 0, "radius": 0.1, "steps": 32}, -0.05),
-    ("grazing_cosine", PERSPECTIVE_CAMERA, {"blur_size": 0, "radius": 0.1}, -0.05),
+     {"integration": "HBAO", "blur_size": 0, "radius": 0.1, "steps": 32}, {"floor_y": -0.05}),
+    ("grazing_cosine", PERSPECTIVE_CAMERA, {"blur_size": 0, "radius": 0.1}, {"floor_y": -0.05}),
+    # One row through the sphere: no vertical neighbour, so the normal is V made
+    # perpendicular to the row's tangent (docs/algorithm.md, "Normals").
+    ("one_row_hbao", PERSPECTIVE_CAMERA, {"integration": "HBAO", "blur_size": 0},
+     {"size": (WIDTH, 1)}),
 ]
 # The floor's height (camera space) in the cases that do not give their own.
 FLOOR_Y = -1.0
@@ -171,11 +176,13 @@ def frame_difference(a, b):
 def main():
     out_path = Path(sys.argv[sys.argv.index("--") + 1])
     report = {"renderer": gpu.platform.renderer_get(), "cases": {}}
-    for name, camera, overrides, *floor_y in CASES:
+    for name, camera, overrides, *scene in CASES:
+        scene = scene[0] if scene else {}
         params = parameters.resolved(overrides)
-        frame = projection.frame_from_camera(camera, WIDTH, HEIGHT)
-        viewport_frame = blender_frame(camera, WIDTH, HEIGHT)
-        depth = synthetic_depth(frame, *floor_y)
+        width, height = scene.get("size", (WIDTH, HEIGHT))
+        frame = projection.frame_from_camera(camera, width, height)
+        viewport_frame = blender_frame(camera, width, height)
+        depth = synthetic_depth(frame, scene.get("floor_y", FLOOR_Y))
         reference = native.compute_ao(depth, None, camera=camera,
                                       params=dict(params, threads=1))
         preview = glsl_ao(depth, viewport_frame, params)
