@@ -86,8 +86,9 @@ AO_FRAGMENT = CAMERA + horizon_sources.HORIZON_SEARCH
 # (hbao_exp_negative, 3e-5 relative error); the GPU's exp differs from it by
 # that much in a tap's weight, far below tests/test_viewport.py's tolerances.
 BLUR_FRAGMENT = COMMON + """
-/* FLT_MAX: sharpness / z overflows for tiny depths; capped, a tap at the
- * same depth weighs 1 instead of 0 * inf (csrc/lib/blur.c). */
+/* FLT_MAX: sharpness / z overflows for tiny depths, and a tap at the same
+ * depth would weigh 0 * inf = NaN; capped, it weighs what any tap at the
+ * same depth does (csrc/lib/blur.c). */
 #define LARGEST_FLOAT 3.402823466e38
 
 void main()
