@@ -34,8 +34,9 @@ SHIFTED_CAMERA = dict(PERSPECTIVE_CAMERA, shift_x=0.1, shift_y=-0.05,
                       pixel_aspect_x=1.0, pixel_aspect_y=1.5)
 ORTHOGRAPHIC_CAMERA = {"type": "ORTHO", "ortho_scale": 7.0, "sensor_fit": "AUTO"}
 
-# The compared cases: (name, camera, parameters). Blur off shows the horizon
-# search alone; blur on adds the two bilateral passes.
+# The compared cases: (name, camera, parameters[, scene]); scene may set the
+# floor's height ("floor_y", camera space) and the image's "size". Blur off
+# shows the horizon search alone; blur on adds the two bilateral passes.
 CASES = [
     ("persp_cosine", PERSPECTIVE_CAMERA, {"blur_size": 0}),
     ("persp_hbao", PERSPECTIVE_CAMERA, {"integration": "HBAO", "blur_size": 0}),
@@ -48,13 +49,30 @@ CASES = [
     ("persp_hbao_blur_strength", PERSPECTIVE_CAMERA,
      {"integration": "HBAO", "blur_size": 15, "blur_sharpness": 4.0, "strength": 2.0}),
     ("ortho_cosine_blur", ORTHOGRAPHIC_CAMERA, {"blur_size": 7, "radius": 0.8}),
+    # The eye 0.05 above the floor, V nearly in its plane: snapped samples on
+    # the floor lie within gamma of V, and only "rising at least as steeply as
+    # V" keeps them from counting as past the normal (docs/algorithm.md, "The
+    # slice of a direction"). The floor must stay unoccluded: these cases
+    # compare planes, not occlusion. A small radius keeps the samples within a
+    # few pixels, where snapping moves them furthest off the slice: without the
+    # rule, radius 0.1 puts false occlusion on about 7 times as many pixels as
+    # radius 1 (measured).
+    ("grazing_hbao", PERSPECTIVE_CAMERA,
+     {"integration": "HBAO", "blur_size": 0, "radius": 0.1, "steps": 32}, {"floor_y": -0.05}),
+    ("grazing_cosine", PERSPECTIVE_CAMERA, {"blur_size": 0, "radius": 0.1}, {"floor_y": -0.05}),
+    # One row through the sphere: no vertical neighbour, so the normal is V made
+    # perpendicular to the row's tangent (docs/algorithm.md, "Normals").
+    ("one_row_hbao", PERSPECTIVE_CAMERA, {"integration": "HBAO", "blur_size": 0},
+     {"size": (WIDTH, 1)}),
 ]
+# The floor's height (camera space) in the cases that do not give their own.
+FLOOR_Y = -1.0
 
 
-def synthetic_depth(frame):
-    """Planar depth (top row first) of a floor, a back wall with sky above it, a box
-    and a sphere, ray cast per pixel centre through `frame` (camera space, camera
-    looking down -z)."""
+def synthetic_depth(frame, floor_y=FLOOR_Y):
+    """Planar depth (top row first) of a floor at height `floor_y`, a back wall
+    with sky above it, a box and a sphere, ray cast per pixel centre through
+    `frame` (camera space, camera looking down -z)."""
     columns = frame.origin_x + (np.arange(frame.width) + 0.5) * frame.pixel_size_x
     rows = frame.origin_y + (frame.height - 1 - np.arange(frame.height) + 0.5) * frame.pixel_size_y
     x, y = np.meshgrid(columns, rows)
@@ -73,8 +91,8 @@ def synthetic_depth(frame):
 
     with np.errstate(divide="ignore", invalid="ignore"):
         if frame.perspective:
-            # Floor y = -1 up to z = -9, wall z = -9 up to y = 2.5, sky above.
-            t = (-1.0 - origin[..., 1]) / direction[..., 1]
+            # Floor y = floor_y up to z = -9, wall z = -9 up to y = 2.5, sky above.
+            t = (floor_y - origin[..., 1]) / direction[..., 1]
             point = origin + direction * t[..., None]
             hit(np.where(point[..., 2] > -9.0, t, np.inf))
             t = (-9.0 - origin[..., 2]) / direction[..., 2]
@@ -158,11 +176,13 @@ def frame_difference(a, b):
 def main():
     out_path = Path(sys.argv[sys.argv.index("--") + 1])
     report = {"renderer": gpu.platform.renderer_get(), "cases": {}}
-    for name, camera, overrides in CASES:
+    for name, camera, overrides, *scene in CASES:
+        scene = scene[0] if scene else {}
         params = parameters.resolved(overrides)
-        frame = projection.frame_from_camera(camera, WIDTH, HEIGHT)
-        viewport_frame = blender_frame(camera, WIDTH, HEIGHT)
-        depth = synthetic_depth(frame)
+        width, height = scene.get("size", (WIDTH, HEIGHT))
+        frame = projection.frame_from_camera(camera, width, height)
+        viewport_frame = blender_frame(camera, width, height)
+        depth = synthetic_depth(frame, scene.get("floor_y", FLOOR_Y))
         reference = native.compute_ao(depth, None, camera=camera,
                                       params=dict(params, threads=1))
         preview = glsl_ao(depth, viewport_frame, params)

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
-"""The preview's GPU passes: viewport depth -> planar depth -> AO -> blur ->
-composite. One AOPipeline per 3D view region keeps its targets and re-creates
+"""The preview's GPU passes: viewport depth -> planar depth -> normals -> AO ->
+blur -> composite. One AOPipeline per 3D view region keeps its targets and re-creates
 them when the region's size changes."""
 import math
 
@@ -8,7 +8,7 @@ import gpu
 from gpu_extras.batch import batch_for_shader
 
 from .. import parameters
-from . import shaders
+from . import shader_sources, shaders
 
 # Two triangles covering normalised device coordinates.
 _QUAD = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
@@ -31,22 +31,24 @@ def release():
 
 
 class _Target:
-    """A single-channel float texture and the framebuffer that draws into it."""
+    """A float texture (one channel unless told) and the framebuffer that draws into it."""
 
-    def __init__(self, width, height):
-        self.texture = gpu.types.GPUTexture((width, height), format="R32F")
+    def __init__(self, width, height, texture_format="R32F"):
+        self.texture = gpu.types.GPUTexture((width, height), format=texture_format)
         self.framebuffer = gpu.types.GPUFrameBuffer(color_slots=self.texture)
 
 
 class AOPipeline:
     def __init__(self):
         self.size = None
-        self._linear_depth = self._ao = self._blurred_rows = None
+        self._linear_depth = self._normals = self._ao = self._blurred_rows = None
 
     def _ensure_size(self, width, height):
         if self.size == (width, height):
             return
         self._linear_depth = _Target(width, height)
+        # Camera-space normals, full float: the AO pass and the blur read them.
+        self._normals = _Target(width, height, "RGBA32F")
         self._ao = _Target(width, height)
         self._blurred_rows = _Target(width, height)
         self.size = (width, height)
@@ -63,19 +65,33 @@ class AOPipeline:
             _draw_quad("linearize")
         return self._linear_depth.texture
 
-    def ambient_occlusion(self, depth_texture, frame, params):
+    def ambient_occlusion(self, depth_texture, frame, params,
+                          depth_precision=shader_sources.FLOAT_DEPTH_PRECISION):
         """Blurred AO (before strength) of a planar-depth texture, as an R32F
-        texture the size of `frame`. `params` as parameters.resolved returns."""
+        texture the size of `frame`. `params` as parameters.resolved returns;
+        `depth_precision` bounds the depth's rounding relative to the depth
+        (docs/algorithm.md, "Depth precision")."""
         width, height = frame.width, frame.height
         self._ensure_size(width, height)
-        shader = shaders.get("ao")
-        with self._ao.framebuffer.bind():
-            shader.bind()
+
+        def bind_camera(shader):
             shader.uniform_sampler("depth_texture", depth_texture)
             shader.uniform_int("image_size", (width, height))
             shader.uniform_float("pixel_size", (frame.pixel_size_x, frame.pixel_size_y))
             shader.uniform_float("origin", (frame.origin_x, frame.origin_y))
             shader.uniform_int("perspective", 1 if frame.perspective else 0)
+            shader.uniform_float("background_depth", params["background_depth"])
+
+        shader = shaders.get("normals")
+        with self._normals.framebuffer.bind():
+            shader.bind()
+            bind_camera(shader)
+            _draw_quad("normals")
+        shader = shaders.get("ao")
+        with self._ao.framebuffer.bind():
+            shader.bind()
+            bind_camera(shader)
+            shader.uniform_sampler("normal_texture", self._normals.texture)
             shader.uniform_float("radius", params["radius"])
             shader.uniform_float("angle_bias", math.radians(params["angle_bias_degrees"]))
             shader.uniform_int("directions", params["directions"])
@@ -83,7 +99,7 @@ class AOPipeline:
             shader.uniform_int("falloff", parameters.FALLOFF_VALUES[params["falloff"]])
             shader.uniform_int("integration",
                                parameters.INTEGRATION_VALUES[params["integration"]])
-            shader.uniform_float("background_depth", params["background_depth"])
+            shader.uniform_float("depth_precision", depth_precision)
             _draw_quad("ao")
         kernel_radius = parameters.blur_kernel_radius(params["blur_size"])
         if kernel_radius < 1:
@@ -94,6 +110,7 @@ class AOPipeline:
             with target.framebuffer.bind():
                 shader.bind()
                 shader.uniform_sampler("depth_texture", depth_texture)
+                shader.uniform_sampler("normal_texture", self._normals.texture)
                 shader.uniform_sampler("ao_texture", source.texture)
                 shader.uniform_int("image_size", (width, height))
                 shader.uniform_int("blur_step", step)

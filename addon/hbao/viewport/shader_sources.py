@@ -7,8 +7,16 @@ reads its inputs with texelFetch (no filtering, no normalised coordinates).
 Textures are bottom-up (OpenGL rows); the algorithm's pixel (i, j) has j
 counted from the top, so j = H - 1 - row wherever the pattern or the
 camera model needs it.
+
+The passes: linearize (planar depth) -> normals (camera space, as
+csrc/lib/normals.c) -> AO (csrc/lib/horizon.c) -> blur along rows, then
+columns (csrc/lib/blur.c) -> composite. The normals are a texture of their
+own because both the AO pass and the blur read them, as both read the
+library's grid->normal. The normal and AO passes' GLSL is in
+horizon_sources.py.
 """
 from ..parameters import FALLOFF_VALUES, INTEGRATION_VALUES
+from . import horizon_sources
 
 # A full-screen quad given in normalised device coordinates: no matrices, so it
 # draws the same in POST_VIEW (3D matrices bound) and into our own framebuffers.
@@ -32,7 +40,7 @@ void main()
 }
 """
 
-# Shared by the AO and blur passes: background test and the camera model.
+# Shared by every pass after linearize: the background test.
 COMMON = """
 #define PI 3.14159265358979323846
 
@@ -43,10 +51,9 @@ bool is_background(float z)
 }
 """
 
-AO_FRAGMENT = COMMON + """
-/* The interleaved 4x4 pattern of docs/algorithm.md. */
-const int PATTERN[16] = int[16](0, 8, 2, 10, 12, 4, 14, 6, 3, 11, 1, 9, 15, 7, 13, 5);
-
+# Shared by the normal and AO passes: depth and position of a pixel (i, j),
+# j from the top, through the camera model of docs/algorithm.md.
+CAMERA = COMMON + """
 float depth_at(ivec2 p)
 {
     return texelFetch(depth_texture, ivec2(p.x, image_size.y - 1 - p.y), 0).r;
@@ -59,183 +66,31 @@ vec3 position_at(ivec2 p, float z)
     return perspective != 0 ? vec3(x * z, y * z, -z) : vec3(x, y, -z);
 }
 
-/* One axis of the reconstructed tangent: the neighbour difference with the
- * smaller depth change (the one before wins a tie, as in csrc/lib/normals.c);
- * false when neither neighbour is usable. */
-bool tangent_along(ivec2 p, ivec2 axis, float z, vec3 position, out vec3 tangent)
+vec3 view_vector(vec3 position)
 {
-    ivec2 after = p + axis;
-    ivec2 before = p - axis;
-    float z_after = all(lessThan(after, image_size)) ? depth_at(after) : 0.0;
-    float z_before = all(greaterThanEqual(before, ivec2(0))) ? depth_at(before) : 0.0;
-    bool has_after = !is_background(z_after);
-    bool has_before = !is_background(z_before);
-    if (has_before && (!has_after || abs(z_before - z) <= abs(z_after - z))) {
-        tangent = position - position_at(before, z_before);
-        return true;
-    }
-    if (has_after) {
-        tangent = position_at(after, z_after) - position;
-        return true;
-    }
-    return false;
-}
-
-vec3 reconstructed_normal(ivec2 p, float z, vec3 position, vec3 view)
-{
-    vec3 dx, dy;
-    if (!tangent_along(p, ivec2(1, 0), z, position, dx) ||
-        !tangent_along(p, ivec2(0, 1), z, position, dy)) {
-        return view;
-    }
-    vec3 n = cross(dx, dy);
-    float len = length(n);
-    if (!(len > 0.0)) {
-        return view;
-    }
-    n /= len;
-    return dot(n, view) < 0.0 ? -n : n;
-}
-
-/* Cosine-weighted visibility of a half slice from V up to angle h. */
-float slice_visibility(float h, float gamma)
-{
-    return (-cos(2.0 * h - gamma) + cos(gamma) + 2.0 * h * sin(gamma)) * 0.25;
-}
-
-float occlusion(ivec2 p)
-{
-    float z = depth_at(p);
-    if (is_background(z)) {
-        return 1.0;
-    }
-    vec3 position = position_at(p, z);
-    vec3 view = perspective != 0 ? normalize(-position) : vec3(0.0, 0.0, 1.0);
-    vec3 normal = reconstructed_normal(p, z, position, view);
-
-    float radius_px = perspective != 0 ? radius / (pixel_size.x * z) : radius / pixel_size.x;
-    if (radius_px < 1.0) {
-        return 1.0;
-    }
-    float inv_ycor = pixel_size.x / pixel_size.y;
-    float rotation = (float(PATTERN[(p.x & 3) + 4 * (p.y & 3)]) + 0.5) / 16.0;
-    float jitter = (float(PATTERN[(p.y & 3) + 4 * (p.x & 3)]) + 0.5) / 16.0;
-    float sin_bias = sin(angle_bias);
-    float step_px = (radius_px - 1.0) / float(steps);
-
-    float hbao_sum = 0.0;
-    float cosine_open = 0.0;
-    float cosine_visible = 0.0;
-    for (int d = 0; d < directions; d++) {
-        float theta = 2.0 * PI * (float(d) + rotation) / float(directions);
-        float cos_theta = cos(theta);
-        float sin_theta = sin(theta);
-        vec3 dir3 = vec3(cos_theta, sin_theta, 0.0);
-        vec3 e = normalize(dir3 - view * dot(dir3, view));
-        vec3 m = cross(view, e);
-        vec3 np = normal - m * dot(normal, m);
-        float np_length = length(np);
-        /* A normal (almost) perpendicular to the slice: no gamma, and no
-         * weight in the cosine sum (csrc/lib/horizon.c, slice_setup). */
-        bool usable = np_length > NORMAL_IN_SLICE_EPSILON;
-        if (!usable && integration == INTEGRATION_COSINE) {
-            continue;
-        }
-        float gamma = usable ? atan(dot(np, e), dot(np, view)) : 0.0;
-
-        float sin_max = sin_bias;
-        float h_open = gamma + 0.5 * PI;
-        float h_max = max(0.0, h_open - angle_bias);
-        bool past_normal = false;
-        float occ = 0.0;
-        for (int s = 0; s < steps; s++) {
-            float t = 1.0 + (float(s) + jitter) * step_px;
-            ivec2 q = ivec2(floor(float(p.x) + 0.5 + cos_theta * t),
-                            floor(float(p.y) + 0.5 - sin_theta * t * inv_ycor));
-            if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, image_size))) {
-                break;
-            }
-            if (q == p) {
-                continue;
-            }
-            float zs = depth_at(q);
-            if (is_background(zs)) {
-                continue;
-            }
-            vec3 delta = position_at(q, zs) - position;
-            float dist2 = dot(delta, delta);
-            if (!(dist2 < radius * radius) || !(dist2 > 0.0)) {
-                continue;
-            }
-            float dist = sqrt(dist2);
-            float weight = falloff == FALLOFF_QUADRATIC ? 1.0 - dist2 / (radius * radius) : 1.0;
-            float cos_v = dot(delta, view) / dist;
-            if (integration == INTEGRATION_HBAO) {
-                if (usable && gamma > 0.0 && cos_v > cos(gamma)) {
-                    /* Beyond the normal inside the slice: half occluded. */
-                    occ = max(occ, 0.5 * (1.0 - sin_bias));
-                    break;
-                }
-                float sin_s = dot(normal, delta) / dist;
-                if (sin_s > sin_max) {
-                    occ += weight * (sin_s - sin_max);
-                    sin_max = sin_s;
-                }
-            }
-            else {
-                /* The sample's angle from V through its elevation above the
-                 * tangent plane; past the normal through its angle to V
-                 * (docs/algorithm.md, "Integration COSINE"). */
-                float h;
-                if (gamma > 0.0 && cos_v > cos(gamma)) {
-                    h = acos(min(cos_v, 1.0));
-                    past_normal = true;
-                }
-                else {
-                    if (past_normal) {
-                        continue;
-                    }
-                    float elevation = dot(normal, delta) / dist / np_length;
-                    h = max(0.0, gamma + acos(clamp(elevation, -1.0, 1.0)));
-                }
-                if (h < h_max) {
-                    occ += weight * (slice_visibility(h_max, gamma) - slice_visibility(h, gamma));
-                    h_max = h;
-                }
-            }
-        }
-        if (integration == INTEGRATION_HBAO) {
-            hbao_sum += occ;
-        }
-        else {
-            float open_visibility = slice_visibility(h_open, gamma);
-            cosine_open += np_length * open_visibility;
-            cosine_visible += np_length * (open_visibility - occ);
-        }
-    }
-    float ao;
-    if (integration == INTEGRATION_HBAO) {
-        ao = 1.0 - hbao_sum / float(directions) / (1.0 - sin_bias);
-    }
-    else {
-        ao = cosine_open > 1e-12 ? cosine_visible / cosine_open : 1.0;
-    }
-    return clamp(ao, 0.0, 1.0);
-}
-
-void main()
-{
-    ivec2 row_up = ivec2(gl_FragCoord.xy);
-    frag_output = vec4(occlusion(ivec2(row_up.x, image_size.y - 1 - row_up.y)), 0.0, 0.0, 1.0);
+    return perspective != 0 ? normalize(-position) : vec3(0.0, 0.0, 1.0);
 }
 """
+
+# The normal and AO passes (horizon_sources.py) on the camera model.
+NORMAL_FRAGMENT = CAMERA + horizon_sources.NORMALS
+AO_FRAGMENT = CAMERA + horizon_sources.HORIZON_SEARCH
 
 # One separable pass of the cross-bilateral blur (docs/algorithm.md, "After
 # sampling", 2); `blur_step` is (1, 0) for rows, (0, 1) for columns;
 # `kernel_radius` and `sigma` come from parameters.blur_kernel_radius and
-# blur_sigma, the library's rule. Direction along the rows does not matter
-# (the kernel is symmetric), so it works bottom-up.
+# blur_sigma, the library's rule. The centre weighs 1 and the taps are summed
+# after it, nearest first on the negative side, as csrc/lib/blur.c does; down
+# a column the order is mirrored (textures are bottom-up), which only changes
+# rounding. The library evaluates exp(-x) with its own polynomial
+# (hbao_exp_negative, 3e-5 relative error); the GPU's exp differs from it by
+# that much in a tap's weight, far below tests/test_viewport.py's tolerances.
 BLUR_FRAGMENT = COMMON + """
+/* FLT_MAX: sharpness / z overflows for tiny depths, and a tap at the same
+ * depth would weigh 0 * inf = NaN; capped, it weighs what any tap at the
+ * same depth does (csrc/lib/blur.c). */
+#define LARGEST_FLOAT 3.402823466e38
+
 void main()
 {
     ivec2 p = ivec2(gl_FragCoord.xy);
@@ -244,23 +99,27 @@ void main()
         frag_output = vec4(1.0, 0.0, 0.0, 1.0);
         return;
     }
-    float sum = 0.0;
-    float weight_sum = 0.0;
+    float factor = min(sharpness / zc, LARGEST_FLOAT);
+    vec3 nc = texelFetch(normal_texture, p, 0).xyz;
+    float sum = texelFetch(ao_texture, p, 0).r;
+    float weight_sum = 1.0;
     for (int x = -kernel_radius; x <= kernel_radius; x++) {
         ivec2 q = p + x * blur_step;
-        if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, image_size))) {
+        if (x == 0 || any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, image_size))) {
             continue;
         }
         float zq = texelFetch(depth_texture, q, 0).r;
         if (is_background(zq)) {
             continue;
         }
-        float edge = sharpness * abs(zq - zc) / zc;
-        float w = exp(-float(x * x) / (2.0 * sigma * sigma) - edge * edge);
+        float difference = (zq - zc) * factor;
+        float bend = max(0.0, 1.0 - dot(texelFetch(normal_texture, q, 0).xyz, nc));
+        float spatial = exp(-float(x * x) / (2.0 * sigma * sigma));
+        float w = spatial * exp(-(difference * difference + NORMAL_SHARPNESS * bend));
         sum += w * texelFetch(ao_texture, q, 0).r;
         weight_sum += w;
     }
-    frag_output = vec4(weight_sum > 0.0 ? sum / weight_sum : 1.0, 0.0, 0.0, 1.0);
+    frag_output = vec4(sum / weight_sum, 0.0, 0.0, 1.0);
 }
 """
 
@@ -280,6 +139,13 @@ void main()
 }
 """
 
+# The depth's rounding relative to the depth (docs/algorithm.md, "Depth
+# precision"): the library's for float depth, 2^-23 (csrc/lib/internal_hbao.h,
+# HBAO_FLOAT_DEPTH_PRECISION). The preview's depth is float: linearised in
+# float from the viewport's depth buffer, never half floats, so the preview
+# neither tests for half floats nor fits half-float normals.
+FLOAT_DEPTH_PRECISION = 1.1920929e-7
+
 # Falloff and integration enum values as the shader sees them (the header's,
 # through parameters.py).
 AO_DEFINES = {
@@ -288,4 +154,13 @@ AO_DEFINES = {
     # csrc/lib/horizon.c: a projected normal shorter than this has no slice
     # angle (tests/test_parameter_contract.py compares the two).
     "NORMAL_IN_SLICE_EPSILON": 1e-6,
+    # csrc/lib/internal_hbao.h, HBAO_BLOCK_PIXELS: the pixels of a block,
+    # which share one step length (tests/test_viewport.py compares the two).
+    "BLOCK_PIXELS": 16,
+}
+
+BLUR_DEFINES = {
+    # csrc/lib/internal_finish.h, HBAO_BLUR_NORMAL_SHARPNESS
+    # (tests/test_viewport.py compares the two).
+    "NORMAL_SHARPNESS": 16.0,
 }

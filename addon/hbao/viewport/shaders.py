@@ -23,24 +23,33 @@ def _create_info(fragment_source, push_constants, samplers, defines=None):
     return info
 
 
+# What the passes that place pixels in camera space (shader_sources.CAMERA) read.
+_CAMERA_CONSTANTS = [("IVEC2", "image_size"), ("VEC2", "pixel_size"), ("VEC2", "origin"),
+                     ("INT", "perspective"), ("FLOAT", "background_depth")]
+
 _DEFINITIONS = {
     "linearize": lambda: _create_info(
         shader_sources.LINEARIZE_FRAGMENT,
         [("VEC4", "depth_coefficients")],
         ["buffer_depth"]),
+    "normals": lambda: _create_info(
+        shader_sources.NORMAL_FRAGMENT,
+        _CAMERA_CONSTANTS,
+        ["depth_texture"]),
     "ao": lambda: _create_info(
         shader_sources.AO_FRAGMENT,
-        [("IVEC2", "image_size"), ("VEC2", "pixel_size"), ("VEC2", "origin"),
-         ("INT", "perspective"), ("FLOAT", "radius"), ("FLOAT", "angle_bias"),
-         ("INT", "directions"), ("INT", "steps"), ("INT", "falloff"),
-         ("INT", "integration"), ("FLOAT", "background_depth")],
-        ["depth_texture"],
+        _CAMERA_CONSTANTS + [
+            ("FLOAT", "radius"), ("FLOAT", "angle_bias"), ("INT", "directions"),
+            ("INT", "steps"), ("INT", "falloff"), ("INT", "integration"),
+            ("FLOAT", "depth_precision")],
+        ["depth_texture", "normal_texture"],
         shader_sources.AO_DEFINES),
     "blur": lambda: _create_info(
         shader_sources.BLUR_FRAGMENT,
         [("IVEC2", "image_size"), ("IVEC2", "blur_step"), ("INT", "kernel_radius"),
          ("FLOAT", "sigma"), ("FLOAT", "sharpness"), ("FLOAT", "background_depth")],
-        ["depth_texture", "ao_texture"]),
+        ["depth_texture", "normal_texture", "ao_texture"],
+        shader_sources.BLUR_DEFINES),
     "composite": lambda: _create_info(
         shader_sources.COMPOSITE_FRAGMENT,
         [("IVEC2", "pixel_offset"), ("FLOAT", "strength")],
@@ -49,7 +58,7 @@ _DEFINITIONS = {
 
 
 def get(name):
-    """The compiled shader `name` (linearize, ao, blur, composite)."""
+    """The compiled shader `name` (linearize, normals, ao, blur, composite)."""
     shader = _shaders.get(name)
     if shader is None:
         shader = gpu.shader.create_from_info(_DEFINITIONS[name]())

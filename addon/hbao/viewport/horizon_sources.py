@@ -1,0 +1,260 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""GLSL of the preview's normal and AO passes: csrc/lib/normals.c and
+csrc/lib/horizon.c, following docs/algorithm.md. Fragment bodies only:
+shader_sources.py puts the shared camera model (depth_at, position_at,
+view_vector, is_background) in front of them and holds the constants they
+are compiled with (AO_DEFINES). Plain strings, no bpy."""
+
+# Camera-space normals reconstructed from depth, facing the viewer
+# (docs/algorithm.md, "Normals"; the rule for float depth, which the
+# preview's is: see shader_sources.FLOAT_DEPTH_PRECISION); (0, 0, 1) on
+# background, as csrc/lib/normals.c writes there.
+NORMALS = """
+/* One axis of the reconstructed tangent: the neighbour difference with the
+ * smaller depth change (the one before wins a tie, as in csrc/lib/normals.c);
+ * false when neither neighbour is usable. */
+bool tangent_along(ivec2 p, ivec2 axis, float z, vec3 position, out vec3 tangent)
+{
+    ivec2 after = p + axis;
+    ivec2 before = p - axis;
+    float z_after = all(lessThan(after, image_size)) ? depth_at(after) : 0.0;
+    float z_before = all(greaterThanEqual(before, ivec2(0))) ? depth_at(before) : 0.0;
+    bool has_after = !is_background(z_after);
+    bool has_before = !is_background(z_before);
+    if (has_before && (!has_after || abs(z_before - z) <= abs(z_after - z))) {
+        tangent = position - position_at(before, z_before);
+        return true;
+    }
+    if (has_after) {
+        tangent = position_at(after, z_after) - position;
+        return true;
+    }
+    return false;
+}
+
+vec3 reconstructed_normal(ivec2 p, float z, vec3 position, vec3 view)
+{
+    vec3 dx, dy;
+    bool have_x = tangent_along(p, ivec2(1, 0), z, position, dx);
+    bool have_y = tangent_along(p, ivec2(0, 1), z, position, dy);
+    vec3 n;
+    if (have_x && have_y) {
+        n = cross(dx, dy);
+    }
+    else if (have_x || have_y) {
+        /* One axis only (a strip one pixel wide or tall): V made
+         * perpendicular to that tangent, so that every sample, which lies
+         * along that axis, has elevation 0 on a plane. */
+        vec3 t = have_x ? dx : dy;
+        float t2 = dot(t, t);
+        if (!(t2 > 0.0) || isinf(t2)) {
+            return view;
+        }
+        n = view - t * (dot(view, t) / t2);
+    }
+    else {
+        return view;
+    }
+    float len = length(n);
+    if (!(len > 0.0) || isinf(len)) {
+        return view;
+    }
+    n /= len;
+    return dot(n, view) < 0.0 ? -n : n;
+}
+
+void main()
+{
+    ivec2 row_up = ivec2(gl_FragCoord.xy);
+    ivec2 p = ivec2(row_up.x, image_size.y - 1 - row_up.y);
+    float z = depth_at(p);
+    if (is_background(z)) {
+        frag_output = vec4(0.0, 0.0, 1.0, 0.0);
+        return;
+    }
+    vec3 position = position_at(p, z);
+    frag_output = vec4(reconstructed_normal(p, z, position, view_vector(position)), 0.0);
+}
+"""
+
+# The horizon search and its integration (csrc/lib/horizon.c, scalar
+# reference), one fragment per pixel, with the step length of the pixel's
+# block: the library's SIMD kernels march a block's 16 pixels together, and
+# its scalar reference gives the same offsets, so the preview must too.
+HORIZON_SEARCH = """
+/* The interleaved 4x4 pattern of docs/algorithm.md. */
+const int PATTERN[16] = int[16](0, 8, 2, 10, 12, 4, 14, 6, 3, 11, 1, 9, 15, 7, 13, 5);
+
+float radius_in_pixels(float z)
+{
+    return perspective != 0 ? radius / (pixel_size.x * z) : radius / pixel_size.x;
+}
+
+/* R_block: the largest R_px >= 1 among the BLOCK_PIXELS pixels x0 + a + 4 k
+ * of p's row (x0 a multiple of 4 BLOCK_PIXELS, a = p.x & 3), which march
+ * with one step length in the library (csrc/lib/horizon.c, hbao_block_step).
+ * R_px falls as the depth grows, in floats too (rounding is monotonic), and
+ * p itself is in the block with R_px >= 1, so R_block is the R_px of the
+ * block's nearest depth: one division instead of sixteen. */
+float block_radius(ivec2 p, float z)
+{
+    if (perspective == 0) {
+        return radius_in_pixels(z); /* the same for every pixel */
+    }
+    int first = (p.x / (4 * BLOCK_PIXELS)) * (4 * BLOCK_PIXELS) + (p.x & 3);
+    int last = min(first + 4 * BLOCK_PIXELS, image_size.x);
+    float nearest = z;
+    for (int i = first; i < last; i += 4) {
+        float zi = depth_at(ivec2(i, p.y));
+        if (!is_background(zi)) {
+            nearest = min(nearest, zi);
+        }
+    }
+    return radius_in_pixels(nearest);
+}
+
+/* Cosine-weighted visibility of a half slice from V up to angle h. */
+float slice_visibility(float h, float gamma)
+{
+    return (-cos(2.0 * h - gamma) + cos(gamma) + 2.0 * h * sin(gamma)) * 0.25;
+}
+
+float occlusion(ivec2 p)
+{
+    float z = depth_at(p);
+    if (is_background(z)) {
+        return 1.0;
+    }
+    float radius_px = radius_in_pixels(z);
+    if (!(radius_px >= 1.0)) {
+        return 1.0;
+    }
+    vec3 position = position_at(p, z);
+    vec3 view = view_vector(position);
+    vec3 normal = texelFetch(normal_texture, ivec2(p.x, image_size.y - 1 - p.y), 0).xyz;
+    float n_dot_v = dot(normal, view);
+    /* docs/algorithm.md, "Depth precision": what rounding the depths can
+     * raise a sample above the tangent plane. */
+    float height_tolerance = depth_precision
+                           * abs(perspective != 0 ? dot(normal, position) : normal.z * position.z);
+
+    float inv_ycor = pixel_size.x / pixel_size.y;
+    float rotation = (float(PATTERN[(p.x & 3) + 4 * (p.y & 3)]) + 0.5) / 16.0;
+    float jitter = (float(PATTERN[(p.y & 3) + 4 * (p.x & 3)]) + 0.5) / 16.0;
+    float sin_bias = sin(angle_bias);
+    float step_px = (block_radius(p, z) - 1.0) / float(steps);
+
+    float hbao_sum = 0.0;
+    float cosine_open = 0.0;
+    float cosine_visible = 0.0;
+    for (int d = 0; d < directions; d++) {
+        float theta = 2.0 * PI * (float(d) + rotation) / float(directions);
+        float cos_theta = cos(theta);
+        float sin_theta = sin(theta);
+        vec3 dir3 = vec3(cos_theta, sin_theta, 0.0);
+        vec3 e = normalize(dir3 - view * dot(dir3, view));
+        vec3 m = cross(view, e);
+        vec3 np = normal - m * dot(normal, m);
+        float np_length = length(np);
+        /* A normal (almost) perpendicular to the slice: no gamma, and no
+         * weight in the cosine sum (csrc/lib/horizon.c, slice_setup). */
+        bool usable = np_length > NORMAL_IN_SLICE_EPSILON;
+        if (!usable && integration == INTEGRATION_COSINE) {
+            continue;
+        }
+        float cos_gamma = usable ? dot(np, view) / np_length : 1.0;
+        float gamma = usable ? atan(dot(np, e), dot(np, view)) : 0.0;
+        bool check_past_normal = usable && gamma > 0.0;
+
+        float sin_max = sin_bias;
+        float h_open = gamma + 0.5 * PI;
+        float h_max = max(0.0, h_open - angle_bias);
+        bool past_normal = false;
+        float occ = 0.0;
+        for (int s = 0; s < steps; s++) {
+            /* The block's offset, the same for its 16 pixels. */
+            float t = 1.0 + (float(s) + jitter) * step_px;
+            ivec2 q = p + ivec2(floor(0.5 + cos_theta * t),
+                                floor(0.5 - sin_theta * t * inv_ycor));
+            if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, image_size))) {
+                break;
+            }
+            if (q == p) {
+                continue;
+            }
+            float zs = depth_at(q);
+            if (is_background(zs)) {
+                continue;
+            }
+            vec3 delta = position_at(q, zs) - position;
+            float dist2 = dot(delta, delta);
+            /* Also what keeps a pixel to its own radius within the block's
+             * longer steps. */
+            if (!(dist2 < radius * radius) || !(dist2 > 0.0)) {
+                continue;
+            }
+            float inv_dist = 1.0 / sqrt(dist2);
+            float weight = falloff == FALLOFF_QUADRATIC ? 1.0 - dist2 / (radius * radius) : 1.0;
+            float cos_v = dot(delta, view) * inv_dist;
+            float sin_s = (dot(delta, normal) - height_tolerance) * inv_dist;
+            /* Past the normal: within gamma of V and rising at least as
+             * steeply as V (docs/algorithm.md, "The slice of a direction"). */
+            bool beyond = check_past_normal && cos_v > cos_gamma && sin_s > n_dot_v;
+            if (integration == INTEGRATION_HBAO) {
+                if (beyond) {
+                    /* Beyond the normal inside the slice: half occluded. */
+                    occ = max(occ, 0.5 * (1.0 - sin_bias));
+                    break;
+                }
+                if (sin_s > sin_max) {
+                    occ += weight * (sin_s - sin_max);
+                    sin_max = sin_s;
+                }
+            }
+            else {
+                /* The sample's angle from V through its elevation above the
+                 * tangent plane; past the normal through its angle to V
+                 * (docs/algorithm.md, "Integration COSINE"). */
+                float h;
+                if (beyond) {
+                    h = acos(min(cos_v, 1.0));
+                    past_normal = true;
+                }
+                else {
+                    if (past_normal) {
+                        continue;
+                    }
+                    float elevation = sin_s / np_length;
+                    h = max(0.0, gamma + acos(clamp(elevation, -1.0, 1.0)));
+                }
+                if (h < h_max) {
+                    occ += weight * (slice_visibility(h_max, gamma) - slice_visibility(h, gamma));
+                    h_max = h;
+                }
+            }
+        }
+        if (integration == INTEGRATION_HBAO) {
+            hbao_sum += occ;
+        }
+        else {
+            float open_visibility = slice_visibility(h_open, gamma);
+            cosine_open += np_length * open_visibility;
+            cosine_visible += np_length * (open_visibility - occ);
+        }
+    }
+    float ao;
+    if (integration == INTEGRATION_HBAO) {
+        ao = 1.0 - hbao_sum / float(directions) / (1.0 - sin_bias);
+    }
+    else {
+        ao = cosine_open > 1e-12 ? cosine_visible / cosine_open : 1.0;
+    }
+    return clamp(ao, 0.0, 1.0);
+}
+
+void main()
+{
+    ivec2 row_up = ivec2(gl_FragCoord.xy);
+    frag_output = vec4(occlusion(ivec2(row_up.x, image_size.y - 1 - row_up.y)), 0.0, 0.0, 1.0);
+}
+"""
