@@ -162,5 +162,5 @@ AO_DEFINES = {
 BLUR_DEFINES = {
     # csrc/lib/internal_finish.h, HBAO_BLUR_NORMAL_SHARPNESS
     # (tests/test_viewport.py compares the two).
-    "NORMAL_SHARPNESS": 16.0,
+    "NORMAL_SHARPNESS": 8.0,
 }
