@@ -108,7 +108,7 @@ static inline int past_the_normal(const march *m, const slice *sl, const float v
 }
 
 /* HBAO integration of one direction: sum of W * (increase of the sine of the
- * elevation above the tangent plane), Bavoil & Sainz with seed 003's rule. */
+ * elevation above the tangent plane), Bavoil & Sainz with the half-occluded rule past the normal. */
 static float direction_occlusion_hbao(const hbao_settings *s, const march *m, const float n[3],
                                       const float v[3], const slice *sl) {
     const int quadratic = s->falloff == HBAO_FALLOFF_QUADRATIC;

@@ -120,7 +120,7 @@ static double corner_cosine_occlusion(double a) {
 
 /* The classic HBAO estimator for the same point, as the library integrates
  * it: the mean over screen directions of sin(elevation of the highest wall
- * point within R in that direction's slice), with seed 003's half-occluded
+ * point within R in that direction's slice), with the half-occluded
  * rule. Derived per slice from the geometry: the slice is the plane through
  * the eye, P and P's screen direction; it cuts the wall in a line. */
 static double corner_hbao_occlusion(const scene_view *view, int i, int j, double depth) {
@@ -396,7 +396,7 @@ TEST_CASE(more_samples_converge_to_brute_force) {
 
 /* Under a table: the camera, below the table top, looks at the floor under
  * it, so the table top lies between V and the floor's normal as seen from
- * the floor: the samples that matter are past the normal, where seed 003's
+ * the floor: the samples that matter are past the normal, where the half-occluded
  * rule decides (docs/algorithm.md). The library must match the brute force,
  * which applies the same documented rule independently. */
 TEST_CASE(past_the_normal_matches_brute_force_under_a_table) {
