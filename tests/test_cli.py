@@ -735,6 +735,12 @@ def test_bad_sequence_flags_are_usage_errors(hbao_tool, tmp_path, arguments, fra
     assert_clean_error(completed, EXIT_USAGE, fragment)
 
 
+def test_a_frame_pattern_without_frames_gets_a_hint(hbao_tool, tmp_path):
+    folder, _ = sequence_folder(tmp_path)
+    completed = run_tool(hbao_tool, folder / "render_####.exr", "-o", folder / "ao.exr")
+    assert_clean_error(completed, EXIT_RUNTIME, "give --frames")
+
+
 # --- command line --------------------------------------------------------------
 
 @pytest.mark.parametrize("arguments, fragment", [

@@ -213,8 +213,11 @@ int ao_command(const cli_options *options, tool_error *error)
 {
     struct stat input_status;
     if (stat(options->input_path, &input_status) != 0)
-        return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot open %s: %s", options->input_path,
-                         strerror(errno));
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot open %s: %s%s", options->input_path,
+                         strerror(errno),
+                         strchr(options->input_path, '#') != NULL
+                             ? " (for an image sequence, give --frames)"
+                             : "");
     if (!S_ISREG(input_status.st_mode))
         return tool_fail(error, TOOL_EXIT_RUNTIME, "%s is not a regular file",
                          options->input_path);
