@@ -122,23 +122,28 @@ def exr_attribute(name, kind, payload):
     return name.encode() + b"\0" + kind.encode() + b"\0" + struct.pack("<i", len(payload)) + payload
 
 
-def scanline_exr(channels, width, height, claimed_size=None):
+def scanline_exr(channels, width, height, claimed_size=None, display_window=None,
+                 data_origin=(0, 0)):
     """A single-part, uncompressed scanline EXR of float channels (name ->
     float32 array of shape (height, width)), written from the OpenEXR file
     layout so that tests can make inputs of any size, or a header whose
     claimed size (claimed_size=(w, h)) the file does not hold: then no chunk
-    table and no chunks follow."""
+    table and no chunks follow. The data window starts at `data_origin`
+    (x, y); the display window (min x, min y, max x, max y) is the data
+    window unless given."""
     claimed_width, claimed_height = claimed_size or (width, height)
     names = sorted(channels)
     # chlist: name, pixel type 2 (float), pLinear, 3 reserved, x/y sampling.
     chlist = b"".join(n.encode() + b"\0" + struct.pack("<iB3xii", 2, 0, 1, 1)
                       for n in names) + b"\0"
-    box = struct.pack("<4i", 0, 0, claimed_width - 1, claimed_height - 1)
+    x0, y0 = data_origin
+    box = struct.pack("<4i", x0, y0, x0 + claimed_width - 1, y0 + claimed_height - 1)
+    display = struct.pack("<4i", *display_window) if display_window else box
     header = (struct.pack("<ii", 20000630, 2)
               + exr_attribute("channels", "chlist", chlist)
               + exr_attribute("compression", "compression", b"\0")
               + exr_attribute("dataWindow", "box2i", box)
-              + exr_attribute("displayWindow", "box2i", box)
+              + exr_attribute("displayWindow", "box2i", display)
               + exr_attribute("lineOrder", "lineOrder", b"\0")
               + exr_attribute("pixelAspectRatio", "float", struct.pack("<f", 1.0))
               + exr_attribute("screenWindowCenter", "v2f", struct.pack("<ff", 0.0, 0.0))
@@ -147,7 +152,7 @@ def scanline_exr(channels, width, height, claimed_size=None):
         return header
     rows = [b"".join(np.ascontiguousarray(channels[n][y], dtype="<f4").tobytes()
                      for n in names) for y in range(height)]
-    chunks = [struct.pack("<ii", y, len(row)) + row for y, row in enumerate(rows)]
+    chunks = [struct.pack("<ii", y0 + y, len(row)) + row for y, row in enumerate(rows)]
     offsets, position = [], len(header) + 8 * height
     for chunk in chunks:
         offsets.append(position)
@@ -861,3 +866,65 @@ def test_info_lists_layers_and_types(hbao_tool):
     assert channels["ViewLayer.Depth.Z"]["max"] == BACKGROUND_DEPTH
     text = run_ok(hbao_tool, "--info", fixture_path("eevee_half")).stdout
     assert "ViewLayer.Depth.Z" in text and "compression:" in text
+
+
+# A cropped border render's EXR: display window 192 x 96, data window 64 x 64 at
+# column 64, row 16 (a multiple of HBAO's 64-column blocks and 4-row sampling
+# pattern, so that both images sample alike).
+FULL_SIZE = (192, 96)
+DATA_WINDOW = (64, 16, 64, 64)
+# The full frame's camera and the crop's differ by float roundings of their view
+# numbers (~1e-7); a step offset within that of a pixel boundary rounds to the
+# other pixel, and at a crease that moves the pixel's AO. So: most pixels agree
+# to 1e-3 (horizon rounding), at most 3 % differ more (test_camera.c's bound).
+CROP_AO_TOLERANCE = 1e-3
+CROP_AO_MAX_DIFFERING_FRACTION = 0.03
+
+
+def _wavy_depth(width, height):
+    """A wavy surface 4..6 units away: valleys occlude everywhere."""
+    y, x = np.mgrid[0:height, 0:width].astype(np.float64)
+    return (5.0 + 0.8 * np.sin(x / 5.0) * np.sin(y / 6.0)).astype(np.float32)
+
+
+def test_a_data_window_gets_the_camera_of_its_crop(hbao_tool, tmp_path):
+    """An EXR whose data window is part of its display window (a cropped border
+    render) gives the AO the full frame gives at the same pixels: the tool
+    crops the camera with libhbao's hbao_camera_crop. A camera that ignored
+    the crop would move every position."""
+    from hbao import exr_passes
+    full_width, full_height = FULL_SIZE
+    x0, y0, width, height = DATA_WINDOW
+    depth = _wavy_depth(full_width, full_height)
+    camera = tmp_path / "camera.json"
+    camera.write_text(json.dumps({"type": "PERSP", "lens": 35.0, "shift_x": 0.1,
+                                  "shift_y": -0.05}))
+    full = tmp_path / "full.exr"
+    full.write_bytes(scanline_exr({"Depth.Z": depth}, full_width, full_height))
+    crop = tmp_path / "crop.exr"
+    crop.write_bytes(scanline_exr({"Depth.Z": depth[y0:y0 + height, x0:x0 + width]}, width,
+                                  height, display_window=(0, 0, full_width - 1, full_height - 1),
+                                  data_origin=(x0, y0)))
+    outputs = {}
+    for name, path in (("full", full), ("crop", crop)):
+        outputs[name] = tmp_path / f"{name}_ao.exr"
+        run_ok(hbao_tool, path, "-o", outputs[name], "--camera", camera, "--radius", "0.2",
+               "--blur", "0", "--threads", "1")
+    full_ao = exr_passes.read_channels(outputs["full"], ["AO"])["AO"]
+    crop_ao = exr_passes.read_channels(outputs["crop"], ["AO"])["AO"]
+    assert crop_ao.shape == (height, width)
+    # The radius reaches at most 0.2 / (4.2 * 36 / 35 / 192) < 9 pixels (depth >= 4.2):
+    # compare the pixels whose samples all lie inside the crop.
+    margin = 10
+    inside = crop_ao[margin:-margin, margin:-margin]
+    same = full_ao[y0 + margin:y0 + height - margin, x0 + margin:x0 + width - margin]
+    differing = np.mean(np.abs(inside - same) > CROP_AO_TOLERANCE)
+    assert differing <= CROP_AO_MAX_DIFFERING_FRACTION, differing
+    assert np.mean(1.0 - same) > 0.05  # there is occlusion to compare
+
+    outside = tmp_path / "outside.exr"
+    outside.write_bytes(scanline_exr({"Depth.Z": depth[:height, :width]}, width, height,
+                                     display_window=(0, 0, full_width - 1, full_height - 1),
+                                     data_origin=(full_width - width // 2, 0)))
+    assert_clean_error(run_tool(hbao_tool, outside, "-o", tmp_path / "outside_ao.exr",
+                                "--camera", camera), 1, "crop rectangle")

@@ -85,6 +85,7 @@ def test_struct_sizes_match_library(native):
     library = native.load_library()
     assert library.hbao_params_size() == ctypes.sizeof(native.HBAOParams)
     assert library.hbao_camera_size() == ctypes.sizeof(native.HBAOCamera)
+    assert library.hbao_view_size() == ctypes.sizeof(native.HBAOView)
 
 
 @pytest.mark.parametrize("params, camera, expected_fragment", [
@@ -172,6 +173,58 @@ def test_layouts_need_no_copy_and_agree(native):
     assert np.abs(out - reference).max() <= EXACT
 
 
+# The view numbers are the library's doubles from float camera fields: exact
+# formulas evaluated in another order differ by a few double roundings.
+VIEW_TOLERANCE = 1e-12
+
+
+def test_camera_view_is_blenders_sensor_fit(native):
+    # AUTO on a portrait image spans its height with sensor_width (never sensor_height).
+    view = native.camera_view({"lens": 50.0, "sensor_height": 10.0, "shift_x": 0.125}, 30, 90)
+    assert view.perspective == 1
+    assert view.pixel_size_y == pytest.approx(36.0 / 50.0 / 90.0, abs=VIEW_TOLERANCE)
+    assert view.pixel_size_x == pytest.approx(view.pixel_size_y, abs=VIEW_TOLERANCE)
+    # shift_x counts the fitted side's length: 0.125 * 90 pixel widths to the right.
+    assert view.origin_x == pytest.approx((-15 + 11.25) * view.pixel_size_x,
+                                          abs=VIEW_TOLERANCE)
+    vertical = native.camera_view({"sensor_fit": "VERTICAL", "sensor_height": 10.0,
+                                   "type": "ORTHO", "ortho_scale": 3.0}, 90, 30)
+    assert vertical.perspective == 0
+    assert vertical.pixel_size_y == pytest.approx(3.0 / 30.0, abs=VIEW_TOLERANCE)
+
+
+def test_camera_crop_keeps_the_dict_and_the_rays(native):
+    camera = {"type": "PERSP", "lens": 35.0, "shift_y": 0.2, "pixel_aspect_y": 2.0,
+              "world_to_camera": [[1.0, 0, 0, 0], [0, 0, 1.0, 0], [0, -1.0, 0, 0], [0, 0, 0, 1]]}
+    cropped = native.camera_crop(camera, 64, 48, 8, 4, 20, 30)
+    assert cropped["world_to_camera"] == camera["world_to_camera"]
+    assert cropped["type"] == "PERSP" and cropped["lens"] == 35.0
+    # 64 x 2 * 48 is taller than wide: AUTO fitted the vertical side, now explicit.
+    assert cropped["sensor_fit"] == "VERTICAL"
+    full = native.camera_view(camera, 64, 48)
+    crop = native.camera_view(cropped, 20, 30)
+    # The crop's bottom-left pixel corner is the full image's (8, 48 - 4 - 30).
+    # Float camera fields: 1e-6 of a pixel size covers their rounding.
+    assert crop.origin_x == pytest.approx(full.origin_x + 8 * full.pixel_size_x,
+                                          abs=1e-6 * full.pixel_size_x)
+    assert crop.origin_y == pytest.approx(full.origin_y + 14 * full.pixel_size_y,
+                                          abs=1e-6 * full.pixel_size_x)
+
+
+@pytest.mark.parametrize("call, fragment", [
+    (lambda n: n.camera_crop({}, 64, 48, 60, 0, 8, 8), "crop rectangle"),
+    (lambda n: n.camera_crop({}, 64, 48, 0, 0, 0, 8), "crop rectangle"),
+    (lambda n: n.camera_crop({}, 0, 48, 0, 0, 8, 8), "image width and height"),
+    (lambda n: n.camera_crop({"lens": -1.0}, 64, 48, 0, 0, 8, 8), "the camera is invalid"),
+    (lambda n: n.camera_view({}, 64, 70000), "image width and height"),
+    (lambda n: n.camera_view({"ortho_scale": 0.0, "type": "ORTHO"}, 64, 48),
+     "the camera is invalid"),
+])
+def test_camera_rule_errors_carry_the_library_message(native, call, fragment):
+    with pytest.raises(native.HBAOError, match=fragment):
+        call(native)
+
+
 def test_missing_library_names_the_path(monkeypatch, tmp_path):
     missing = tmp_path / "nowhere" / "libhbao.so"
     monkeypatch.setenv("HBAO_LIBRARY", str(missing))
@@ -191,7 +244,10 @@ def test_incompatible_library_is_refused(monkeypatch, tmp_path):
         "void hbao_camera_default(void *c) { (void)c; }\n"
         "size_t hbao_params_size(void) { return 48; }\n"
         "size_t hbao_camera_size(void) { return 104; }\n"
-        "int32_t hbao_compute(void) { return 0; }\n")
+        "int32_t hbao_compute(void) { return 0; }\n"
+        "size_t hbao_view_size(void) { return 40; }\n"
+        "int32_t hbao_camera_view(void) { return 0; }\n"
+        "int32_t hbao_camera_crop(void) { return 0; }\n")
     fake = tmp_path / "libfake.so"
     subprocess.run(["cc", "-shared", "-fPIC", "-o", str(fake), str(source)], check=True)
     monkeypatch.setenv("HBAO_LIBRARY", str(fake))

@@ -31,7 +31,7 @@ PYTHON_ENUMS = {
     "hbao_projection": parameters.PROJECTION_VALUES,
     "hbao_sensor_fit": parameters.SENSOR_FIT_VALUES,
 }
-C_FIELD_TYPES = {"float": ctypes.c_float, "int32_t": ctypes.c_int32}
+C_FIELD_TYPES = {"float": ctypes.c_float, "int32_t": ctypes.c_int32, "double": ctypes.c_double}
 
 
 def _number(literal):
@@ -128,7 +128,8 @@ def test_every_enum_matches_the_header():
 
 
 @pytest.mark.parametrize("struct_name, structure", [("hbao_params", native.HBAOParams),
-                                                    ("hbao_camera", native.HBAOCamera)])
+                                                    ("hbao_camera", native.HBAOCamera),
+                                                    ("hbao_view", native.HBAOView)])
 def test_the_bindings_structs_match_the_header(struct_name, structure):
     fields = header_struct(struct_name)
     assert [name for name, _, _ in fields] == [name for name, _ in structure._fields_]

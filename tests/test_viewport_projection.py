@@ -1,8 +1,10 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """The viewport preview's camera model and parameters without Blender: the
-frame from a projection matrix equals the library's camera model, and the
-depth-buffer linearisation inverts the projection."""
+frame from a projection matrix equals the library's camera model (libhbao's
+hbao_camera_view, through the binding), and the depth-buffer linearisation
+inverts the projection."""
 import math
+import re
 import sys
 
 import pytest
@@ -17,6 +19,17 @@ from hbao.viewport import projection  # noqa: E402
 
 # float64 throughout: only rounding separates the two derivations.
 TOLERANCE = 1e-9
+# A cropped camera's sensor and shift are float32 fields of hbao_camera (2^-24
+# relative) of numbers up to a few image widths: 1e-5 pixel widths bounds their
+# rounding, and 1e-6 relative the pixel sizes'.
+CROP_TOLERANCE_PIXELS = 1e-5
+CROP_TOLERANCE_RELATIVE = 1e-6
+
+
+@pytest.fixture(autouse=True)
+def library(native):
+    """frame_from_camera and crop_camera call libhbao: this build's."""
+    return native
 
 
 def _camera_matrix(frame, near=0.1, far=100.0):
@@ -76,21 +89,13 @@ def test_a_cropped_border_sees_the_same_pixels(camera, size, border):
     cropped = projection.frame_from_camera(
         camera_model.crop_camera(camera, *size, border), x1 - x0, y1 - y0)
     assert cropped.perspective == full.perspective
-    assert cropped.pixel_size_x == pytest.approx(full.pixel_size_x, abs=TOLERANCE)
-    assert cropped.pixel_size_y == pytest.approx(full.pixel_size_y, abs=TOLERANCE)
+    assert cropped.pixel_size_x == pytest.approx(full.pixel_size_x, rel=CROP_TOLERANCE_RELATIVE)
+    assert cropped.pixel_size_y == pytest.approx(full.pixel_size_y, rel=CROP_TOLERANCE_RELATIVE)
+    tolerance = CROP_TOLERANCE_PIXELS * full.pixel_size_x
     assert cropped.origin_x == pytest.approx(full.origin_x + x0 * full.pixel_size_x,
-                                             abs=TOLERANCE)
+                                             abs=tolerance)
     assert cropped.origin_y == pytest.approx(full.origin_y + y0 * full.pixel_size_y,
-                                             abs=TOLERANCE)
-
-
-def test_auto_fit_spans_the_larger_side_with_sensor_width():
-    # Blender's BKE_camera_sensor_size: AUTO never uses sensor_height.
-    camera = {"sensor_width": 36.0, "sensor_height": 10.0}
-    assert camera_model.sensor_fit(camera, 30, 90) == ("VERTICAL", 36.0, 90.0)
-    assert camera_model.sensor_fit(camera, 90, 30) == ("HORIZONTAL", 36.0, 90.0)
-    vertical = dict(camera, sensor_fit="VERTICAL")
-    assert camera_model.sensor_fit(vertical, 90, 30) == ("VERTICAL", 10.0, 30.0)
+                                             abs=tolerance)
 
 
 def test_camera_model_follows_blender_fit():
@@ -99,8 +104,31 @@ def test_camera_model_follows_blender_fit():
     assert wide.pixel_size_x == pytest.approx(36.0 / 50.0 / 64.0, abs=TOLERANCE)
     assert wide.origin_x == pytest.approx(-32 * wide.pixel_size_x, abs=TOLERANCE)
     # AUTO on a tall image spans the height with sensor_width.
-    tall = projection.frame_from_camera({"lens": 50.0}, 48, 64)
+    tall = projection.frame_from_camera({"lens": 50.0, "sensor_height": 10.0}, 48, 64)
     assert tall.pixel_size_y == pytest.approx(36.0 / 50.0 / 64.0, abs=TOLERANCE)
+    vertical = projection.frame_from_camera({"sensor_fit": "VERTICAL", "sensor_height": 10.0},
+                                            64, 48)
+    assert vertical.pixel_size_y == pytest.approx(10.0 / 50.0 / 48.0, abs=TOLERANCE)
+
+
+def test_without_the_library_the_frame_fails_with_its_message(library, monkeypatch, tmp_path):
+    """The preview's camera frame is the library's: without libhbao it raises the
+    binding's error naming the missing file (viewport/draw.py reports it)."""
+    missing = tmp_path / "libhbao.so"
+    monkeypatch.setenv("HBAO_LIBRARY", str(missing))
+    library.unload_library()
+    try:
+        with pytest.raises(library.HBAOLibraryError, match=re.escape(str(missing))):
+            projection.frame_from_camera({"lens": 50.0}, 64, 48)
+    finally:
+        library.unload_library()
+
+
+def test_bad_sizes_and_cameras_are_refused():
+    with pytest.raises(Exception, match="image width and height"):
+        projection.frame_from_camera({}, 0, 48)
+    with pytest.raises(ValueError, match="camera type"):
+        projection.frame_from_camera({"type": "PANO"}, 64, 48)
 
 
 @pytest.mark.parametrize("perspective", [True, False])

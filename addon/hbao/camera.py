@@ -1,5 +1,6 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """The scene camera as the camera dict native.compute_ao() takes."""
+from . import native
 
 
 class CameraError(ValueError):
@@ -56,47 +57,13 @@ def _border_pixels(render, width, height):
     return x0, max(x1, x0 + 1), y0, max(y1, y0 + 1)
 
 
-def sensor_fit(camera, width, height):
-    """Blender's sensor-fit rule (BKE_camera_params_compute_viewplane) for a
-    camera dict on a `width` x `height` image: (fitted axis "HORIZONTAL" or
-    "VERTICAL", the sensor size in mm (or ortho scale's side) spanning it, and
-    that side's length in pixel widths). AUTO fits the larger side of the
-    aspect-corrected image, with sensor_width whichever side that is. The C
-    library (csrc/lib/camera.c) and this function are the rule's two
-    implementations; tests/test_viewport_projection.py ties the Python uses
-    of it together."""
-    aspect_x = float(camera.get("pixel_aspect_x", 1.0))
-    aspect_y = float(camera.get("pixel_aspect_y", 1.0))
-    requested = camera.get("sensor_fit", "AUTO")
-    fit = requested
-    if fit == "AUTO":
-        fit = "HORIZONTAL" if aspect_x * width >= aspect_y * height else "VERTICAL"
-    sensor = float(camera.get("sensor_height", 24.0)) if requested == "VERTICAL" \
-        else float(camera.get("sensor_width", 36.0))
-    fitted_side = width if fit == "HORIZONTAL" else aspect_y / aspect_x * height
-    return fit, sensor, fitted_side
-
-
 def crop_camera(description, width, height, border):
     """The camera dict of the `border` (x0, x1, y0, y1 pixels, y from the
     bottom) of a `width` x `height` image seen by camera dict `description`:
-    same focal length in pixels, the principal point moved by a lens shift,
-    the sensor fitted horizontally to the crop."""
+    the same view rays, by libhbao's crop rule (native.camera_crop), which
+    the CLI applies to EXR data windows too. Raises native's errors."""
     x0, x1, y0, y1 = border
-    _fit, sensor, fitted_side = sensor_fit(description, width, height)
-    ycor = float(description.get("pixel_aspect_y", 1.0)) / \
-        float(description.get("pixel_aspect_x", 1.0))
-    crop_width = x1 - x0
-    # The crop's centre relative to the full frame's, in pixel widths.
-    dx = (x0 + x1) / 2.0 - width / 2.0
-    dy = ((y0 + y1) / 2.0 - height / 2.0) * ycor
-    cropped = dict(description)
-    cropped["sensor_fit"] = "HORIZONTAL"
-    cropped["sensor_width"] = sensor * crop_width / fitted_side
-    cropped["ortho_scale"] = float(description.get("ortho_scale", 6.0)) * crop_width / fitted_side
-    cropped["shift_x"] = (float(description.get("shift_x", 0.0)) * fitted_side + dx) / crop_width
-    cropped["shift_y"] = (float(description.get("shift_y", 0.0)) * fitted_side + dy) / crop_width
-    return cropped
+    return native.camera_crop(description, width, height, x0, height - y1, x1 - x0, y1 - y0)
 
 
 def camera_for_render_result(scene, camera_object=None):

@@ -13,11 +13,12 @@ from pathlib import Path
 import numpy as np
 
 from . import library_loading
+from .native_structs import HBAOCamera, HBAOChannel, HBAOParams, HBAOView
 from .parameters import (FALLOFF_VALUES, INTEGRATION_VALUES, PROJECTION_VALUES,
                          SENSOR_FIT_VALUES)
 
 __all__ = [
-    "HBAOError", "HBAOLibraryError", "compute_ao", "default_params",
+    "HBAOError", "HBAOLibraryError", "compute_ao", "default_params", "camera_view", "camera_crop",
     "library_path", "load_library", "library_version",
     "PARAMETER_NAMES", "FALLOFF_NAMES", "INTEGRATION_NAMES",
 ]
@@ -43,50 +44,6 @@ class HBAOLibraryError(RuntimeError):
     """libhbao could not be loaded, or it does not match this binding."""
 
 
-# --- mirrored structs (keep in the header's field order) --------------------
-
-class HBAOParams(ctypes.Structure):
-    _fields_ = [
-        ("radius", ctypes.c_float),
-        ("angle_bias_degrees", ctypes.c_float),
-        ("directions", ctypes.c_int32),
-        ("steps", ctypes.c_int32),
-        ("falloff", ctypes.c_int32),
-        ("integration", ctypes.c_int32),
-        ("blur_size", ctypes.c_int32),
-        ("blur_sharpness", ctypes.c_float),
-        ("half_resolution", ctypes.c_int32),
-        ("strength", ctypes.c_float),
-        ("threads", ctypes.c_int32),
-        ("background_depth", ctypes.c_float),
-        ("implementation", ctypes.c_int32),
-    ]
-
-
-class HBAOCamera(ctypes.Structure):
-    _fields_ = [
-        ("projection", ctypes.c_int32),
-        ("lens", ctypes.c_float),
-        ("sensor_width", ctypes.c_float),
-        ("sensor_height", ctypes.c_float),
-        ("sensor_fit", ctypes.c_int32),
-        ("shift_x", ctypes.c_float),
-        ("shift_y", ctypes.c_float),
-        ("ortho_scale", ctypes.c_float),
-        ("pixel_aspect_x", ctypes.c_float),
-        ("pixel_aspect_y", ctypes.c_float),
-        ("world_to_camera", ctypes.c_float * 16),
-    ]
-
-
-class HBAOChannel(ctypes.Structure):
-    _fields_ = [
-        ("data", ctypes.POINTER(ctypes.c_float)),
-        ("pixel_stride", ctypes.c_int32),
-        ("row_stride", ctypes.c_int64),
-    ]
-
-
 # Enum names as Blender spells them, mapped to the header's values (parameters.py).
 FALLOFF_NAMES = FALLOFF_VALUES
 INTEGRATION_NAMES = INTEGRATION_VALUES
@@ -108,6 +65,10 @@ _FUNCTIONS = {
     "hbao_camera_default": (None, [_CAMERA_P]),
     "hbao_params_size": (ctypes.c_size_t, []),
     "hbao_camera_size": (ctypes.c_size_t, []),
+    "hbao_view_size": (ctypes.c_size_t, []),
+    "hbao_camera_view": (ctypes.c_int32, [_CAMERA_P, ctypes.c_int32, ctypes.c_int32,
+                                          ctypes.POINTER(HBAOView)]),
+    "hbao_camera_crop": (ctypes.c_int32, [_CAMERA_P] + [ctypes.c_int32] * 6 + [_CAMERA_P]),
     "hbao_compute": (ctypes.c_int32, [_PARAMS_P, _CAMERA_P, ctypes.c_int32, ctypes.c_int32,
                                       _CHANNEL_P, _CHANNEL_P, ctypes.POINTER(ctypes.c_float),
                                       ctypes.c_int64]),
@@ -124,7 +85,8 @@ _LIBRARY = library_loading.NativeLibrary(
     handshake=library_loading.Handshake(
         "hbao_version", BINDING_VERSION_MAJOR,
         [("hbao_params", "hbao_params_size", HBAOParams),
-         ("hbao_camera", "hbao_camera_size", HBAOCamera)],
+         ("hbao_camera", "hbao_camera_size", HBAOCamera),
+         ("hbao_view", "hbao_view_size", HBAOView)],
         version_key=lambda packed: packed // 10000,
         describe=_version_text,
         expected_text=f"{BINDING_VERSION_MAJOR}.x"),
@@ -205,6 +167,27 @@ def _camera_struct(camera):
             raise ValueError(f"camera world_to_camera must be 4x4, not {matrix.shape}")
         structure.world_to_camera[:] = [float(v) for v in matrix.reshape(16)]
     return structure
+
+
+def camera_view(camera, width, height):
+    """The HBAOView of camera dict `camera` on a `width` x `height` image: libhbao's
+    sensor fit (hbao_camera_view). Raises HBAOError, HBAOLibraryError, ValueError."""
+    view = HBAOView()
+    _check(load_library().hbao_camera_view(ctypes.byref(_camera_struct(camera)), width, height,
+                                           ctypes.byref(view)))
+    return view
+
+
+def camera_crop(camera, full_width, full_height, x, y, width, height):
+    """The camera dict of the `width` x `height` rectangle at column `x`, row `y` (from the
+    top) of the full image seen by camera dict `camera`, with the same view rays
+    (hbao_camera_crop). Raises HBAOError, HBAOLibraryError, ValueError."""
+    structure = _camera_struct(camera)
+    _check(load_library().hbao_camera_crop(ctypes.byref(structure), full_width, full_height,
+                                           x, y, width, height, ctypes.byref(structure)))
+    fit = next(name for name, value in SENSOR_FIT_NAMES.items() if value == structure.sensor_fit)
+    return dict(camera or {}, sensor_fit=fit,
+                **{name: getattr(structure, name) for name in _CAMERA_FLOAT_NAMES})
 
 
 def _as_float32(array):

@@ -67,7 +67,9 @@ extern "C" {
       "the camera is invalid (lens, sensor, ortho scale and pixel aspect must be "  \
       "finite and > 0; the matrix must be finite and invertible)")                  \
     X(HBAO_ERROR_OUT_OF_MEMORY, "out of memory")                                     \
-    X(HBAO_ERROR_THREAD, "could not start a worker thread")
+    X(HBAO_ERROR_THREAD, "could not start a worker thread")                           \
+    X(HBAO_ERROR_INVALID_RECTANGLE,                                                  \
+      "the crop rectangle must be at least 1 x 1 and lie inside the image")
 
 typedef enum hbao_result_code {
 #define HBAO_RESULT_ENUM_ENTRY(name, message) name,
@@ -222,6 +224,26 @@ typedef struct hbao_camera {
         }                                                                        \
     }
 
+/**
+ * Where a camera puts the pixels of a width x height image (docs/algorithm.md,
+ * "Camera"): pixel (i, j), column i from the left and row j from the top, lies
+ * at
+ *
+ *   x = origin_x + (i + 0.5) * pixel_size_x
+ *   y = origin_y + (height - 1 - j + 0.5) * pixel_size_y
+ *
+ * per unit depth when perspective (camera-space P = (x depth, y depth, -depth))
+ * and in scene units when orthographic (P = (x, y, -depth)). These are the
+ * numbers a renderer of the same view (the add-on's GLSL preview) needs.
+ */
+typedef struct hbao_view {
+    int32_t perspective;  /**< 1 perspective, 0 orthographic */
+    double pixel_size_x;  /**< view-plane width of one pixel */
+    double pixel_size_y;  /**< its height: pixel_size_x * pixel_aspect_y / pixel_aspect_x */
+    double origin_x;      /**< left edge of the image */
+    double origin_y;      /**< bottom edge of the image */
+} hbao_view;
+
 /** A read-only view of one image channel (or of 3 consecutive channels, for
  *  normals). Strides count floats; row_stride may be negative. */
 typedef struct hbao_channel {
@@ -293,6 +315,43 @@ HBAO_EXPORT int32_t hbao_best_implementation(void);
  *  so that bindings (ctypes) can check their struct layouts on load. */
 HBAO_EXPORT size_t hbao_params_size(void);
 HBAO_EXPORT size_t hbao_camera_size(void);
+/** sizeof(hbao_view) as compiled into the library (see above). */
+HBAO_EXPORT size_t hbao_view_size(void);
+
+/**
+ * The view frame of `camera` on a width x height image: Blender's sensor fit
+ * (BKE_camera_params_compute_viewplane), the one implementation of it that
+ * hbao_compute() and every front end use.
+ *
+ * @param width, height  image size, each in [1, 65536]
+ * @return HBAO_ERROR_NULL_ARGUMENT, HBAO_ERROR_INVALID_SIZE,
+ *         HBAO_ERROR_INVALID_CAMERA (as hbao_compute() would), and then
+ *         *view is unchanged
+ */
+HBAO_EXPORT hbao_result hbao_camera_view(const hbao_camera *camera, int32_t width,
+                                         int32_t height, hbao_view *view);
+
+/**
+ * The camera of the sub-rectangle (x, y, width, height) of a full_width x
+ * full_height image (a border render, an EXR data window inside its display
+ * window): each of its pixels gets the view ray the full camera gives the
+ * same pixel. The sensor fit is made explicit (AUTO becomes the side it
+ * fitted), the fitted sensor side and the ortho scale are scaled to the
+ * crop and the lens shift moves the centre; lens, pixel aspect and matrix
+ * are kept. A crop of the whole image returns the camera unchanged.
+ *
+ * @param full_width, full_height  the full image, each in [1, 65536]
+ * @param x, y           the crop's top-left pixel in the full image (y down)
+ * @param width, height  the crop, >= 1, inside the full image
+ * @param cropped        output; may be `camera`
+ * @return HBAO_ERROR_NULL_ARGUMENT, HBAO_ERROR_INVALID_SIZE,
+ *         HBAO_ERROR_INVALID_RECTANGLE, HBAO_ERROR_INVALID_CAMERA (for the
+ *         camera, or when the cropped camera's numbers leave float's range),
+ *         and then *cropped is unchanged
+ */
+HBAO_EXPORT hbao_result hbao_camera_crop(const hbao_camera *camera, int32_t full_width,
+                                         int32_t full_height, int32_t x, int32_t y,
+                                         int32_t width, int32_t height, hbao_camera *cropped);
 
 /**
  * Compute ambient occlusion.

@@ -29,3 +29,5 @@ void hbao_camera_default(hbao_camera *camera) {
 size_t hbao_params_size(void) { return sizeof(hbao_params); }
 
 size_t hbao_camera_size(void) { return sizeof(hbao_camera); }
+
+size_t hbao_view_size(void) { return sizeof(hbao_view); }

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
 /* Blender's camera model: where each pixel lies in the view plane.
  * Follows BKE_camera_params_compute_viewplane (docs/algorithm.md, "Camera"). */
+#include <float.h>
 #include <math.h>
 
 #include "internal_hbao.h"
@@ -58,34 +59,128 @@ hbao_result hbao_validate_camera(const hbao_camera *camera) {
     return HBAO_SUCCESS;
 }
 
+/* Blender's view plane of a camera on a width x height image, in units of
+ * one pixel width: the sensor-fit rule, written once for hbao_compute(),
+ * hbao_camera_view() and hbao_camera_crop(). */
+typedef struct view_plane {
+    int horizontal_fit;
+    int orthographic;
+    double sensor_size; /* mm of sensor spanning the fitted side */
+    double viewfac;     /* the fitted side's length, in pixel widths */
+    double ycor;        /* pixel height / pixel width */
+    double pixel_size;  /* view-plane width of one pixel (per unit depth if perspective) */
+    double left;        /* the image's left edge, in pixel widths */
+    double bottom;      /* its bottom edge, in pixel widths */
+} view_plane;
+
+static view_plane fit_view_plane(const hbao_camera *camera, int width, int height) {
+    view_plane plane;
+    const double aspect_x = camera->pixel_aspect_x, aspect_y = camera->pixel_aspect_y;
+    plane.ycor = aspect_y / aspect_x;
+    if (camera->sensor_fit == HBAO_SENSOR_FIT_AUTO)
+        plane.horizontal_fit = aspect_x * width >= aspect_y * height;
+    else
+        plane.horizontal_fit = camera->sensor_fit == HBAO_SENSOR_FIT_HORIZONTAL;
+    /* AUTO always uses sensor_width, for whichever side is larger
+     * (BKE_camera_sensor_size). */
+    plane.sensor_size = camera->sensor_fit == HBAO_SENSOR_FIT_VERTICAL ? camera->sensor_height
+                                                                       : camera->sensor_width;
+    plane.viewfac = plane.horizontal_fit ? (double)width : plane.ycor * height;
+    plane.orthographic = camera->projection == HBAO_PROJECTION_ORTHOGRAPHIC;
+    plane.pixel_size =
+        (plane.orthographic ? camera->ortho_scale : plane.sensor_size / camera->lens) /
+        plane.viewfac;
+    plane.left = -0.5 * width + camera->shift_x * plane.viewfac;
+    plane.bottom = -0.5 * plane.ycor * height + camera->shift_y * plane.viewfac;
+    return plane;
+}
+
 void hbao_grid_set_projection(hbao_grid *grid, const hbao_camera *camera, int full_width,
                               int full_height, int scale) {
-    const double aspect_x = camera->pixel_aspect_x, aspect_y = camera->pixel_aspect_y;
-    const double ycor = aspect_y / aspect_x;
-    int horizontal_fit;
-    if (camera->sensor_fit == HBAO_SENSOR_FIT_AUTO)
-        horizontal_fit = aspect_x * full_width >= aspect_y * full_height;
-    else
-        horizontal_fit = camera->sensor_fit == HBAO_SENSOR_FIT_HORIZONTAL;
-    /* AUTO always uses sensor_width, for whichever side is larger. */
-    const double sensor_size = camera->sensor_fit == HBAO_SENSOR_FIT_VERTICAL
-                                   ? camera->sensor_height
-                                   : camera->sensor_width;
-    const double viewfac = horizontal_fit ? (double)full_width : ycor * full_height;
-    const int orthographic = camera->projection == HBAO_PROJECTION_ORTHOGRAPHIC;
-    const double pixel_size =
-        (orthographic ? camera->ortho_scale : sensor_size / camera->lens) / viewfac;
-    const double left = -0.5 * full_width + camera->shift_x * viewfac;
-    const double bottom = -0.5 * ycor * full_height + camera->shift_y * viewfac;
+    const view_plane plane = fit_view_plane(camera, full_width, full_height);
+    const double pixel_size = plane.pixel_size, ycor = plane.ycor;
 
     /* Column i of the grid is full-resolution pixel scale * i, whose centre
      * lies at (left + scale * i + 0.5) * pixel_size; likewise for rows,
      * counted from the top. */
     grid->x_step = (float)(scale * pixel_size);
-    grid->x_offset = (float)((left + 0.5) / scale);
+    grid->x_offset = (float)((plane.left + 0.5) / scale);
     grid->y_step = (float)(-scale * ycor * pixel_size);
-    grid->y_offset = (float)((bottom + (full_height - 0.5) * ycor) / (-scale * ycor));
-    grid->orthographic = orthographic;
+    grid->y_offset = (float)((plane.bottom + (full_height - 0.5) * ycor) / (-scale * ycor));
+    grid->orthographic = plane.orthographic;
     grid->pixel_size = (float)(pixel_size * scale);
     grid->ycor = (float)ycor;
+}
+
+static int image_size_is_valid(int32_t width, int32_t height) {
+    return width >= 1 && height >= 1 && width <= HBAO_MAX_IMAGE_SIZE &&
+           height <= HBAO_MAX_IMAGE_SIZE;
+}
+
+hbao_result hbao_camera_view(const hbao_camera *camera, int32_t width, int32_t height,
+                             hbao_view *view) {
+    if (camera == NULL || view == NULL) return HBAO_ERROR_NULL_ARGUMENT;
+    if (!image_size_is_valid(width, height)) return HBAO_ERROR_INVALID_SIZE;
+    const hbao_result result = hbao_validate_camera(camera);
+    if (result != HBAO_SUCCESS) return result;
+    const view_plane plane = fit_view_plane(camera, width, height);
+    view->perspective = !plane.orthographic;
+    view->pixel_size_x = plane.pixel_size;
+    view->pixel_size_y = plane.ycor * plane.pixel_size;
+    view->origin_x = plane.left * plane.pixel_size;
+    view->origin_y = plane.bottom * plane.pixel_size;
+    return HBAO_SUCCESS;
+}
+
+/* A double that converts to a finite float (converting one beyond FLT_MAX is
+ * undefined behaviour in C). */
+static int fits_float(double value) { return isfinite(value) && fabs(value) <= FLT_MAX; }
+
+hbao_result hbao_camera_crop(const hbao_camera *camera, int32_t full_width, int32_t full_height,
+                             int32_t x, int32_t y, int32_t width, int32_t height,
+                             hbao_camera *cropped) {
+    if (camera == NULL || cropped == NULL) return HBAO_ERROR_NULL_ARGUMENT;
+    if (!image_size_is_valid(full_width, full_height)) return HBAO_ERROR_INVALID_SIZE;
+    /* 64-bit sums: x + width must not wrap around for absurd arguments. */
+    if (x < 0 || y < 0 || width < 1 || height < 1 || (int64_t)x + width > full_width ||
+        (int64_t)y + height > full_height)
+        return HBAO_ERROR_INVALID_RECTANGLE;
+    hbao_result result = hbao_validate_camera(camera);
+    if (result != HBAO_SUCCESS) return result;
+    if (x == 0 && y == 0 && width == full_width && height == full_height) {
+        *cropped = *camera;
+        return HBAO_SUCCESS;
+    }
+
+    const view_plane full = fit_view_plane(camera, full_width, full_height);
+    /* The crop keeps the full image's fitted side, so that its pixels keep
+     * their size: that side's sensor (or ortho scale) shrinks with it. */
+    const double crop_viewfac = full.horizontal_fit ? (double)width : full.ycor * height;
+    const double scale = crop_viewfac / full.viewfac;
+    /* The crop's left and bottom edges in the full view plane, in pixel
+     * widths; the crop's own plane puts them at -width / 2 + shift * viewfac. */
+    const double left = full.left + x;
+    const double bottom = full.bottom + full.ycor * ((double)full_height - y - height);
+    const double sensor_size = full.sensor_size * scale;
+    const double ortho_scale = camera->ortho_scale * scale;
+    const double shift_x = (left + 0.5 * width) / crop_viewfac;
+    const double shift_y = (bottom + 0.5 * full.ycor * height) / crop_viewfac;
+    if (!fits_float(sensor_size) || !fits_float(ortho_scale) || !fits_float(shift_x) ||
+        !fits_float(shift_y))
+        return HBAO_ERROR_INVALID_CAMERA;
+
+    hbao_camera out = *camera;
+    out.sensor_fit = full.horizontal_fit ? HBAO_SENSOR_FIT_HORIZONTAL : HBAO_SENSOR_FIT_VERTICAL;
+    if (full.horizontal_fit)
+        out.sensor_width = (float)sensor_size;
+    else
+        out.sensor_height = (float)sensor_size;
+    out.ortho_scale = (float)ortho_scale;
+    out.shift_x = (float)shift_x;
+    out.shift_y = (float)shift_y;
+    /* A sensor or ortho scale scaled below float's range is not a camera. */
+    result = hbao_validate_camera(&out);
+    if (result != HBAO_SUCCESS) return result;
+    *cropped = out;
+    return HBAO_SUCCESS;
 }

@@ -186,8 +186,12 @@ int ao_compute_input(const cli_options *options, exr_input *input, ao_buffers *b
     status = resolve_camera(options, input, &camera, error);
     if (status != TOOL_EXIT_SUCCESS) return status;
     const bool use_normals = passes.has_normal && !options->ignore_normals;
-    const hbao_camera cropped =
-        camera_for_data_window(&camera.camera, &input->display_window, &input->data_window);
+    hbao_camera cropped;
+    const hbao_result cropping = camera_for_data_window(
+        &camera.camera, &input->display_window, &input->data_window, &cropped);
+    if (cropping != HBAO_SUCCESS)
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: cannot compute AO: %s",
+                         options->input_path, hbao_result_message(cropping));
 
     status = read_passes(input, &passes, use_normals, buffers, error);
     if (status != TOOL_EXIT_SUCCESS) return status;

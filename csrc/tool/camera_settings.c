@@ -30,60 +30,24 @@ void camera_settings_apply(camera_settings *base, const camera_settings *overrid
     base->fields_set |= set;
 }
 
-static double rect_width(const pixel_rect *rect)
+/* The full image's size and the crop's place in it, as int32 or -1 where a
+ * header's 32-bit window coordinates overflow it (hbao_camera_crop refuses -1). */
+static int32_t as_int32(int64_t value)
 {
-    return (double)rect->max_x - rect->min_x + 1.0;
+    return value >= INT32_MIN && value <= INT32_MAX ? (int32_t)value : -1;
 }
 
-static double rect_height(const pixel_rect *rect)
+hbao_result camera_for_data_window(const hbao_camera *camera, const pixel_rect *display,
+                                   const pixel_rect *data, hbao_camera *cropped)
 {
-    return (double)rect->max_y - rect->min_y + 1.0;
-}
-
-hbao_camera camera_for_data_window(const hbao_camera *camera, const pixel_rect *display,
-                                   const pixel_rect *data)
-{
-    if (memcmp(display, data, sizeof *data) == 0) return *camera;
-
-    /* Blender's view plane, in units of display pixels horizontally and
-     * ycor * pixels vertically (ycor = pixel_aspect_y / pixel_aspect_x). */
-    const double full_width = rect_width(display), full_height = rect_height(display);
-    const double crop_width = rect_width(data), crop_height = rect_height(data);
-    const double ycor = (double)camera->pixel_aspect_y / camera->pixel_aspect_x;
-
-    int32_t fit = camera->sensor_fit;
-    if (fit == HBAO_SENSOR_FIT_AUTO)
-        fit = camera->pixel_aspect_x * full_width >= camera->pixel_aspect_y * full_height
-                  ? HBAO_SENSOR_FIT_HORIZONTAL
-                  : HBAO_SENSOR_FIT_VERTICAL;
-    /* AUTO uses sensor_width for whichever side it fits (BKE_camera_sensor_size). */
-    const double sensor = camera->sensor_fit == HBAO_SENSOR_FIT_VERTICAL ? camera->sensor_height
-                                                                          : camera->sensor_width;
-    const bool horizontal = fit == HBAO_SENSOR_FIT_HORIZONTAL;
-    const double full_fitted = horizontal ? full_width : ycor * full_height;
-    const double crop_fitted = horizontal ? crop_width : ycor * crop_height;
-    const double scale = crop_fitted / full_fitted;
-
-    /* Offsets of the crop's lower-left corner from the frame's, bottom-up. */
-    const double offset_x = (double)data->min_x - display->min_x;
-    const double offset_y = (double)display->max_y - data->max_y;
-    /* Centre shift in view-plane units: the old shift plus the move of the
-     * window centre from the full frame's to the crop's. */
-    const double shift_x_plane =
-        camera->shift_x * full_fitted + offset_x + 0.5 * (crop_width - full_width);
-    const double shift_y_plane =
-        camera->shift_y * full_fitted + ycor * (offset_y + 0.5 * (crop_height - full_height));
-
-    hbao_camera cropped = *camera;
-    cropped.sensor_fit = fit;
-    if (horizontal)
-        cropped.sensor_width = (float)(sensor * scale);
-    else
-        cropped.sensor_height = (float)(sensor * scale);
-    cropped.ortho_scale = (float)(camera->ortho_scale * scale);
-    cropped.shift_x = (float)(shift_x_plane / crop_fitted);
-    cropped.shift_y = (float)(shift_y_plane / crop_fitted);
-    return cropped;
+    const int64_t full_width = (int64_t)display->max_x - display->min_x + 1;
+    const int64_t full_height = (int64_t)display->max_y - display->min_y + 1;
+    const int64_t width = (int64_t)data->max_x - data->min_x + 1;
+    const int64_t height = (int64_t)data->max_y - data->min_y + 1;
+    return hbao_camera_crop(camera, as_int32(full_width), as_int32(full_height),
+                            as_int32((int64_t)data->min_x - display->min_x),
+                            as_int32((int64_t)data->min_y - display->min_y), as_int32(width),
+                            as_int32(height), cropped);
 }
 
 bool matrix_is_identity(const float matrix[16])

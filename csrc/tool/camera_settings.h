@@ -40,15 +40,13 @@ void camera_settings_init(camera_settings *settings);
 void camera_settings_apply(camera_settings *base, const camera_settings *override);
 
 /**
- * The camera for the sub-rectangle `data` of the full frame `display`
- * (Blender's border render): same focal length per pixel and same view
- * rays, with the sensor fit made explicit, the fitted sensor side (or the
- * ortho scale) scaled to the crop and the lens shift moved to the crop's
- * centre. Follows Blender's BKE_camera_params_compute_viewplane(). Identical
- * rectangles return the camera unchanged.
+ * The camera for the data window `data` of the display window `display`
+ * (Blender's cropped border render): hbao_camera_crop() with EXR's window
+ * coordinates. Its result code: a data window that is not inside the
+ * display window gives HBAO_ERROR_INVALID_RECTANGLE.
  */
-hbao_camera camera_for_data_window(const hbao_camera *camera, const pixel_rect *display,
-                                   const pixel_rect *data);
+hbao_result camera_for_data_window(const hbao_camera *camera, const pixel_rect *display,
+                                   const pixel_rect *data, hbao_camera *cropped);
 
 /** True when the 4x4 matrix is the identity. */
 bool matrix_is_identity(const float matrix[16]);

@@ -10,14 +10,15 @@ docs/algorithm.md) at
 
 per unit depth (perspective: P = (x * depth, y * depth, -depth)) or in scene
 units (orthographic: P = (x, y, -depth)). A ViewFrame holds those four numbers.
-The C library derives them from a Blender camera (frame_from_camera); the 3D
-viewport has no camera in free view, only its projection matrix
-(frame_from_projection_matrix). Both give the same frame for the same view, which
-tests/test_viewport_projection.py checks.
+The C library derives them from a Blender camera (frame_from_camera calls its
+hbao_camera_view through the binding, so it needs libhbao); the 3D viewport has
+no camera in free view, only its projection matrix (frame_from_projection_matrix).
+Both give the same frame for the same view, which tests/test_viewport_projection.py
+checks.
 """
 from dataclasses import dataclass
 
-from ..camera import sensor_fit
+from .. import native
 
 
 @dataclass(frozen=True)
@@ -38,26 +39,15 @@ class ViewFrame:
 
 def frame_from_camera(camera, width, height):
     """The frame of docs/algorithm.md's camera model (Blender's
-    BKE_camera_params_compute_viewplane) for a camera dict as native.compute_ao takes."""
-    if width < 1 or height < 1:
-        raise ValueError(f"image size must be positive, not {width}x{height}")
-    camera = dict(camera or {})
-    projection = camera.get("type", "PERSP")
-    if projection not in ("PERSP", "ORTHO"):
-        raise ValueError(f"camera type must be PERSP or ORTHO, not {projection!r}")
-    ycor = float(camera.get("pixel_aspect_y", 1.0)) / float(camera.get("pixel_aspect_x", 1.0))
-    _fit, sensor_size, viewfac = sensor_fit(camera, width, height)
-    if projection == "PERSP":
-        pixel_size = sensor_size / float(camera.get("lens", 50.0)) / viewfac
-    else:
-        pixel_size = float(camera.get("ortho_scale", 6.0)) / viewfac
-    shift_x = float(camera.get("shift_x", 0.0))
-    shift_y = float(camera.get("shift_y", 0.0))
+    BKE_camera_params_compute_viewplane) for a camera dict as native.compute_ao takes:
+    libhbao's own numbers (native.camera_view). Raises native.HBAOLibraryError when
+    the library cannot be loaded, native.HBAOError for a size or camera it refuses,
+    ValueError for a malformed camera dict."""
+    view = native.camera_view(camera, width, height)
     return ViewFrame(
-        width=width, height=height, perspective=projection == "PERSP",
-        pixel_size_x=pixel_size, pixel_size_y=ycor * pixel_size,
-        origin_x=(-width / 2.0 + shift_x * viewfac) * pixel_size,
-        origin_y=(-ycor * height / 2.0 + shift_y * viewfac) * pixel_size)
+        width=width, height=height, perspective=bool(view.perspective),
+        pixel_size_x=view.pixel_size_x, pixel_size_y=view.pixel_size_y,
+        origin_x=view.origin_x, origin_y=view.origin_y)
 
 
 def frame_from_projection_matrix(matrix, width, height):
