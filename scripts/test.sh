@@ -44,8 +44,10 @@ scripts/fuzz_cli.sh 100 1
 echo "== coverage-guided fuzzing (libFuzzer + ASan + UBSan), 60 s"
 scripts/fuzz.sh 60
 
-echo "== PEP 8"
+echo "== style: PEP 8 (Python), .clang-format (C)"
 "$PYTHON" -m pycodestyle addon scripts tests $( [ -d bench ] && echo bench )
+# shellcheck disable=SC2046
+clang-format --dry-run --Werror $(git ls-files 'csrc/*.c' 'csrc/*.h')
 
 echo "== soak: a 50-frame animation with the node and 200 CLI runs (memory, time, leftovers)"
 scripts/soak.sh --frames 50 --runs 200 --report out/soak/test-report.md

@@ -131,10 +131,14 @@ static int parse_implementations(const char *list, int wanted[COLUMN_COUNT]) {
     snprintf(copy, sizeof copy, "%s", list);
     for (char *token = strtok(copy, ","); token != NULL; token = strtok(NULL, ",")) {
         int implementation;
-        if (!strcmp(token, "scalar")) implementation = HBAO_IMPLEMENTATION_SCALAR;
-        else if (!strcmp(token, "avx2")) implementation = HBAO_IMPLEMENTATION_AVX2;
-        else if (!strcmp(token, "avx512")) implementation = HBAO_IMPLEMENTATION_AVX512;
-        else return 0;
+        if (!strcmp(token, "scalar"))
+            implementation = HBAO_IMPLEMENTATION_SCALAR;
+        else if (!strcmp(token, "avx2"))
+            implementation = HBAO_IMPLEMENTATION_AVX2;
+        else if (!strcmp(token, "avx512"))
+            implementation = HBAO_IMPLEMENTATION_AVX512;
+        else
+            return 0;
         for (int c = 0; c < COLUMN_COUNT; c++)
             if (all_columns[c].implementation == implementation) wanted[c] = 1;
     }
@@ -155,14 +159,16 @@ int main(int argc, char **argv) {
     int wanted[COLUMN_COUNT];
     parse_implementations("scalar,avx2,avx512", wanted);
     for (int a = 1; a < argc; a++) {
-        if (!strcmp(argv[a], "--runs") && a + 1 < argc) runs = atoi(argv[++a]);
-        else if (!strcmp(argv[a], "--radius") && a + 1 < argc) radius = (float)atof(argv[++a]);
-        else if (!strcmp(argv[a], "--no-4k")) with_4k = 0;
+        if (!strcmp(argv[a], "--runs") && a + 1 < argc)
+            runs = atoi(argv[++a]);
+        else if (!strcmp(argv[a], "--radius") && a + 1 < argc)
+            radius = (float)atof(argv[++a]);
+        else if (!strcmp(argv[a], "--no-4k"))
+            with_4k = 0;
         else if (!strcmp(argv[a], "--quick")) { /* the README's quick look */
             runs = 3;
             with_4k = 0;
-        }
-        else if (!strcmp(argv[a], "--implementations") && a + 1 < argc) {
+        } else if (!strcmp(argv[a], "--implementations") && a + 1 < argc) {
             if (!parse_implementations(argv[++a], wanted)) {
                 usage(argv[0]);
                 return 2;
@@ -197,13 +203,17 @@ int main(int argc, char **argv) {
     printf("# hbao_compute speed: radius %g (scene ~3-7 units deep), median of %d rounds after a "
            "warm-up round, ms per frame\n\n",
            radius, runs);
-    printf("Cosine integration; 'defaults' = %d directions x %d steps, blur %d. Best implementation on "
-           "this CPU: %s. The scalar column is the portable reference code (horizon search and blur) on "
-           "1 thread. A round times every column once (and the last one without blur). Cells: median "
-           "wall-clock ms (median process CPU ms, all threads together). Speed-up and blur share "
-           "((time - time without blur) / time, on the last column; wall (CPU; the blur's own CPU ms)) "
-           "are medians of the per-round values.\n",
-           HBAO_DEFAULT_DIRECTIONS, HBAO_DEFAULT_STEPS, HBAO_DEFAULT_BLUR_SIZE, kernel_names[best]);
+    printf(
+        "Cosine integration; 'defaults' = %d directions x %d steps, blur %d. Best implementation "
+        "on "
+        "this CPU: %s. The scalar column is the portable reference code (horizon search and blur) "
+        "on "
+        "1 thread. A round times every column once (and the last one without blur). Cells: median "
+        "wall-clock ms (median process CPU ms, all threads together). Speed-up and blur share "
+        "((time - time without blur) / time, on the last column; wall (CPU; the blur's own CPU "
+        "ms)) "
+        "are medians of the per-round values.\n",
+        HBAO_DEFAULT_DIRECTIONS, HBAO_DEFAULT_STEPS, HBAO_DEFAULT_BLUR_SIZE, kernel_names[best]);
     print_load("before");
     printf("\n| settings | size |");
     int last_column = -1, scalar_column = -1;
@@ -269,7 +279,7 @@ int main(int argc, char **argv) {
                 } else if (memcmp(reference, ao, pixels * sizeof(float)) != 0) {
                     mismatched = 1;
                     fprintf(stderr, "bench_speed: %s, %s: output differs from the first column's\n",
-                                    row->name, all_columns[c].name);
+                            row->name, all_columns[c].name);
                 }
             }
         }
@@ -287,7 +297,8 @@ int main(int argc, char **argv) {
         speedup[r] = 0.0;
         if (scalar_column >= 0 && scalar_column != last_column) {
             for (int k = 0; k < runs; k++)
-                scratch[k] = times[scalar_column * runs + k].wall / times[last_column * runs + k].wall;
+                scratch[k] =
+                    times[scalar_column * runs + k].wall / times[last_column * runs + k].wall;
             speedup[r] = median_of(scratch, runs);
             printf(" %.1fx |", speedup[r]);
         } else {
@@ -296,7 +307,8 @@ int main(int argc, char **argv) {
         /* The blur's share, wall and CPU, and its own CPU time, per round. */
         double share_wall, share_cpu, blur_cpu;
         for (int k = 0; k < runs; k++) {
-            const timing with = times[last_column * runs + k], without = times[UNBLURRED * runs + k];
+            const timing with = times[last_column * runs + k],
+                         without = times[UNBLURRED * runs + k];
             scratch[k] = (with.wall - without.wall) / with.wall;
             scratch[runs + k] = (with.cpu - without.cpu) / with.cpu;
         }
@@ -305,7 +317,8 @@ int main(int argc, char **argv) {
         for (int k = 0; k < runs; k++)
             scratch[k] = times[last_column * runs + k].cpu - times[UNBLURRED * runs + k].cpu;
         blur_cpu = median_of(scratch, runs);
-        printf(" %.0f %% (%.0f %%; %.1f ms) |\n", 100.0 * share_wall, 100.0 * share_cpu, 1e3 * blur_cpu);
+        printf(" %.0f %% (%.0f %%; %.1f ms) |\n", 100.0 * share_wall, 100.0 * share_cpu,
+               1e3 * blur_cpu);
         fflush(stdout);
         free(ao);
         free(reference);
@@ -328,8 +341,9 @@ int main(int argc, char **argv) {
         if (ao == NULL || cpu == NULL) return 1;
         printf("\n## Stages around the horizon search, 1920x1080, %s, 1 thread, median CPU ms\n\n",
                kernel_names[best]);
-        printf("Radius 1e-4 (under a pixel everywhere, so no horizon is searched): depth conversion, "
-               "normals, [upsample], blur, output. Median CPU ms (fastest call's).\n\n");
+        printf(
+            "Radius 1e-4 (under a pixel everywhere, so no horizon is searched): depth conversion, "
+            "normals, [upsample], blur, output. Median CPU ms (fastest call's).\n\n");
         printf("| resolution | blur 0 | blur %d | blur 15 | blur %d alone | blur 15 alone |\n",
                HBAO_DEFAULT_BLUR_SIZE, HBAO_DEFAULT_BLUR_SIZE);
         printf("|---|---|---|---|---|---|\n");
@@ -380,7 +394,8 @@ int main(int argc, char **argv) {
             printf(" - |\n");
     }
     if (speedup[0] > 0.0)
-        printf("| speed-up over the scalar reference on 1 thread (defaults, full) | >= %.0fx | %.1fx | "
+        printf("| speed-up over the scalar reference on 1 thread (defaults, full) | >= %.0fx | "
+               "%.1fx | "
                "%s | |\n",
                TARGET_SPEEDUP, speedup[0], speedup[0] >= TARGET_SPEEDUP ? "yes" : "no");
     if (mismatched) printf("\nWARNING: some columns' output was not bit-identical (see stderr).\n");

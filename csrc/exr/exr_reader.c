@@ -16,23 +16,22 @@
 static _Thread_local char last_error_message[512];
 
 static void keep_error_message(exr_const_context_t context, exr_result_t code,
-                               const char *message)
-{
+                               const char *message) {
     (void)context;
     (void)code;
     snprintf(last_error_message, sizeof last_error_message, "%s", message ? message : "");
 }
 
-void exr_clear_last_error(void) { last_error_message[0] = '\0'; }
+void exr_clear_last_error(void) {
+    last_error_message[0] = '\0';
+}
 
-const char *exr_error_text(exr_result_t result)
-{
+const char *exr_error_text(exr_result_t result) {
     if (last_error_message[0] != '\0') return last_error_message;
     return exr_get_default_error_message(result);
 }
 
-exr_context_initializer_t exr_quiet_initializer(void)
-{
+exr_context_initializer_t exr_quiet_initializer(void) {
     exr_context_initializer_t initializer = EXR_DEFAULT_CONTEXT_INITIALIZER;
     initializer.error_handler_fn = keep_error_message;
     /* Let OpenEXRCore refuse absurd sizes in a corrupt header before anyone
@@ -42,56 +41,56 @@ exr_context_initializer_t exr_quiet_initializer(void)
     return initializer;
 }
 
-int exr_pixel_type_size(exr_pixel_type_t type) { return type == EXR_PIXEL_HALF ? 2 : 4; }
+int exr_pixel_type_size(exr_pixel_type_t type) {
+    return type == EXR_PIXEL_HALF ? 2 : 4;
+}
 
-const char *exr_pixel_type_name(exr_pixel_type_t type)
-{
+const char *exr_pixel_type_name(exr_pixel_type_t type) {
     switch (type) {
-    case EXR_PIXEL_HALF: return "half";
-    case EXR_PIXEL_FLOAT: return "float";
-    case EXR_PIXEL_UINT: return "uint";
-    default: return "unknown";
+        case EXR_PIXEL_HALF:
+            return "half";
+        case EXR_PIXEL_FLOAT:
+            return "float";
+        case EXR_PIXEL_UINT:
+            return "uint";
+        default:
+            return "unknown";
     }
 }
 
-const char *exr_compression_name(exr_compression_t compression)
-{
-    static const char *const names[] = {"none", "rle",   "zips", "zip",  "piz",
+const char *exr_compression_name(exr_compression_t compression) {
+    static const char *const names[] = {"none",  "rle", "zips", "zip",  "piz",
                                         "pxr24", "b44", "b44a", "dwaa", "dwab"};
-    if ((int)compression >= 0 && compression < EXR_COMPRESSION_LAST_TYPE)
-        return names[compression];
+    if ((int)compression >= 0 && compression < EXR_COMPRESSION_LAST_TYPE) return names[compression];
     return "unknown";
 }
 
-#define CHECK_EXR(call, what)                                                                   \
-    do {                                                                                        \
-        exr_result_t check_result_ = (call);                                                    \
-        if (check_result_ != EXR_ERR_SUCCESS) {                                                 \
-            status = tool_fail(error, TOOL_EXIT_RUNTIME, "%s: %s: %s (%s)", input->path, what,  \
-                               exr_error_text(check_result_),                                   \
-                               exr_get_error_code_as_string(check_result_));                    \
-            goto fail;                                                                          \
-        }                                                                                       \
+#define CHECK_EXR(call, what)                                                                      \
+    do {                                                                                           \
+        exr_result_t check_result_ = (call);                                                       \
+        if (check_result_ != EXR_ERR_SUCCESS) {                                                    \
+            status = tool_fail(error, TOOL_EXIT_RUNTIME, "%s: %s: %s (%s)", input->path, what,     \
+                               exr_error_text(check_result_),                                      \
+                               exr_get_error_code_as_string(check_result_));                       \
+            goto fail;                                                                             \
+        }                                                                                          \
     } while (0)
 
-static pixel_rect rect_from_box(const exr_attr_box2i_t *box)
-{
+static pixel_rect rect_from_box(const exr_attr_box2i_t *box) {
     pixel_rect rect = {box->min.x, box->min.y, box->max.x, box->max.y};
     return rect;
 }
 
 /* A part's name for messages: Blender names each part after its pass
  * ("ViewLayer.Depth"); a single-part file usually has none. */
-static const char *part_name(const exr_input *input, int part)
-{
+static const char *part_name(const exr_input *input, int part) {
     const char *name = NULL;
     if (exr_get_name(input->context, part, &name) != EXR_ERR_SUCCESS || name == NULL)
         return "unnamed";
     return name;
 }
 
-static bool same_box(const exr_attr_box2i_t *a, const exr_attr_box2i_t *b)
-{
+static bool same_box(const exr_attr_box2i_t *a, const exr_attr_box2i_t *b) {
     return a->min.x == b->min.x && a->min.y == b->min.y && a->max.x == b->max.x &&
            a->max.y == b->max.y;
 }
@@ -100,14 +99,12 @@ static bool same_box(const exr_attr_box2i_t *a, const exr_attr_box2i_t *b)
  * same one (Blender 5 writes all passes with the render's windows), or the
  * passes would not line up pixel for pixel. */
 static int check_part_windows(exr_input *input, const exr_attr_box2i_t *data_window,
-                              const exr_attr_box2i_t *display_window, tool_error *error)
-{
+                              const exr_attr_box2i_t *display_window, tool_error *error) {
     int status = TOOL_EXIT_SUCCESS;
     for (int part = 1; part < input->part_count; ++part) {
         exr_attr_box2i_t part_data, part_display;
         CHECK_EXR(exr_get_data_window(input->context, part, &part_data), "no data window");
-        CHECK_EXR(exr_get_display_window(input->context, part, &part_display),
-                  "no display window");
+        CHECK_EXR(exr_get_display_window(input->context, part, &part_display), "no display window");
         const bool data_differs = !same_box(&part_data, data_window);
         if (data_differs || !same_box(&part_display, display_window)) {
             const exr_attr_box2i_t *theirs = data_differs ? &part_data : &part_display;
@@ -127,8 +124,7 @@ fail:
 }
 
 /* Scanlines per chunk of `part` (1, 16 or 32 by compression). */
-static int part_lines_per_chunk(exr_input *input, int part, int32_t *lines, tool_error *error)
-{
+static int part_lines_per_chunk(exr_input *input, int part, int32_t *lines, tool_error *error) {
     int status = TOOL_EXIT_SUCCESS;
     CHECK_EXR(exr_get_scanlines_per_chunk(input->context, part, lines),
               "cannot read the chunk layout");
@@ -144,8 +140,7 @@ fail:
  * (a corrupt offset table) would send the decoder's copy outside the buffers.
  * Its bytes must lie inside the file, whose size is file_size. */
 static int read_chunk_info(exr_input *input, int part, int32_t lines_per_chunk, int64_t y,
-                           int64_t file_size, exr_chunk_info_t *chunk, tool_error *error)
-{
+                           int64_t file_size, exr_chunk_info_t *chunk, tool_error *error) {
     int status = TOOL_EXIT_SUCCESS;
     CHECK_EXR(exr_read_scanline_chunk_info(input->context, part, (int)y, chunk),
               "cannot read a chunk (file truncated or corrupt?)");
@@ -170,24 +165,21 @@ typedef struct part_channel {
 /* Several parts' lists, each sorted, merge into one list sorted the same way
  * (OpenEXRCore orders a part's channels by strcmp), so that the first layer
  * "in channel-name order" is the same whatever the file's part layout. */
-static int compare_channel_names(const void *a, const void *b)
-{
+static int compare_channel_names(const void *a, const void *b) {
     return strcmp(((const part_channel *)a)->entry.name.str,
                   ((const part_channel *)b)->entry.name.str);
 }
 
-static int fail_no_channels(const exr_input *input, int part, tool_error *error)
-{
+static int fail_no_channels(const exr_input *input, int part, tool_error *error) {
     if (input->part_count == 1)
         return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: has no channels", input->path);
-    return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: part %d (\"%s\") has no channels",
-                     input->path, part, part_name(input, part));
+    return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: part %d (\"%s\") has no channels", input->path,
+                     part, part_name(input, part));
 }
 
 /* input->channels: the union of every part's channels, each with its part.
  * What it allocates, exr_input_close() frees. */
-static int collect_channels(exr_input *input, tool_error *error)
-{
+static int collect_channels(exr_input *input, tool_error *error) {
     int status = TOOL_EXIT_SUCCESS;
     int64_t total = 0;
     const exr_attr_chlist_t *list = NULL;
@@ -234,8 +226,8 @@ static int collect_channels(exr_input *input, tool_error *error)
             status = tool_fail(error, TOOL_EXIT_RUNTIME,
                                "%s: channel %s is in part %d (\"%s\") and in part %d (\"%s\"); "
                                "channel names must be unique across parts",
-                               input->path, entries[c].name.str, first,
-                               part_name(input, first), second, part_name(input, second));
+                               input->path, entries[c].name.str, first, part_name(input, first),
+                               second, part_name(input, second));
             break;
         }
     }
@@ -249,8 +241,7 @@ fail:
  * small file fails here (its chunk table or its chunks do not fit in the
  * file). The chunk table itself is 8 bytes per chunk, which OpenEXRCore
  * checks against the file size. */
-static int check_chunks(exr_input *input, tool_error *error)
-{
+static int check_chunks(exr_input *input, tool_error *error) {
     int status = TOOL_EXIT_SUCCESS;
     struct stat file_status;
     if (stat(input->path, &file_status) != 0)
@@ -262,8 +253,8 @@ static int check_chunks(exr_input *input, tool_error *error)
         if (status != TOOL_EXIT_SUCCESS) return status;
         for (int64_t y = window->min_y; y <= window->max_y; y += lines_per_chunk) {
             exr_chunk_info_t chunk;
-            status = read_chunk_info(input, part, lines_per_chunk, y,
-                                     (int64_t)file_status.st_size, &chunk, error);
+            status = read_chunk_info(input, part, lines_per_chunk, y, (int64_t)file_status.st_size,
+                                     &chunk, error);
             if (status != TOOL_EXIT_SUCCESS) {
                 char detail[TOOL_ERROR_MESSAGE_SIZE];
                 snprintf(detail, sizeof detail, "%s", error->message);
@@ -279,9 +270,7 @@ static int check_chunks(exr_input *input, tool_error *error)
     return status;
 }
 
-
-int exr_input_open(exr_input *input, const char *path, tool_error *error)
-{
+int exr_input_open(exr_input *input, const char *path, tool_error *error) {
     memset(input, 0, sizeof *input);
     input->path = path;
     exr_clear_last_error();
@@ -301,8 +290,7 @@ int exr_input_open(exr_input *input, const char *path, tool_error *error)
     }
     for (int part = 0; part < input->part_count; ++part) {
         exr_storage_t storage;
-        CHECK_EXR(exr_get_storage(input->context, part, &storage),
-                  "cannot read the storage type");
+        CHECK_EXR(exr_get_storage(input->context, part, &storage), "cannot read the storage type");
         if (storage != EXR_STORAGE_SCANLINE) {
             status = tool_fail(error, TOOL_EXIT_RUNTIME,
                                "%s: only scanline images are supported (part %d, \"%s\", is "
@@ -368,16 +356,14 @@ fail:
     return status;
 }
 
-int exr_input_find_channel(const exr_input *input, const char *name)
-{
+int exr_input_find_channel(const exr_input *input, const char *name) {
     for (int c = 0; c < input->channels->num_channels; ++c)
         if (strcmp(input->channels->entries[c].name.str, name) == 0) return c;
     return -1;
 }
 
 static const exr_channel_request *find_request(const exr_channel_request *requests, int count,
-                                               const char *name)
-{
+                                               const char *name) {
     for (int r = 0; r < count; ++r)
         if (strcmp(requests[r].name, name) == 0) return &requests[r];
     return NULL;
@@ -386,8 +372,7 @@ static const exr_channel_request *find_request(const exr_channel_request *reques
 /* Decode the requests that name channels of `part`; the others are left to
  * the other parts (a name is in one part only). */
 static int read_part(exr_input *input, int part, const exr_channel_request *requests, int count,
-                     tool_error *error)
-{
+                     tool_error *error) {
     int status = TOOL_EXIT_SUCCESS;
     exr_decode_pipeline_t decoder = EXR_DECODE_PIPELINE_INITIALIZER;
     bool decoder_ready = false;
@@ -399,8 +384,7 @@ static int read_part(exr_input *input, int part, const exr_channel_request *requ
     const pixel_rect *window = &input->data_window;
     for (int64_t y = window->min_y; y <= window->max_y; y += lines_per_chunk) {
         exr_chunk_info_t chunk;
-        status = read_chunk_info(input, part, lines_per_chunk, y, input->file_size, &chunk,
-                                 error);
+        status = read_chunk_info(input, part, lines_per_chunk, y, input->file_size, &chunk, error);
         if (status != TOOL_EXIT_SUCCESS) goto fail;
         if (!decoder_ready) {
             CHECK_EXR(exr_decoding_initialize(input->context, part, &chunk, &decoder),
@@ -447,8 +431,7 @@ fail:
 }
 
 int exr_input_read(exr_input *input, const exr_channel_request *requests, int count,
-                   tool_error *error)
-{
+                   tool_error *error) {
     exr_clear_last_error();
     /* Only parts that hold a requested channel are decoded: reading Depth
      * from Blender 5's one-part-per-pass files skips Combined and the rest. */
@@ -470,8 +453,7 @@ int exr_input_read(exr_input *input, const exr_channel_request *requests, int co
     return status;
 }
 
-void exr_input_close(exr_input *input)
-{
+void exr_input_close(exr_input *input) {
     if (input->context != NULL) exr_finish(&input->context);
     input->context = NULL;
     input->channels = NULL;

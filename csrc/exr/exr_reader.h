@@ -21,7 +21,7 @@ typedef struct exr_input {
     const char *path;
     pixel_rect data_window;
     pixel_rect display_window;
-    int32_t width, height; /**< of the data window */
+    int32_t width, height;    /**< of the data window */
     float pixel_aspect_ratio; /**< pixel width / height; 1 when absent */
     bool has_pixel_aspect_ratio;
     exr_attr_v2f_t screen_window_center;
@@ -32,7 +32,7 @@ typedef struct exr_input {
     int part_count;
     /** Every part's channels, sorted by name; names are unique across parts. */
     const exr_attr_chlist_t *channels;
-    int *channel_parts; /**< the part that holds channels->entries[c] */
+    int *channel_parts;              /**< the part that holds channels->entries[c] */
     exr_attr_chlist_t channel_union; /* storage behind `channels`; names owned by the context */
 } exr_input;
 

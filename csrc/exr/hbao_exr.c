@@ -26,32 +26,34 @@ struct hbao_exr_file {
     char *path; /* owned: input.path points at it */
 };
 
-int32_t hbao_exr_interface_version(void) { return HBAO_EXR_INTERFACE_VERSION; }
+int32_t hbao_exr_interface_version(void) {
+    return HBAO_EXR_INTERFACE_VERSION;
+}
 
-int32_t hbao_exr_channel_request_size(void) { return (int32_t)sizeof(hbao_exr_channel_request); }
+int32_t hbao_exr_channel_request_size(void) {
+    return (int32_t)sizeof(hbao_exr_channel_request);
+}
 
-const char *hbao_exr_result_message(int32_t result)
-{
-#define HBAO_EXR_RESULT_MESSAGE_CASE(name, value, message)                                       \
-    case value: return message;
+const char *hbao_exr_result_message(int32_t result) {
+#define HBAO_EXR_RESULT_MESSAGE_CASE(name, value, message)                                         \
+    case value:                                                                                    \
+        return message;
     switch (result) {
         HBAO_EXR_RESULTS(HBAO_EXR_RESULT_MESSAGE_CASE)
-    default: return "unknown result";
+        default:
+            return "unknown result";
     }
 #undef HBAO_EXR_RESULT_MESSAGE_CASE
 }
 
-static void copy_message(char *message, int32_t message_size, const char *text)
-{
-    if (message != NULL && message_size > 0)
-        snprintf(message, (size_t)message_size, "%s", text);
+static void copy_message(char *message, int32_t message_size, const char *text) {
+    if (message != NULL && message_size > 0) snprintf(message, (size_t)message_size, "%s", text);
 }
 
 static int32_t fail(char *message, int32_t message_size, int32_t result, const char *format, ...)
     __attribute__((format(printf, 4, 5)));
 
-static int32_t fail(char *message, int32_t message_size, int32_t result, const char *format, ...)
-{
+static int32_t fail(char *message, int32_t message_size, int32_t result, const char *format, ...) {
     if (message != NULL && message_size > 0) {
         va_list arguments;
         va_start(arguments, format);
@@ -64,23 +66,20 @@ static int32_t fail(char *message, int32_t message_size, int32_t result, const c
 /* exr_input_open reports every failure the same way; tell a file that cannot
  * be opened at all (missing, unreadable) from one that is not a valid EXR. */
 static int32_t open_failure(const char *path, const tool_error *error, char *message,
-                            int32_t message_size)
-{
+                            int32_t message_size) {
     if (access(path, R_OK) != 0) {
         int access_error = errno;
         char reason[256];
         if (strerror_r(access_error, reason, sizeof reason) != 0)
             snprintf(reason, sizeof reason, "error %d", access_error);
-        return fail(message, message_size, HBAO_EXR_ERROR_FILE_ACCESS, "%s: cannot open: %s",
-                    path, reason);
+        return fail(message, message_size, HBAO_EXR_ERROR_FILE_ACCESS, "%s: cannot open: %s", path,
+                    reason);
     }
     copy_message(message, message_size, error->message);
     return HBAO_EXR_ERROR_FORMAT;
 }
 
-int32_t hbao_exr_open(const char *path, hbao_exr_file **file, char *message,
-                      int32_t message_size)
-{
+int32_t hbao_exr_open(const char *path, hbao_exr_file **file, char *message, int32_t message_size) {
     if (file == NULL)
         return fail(message, message_size, HBAO_EXR_ERROR_INVALID_ARGUMENT,
                     "hbao_exr_open: file is NULL");
@@ -108,31 +107,26 @@ int32_t hbao_exr_open(const char *path, hbao_exr_file **file, char *message,
     return HBAO_EXR_SUCCESS;
 }
 
-void hbao_exr_size(const hbao_exr_file *file, int32_t *width, int32_t *height)
-{
+void hbao_exr_size(const hbao_exr_file *file, int32_t *width, int32_t *height) {
     if (width != NULL) *width = file != NULL ? file->input.width : 0;
     if (height != NULL) *height = file != NULL ? file->input.height : 0;
 }
 
-int32_t hbao_exr_channel_count(const hbao_exr_file *file)
-{
+int32_t hbao_exr_channel_count(const hbao_exr_file *file) {
     return file != NULL ? file->input.channels->num_channels : 0;
 }
 
-const char *hbao_exr_channel_name(const hbao_exr_file *file, int32_t index)
-{
+const char *hbao_exr_channel_name(const hbao_exr_file *file, int32_t index) {
     if (file == NULL || index < 0 || index >= file->input.channels->num_channels) return NULL;
     return file->input.channels->entries[index].name.str;
 }
 
-int32_t hbao_exr_has_channel(const hbao_exr_file *file, const char *name)
-{
+int32_t hbao_exr_has_channel(const hbao_exr_file *file, const char *name) {
     return file != NULL && name != NULL && exr_input_find_channel(&file->input, name) >= 0;
 }
 
 static int32_t check_request(const hbao_exr_file *file, const hbao_exr_channel_request *requests,
-                             int32_t index, char *message, int32_t message_size)
-{
+                             int32_t index, char *message, int32_t message_size) {
     const hbao_exr_channel_request *request = &requests[index];
     if (request->name == NULL || request->data == NULL)
         return fail(message, message_size, HBAO_EXR_ERROR_INVALID_ARGUMENT,
@@ -154,8 +148,7 @@ static int32_t check_request(const hbao_exr_file *file, const hbao_exr_channel_r
 }
 
 int32_t hbao_exr_read_channels(hbao_exr_file *file, const hbao_exr_channel_request *requests,
-                               int32_t count, char *message, int32_t message_size)
-{
+                               int32_t count, char *message, int32_t message_size) {
     if (file == NULL || count < 0 || (count > 0 && requests == NULL))
         return fail(message, message_size, HBAO_EXR_ERROR_INVALID_ARGUMENT,
                     "hbao_exr_read_channels: no file, or no requests for count %d", (int)count);
@@ -166,8 +159,8 @@ int32_t hbao_exr_read_channels(hbao_exr_file *file, const hbao_exr_channel_reque
     if (count == 0) return HBAO_EXR_SUCCESS;
     exr_channel_request *reader_requests = calloc((size_t)count, sizeof *reader_requests);
     if (reader_requests == NULL)
-        return fail(message, message_size, HBAO_EXR_ERROR_OUT_OF_MEMORY,
-                    "%s: out of memory", file->path);
+        return fail(message, message_size, HBAO_EXR_ERROR_OUT_OF_MEMORY, "%s: out of memory",
+                    file->path);
     for (int32_t r = 0; r < count; ++r) {
         reader_requests[r].name = requests[r].name;
         reader_requests[r].type = EXR_PIXEL_FLOAT;
@@ -187,14 +180,12 @@ int32_t hbao_exr_read_channels(hbao_exr_file *file, const hbao_exr_channel_reque
 
 int32_t hbao_exr_read_channel(hbao_exr_file *file, const char *name, float *out,
                               int32_t pixel_stride, int64_t row_stride, char *message,
-                              int32_t message_size)
-{
+                              int32_t message_size) {
     hbao_exr_channel_request request = {name, out, pixel_stride, row_stride};
     return hbao_exr_read_channels(file, &request, 1, message, message_size);
 }
 
-void hbao_exr_close(hbao_exr_file **file)
-{
+void hbao_exr_close(hbao_exr_file **file) {
     if (file == NULL || *file == NULL) return;
     exr_input_close(&(*file)->input);
     free((*file)->path);

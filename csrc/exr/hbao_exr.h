@@ -49,12 +49,12 @@ extern "C" {
 
 /* One list generates the result codes and their messages (see
  * hbao_exr_result_message), so that the two cannot drift apart. */
-#define HBAO_EXR_RESULTS(X)                                                                     \
-    X(HBAO_EXR_SUCCESS, 0, "success")                                                           \
-    X(HBAO_EXR_ERROR_INVALID_ARGUMENT, 1, "invalid argument")                                   \
-    X(HBAO_EXR_ERROR_OUT_OF_MEMORY, 2, "out of memory")                                         \
-    X(HBAO_EXR_ERROR_FILE_ACCESS, 3, "the file cannot be opened")                              \
-    X(HBAO_EXR_ERROR_FORMAT, 4, "not a readable EXR file, or a corrupt or truncated one")       \
+#define HBAO_EXR_RESULTS(X)                                                                        \
+    X(HBAO_EXR_SUCCESS, 0, "success")                                                              \
+    X(HBAO_EXR_ERROR_INVALID_ARGUMENT, 1, "invalid argument")                                      \
+    X(HBAO_EXR_ERROR_OUT_OF_MEMORY, 2, "out of memory")                                            \
+    X(HBAO_EXR_ERROR_FILE_ACCESS, 3, "the file cannot be opened")                                  \
+    X(HBAO_EXR_ERROR_FORMAT, 4, "not a readable EXR file, or a corrupt or truncated one")          \
     X(HBAO_EXR_ERROR_MISSING_CHANNEL, 5, "the file has no channel of that name")
 
 #define HBAO_EXR_RESULT_ENUM_ENTRY(name, value, message) name = value,
@@ -120,8 +120,7 @@ HBAO_EXR_EXPORT int32_t hbao_exr_has_channel(const hbao_exr_file *file, const ch
  */
 HBAO_EXR_EXPORT int32_t hbao_exr_read_channels(hbao_exr_file *file,
                                                const hbao_exr_channel_request *requests,
-                                               int32_t count, char *message,
-                                               int32_t message_size);
+                                               int32_t count, char *message, int32_t message_size);
 
 /** hbao_exr_read_channels for a single channel. */
 HBAO_EXR_EXPORT int32_t hbao_exr_read_channel(hbao_exr_file *file, const char *name, float *out,

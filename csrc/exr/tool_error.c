@@ -4,8 +4,7 @@
 #include <stdarg.h>
 #include <stdio.h>
 
-int tool_fail(tool_error *error, int status, const char *format, ...)
-{
+int tool_fail(tool_error *error, int status, const char *format, ...) {
     va_list arguments;
     va_start(arguments, format);
     vsnprintf(error->message, sizeof error->message, format, arguments);
@@ -13,8 +12,7 @@ int tool_fail(tool_error *error, int status, const char *format, ...)
     return status;
 }
 
-void tool_warn(const char *format, ...)
-{
+void tool_warn(const char *format, ...) {
     va_list arguments;
     /* One line at a time when several frames run at once. */
     flockfile(stderr);

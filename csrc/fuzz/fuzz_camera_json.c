@@ -13,15 +13,13 @@
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
-static void require(bool condition, const char *what)
-{
+static void require(bool condition, const char *what) {
     if (condition) return;
     fprintf(stderr, "fuzz: the parser accepted a camera whose %s\n", what);
     abort();
 }
 
-int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
-{
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     char *text = malloc(size + 1);
     if (text == NULL) return 0;
     memcpy(text, data, size);
@@ -46,7 +44,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                     c->pixel_aspect_y > 0.0f && isfinite(c->pixel_aspect_y),
                 "pixel aspect is not finite and positive");
         require(isfinite(c->shift_x) && isfinite(c->shift_y), "shift is not finite");
-        for (int k = 0; k < 16; ++k) require(isfinite(c->world_to_camera[k]), "matrix is not finite");
+        for (int k = 0; k < 16; ++k)
+            require(isfinite(c->world_to_camera[k]), "matrix is not finite");
     }
     free(text);
     return 0;

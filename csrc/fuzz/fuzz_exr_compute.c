@@ -31,8 +31,7 @@ static char *variants[4][20] = {
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
-int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
-{
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     char **argv = variants[size % 4];
     int argc = 0;
     while (argv[argc] != NULL) ++argc;

@@ -17,15 +17,13 @@
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
-static void fail(const char *what, const char *detail)
-{
+static void fail(const char *what, const char *detail) {
     fprintf(stderr, "fuzz: %s: %s\n", what, detail);
     abort();
 }
 
 /* Decode every channel of the output as float. */
-static void check_output(const char *path, int expected_channels)
-{
+static void check_output(const char *path, int expected_channels) {
     exr_input output;
     tool_error error;
     if (exr_input_open(&output, path, &error) != TOOL_EXIT_SUCCESS)
@@ -49,15 +47,27 @@ static void check_output(const char *path, int expected_channels)
     exr_input_close(&output);
 }
 
-int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
-{
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     const char *input_path = fuzz_input_file(data, size);
     static char output_path[4200], preview_path[4200];
     snprintf(output_path, sizeof output_path, "%s/out.exr", fuzz_scratch_folder());
     snprintf(preview_path, sizeof preview_path, "%s/out.png", fuzz_scratch_folder());
-    char *argv[] = {"hbao", (char *)input_path, "-o", output_path, "--keep-input",
-                    "--preview", preview_path, "--directions", "1", "--steps", "1",
-                    "--blur", "0", "--threads", "1", NULL};
+    char *argv[] = {"hbao",
+                    (char *)input_path,
+                    "-o",
+                    output_path,
+                    "--keep-input",
+                    "--preview",
+                    preview_path,
+                    "--directions",
+                    "1",
+                    "--steps",
+                    "1",
+                    "--blur",
+                    "0",
+                    "--threads",
+                    "1",
+                    NULL};
     const int argc = (int)(sizeof argv / sizeof argv[0]) - 1;
     cli_options options;
     tool_error error;

@@ -48,27 +48,26 @@ extern "C" {
 #define HBAO_VERSION_MINOR 1
 #define HBAO_VERSION_PATCH 0
 /** Packed version: major * 10000 + minor * 100 + patch. */
-#define HBAO_VERSION \
-    (HBAO_VERSION_MAJOR * 10000 + HBAO_VERSION_MINOR * 100 + HBAO_VERSION_PATCH)
+#define HBAO_VERSION (HBAO_VERSION_MAJOR * 10000 + HBAO_VERSION_MINOR * 100 + HBAO_VERSION_PATCH)
 
 /**
  * The result codes and their messages, generated from one list so that they
  * cannot drift apart.
  */
-#define HBAO_RESULT_LIST(X)                                                          \
-    X(HBAO_SUCCESS, "success")                                                       \
-    X(HBAO_ERROR_NULL_ARGUMENT, "a required pointer argument is NULL")               \
-    X(HBAO_ERROR_INVALID_SIZE, "image width and height must be in [1, 65536]")       \
-    X(HBAO_ERROR_INVALID_STRIDE, "a pixel or row stride is too small for the image") \
-    X(HBAO_ERROR_INVALID_PARAMETER,                                                  \
-      "a parameter is not a number, negative where it must not be, or an unknown " \
-      "enum value")                                                                  \
-    X(HBAO_ERROR_INVALID_CAMERA,                                                     \
-      "the camera is invalid (lens, sensor, ortho scale and pixel aspect must be "  \
-      "finite and > 0; the matrix must be finite and invertible)")                  \
-    X(HBAO_ERROR_OUT_OF_MEMORY, "out of memory")                                     \
-    X(HBAO_ERROR_THREAD, "could not start a worker thread")                           \
-    X(HBAO_ERROR_INVALID_RECTANGLE,                                                  \
+#define HBAO_RESULT_LIST(X)                                                                        \
+    X(HBAO_SUCCESS, "success")                                                                     \
+    X(HBAO_ERROR_NULL_ARGUMENT, "a required pointer argument is NULL")                             \
+    X(HBAO_ERROR_INVALID_SIZE, "image width and height must be in [1, 65536]")                     \
+    X(HBAO_ERROR_INVALID_STRIDE, "a pixel or row stride is too small for the image")               \
+    X(HBAO_ERROR_INVALID_PARAMETER,                                                                \
+      "a parameter is not a number, negative where it must not be, or an unknown "                 \
+      "enum value")                                                                                \
+    X(HBAO_ERROR_INVALID_CAMERA,                                                                   \
+      "the camera is invalid (lens, sensor, ortho scale and pixel aspect must be "                 \
+      "finite and > 0; the matrix must be finite and invertible)")                                 \
+    X(HBAO_ERROR_OUT_OF_MEMORY, "out of memory")                                                   \
+    X(HBAO_ERROR_THREAD, "could not start a worker thread")                                        \
+    X(HBAO_ERROR_INVALID_RECTANGLE,                                                                \
       "the crop rectangle must be at least 1 x 1 and lie inside the image")
 
 typedef enum hbao_result_code {
@@ -175,13 +174,12 @@ typedef enum hbao_implementation {
 /** EEVEE's half-float Depth pass stores background as 65504, Cycles as 1e10. */
 #define HBAO_DEFAULT_BACKGROUND_DEPTH 65504.0f
 
-#define HBAO_PARAMS_DEFAULT_INITIALIZER                                         \
-    {                                                                           \
-        HBAO_DEFAULT_RADIUS, HBAO_DEFAULT_ANGLE_BIAS_DEGREES,                   \
-            HBAO_DEFAULT_DIRECTIONS, HBAO_DEFAULT_STEPS, HBAO_FALLOFF_NONE,     \
-            HBAO_INTEGRATION_COSINE, HBAO_DEFAULT_BLUR_SIZE,                    \
-            HBAO_DEFAULT_BLUR_SHARPNESS, 0, HBAO_DEFAULT_STRENGTH, 0,           \
-            HBAO_DEFAULT_BACKGROUND_DEPTH, 0                                    \
+#define HBAO_PARAMS_DEFAULT_INITIALIZER                                                            \
+    {                                                                                              \
+        HBAO_DEFAULT_RADIUS, HBAO_DEFAULT_ANGLE_BIAS_DEGREES, HBAO_DEFAULT_DIRECTIONS,             \
+            HBAO_DEFAULT_STEPS, HBAO_FALLOFF_NONE, HBAO_INTEGRATION_COSINE,                        \
+            HBAO_DEFAULT_BLUR_SIZE, HBAO_DEFAULT_BLUR_SHARPNESS, 0, HBAO_DEFAULT_STRENGTH, 0,      \
+            HBAO_DEFAULT_BACKGROUND_DEPTH, 0                                                       \
     }
 
 typedef enum hbao_projection {
@@ -198,15 +196,15 @@ typedef enum hbao_sensor_fit {
 
 /** Blender's camera model, with Blender's property names and defaults. */
 typedef struct hbao_camera {
-    int32_t projection;     /**< hbao_projection */
-    float lens;             /**< focal length, mm (perspective) */
-    float sensor_width;     /**< mm */
-    float sensor_height;    /**< mm */
-    int32_t sensor_fit;     /**< hbao_sensor_fit */
-    float shift_x;          /**< lens shift, in units of the fitted sensor side */
+    int32_t projection;  /**< hbao_projection */
+    float lens;          /**< focal length, mm (perspective) */
+    float sensor_width;  /**< mm */
+    float sensor_height; /**< mm */
+    int32_t sensor_fit;  /**< hbao_sensor_fit */
+    float shift_x;       /**< lens shift, in units of the fitted sensor side */
     float shift_y;
-    float ortho_scale;      /**< view width of the fitted side (orthographic) */
-    float pixel_aspect_x;   /**< scene.render.pixel_aspect_x */
+    float ortho_scale;    /**< view width of the fitted side (orthographic) */
+    float pixel_aspect_x; /**< scene.render.pixel_aspect_x */
     float pixel_aspect_y;
     /** Row-major 4x4 world-to-camera matrix (camera.matrix_world inverted).
      *  Only its rotation is used: it maps the world-space Normal pass into
@@ -214,14 +212,13 @@ typedef struct hbao_camera {
     float world_to_camera[16];
 } hbao_camera;
 
-#define HBAO_CAMERA_DEFAULT_INITIALIZER                                          \
-    {                                                                            \
-        HBAO_PROJECTION_PERSPECTIVE, 50.0f, 36.0f, 24.0f, HBAO_SENSOR_FIT_AUTO,  \
-            0.0f, 0.0f, 6.0f, 1.0f, 1.0f,                                        \
-        {                                                                        \
-            1.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f,    \
-                0.0f, 0.0f, 0.0f, 0.0f, 1.0f                                     \
-        }                                                                        \
+#define HBAO_CAMERA_DEFAULT_INITIALIZER                                                            \
+    {                                                                                              \
+        HBAO_PROJECTION_PERSPECTIVE, 50.0f, 36.0f, 24.0f, HBAO_SENSOR_FIT_AUTO, 0.0f, 0.0f, 6.0f,  \
+            1.0f, 1.0f, {                                                                          \
+            1.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f, 0.0f, 0.0f,    \
+                0.0f, 1.0f                                                                         \
+        }                                                                                          \
     }
 
 /**
@@ -237,11 +234,11 @@ typedef struct hbao_camera {
  * numbers a renderer of the same view (the add-on's GLSL preview) needs.
  */
 typedef struct hbao_view {
-    int32_t perspective;  /**< 1 perspective, 0 orthographic */
-    double pixel_size_x;  /**< view-plane width of one pixel */
-    double pixel_size_y;  /**< its height: pixel_size_x * pixel_aspect_y / pixel_aspect_x */
-    double origin_x;      /**< left edge of the image */
-    double origin_y;      /**< bottom edge of the image */
+    int32_t perspective; /**< 1 perspective, 0 orthographic */
+    double pixel_size_x; /**< view-plane width of one pixel */
+    double pixel_size_y; /**< its height: pixel_size_x * pixel_aspect_y / pixel_aspect_x */
+    double origin_x;     /**< left edge of the image */
+    double origin_y;     /**< bottom edge of the image */
 } hbao_view;
 
 /** A read-only view of one image channel (or of 3 consecutive channels, for
@@ -255,19 +252,19 @@ typedef struct hbao_channel {
 
 /** The fields of hbao_params in struct order, each with its bit in
  *  hbao_params_resolve()'s report and its name (the struct member's). */
-#define HBAO_PARAM_FIELD_LIST(X)                                               \
-    X(HBAO_PARAM_FIELD_RADIUS, 0, "radius")                                    \
-    X(HBAO_PARAM_FIELD_ANGLE_BIAS_DEGREES, 1, "angle_bias_degrees")            \
-    X(HBAO_PARAM_FIELD_DIRECTIONS, 2, "directions")                            \
-    X(HBAO_PARAM_FIELD_STEPS, 3, "steps")                                      \
-    X(HBAO_PARAM_FIELD_FALLOFF, 4, "falloff")                                  \
-    X(HBAO_PARAM_FIELD_INTEGRATION, 5, "integration")                          \
-    X(HBAO_PARAM_FIELD_BLUR_SIZE, 6, "blur_size")                              \
-    X(HBAO_PARAM_FIELD_BLUR_SHARPNESS, 7, "blur_sharpness")                    \
-    X(HBAO_PARAM_FIELD_HALF_RESOLUTION, 8, "half_resolution")                  \
-    X(HBAO_PARAM_FIELD_STRENGTH, 9, "strength")                                \
-    X(HBAO_PARAM_FIELD_THREADS, 10, "threads")                                 \
-    X(HBAO_PARAM_FIELD_BACKGROUND_DEPTH, 11, "background_depth")               \
+#define HBAO_PARAM_FIELD_LIST(X)                                                                   \
+    X(HBAO_PARAM_FIELD_RADIUS, 0, "radius")                                                        \
+    X(HBAO_PARAM_FIELD_ANGLE_BIAS_DEGREES, 1, "angle_bias_degrees")                                \
+    X(HBAO_PARAM_FIELD_DIRECTIONS, 2, "directions")                                                \
+    X(HBAO_PARAM_FIELD_STEPS, 3, "steps")                                                          \
+    X(HBAO_PARAM_FIELD_FALLOFF, 4, "falloff")                                                      \
+    X(HBAO_PARAM_FIELD_INTEGRATION, 5, "integration")                                              \
+    X(HBAO_PARAM_FIELD_BLUR_SIZE, 6, "blur_size")                                                  \
+    X(HBAO_PARAM_FIELD_BLUR_SHARPNESS, 7, "blur_sharpness")                                        \
+    X(HBAO_PARAM_FIELD_HALF_RESOLUTION, 8, "half_resolution")                                      \
+    X(HBAO_PARAM_FIELD_STRENGTH, 9, "strength")                                                    \
+    X(HBAO_PARAM_FIELD_THREADS, 10, "threads")                                                     \
+    X(HBAO_PARAM_FIELD_BACKGROUND_DEPTH, 11, "background_depth")                                   \
     X(HBAO_PARAM_FIELD_IMPLEMENTATION, 12, "implementation")
 
 typedef enum hbao_param_field {
@@ -328,8 +325,8 @@ HBAO_EXPORT size_t hbao_view_size(void);
  *         HBAO_ERROR_INVALID_CAMERA (as hbao_compute() would), and then
  *         *view is unchanged
  */
-HBAO_EXPORT hbao_result hbao_camera_view(const hbao_camera *camera, int32_t width,
-                                         int32_t height, hbao_view *view);
+HBAO_EXPORT hbao_result hbao_camera_view(const hbao_camera *camera, int32_t width, int32_t height,
+                                         hbao_view *view);
 
 /**
  * The camera of the sub-rectangle (x, y, width, height) of a full_width x
@@ -350,8 +347,8 @@ HBAO_EXPORT hbao_result hbao_camera_view(const hbao_camera *camera, int32_t widt
  *         and then *cropped is unchanged
  */
 HBAO_EXPORT hbao_result hbao_camera_crop(const hbao_camera *camera, int32_t full_width,
-                                         int32_t full_height, int32_t x, int32_t y,
-                                         int32_t width, int32_t height, hbao_camera *cropped);
+                                         int32_t full_height, int32_t x, int32_t y, int32_t width,
+                                         int32_t height, hbao_camera *cropped);
 
 /**
  * Compute ambient occlusion.
@@ -367,8 +364,7 @@ HBAO_EXPORT hbao_result hbao_camera_crop(const hbao_camera *camera, int32_t full
  */
 HBAO_EXPORT hbao_result hbao_compute(const hbao_params *params, const hbao_camera *camera,
                                      int32_t width, int32_t height, const hbao_channel *depth,
-                                     const hbao_channel *normal, float *ao,
-                                     int64_t ao_row_stride);
+                                     const hbao_channel *normal, float *ao, int64_t ao_row_stride);
 
 #ifdef __cplusplus
 }

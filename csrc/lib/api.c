@@ -2,7 +2,9 @@
 /* Version, result messages and defaults: the small parts of the public API. */
 #include "internal_hbao.h"
 
-int32_t hbao_version(void) { return HBAO_VERSION; }
+int32_t hbao_version(void) {
+    return HBAO_VERSION;
+}
 
 const char *hbao_result_message(hbao_result result) {
     static const char *const messages[] = {
@@ -26,8 +28,14 @@ void hbao_camera_default(hbao_camera *camera) {
     *camera = defaults;
 }
 
-size_t hbao_params_size(void) { return sizeof(hbao_params); }
+size_t hbao_params_size(void) {
+    return sizeof(hbao_params);
+}
 
-size_t hbao_camera_size(void) { return sizeof(hbao_camera); }
+size_t hbao_camera_size(void) {
+    return sizeof(hbao_camera);
+}
 
-size_t hbao_view_size(void) { return sizeof(hbao_view); }
+size_t hbao_view_size(void) {
+    return sizeof(hbao_view);
+}

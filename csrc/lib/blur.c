@@ -37,7 +37,7 @@ typedef struct finish_job {
     const float *depth;    /* full resolution, 0 = background */
     int width, height;
     int half_resolution;
-    int radius;         /* taps on each side; 0 = no blur */
+    int radius; /* taps on each side; 0 = no blur */
     int band_rows;
     int implementation; /* resolved: which compiled copy runs */
     float sharpness;
@@ -82,8 +82,8 @@ typedef struct centre_row {
  * branch marks background; the weight is finite, so the product is exact.
  * The vector loop below performs exactly these operations lane by lane.
  * Background centres give 1. */
-static HBAO_ALWAYS_INLINE float blur_pixel(const tap_set *taps, const centre_row *c, float sharpness,
-                                           int width, int i) {
+static HBAO_ALWAYS_INLINE float blur_pixel(const tap_set *taps, const centre_row *c,
+                                           float sharpness, int width, int i) {
     const float zc = c->z[i];
     const float scaled = zc > 0.0f ? sharpness / zc : 0.0f;
     const float factor = scaled < FLT_MAX ? scaled : FLT_MAX;
@@ -93,8 +93,8 @@ static HBAO_ALWAYS_INLINE float blur_pixel(const tap_set *taps, const centre_row
         if (taps->along_row && (at < 0 || at >= width)) continue;
         const float z = taps->z[t][at];
         const float difference = (z - zc) * factor;
-        const float facing = taps->nx[t][at] * c->nx[i] + taps->ny[t][at] * c->ny[i] +
-                             taps->nz[t][at] * c->nz[i];
+        const float facing =
+            taps->nx[t][at] * c->nx[i] + taps->ny[t][at] * c->ny[i] + taps->nz[t][at] * c->nz[i];
         const float bend = 1.0f - facing;
         const float exponent =
             difference * difference + HBAO_BLUR_NORMAL_SHARPNESS * (bend > 0.0f ? bend : 0.0f);
@@ -146,16 +146,14 @@ static HBAO_ALWAYS_INLINE void blur_lanes(const tap_set *taps, const centre_row 
     const vint geometry = zc > 0.0f;
     const vfloat scaled = select_lanes(geometry, sharpness / zc, zero);
     const vfloat factor = select_lanes(scaled < FLT_MAX, scaled, zero + FLT_MAX);
-    const vfloat cx = load_lanes(c->nx + i), cy = load_lanes(c->ny + i),
-                 cz = load_lanes(c->nz + i);
+    const vfloat cx = load_lanes(c->nx + i), cy = load_lanes(c->ny + i), cz = load_lanes(c->nz + i);
     vfloat sum = load_lanes(c->ao + i), weight_sum = one;
     for (int t = 0; t < taps->count; t++) {
         const int at = i + taps->offset[t];
         const vfloat z = load_lanes(taps->z[t] + at);
         const vfloat difference = (z - zc) * factor;
         const vfloat facing = load_lanes(taps->nx[t] + at) * cx +
-                              load_lanes(taps->ny[t] + at) * cy +
-                              load_lanes(taps->nz[t] + at) * cz;
+                              load_lanes(taps->ny[t] + at) * cy + load_lanes(taps->nz[t] + at) * cz;
         const vfloat bend = 1.0f - facing;
         const vfloat exponent = difference * difference +
                                 HBAO_BLUR_NORMAL_SHARPNESS * (vfloat)((vint)bend & (bend > 0.0f));
@@ -208,8 +206,8 @@ static HBAO_ALWAYS_INLINE void make_row(const finish_job *job, band_memory *m, i
     const ring_row *slot = &m->ring[j % (2 * radius + 1)];
     const float *raw;
     if (job->half_resolution) {
-        hbao_upsample_row(job->implementation, job->grid, job->grid_ao, job->depth, width, j, m->raw,
-                          slot->nx, slot->ny, slot->nz);
+        hbao_upsample_row(job->implementation, job->grid, job->grid_ao, job->depth, width, j,
+                          m->raw, slot->nx, slot->ny, slot->nz);
         raw = m->raw;
     } else {
         raw = job->grid_ao + (size_t)j * width;
@@ -309,7 +307,9 @@ static HBAO_ALWAYS_INLINE void finish_band(void *context, int band) {
     free(m.block);
 }
 
-static void finish_band_portable(void *context, int band) { finish_band(context, band); }
+static void finish_band_portable(void *context, int band) {
+    finish_band(context, band);
+}
 
 #ifdef HBAO_FINISH_X86
 HBAO_TARGET_AVX2 static void finish_band_avx2(void *context, int band) {

@@ -6,7 +6,9 @@
 
 #include "internal_hbao.h"
 
-static int finite_positive(float value) { return isfinite(value) && value > 0.0f; }
+static int finite_positive(float value) {
+    return isfinite(value) && value > 0.0f;
+}
 
 /* The rotation part (upper-left 3x3) maps normals into the camera; only its
  * direction matters, the normals are renormalised after it. So the test is
@@ -25,8 +27,9 @@ static int finite_positive(float value) { return isfinite(value) && value > 0.0f
 static int rotation_part_is_invertible(const float *m) {
     double row_length_product = 1.0;
     for (int r = 0; r < 3; r++) {
-        const double length = sqrt((double)m[4 * r] * m[4 * r] + (double)m[4 * r + 1] * m[4 * r + 1] +
-                                   (double)m[4 * r + 2] * m[4 * r + 2]);
+        const double length =
+            sqrt((double)m[4 * r] * m[4 * r] + (double)m[4 * r + 1] * m[4 * r + 1] +
+                 (double)m[4 * r + 2] * m[4 * r + 2]);
         if (!(length >= MIN_ROW_LENGTH && length <= MAX_ROW_LENGTH)) return 0;
         row_length_product *= length;
     }
@@ -134,7 +137,9 @@ hbao_result hbao_camera_view(const hbao_camera *camera, int32_t width, int32_t h
 
 /* A double that converts to a finite float (converting one beyond FLT_MAX is
  * undefined behaviour in C). */
-static int fits_float(double value) { return isfinite(value) && fabs(value) <= FLT_MAX; }
+static int fits_float(double value) {
+    return isfinite(value) && fabs(value) <= FLT_MAX;
+}
 
 hbao_result hbao_camera_crop(const hbao_camera *camera, int32_t full_width, int32_t full_height,
                              int32_t x, int32_t y, int32_t width, int32_t height,

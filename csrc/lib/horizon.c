@@ -19,8 +19,8 @@ typedef hbao_horizon_job horizon_job;
 typedef struct march {
     const hbao_grid *grid;
     int i, j;
-    float p[3];      /* the pixel's position */
-    float dc, ds;    /* the direction, view plane */
+    float p[3];   /* the pixel's position */
+    float dc, ds; /* the direction, view plane */
     float inv_ycor;
     float jitter;
     float step_px;
@@ -57,10 +57,10 @@ static inline int march_sample(const march *m, int step, float delta[3], float *
 
 /* The slice of a direction: its axes and the normal projected into it. */
 typedef struct slice {
-    float e[3];          /* in-slice axis perpendicular to V, marching side */
-    float np_length;     /* |normal projected into the slice| */
-    float inv_np;        /* 1 / np_length */
-    float cos_gamma;     /* angle of the projected normal from V towards e */
+    float e[3];      /* in-slice axis perpendicular to V, marching side */
+    float np_length; /* |normal projected into the slice| */
+    float inv_np;    /* 1 / np_length */
+    float cos_gamma; /* angle of the projected normal from V towards e */
     float sin_gamma;
     int usable;
 } slice;
@@ -345,7 +345,8 @@ static void horizon_tile(void *context, int tile) {
             float *out = job->ao + (size_t)j * width;
             for (int a = 0; a < 4; a++) {
                 const float step_px = hbao_block_step(job, x0, x1, j, a);
-                for (int i = x0 + a; i < x1; i += 4) out[i] = hbao_horizon_pixel(job, i, j, step_px);
+                for (int i = x0 + a; i < x1; i += 4)
+                    out[i] = hbao_horizon_pixel(job, i, j, step_px);
             }
         }
     }
@@ -398,7 +399,8 @@ void hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *grid,
         const double rotation = (bayer_4x4[cell] + 0.5) / 16.0;
         job.jitter[cell] = (float)((bayer_4x4[j + 4 * i] + 0.5) / 16.0);
         for (int d = 0; d < settings->directions; d++) {
-            const double theta = 2.0 * 3.14159265358979323846 * (d + rotation) / settings->directions;
+            const double theta =
+                2.0 * 3.14159265358979323846 * (d + rotation) / settings->directions;
             job.direction_cos[cell][d] = (float)cos(theta);
             job.direction_sin[cell][d] = (float)sin(theta);
         }
@@ -410,7 +412,8 @@ void hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *grid,
     float *phase_depth = NULL;
     job.phase_depth = NULL;
     /* whole blocks, so that a block's depths are always one full load */
-    job.phase_width = ((grid->width + 3) / 4 + HBAO_BLOCK_PIXELS - 1) / HBAO_BLOCK_PIXELS * HBAO_BLOCK_PIXELS;
+    job.phase_width =
+        ((grid->width + 3) / 4 + HBAO_BLOCK_PIXELS - 1) / HBAO_BLOCK_PIXELS * HBAO_BLOCK_PIXELS;
     if (tiled.simd != NULL) {
         phase_depth = malloc((size_t)4 * grid->height * job.phase_width * sizeof(float));
         /* Without memory for the copy the scalar reference computes the same

@@ -51,7 +51,9 @@ void hbao_horizon_span_avx2(const hbao_horizon_job *job, int x0, int x1, int j) 
 
 #else /* not built for x86-64: never chosen */
 
-int hbao_horizon_avx2_available(void) { return 0; }
+int hbao_horizon_avx2_available(void) {
+    return 0;
+}
 
 void hbao_horizon_span_avx2(const hbao_horizon_job *job, int x0, int x1, int j) {
     float *out = job->ao + (size_t)j * job->grid->width;

@@ -20,7 +20,9 @@
 #define V_SET _mm512_set1_ps
 #define V_LOADU _mm512_loadu_ps
 #define V_STOREU _mm512_storeu_ps
-#define V_NEG(a) _mm512_castsi512_ps(_mm512_xor_si512(_mm512_castps_si512(a), _mm512_set1_epi32((int)0x80000000u)))
+#define V_NEG(a)                                                                                   \
+    _mm512_castsi512_ps(                                                                           \
+        _mm512_xor_si512(_mm512_castps_si512(a), _mm512_set1_epi32((int)0x80000000u)))
 #define V_MAX0(a) _mm512_max_ps((a), _mm512_setzero_ps()) /* NaN -> 0, like fmaxf(0, a) */
 #define V_GT(a, b) _mm512_cmp_ps_mask((a), (b), _CMP_GT_OQ)
 #define V_GE(a, b) _mm512_cmp_ps_mask((a), (b), _CMP_GE_OQ)
@@ -51,7 +53,9 @@ void hbao_horizon_span_avx512(const hbao_horizon_job *job, int x0, int x1, int j
 
 #else /* not built for x86-64: never chosen */
 
-int hbao_horizon_avx512_available(void) { return 0; }
+int hbao_horizon_avx512_available(void) {
+    return 0;
+}
 
 void hbao_horizon_span_avx512(const hbao_horizon_job *job, int x0, int x1, int j) {
     float *out = job->ao + (size_t)j * job->grid->width;

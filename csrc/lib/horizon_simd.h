@@ -72,9 +72,9 @@ static inline void SIMD_NAME(slice_setup)(const VF v[3], const VF n[3], VF dc, V
 typedef struct SIMD_NAME(block) {
     const hbao_horizon_job *job;
     const hbao_grid *grid;
-    VI lane_i;       /* the lanes' columns: first_i + 4 k */
-    int phase;       /* first_i & 3: the lanes' column phase */
-    int first_x;     /* lane 0's index in its phase_depth row: first_i / 4 */
+    VI lane_i;   /* the lanes' columns: first_i + 4 k */
+    int phase;   /* first_i & 3: the lanes' column phase */
+    int first_x; /* lane 0's index in its phase_depth row: first_i / 4 */
     int j;
     float jitter, step_px, inv_ycor; /* shared by the block */
     VF p[3], v[3], n[3];
@@ -108,7 +108,8 @@ static inline int SIMD_NAME(fetch_steps)(const SIMD_NAME(block) * b, int steps, 
         if (sj < 0 || sj >= g->height) break; /* every lane's sample leaves the image */
         const VI si = I_ADD(b->lane_i, I_SET(ox));
         const VF column = I_TO_F(si); /* exact: |si| < 2^24 */
-        alive = M_AND(alive, M_AND(V_GE(column, V_SET(0.0f)), V_LT(column, V_SET((float)g->width))));
+        alive =
+            M_AND(alive, M_AND(V_GE(column, V_SET(0.0f)), V_LT(column, V_SET((float)g->width))));
         const VM candidate = (ox == 0 && oy == 0) ? M_ANDNOT(alive, alive) : alive;
         /* lane k samples column first_i + 4 k + ox: phase (phase + ox) mod 4,
          * index first_x + k + floor((phase + ox) / 4) of that phase's row */
@@ -152,18 +153,22 @@ static inline VM SIMD_NAME(sample)(const SIMD_NAME(block) * b, const SIMD_NAME(f
 }
 
 /* horizon.c's sample_elevation and past_the_normal */
-static inline VF SIMD_NAME(sample_elevation)(const SIMD_NAME(block) * b, const VF delta[3], VF inv_dist) {
+static inline VF SIMD_NAME(sample_elevation)(const SIMD_NAME(block) * b, const VF delta[3],
+                                             VF inv_dist) {
     const VF height = SIMD_NAME(dot3)(delta[0], delta[1], delta[2], b->n[0], b->n[1], b->n[2]);
     return V_MUL(V_SUB(height, b->height_tolerance), inv_dist);
 }
 
-static inline VF SIMD_NAME(cos_to_view)(const SIMD_NAME(block) * b, const VF delta[3], VF inv_dist) {
-    return V_MUL(SIMD_NAME(dot3)(delta[0], delta[1], delta[2], b->v[0], b->v[1], b->v[2]), inv_dist);
+static inline VF SIMD_NAME(cos_to_view)(const SIMD_NAME(block) * b, const VF delta[3],
+                                        VF inv_dist) {
+    return V_MUL(SIMD_NAME(dot3)(delta[0], delta[1], delta[2], b->v[0], b->v[1], b->v[2]),
+                 inv_dist);
 }
 
 static inline VM SIMD_NAME(past_the_normal)(const SIMD_NAME(block) * b, const SIMD_NAME(slice) * sl,
                                             const VF delta[3], VF inv_dist, VF sin_s) {
-    return M_AND(V_GT(SIMD_NAME(cos_to_view)(b, delta, inv_dist), sl->cos_gamma), V_GT(sin_s, b->n_dot_v));
+    return M_AND(V_GT(SIMD_NAME(cos_to_view)(b, delta, inv_dist), sl->cos_gamma),
+                 V_GT(sin_s, b->n_dot_v));
 }
 
 static VF SIMD_NAME(direction_occlusion_hbao)(const hbao_settings *s, const SIMD_NAME(block) * b,
@@ -188,19 +193,23 @@ static VF SIMD_NAME(direction_occlusion_hbao)(const hbao_settings *s, const SIMD
         if (any_check) {
             const VM past = M_AND(M_AND(ok, check_past_normal),
                                   SIMD_NAME(past_the_normal)(b, sl, delta, inv_dist, sin_s));
-            occlusion = V_SELECT(M_AND(past, V_LT(occlusion, half_occluded)), occlusion, half_occluded);
+            occlusion =
+                V_SELECT(M_AND(past, V_LT(occlusion, half_occluded)), occlusion, half_occluded);
             alive = M_ANDNOT(past, alive);
             rest = M_ANDNOT(past, ok);
         }
         const VM rise = M_AND(rest, V_GT(sin_s, sin_max));
-        const VF weight = quadratic ? V_SUB(V_SET(1.0f), V_MUL(dist2, b->inv_radius2)) : V_SET(1.0f);
-        occlusion = V_SELECT(rise, occlusion, V_ADD(occlusion, V_MUL(weight, V_SUB(sin_s, sin_max))));
+        const VF weight =
+            quadratic ? V_SUB(V_SET(1.0f), V_MUL(dist2, b->inv_radius2)) : V_SET(1.0f);
+        occlusion =
+            V_SELECT(rise, occlusion, V_ADD(occlusion, V_MUL(weight, V_SUB(sin_s, sin_max))));
         sin_max = V_SELECT(rise, sin_max, sin_s);
     }
     return occlusion;
 }
 
-static inline VF SIMD_NAME(half_slice_visibility)(VF h, VF cos_h, VF sin_h, const SIMD_NAME(slice) * sl) {
+static inline VF SIMD_NAME(half_slice_visibility)(VF h, VF cos_h, VF sin_h,
+                                                  const SIMD_NAME(slice) * sl) {
     const VF cos_2h = V_SUB(V_MUL(V_MUL(V_SET(2.0f), cos_h), cos_h), V_SET(1.0f));
     const VF sin_2h = V_MUL(V_MUL(V_SET(2.0f), sin_h), cos_h);
     const VF cos_2h_minus_gamma = V_ADD(V_MUL(cos_2h, sl->cos_gamma), V_MUL(sin_2h, sl->sin_gamma));
@@ -216,8 +225,10 @@ static inline VF SIMD_NAME(horizon_visibility)(VM past_normal, VF cos_past_max, 
     const VF angle = V_ADD(gamma, SIMD_NAME(acos)(elevation_max));
     const VM flat = V_LE(angle, V_SET(0.0f));
     VF h = V_SELECT(flat, angle, V_SET(0.0f));
-    VF cos_h = V_SELECT(flat, V_SUB(V_MUL(sl->cos_gamma, cos_a), V_MUL(sl->sin_gamma, sin_a)), V_SET(1.0f));
-    VF sin_h = V_SELECT(flat, V_ADD(V_MUL(sl->sin_gamma, cos_a), V_MUL(sl->cos_gamma, sin_a)), V_SET(0.0f));
+    VF cos_h = V_SELECT(flat, V_SUB(V_MUL(sl->cos_gamma, cos_a), V_MUL(sl->sin_gamma, sin_a)),
+                        V_SET(1.0f));
+    VF sin_h = V_SELECT(flat, V_ADD(V_MUL(sl->sin_gamma, cos_a), V_MUL(sl->cos_gamma, sin_a)),
+                        V_SET(0.0f));
     if (M_ANY(past_normal)) {
         const VF past_sin = V_SQRT(V_MAX0(V_SUB(V_SET(1.0f), V_MUL(cos_past_max, cos_past_max))));
         h = V_SELECT(past_normal, h, SIMD_NAME(acos)(cos_past_max));
@@ -231,9 +242,10 @@ static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SI
                                                 VM active, float dc, float ds,
                                                 const SIMD_NAME(slice) * sl, VF *open_part) {
     const VF gamma = V_SUB(V_SET(0.5f * HBAO_PI), SIMD_NAME(acos)(sl->sin_gamma));
-    *open_part = V_MUL(V_SET(0.25f), V_ADD(V_MUL(V_SET(2.0f), sl->cos_gamma),
-                                           V_MUL(V_ADD(V_MUL(V_SET(2.0f), gamma), V_SET(HBAO_PI)),
-                                                 sl->sin_gamma)));
+    *open_part =
+        V_MUL(V_SET(0.25f),
+              V_ADD(V_MUL(V_SET(2.0f), sl->cos_gamma),
+                    V_MUL(V_ADD(V_MUL(V_SET(2.0f), gamma), V_SET(HBAO_PI)), sl->sin_gamma)));
     const VF inv_np = sl->inv_np;
     const VM check_past_normal = V_GT(sl->sin_gamma, V_SET(0.0f));
     const int any_check = M_ANY(M_AND(check_past_normal, active));
@@ -258,9 +270,11 @@ static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SI
         if (any_check) {
             const VF cos_v = SIMD_NAME(cos_to_view)(b, delta, inv_dist);
             const VM past = M_AND(V_GT(cos_v, sl->cos_gamma), V_GT(sin_s, b->n_dot_v));
-            const VM newly = M_AND(M_AND(M_AND(ok, check_past_normal), past), V_GT(cos_v, cos_past_max));
+            const VM newly =
+                M_AND(M_AND(M_AND(ok, check_past_normal), past), V_GT(cos_v, cos_past_max));
             past_normal = M_OR(past_normal, newly);
-            cos_past_max = V_SELECT(newly, cos_past_max, V_SELECT(V_GT(cos_v, V_SET(1.0f)), cos_v, V_SET(1.0f)));
+            cos_past_max = V_SELECT(newly, cos_past_max,
+                                    V_SELECT(V_GT(cos_v, V_SET(1.0f)), cos_v, V_SET(1.0f)));
             raised = newly;
         }
         const VM elevation_candidates = M_ANDNOT(past_normal, M_ANDNOT(raised, ok));
@@ -273,21 +287,23 @@ static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SI
             const VF visibility =
                 SIMD_NAME(horizon_visibility)(past_normal, cos_past_max, elevation_max, gamma, sl);
             const VF weight = V_SUB(V_SET(1.0f), V_MUL(dist2, b->inv_radius2));
-            occlusion = V_SELECT(raised, occlusion,
-                                 V_ADD(occlusion, V_MUL(weight, V_SUB(visibility_at_max, visibility))));
+            occlusion =
+                V_SELECT(raised, occlusion,
+                         V_ADD(occlusion, V_MUL(weight, V_SUB(visibility_at_max, visibility))));
             visibility_at_max = V_SELECT(raised, visibility_at_max, visibility);
         }
     }
     if (!quadratic)
-        occlusion = V_SUB(visibility_start, SIMD_NAME(horizon_visibility)(past_normal, cos_past_max,
-                                                                          elevation_max, gamma, sl));
+        occlusion =
+            V_SUB(visibility_start, SIMD_NAME(horizon_visibility)(past_normal, cos_past_max,
+                                                                  elevation_max, gamma, sl));
     return occlusion;
 }
 
 /* Lanes first_lane .. first_lane + SIMD_LANES - 1 of the block of phase a
  * at x0 in row j, with the block's step step_px. */
-static void SIMD_NAME(lanes_ao)(const hbao_horizon_job *job, int x0, int x1, int j, int a, int first_lane,
-                                float step_px) {
+static void SIMD_NAME(lanes_ao)(const hbao_horizon_job *job, int x0, int x1, int j, int a,
+                                int first_lane, float step_px) {
     const hbao_settings *s = job->settings;
     const hbao_grid *g = job->grid;
     SIMD_NAME(block) b;
@@ -298,7 +314,8 @@ static void SIMD_NAME(lanes_ao)(const hbao_horizon_job *job, int x0, int x1, int
     b.phase = a;
     b.first_x = first_i / 4;
     /* phase_depth rows are padded to whole blocks with zeros: background */
-    const VF z = V_LOADU(job->phase_depth + ((size_t)a * g->height + j) * job->phase_width + b.first_x);
+    const VF z =
+        V_LOADU(job->phase_depth + ((size_t)a * g->height + j) * job->phase_width + b.first_x);
     b.lane_i = I_ADD(I_SET(first_i), I_MULLO(I_LANES, I_SET(4)));
     const VF column = V_MUL(V_ADD(I_TO_F(b.lane_i), V_SET(g->x_offset)), V_SET(g->x_step));
     const VF row = V_SET(hbao_grid_y(g, j));
@@ -323,7 +340,9 @@ static void SIMD_NAME(lanes_ao)(const hbao_horizon_job *job, int x0, int x1, int
             b.v[1] = V_SET(0.0f);
             b.v[2] = V_SET(1.0f);
         } else {
-            const VF inv = V_DIV(V_SET(1.0f), V_SQRT(SIMD_NAME(dot3)(b.p[0], b.p[1], b.p[2], b.p[0], b.p[1], b.p[2])));
+            const VF inv =
+                V_DIV(V_SET(1.0f),
+                      V_SQRT(SIMD_NAME(dot3)(b.p[0], b.p[1], b.p[2], b.p[0], b.p[1], b.p[2])));
             for (int c = 0; c < 3; c++) b.v[c] = V_MUL(V_NEG(b.p[c]), inv);
         }
         float normal_lanes[3][SIMD_LANES];
@@ -335,10 +354,11 @@ static void SIMD_NAME(lanes_ao)(const hbao_horizon_job *job, int x0, int x1, int
         for (int c = 0; c < 3; c++) b.n[c] = V_LOADU(normal_lanes[c]);
         b.n_dot_v = SIMD_NAME(dot3)(b.n[0], b.n[1], b.n[2], b.v[0], b.v[1], b.v[2]);
         /* hbao_rounding_along_normal */
-        const VF along = g->orthographic ? V_MUL(b.n[2], b.p[2])
-                                         : SIMD_NAME(dot3)(b.n[0], b.n[1], b.n[2], b.p[0], b.p[1], b.p[2]);
-        b.height_tolerance =
-            V_MUL(V_SET(g->depth_precision), V_SELECT(V_LT(along, V_SET(0.0f)), along, V_NEG(along)));
+        const VF along = g->orthographic
+                             ? V_MUL(b.n[2], b.p[2])
+                             : SIMD_NAME(dot3)(b.n[0], b.n[1], b.n[2], b.p[0], b.p[1], b.p[2]);
+        b.height_tolerance = V_MUL(V_SET(g->depth_precision),
+                                   V_SELECT(V_LT(along, V_SET(0.0f)), along, V_NEG(along)));
 
         const int cosine = s->integration == HBAO_INTEGRATION_COSINE;
         VF occlusion_sum = V_SET(0.0f), visible_sum = V_SET(0.0f), open_sum = V_SET(0.0f);
@@ -350,18 +370,23 @@ static void SIMD_NAME(lanes_ao)(const hbao_horizon_job *job, int x0, int x1, int
                 const VM lanes = M_AND(active, sl.usable);
                 if (!M_ANY(lanes)) continue;
                 VF open;
-                const VF occlusion = SIMD_NAME(direction_occlusion_cosine)(s, &b, lanes, dc, ds, &sl, &open);
-                visible_sum = V_SELECT(lanes, visible_sum, V_ADD(visible_sum, V_MUL(sl.np_length, V_SUB(open, occlusion))));
+                const VF occlusion =
+                    SIMD_NAME(direction_occlusion_cosine)(s, &b, lanes, dc, ds, &sl, &open);
+                visible_sum =
+                    V_SELECT(lanes, visible_sum,
+                             V_ADD(visible_sum, V_MUL(sl.np_length, V_SUB(open, occlusion))));
                 open_sum = V_SELECT(lanes, open_sum, V_ADD(open_sum, V_MUL(sl.np_length, open)));
             } else {
-                occlusion_sum = V_ADD(occlusion_sum, SIMD_NAME(direction_occlusion_hbao)(s, &b, active, dc, ds, &sl));
+                occlusion_sum = V_ADD(
+                    occlusion_sum, SIMD_NAME(direction_occlusion_hbao)(s, &b, active, dc, ds, &sl));
             }
         }
         VF ao;
         if (cosine)
             ao = V_SELECT(V_GT(open_sum, V_SET(1e-12f)), V_SET(1.0f), V_DIV(visible_sum, open_sum));
         else
-            ao = V_SUB(V_SET(1.0f), V_DIV(occlusion_sum, V_SET((float)s->directions * (1.0f - s->sin_bias))));
+            ao = V_SUB(V_SET(1.0f),
+                       V_DIV(occlusion_sum, V_SET((float)s->directions * (1.0f - s->sin_bias))));
         ao = V_ZERO_UNLESS(V_GT(ao, V_SET(0.0f)), ao); /* !(ao > 0) -> 0, NaN included */
         ao = V_SELECT(V_LT(ao, V_SET(1.0f)), V_SET(1.0f), ao);
         ao = V_SELECT(active, V_SET(1.0f), ao);

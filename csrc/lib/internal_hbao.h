@@ -28,7 +28,7 @@
 /* Parameters after clamping to the documented limits. */
 typedef struct hbao_settings {
     float radius;
-    float bias_rad;  /* angle bias */
+    float bias_rad; /* angle bias */
     float sin_bias;
     float cos_bias;
     int directions;
@@ -48,8 +48,8 @@ typedef struct hbao_settings {
  * half-resolution grid. Depth is dense and positive; 0 marks background. */
 typedef struct hbao_grid {
     int width, height;
-    float *depth;     /* width * height */
-    float *normal;    /* width * height * 3, camera space, facing the viewer */
+    float *depth;  /* width * height */
+    float *normal; /* width * height * 3, camera space, facing the viewer */
     /* View-plane coordinates (per unit depth if perspective) of column i and
      * row j: (i + x_offset) * x_step and (j + y_offset) * y_step. Computed,
      * not tabulated, so that SIMD code needs no gather for them. */
@@ -86,7 +86,7 @@ static inline float hbao_rounding_along_normal(const hbao_grid *grid, const floa
  * chosen when the library loads (GCC's target_clones). Their operations are
  * element-wise and never contracted into FMAs (ISO C mode), so every copy
  * computes the same floats. */
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && \
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) &&                             \
     !defined(__SANITIZE_ADDRESS__)
 #define HBAO_VECTOR_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
 #else
@@ -130,8 +130,8 @@ int hbao_available_cores(void);
 
 /* normals.c: grid->normal from the given normals (world space, sampled at
  * full-resolution pixel (scale*i, scale*j)) or reconstructed from depth. */
-void hbao_compute_normals(const hbao_settings *settings, const hbao_camera *camera,
-                          hbao_grid *grid, const hbao_channel *normal, int scale);
+void hbao_compute_normals(const hbao_settings *settings, const hbao_camera *camera, hbao_grid *grid,
+                          const hbao_channel *normal, int scale);
 
 /* horizon.c: raw AO on the grid (dense, grid->width wide). */
 void hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *grid, float *ao);

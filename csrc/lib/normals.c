@@ -79,7 +79,8 @@ static int fit_tangent(const hbao_grid *grid, int i, int j, int di, int dj, cons
     float first_step = INFINITY;
     for (int side = -1; side <= 1; side += 2) {
         float z;
-        if (usable_depth(grid, i + side * di, j + side * dj, &z)) first_step = fminf(first_step, fabsf(z - z0));
+        if (usable_depth(grid, i + side * di, j + side * dj, &z))
+            first_step = fminf(first_step, fabsf(z - z0));
     }
     if (first_step == INFINITY) return 0;
     const float limit = 2.0f * first_step + 2.0f * grid->depth_precision * z0;
@@ -91,7 +92,8 @@ static int fit_tangent(const hbao_grid *grid, int i, int j, int di, int dj, cons
     for (int sign = -1; sign <= 1; sign += 2) {
         float previous = z0, z;
         for (int k = sign; k * sign <= HALF_DEPTH_FIT_REACH; k += sign) {
-            if (!usable_depth(grid, i + k * di, j + k * dj, &z) || !(fabsf(z - previous) <= limit)) break;
+            if (!usable_depth(grid, i + k * di, j + k * dj, &z) || !(fabsf(z - previous) <= limit))
+                break;
             previous = z;
             sum_z += z;
             sum_kz += (float)k * z;
@@ -249,8 +251,8 @@ static float detect_depth_precision(const hbao_settings *settings, const hbao_gr
     return atomic_load(&job.not_half) ? HBAO_FLOAT_DEPTH_PRECISION : HBAO_HALF_DEPTH_PRECISION;
 }
 
-void hbao_compute_normals(const hbao_settings *settings, const hbao_camera *camera,
-                          hbao_grid *grid, const hbao_channel *normal, int scale) {
+void hbao_compute_normals(const hbao_settings *settings, const hbao_camera *camera, hbao_grid *grid,
+                          const hbao_channel *normal, int scale) {
     grid->depth_precision = detect_depth_precision(settings, grid);
     normal_job job = {camera, grid, normal, scale};
     hbao_parallel_rows(settings->threads, grid->height, normal_row, &job);

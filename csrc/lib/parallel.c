@@ -24,8 +24,8 @@ static void *drain_rows(void *argument) {
     for (;;) {
         const int first = atomic_fetch_add(&queue->next_row, HBAO_ROWS_PER_GRAB);
         if (first >= queue->rows) break;
-        const int last = first + HBAO_ROWS_PER_GRAB < queue->rows ? first + HBAO_ROWS_PER_GRAB
-                                                                   : queue->rows;
+        const int last =
+            first + HBAO_ROWS_PER_GRAB < queue->rows ? first + HBAO_ROWS_PER_GRAB : queue->rows;
         for (int row = first; row < last; row++) queue->job(queue->context, row);
     }
     return NULL;

@@ -25,8 +25,7 @@ static void clamp_float(float *value, float low, float high, uint32_t field, uin
     }
 }
 
-hbao_result hbao_params_resolve(const hbao_params *in, hbao_params *out,
-                                uint32_t *clamped_fields) {
+hbao_result hbao_params_resolve(const hbao_params *in, hbao_params *out, uint32_t *clamped_fields) {
     if (clamped_fields != NULL) *clamped_fields = 0;
     if (in == NULL || out == NULL) return HBAO_ERROR_NULL_ARGUMENT;
     hbao_params p = *in;
@@ -52,7 +51,8 @@ hbao_result hbao_params_resolve(const hbao_params *in, hbao_params *out,
     /* +infinity is a legal background depth: nothing is background. */
     if (isnan(p.background_depth) || !(p.background_depth > 0.0f))
         invalid |= HBAO_PARAM_FIELD_BACKGROUND_DEPTH;
-    if (p.implementation < HBAO_IMPLEMENTATION_AUTO || p.implementation > HBAO_IMPLEMENTATION_AVX512)
+    if (p.implementation < HBAO_IMPLEMENTATION_AUTO ||
+        p.implementation > HBAO_IMPLEMENTATION_AVX512)
         invalid |= HBAO_PARAM_FIELD_IMPLEMENTATION;
     if (invalid != 0) {
         if (clamped_fields != NULL) *clamped_fields = invalid;
@@ -65,10 +65,12 @@ hbao_result hbao_params_resolve(const hbao_params *in, hbao_params *out,
 
 const char *hbao_param_field_name(uint32_t bit) {
     switch (bit) {
-#define HBAO_PARAM_FIELD_NAME_CASE(name, bit_index, text) \
-    case name: return text;
+#define HBAO_PARAM_FIELD_NAME_CASE(name, bit_index, text)                                          \
+    case name:                                                                                     \
+        return text;
         HBAO_PARAM_FIELD_LIST(HBAO_PARAM_FIELD_NAME_CASE)
 #undef HBAO_PARAM_FIELD_NAME_CASE
-    default: return NULL;
+        default:
+            return NULL;
     }
 }

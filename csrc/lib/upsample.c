@@ -10,10 +10,11 @@
 /* One candidate's share: bilinear weight times depth similarity, for the AO
  * and for the blur's guide normal alike. Written with selects only (no
  * branches) so that the row loop vectorizes. */
-static HBAO_ALWAYS_INLINE void add_candidate(float bilinear, float zs, float ao, const float *normal,
-                                             float z, float *sum, float *weight_sum,
-                                             float *nearest_ao, float *nearest_difference,
-                                             float normal_sum[3], float nearest_normal[3]) {
+static HBAO_ALWAYS_INLINE void add_candidate(float bilinear, float zs, float ao,
+                                             const float *normal, float z, float *sum,
+                                             float *weight_sum, float *nearest_ao,
+                                             float *nearest_difference, float normal_sum[3],
+                                             float nearest_normal[3]) {
     const int usable = (bilinear > 0.0f) & (zs > 0.0f);
     const float difference = fabsf(zs - z) / z;
     const float scaled = HBAO_UPSAMPLE_SHARPNESS * difference;
@@ -60,9 +61,8 @@ static HBAO_ALWAYS_INLINE void finish_pixel(float z, float sum, float weight_sum
  * upsample_row, skip the bottom candidates). */
 static HBAO_ALWAYS_INLINE void upsample_rows(const hbao_grid *half, const float *half_ao,
                                              const float *full_depth, int width, int j,
-                                             int two_rows, float *restrict out,
-                                             float *restrict nx, float *restrict ny,
-                                             float *restrict nz) {
+                                             int two_rows, float *restrict out, float *restrict nx,
+                                             float *restrict ny, float *restrict nz) {
     const int half_width = half->width;
     const int r0 = j / 2;
     const int r1 = two_rows ? r0 + 1 : r0;

@@ -48,7 +48,8 @@ static inline scene_plane scene_plane_make(double px, double py, double pz, doub
 }
 
 /* Keep only the part of the plane where dot((nx, ny, nz), x) <= offset. */
-static inline void scene_plane_clip(scene_plane *p, double nx, double ny, double nz, double offset) {
+static inline void scene_plane_clip(scene_plane *p, double nx, double ny, double nz,
+                                    double offset) {
     p->clip_normal[p->clips][0] = nx;
     p->clip_normal[p->clips][1] = ny;
     p->clip_normal[p->clips][2] = nz;
@@ -57,11 +58,13 @@ static inline void scene_plane_clip(scene_plane *p, double nx, double ny, double
 }
 
 static inline void mat_mul_point(const double m[16], const double p[3], double out[3]) {
-    for (int r = 0; r < 3; r++) out[r] = m[4 * r] * p[0] + m[4 * r + 1] * p[1] + m[4 * r + 2] * p[2] + m[4 * r + 3];
+    for (int r = 0; r < 3; r++)
+        out[r] = m[4 * r] * p[0] + m[4 * r + 1] * p[1] + m[4 * r + 2] * p[2] + m[4 * r + 3];
 }
 
 static inline void mat_mul_dir(const double m[16], const double p[3], double out[3]) {
-    for (int r = 0; r < 3; r++) out[r] = m[4 * r] * p[0] + m[4 * r + 1] * p[1] + m[4 * r + 2] * p[2];
+    for (int r = 0; r < 3; r++)
+        out[r] = m[4 * r] * p[0] + m[4 * r + 1] * p[1] + m[4 * r + 2] * p[2];
 }
 
 /* A camera at `eye` looking at `target`, world up +Z (Blender's convention:
@@ -71,7 +74,8 @@ static inline void scene_look_at(scene_view *view, const double eye[3], const do
     double fl = sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
     for (int c = 0; c < 3; c++) f[c] /= fl;
     const double up[3] = {0, 0, 1};
-    double r[3] = {f[1] * up[2] - f[2] * up[1], f[2] * up[0] - f[0] * up[2], f[0] * up[1] - f[1] * up[0]};
+    double r[3] = {f[1] * up[2] - f[2] * up[1], f[2] * up[0] - f[0] * up[2],
+                   f[0] * up[1] - f[1] * up[0]};
     double rl = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]);
     for (int c = 0; c < 3; c++) r[c] /= rl;
     double u[3] = {r[1] * f[2] - r[2] * f[1], r[2] * f[0] - r[0] * f[2], r[0] * f[1] - r[1] * f[0]};
@@ -100,41 +104,53 @@ static inline void scene_look_at(scene_view *view, const double eye[3], const do
 
 /* The camera-space ray of pixel (i, j): origin and direction with z = -1. */
 static inline void scene_pixel_ray(const scene_view *view, double i, double j, double origin[3],
-                            double direction[3]) {
+                                   double direction[3]) {
     const hbao_camera *c = &view->camera;
     const double w = view->width, h = view->height;
     const double ycor = (double)c->pixel_aspect_y / c->pixel_aspect_x;
-    int horizontal = c->sensor_fit == HBAO_SENSOR_FIT_HORIZONTAL ||
-                     (c->sensor_fit == HBAO_SENSOR_FIT_AUTO && c->pixel_aspect_x * w >= c->pixel_aspect_y * h);
-    const double sensor = c->sensor_fit == HBAO_SENSOR_FIT_VERTICAL ? c->sensor_height : c->sensor_width;
+    int horizontal =
+        c->sensor_fit == HBAO_SENSOR_FIT_HORIZONTAL ||
+        (c->sensor_fit == HBAO_SENSOR_FIT_AUTO && c->pixel_aspect_x * w >= c->pixel_aspect_y * h);
+    const double sensor =
+        c->sensor_fit == HBAO_SENSOR_FIT_VERTICAL ? c->sensor_height : c->sensor_width;
     const double viewfac = horizontal ? w : ycor * h;
     const int ortho = c->projection == HBAO_PROJECTION_ORTHOGRAPHIC;
     const double size = (ortho ? c->ortho_scale : sensor / c->lens) / viewfac;
     const double x = (-0.5 * w + c->shift_x * viewfac + i + 0.5) * size;
     const double y = (-0.5 * ycor * h + c->shift_y * viewfac + (h - 1 - j + 0.5) * ycor) * size;
     if (ortho) {
-        origin[0] = x; origin[1] = y; origin[2] = 0;
-        direction[0] = 0; direction[1] = 0; direction[2] = -1;
+        origin[0] = x;
+        origin[1] = y;
+        origin[2] = 0;
+        direction[0] = 0;
+        direction[1] = 0;
+        direction[2] = -1;
     } else {
         origin[0] = origin[1] = origin[2] = 0;
-        direction[0] = x; direction[1] = y; direction[2] = -1;
+        direction[0] = x;
+        direction[1] = y;
+        direction[2] = -1;
     }
 }
 
 /* Nearest hit of a world-space ray: returns t (or INFINITY), normal in world. */
-static inline double scene_trace(const scene *s, const double o[3], const double d[3], double normal[3]) {
+static inline double scene_trace(const scene *s, const double o[3], const double d[3],
+                                 double normal[3]) {
     double best = INFINITY;
     for (int k = 0; k < s->planes; k++) {
         const scene_plane *p = &s->plane[k];
         const double denom = p->normal[0] * d[0] + p->normal[1] * d[1] + p->normal[2] * d[2];
         if (fabs(denom) < 1e-12) continue;
-        const double t = ((p->point[0] - o[0]) * p->normal[0] + (p->point[1] - o[1]) * p->normal[1] +
-                          (p->point[2] - o[2]) * p->normal[2]) / denom;
+        const double t =
+            ((p->point[0] - o[0]) * p->normal[0] + (p->point[1] - o[1]) * p->normal[1] +
+             (p->point[2] - o[2]) * p->normal[2]) /
+            denom;
         if (!(t > 1e-9) || t >= best) continue;
         const double x[3] = {o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]};
         int inside = 1;
         for (int c = 0; c < p->clips; c++) {
-            const double v = p->clip_normal[c][0] * x[0] + p->clip_normal[c][1] * x[1] + p->clip_normal[c][2] * x[2];
+            const double v = p->clip_normal[c][0] * x[0] + p->clip_normal[c][1] * x[1] +
+                             p->clip_normal[c][2] * x[2];
             if (v > p->clip_offset[c] + 1e-12) inside = 0;
         }
         if (!inside) continue;
@@ -146,7 +162,8 @@ static inline double scene_trace(const scene *s, const double o[3], const double
 
 /* Depth (planar, Cycles' 1e10 for background) and world normals (xyz per
  * pixel, 0 for background) of the scene; caller frees both. */
-static inline void scene_render(const scene *s, const scene_view *view, float **depth_out, float **normal_out) {
+static inline void scene_render(const scene *s, const scene_view *view, float **depth_out,
+                                float **normal_out) {
     const size_t pixels = (size_t)view->width * view->height;
     float *depth = malloc(pixels * sizeof(float));
     float *normal = malloc(pixels * 3 * sizeof(float));
@@ -168,7 +185,8 @@ static inline void scene_render(const scene *s, const scene_view *view, float **
 }
 
 /* World position of pixel (i, j) at its depth. */
-static inline void scene_pixel_position(const scene_view *view, int i, int j, double depth, double world[3]) {
+static inline void scene_pixel_position(const scene_view *view, int i, int j, double depth,
+                                        double world[3]) {
     double o[3], d[3], p[3];
     scene_pixel_ray(view, i, j, o, d);
     for (int c = 0; c < 3; c++) p[c] = o[c] + depth * d[c];

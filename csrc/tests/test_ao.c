@@ -23,12 +23,13 @@ static hbao_params exact_params(int integration) {
     return p;
 }
 
-static float *run(const hbao_params *p, const scene_view *view, const float *depth, const float *normal) {
+static float *run(const hbao_params *p, const scene_view *view, const float *depth,
+                  const float *normal) {
     float *ao = malloc((size_t)view->width * view->height * sizeof(float));
     hbao_channel d = {depth, 1, view->width};
     hbao_channel n = {normal, 3, 3 * (int64_t)view->width};
-    CHECK_RESULT(hbao_compute(p, &view->camera, view->width, view->height, &d, normal ? &n : NULL, ao,
-                              view->width),
+    CHECK_RESULT(hbao_compute(p, &view->camera, view->width, view->height, &d, normal ? &n : NULL,
+                              ao, view->width),
                  HBAO_SUCCESS);
     return ao;
 }
@@ -68,7 +69,8 @@ static void render_standard_view(scene s, int width, int height, scene_view *vie
 
 /* A single plane occludes nothing: AO = 1. Tolerance 1e-4: samples on the
  * plane have elevation 0 up to float rounding of positions (~1e-6 relative). */
-static void check_plane_is_unoccluded(const double eye[3], const double target[3], scene_plane plane) {
+static void check_plane_is_unoccluded(const double eye[3], const double target[3],
+                                      scene_plane plane) {
     scene s;
     memset(&s, 0, sizeof s);
     s.planes = 1;
@@ -82,8 +84,10 @@ static void check_plane_is_unoccluded(const double eye[3], const double target[3
             p.radius = 2.0f;
             float *ao = run(&p, &view, depth, given ? normal : NULL);
             float worst = 1.0f;
-            for (int k = 0; k < view.width * view.height; k++) worst = ao[k] < worst ? ao[k] : worst;
-            if (worst < 1.0f - 1e-4f) printf("  integration %d given normals %d\n", integration, given);
+            for (int k = 0; k < view.width * view.height; k++)
+                worst = ao[k] < worst ? ao[k] : worst;
+            if (worst < 1.0f - 1e-4f)
+                printf("  integration %d given normals %d\n", integration, given);
             CHECK_NEAR(worst, 1.0f, 1e-4);
             free(ao);
         }
@@ -159,12 +163,13 @@ static double corner_hbao_occlusion(const scene_view *view, int i, int j, double
             const double a = -(p_world[0] + b * ex) / vx; /* x = 0 */
             double x[3];
             for (int c = 0; c < 3; c++) x[c] = p_world[c] + a * v_w[c] + b * e_w[c];
-            if (x[2] < 0.0) continue;                   /* below the floor: hidden */
+            if (x[2] < 0.0) continue; /* below the floor: hidden */
             double delta[3] = {x[0] - p_world[0], x[1] - p_world[1], x[2] - p_world[2]};
-            const double dist = sqrt(delta[0] * delta[0] + delta[1] * delta[1] + delta[2] * delta[2]);
-            if (dist >= 1.0) continue;                  /* radius R = 1 */
+            const double dist =
+                sqrt(delta[0] * delta[0] + delta[1] * delta[1] + delta[2] * delta[2]);
+            if (dist >= 1.0) continue; /* radius R = 1 */
             const double cos_h = (delta[0] * v_w[0] + delta[1] * v_w[1] + delta[2] * v_w[2]) / dist;
-            if (ne > 0.0 && cos_h > nv / np_len) {     /* past the normal */
+            if (ne > 0.0 && cos_h > nv / np_len) { /* past the normal */
                 if (occlusion < 0.5) occlusion = 0.5;
                 break;
             }
@@ -202,8 +207,8 @@ static void check_corner(int integration) {
                 j >= view.height - radius_px || a < 0.05 || a > 1.2)
                 continue;
             const double expected = 1.0 - (integration == HBAO_INTEGRATION_COSINE
-                                                ? corner_cosine_occlusion(a)
-                                                : corner_hbao_occlusion(&view, i, j, depth[k]));
+                                               ? corner_cosine_occlusion(a)
+                                               : corner_hbao_occlusion(&view, i, j, depth[k]));
             const double error = fabs(ao[k] - expected);
             error_sum += error;
             worst = error > worst ? error : worst;
@@ -216,7 +221,8 @@ static void check_corner(int integration) {
      * leave room for that and nothing like a wrong formula (which is off by
      * 0.1 or more near the wall). */
     printf("  corner (%s): %d pixels, mean |error| %.4f, worst %.4f\n",
-           integration == HBAO_INTEGRATION_COSINE ? "cosine" : "hbao", count, error_sum / count, worst);
+           integration == HBAO_INTEGRATION_COSINE ? "cosine" : "hbao", count, error_sum / count,
+           worst);
     CHECK(error_sum / count < 0.02);
     CHECK(worst < 0.06);
     free(ao);
@@ -224,9 +230,13 @@ static void check_corner(int integration) {
     free(normal);
 }
 
-TEST_CASE(corner_matches_analytic_cosine) { check_corner(HBAO_INTEGRATION_COSINE); }
+TEST_CASE(corner_matches_analytic_cosine) {
+    check_corner(HBAO_INTEGRATION_COSINE);
+}
 
-TEST_CASE(corner_matches_analytic_hbao) { check_corner(HBAO_INTEGRATION_HBAO); }
+TEST_CASE(corner_matches_analytic_hbao) {
+    check_corner(HBAO_INTEGRATION_HBAO);
+}
 
 TEST_CASE(corner_value_at_the_crease_is_one_half) {
     /* At the crease the wall takes exactly half the hemisphere, in both
@@ -298,7 +308,8 @@ static double brute_force_cosine(const scene_view *view, const float *depth, con
     const float *m = view->camera.world_to_camera;
     const float *nw = normal_w + 3 * ((size_t)j * view->width + i);
     double n[3];
-    for (int r = 0; r < 3; r++) n[r] = m[4 * r] * nw[0] + m[4 * r + 1] * nw[1] + m[4 * r + 2] * nw[2];
+    for (int r = 0; r < 3; r++)
+        n[r] = m[4 * r] * nw[0] + m[4 * r + 1] * nw[1] + m[4 * r + 2] * nw[2];
     const double pixel = 36.0 / 50.0 / view->width; /* per unit depth, horizontal fit */
     const double radius_px = radius / (pixel * -p[2]);
     double visible = 0.0, open = 0.0;
@@ -309,7 +320,8 @@ static double brute_force_cosine(const scene_view *view, const float *depth, con
         double e[3] = {dc - v[0] * dv, ds - v[1] * dv, -v[2] * dv};
         const double el = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
         for (int c = 0; c < 3; c++) e[c] /= el;
-        const double mm[3] = {v[1] * e[2] - v[2] * e[1], v[2] * e[0] - v[0] * e[2], v[0] * e[1] - v[1] * e[0]};
+        const double mm[3] = {v[1] * e[2] - v[2] * e[1], v[2] * e[0] - v[0] * e[2],
+                              v[0] * e[1] - v[1] * e[0]};
         const double nm = n[0] * mm[0] + n[1] * mm[1] + n[2] * mm[2];
         const double np[3] = {n[0] - mm[0] * nm, n[1] - mm[1] * nm, n[2] - mm[2] * nm};
         const double npl = sqrt(np[0] * np[0] + np[1] * np[1] + np[2] * np[2]);
@@ -339,11 +351,12 @@ static double brute_force_cosine(const scene_view *view, const float *depth, con
             if (gamma > 0 && cos_v > cos(gamma) && sin_s > n[0] * v[0] + n[1] * v[1] + n[2] * v[2])
                 hs = acos(fmin(1.0, cos_v));
             else
-                hs = gamma + acos(fmax(-1.0, fmin(1.0, (q[0] * n[0] + q[1] * n[1] + q[2] * n[2]) / dist / npl)));
+                hs = gamma + acos(fmax(-1.0, fmin(1.0, (q[0] * n[0] + q[1] * n[1] + q[2] * n[2]) /
+                                                           dist / npl)));
             if (hs < h) h = hs;
         }
         /* visibility integral from 0 to h of cos(t - gamma) sin(t) dt */
-#define HALF_SLICE(x) (0.25 * (-cos(2 * (x) - gamma) + cos(gamma) + 2 * (x) * sin(gamma)))
+#define HALF_SLICE(x) (0.25 * (-cos(2 * (x)-gamma) + cos(gamma) + 2 * (x)*sin(gamma)))
         visible += npl * HALF_SLICE(h);
         open += npl * HALF_SLICE(h_open);
 #undef HALF_SLICE
@@ -362,7 +375,8 @@ TEST_CASE(more_samples_converge_to_brute_force) {
     for (int j = 2; j < view.height; j += 4)
         for (int i = 2; i < view.width; i += 4) {
             const size_t k = (size_t)j * view.width + i;
-            reference[k] = depth[k] < 1e9f ? brute_force_cosine(&view, depth, normal, i, j, radius) : 1.0;
+            reference[k] =
+                depth[k] < 1e9f ? brute_force_cosine(&view, depth, normal, i, j, radius) : 1.0;
             count++;
         }
     const int settings[4][2] = {{4, 3}, {8, 6}, {16, 16}, {32, 32}};
@@ -403,9 +417,9 @@ TEST_CASE(past_the_normal_matches_brute_force_under_a_table) {
     scene s;
     memset(&s, 0, sizeof s);
     s.planes = 2;
-    s.plane[0] = scene_plane_make(0, 0, 0, 0, 0, 1);     /* the floor */
-    s.plane[1] = scene_plane_make(0, 0, 0.5, 0, 0, -1);  /* the table top's underside */
-    scene_plane_clip(&s.plane[1], 0, -1, 0, -1.0);      /* y >= 1: starting 1 m in front of the camera */
+    s.plane[0] = scene_plane_make(0, 0, 0, 0, 0, 1);    /* the floor */
+    s.plane[1] = scene_plane_make(0, 0, 0.5, 0, 0, -1); /* the table top's underside */
+    scene_plane_clip(&s.plane[1], 0, -1, 0, -1.0); /* y >= 1: starting 1 m in front of the camera */
     const double eye[3] = {0, 0, 0.3}, target[3] = {0, 3.0, 0.0};
     scene_view view = make_view(120, 90, eye, target);
     float *depth, *normal;
@@ -431,7 +445,8 @@ TEST_CASE(past_the_normal_matches_brute_force_under_a_table) {
             count++;
         }
     CHECK(count > 50);
-    printf("  %d floor pixels under the table: mean brute-force occlusion %.3f, mean |AO - brute force| %.4f\n",
+    printf("  %d floor pixels under the table: mean brute-force occlusion %.3f, mean |AO - brute "
+           "force| %.4f\n",
            count, darkness / count, error_sum / count);
     CHECK(darkness / count > 0.1); /* the table does occlude: the case is not trivial */
     /* The table top is seen at grazing angles, so snapping moves a step's
@@ -455,11 +470,13 @@ static uint32_t next_random(void) {
     rng_state ^= rng_state << 5;
     return rng_state;
 }
-static float random_unit(void) { return (float)(next_random() >> 8) / 16777216.0f; }
+static float random_unit(void) {
+    return (float)(next_random() >> 8) / 16777216.0f;
+}
 
 TEST_CASE(random_and_degenerate_inputs_give_finite_ao_in_range) {
-    static const float specials[] = {NAN, INFINITY, -INFINITY, 0.0f, -1.0f, 1e10f, 65504.0f, 1e-38f,
-                                     1e-45f, 3e38f, 1e-3f, 1.0f};
+    static const float specials[] = {NAN,      INFINITY, -INFINITY, 0.0f,  -1.0f, 1e10f,
+                                     65504.0f, 1e-38f,   1e-45f,    3e38f, 1e-3f, 1.0f};
     const int sizes[][2] = {{1, 1}, {1, 7}, {9, 1}, {2, 2}, {37, 23}, {64, 48}};
     for (int trial = 0; trial < 60; trial++) {
         const int w = sizes[trial % 6][0], h = sizes[trial % 6][1];
@@ -468,9 +485,11 @@ TEST_CASE(random_and_degenerate_inputs_give_finite_ao_in_range) {
         float *normal = malloc(pixels * 3 * sizeof(float));
         float *ao = malloc(pixels * sizeof(float));
         for (size_t k = 0; k < pixels; k++) {
-            depth[k] = (next_random() % 4 == 0) ? specials[next_random() % 12] : 0.5f + 20.0f * random_unit();
+            depth[k] = (next_random() % 4 == 0) ? specials[next_random() % 12]
+                                                : 0.5f + 20.0f * random_unit();
             for (int c = 0; c < 3; c++)
-                normal[3 * k + c] = (next_random() % 8 == 0) ? specials[next_random() % 12] : 2.0f * random_unit() - 1.0f;
+                normal[3 * k + c] = (next_random() % 8 == 0) ? specials[next_random() % 12]
+                                                             : 2.0f * random_unit() - 1.0f;
         }
         hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
         p.radius = (trial % 5 == 0) ? 1e30f : 0.01f + 5.0f * random_unit();
@@ -485,13 +504,15 @@ TEST_CASE(random_and_degenerate_inputs_give_finite_ao_in_range) {
         p.strength = 20.0f * random_unit();
         p.threads = 1 + trial % 3;
         hbao_camera camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
-        camera.projection = trial % 3 == 0 ? HBAO_PROJECTION_ORTHOGRAPHIC : HBAO_PROJECTION_PERSPECTIVE;
+        camera.projection =
+            trial % 3 == 0 ? HBAO_PROJECTION_ORTHOGRAPHIC : HBAO_PROJECTION_PERSPECTIVE;
         camera.lens = 1.0f + 200.0f * random_unit();
         camera.shift_x = random_unit() - 0.5f;
         camera.sensor_fit = trial % 3;
         hbao_channel d = {depth, 1, w};
         hbao_channel n = {normal, 3, 3 * (int64_t)w};
-        CHECK_RESULT(hbao_compute(&p, &camera, w, h, &d, (trial & 4) ? &n : NULL, ao, w), HBAO_SUCCESS);
+        CHECK_RESULT(hbao_compute(&p, &camera, w, h, &d, (trial & 4) ? &n : NULL, ao, w),
+                     HBAO_SUCCESS);
         int bad = 0;
         for (size_t k = 0; k < pixels; k++)
             if (!(ao[k] >= 0.0f && ao[k] <= 1.0f)) bad++;
@@ -536,14 +557,16 @@ TEST_CASE(bottom_up_rows_with_negative_stride) {
      * depth in an RGBA-like 4-float pixel. */
     float *flipped = malloc((size_t)w * h * 4 * sizeof(float));
     for (int j = 0; j < h; j++)
-        for (int i = 0; i < w; i++) flipped[4 * ((size_t)(h - 1 - j) * w + i)] = depth[(size_t)j * w + i];
+        for (int i = 0; i < w; i++)
+            flipped[4 * ((size_t)(h - 1 - j) * w + i)] = depth[(size_t)j * w + i];
     hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
     float *top_down = run(&p, &view, depth, NULL);
     float *ao = malloc((size_t)w * h * sizeof(float));
     hbao_channel d = {flipped + 4 * (size_t)(h - 1) * w, 4, -4 * (int64_t)w};
     /* the output bottom-up too */
-    CHECK_RESULT(hbao_compute(&p, &view.camera, w, h, &d, NULL, ao + (size_t)(h - 1) * w, -(int64_t)w),
-                 HBAO_SUCCESS);
+    CHECK_RESULT(
+        hbao_compute(&p, &view.camera, w, h, &d, NULL, ao + (size_t)(h - 1) * w, -(int64_t)w),
+        HBAO_SUCCESS);
     int mismatches = 0;
     for (int j = 0; j < h; j++)
         for (int i = 0; i < w; i++)
@@ -683,9 +706,11 @@ TEST_CASE(simd_paths_match_scalar_reference_bit_for_bit) {
     float *depth, *normal;
     /* odd sizes: row tails that the SIMD kernels leave to scalar code */
     render_standard_view(boxes_scene(), 203, 157, &view, &depth, &normal);
-    for (int k = 0; k < 300; k++) depth[(k * 7919) % (view.width * view.height)] = 1e10f; /* holes */
+    for (int k = 0; k < 300; k++)
+        depth[(k * 7919) % (view.width * view.height)] = 1e10f; /* holes */
     const size_t bytes = (size_t)view.width * view.height * sizeof(float);
-    const int kernels[] = {HBAO_IMPLEMENTATION_AVX2, HBAO_IMPLEMENTATION_AVX512, HBAO_IMPLEMENTATION_AUTO};
+    const int kernels[] = {HBAO_IMPLEMENTATION_AVX2, HBAO_IMPLEMENTATION_AVX512,
+                           HBAO_IMPLEMENTATION_AUTO};
     for (int variant = 0; variant < 16; variant++) {
         hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
         p.integration = variant & 1;
@@ -695,7 +720,8 @@ TEST_CASE(simd_paths_match_scalar_reference_bit_for_bit) {
         p.directions = 7;
         p.steps = 5;
         p.radius = 0.9f;
-        view.camera.projection = (variant & 8) ? HBAO_PROJECTION_ORTHOGRAPHIC : HBAO_PROJECTION_PERSPECTIVE;
+        view.camera.projection =
+            (variant & 8) ? HBAO_PROJECTION_ORTHOGRAPHIC : HBAO_PROJECTION_PERSPECTIVE;
         p.implementation = HBAO_IMPLEMENTATION_SCALAR;
         float *scalar = run(&p, &view, depth, (variant & 4) ? NULL : normal);
         for (int k = 0; k < 3; k++) {
@@ -703,7 +729,9 @@ TEST_CASE(simd_paths_match_scalar_reference_bit_for_bit) {
             float *fast = run(&p, &view, depth, (variant & 4) ? NULL : normal);
             int differing = 0;
             for (int q = 0; q < view.width * view.height; q++) differing += scalar[q] != fast[q];
-            if (differing) printf("  variant %d, kernel %d: %d pixels differ\n", variant, kernels[k], differing);
+            if (differing)
+                printf("  variant %d, kernel %d: %d pixels differ\n", variant, kernels[k],
+                       differing);
             CHECK(memcmp(scalar, fast, bytes) == 0);
             free(fast);
         }
@@ -716,10 +744,12 @@ TEST_CASE(simd_paths_match_scalar_reference_bit_for_bit) {
 TEST_MAIN(TEST_ENTRY(plane_facing_camera_is_unoccluded), TEST_ENTRY(tilted_plane_is_unoccluded),
           TEST_ENTRY(corner_matches_analytic_cosine), TEST_ENTRY(corner_matches_analytic_hbao),
           TEST_ENTRY(corner_value_at_the_crease_is_one_half),
-          TEST_ENTRY(scaling_depth_and_radius_keeps_ao), TEST_ENTRY(more_samples_converge_to_brute_force),
+          TEST_ENTRY(scaling_depth_and_radius_keeps_ao),
+          TEST_ENTRY(more_samples_converge_to_brute_force),
           TEST_ENTRY(past_the_normal_matches_brute_force_under_a_table),
           TEST_ENTRY(random_and_degenerate_inputs_give_finite_ao_in_range),
-          TEST_ENTRY(identical_output_for_any_thread_count), TEST_ENTRY(bottom_up_rows_with_negative_stride),
+          TEST_ENTRY(identical_output_for_any_thread_count),
+          TEST_ENTRY(bottom_up_rows_with_negative_stride),
           TEST_ENTRY(half_resolution_is_close_to_full), TEST_ENTRY(blur_keeps_depth_edges),
           TEST_ENTRY(strength_is_a_power), TEST_ENTRY(background_never_occludes),
           TEST_ENTRY(tiny_projected_radius_gives_one),

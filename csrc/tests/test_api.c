@@ -26,21 +26,22 @@ static void fill_inputs(void) {
 
 /* One clampable field: set below (high = 0) or above (high = 1) its range,
  * and read back. */
-#define FIELD_CASES(X)                                                                        \
-    X(HBAO_PARAM_FIELD_ANGLE_BIAS_DEGREES, angle_bias_degrees, -5.0f, 90.0f, 0.0,              \
-      HBAO_MAX_ANGLE_BIAS_DEGREES)                                                            \
-    X(HBAO_PARAM_FIELD_DIRECTIONS, directions, 0, 1000, 1, HBAO_MAX_DIRECTIONS)               \
-    X(HBAO_PARAM_FIELD_STEPS, steps, -7, 500, 1, HBAO_MAX_STEPS)                              \
-    X(HBAO_PARAM_FIELD_BLUR_SIZE, blur_size, -1, 99, 0, HBAO_MAX_BLUR_SIZE)                   \
-    X(HBAO_PARAM_FIELD_BLUR_SHARPNESS, blur_sharpness, -1.0f, 1e6f, 0.0,                      \
-      HBAO_MAX_BLUR_SHARPNESS)                                                                \
+#define FIELD_CASES(X)                                                                             \
+    X(HBAO_PARAM_FIELD_ANGLE_BIAS_DEGREES, angle_bias_degrees, -5.0f, 90.0f, 0.0,                  \
+      HBAO_MAX_ANGLE_BIAS_DEGREES)                                                                 \
+    X(HBAO_PARAM_FIELD_DIRECTIONS, directions, 0, 1000, 1, HBAO_MAX_DIRECTIONS)                    \
+    X(HBAO_PARAM_FIELD_STEPS, steps, -7, 500, 1, HBAO_MAX_STEPS)                                   \
+    X(HBAO_PARAM_FIELD_BLUR_SIZE, blur_size, -1, 99, 0, HBAO_MAX_BLUR_SIZE)                        \
+    X(HBAO_PARAM_FIELD_BLUR_SHARPNESS, blur_sharpness, -1.0f, 1e6f, 0.0, HBAO_MAX_BLUR_SHARPNESS)  \
     X(HBAO_PARAM_FIELD_STRENGTH, strength, -0.5f, 17.0f, 0.0, HBAO_MAX_STRENGTH)
 
-#define FIELD_ACCESSORS(bit, member, low_value, high_value, low_limit, high_limit)            \
-    static void set_##member(hbao_params *p, int high) {                                      \
-        p->member = high ? (high_value) : (low_value);                                        \
-    }                                                                                         \
-    static double get_##member(const hbao_params *p) { return (double)p->member; }
+#define FIELD_ACCESSORS(bit, member, low_value, high_value, low_limit, high_limit)                 \
+    static void set_##member(hbao_params *p, int high) {                                           \
+        p->member = high ? (high_value) : (low_value);                                             \
+    }                                                                                              \
+    static double get_##member(const hbao_params *p) {                                             \
+        return (double)p->member;                                                                  \
+    }
 FIELD_CASES(FIELD_ACCESSORS)
 #undef FIELD_ACCESSORS
 
@@ -75,7 +76,8 @@ TEST_CASE(sizes_and_strides_are_checked) {
     hbao_channel overlapping = {depth, 1, W - 1};
     CHECK_RESULT(hbao_compute(&p, &c, W, H, &overlapping, NULL, ao, W), HBAO_ERROR_INVALID_STRIDE);
     hbao_channel zero_pixel_stride = {depth, 0, W};
-    CHECK_RESULT(hbao_compute(&p, &c, W, H, &zero_pixel_stride, NULL, ao, W), HBAO_ERROR_INVALID_STRIDE);
+    CHECK_RESULT(hbao_compute(&p, &c, W, H, &zero_pixel_stride, NULL, ao, W),
+                 HBAO_ERROR_INVALID_STRIDE);
     hbao_channel thin_normals = {normal, 2, 3 * W};
     CHECK_RESULT(hbao_compute(&p, &c, W, H, &d, &thin_normals, ao, W), HBAO_ERROR_INVALID_STRIDE);
     CHECK_RESULT(hbao_compute(&p, &c, W, H, &d, NULL, ao, W - 1), HBAO_ERROR_INVALID_STRIDE);
@@ -221,7 +223,7 @@ TEST_CASE(params_resolve_clamps_each_field_and_names_it) {
         double (*get)(const hbao_params *);
         double low_limit, high_limit;
     } cases[] = {
-#define FIELD_CASE(bit, member, low_value, high_value, low_limit, high_limit)                  \
+#define FIELD_CASE(bit, member, low_value, high_value, low_limit, high_limit)                      \
     {bit, set_##member, get_##member, low_limit, high_limit},
         FIELD_CASES(FIELD_CASE)
 #undef FIELD_CASE
@@ -386,7 +388,8 @@ TEST_CASE(concurrent_calls_agree) {
     memset(calls, 0, sizeof calls);
     call_in_thread(&calls[0]);
     pthread_t threads[4];
-    for (int t = 0; t < 4; t++) CHECK(pthread_create(&threads[t], NULL, call_in_thread, &calls[t + 1]) == 0);
+    for (int t = 0; t < 4; t++)
+        CHECK(pthread_create(&threads[t], NULL, call_in_thread, &calls[t + 1]) == 0);
     for (int t = 0; t < 4; t++) pthread_join(threads[t], NULL);
     for (int t = 0; t < 5; t++) {
         CHECK_RESULT(calls[t].result, HBAO_SUCCESS);

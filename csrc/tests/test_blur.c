@@ -50,7 +50,8 @@ TEST_CASE(flat_plane_at_extreme_depths_is_unoccluded) {
             hbao_channel channel = {depth, 1, w};
             CHECK_RESULT(hbao_compute(&p, &camera, w, h, &channel, NULL, ao, w), HBAO_SUCCESS);
             const float low = minimum(ao, w * h);
-            if (low < 1.0f - 1e-4f) printf("  depth %g, variant %d: min AO %g\n", depths[d], variant, low);
+            if (low < 1.0f - 1e-4f)
+                printf("  depth %g, variant %d: min AO %g\n", depths[d], variant, low);
             CHECK_NEAR(low, 1.0f, 1e-4);
             CHECK(count_outside_unit_range(ao, w * h) == 0);
         }
@@ -102,7 +103,8 @@ TEST_CASE(random_depths_over_the_float_range_stay_in_range) {
             bits.u = state >> 1;
             if ((bits.u >> 23) == 255u) bits.u &= ~(1u << 30);
             depth[k] = bits.f;
-            for (int c = 0; c < 3; c++) normal[3 * k + c] = (float)((state >> (8 * c)) & 255u) - 127.5f;
+            for (int c = 0; c < 3; c++)
+                normal[3 * k + c] = (float)((state >> (8 * c)) & 255u) - 127.5f;
         }
         hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
         p.background_depth = INFINITY;
@@ -138,7 +140,9 @@ TEST_CASE(identical_output_for_any_band_height) {
         for (int i = 0; i < w; i++) {
             const int k = j * w + i;
             /* a sloped floor with steps and holes: depth edges, creases, background */
-            depth[k] = (i * 7 + j * 3) % 101 == 0 ? 1e10f : 2.0f + 0.01f * (float)j + 0.3f * (float)((i / 9) % 3);
+            depth[k] = (i * 7 + j * 3) % 101 == 0
+                           ? 1e10f
+                           : 2.0f + 0.01f * (float)j + 0.3f * (float)((i / 9) % 3);
             normal[3 * k] = (float)((i / 9) % 3) - 1.0f;
             normal[3 * k + 1] = 0.2f;
             normal[3 * k + 2] = 1.0f;
@@ -158,14 +162,14 @@ TEST_CASE(identical_output_for_any_band_height) {
         CHECK_RESULT(hbao_compute(&p, &camera, w, h, &d, &n, one, w), HBAO_SUCCESS);
         const int threads[] = {2, 5};
         for (int t = 0; t < 2; t++) {
-            for (int implementation = HBAO_IMPLEMENTATION_AUTO; implementation <= HBAO_IMPLEMENTATION_AVX512;
-                 implementation++) {
+            for (int implementation = HBAO_IMPLEMENTATION_AUTO;
+                 implementation <= HBAO_IMPLEMENTATION_AVX512; implementation++) {
                 p.threads = threads[t];
                 p.implementation = implementation;
                 CHECK_RESULT(hbao_compute(&p, &camera, w, h, &d, &n, many, w), HBAO_SUCCESS);
                 if (memcmp(one, many, sizeof one) != 0)
-                    printf("  blur %d, half %d, %d threads, implementation %d differ\n", p.blur_size,
-                           p.half_resolution, threads[t], implementation);
+                    printf("  blur %d, half %d, %d threads, implementation %d differ\n",
+                           p.blur_size, p.half_resolution, threads[t], implementation);
                 CHECK(memcmp(one, many, sizeof one) == 0);
             }
         }
@@ -276,11 +280,13 @@ TEST_CASE(blur_keeps_a_thin_fin) {
             p.blur_size = 0;
             double face_unblurred, floor_unblurred;
             fin_errors(&p, &face_unblurred, &floor_unblurred);
-            const double floor_ratio = floor_near / floor_unblurred, face_ratio = face / face_unblurred;
-            printf("  %s resolution, blur %d: mean |AO - converged| on the floor next to the fin %.4f "
-                   "(unblurred %.4f, ratio %.2f), on its face %.4f (unblurred %.4f, ratio %.2f)\n",
-                   half ? "half" : "full", sizes[s], floor_near, floor_unblurred, floor_ratio, face,
-                   face_unblurred, face_ratio);
+            const double floor_ratio = floor_near / floor_unblurred,
+                         face_ratio = face / face_unblurred;
+            printf(
+                "  %s resolution, blur %d: mean |AO - converged| on the floor next to the fin %.4f "
+                "(unblurred %.4f, ratio %.2f), on its face %.4f (unblurred %.4f, ratio %.2f)\n",
+                half ? "half" : "full", sizes[s], floor_near, floor_unblurred, floor_ratio, face,
+                face_unblurred, face_ratio);
             CHECK(floor_ratio < floor_limit[half][s]);
             CHECK(face_ratio < face_limit[half][s]);
         }

@@ -132,8 +132,7 @@ TEST_CASE(cropped_camera_keeps_the_view_rays) {
     for (int c = 0; c < CASE_COUNT; c++)
         for (int s = 0; s < SIZE_COUNT; s++)
             for (int r = 0; r < RECT_COUNT; r++)
-                check_crop_sees_the_full_rays(&cases[c].camera, SIZES[s][0], SIZES[s][1],
-                                              RECTS[r]);
+                check_crop_sees_the_full_rays(&cases[c].camera, SIZES[s][0], SIZES[s][1], RECTS[r]);
 }
 
 TEST_CASE(crop_of_a_crop_equals_the_direct_crop) {
@@ -200,10 +199,10 @@ TEST_CASE(crop_rejects_bad_arguments) {
                  HBAO_ERROR_INVALID_SIZE);
     CHECK_RESULT(hbao_camera_crop(&camera, 64, INT32_MAX, 0, 0, 8, 8, &out),
                  HBAO_ERROR_INVALID_SIZE);
-    const int32_t bad_rects[][4] = {{-1, 0, 8, 8},       {0, -1, 8, 8},       {0, 0, 0, 8},
-                                    {0, 0, 8, 0},        {0, 0, -8, 8},       {57, 0, 8, 8},
-                                    {0, 41, 8, 8},       {0, 0, 65, 48},      {1, 0, INT32_MAX, 8},
-                                    {INT32_MAX, 0, 8, 8}, {0, INT32_MIN, 8, 8}, {0, 0, 64, 49}};
+    const int32_t bad_rects[][4] = {
+        {-1, 0, 8, 8},        {0, -1, 8, 8},        {0, 0, 0, 8},         {0, 0, 8, 0},
+        {0, 0, -8, 8},        {57, 0, 8, 8},        {0, 41, 8, 8},        {0, 0, 65, 48},
+        {1, 0, INT32_MAX, 8}, {INT32_MAX, 0, 8, 8}, {0, INT32_MIN, 8, 8}, {0, 0, 64, 49}};
     for (size_t k = 0; k < sizeof bad_rects / sizeof bad_rects[0]; k++)
         CHECK_RESULT(hbao_camera_crop(&camera, 64, 48, bad_rects[k][0], bad_rects[k][1],
                                       bad_rects[k][2], bad_rects[k][3], &out),
@@ -214,8 +213,7 @@ TEST_CASE(crop_rejects_bad_arguments) {
     /* A shift that the crop carries beyond float's range. */
     hbao_camera far_shift = camera;
     far_shift.shift_x = 3e38f;
-    CHECK_RESULT(hbao_camera_crop(&far_shift, 64, 48, 0, 0, 8, 8, &out),
-                 HBAO_ERROR_INVALID_CAMERA);
+    CHECK_RESULT(hbao_camera_crop(&far_shift, 64, 48, 0, 0, 8, 8, &out), HBAO_ERROR_INVALID_CAMERA);
     /* A sensor that the crop scales below float's range. */
     hbao_camera tiny = camera;
     tiny.sensor_width = 1e-44f;
@@ -288,12 +286,11 @@ TEST_CASE(ao_of_a_crop_equals_the_full_ao) {
         CHECK_RESULT(hbao_compute(&p, &view.camera, full_width, full_height, &full_depth, NULL,
                                   full_ao, full_width),
                      HBAO_SUCCESS);
-        CHECK_RESULT(hbao_compute(&p, &cropped, rect[2], rect[3], &crop_depth, NULL, crop_ao,
-                                  rect[2]),
-                     HBAO_SUCCESS);
+        CHECK_RESULT(
+            hbao_compute(&p, &cropped, rect[2], rect[3], &crop_depth, NULL, crop_ao, rect[2]),
+            HBAO_SUCCESS);
         hbao_view frame;
-        CHECK_RESULT(hbao_camera_view(&view.camera, full_width, full_height, &frame),
-                     HBAO_SUCCESS);
+        CHECK_RESULT(hbao_camera_view(&view.camera, full_width, full_height, &frame), HBAO_SUCCESS);
         int compared = 0, flipped = 0;
         double occlusion = 0.0;
         for (int j = 0; j < rect[3]; j++) {

@@ -15,37 +15,35 @@ static int test_failures;
 
 #define TEST_CASE(name) static void name(void)
 
-#define CHECK(condition)                                                           \
-    do {                                                                           \
-        if (!(condition)) {                                                        \
-            fprintf(stderr, "%s:%d: CHECK failed: %s\n", __FILE__, __LINE__,       \
-                    #condition);                                                   \
-            test_failures++;                                                       \
-        }                                                                          \
+#define CHECK(condition)                                                                           \
+    do {                                                                                           \
+        if (!(condition)) {                                                                        \
+            fprintf(stderr, "%s:%d: CHECK failed: %s\n", __FILE__, __LINE__, #condition);          \
+            test_failures++;                                                                       \
+        }                                                                                          \
     } while (0)
 
 /* |actual - expected| <= tolerance, with both values printed on failure. */
-#define CHECK_NEAR(actual, expected, tolerance)                                    \
-    do {                                                                           \
-        double check_a_ = (double)(actual), check_e_ = (double)(expected);         \
-        if (!(fabs(check_a_ - check_e_) <= (double)(tolerance))) {                 \
-            fprintf(stderr, "%s:%d: CHECK_NEAR failed: %s = %.6g, expected %.6g "   \
-                            "+- %.3g\n",                                           \
-                    __FILE__, __LINE__, #actual, check_a_, check_e_,               \
-                    (double)(tolerance));                                          \
-            test_failures++;                                                       \
-        }                                                                          \
+#define CHECK_NEAR(actual, expected, tolerance)                                                    \
+    do {                                                                                           \
+        double check_a_ = (double)(actual), check_e_ = (double)(expected);                         \
+        if (!(fabs(check_a_ - check_e_) <= (double)(tolerance))) {                                 \
+            fprintf(stderr,                                                                        \
+                    "%s:%d: CHECK_NEAR failed: %s = %.6g, expected %.6g "                          \
+                    "+- %.3g\n",                                                                   \
+                    __FILE__, __LINE__, #actual, check_a_, check_e_, (double)(tolerance));         \
+            test_failures++;                                                                       \
+        }                                                                                          \
     } while (0)
 
-#define CHECK_RESULT(call, expected)                                               \
-    do {                                                                           \
-        int check_r_ = (int)(call);                                                \
-        if (check_r_ != (int)(expected)) {                                         \
-            fprintf(stderr, "%s:%d: %s returned %d (%s), expected %s\n", __FILE__,  \
-                    __LINE__, #call, check_r_, hbao_result_message(check_r_),      \
-                    #expected);                                                    \
-            test_failures++;                                                       \
-        }                                                                          \
+#define CHECK_RESULT(call, expected)                                                               \
+    do {                                                                                           \
+        int check_r_ = (int)(call);                                                                \
+        if (check_r_ != (int)(expected)) {                                                         \
+            fprintf(stderr, "%s:%d: %s returned %d (%s), expected %s\n", __FILE__, __LINE__,       \
+                    #call, check_r_, hbao_result_message(check_r_), #expected);                    \
+            test_failures++;                                                                       \
+        }                                                                                          \
     } while (0)
 
 typedef struct test_entry {
@@ -53,26 +51,26 @@ typedef struct test_entry {
     void (*run)(void);
 } test_entry;
 
-#define TEST_ENTRY(name) {#name, name}
+#define TEST_ENTRY(name)                                                                           \
+    { #name, name }
 
-#define TEST_MAIN(...)                                                             \
-    int main(int argc, char **argv) {                                              \
-        static const test_entry tests[] = {__VA_ARGS__};                           \
-        const size_t count = sizeof(tests) / sizeof(tests[0]);                     \
-        int ran = 0;                                                               \
-        for (size_t i = 0; i < count; i++) {                                       \
-            if (argc > 1 && strcmp(argv[1], tests[i].name) != 0) continue;         \
-            int before = test_failures;                                            \
-            tests[i].run();                                                        \
-            printf("%s %s\n", test_failures == before ? "PASS" : "FAIL",            \
-                   tests[i].name);                                                 \
-            ran++;                                                                 \
-        }                                                                          \
-        if (ran == 0) {                                                            \
-            fprintf(stderr, "no test case named %s\n", argc > 1 ? argv[1] : "");   \
-            return 2;                                                              \
-        }                                                                          \
-        return test_failures == 0 ? 0 : 1;                                         \
+#define TEST_MAIN(...)                                                                             \
+    int main(int argc, char **argv) {                                                              \
+        static const test_entry tests[] = {__VA_ARGS__};                                           \
+        const size_t count = sizeof(tests) / sizeof(tests[0]);                                     \
+        int ran = 0;                                                                               \
+        for (size_t i = 0; i < count; i++) {                                                       \
+            if (argc > 1 && strcmp(argv[1], tests[i].name) != 0) continue;                         \
+            int before = test_failures;                                                            \
+            tests[i].run();                                                                        \
+            printf("%s %s\n", test_failures == before ? "PASS" : "FAIL", tests[i].name);           \
+            ran++;                                                                                 \
+        }                                                                                          \
+        if (ran == 0) {                                                                            \
+            fprintf(stderr, "no test case named %s\n", argc > 1 ? argv[1] : "");                   \
+            return 2;                                                                              \
+        }                                                                                          \
+        return test_failures == 0 ? 0 : 1;                                                         \
     }
 
 #endif /* HBAO_TEST_HARNESS_H */

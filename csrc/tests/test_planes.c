@@ -110,7 +110,8 @@ static void check_plane(const char *label, const scene *s, const scene_view *vie
             }
             case_worst = fminf(case_worst, worst);
             if (!(worst >= PLANE_MIN_AO))
-                printf("  %s, %s depth, %s, %s normals: min AO %.4f, %.2f %% of the plane below %.2f\n",
+                printf("  %s, %s depth, %s, %s normals: min AO %.4f, %.2f %% of the plane below "
+                       "%.2f\n",
                        label, precision == DEPTH_HALF ? "half" : "float",
                        integration == HBAO_INTEGRATION_COSINE ? "cosine" : "hbao",
                        given ? "supplied" : "reconstructed", worst,
@@ -142,7 +143,8 @@ static void check_floors(depth_precision precision) {
     }
     /* looking along a diagonal, 3 degrees down, from a lower eye (a child,
      * or a camera on a table): the floor's depth gradient runs diagonally */
-    const double eye[3] = {0.3, -0.2, 0.8}, target[3] = {40.0, 40.0, 0.8 - 56.6 * tan(3.0 * PI / 180.0)};
+    const double eye[3] = {0.3, -0.2, 0.8},
+                 target[3] = {40.0, 40.0, 0.8 - 56.6 * tan(3.0 * PI / 180.0)};
     const scene_view view = make_view(960, 540, eye, target, 0);
     check_plane("floor, diagonal view from 0.8 m", &s, &view, precision);
 }
@@ -219,7 +221,8 @@ static void check_thin_images(int width, int height) {
             const scene s = tilted_plane(tilts[k], 40.0);
             scene_view view = make_view(width, height, eye, target, 0);
             char label[80];
-            snprintf(label, sizeof label, "%d x %d image of a plane tilted %.0f deg", width, height, tilts[k]);
+            snprintf(label, sizeof label, "%d x %d image of a plane tilted %.0f deg", width, height,
+                     tilts[k]);
             check_plane(label, &s, &view, (depth_precision)precision);
         }
     }
@@ -254,8 +257,9 @@ TEST_CASE(wall_on_grazing_floor_still_occludes) {
     for (int integration = 0; integration <= 1; integration++) {
         hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
         p.integration = integration;
-        CHECK_RESULT(hbao_compute(&p, &view.camera, view.width, view.height, &d, NULL, ao, view.width),
-                     HBAO_SUCCESS);
+        CHECK_RESULT(
+            hbao_compute(&p, &view.camera, view.width, view.height, &d, NULL, ao, view.width),
+            HBAO_SUCCESS);
         /* darkest floor pixel (normal up) within 0.3 m of the wall */
         float darkest = 1.0f;
         for (int j = 0; j < view.height; j++)
@@ -301,11 +305,13 @@ TEST_CASE(simd_kernels_match_scalar_on_half_depth_planes) {
             p.integration = variant & 1;
             p.falloff = variant >> 1;
             p.implementation = HBAO_IMPLEMENTATION_SCALAR;
-            CHECK_RESULT(hbao_compute(&p, &view.camera, view.width, view.height, &d, NULL, scalar, view.width),
+            CHECK_RESULT(hbao_compute(&p, &view.camera, view.width, view.height, &d, NULL, scalar,
+                                      view.width),
                          HBAO_SUCCESS);
             for (int k = 0; k < 2; k++) {
                 p.implementation = kernels[k];
-                CHECK_RESULT(hbao_compute(&p, &view.camera, view.width, view.height, &d, NULL, fast, view.width),
+                CHECK_RESULT(hbao_compute(&p, &view.camera, view.width, view.height, &d, NULL, fast,
+                                          view.width),
                              HBAO_SUCCESS);
                 CHECK(memcmp(scalar, fast, pixels * sizeof(float)) == 0);
             }
@@ -317,10 +323,11 @@ TEST_CASE(simd_kernels_match_scalar_on_half_depth_planes) {
     }
 }
 
-TEST_MAIN(TEST_ENTRY(floor_from_eye_height_float_depth), TEST_ENTRY(floor_from_eye_height_half_depth),
-          TEST_ENTRY(tilted_planes_float_depth), TEST_ENTRY(tilted_planes_half_depth),
-          TEST_ENTRY(orthographic_tilted_planes_float_depth),
+TEST_MAIN(TEST_ENTRY(floor_from_eye_height_float_depth),
+          TEST_ENTRY(floor_from_eye_height_half_depth), TEST_ENTRY(tilted_planes_float_depth),
+          TEST_ENTRY(tilted_planes_half_depth), TEST_ENTRY(orthographic_tilted_planes_float_depth),
           TEST_ENTRY(orthographic_tilted_planes_half_depth),
-          TEST_ENTRY(one_pixel_wide_image_of_tilted_planes), TEST_ENTRY(one_pixel_tall_image_of_tilted_planes),
+          TEST_ENTRY(one_pixel_wide_image_of_tilted_planes),
+          TEST_ENTRY(one_pixel_tall_image_of_tilted_planes),
           TEST_ENTRY(wall_on_grazing_floor_still_occludes),
           TEST_ENTRY(simd_kernels_match_scalar_on_half_depth_planes))

@@ -18,8 +18,7 @@
  * (hard link, symbolic link, "./x" vs "x"): stat() identity, not strings.
  * What else may be written is atomic_file_begin()'s rule. */
 static int refuse_overwriting_input(const char *output, const char *flag,
-                                    const struct stat *input_status, tool_error *error)
-{
+                                    const struct stat *input_status, tool_error *error) {
     struct stat output_status;
     if (stat(output, &output_status) != 0) return TOOL_EXIT_SUCCESS;
     if (output_status.st_dev == input_status->st_dev &&
@@ -31,8 +30,7 @@ static int refuse_overwriting_input(const char *output, const char *flag,
 
 /* Defaults, then the EXR header's pixel aspect, then the JSON file, then flags. */
 static int resolve_camera(const cli_options *options, const exr_input *input,
-                          camera_settings *resolved, tool_error *error)
-{
+                          camera_settings *resolved, tool_error *error) {
     camera_settings_init(resolved);
     if (input->has_pixel_aspect_ratio && input->pixel_aspect_ratio > 0.0f &&
         isfinite(input->pixel_aspect_ratio)) {
@@ -52,8 +50,7 @@ static int resolve_camera(const cli_options *options, const exr_input *input,
     return TOOL_EXIT_SUCCESS;
 }
 
-void ao_buffers_free(ao_buffers *buffers)
-{
+void ao_buffers_free(ao_buffers *buffers) {
     free(buffers->depth);
     free(buffers->normal);
     free(buffers->ao);
@@ -63,8 +60,7 @@ void ao_buffers_free(ao_buffers *buffers)
 }
 
 static exr_channel_request float_request(const char *name, float *data, int components,
-                                         int32_t width)
-{
+                                         int32_t width) {
     exr_channel_request request = {name, EXR_PIXEL_FLOAT, (uint8_t *)data,
                                    (int32_t)(components * sizeof(float)),
                                    (int64_t)width * components * (int64_t)sizeof(float)};
@@ -72,15 +68,14 @@ static exr_channel_request float_request(const char *name, float *data, int comp
 }
 
 static int read_passes(exr_input *input, const blender_passes *passes, bool use_normals,
-                       ao_buffers *buffers, tool_error *error)
-{
+                       ao_buffers *buffers, tool_error *error) {
     const size_t pixel_count = (size_t)input->width * (size_t)input->height;
     buffers->depth = malloc(pixel_count * sizeof(float));
     buffers->ao = malloc(pixel_count * sizeof(float));
     if (use_normals) buffers->normal = malloc(3 * pixel_count * sizeof(float));
     if (buffers->depth == NULL || buffers->ao == NULL || (use_normals && buffers->normal == NULL))
-        return tool_fail(error, TOOL_EXIT_RUNTIME, "out of memory for a %dx%d image",
-                         input->width, input->height);
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "out of memory for a %dx%d image", input->width,
+                         input->height);
     exr_channel_request requests[4];
     int count = 0;
     requests[count++] = float_request(passes->depth, buffers->depth, 1, input->width);
@@ -92,8 +87,7 @@ static int read_passes(exr_input *input, const blender_passes *passes, bool use_
 
 /* --keep-input: every channel but a previous AO, decoded in its own type. */
 static int read_copies(exr_input *input, const char *ao_channel, ao_buffers *buffers,
-                       exr_output_channel *outputs, int *output_count, tool_error *error)
-{
+                       exr_output_channel *outputs, int *output_count, tool_error *error) {
     const int channel_count = input->channels->num_channels;
     const size_t pixel_count = (size_t)input->width * (size_t)input->height;
     buffers->copies = calloc((size_t)channel_count, sizeof *buffers->copies);
@@ -120,8 +114,11 @@ static int read_copies(exr_input *input, const char *ao_channel, ao_buffers *buf
         exr_channel_request request = {channel->name.str, channel->pixel_type, data, size,
                                        (int64_t)input->width * size};
         requests[count] = request;
-        exr_output_channel output = {channel->name.str, channel->pixel_type,
-                                     (exr_perceptual_treatment_t)channel->p_linear, data, size,
+        exr_output_channel output = {channel->name.str,
+                                     channel->pixel_type,
+                                     (exr_perceptual_treatment_t)channel->p_linear,
+                                     data,
+                                     size,
                                      (int64_t)input->width * size};
         outputs[(*output_count)++] = output;
         ++count;
@@ -138,24 +135,21 @@ typedef struct output_files {
     atomic_file exr, png;
 } output_files;
 
-static int begin_outputs(const cli_options *options, output_files *files, tool_error *error)
-{
+static int begin_outputs(const cli_options *options, output_files *files, tool_error *error) {
     int status = atomic_file_begin(&files->exr, options->output_path, error);
     if (status == TOOL_EXIT_SUCCESS && options->preview_path != NULL)
         status = atomic_file_begin(&files->png, options->preview_path, error);
     return status;
 }
 
-static void abort_outputs(output_files *files)
-{
+static void abort_outputs(output_files *files) {
     atomic_file_abort(&files->exr);
     atomic_file_abort(&files->png);
 }
 
 static int write_outputs(const cli_options *options, const exr_input *input,
                          const exr_output_channel *channels, int channel_count, const float *ao,
-                         output_files *files, tool_error *error)
-{
+                         output_files *files, tool_error *error) {
     exr_output_layout layout = {input->data_window,
                                 input->display_window,
                                 input->pixel_aspect_ratio,
@@ -176,8 +170,7 @@ static int write_outputs(const cli_options *options, const exr_input *input,
 }
 
 int ao_compute_input(const cli_options *options, exr_input *input, ao_buffers *buffers,
-                     tool_error *error)
-{
+                     tool_error *error) {
     blender_passes passes;
     int status = blender_find_passes(input, options->layer, &passes, error);
     if (status != TOOL_EXIT_SUCCESS) return status;
@@ -187,11 +180,11 @@ int ao_compute_input(const cli_options *options, exr_input *input, ao_buffers *b
     if (status != TOOL_EXIT_SUCCESS) return status;
     const bool use_normals = passes.has_normal && !options->ignore_normals;
     hbao_camera cropped;
-    const hbao_result cropping = camera_for_data_window(
-        &camera.camera, &input->display_window, &input->data_window, &cropped);
+    const hbao_result cropping = camera_for_data_window(&camera.camera, &input->display_window,
+                                                        &input->data_window, &cropped);
     if (cropping != HBAO_SUCCESS)
-        return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: cannot compute AO: %s",
-                         options->input_path, hbao_result_message(cropping));
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: cannot compute AO: %s", options->input_path,
+                         hbao_result_message(cropping));
 
     status = read_passes(input, &passes, use_normals, buffers, error);
     if (status != TOOL_EXIT_SUCCESS) return status;
@@ -204,31 +197,27 @@ int ao_compute_input(const cli_options *options, exr_input *input, ao_buffers *b
 
     hbao_channel depth = {buffers->depth, 1, input->width};
     hbao_channel normal = {buffers->normal, 3, (int64_t)input->width * 3};
-    hbao_result result = hbao_compute(&options->params, &cropped, input->width, input->height,
-                                      &depth, use_normals ? &normal : NULL, buffers->ao,
-                                      input->width);
+    hbao_result result =
+        hbao_compute(&options->params, &cropped, input->width, input->height, &depth,
+                     use_normals ? &normal : NULL, buffers->ao, input->width);
     if (result != HBAO_SUCCESS)
-        return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: cannot compute AO: %s",
-                         options->input_path, hbao_result_message(result));
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: cannot compute AO: %s", options->input_path,
+                         hbao_result_message(result));
     return TOOL_EXIT_SUCCESS;
 }
 
-int ao_command(const cli_options *options, tool_error *error)
-{
+int ao_command(const cli_options *options, tool_error *error) {
     struct stat input_status;
     if (stat(options->input_path, &input_status) != 0)
-        return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot open %s: %s%s", options->input_path,
-                         strerror(errno),
-                         strchr(options->input_path, '#') != NULL
-                             ? " (for an image sequence, give --frames)"
-                             : "");
+        return tool_fail(
+            error, TOOL_EXIT_RUNTIME, "cannot open %s: %s%s", options->input_path, strerror(errno),
+            strchr(options->input_path, '#') != NULL ? " (for an image sequence, give --frames)"
+                                                     : "");
     if (!S_ISREG(input_status.st_mode))
-        return tool_fail(error, TOOL_EXIT_RUNTIME, "%s is not a regular file",
-                         options->input_path);
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "%s is not a regular file", options->input_path);
     int status = refuse_overwriting_input(options->output_path, "-o", &input_status, error);
     if (status == TOOL_EXIT_SUCCESS && options->preview_path != NULL)
-        status = refuse_overwriting_input(options->preview_path, "--preview", &input_status,
-                                          error);
+        status = refuse_overwriting_input(options->preview_path, "--preview", &input_status, error);
     if (status != TOOL_EXIT_SUCCESS) return status;
 
     exr_input input;
@@ -250,9 +239,9 @@ int ao_command(const cli_options *options, tool_error *error)
     }
     int output_count = 0;
     /* AO is a linear quantity (a visibility fraction). */
-    exr_output_channel ao_channel = {options->ao_channel, EXR_PIXEL_FLOAT, EXR_PERCEPTUALLY_LINEAR,
-                                     (uint8_t *)buffers.ao, sizeof(float),
-                                     (int64_t)input.width * sizeof(float)};
+    exr_output_channel ao_channel = {options->ao_channel,     EXR_PIXEL_FLOAT,
+                                     EXR_PERCEPTUALLY_LINEAR, (uint8_t *)buffers.ao,
+                                     sizeof(float),           (int64_t)input.width * sizeof(float)};
     outputs[output_count++] = ao_channel;
     if (options->keep_input) {
         status = read_copies(&input, options->ao_channel, &buffers, outputs, &output_count, error);

@@ -31,8 +31,7 @@ static bool handlers_installed;
  * the handler installation and the umask() probe take turns. */
 static pthread_mutex_t slots_lock = PTHREAD_MUTEX_INITIALIZER;
 
-static void remove_temporary_files(int signal_number)
-{
+static void remove_temporary_files(int signal_number) {
     for (int s = 0; s < CLEANUP_SLOTS; ++s)
         if (cleanup_active[s]) unlink(cleanup_paths[s]);
     /* Die of the same signal, so that the parent (a shell, a render farm)
@@ -42,8 +41,7 @@ static void remove_temporary_files(int signal_number)
     raise(signal_number);
 }
 
-void atomic_file_install_signal_handlers(void)
-{
+void atomic_file_install_signal_handlers(void) {
     pthread_mutex_lock(&slots_lock);
     if (handlers_installed) {
         pthread_mutex_unlock(&slots_lock);
@@ -53,8 +51,7 @@ void atomic_file_install_signal_handlers(void)
     for (int i = 0; i < CLEANUP_SIGNAL_COUNT; ++i) {
         struct sigaction previous;
         /* A signal the caller chose to ignore (nohup) stays ignored. */
-        if (sigaction(cleanup_signals[i], NULL, &previous) != 0 ||
-            previous.sa_handler == SIG_IGN)
+        if (sigaction(cleanup_signals[i], NULL, &previous) != 0 || previous.sa_handler == SIG_IGN)
             continue;
         struct sigaction action;
         memset(&action, 0, sizeof action);
@@ -68,27 +65,23 @@ void atomic_file_install_signal_handlers(void)
 /* Creating, renaming and unlinking a temporary file happen with the cleanup
  * signals blocked, so that the handler never misses a file that exists nor
  * sees a half-written path. */
-void atomic_file_block_signals(sigset_t *previous)
-{
+void atomic_file_block_signals(sigset_t *previous) {
     sigset_t blocked;
     sigemptyset(&blocked);
     for (int i = 0; i < CLEANUP_SIGNAL_COUNT; ++i) sigaddset(&blocked, cleanup_signals[i]);
     pthread_sigmask(SIG_BLOCK, &blocked, previous);
 }
 
-void atomic_file_restore_signals(const sigset_t *previous)
-{
+void atomic_file_restore_signals(const sigset_t *previous) {
     pthread_sigmask(SIG_SETMASK, previous, NULL);
 }
 
-static void block_cleanup_signals(sigset_t *previous)
-{
+static void block_cleanup_signals(sigset_t *previous) {
     atomic_file_block_signals(previous);
     pthread_mutex_lock(&slots_lock);
 }
 
-static void restore_signals(const sigset_t *previous)
-{
+static void restore_signals(const sigset_t *previous) {
     pthread_mutex_unlock(&slots_lock);
     atomic_file_restore_signals(previous);
 }
@@ -96,8 +89,7 @@ static void restore_signals(const sigset_t *previous)
 /* Called with the slots locked. With no free slot the file is still
  * written, only not removed by a signal; ATOMIC_FILE_MAX_OPEN is sized so
  * that this does not happen. */
-static int claim_cleanup_slot(const char *path)
-{
+static int claim_cleanup_slot(const char *path) {
     for (int s = 0; s < CLEANUP_SLOTS; ++s) {
         if (cleanup_active[s]) continue;
         strcpy(cleanup_paths[s], path); /* both are PATH_MAX buffers */
@@ -107,8 +99,7 @@ static int claim_cleanup_slot(const char *path)
     return -1;
 }
 
-static void release_cleanup_slot(atomic_file *file)
-{
+static void release_cleanup_slot(atomic_file *file) {
     if (file->cleanup_slot >= 0) cleanup_active[file->cleanup_slot] = 0;
     file->cleanup_slot = -1;
 }
@@ -117,8 +108,7 @@ static void release_cleanup_slot(atomic_file *file)
 
 /* Follow `path` while it is a symbolic link (a dangling one too: writing
  * through it creates its target, as `echo > link` does). */
-static int follow_symbolic_links(const char *path, char resolved[PATH_MAX], tool_error *error)
-{
+static int follow_symbolic_links(const char *path, char resolved[PATH_MAX], tool_error *error) {
     if (strlen(path) >= PATH_MAX)
         return tool_fail(error, TOOL_EXIT_USAGE, "output path too long: %s", path);
     strcpy(resolved, path);
@@ -148,8 +138,7 @@ static int follow_symbolic_links(const char *path, char resolved[PATH_MAX], tool
 /* A temporary file in the destination's directory, so that rename() stays
  * on one file system; the leading dot keeps it out of casual listings. The
  * name has a fixed length, whatever the destination's. */
-static int create_named_temporary(atomic_file *file, tool_error *error)
-{
+static int create_named_temporary(atomic_file *file, tool_error *error) {
     const char *slash = strrchr(file->destination, '/');
     int directory_length = slash ? (int)(slash - file->destination + 1) : 0;
     int written = snprintf(file->temporary_path, sizeof file->temporary_path,
@@ -170,8 +159,7 @@ static int create_named_temporary(atomic_file *file, tool_error *error)
 
 /* For a FIFO or a device: an unnamed file in $TMPDIR (unlinked at once, so
  * nothing can be left behind) that holds the data until commit. */
-static int create_unnamed_temporary(atomic_file *file, tool_error *error)
-{
+static int create_unnamed_temporary(atomic_file *file, tool_error *error) {
     const char *folder = getenv("TMPDIR");
     if (folder == NULL || folder[0] == '\0') folder = "/tmp";
     char path[PATH_MAX];
@@ -191,8 +179,7 @@ static int create_unnamed_temporary(atomic_file *file, tool_error *error)
     return TOOL_EXIT_SUCCESS;
 }
 
-int atomic_file_begin(atomic_file *file, const char *destination, tool_error *error)
-{
+int atomic_file_begin(atomic_file *file, const char *destination, tool_error *error) {
     memset(file, 0, sizeof *file);
     file->fd = -1;
     file->cleanup_slot = -1;
@@ -240,18 +227,17 @@ int atomic_file_begin(atomic_file *file, const char *destination, tool_error *er
     if (fchmod(file->fd, 0666 & ~mask) != 0) {
         int saved = errno;
         atomic_file_abort(file);
-        return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot set permissions of %s: %s",
-                         destination, strerror(saved));
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot set permissions of %s: %s", destination,
+                         strerror(saved));
     }
     return TOOL_EXIT_SUCCESS;
 }
 
 /* Copy the whole temporary file to the FIFO or device, in order. */
-static int copy_through(atomic_file *file, tool_error *error)
-{
+static int copy_through(atomic_file *file, tool_error *error) {
     if (lseek(file->fd, 0, SEEK_SET) != 0)
-        return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot reread the data for %s: %s",
-                         file->name, strerror(errno));
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot reread the data for %s: %s", file->name,
+                         strerror(errno));
     /* No O_CREAT: the destination exists; no O_TRUNC: a device or FIFO has
      * nothing to truncate. Opening a FIFO waits for its reader. */
     int sink = open(file->destination, O_WRONLY | O_NOCTTY | O_CLOEXEC);
@@ -282,13 +268,12 @@ static int copy_through(atomic_file *file, tool_error *error)
         if (status != TOOL_EXIT_SUCCESS) break;
     }
     if (close(sink) != 0 && status == TOOL_EXIT_SUCCESS)
-        status = tool_fail(error, TOOL_EXIT_RUNTIME, "cannot write %s: %s", file->name,
-                           strerror(errno));
+        status =
+            tool_fail(error, TOOL_EXIT_RUNTIME, "cannot write %s: %s", file->name, strerror(errno));
     return status;
 }
 
-int atomic_file_commit(atomic_file *file, tool_error *error)
-{
+int atomic_file_commit(atomic_file *file, tool_error *error) {
     if (!file->active) return tool_fail(error, TOOL_EXIT_RUNTIME, "internal: nothing to commit");
     if (file->write_through) {
         int status = copy_through(file, error);
@@ -320,8 +305,7 @@ int atomic_file_commit(atomic_file *file, tool_error *error)
     return TOOL_EXIT_SUCCESS;
 }
 
-void atomic_file_abort(atomic_file *file)
-{
+void atomic_file_abort(atomic_file *file) {
     if (file->fd >= 0) close(file->fd);
     file->fd = -1;
     sigset_t previous;

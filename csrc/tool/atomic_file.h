@@ -41,17 +41,18 @@
 #define ATOMIC_FILE_MAX_OPEN 64
 
 typedef struct atomic_file {
-    int fd;                          /**< open on the temporary file; -1 once closed */
-    const char *name;                /**< the destination as the user gave it, for messages */
-    char destination[PATH_MAX];      /**< symbolic links followed */
-    char temporary_path[PATH_MAX];   /**< empty when the temporary file is unnamed */
-    bool active;                     /**< begun, not yet committed or aborted */
-    bool write_through;              /**< FIFO or character device: copy, do not rename */
-    int cleanup_slot;                /**< the signal handler's record of temporary_path, or -1 */
+    int fd;                        /**< open on the temporary file; -1 once closed */
+    const char *name;              /**< the destination as the user gave it, for messages */
+    char destination[PATH_MAX];    /**< symbolic links followed */
+    char temporary_path[PATH_MAX]; /**< empty when the temporary file is unnamed */
+    bool active;                   /**< begun, not yet committed or aborted */
+    bool write_through;            /**< FIFO or character device: copy, do not rename */
+    int cleanup_slot;              /**< the signal handler's record of temporary_path, or -1 */
 } atomic_file;
 
 /** A file on which atomic_file_abort() is a no-op, before atomic_file_begin(). */
-#define ATOMIC_FILE_IDLE {.fd = -1, .cleanup_slot = -1}
+#define ATOMIC_FILE_IDLE                                                                           \
+    { .fd = -1, .cleanup_slot = -1 }
 
 /** Prepare writing `destination` (kept by pointer for messages): create the
  *  temporary file (mode 0666 & ~umask) or refuse a destination that must not

@@ -8,15 +8,13 @@ static const char depth_suffix[] = ".Depth.Z";
 static const char *const normal_names[3] = {"Normal.X", "Normal.Y", "Normal.Z"};
 
 /* Length of the layer prefix when `name` is "<layer>.Depth.Z", else -1. */
-static int depth_layer_length(const char *name)
-{
+static int depth_layer_length(const char *name) {
     size_t length = strlen(name), suffix = strlen(depth_suffix);
     if (length <= suffix || strcmp(name + length - suffix, depth_suffix) != 0) return -1;
     return (int)(length - suffix);
 }
 
-int blender_depth_layers(const exr_input *input, const char **names, int capacity)
-{
+int blender_depth_layers(const exr_input *input, const char **names, int capacity) {
     int found = 0;
     for (int c = 0; c < input->channels->num_channels; ++c) {
         const char *name = input->channels->entries[c].name.str;
@@ -27,8 +25,7 @@ int blender_depth_layers(const exr_input *input, const char **names, int capacit
     return found;
 }
 
-static bool set_name(char *out, const char *prefix, int prefix_length, const char *suffix)
-{
+static bool set_name(char *out, const char *prefix, int prefix_length, const char *suffix) {
     int written = snprintf(out, BLENDER_CHANNEL_NAME_MAX, "%.*s%s", prefix_length, prefix, suffix);
     return written >= 0 && written < BLENDER_CHANNEL_NAME_MAX;
 }
@@ -36,8 +33,7 @@ static bool set_name(char *out, const char *prefix, int prefix_length, const cha
 /* `layer` may be "" (a file without view layers: "Depth.Z", "Normal.X"). */
 static int fill_passes(const exr_input *input, const char *layer, int layer_length,
                        const char *depth_channel, bool look_for_normals, blender_passes *passes,
-                       tool_error *error)
-{
+                       tool_error *error) {
     memset(passes, 0, sizeof *passes);
     if (!set_name(passes->layer, layer, layer_length, "") ||
         !set_name(passes->depth, depth_channel, (int)strlen(depth_channel), ""))
@@ -53,8 +49,7 @@ static int fill_passes(const exr_input *input, const char *layer, int layer_leng
     return TOOL_EXIT_SUCCESS;
 }
 
-static int fail_listing_layers(const exr_input *input, const char *problem, tool_error *error)
-{
+static int fail_listing_layers(const exr_input *input, const char *problem, tool_error *error) {
     char list[600] = "";
     for (int c = 0; c < input->channels->num_channels; ++c) {
         const char *name = input->channels->entries[c].name.str;
@@ -69,13 +64,12 @@ static int fail_listing_layers(const exr_input *input, const char *problem, tool
                          "<ViewLayer>.Depth.Z or Z): enable the Z/Depth pass in Blender's "
                          "View Layer properties",
                          input->path, problem);
-    return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: %s; layers with a Depth pass: %s",
-                     input->path, problem, list);
+    return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: %s; layers with a Depth pass: %s", input->path,
+                     problem, list);
 }
 
 int blender_find_passes(const exr_input *input, const char *requested, blender_passes *passes,
-                        tool_error *error)
-{
+                        tool_error *error) {
     if (requested != NULL) {
         char depth[BLENDER_CHANNEL_NAME_MAX];
         if (!set_name(depth, requested, (int)strlen(requested), depth_suffix))
@@ -86,8 +80,7 @@ int blender_find_passes(const exr_input *input, const char *requested, blender_p
                      depth);
             return fail_listing_layers(input, problem, error);
         }
-        return fill_passes(input, requested, (int)strlen(requested), depth, true, passes,
-                           error);
+        return fill_passes(input, requested, (int)strlen(requested), depth, true, passes, error);
     }
     for (int c = 0; c < input->channels->num_channels; ++c) {
         const char *name = input->channels->entries[c].name.str;

@@ -50,8 +50,7 @@ static const float_field float_fields[] = {
 
 static int read_enum(const cJSON *root, const char *key, const named_value *names, size_t count,
                      uint32_t field, int32_t *out, camera_settings *settings, const char *source,
-                     tool_error *error)
-{
+                     tool_error *error) {
     const cJSON *item = cJSON_GetObjectItemCaseSensitive(root, key);
     if (item == NULL) return TOOL_EXIT_SUCCESS;
     if (!cJSON_IsString(item))
@@ -73,8 +72,7 @@ static int read_enum(const cJSON *root, const char *key, const named_value *name
 }
 
 static int read_number(const cJSON *item, const char *what, const char *source, float *out,
-                       tool_error *error)
-{
+                       tool_error *error) {
     if (!cJSON_IsNumber(item) || !isfinite(item->valuedouble) || fabs(item->valuedouble) > FLT_MAX)
         return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: %s must be a finite number", source, what);
     *out = (float)item->valuedouble;
@@ -82,8 +80,7 @@ static int read_number(const cJSON *item, const char *what, const char *source, 
 }
 
 static int read_matrix(const cJSON *root, camera_settings *settings, const char *source,
-                       tool_error *error)
-{
+                       tool_error *error) {
     const char *key = "world_to_camera";
     const cJSON *rows = cJSON_GetObjectItemCaseSensitive(root, key);
     if (rows == NULL) return TOOL_EXIT_SUCCESS;
@@ -99,8 +96,8 @@ static int read_matrix(const cJSON *root, camera_settings *settings, const char 
         for (int c = 0; c < 4; ++c) {
             char what[64];
             snprintf(what, sizeof what, "\"%s\"[%d][%d]", key, r, c);
-            int status = read_number(cJSON_GetArrayItem(row, c), what, source, &matrix[r * 4 + c],
-                                     error);
+            int status =
+                read_number(cJSON_GetArrayItem(row, c), what, source, &matrix[r * 4 + c], error);
             if (status != TOOL_EXIT_SUCCESS) return status;
         }
     }
@@ -110,23 +107,21 @@ static int read_matrix(const cJSON *root, camera_settings *settings, const char 
 }
 
 int camera_json_parse(const char *text, const char *source, camera_settings *settings,
-                      tool_error *error)
-{
+                      tool_error *error) {
     cJSON *root = cJSON_Parse(text);
-    if (root == NULL)
-        return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: not valid JSON", source);
+    if (root == NULL) return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: not valid JSON", source);
     int status = TOOL_EXIT_SUCCESS;
     if (!cJSON_IsObject(root)) {
         status = tool_fail(error, TOOL_EXIT_RUNTIME, "%s: expected a JSON object", source);
         goto done;
     }
-    status = read_enum(root, "type", projection_names, COUNT_OF(projection_names),
-                       CAMERA_FIELD_PROJECTION, &settings->camera.projection, settings, source,
-                       error);
+    status =
+        read_enum(root, "type", projection_names, COUNT_OF(projection_names),
+                  CAMERA_FIELD_PROJECTION, &settings->camera.projection, settings, source, error);
     if (status != TOOL_EXIT_SUCCESS) goto done;
-    status = read_enum(root, "sensor_fit", sensor_fit_names, COUNT_OF(sensor_fit_names),
-                       CAMERA_FIELD_SENSOR_FIT, &settings->camera.sensor_fit, settings, source,
-                       error);
+    status =
+        read_enum(root, "sensor_fit", sensor_fit_names, COUNT_OF(sensor_fit_names),
+                  CAMERA_FIELD_SENSOR_FIT, &settings->camera.sensor_fit, settings, source, error);
     if (status != TOOL_EXIT_SUCCESS) goto done;
     for (size_t i = 0; i < COUNT_OF(float_fields); ++i) {
         const float_field *field = &float_fields[i];
@@ -149,8 +144,7 @@ done:
     return status;
 }
 
-int camera_json_load(const char *path, camera_settings *settings, tool_error *error)
-{
+int camera_json_load(const char *path, camera_settings *settings, tool_error *error) {
     FILE *file = fopen(path, "rb");
     if (file == NULL)
         return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot open camera file %s: %s", path,
@@ -167,8 +161,8 @@ int camera_json_load(const char *path, camera_settings *settings, tool_error *er
     if (read_failed)
         status = tool_fail(error, TOOL_EXIT_RUNTIME, "cannot read camera file %s", path);
     else if (length > CAMERA_JSON_MAX_BYTES)
-        status = tool_fail(error, TOOL_EXIT_RUNTIME, "camera file %s is larger than %d bytes",
-                           path, CAMERA_JSON_MAX_BYTES);
+        status = tool_fail(error, TOOL_EXIT_RUNTIME, "camera file %s is larger than %d bytes", path,
+                           CAMERA_JSON_MAX_BYTES);
     else {
         text[length] = '\0';
         status = camera_json_parse(text, path, settings, error);

@@ -3,15 +3,13 @@
 
 #include <string.h>
 
-void camera_settings_init(camera_settings *settings)
-{
+void camera_settings_init(camera_settings *settings) {
     hbao_camera defaults = HBAO_CAMERA_DEFAULT_INITIALIZER;
     settings->camera = defaults;
     settings->fields_set = 0;
 }
 
-void camera_settings_apply(camera_settings *base, const camera_settings *override)
-{
+void camera_settings_apply(camera_settings *base, const camera_settings *override) {
     const hbao_camera *from = &override->camera;
     hbao_camera *to = &base->camera;
     uint32_t set = override->fields_set;
@@ -32,14 +30,12 @@ void camera_settings_apply(camera_settings *base, const camera_settings *overrid
 
 /* The full image's size and the crop's place in it, as int32 or -1 where a
  * header's 32-bit window coordinates overflow it (hbao_camera_crop refuses -1). */
-static int32_t as_int32(int64_t value)
-{
+static int32_t as_int32(int64_t value) {
     return value >= INT32_MIN && value <= INT32_MAX ? (int32_t)value : -1;
 }
 
 hbao_result camera_for_data_window(const hbao_camera *camera, const pixel_rect *display,
-                                   const pixel_rect *data, hbao_camera *cropped)
-{
+                                   const pixel_rect *data, hbao_camera *cropped) {
     const int64_t full_width = (int64_t)display->max_x - display->min_x + 1;
     const int64_t full_height = (int64_t)display->max_y - display->min_y + 1;
     const int64_t width = (int64_t)data->max_x - data->min_x + 1;
@@ -50,8 +46,7 @@ hbao_result camera_for_data_window(const hbao_camera *camera, const pixel_rect *
                             as_int32(height), cropped);
 }
 
-bool matrix_is_identity(const float matrix[16])
-{
+bool matrix_is_identity(const float matrix[16]) {
     for (int i = 0; i < 16; ++i)
         if (matrix[i] != (i % 5 == 0 ? 1.0f : 0.0f)) return false;
     return true;

@@ -114,16 +114,12 @@ static const choice sensor_fit_choices[] = {{"AUTO", HBAO_SENSOR_FIT_AUTO},
                                             {NULL, 0}};
 /* Lossless methods only: AO is stored as 32-bit float, which the lossy
  * methods would quantise (pxr24) or pass through uncompressed (b44). */
-static const choice compression_choices[] = {{"none", EXR_COMPRESSION_NONE},
-                                             {"rle", EXR_COMPRESSION_RLE},
-                                             {"zips", EXR_COMPRESSION_ZIPS},
-                                             {"zip", EXR_COMPRESSION_ZIP},
-                                             {"piz", EXR_COMPRESSION_PIZ},
-                                             {NULL, 0}};
+static const choice compression_choices[] = {
+    {"none", EXR_COMPRESSION_NONE}, {"rle", EXR_COMPRESSION_RLE}, {"zips", EXR_COMPRESSION_ZIPS},
+    {"zip", EXR_COMPRESSION_ZIP},   {"piz", EXR_COMPRESSION_PIZ}, {NULL, 0}};
 
 static int parse_choice(const char *flag, const char *text, const choice *choices, int32_t *out,
-                        tool_error *error)
-{
+                        tool_error *error) {
     char names[128] = "";
     for (const choice *c = choices; c->name != NULL; ++c) {
         if (strcmp(c->name, text) == 0) {
@@ -138,12 +134,10 @@ static int parse_choice(const char *flag, const char *text, const choice *choice
 
 /* A finite float in [minimum, maximum]; `positive` makes the minimum exclusive of 0. */
 static int parse_float_flag(const char *flag, const char *text, float minimum, float maximum,
-                            bool positive, float *out, tool_error *error)
-{
+                            bool positive, float *out, tool_error *error) {
     float value;
     if (!parse_finite_float(text, &value))
-        return tool_fail(error, TOOL_EXIT_USAGE, "--%s: \"%s\" is not a finite number", flag,
-                         text);
+        return tool_fail(error, TOOL_EXIT_USAGE, "--%s: \"%s\" is not a finite number", flag, text);
     if (positive && !(value > 0.0f))
         return tool_fail(error, TOOL_EXIT_USAGE, "--%s: must be > 0 (got %s)", flag, text);
     if (value < minimum || value > maximum)
@@ -154,8 +148,7 @@ static int parse_float_flag(const char *flag, const char *text, float minimum, f
 }
 
 static int parse_int_flag(const char *flag, const char *text, int32_t minimum, int32_t maximum,
-                          int32_t *out, tool_error *error)
-{
+                          int32_t *out, tool_error *error) {
     int32_t value;
     if (!parse_int32(text, &value))
         return tool_fail(error, TOOL_EXIT_USAGE, "--%s: \"%s\" is not an integer", flag, text);
@@ -166,8 +159,7 @@ static int parse_int_flag(const char *flag, const char *text, int32_t minimum, i
     return TOOL_EXIT_SUCCESS;
 }
 
-static const option_spec *find_long_option(const char *name, size_t length)
-{
+static const option_spec *find_long_option(const char *name, size_t length) {
     for (size_t i = 0; i < OPTION_COUNT; ++i)
         if (strlen(option_specs[i].name) == length &&
             strncmp(option_specs[i].name, name, length) == 0)
@@ -175,143 +167,168 @@ static const option_spec *find_long_option(const char *name, size_t length)
     return NULL;
 }
 
-static const option_spec *find_short_option(char name)
-{
+static const option_spec *find_short_option(char name) {
     for (size_t i = 0; i < OPTION_COUNT; ++i)
         if (option_specs[i].short_name == name) return &option_specs[i];
     return NULL;
 }
 
 static int apply_option(const option_spec *spec, const char *value, cli_options *options,
-                        tool_error *error)
-{
+                        tool_error *error) {
     hbao_params *params = &options->params;
     camera_settings *flags = &options->camera_flags;
     hbao_camera *camera = &flags->camera;
     const char *flag = spec->name;
     int status = TOOL_EXIT_SUCCESS;
     switch (spec->id) {
-    case OPTION_OUTPUT: options->output_path = value; break;
-    case OPTION_LAYER: options->layer = value; break;
-    case OPTION_AO_CHANNEL:
-        if (value[0] == '\0')
-            return tool_fail(error, TOOL_EXIT_USAGE, "--ao-channel: the name is empty");
-        options->ao_channel = value;
-        break;
-    case OPTION_KEEP_INPUT: options->keep_input = true; break;
-    case OPTION_NO_NORMALS: options->ignore_normals = true; break;
-    case OPTION_PREVIEW: options->preview_path = value; break;
-    case OPTION_COMPRESSION: {
-        int32_t compression = EXR_COMPRESSION_ZIP;
-        status = parse_choice(flag, value, compression_choices, &compression, error);
-        options->compression = (exr_compression_t)compression;
-        break;
-    }
-    /* AO parameters: only the syntax here; their limits are libhbao's
+        case OPTION_OUTPUT:
+            options->output_path = value;
+            break;
+        case OPTION_LAYER:
+            options->layer = value;
+            break;
+        case OPTION_AO_CHANNEL:
+            if (value[0] == '\0')
+                return tool_fail(error, TOOL_EXIT_USAGE, "--ao-channel: the name is empty");
+            options->ao_channel = value;
+            break;
+        case OPTION_KEEP_INPUT:
+            options->keep_input = true;
+            break;
+        case OPTION_NO_NORMALS:
+            options->ignore_normals = true;
+            break;
+        case OPTION_PREVIEW:
+            options->preview_path = value;
+            break;
+        case OPTION_COMPRESSION: {
+            int32_t compression = EXR_COMPRESSION_ZIP;
+            status = parse_choice(flag, value, compression_choices, &compression, error);
+            options->compression = (exr_compression_t)compression;
+            break;
+        }
+        /* AO parameters: only the syntax here; their limits are libhbao's
      * (hbao_params_resolve, in resolve_params below). */
-    case OPTION_RADIUS:
-        status = parse_float_flag(flag, value, -FLT_MAX, FLT_MAX, false, &params->radius, error);
-        break;
-    case OPTION_ANGLE_BIAS:
-        status = parse_float_flag(flag, value, -FLT_MAX, FLT_MAX, false,
-                                  &params->angle_bias_degrees, error);
-        break;
-    case OPTION_DIRECTIONS:
-        status = parse_int_flag(flag, value, INT32_MIN, INT32_MAX, &params->directions, error);
-        break;
-    case OPTION_STEPS:
-        status = parse_int_flag(flag, value, INT32_MIN, INT32_MAX, &params->steps, error);
-        break;
-    case OPTION_BLUR:
-        status = parse_int_flag(flag, value, INT32_MIN, INT32_MAX, &params->blur_size, error);
-        break;
-    case OPTION_BLUR_SHARPNESS:
-        status = parse_float_flag(flag, value, -FLT_MAX, FLT_MAX, false, &params->blur_sharpness,
-                                  error);
-        break;
-    case OPTION_HALF_RES: params->half_resolution = 1; break;
-    case OPTION_FALLOFF:
-        status = parse_choice(flag, value, falloff_choices, &params->falloff, error);
-        break;
-    case OPTION_INTEGRATION:
-        status = parse_choice(flag, value, integration_choices, &params->integration, error);
-        break;
-    case OPTION_STRENGTH:
-        status = parse_float_flag(flag, value, -FLT_MAX, FLT_MAX, false, &params->strength,
-                                  error);
-        break;
-    case OPTION_THREADS:
-        status = parse_int_flag(flag, value, INT32_MIN, INT32_MAX, &params->threads, error);
-        break;
-    case OPTION_CAMERA: options->camera_path = value; break;
-    case OPTION_CAMERA_TYPE:
-        status = parse_choice(flag, value, camera_type_choices, &camera->projection, error);
-        flags->fields_set |= CAMERA_FIELD_PROJECTION;
-        break;
-    case OPTION_LENS:
-        status = parse_float_flag(flag, value, 0.0f, FLT_MAX, true, &camera->lens, error);
-        flags->fields_set |= CAMERA_FIELD_LENS;
-        break;
-    case OPTION_SENSOR_WIDTH:
-        status = parse_float_flag(flag, value, 0.0f, FLT_MAX, true, &camera->sensor_width, error);
-        flags->fields_set |= CAMERA_FIELD_SENSOR_WIDTH;
-        break;
-    case OPTION_SENSOR_HEIGHT:
-        status =
-            parse_float_flag(flag, value, 0.0f, FLT_MAX, true, &camera->sensor_height, error);
-        flags->fields_set |= CAMERA_FIELD_SENSOR_HEIGHT;
-        break;
-    case OPTION_SENSOR_FIT:
-        status = parse_choice(flag, value, sensor_fit_choices, &camera->sensor_fit, error);
-        flags->fields_set |= CAMERA_FIELD_SENSOR_FIT;
-        break;
-    case OPTION_SHIFT_X:
-        status = parse_float_flag(flag, value, -FLT_MAX, FLT_MAX, false, &camera->shift_x, error);
-        flags->fields_set |= CAMERA_FIELD_SHIFT_X;
-        break;
-    case OPTION_SHIFT_Y:
-        status = parse_float_flag(flag, value, -FLT_MAX, FLT_MAX, false, &camera->shift_y, error);
-        flags->fields_set |= CAMERA_FIELD_SHIFT_Y;
-        break;
-    case OPTION_ORTHO_SCALE:
-        /* An ortho scale only means something for an orthographic camera. */
-        status = parse_float_flag(flag, value, 0.0f, FLT_MAX, true, &camera->ortho_scale, error);
-        camera->projection = HBAO_PROJECTION_ORTHOGRAPHIC;
-        flags->fields_set |= CAMERA_FIELD_ORTHO_SCALE | CAMERA_FIELD_PROJECTION;
-        break;
-    case OPTION_PIXEL_ASPECT_X:
-        status =
-            parse_float_flag(flag, value, 0.0f, FLT_MAX, true, &camera->pixel_aspect_x, error);
-        flags->fields_set |= CAMERA_FIELD_PIXEL_ASPECT_X;
-        break;
-    case OPTION_PIXEL_ASPECT_Y:
-        status =
-            parse_float_flag(flag, value, 0.0f, FLT_MAX, true, &camera->pixel_aspect_y, error);
-        flags->fields_set |= CAMERA_FIELD_PIXEL_ASPECT_Y;
-        break;
-    case OPTION_WORLD_TO_CAMERA:
-        if (!parse_float_list(value, camera->world_to_camera, 16))
-            return tool_fail(error, TOOL_EXIT_USAGE,
-                             "--world-to-camera: expected one argument holding 16 finite "
-                             "numbers (row-major, separated by commas or spaces), got \"%s\"",
-                             value);
-        flags->fields_set |= CAMERA_FIELD_WORLD_TO_CAMERA;
-        break;
-    case OPTION_FRAMES:
-        if (!frame_list_parse(value, &options->frames))
-            return tool_fail(error, TOOL_EXIT_USAGE,
-                             "--frames: \"%s\" is not a frame list like 1-250 or 1-10,20 "
-                             "(frames in [0, %d], at most %d ranges, none twice)",
-                             value, FRAME_MAX, FRAME_RANGES_MAX);
-        break;
-    case OPTION_JOBS:
-        status = parse_int_flag(flag, value, 1, CLI_MAX_JOBS, &options->jobs, error);
-        break;
-    case OPTION_FORCE: options->force = true; break;
-    case OPTION_INFO: options->mode = TOOL_MODE_INFO; break;
-    case OPTION_JSON: options->info_json = true; break;
-    case OPTION_HELP: /* handled after parsing */ break;
-    case OPTION_VERSION: break;
+        case OPTION_RADIUS:
+            status =
+                parse_float_flag(flag, value, -FLT_MAX, FLT_MAX, false, &params->radius, error);
+            break;
+        case OPTION_ANGLE_BIAS:
+            status = parse_float_flag(flag, value, -FLT_MAX, FLT_MAX, false,
+                                      &params->angle_bias_degrees, error);
+            break;
+        case OPTION_DIRECTIONS:
+            status = parse_int_flag(flag, value, INT32_MIN, INT32_MAX, &params->directions, error);
+            break;
+        case OPTION_STEPS:
+            status = parse_int_flag(flag, value, INT32_MIN, INT32_MAX, &params->steps, error);
+            break;
+        case OPTION_BLUR:
+            status = parse_int_flag(flag, value, INT32_MIN, INT32_MAX, &params->blur_size, error);
+            break;
+        case OPTION_BLUR_SHARPNESS:
+            status = parse_float_flag(flag, value, -FLT_MAX, FLT_MAX, false,
+                                      &params->blur_sharpness, error);
+            break;
+        case OPTION_HALF_RES:
+            params->half_resolution = 1;
+            break;
+        case OPTION_FALLOFF:
+            status = parse_choice(flag, value, falloff_choices, &params->falloff, error);
+            break;
+        case OPTION_INTEGRATION:
+            status = parse_choice(flag, value, integration_choices, &params->integration, error);
+            break;
+        case OPTION_STRENGTH:
+            status =
+                parse_float_flag(flag, value, -FLT_MAX, FLT_MAX, false, &params->strength, error);
+            break;
+        case OPTION_THREADS:
+            status = parse_int_flag(flag, value, INT32_MIN, INT32_MAX, &params->threads, error);
+            break;
+        case OPTION_CAMERA:
+            options->camera_path = value;
+            break;
+        case OPTION_CAMERA_TYPE:
+            status = parse_choice(flag, value, camera_type_choices, &camera->projection, error);
+            flags->fields_set |= CAMERA_FIELD_PROJECTION;
+            break;
+        case OPTION_LENS:
+            status = parse_float_flag(flag, value, 0.0f, FLT_MAX, true, &camera->lens, error);
+            flags->fields_set |= CAMERA_FIELD_LENS;
+            break;
+        case OPTION_SENSOR_WIDTH:
+            status =
+                parse_float_flag(flag, value, 0.0f, FLT_MAX, true, &camera->sensor_width, error);
+            flags->fields_set |= CAMERA_FIELD_SENSOR_WIDTH;
+            break;
+        case OPTION_SENSOR_HEIGHT:
+            status =
+                parse_float_flag(flag, value, 0.0f, FLT_MAX, true, &camera->sensor_height, error);
+            flags->fields_set |= CAMERA_FIELD_SENSOR_HEIGHT;
+            break;
+        case OPTION_SENSOR_FIT:
+            status = parse_choice(flag, value, sensor_fit_choices, &camera->sensor_fit, error);
+            flags->fields_set |= CAMERA_FIELD_SENSOR_FIT;
+            break;
+        case OPTION_SHIFT_X:
+            status =
+                parse_float_flag(flag, value, -FLT_MAX, FLT_MAX, false, &camera->shift_x, error);
+            flags->fields_set |= CAMERA_FIELD_SHIFT_X;
+            break;
+        case OPTION_SHIFT_Y:
+            status =
+                parse_float_flag(flag, value, -FLT_MAX, FLT_MAX, false, &camera->shift_y, error);
+            flags->fields_set |= CAMERA_FIELD_SHIFT_Y;
+            break;
+        case OPTION_ORTHO_SCALE:
+            /* An ortho scale only means something for an orthographic camera. */
+            status =
+                parse_float_flag(flag, value, 0.0f, FLT_MAX, true, &camera->ortho_scale, error);
+            camera->projection = HBAO_PROJECTION_ORTHOGRAPHIC;
+            flags->fields_set |= CAMERA_FIELD_ORTHO_SCALE | CAMERA_FIELD_PROJECTION;
+            break;
+        case OPTION_PIXEL_ASPECT_X:
+            status =
+                parse_float_flag(flag, value, 0.0f, FLT_MAX, true, &camera->pixel_aspect_x, error);
+            flags->fields_set |= CAMERA_FIELD_PIXEL_ASPECT_X;
+            break;
+        case OPTION_PIXEL_ASPECT_Y:
+            status =
+                parse_float_flag(flag, value, 0.0f, FLT_MAX, true, &camera->pixel_aspect_y, error);
+            flags->fields_set |= CAMERA_FIELD_PIXEL_ASPECT_Y;
+            break;
+        case OPTION_WORLD_TO_CAMERA:
+            if (!parse_float_list(value, camera->world_to_camera, 16))
+                return tool_fail(error, TOOL_EXIT_USAGE,
+                                 "--world-to-camera: expected one argument holding 16 finite "
+                                 "numbers (row-major, separated by commas or spaces), got \"%s\"",
+                                 value);
+            flags->fields_set |= CAMERA_FIELD_WORLD_TO_CAMERA;
+            break;
+        case OPTION_FRAMES:
+            if (!frame_list_parse(value, &options->frames))
+                return tool_fail(error, TOOL_EXIT_USAGE,
+                                 "--frames: \"%s\" is not a frame list like 1-250 or 1-10,20 "
+                                 "(frames in [0, %d], at most %d ranges, none twice)",
+                                 value, FRAME_MAX, FRAME_RANGES_MAX);
+            break;
+        case OPTION_JOBS:
+            status = parse_int_flag(flag, value, 1, CLI_MAX_JOBS, &options->jobs, error);
+            break;
+        case OPTION_FORCE:
+            options->force = true;
+            break;
+        case OPTION_INFO:
+            options->mode = TOOL_MODE_INFO;
+            break;
+        case OPTION_JSON:
+            options->info_json = true;
+            break;
+        case OPTION_HELP: /* handled after parsing */
+            break;
+        case OPTION_VERSION:
+            break;
     }
     return status;
 }
@@ -333,26 +350,33 @@ static const struct {
     {HBAO_PARAM_FIELD_THREADS, "threads"},
 };
 
-static double param_value(const hbao_params *params, uint32_t field)
-{
+static double param_value(const hbao_params *params, uint32_t field) {
     switch (field) {
-    case HBAO_PARAM_FIELD_RADIUS: return params->radius;
-    case HBAO_PARAM_FIELD_ANGLE_BIAS_DEGREES: return params->angle_bias_degrees;
-    case HBAO_PARAM_FIELD_DIRECTIONS: return params->directions;
-    case HBAO_PARAM_FIELD_STEPS: return params->steps;
-    case HBAO_PARAM_FIELD_BLUR_SIZE: return params->blur_size;
-    case HBAO_PARAM_FIELD_BLUR_SHARPNESS: return params->blur_sharpness;
-    case HBAO_PARAM_FIELD_STRENGTH: return params->strength;
-    case HBAO_PARAM_FIELD_THREADS: return params->threads;
-    default: return NAN;
+        case HBAO_PARAM_FIELD_RADIUS:
+            return params->radius;
+        case HBAO_PARAM_FIELD_ANGLE_BIAS_DEGREES:
+            return params->angle_bias_degrees;
+        case HBAO_PARAM_FIELD_DIRECTIONS:
+            return params->directions;
+        case HBAO_PARAM_FIELD_STEPS:
+            return params->steps;
+        case HBAO_PARAM_FIELD_BLUR_SIZE:
+            return params->blur_size;
+        case HBAO_PARAM_FIELD_BLUR_SHARPNESS:
+            return params->blur_sharpness;
+        case HBAO_PARAM_FIELD_STRENGTH:
+            return params->strength;
+        case HBAO_PARAM_FIELD_THREADS:
+            return params->threads;
+        default:
+            return NAN;
     }
 }
 
 /* The library decides (hbao_params_resolve): like the add-on, the tool
  * clamps out-of-range values with one warning per value and goes on; only
  * values with no nearest legal value (a negative radius) are refused. */
-static int resolve_params(hbao_params *params, tool_error *error)
-{
+static int resolve_params(hbao_params *params, tool_error *error) {
     hbao_params resolved;
     uint32_t fields = 0;
     hbao_result result = hbao_params_resolve(params, &resolved, &fields);
@@ -373,8 +397,7 @@ static int resolve_params(hbao_params *params, tool_error *error)
     return TOOL_EXIT_SUCCESS;
 }
 
-static void options_init(cli_options *options)
-{
+static void options_init(cli_options *options) {
     memset(options, 0, sizeof *options);
     options->mode = TOOL_MODE_COMPUTE;
     options->compression = EXR_COMPRESSION_ZIP;
@@ -385,8 +408,7 @@ static void options_init(cli_options *options)
     camera_settings_init(&options->camera_flags);
 }
 
-int cli_parse(int argc, char **argv, cli_options *options, tool_error *error)
-{
+int cli_parse(int argc, char **argv, cli_options *options, tool_error *error) {
     options_init(options);
     bool only_positionals = false;
     bool wants_help = false, wants_version = false;
@@ -443,13 +465,15 @@ int cli_parse(int argc, char **argv, cli_options *options, tool_error *error)
     }
 
     if (options->input_path == NULL)
-        return tool_fail(error, TOOL_EXIT_USAGE, "no input file (usage: hbao INPUT.exr -o "
-                                                 "OUTPUT.exr [options]; see hbao --help)");
+        return tool_fail(error, TOOL_EXIT_USAGE,
+                         "no input file (usage: hbao INPUT.exr -o "
+                         "OUTPUT.exr [options]; see hbao --help)");
     const bool sequence = options->frames.range_count > 0;
     if (options->mode == TOOL_MODE_INFO) {
         if (options->output_path != NULL || options->preview_path != NULL)
             return tool_fail(error, TOOL_EXIT_USAGE, "--info writes nothing: drop -o/--preview");
-        if (sequence) return tool_fail(error, TOOL_EXIT_USAGE, "--info reads one file: drop --frames");
+        if (sequence)
+            return tool_fail(error, TOOL_EXIT_USAGE, "--info reads one file: drop --frames");
         return TOOL_EXIT_SUCCESS;
     }
     if (!sequence && (options->jobs != 1 || options->force))
@@ -480,123 +504,123 @@ int cli_parse(int argc, char **argv, cli_options *options, tool_error *error)
     return resolve_params(&options->params, error);
 }
 
-void cli_print_help(FILE *stream)
-{
-    fprintf(stream,
-"usage: hbao INPUT.exr -o OUTPUT.exr [options]\n"
-"       hbao --info FILE.exr [--json]\n"
-"\n"
-"Horizon-based ambient occlusion from the Depth (and Normal) pass of a Blender\n"
-"multilayer OpenEXR render. Writes an EXR whose float channel `AO` holds the\n"
-"occlusion: 1 = unoccluded, 0 = fully occluded; background pixels get 1.\n"
-"\n"
-"Input and output:\n"
-"  -o, --output FILE       output EXR (required). Written to a temporary file\n"
-"                          .hbao-tmp-XXXXXX next to it and renamed over it when\n"
-"                          complete, so it appears whole or not at all; never the\n"
-"                          input. A symbolic link is followed: its target is\n"
-"                          replaced, the link kept. A FIFO or character device\n"
-"                          (/dev/null, /dev/stdout) is written through, never\n"
-"                          replaced. A directory, block device or socket is\n"
-"                          refused (exit 2). Ctrl-C, SIGTERM and SIGHUP remove\n"
-"                          the temporary files. The same holds for --preview.\n"
-"  --layer NAME            view layer to use (channels NAME.Depth.Z and, if\n"
-"                          present, NAME.Normal.X/Y/Z). Default: the first layer,\n"
-"                          in channel-name order, that has a Depth pass; a plain\n"
-"                          `Depth.Z` or `Z` channel is used if no layer has one.\n"
-"  --no-normals            ignore the Normal pass; reconstruct normals from depth.\n"
-"  --ao-channel NAME       name of the output channel (default AO). `Y` makes\n"
-"                          image viewers and Blender show the AO as grayscale.\n"
-"  --keep-input            also copy every input channel (same names and pixel\n"
-"                          types) and header attributes into the output; an input\n"
-"                          channel with the AO channel's name is replaced.\n"
-"  --compression METHOD    none, rle, zips, zip (default) or piz (lossless only).\n"
-"  --preview FILE.png      also write the AO as an 8-bit grayscale PNG: the linear\n"
-"                          AO value 0..1 maps to 0..255, no gamma curve.\n"
-"  --info                  print the file's layout (layers, channels, pixel types,\n"
-"                          compression, windows) and per-channel min/max/mean of\n"
-"                          the finite values and the count of non-finite ones.\n"
-"  --json                  with --info: print it as JSON.\n"
-"\n"
-"AO parameters (defaults and limits from libhbao; a value outside its range is\n"
-"clamped to it, with a warning, as the Blender add-on does):\n"
-"  --radius R              AO radius in scene units (>= 0, else an error;\n"
-"                          default %g)\n"
-"  --angle-bias DEG        ignore occluders this far above the tangent plane\n"
-"                          [0, %g] (default %g)\n"
-"  --directions N          directions per pixel [1, %d] (default %d)\n"
-"  --steps N               steps per direction [1, %d] (default %d)\n"
-"  --blur N                bilateral blur width in pixels [0, %d]; 0 or 1 = off\n"
-"                          (default %d)\n"
-"  --blur-sharpness S      how strongly the blur stops at depth edges [0, %g]\n"
-"                          (default %g)\n"
-"  --half-res              compute at half resolution, upsample depth-aware\n"
-"  --falloff F             none (default: what Cycles' AO pass measures) or\n"
-"                          quadratic (HBAO's 1 - (d/radius)^2 attenuation)\n"
-"  --integration I         cosine (default: what Cycles' AO pass measures) or hbao\n"
-"  --strength S            ao = ao^S, [0, %g] (default %g)\n"
-"  --threads N             worker threads, at most %d; 0 (or less) = one per\n"
-"                          core (default)\n"
-"\n"
-"Camera (Blender's camera model and names; flags override --camera):\n"
-"  --camera FILE.json      JSON object with Blender's property names: type\n"
-"                          (\"PERSP\"/\"ORTHO\"), lens, sensor_width, sensor_height,\n"
-"                          sensor_fit (\"AUTO\"/\"HORIZONTAL\"/\"VERTICAL\"), shift_x,\n"
-"                          shift_y, ortho_scale, pixel_aspect_x, pixel_aspect_y,\n"
-"                          world_to_camera (4 rows of 4 numbers). Missing keys keep\n"
-"                          their defaults; unknown keys are ignored.\n"
-"  --camera-type T         PERSP or ORTHO\n"
-"  --lens MM               focal length (default 50)\n"
-"  --sensor-width MM       (default 36)\n"
-"  --sensor-height MM      (default 24)\n"
-"  --sensor-fit FIT        AUTO (default), HORIZONTAL or VERTICAL\n"
-"  --shift-x S, --shift-y S  lens shift in units of the fitted sensor side\n"
-"  --ortho-scale S         orthographic view size; implies --camera-type ORTHO\n"
-"  --pixel-aspect-x A, --pixel-aspect-y A\n"
-"                          default: x = the EXR header's pixelAspectRatio, y = 1\n"
-"  --world-to-camera \"M\"   ONE argument holding the 16 numbers of the row-major\n"
-"                          world-to-camera matrix (camera.matrix_world inverted),\n"
-"                          separated by commas and/or spaces, e.g.\n"
-"                          --world-to-camera \"1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1\".\n"
-"                          It maps Blender's world-space Normal pass into camera\n"
-"                          space. Without it (and without world_to_camera in the\n"
-"                          JSON) the identity is used, i.e. normals are taken as\n"
-"                          already in camera space: wrong for Blender's Normal pass\n"
-"                          unless the camera sits at the origin looking down -Z, so\n"
-"                          the tool warns; pass the matrix or --no-normals.\n"
-"\n"
-"Sequences:\n"
-"  --frames LIST           compute every frame of LIST (1-250, or 1-10,20,30-40;\n"
-"                          frames in [0, %d]). The input, -o and --preview\n"
-"                          names must hold a run of '#', replaced by the frame\n"
-"                          number zero-padded to the run's length, as Blender\n"
-"                          names frames: hbao 'render_####.exr' -o 'ao_####.exr'\n"
-"                          --frames 1-250. An output at least as new as its input\n"
-"                          (and --camera file) is up to date and skipped. One\n"
-"                          progress line per frame; every frame is attempted, and\n"
-"                          the exit status is 1 (2 for a usage error in a frame)\n"
-"                          when any failed, with the list of failed frames.\n"
-"  -j, --jobs N            frames computed at once [1, %d] (default 1); without\n"
-"                          --threads, each frame gets cores / N threads\n"
-"  --force                 recompute frames that are up to date (changed flags\n"
-"                          are not detected)\n"
-"\n"
-"Data window: the tool works on the EXR's data window and writes the output with\n"
-"the same data and display windows; when the data window is a part of the\n"
-"display window, the camera is adjusted to that part (same view rays). Blender\n"
-"itself always writes data window = display window: a border render without\n"
-"cropping is a full frame (unrendered pixels are background, AO 1); with\n"
-"\"Crop to Render Region\" nothing in the file says where the region was, so\n"
-"the camera must describe the cropped view (sensor and shift).\n"
-"\n"
-"Exit status: 0 success, 1 runtime error (unreadable or corrupt file, cannot\n"
-"write), 2 usage error (bad flag or value, output would overwrite the input).\n"
-"  -h, --help              this help\n"
-"  --version               print the tool's and libhbao's versions\n",
-            (double)HBAO_DEFAULT_RADIUS, (double)HBAO_MAX_ANGLE_BIAS_DEGREES,
-            (double)HBAO_DEFAULT_ANGLE_BIAS_DEGREES, HBAO_MAX_DIRECTIONS,
-            HBAO_DEFAULT_DIRECTIONS, HBAO_MAX_STEPS, HBAO_DEFAULT_STEPS, HBAO_MAX_BLUR_SIZE,
-            HBAO_DEFAULT_BLUR_SIZE, (double)HBAO_MAX_BLUR_SHARPNESS,
-            (double)HBAO_DEFAULT_BLUR_SHARPNESS, (double)HBAO_MAX_STRENGTH,
-            (double)HBAO_DEFAULT_STRENGTH, HBAO_MAX_THREADS, FRAME_MAX, CLI_MAX_JOBS);
+void cli_print_help(FILE *stream) {
+    fprintf(
+        stream,
+        "usage: hbao INPUT.exr -o OUTPUT.exr [options]\n"
+        "       hbao --info FILE.exr [--json]\n"
+        "\n"
+        "Horizon-based ambient occlusion from the Depth (and Normal) pass of a Blender\n"
+        "multilayer OpenEXR render. Writes an EXR whose float channel `AO` holds the\n"
+        "occlusion: 1 = unoccluded, 0 = fully occluded; background pixels get 1.\n"
+        "\n"
+        "Input and output:\n"
+        "  -o, --output FILE       output EXR (required). Written to a temporary file\n"
+        "                          .hbao-tmp-XXXXXX next to it and renamed over it when\n"
+        "                          complete, so it appears whole or not at all; never the\n"
+        "                          input. A symbolic link is followed: its target is\n"
+        "                          replaced, the link kept. A FIFO or character device\n"
+        "                          (/dev/null, /dev/stdout) is written through, never\n"
+        "                          replaced. A directory, block device or socket is\n"
+        "                          refused (exit 2). Ctrl-C, SIGTERM and SIGHUP remove\n"
+        "                          the temporary files. The same holds for --preview.\n"
+        "  --layer NAME            view layer to use (channels NAME.Depth.Z and, if\n"
+        "                          present, NAME.Normal.X/Y/Z). Default: the first layer,\n"
+        "                          in channel-name order, that has a Depth pass; a plain\n"
+        "                          `Depth.Z` or `Z` channel is used if no layer has one.\n"
+        "  --no-normals            ignore the Normal pass; reconstruct normals from depth.\n"
+        "  --ao-channel NAME       name of the output channel (default AO). `Y` makes\n"
+        "                          image viewers and Blender show the AO as grayscale.\n"
+        "  --keep-input            also copy every input channel (same names and pixel\n"
+        "                          types) and header attributes into the output; an input\n"
+        "                          channel with the AO channel's name is replaced.\n"
+        "  --compression METHOD    none, rle, zips, zip (default) or piz (lossless only).\n"
+        "  --preview FILE.png      also write the AO as an 8-bit grayscale PNG: the linear\n"
+        "                          AO value 0..1 maps to 0..255, no gamma curve.\n"
+        "  --info                  print the file's layout (layers, channels, pixel types,\n"
+        "                          compression, windows) and per-channel min/max/mean of\n"
+        "                          the finite values and the count of non-finite ones.\n"
+        "  --json                  with --info: print it as JSON.\n"
+        "\n"
+        "AO parameters (defaults and limits from libhbao; a value outside its range is\n"
+        "clamped to it, with a warning, as the Blender add-on does):\n"
+        "  --radius R              AO radius in scene units (>= 0, else an error;\n"
+        "                          default %g)\n"
+        "  --angle-bias DEG        ignore occluders this far above the tangent plane\n"
+        "                          [0, %g] (default %g)\n"
+        "  --directions N          directions per pixel [1, %d] (default %d)\n"
+        "  --steps N               steps per direction [1, %d] (default %d)\n"
+        "  --blur N                bilateral blur width in pixels [0, %d]; 0 or 1 = off\n"
+        "                          (default %d)\n"
+        "  --blur-sharpness S      how strongly the blur stops at depth edges [0, %g]\n"
+        "                          (default %g)\n"
+        "  --half-res              compute at half resolution, upsample depth-aware\n"
+        "  --falloff F             none (default: what Cycles' AO pass measures) or\n"
+        "                          quadratic (HBAO's 1 - (d/radius)^2 attenuation)\n"
+        "  --integration I         cosine (default: what Cycles' AO pass measures) or hbao\n"
+        "  --strength S            ao = ao^S, [0, %g] (default %g)\n"
+        "  --threads N             worker threads, at most %d; 0 (or less) = one per\n"
+        "                          core (default)\n"
+        "\n"
+        "Camera (Blender's camera model and names; flags override --camera):\n"
+        "  --camera FILE.json      JSON object with Blender's property names: type\n"
+        "                          (\"PERSP\"/\"ORTHO\"), lens, sensor_width, sensor_height,\n"
+        "                          sensor_fit (\"AUTO\"/\"HORIZONTAL\"/\"VERTICAL\"), shift_x,\n"
+        "                          shift_y, ortho_scale, pixel_aspect_x, pixel_aspect_y,\n"
+        "                          world_to_camera (4 rows of 4 numbers). Missing keys keep\n"
+        "                          their defaults; unknown keys are ignored.\n"
+        "  --camera-type T         PERSP or ORTHO\n"
+        "  --lens MM               focal length (default 50)\n"
+        "  --sensor-width MM       (default 36)\n"
+        "  --sensor-height MM      (default 24)\n"
+        "  --sensor-fit FIT        AUTO (default), HORIZONTAL or VERTICAL\n"
+        "  --shift-x S, --shift-y S  lens shift in units of the fitted sensor side\n"
+        "  --ortho-scale S         orthographic view size; implies --camera-type ORTHO\n"
+        "  --pixel-aspect-x A, --pixel-aspect-y A\n"
+        "                          default: x = the EXR header's pixelAspectRatio, y = 1\n"
+        "  --world-to-camera \"M\"   ONE argument holding the 16 numbers of the row-major\n"
+        "                          world-to-camera matrix (camera.matrix_world inverted),\n"
+        "                          separated by commas and/or spaces, e.g.\n"
+        "                          --world-to-camera \"1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1\".\n"
+        "                          It maps Blender's world-space Normal pass into camera\n"
+        "                          space. Without it (and without world_to_camera in the\n"
+        "                          JSON) the identity is used, i.e. normals are taken as\n"
+        "                          already in camera space: wrong for Blender's Normal pass\n"
+        "                          unless the camera sits at the origin looking down -Z, so\n"
+        "                          the tool warns; pass the matrix or --no-normals.\n"
+        "\n"
+        "Sequences:\n"
+        "  --frames LIST           compute every frame of LIST (1-250, or 1-10,20,30-40;\n"
+        "                          frames in [0, %d]). The input, -o and --preview\n"
+        "                          names must hold a run of '#', replaced by the frame\n"
+        "                          number zero-padded to the run's length, as Blender\n"
+        "                          names frames: hbao 'render_####.exr' -o 'ao_####.exr'\n"
+        "                          --frames 1-250. An output at least as new as its input\n"
+        "                          (and --camera file) is up to date and skipped. One\n"
+        "                          progress line per frame; every frame is attempted, and\n"
+        "                          the exit status is 1 (2 for a usage error in a frame)\n"
+        "                          when any failed, with the list of failed frames.\n"
+        "  -j, --jobs N            frames computed at once [1, %d] (default 1); without\n"
+        "                          --threads, each frame gets cores / N threads\n"
+        "  --force                 recompute frames that are up to date (changed flags\n"
+        "                          are not detected)\n"
+        "\n"
+        "Data window: the tool works on the EXR's data window and writes the output with\n"
+        "the same data and display windows; when the data window is a part of the\n"
+        "display window, the camera is adjusted to that part (same view rays). Blender\n"
+        "itself always writes data window = display window: a border render without\n"
+        "cropping is a full frame (unrendered pixels are background, AO 1); with\n"
+        "\"Crop to Render Region\" nothing in the file says where the region was, so\n"
+        "the camera must describe the cropped view (sensor and shift).\n"
+        "\n"
+        "Exit status: 0 success, 1 runtime error (unreadable or corrupt file, cannot\n"
+        "write), 2 usage error (bad flag or value, output would overwrite the input).\n"
+        "  -h, --help              this help\n"
+        "  --version               print the tool's and libhbao's versions\n",
+        (double)HBAO_DEFAULT_RADIUS, (double)HBAO_MAX_ANGLE_BIAS_DEGREES,
+        (double)HBAO_DEFAULT_ANGLE_BIAS_DEGREES, HBAO_MAX_DIRECTIONS, HBAO_DEFAULT_DIRECTIONS,
+        HBAO_MAX_STEPS, HBAO_DEFAULT_STEPS, HBAO_MAX_BLUR_SIZE, HBAO_DEFAULT_BLUR_SIZE,
+        (double)HBAO_MAX_BLUR_SHARPNESS, (double)HBAO_DEFAULT_BLUR_SHARPNESS,
+        (double)HBAO_MAX_STRENGTH, (double)HBAO_DEFAULT_STRENGTH, HBAO_MAX_THREADS, FRAME_MAX,
+        CLI_MAX_JOBS);
 }

@@ -14,9 +14,9 @@
 #include "tool_error.h"
 
 typedef enum tool_mode {
-    TOOL_MODE_COMPUTE, /**< hbao INPUT.exr -o OUTPUT.exr */
+    TOOL_MODE_COMPUTE,  /**< hbao INPUT.exr -o OUTPUT.exr */
     TOOL_MODE_SEQUENCE, /**< hbao IN_####.exr -o OUT_####.exr --frames 1-250 */
-    TOOL_MODE_INFO,    /**< hbao --info FILE.exr */
+    TOOL_MODE_INFO,     /**< hbao --info FILE.exr */
     TOOL_MODE_HELP,
     TOOL_MODE_VERSION
 } tool_mode;
@@ -29,10 +29,10 @@ typedef struct cli_options {
     tool_mode mode;
     const char *input_path;
     const char *output_path;
-    const char *preview_path;  /**< NULL: no PNG */
-    const char *camera_path;   /**< NULL: no camera JSON */
-    const char *layer;         /**< NULL: first view layer with a Depth pass */
-    const char *ao_channel;    /**< name of the output channel, "AO" by default */
+    const char *preview_path; /**< NULL: no PNG */
+    const char *camera_path;  /**< NULL: no camera JSON */
+    const char *layer;        /**< NULL: first view layer with a Depth pass */
+    const char *ao_channel;   /**< name of the output channel, "AO" by default */
     bool keep_input;
     bool ignore_normals;
     bool info_json;

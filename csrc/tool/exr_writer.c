@@ -9,10 +9,9 @@
 
 /* OpenEXRCore writes through this callback so that the tool decides where
  * the bytes go (an atomic_file's temporary file). */
-static int64_t write_to_descriptor(exr_const_context_t context, void *user_data,
-                                   const void *buffer, uint64_t size, uint64_t offset,
-                                   exr_stream_error_func_ptr_t error_callback)
-{
+static int64_t write_to_descriptor(exr_const_context_t context, void *user_data, const void *buffer,
+                                   uint64_t size, uint64_t offset,
+                                   exr_stream_error_func_ptr_t error_callback) {
     const int fd = *(const int *)user_data;
     const uint8_t *bytes = buffer;
     uint64_t done = 0;
@@ -29,27 +28,25 @@ static int64_t write_to_descriptor(exr_const_context_t context, void *user_data,
     return (int64_t)done;
 }
 
-#define CHECK_EXR(call, what)                                                                \
-    do {                                                                                     \
-        exr_result_t check_result_ = (call);                                                 \
-        if (check_result_ != EXR_ERR_SUCCESS) {                                              \
-            status = tool_fail(error, TOOL_EXIT_RUNTIME, "cannot write %s: %s: %s (%s)",     \
-                               name, what, exr_error_text(check_result_),                    \
-                               exr_get_error_code_as_string(check_result_));                 \
-            goto fail;                                                                       \
-        }                                                                                    \
+#define CHECK_EXR(call, what)                                                                      \
+    do {                                                                                           \
+        exr_result_t check_result_ = (call);                                                       \
+        if (check_result_ != EXR_ERR_SUCCESS) {                                                    \
+            status = tool_fail(error, TOOL_EXIT_RUNTIME, "cannot write %s: %s: %s (%s)", name,     \
+                               what, exr_error_text(check_result_),                                \
+                               exr_get_error_code_as_string(check_result_));                       \
+            goto fail;                                                                             \
+        }                                                                                          \
     } while (0)
 
 static const exr_output_channel *find_channel(const exr_output_channel *channels, int count,
-                                              const char *channel_name)
-{
+                                              const char *channel_name) {
     for (int c = 0; c < count; ++c)
         if (strcmp(channels[c].name, channel_name) == 0) return &channels[c];
     return NULL;
 }
 
-static exr_attr_box2i_t box_from_rect(const pixel_rect *rect)
-{
+static exr_attr_box2i_t box_from_rect(const pixel_rect *rect) {
     exr_attr_box2i_t box;
     box.min.x = rect->min_x;
     box.min.y = rect->min_y;
@@ -61,17 +58,20 @@ static exr_attr_box2i_t box_from_rect(const pixel_rect *rect)
 /* Scanlines per chunk for each compression, as the OpenEXR file layout
  * defines them. OpenEXRCore 3.1 computes this only when it writes the header,
  * too late for fix_copied_chunk_count(); exr_write_image() checks the two agree. */
-static int32_t lines_per_chunk_for(exr_compression_t compression)
-{
+static int32_t lines_per_chunk_for(exr_compression_t compression) {
     switch (compression) {
-    case EXR_COMPRESSION_ZIP:
-    case EXR_COMPRESSION_PXR24: return 16;
-    case EXR_COMPRESSION_PIZ:
-    case EXR_COMPRESSION_B44:
-    case EXR_COMPRESSION_B44A:
-    case EXR_COMPRESSION_DWAA: return 32;
-    case EXR_COMPRESSION_DWAB: return 256;
-    default: return 1; /* none, RLE, ZIPS */
+        case EXR_COMPRESSION_ZIP:
+        case EXR_COMPRESSION_PXR24:
+            return 16;
+        case EXR_COMPRESSION_PIZ:
+        case EXR_COMPRESSION_B44:
+        case EXR_COMPRESSION_B44A:
+        case EXR_COMPRESSION_DWAA:
+            return 32;
+        case EXR_COMPRESSION_DWAB:
+            return 256;
+        default:
+            return 1; /* none, RLE, ZIPS */
     }
 }
 
@@ -83,8 +83,7 @@ static int32_t lines_per_chunk_for(exr_compression_t compression)
  * readers may trust it): it must count this file's chunks. A header without
  * one is left without one. */
 static exr_result_t fix_copied_chunk_count(exr_context_t context, int part,
-                                           const exr_output_layout *layout)
-{
+                                           const exr_output_layout *layout) {
     const exr_attribute_t *copied = NULL;
     if (exr_get_attribute_by_name(context, part, "chunkCount", &copied) != EXR_ERR_SUCCESS)
         return EXR_ERR_SUCCESS;
@@ -94,8 +93,7 @@ static exr_result_t fix_copied_chunk_count(exr_context_t context, int part,
 }
 
 int exr_write_image(int fd, const char *name, const exr_output_layout *layout,
-                    const exr_output_channel *channels, int count, tool_error *error)
-{
+                    const exr_output_channel *channels, int count, tool_error *error) {
     int status = TOOL_EXIT_SUCCESS;
     int descriptor = fd;
     exr_context_t context = NULL;
@@ -115,11 +113,10 @@ int exr_write_image(int fd, const char *name, const exr_output_layout *layout,
     CHECK_EXR(exr_add_part(context, NULL, EXR_STORAGE_SCANLINE, &part), "cannot add a part");
     exr_attr_box2i_t display_window = box_from_rect(&layout->display_window);
     exr_attr_box2i_t data_window = box_from_rect(&layout->data_window);
-    CHECK_EXR(exr_initialize_required_attr(context, part, &display_window, &data_window,
-                                           layout->pixel_aspect_ratio,
-                                           &layout->screen_window_center,
-                                           layout->screen_window_width,
-                                           EXR_LINEORDER_INCREASING_Y, layout->compression),
+    CHECK_EXR(exr_initialize_required_attr(
+                  context, part, &display_window, &data_window, layout->pixel_aspect_ratio,
+                  &layout->screen_window_center, layout->screen_window_width,
+                  EXR_LINEORDER_INCREASING_Y, layout->compression),
               "bad header");
     for (int c = 0; c < count; ++c) {
         CHECK_EXR(exr_add_channel(context, part, channels[c].name, channels[c].type,

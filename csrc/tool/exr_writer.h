@@ -27,7 +27,7 @@ typedef struct exr_output_channel {
     const char *name;
     exr_pixel_type_t type;
     exr_perceptual_treatment_t perceptual; /**< a hint for lossy codecs; kept when copying */
-    const uint8_t *data; /**< top-left pixel of the data window */
+    const uint8_t *data;                   /**< top-left pixel of the data window */
     int32_t pixel_stride;
     int64_t row_stride;
 } exr_output_channel;

@@ -7,8 +7,7 @@
 
 #include "number_parsing.h"
 
-static bool parse_frame(const char *text, size_t length, int32_t *frame)
-{
+static bool parse_frame(const char *text, size_t length, int32_t *frame) {
     char copy[16];
     if (length == 0 || length >= sizeof copy) return false;
     memcpy(copy, text, length);
@@ -19,8 +18,7 @@ static bool parse_frame(const char *text, size_t length, int32_t *frame)
     return parse_int32(copy, frame) && *frame <= FRAME_MAX;
 }
 
-bool frame_list_parse(const char *text, frame_list *list)
-{
+bool frame_list_parse(const char *text, frame_list *list) {
     memset(list, 0, sizeof *list);
     const char *cursor = text;
     for (;;) {
@@ -47,16 +45,14 @@ bool frame_list_parse(const char *text, frame_list *list)
     }
 }
 
-int64_t frame_list_count(const frame_list *list)
-{
+int64_t frame_list_count(const frame_list *list) {
     int64_t count = 0;
     for (int r = 0; r < list->range_count; ++r)
         count += (int64_t)list->ranges[r].last - list->ranges[r].first + 1;
     return count;
 }
 
-int32_t frame_list_at(const frame_list *list, int64_t index)
-{
+int32_t frame_list_at(const frame_list *list, int64_t index) {
     for (int r = 0; r < list->range_count; ++r) {
         const int64_t size = (int64_t)list->ranges[r].last - list->ranges[r].first + 1;
         if (index < size) return (int32_t)(list->ranges[r].first + index);
@@ -65,10 +61,11 @@ int32_t frame_list_at(const frame_list *list, int64_t index)
     return -1;
 }
 
-bool frame_pattern_has_frame(const char *pattern) { return strchr(pattern, '#') != NULL; }
+bool frame_pattern_has_frame(const char *pattern) {
+    return strchr(pattern, '#') != NULL;
+}
 
-bool frame_pattern_path(const char *pattern, int32_t frame, char *path, size_t size)
-{
+bool frame_pattern_path(const char *pattern, int32_t frame, char *path, size_t size) {
     const char *run_end = strrchr(pattern, '#');
     if (run_end == NULL) {
         int written = snprintf(path, size, "%s", pattern);

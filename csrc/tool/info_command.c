@@ -16,8 +16,7 @@ typedef struct channel_statistics {
     int64_t finite_count, nonfinite_count;
 } channel_statistics;
 
-static channel_statistics measure(const float *values, int64_t count)
-{
+static channel_statistics measure(const float *values, int64_t count) {
     channel_statistics stats = {INFINITY, -INFINITY, 0.0, 0, 0};
     double sum = 0.0;
     for (int64_t i = 0; i < count; ++i) {
@@ -35,15 +34,13 @@ static channel_statistics measure(const float *values, int64_t count)
     return stats;
 }
 
-static cJSON *rect_json(const pixel_rect *rect)
-{
+static cJSON *rect_json(const pixel_rect *rect) {
     int values[4] = {rect->min_x, rect->min_y, rect->max_x, rect->max_y};
     return cJSON_CreateIntArray(values, 4);
 }
 
-static void print_text(const exr_input *input, const channel_statistics *stats,
-                       const char **layers, int layer_count)
-{
+static void print_text(const exr_input *input, const channel_statistics *stats, const char **layers,
+                       int layer_count) {
     const pixel_rect *data = &input->data_window, *display = &input->display_window;
     printf("%s\n", input->path);
     printf("  size (data window): %dx%d\n", input->width, input->height);
@@ -74,9 +71,8 @@ static void print_text(const exr_input *input, const channel_statistics *stats,
     }
 }
 
-static int print_json(const exr_input *input, const channel_statistics *stats,
-                      const char **layers, int layer_count, tool_error *error)
-{
+static int print_json(const exr_input *input, const channel_statistics *stats, const char **layers,
+                      int layer_count, tool_error *error) {
     cJSON *root = cJSON_CreateObject();
     cJSON *layer_list = cJSON_CreateArray();
     cJSON *channel_list = cJSON_CreateArray();
@@ -132,8 +128,7 @@ out_of_memory:
     return tool_fail(error, TOOL_EXIT_RUNTIME, "out of memory");
 }
 
-int info_command(const char *path, bool as_json, tool_error *error)
-{
+int info_command(const char *path, bool as_json, tool_error *error) {
     exr_input input;
     int status = exr_input_open(&input, path, error);
     if (status != TOOL_EXIT_SUCCESS) return status;

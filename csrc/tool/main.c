@@ -12,27 +12,33 @@
 #include "sequence_command.h"
 #include "tool_error.h"
 
-static void print_version(void)
-{
+static void print_version(void) {
     int32_t version = hbao_version();
     printf("hbao %d.%d.%d (libhbao %d.%d.%d)\n", HBAO_VERSION_MAJOR, HBAO_VERSION_MINOR,
            HBAO_VERSION_PATCH, version / 10000, version / 100 % 100, version % 100);
 }
 
-int main(int argc, char **argv)
-{
+int main(int argc, char **argv) {
     cli_options options;
     tool_error error = {{0}};
     int status = cli_parse(argc, argv, &options, &error);
     if (status == TOOL_EXIT_SUCCESS) {
         switch (options.mode) {
-        case TOOL_MODE_HELP: cli_print_help(stdout); break;
-        case TOOL_MODE_VERSION: print_version(); break;
-        case TOOL_MODE_INFO:
-            status = info_command(options.input_path, options.info_json, &error);
-            break;
-        case TOOL_MODE_COMPUTE: status = ao_command(&options, &error); break;
-        case TOOL_MODE_SEQUENCE: status = sequence_command(&options, &error); break;
+            case TOOL_MODE_HELP:
+                cli_print_help(stdout);
+                break;
+            case TOOL_MODE_VERSION:
+                print_version();
+                break;
+            case TOOL_MODE_INFO:
+                status = info_command(options.input_path, options.info_json, &error);
+                break;
+            case TOOL_MODE_COMPUTE:
+                status = ao_command(&options, &error);
+                break;
+            case TOOL_MODE_SEQUENCE:
+                status = sequence_command(&options, &error);
+                break;
         }
     }
     if (status != TOOL_EXIT_SUCCESS) fprintf(stderr, "hbao: error: %s\n", error.message);

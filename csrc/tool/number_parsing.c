@@ -8,8 +8,7 @@
 #include <stdlib.h>
 
 /* Parses one float at *cursor, advancing it past the number. */
-static bool parse_float_at(const char **cursor, float *value)
-{
+static bool parse_float_at(const char **cursor, float *value) {
     const char *start = *cursor;
     if (*start == '\0' || isspace((unsigned char)*start)) return false;
     char *end = NULL;
@@ -22,33 +21,28 @@ static bool parse_float_at(const char **cursor, float *value)
     return true;
 }
 
-bool parse_finite_float(const char *text, float *value)
-{
+bool parse_finite_float(const char *text, float *value) {
     const char *cursor = text;
     return parse_float_at(&cursor, value) && *cursor == '\0';
 }
 
-bool parse_int32(const char *text, int32_t *value)
-{
+bool parse_int32(const char *text, int32_t *value) {
     if (*text == '\0' || isspace((unsigned char)*text)) return false;
     char *end = NULL;
     errno = 0;
     long long parsed = strtoll(text, &end, 10);
-    if (end == text || *end != '\0' || errno == ERANGE || parsed < INT32_MIN ||
-        parsed > INT32_MAX)
+    if (end == text || *end != '\0' || errno == ERANGE || parsed < INT32_MIN || parsed > INT32_MAX)
         return false;
     *value = (int32_t)parsed;
     return true;
 }
 
-static const char *skip_separators(const char *cursor)
-{
+static const char *skip_separators(const char *cursor) {
     while (*cursor == ',' || isspace((unsigned char)*cursor)) ++cursor;
     return cursor;
 }
 
-bool parse_float_list(const char *text, float *values, int count)
-{
+bool parse_float_list(const char *text, float *values, int count) {
     const char *cursor = skip_separators(text);
     for (int i = 0; i < count; ++i) {
         if (!parse_float_at(&cursor, &values[i])) return false;

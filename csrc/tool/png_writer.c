@@ -10,8 +10,7 @@
 
 #define PNG_MAX_VALUE 255.0f
 
-static uint8_t to_byte(float value)
-{
+static uint8_t to_byte(float value) {
     /* The library guarantees [0, 1]; clamp anyway so a NaN can never
      * become an undefined conversion. */
     if (!(value > 0.0f)) return 0;
@@ -24,8 +23,7 @@ typedef struct png_sink {
     int failed;
 } png_sink;
 
-static void write_bytes(png_structp png, png_bytep data, size_t length)
-{
+static void write_bytes(png_structp png, png_bytep data, size_t length) {
     png_sink *sink = png_get_io_ptr(png);
     size_t done = 0;
     while (done < length) {
@@ -38,33 +36,32 @@ static void write_bytes(png_structp png, png_bytep data, size_t length)
     }
 }
 
-static void flush_nothing(png_structp png) { (void)png; }
+static void flush_nothing(png_structp png) {
+    (void)png;
+}
 
 /* libpng reports errors by longjmp; this keeps the message for our error. */
 static _Thread_local char png_message[256];
 
-static void on_png_error(png_structp png, png_const_charp message)
-{
+static void on_png_error(png_structp png, png_const_charp message) {
     snprintf(png_message, sizeof png_message, "%s", message);
     png_longjmp(png, 1);
 }
 
-static void on_png_warning(png_structp png, png_const_charp message)
-{
+static void on_png_warning(png_structp png, png_const_charp message) {
     (void)png;
     (void)message;
 }
 
 int png_write_gray(int fd, const char *name, const float *pixels, int32_t width, int32_t height,
-                   int64_t row_stride, tool_error *error)
-{
+                   int64_t row_stride, tool_error *error) {
     png_sink sink = {fd, 0};
     png_message[0] = '\0';
     /* volatile: modified between setjmp and a possible longjmp. */
     uint8_t *volatile row = malloc((size_t)width);
     if (row == NULL) return tool_fail(error, TOOL_EXIT_RUNTIME, "out of memory");
-    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, on_png_error,
-                                              on_png_warning);
+    png_structp png =
+        png_create_write_struct(PNG_LIBPNG_VER_STRING, NULL, on_png_error, on_png_warning);
     png_infop info = png ? png_create_info_struct(png) : NULL;
     if (png == NULL || info == NULL) {
         png_destroy_write_struct(&png, &info);

@@ -28,8 +28,7 @@ typedef struct sequence_run {
     pthread_mutex_t lock;
 } sequence_run;
 
-static bool newer_or_equal(const struct stat *a, const struct stat *b)
-{
+static bool newer_or_equal(const struct stat *a, const struct stat *b) {
     if (a->st_mtim.tv_sec != b->st_mtim.tv_sec) return a->st_mtim.tv_sec > b->st_mtim.tv_sec;
     return a->st_mtim.tv_nsec >= b->st_mtim.tv_nsec;
 }
@@ -37,8 +36,7 @@ static bool newer_or_equal(const struct stat *a, const struct stat *b)
 /* Up to date, as make decides: every output exists and is at least as new
  * as the input and the camera file. Changed flags are not detected, hence
  * --force. */
-static bool up_to_date(const cli_options *frame)
-{
+static bool up_to_date(const cli_options *frame) {
     struct stat input, output, other;
     if (stat(frame->input_path, &input) != 0 || stat(frame->output_path, &output) != 0 ||
         !S_ISREG(output.st_mode) || !newer_or_equal(&output, &input))
@@ -53,8 +51,7 @@ static bool up_to_date(const cli_options *frame)
 }
 
 static void report(sequence_run *run, const frame_outcome *outcome, const char *output,
-                   const char *message)
-{
+                   const char *message) {
     pthread_mutex_lock(&run->lock);
     const int64_t done = ++run->finished;
     flockfile(stderr);
@@ -69,8 +66,7 @@ static void report(sequence_run *run, const frame_outcome *outcome, const char *
     pthread_mutex_unlock(&run->lock);
 }
 
-static void run_frame(sequence_run *run, frame_outcome *outcome)
-{
+static void run_frame(sequence_run *run, frame_outcome *outcome) {
     const cli_options *options = run->options;
     char input[PATH_MAX], output[PATH_MAX], preview[PATH_MAX];
     cli_options frame = *options;
@@ -93,8 +89,7 @@ static void run_frame(sequence_run *run, frame_outcome *outcome)
     report(run, outcome, output, error.message);
 }
 
-static void *worker(void *context)
-{
+static void *worker(void *context) {
     sequence_run *run = context;
     for (;;) {
         pthread_mutex_lock(&run->lock);
@@ -106,8 +101,7 @@ static void *worker(void *context)
 }
 
 /* "3 of 250 frames failed: 4, 17, 200" (the list shortened to fit). */
-static int summarize(const sequence_run *run, tool_error *error)
-{
+static int summarize(const sequence_run *run, tool_error *error) {
     static const char ellipsis[] = ", ...";
     int status = TOOL_EXIT_SUCCESS;
     int64_t failed = 0;
@@ -133,19 +127,18 @@ static int summarize(const sequence_run *run, tool_error *error)
                      (long long)run->count, list);
 }
 
-static int available_cores(void)
-{
+static int available_cores(void) {
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
     return cores < 1 ? 1 : (int)cores;
 }
 
-int sequence_command(const cli_options *options, tool_error *error)
-{
+int sequence_command(const cli_options *options, tool_error *error) {
     sequence_run run = {0};
     run.count = frame_list_count(&options->frames);
     run.outcomes = calloc((size_t)run.count, sizeof *run.outcomes);
     if (run.outcomes == NULL) return tool_fail(error, TOOL_EXIT_RUNTIME, "out of memory");
-    for (int64_t i = 0; i < run.count; ++i) run.outcomes[i].frame = frame_list_at(&options->frames, i);
+    for (int64_t i = 0; i < run.count; ++i)
+        run.outcomes[i].frame = frame_list_at(&options->frames, i);
 
     cli_options shared = *options;
     int jobs = options->jobs < 1 ? 1 : options->jobs;
