@@ -83,7 +83,8 @@ def menu_report(window, area):
     texts = []
     with override(window, area):
         context = bpy.context
-        fake = type("FakeMenu", (), {"layout": Recorder(texts), "bl_idname": getattr(menu, "bl_idname", menu.__name__)})()
+        fake = type("FakeMenu", (), {"layout": Recorder(texts),
+                                     "bl_idname": getattr(menu, "bl_idname", menu.__name__)})()
         menu.draw(fake, context)
         import nodeitems_utils
         labels = [item.label for item in nodeitems_utils.node_items_iter(context)
