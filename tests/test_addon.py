@@ -306,7 +306,7 @@ def test_a_value_that_is_not_a_number_renders_without_ao_and_says_so(run_in_blen
     outputs = node_outputs(out, 1, "Bad")
     assert np.all(outputs["ao"] == 1.0)
     assert np.abs(outputs["image"] - outputs["render"]).max() <= EXACT
-    assert "Bad: Radius is not a number" in stdout, stdout[-3000:]
+    assert 'node "Bad": Radius is not a number' in stdout, stdout[-3000:]
 
 
 def _camera_of(blender, user_scripts, blend, tmp_path):

@@ -10,91 +10,20 @@ nothing of the hook: it announces that nodes came or went through
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 
-from . import compat, parameters
+from . import compat, parameters, report
+from .node_group import (AO_OUTPUT, AO_PASS_INPUT, DEPTH_INPUT, GROUP_TREE_NAME,  # noqa: F401
+                         IMAGE_INPUT, IMAGE_OUTPUT, NORMAL_INPUT, VALUE_INPUTS, group_tree,
+                         upgrade_group_tree)
 from .parameters import FALLOFF_ITEMS, INTEGRATION_ITEMS
 
 NODE_IDNAME = "CompositorNodeHBAO"
-# One group tree shared by every HBAO node (the values live on each node's
-# own sockets). The leading dot hides it from data-block menus.
-GROUP_TREE_NAME = ".HBAO"
-# Bumped when the group's sockets or contents change; older trees are rebuilt.
-GROUP_TREE_VERSION = 1
-GROUP_VERSION_KEY = "hbao_group_version"
-
-IMAGE_INPUT = "Image"
-DEPTH_INPUT = "Depth"
-NORMAL_INPUT = "Normal"
-# The hidden input the hook links the computed AO pass to. Its default, 1,
-# is what the node outputs when the hook could not run: no AO, no harm.
-AO_PASS_INPUT = "HBAO Pass"
-IMAGE_OUTPUT = "Image"
-AO_OUTPUT = "AO"
-
-# The radius socket's upper end: far beyond any scene, but finite.
-MAX_RADIUS = 1.0e4
-
-# The parameters an artist can animate or drive with a Value node: one float
-# socket each, named as parameters.LABELS names it -> (params key, default,
-# socket min, socket max), the range the library's limits (parameters.LIMITS).
 _D = parameters.DEFAULTS
-VALUE_INPUTS = {
-    parameters.LABELS[key]: (key, float(_D[key]),
-                             *((0.0, MAX_RADIUS) if key == "radius"
-                               else (float(parameters.LIMITS[key][0]),
-                                     float(parameters.LIMITS[key][1]))))
-    for key in ("radius", "angle_bias_degrees", "directions", "steps", "blur_size", "strength")
-}
+# Status lines longer than this are cut with an ellipsis: about what the
+# node's default width shows at 100 % zoom (the full text is the tooltip).
+MAX_STATUS_CHARACTERS = 30
 # Called with no arguments when an HBAO node is added, copied or deleted
 # (the hook's handlers subscribe: node callbacks must not edit the tree).
 changed_callbacks = []
-
-
-def _new_input(tree, socket_type, name, default=None, minimum=None, maximum=None):
-    socket = compat.new_group_socket(tree, "INPUT", socket_type, name)
-    if default is not None:
-        socket.default_value = default
-    if minimum is not None:
-        socket.min_value = minimum
-        socket.max_value = maximum
-    return socket
-
-
-def _build_group_tree(tree):
-    tree.nodes.clear()
-    compat.clear_group_interface(tree)
-    _new_input(tree, "NodeSocketColor", IMAGE_INPUT, (1.0, 1.0, 1.0, 1.0))
-    _new_input(tree, "NodeSocketFloat", DEPTH_INPUT, 0.0)
-    _new_input(tree, "NodeSocketVector", NORMAL_INPUT)
-    for name, (_key, default, minimum, maximum) in VALUE_INPUTS.items():
-        _new_input(tree, "NodeSocketFloat", name, default, minimum, maximum)
-    _new_input(tree, "NodeSocketFloat", AO_PASS_INPUT, 1.0, 0.0, 1.0)
-    compat.new_group_socket(tree, "OUTPUT", "NodeSocketColor", IMAGE_OUTPUT)
-    compat.new_group_socket(tree, "OUTPUT", "NodeSocketFloat", AO_OUTPUT)
-
-    group_input = tree.nodes.new("NodeGroupInput")
-    group_input.location = (-300, 0)
-    group_output = tree.nodes.new("NodeGroupOutput")
-    group_output.location = (300, 0)
-    multiply, colour_a, colour_b, product = compat.new_multiply_node(tree)
-    multiply.name = multiply.label = "Image x AO"
-    tree.links.new(group_input.outputs[IMAGE_INPUT], colour_a)
-    tree.links.new(group_input.outputs[AO_PASS_INPUT], colour_b)
-    tree.links.new(product, group_output.inputs[IMAGE_OUTPUT])
-    tree.links.new(group_input.outputs[AO_PASS_INPUT], group_output.inputs[AO_OUTPUT])
-    tree[GROUP_VERSION_KEY] = GROUP_TREE_VERSION
-
-
-def group_tree():
-    """The shared group tree, created or rebuilt when missing or outdated."""
-    tree = bpy.data.node_groups.get(GROUP_TREE_NAME)
-    up_to_date = tree is not None and tree.get(GROUP_VERSION_KEY) == GROUP_TREE_VERSION
-    if up_to_date and tree.library is None:
-        return tree
-    if tree is None or tree.library is not None:
-        tree = bpy.data.node_groups.new(GROUP_TREE_NAME, "CompositorNodeTree")
-    _build_group_tree(tree)
-    tree.use_fake_user = False
-    return tree
 
 
 def is_hbao_node(node):
@@ -154,6 +83,8 @@ class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
                                         "this node")
     status: StringProperty(name="Status", default="",
                            description="Last message from the render hook about this node")
+    status_details: StringProperty(name="Status Details", default="",
+                                   description="The full text of the render hook's messages")
 
     @classmethod
     def poll(cls, tree):
@@ -180,7 +111,14 @@ class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
         layout.prop(self, "integration")
         layout.prop(self, "half_resolution")
         if self.status:
-            layout.label(text=self.status, icon="INFO")
+            # A borderless button: its tooltip (and a click: the Info editor)
+            # gives the full text that the short status line stands for.
+            text = self.status
+            if len(text) > MAX_STATUS_CHARACTERS:
+                text = text[:MAX_STATUS_CHARACTERS - 1] + "\u2026"
+            button = layout.operator(HBAO_OT_node_status.bl_idname, text=text, icon="ERROR",
+                                     emboss=False)
+            button.details = self.status_details or self.status
 
     def draw_buttons_ext(self, context, layout):
         self.draw_buttons(context, layout)
@@ -189,6 +127,87 @@ class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
 
     def draw_label(self):
         return "HBAO"
+
+
+class HBAO_OT_node_status(bpy.types.Operator):
+    """What the render hook said about this HBAO node"""
+    bl_idname = "hbao.node_status"
+    bl_label = "HBAO Node Status"
+    bl_options = {"INTERNAL"}
+
+    details: StringProperty(options={"SKIP_SAVE"})
+
+    @classmethod
+    def description(cls, _context, properties):
+        return properties.details
+
+    def execute(self, _context):
+        for line in self.details.splitlines():
+            self.report({"WARNING"}, f"HBAO {line}")
+        return {"FINISHED"}
+
+
+def show_messages(node, messages):
+    """Show `messages` (report.NodeMessage) on `node`: the first one's short
+    form, how many more there are, and every full text in the tooltip."""
+    status = messages[0].short if messages else ""
+    if len(messages) > 1:
+        status += f" (+{len(messages) - 1})"
+    node.status = status
+    node.status_details = "\n".join(messages)
+
+
+def apply_node_messages():
+    """Show what the hook last said about each node (main thread only: the
+    render thread only posts it, report.post_node_messages)."""
+    if not report.in_main_thread():
+        return
+    changed = False
+    for scene_name, statuses in report.take_node_messages():
+        scene = bpy.data.scenes.get(scene_name)
+        for node in hbao_nodes(compat.compositor_tree(scene) if scene else None):
+            if node.name in statuses:
+                show_messages(node, statuses[node.name])
+                changed = True
+    if changed:
+        for window in getattr(bpy.context.window_manager, "windows", ()):
+            for area in window.screen.areas:
+                if area.type == "NODE_EDITOR":
+                    area.tag_redraw()
+
+
+# While an F12 render job runs, its handlers run in the job's thread; this
+# timer, started from render_init (main thread), shows the messages once the
+# job has ended and nodes may be written again.
+_POLL_S = 0.2
+
+
+def _apply_when_render_ends():
+    if bpy.app.is_job_running("RENDER"):
+        return _POLL_S
+    apply_node_messages()
+    return None
+
+
+@bpy.app.handlers.persistent
+def _on_render_init(*_args):
+    if report.in_main_thread() and not bpy.app.background:
+        bpy.app.timers.register(_apply_when_render_ends, first_interval=_POLL_S)
+
+
+@bpy.app.handlers.persistent
+def _on_render_done(*_args):
+    apply_node_messages()  # `-b` and blocking renders: the main thread
+
+
+@bpy.app.handlers.persistent
+def _on_load_post(*_args):
+    upgrade_group_tree()
+
+
+_HANDLERS = (("render_init", _on_render_init), ("render_post", _on_render_done),
+             ("render_complete", _on_render_done), ("render_cancel", _on_render_done),
+             ("load_post", _on_load_post))
 
 
 def _draw_add_menu(menu, context):
@@ -202,6 +221,9 @@ def _draw_add_menu(menu, context):
 
 def register():
     bpy.utils.register_class(CompositorNodeHBAO)
+    bpy.utils.register_class(HBAO_OT_node_status)
+    for name, function in _HANDLERS:
+        getattr(bpy.app.handlers, name).append(function)
     menu = compat.compositor_filter_menu()
     if menu is not None:
         menu.append(_draw_add_menu)
@@ -211,4 +233,9 @@ def unregister():
     menu = compat.compositor_filter_menu()
     if menu is not None:
         menu.remove(_draw_add_menu)
+    for name, function in _HANDLERS:
+        handlers = getattr(bpy.app.handlers, name)
+        while function in handlers:
+            handlers.remove(function)
+    bpy.utils.unregister_class(HBAO_OT_node_status)
     bpy.utils.unregister_class(CompositorNodeHBAO)

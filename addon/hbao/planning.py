@@ -5,6 +5,7 @@ parameters at that frame."""
 from . import compat
 from .helper_scene import MANAGED_NODE_KEY
 from .node import DEPTH_INPUT, NORMAL_INPUT, hbao_nodes, pass_name
+from .report import NodeMessage, post_node_messages
 from .socket_values import node_params, upstream
 
 
@@ -18,42 +19,64 @@ class Job:
 
 
 def pass_source(socket, scene, expected):
-    """(view layer name, error) of the Render Layers pass feeding `socket`."""
+    """(view layer name, error, short error) of the Render Layers pass feeding
+    `socket`; the short error fits the node's status line."""
     source = upstream(socket)
     if source is None:
-        return None, None
+        return None, None, None
     node = source.node
     if node.bl_idname != "CompositorNodeRLayers" or node.get(MANAGED_NODE_KEY):
-        return None, f"{socket.name} must come straight from a Render Layers node"
+        return (None, f"{socket.name} must come straight from a Render Layers node",
+                "wrong source")
     if node.scene is not None and node.scene != scene:
-        return None, f"{socket.name} comes from another scene ({node.scene.name})"
+        return (None, f"{socket.name} comes from another scene ({node.scene.name})",
+                "other scene")
     if source.identifier != expected and source.name != expected:
-        return None, f"{socket.name} is linked to the {source.name} pass, not {expected}"
-    return node.layer, None
+        return (None, f"{socket.name} is linked to the {source.name} pass, not {expected}",
+                "wrong pass")
+    return node.layer, None, None
+
+
+def _plan_node(node, main, frame, warnings):
+    """The Job of one HBAO node, or None when it computes nothing."""
+    depth_layer, error, short = pass_source(node.inputs[DEPTH_INPUT], main, "Depth")
+    if depth_layer is None:
+        if error is None:
+            warnings.append(NodeMessage(node.name, "Depth is not linked; AO off (the node "
+                                        "passes Image through)", "Depth not linked: AO off"))
+        else:
+            warnings.append(NodeMessage(node.name, f"{error}; AO off", f"Depth: {short}, AO off"))
+        return None
+    normal_layer, error, short = pass_source(node.inputs[NORMAL_INPUT], main, "Normal")
+    if error:
+        warnings.append(NodeMessage(node.name, f"{error}; reconstructing normals from depth",
+                                    f"Normal: {short}, ignored"))
+    try:
+        params = node_params(node, frame, warnings)
+    except ValueError as value_error:
+        warnings.append(NodeMessage(node.name, f"{value_error}; AO off",
+                                    getattr(value_error, "short", "Invalid value: AO off")))
+        return None
+    if normal_layer is not None and normal_layer != depth_layer:
+        warnings.append(NodeMessage(node.name, "Normal comes from another view layer than "
+                                    "Depth; reconstructing normals from depth",
+                                    "Normal: other layer, ignored"))
+    return Job(node, depth_layer, normal_layer == depth_layer, params)
 
 
 def plan(main, frame):
-    """The AO computations `main` needs at `frame`: ([Job], [warning])."""
+    """The AO computations `main` needs at `frame`: ([Job], [NodeMessage]).
+    The messages are also posted for the nodes' status lines (each node of
+    the tree gets its own, or none: a good frame clears an old status)."""
     jobs, warnings = [], []
-    for node in hbao_nodes(compat.compositor_tree(main)):
+    nodes = hbao_nodes(compat.compositor_tree(main))
+    for node in nodes:
         if node.mute:
             continue
         if not any(output.is_linked for output in node.outputs):
             continue  # nobody looks at it: costs nothing
-        depth_layer, error = pass_source(node.inputs[DEPTH_INPUT], main, "Depth")
-        if depth_layer is None:
-            warnings.append(f"{node.name}: {error or 'Depth is not linked'}; AO = 1")
-            continue
-        normal_layer, error = pass_source(node.inputs[NORMAL_INPUT], main, "Normal")
-        if error:
-            warnings.append(f"{node.name}: {error}; reconstructing normals from depth")
-        try:
-            params = node_params(node, frame, warnings)
-        except ValueError as value_error:
-            warnings.append(f"{value_error}; AO = 1")
-            continue
-        jobs.append(Job(node, depth_layer, normal_layer == depth_layer, params))
-        if normal_layer is not None and normal_layer != depth_layer:
-            warnings.append(f"{node.name}: Normal comes from another view layer than Depth; "
-                            f"reconstructing normals from depth")
+        job = _plan_node(node, main, frame, warnings)
+        if job is not None:
+            jobs.append(job)
+    post_node_messages(main.name, [node.name for node in nodes], warnings)
     return jobs, warnings

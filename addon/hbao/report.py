@@ -1,9 +1,17 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """How the render hook tells the artist what happened: one console prefix,
-and whether the caller may change Blender data (only the main thread may)."""
+messages about a node that read well after Blender's "HBAO " report prefix
+and carry a short form for the node's status line, and whether the caller
+may change Blender data (only the main thread may)."""
 import threading
 
 LOG_PREFIX = "HBAO:"
+
+# scene name -> {node name: [NodeMessage]}: what the last planned frame said
+# about each HBAO node of the scene, waiting for the main thread to show it on
+# the nodes (node.apply_node_messages). Written by the render thread: one
+# dict assignment, atomic under the GIL.
+_pending_node_messages = {}
 
 
 def log(message):
@@ -14,3 +22,37 @@ def in_main_thread():
     """F12 runs the render handlers in the render job's thread, where adding
     or removing data blocks and nodes is not allowed."""
     return threading.current_thread() is threading.main_thread()
+
+
+class NodeMessage(str):
+    """A message about one HBAO node. As a string it is the full text,
+    'node "NAME": what happened; what it means', so that the engine's report
+    reads 'HBAO node "HBAO": Depth is not linked; AO off'; `short` is the
+    form that fits the node's status line."""
+
+    def __new__(cls, node_name, detail, short):
+        message = super().__new__(cls, f'node "{node_name}": {detail}')
+        message.node_name = node_name
+        message.short = short
+        return message
+
+
+def post_node_messages(scene_name, node_names, messages):
+    """Replace what the nodes `node_names` of scene `scene_name` show with
+    `messages` (the NodeMessages among them; none clears a node's status).
+    Any thread may call it."""
+    statuses = {name: [] for name in node_names}
+    for message in messages:
+        if isinstance(message, NodeMessage):
+            statuses.setdefault(message.node_name, []).append(message)
+    _pending_node_messages[scene_name] = statuses
+
+
+def take_node_messages():
+    """[(scene name, {node name: [NodeMessage]})] posted since the last call."""
+    taken = []
+    for scene_name in list(_pending_node_messages):
+        statuses = _pending_node_messages.pop(scene_name, None)
+        if statuses is not None:
+            taken.append((scene_name, statuses))
+    return taken

@@ -3,6 +3,7 @@
 keyframed or fed by a Value node, resolved into library parameters."""
 from . import compat, parameters
 from .node import VALUE_INPUTS
+from .report import NodeMessage
 
 # Reroute chains longer than this are treated as unlinked (a cycle guard).
 MAX_REROUTES = 64
@@ -44,16 +45,35 @@ def socket_value(tree, socket, frame, warnings):
         return _animated(tree, socket, "default_value", frame, socket.default_value)
     if source.node.bl_idname in compat.VALUE_NODE_IDNAMES:
         return _animated(tree, source, "default_value", frame, source.default_value)
-    warnings.append(f"{socket.node.name}: {socket.name} comes from {source.node.name!r}; "
-                    f"only a Value node can drive it, using {socket.default_value:g}")
+    warnings.append(NodeMessage(
+        socket.node.name, f"{socket.name} comes from {source.node.name!r}; only a Value node "
+        f"can drive it, using {socket.default_value:g}", f"{socket.name}: use a Value node"))
     return socket.default_value
+
+
+def _label_of(message):
+    """The parameter a parameters.resolved() message is about (it starts with its label)."""
+    return next((label for label in sorted(parameters.LABELS.values(), key=len, reverse=True)
+                 if message.startswith(label)), "A value")
+
+
+def _short_error(message):
+    label = _label_of(message)
+    what = ("not a number" if "not a number" in message
+            else "negative" if "negative" in message else "invalid")
+    return f"{label} {what}: AO off"
+
+
+def _short_clamp(message):
+    return f"{_label_of(message)} clamped to {message.rsplit('using ', 1)[-1]}"
 
 
 def node_params(node, frame, warnings):
     """The params dict for native.compute_ao() from the node at `frame`,
     resolved (completed and clamped) once, by parameters.resolved; each
-    clamped value adds a warning naming the node. Raises ValueError naming
-    the node when a value cannot be used at all (not a number, negative)."""
+    clamped value adds a NodeMessage. Raises ValueError when a value cannot
+    be used at all (not a number, negative), its `short` attribute the form
+    that fits the node's status line."""
     tree = node.id_data
     raw = {
         "falloff": node.falloff,
@@ -61,12 +81,14 @@ def node_params(node, frame, warnings):
         "half_resolution": int(node.half_resolution),
         "blur_sharpness": float(node.blur_sharpness),
     }
-    for name, (key, *_range) in VALUE_INPUTS.items():
+    for name, (key, *_socket) in VALUE_INPUTS.items():
         raw[key] = float(socket_value(tree, node.inputs[name], frame, warnings))
     clamped = []
     try:
         params = parameters.resolved(raw, clamped)
     except ValueError as error:
-        raise ValueError(f"{node.name}: {error}") from error
-    warnings += [f"{node.name}: {message}" for message in clamped]
+        unusable = ValueError(str(error))
+        unusable.short = _short_error(str(error))
+        raise unusable from error
+    warnings += [NodeMessage(node.name, message, _short_clamp(message)) for message in clamped]
     return params

@@ -1,0 +1,161 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The group tree every HBAO node shares: its sockets (which carry the
+artist's values), its contents (Image x AO pass), and its upgrade when a file
+saved with an older layout is opened."""
+import bpy
+
+from . import compat, parameters
+
+# One group tree shared by every HBAO node (the values live on each node's
+# own sockets). The leading dot hides it from data-block menus.
+GROUP_TREE_NAME = ".HBAO"
+# Bumped when the group's sockets or contents change; older trees are rebuilt
+# and the nodes using them keep their values and links (upgrade_group_tree).
+# 2: Directions, Steps and Blur Size became integer sockets.
+GROUP_TREE_VERSION = 2
+GROUP_VERSION_KEY = "hbao_group_version"
+
+IMAGE_INPUT = "Image"
+DEPTH_INPUT = "Depth"
+NORMAL_INPUT = "Normal"
+# The hidden input the hook links the computed AO pass to. Its default, 1,
+# is what the node outputs when the hook could not run: no AO, no harm.
+AO_PASS_INPUT = "HBAO Pass"
+IMAGE_OUTPUT = "Image"
+AO_OUTPUT = "AO"
+
+# The radius socket's upper end: far beyond any scene, but finite.
+MAX_RADIUS = 1.0e4
+
+_D = parameters.DEFAULTS
+
+
+def _value_input(key):
+    """(params key, default, socket min, socket max, socket type) of a value
+    socket: the library's limits (parameters.LIMITS); whole-number parameters
+    get integer sockets, so the node shows 4, not 4.000."""
+    if key == "radius":
+        return key, float(_D[key]), 0.0, MAX_RADIUS, "NodeSocketFloat"
+    low, high, whole = parameters.LIMITS[key]
+    if whole:
+        return key, int(_D[key]), int(low), int(high), "NodeSocketInt"
+    return key, float(_D[key]), float(low), float(high), "NodeSocketFloat"
+
+
+# The parameters an artist can animate or drive with a Value node: one socket
+# each, named as parameters.LABELS names it. Their order is part of the file
+# format: keyframes address sockets by index (nodes["HBAO"].inputs[3]).
+VALUE_INPUTS = {
+    parameters.LABELS[key]: _value_input(key)
+    for key in ("radius", "angle_bias_degrees", "directions", "steps", "blur_size", "strength")
+}
+
+
+def _new_input(tree, socket_type, name, default=None, minimum=None, maximum=None):
+    socket = compat.new_group_socket(tree, "INPUT", socket_type, name)
+    if default is not None:
+        socket.default_value = default
+    if minimum is not None:
+        socket.min_value = minimum
+        socket.max_value = maximum
+    return socket
+
+
+def _build_group_tree(tree):
+    tree.nodes.clear()
+    compat.clear_group_interface(tree)
+    _new_input(tree, "NodeSocketColor", IMAGE_INPUT, (1.0, 1.0, 1.0, 1.0))
+    _new_input(tree, "NodeSocketFloat", DEPTH_INPUT, 0.0)
+    _new_input(tree, "NodeSocketVector", NORMAL_INPUT)
+    for name, (_key, default, minimum, maximum, socket_type) in VALUE_INPUTS.items():
+        _new_input(tree, socket_type, name, default, minimum, maximum)
+    _new_input(tree, "NodeSocketFloat", AO_PASS_INPUT, 1.0, 0.0, 1.0)
+    compat.new_group_socket(tree, "OUTPUT", "NodeSocketColor", IMAGE_OUTPUT)
+    compat.new_group_socket(tree, "OUTPUT", "NodeSocketFloat", AO_OUTPUT)
+
+    group_input = tree.nodes.new("NodeGroupInput")
+    group_input.location = (-300, 0)
+    group_output = tree.nodes.new("NodeGroupOutput")
+    group_output.location = (300, 0)
+    multiply, colour_a, colour_b, product = compat.new_multiply_node(tree)
+    multiply.name = multiply.label = "Image x AO"
+    tree.links.new(group_input.outputs[IMAGE_INPUT], colour_a)
+    tree.links.new(group_input.outputs[AO_PASS_INPUT], colour_b)
+    tree.links.new(product, group_output.inputs[IMAGE_OUTPUT])
+    tree.links.new(group_input.outputs[AO_PASS_INPUT], group_output.inputs[AO_OUTPUT])
+    tree[GROUP_VERSION_KEY] = GROUP_TREE_VERSION
+
+
+def _is_current(tree):
+    return tree is not None and tree.get(GROUP_VERSION_KEY) == GROUP_TREE_VERSION
+
+
+def _users(tree):
+    """The group nodes of the scenes' compositor trees that use `tree`."""
+    return [node for scene in bpy.data.scenes
+            for node in getattr(compat.compositor_tree(scene), "nodes", ())
+            if getattr(node, "node_tree", None) == tree]
+
+
+def _socket_state(socket):
+    """What rebuilding the group's interface would lose: the socket's value and
+    where its links come from, by node name and output index (sockets are new
+    objects after the rebuild)."""
+    value = socket.default_value
+    value = tuple(value) if hasattr(value, "__len__") else value
+    sources = [(link.from_node.name, list(link.from_node.outputs).index(link.from_socket))
+               for link in socket.links]
+    return value, sources
+
+
+def _output_links(node):
+    """Where the node's outputs go: (output name, to node name, to input index)."""
+    return [(socket.name, link.to_node.name, list(link.to_node.inputs).index(link.to_socket))
+            for socket in node.outputs for link in socket.links]
+
+
+def _restore(node, states, targets):
+    tree = node.id_data
+    for output_name, to_name, index in targets:
+        output = node.outputs.get(output_name)
+        if output is not None:
+            tree.links.new(output, tree.nodes[to_name].inputs[index])
+    for name, (value, sources) in states.items():
+        socket = node.inputs.get(name)
+        if socket is None:
+            continue
+        try:
+            socket.default_value = (int(round(value)) if isinstance(socket.default_value, int)
+                                    else value)
+        except (TypeError, ValueError):
+            pass  # a socket whose kind changed beyond a number: keep its default
+        for from_name, index in sources:
+            tree.links.new(tree.nodes[from_name].outputs[index], socket)
+
+
+def upgrade_group_tree():
+    """Rebuild an outdated shared group in place (same name, same socket
+    order, so keyframes stay on their sockets), keeping each node's values and
+    links. Called after a file is loaded."""
+    tree = bpy.data.node_groups.get(GROUP_TREE_NAME)
+    if tree is None or _is_current(tree) or tree.library is not None:
+        return
+    saved = [(node, {socket.name: _socket_state(socket) for socket in node.inputs},
+              _output_links(node)) for node in _users(tree)]
+    _build_group_tree(tree)
+    for node, states, targets in saved:
+        _restore(node, states, targets)
+
+
+def group_tree():
+    """The shared group tree, created or rebuilt when missing or outdated."""
+    tree = bpy.data.node_groups.get(GROUP_TREE_NAME)
+    if _is_current(tree) and tree.library is None:
+        return tree
+    if tree is None or tree.library is not None:
+        tree = bpy.data.node_groups.new(GROUP_TREE_NAME, "CompositorNodeTree")
+        _build_group_tree(tree)
+    else:
+        upgrade_group_tree()
+    tree.use_fake_user = False
+    return tree

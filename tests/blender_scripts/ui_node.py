@@ -1,0 +1,170 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Run in a Blender window (xvfb) by tests/test_ui.py on the file
+ui_old_file.py saved: what an artist meets on the HBAO node.
+
+- the shared group was upgraded: integer sockets, values, links, keyframes kept;
+- Add > Filter draws "HBAO"; the node search items do not offer ".HBAO";
+- F12 renders (the render job's thread) with a fault, then with a clamped
+  value, then with nothing wrong: the node's status after each, and
+  screenshots of the node editor showing it.
+
+  blender --addons hbao --python ui_node.py OLD.blend -- OUT.json SHOT_DIR
+"""
+import json
+import sys
+import time
+from pathlib import Path
+
+import bpy
+
+args = sys.argv[sys.argv.index("--") + 1:]
+OUT, SHOTS = Path(args[0]), Path(args[1])
+# Cycles at 96x64, 4 samples, takes about a second; far more means a hang.
+RENDER_TIMEOUT_S = 120.0
+# After the job ends the add-on's timer polls every 0.2 s: give it a few.
+SETTLE_S = 1.0
+
+node_module = sys.modules["hbao.node"]
+socket_values = sys.modules["hbao.socket_values"]
+compat = sys.modules["hbao.compat"]
+scene = bpy.context.scene
+tree = compat.compositor_tree(scene)
+hbao = tree.nodes["HBAO"]
+report = {}
+
+
+class Recorder:
+    """Stands in for a UILayout: records the text of every operator drawn."""
+
+    def __init__(self, texts):
+        self.texts = texts
+
+    def operator(self, _idname, text="", **_kwargs):
+        self.texts.append(text)
+        return Recorder(self.texts)
+
+    def __getattr__(self, _name):
+        return lambda *a, **k: Recorder(self.texts)
+
+    def __setattr__(self, name, value):
+        object.__setattr__(self, name, value)
+
+
+def upgrade_report():
+    blur = hbao.inputs["Blur Size"]
+    steps = hbao.inputs["Steps"]
+    return {
+        "socket_types": {name: hbao.inputs[name].bl_idname
+                         for name in ("Radius", "Directions", "Steps", "Blur Size")},
+        "directions": hbao.inputs["Directions"].default_value,
+        "steps_source": steps.links[0].from_node.name if steps.is_linked else None,
+        "depth_linked": hbao.inputs["Depth"].is_linked,
+        "image_output_to": sorted(link.to_node.name for link in hbao.outputs["Image"].links),
+        "blur_at_11": socket_values.socket_value(tree, blur, 11.0, []),
+        "blur_at_1": socket_values.socket_value(tree, blur, 1.0, []),
+    }
+
+
+def node_editor(window):
+    area = max(window.screen.areas, key=lambda a: a.width * a.height)
+    area.type = "NODE_EDITOR"
+    area.ui_type = "CompositorNodeTree"
+    return area
+
+
+def override(window, area):
+    region = next(r for r in area.regions if r.type == "WINDOW")
+    return bpy.context.temp_override(window=window, screen=window.screen, area=area,
+                                     region=region)
+
+
+def menu_report(window, area):
+    menu = compat.compositor_filter_menu()
+    texts = []
+    with override(window, area):
+        context = bpy.context
+        fake = type("FakeMenu", (), {"layout": Recorder(texts),
+                                     "bl_idname": getattr(menu, "bl_idname", menu.__name__)})()
+        menu.draw(fake, context)
+        import nodeitems_utils
+        labels = [item.label for item in nodeitems_utils.node_items_iter(context)
+                  if hasattr(item, "label")]
+    return {"menu": menu.__name__, "menu_texts": texts,
+            "search_labels_with_hbao": [label for label in labels if "HBAO" in label]}
+
+
+def screenshot(window, area, name):
+    with override(window, area):
+        bpy.ops.node.view_all()
+        bpy.ops.wm.redraw_timer(type="DRAW_WIN_SWAP", iterations=2)
+        bpy.ops.screen.screenshot_area(filepath=str(SHOTS / name), check_existing=False)
+
+
+RENDERS = [
+    # (name, what to change before rendering)
+    ("depth_unlinked", lambda: tree.links.remove(hbao.inputs["Depth"].links[0])),
+    ("clamped", lambda: (tree.links.new(tree.nodes["Render Layers"].outputs["Depth"],
+                                        hbao.inputs["Depth"]),
+                         setattr(tree.nodes["Steps Value"].outputs[0], "default_value", 100.0))),
+    ("good", lambda: setattr(tree.nodes["Steps Value"].outputs[0], "default_value", 7.0)),
+]
+state = {"index": 0, "started": None, "done": False}
+
+
+def on_done(*_args):
+    state["done"] = True
+
+
+def run_renders():
+    window = bpy.context.window_manager.windows[0]
+    area = state.get("area")
+    if state["started"] is None:
+        name, change = RENDERS[state["index"]]
+        change()
+        state.update(started=time.monotonic(), done=False, ended=None)
+        print("UI: render", name, bpy.ops.render.render("INVOKE_DEFAULT"), flush=True)
+        return 0.25
+    if not state["done"] or bpy.app.is_job_running("RENDER"):
+        if time.monotonic() - state["started"] > RENDER_TIMEOUT_S:
+            report["timeout"] = RENDERS[state["index"]][0]
+            return finish()
+        return 0.25
+    if state["ended"] is None:
+        state["ended"] = time.monotonic()
+        return SETTLE_S
+    name = RENDERS[state["index"]][0]
+    report.setdefault("renders", {})[name] = {"status": hbao.status,
+                                              "details": hbao.status_details}
+    # The render window opened over the main window: screenshot the main one.
+    screenshot(window, area, f"ui_node_{name}.png")
+    state["index"] += 1
+    state["started"] = None
+    if state["index"] == len(RENDERS):
+        return finish()
+    return 0.25
+
+
+def finish():
+    OUT.write_text(json.dumps(report, indent=2))
+    print(json.dumps(report, indent=2))
+    bpy.ops.wm.quit_blender()
+    return None
+
+
+def start():
+    try:
+        window = bpy.context.window_manager.windows[0]
+        bpy.context.preferences.view.render_display_type = "NONE"  # the node editor stays
+        report["upgrade"] = upgrade_report()
+        area = state["area"] = node_editor(window)
+        report.update(menu_report(window, area))
+        bpy.app.handlers.render_complete.append(on_done)
+        bpy.app.handlers.render_cancel.append(on_done)
+        bpy.app.timers.register(run_renders, first_interval=0.5)
+    except Exception as error:
+        report["error"] = f"{type(error).__name__}: {error}"
+        finish()
+    return None
+
+
+bpy.app.timers.register(start, first_interval=0.5)

@@ -1,0 +1,83 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The HBAO node as an artist meets it, in Debian's Blender with a window
+(xvfb): a file saved with the old float sockets opens with integer sockets
+and keeps its values, links and keyframes; Add > Filter offers HBAO and the
+node search does not offer the internal group; F12 renders leave a current
+status line on the node. Screenshots of the node editor are kept in
+out/test-artifacts/ (ui_node_*.png)."""
+import json
+
+import pytest
+
+from conftest import REPO
+
+SCRIPTS = REPO / "tests" / "blender_scripts"
+ARTIFACTS = REPO / "out" / "test-artifacts"
+# The node's status line must fit the node: node.MAX_STATUS_CHARACTERS.
+MAX_STATUS_CHARACTERS = 30
+
+pytestmark = pytest.mark.ui
+
+
+@pytest.fixture(scope="module")
+def ui_report(run_blender, tmp_path_factory):
+    folder = tmp_path_factory.mktemp("ui")
+    old_file = folder / "old_float_sockets.blend"
+    saved = run_blender(SCRIPTS / "ui_old_file.py", old_file)
+    assert "OLD SOCKET NodeSocketFloat" in saved.stdout, saved.stdout[-3000:]
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
+    out = folder / "ui.json"
+    completed = run_blender(SCRIPTS / "ui_node.py", out, ARTIFACTS, blend=old_file, ui=True)
+    assert out.is_file(), completed.stdout[-4000:]
+    report = json.loads(out.read_text())
+    assert "error" not in report and "timeout" not in report, report
+    return report
+
+
+def test_old_file_gets_integer_sockets_and_keeps_values_links_keyframes(ui_report):
+    upgrade = ui_report["upgrade"]
+    assert upgrade["socket_types"] == {"Radius": "NodeSocketFloat",
+                                       "Directions": "NodeSocketInt",
+                                       "Steps": "NodeSocketInt",
+                                       "Blur Size": "NodeSocketInt"}
+    assert upgrade["directions"] == 8
+    assert upgrade["steps_source"] == "Steps Value"
+    assert upgrade["depth_linked"]
+    assert upgrade["image_output_to"] == ["Composite"]
+    # Keyframes 3 at frame 1 and 9 at frame 11: exact at the keys.
+    assert upgrade["blur_at_1"] == 3.0 and upgrade["blur_at_11"] == 9.0
+
+
+def test_add_filter_menu_offers_hbao(ui_report):
+    assert "HBAO" in ui_report["menu_texts"], ui_report["menu"]
+
+
+def test_node_search_does_not_offer_the_internal_group(ui_report):
+    assert ".HBAO" not in ui_report["search_labels_with_hbao"]
+
+
+@pytest.mark.xfail(strict=True, reason="F12: the node's status is not yet applied after the "
+                   "render job (node.apply_node_messages); the console and report are")
+def test_status_after_a_fault_says_so(ui_report):
+    render = ui_report["renders"]["depth_unlinked"]
+    assert render["status"] == "Depth not linked: AO off"
+    assert 'node "HBAO": Depth is not linked; AO off' in render["details"]
+    assert (ARTIFACTS / "ui_node_depth_unlinked.png").is_file()
+
+
+@pytest.mark.xfail(strict=True, reason="F12: the node's status is not yet applied after the "
+                   "render job (node.apply_node_messages); the console and report are")
+def test_status_names_a_clamped_value(ui_report):
+    render = ui_report["renders"]["clamped"]
+    assert render["status"] == "Steps clamped to 64"
+    assert 'node "HBAO": Steps 100 is above the limit 64; using 64' in render["details"]
+
+
+def test_status_is_cleared_by_a_good_render(ui_report):
+    assert ui_report["renders"]["good"] == {"status": "", "details": ""}
+
+
+def test_status_lines_fit_the_node(ui_report):
+    for render in ui_report["renders"].values():
+        assert len(render["status"]) <= MAX_STATUS_CHARACTERS, render
+        assert "HBAO HBAO" not in render["details"]
