@@ -28,6 +28,7 @@ PACKAGES=(
     python3 python3-numpy python3-pytest python3-venv
     python3-pycodestyle  # the PEP 8 check of the test suite
     xvfb xauth         # F12 and viewport tests in a real window
+    xdotool            # tests/test_faults_ui.py: a real Escape key press during F12
 )
 
 missing=()

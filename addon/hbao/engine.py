@@ -54,8 +54,16 @@ def compute_passes(engine, depsgraph, width, height):
     channels, timings = handover.read_main_passes(main, jobs)
 
     results = {}
+    # Esc: Blender asks through test_break(); the passes are left at 1 and
+    # the render ends as Blender decides (the scratch file is already gone).
+    if engine.test_break():
+        log("render cancelled: no AO computed")
+        return {}
     compute_time = 0.0
     for index, job in enumerate(jobs):
+        if engine.test_break():
+            log("render cancelled: AO left out")
+            return {}
         engine.update_stats("HBAO", f"{job.node_name}: computing AO ({index + 1}/{len(jobs)})")
         depth = channels[("depth", job.layer)]
         if depth.shape != (height, width):

@@ -1,0 +1,52 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Run inside Blender by tests/test_faults.py: addon_render.py with one
+fault set up first, by a render_pre handler registered after the add-on's
+(so it acts after the hook synced) or in the scratch folder.
+
+  blender -b --addons hbao --python fault_render.py -- '<json spec>' <out dir> <fault>
+
+Faults:
+  unreadable_save   the scratch path (HBAO_TEMP_DIR/hbao-passes-<pid>-<thread>.exr,
+                    known here: a -b render runs in this thread) is a link to
+                    /dev/null: the save "succeeds", the file read back is empty.
+  helper_resized    after the hook synced the helper scene, its
+                    resolution_percentage is halved (meant to make its pass
+                    smaller than the Render Result; Blender renders it at full
+                    size anyway).
+"""
+import os
+import runpy
+import sys
+import threading
+
+import bpy
+
+argv = sys.argv[sys.argv.index("--") + 1:]
+fault = argv[2]
+RENDER_SCRIPT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "addon_render.py")
+
+
+def helper_scenes():
+    return [s for s in bpy.data.scenes if s.name.startswith(".HBAO") or s.get("hbao_main_scene")]
+
+
+if fault == "unreadable_save":
+    # The add-on's own naming (handover._scratch_path): the test checks the
+    # link is gone afterwards, so a changed name fails it rather than passing.
+    link = os.path.join(os.environ["HBAO_TEMP_DIR"],
+                        f"hbao-passes-{os.getpid()}-{threading.get_ident()}.exr")
+    os.symlink("/dev/null", link)
+    print("FAULT link", link, flush=True)
+elif fault == "helper_resized":
+    @bpy.app.handlers.persistent
+    def _resize_helper(scene, *_args):
+        for helper in helper_scenes():
+            if helper != scene and helper.render.resolution_percentage == 100:
+                helper.render.resolution_percentage = 50
+                print("FAULT resized", helper.name, flush=True)
+
+    bpy.app.handlers.render_pre.append(_resize_helper)
+else:
+    raise ValueError(f"unknown fault {fault!r}")
+
+runpy.run_path(RENDER_SCRIPT, run_name="__main__")
