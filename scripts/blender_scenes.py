@@ -291,6 +291,24 @@ class Compositor:
         return FileOutput(self, node)
 
 
+def hbao_test_tree(scene, out_dir, name="HBAO0"):
+    """Render Layers -> one HBAO node -> the final image, and a File Output
+    writing OUT_DIR/nodes_<frame>.exr with Render, <name>_AO and <name>_Image:
+    the tree the F12 and fault scripts render. Returns the HBAO node."""
+    compositor = Compositor(scene)
+    layers = compositor.render_layers()
+    node = compositor.node("CompositorNodeHBAO")
+    node.name = name
+    for socket in ("Image", "Depth", "Normal"):
+        compositor.link(layers.outputs[socket], node.inputs[socket])
+    compositor.composite(node.outputs["Image"])
+    files = compositor.file_output(out_dir, "nodes_")
+    for slot, socket in (("Render", layers.outputs["Image"]), (f"{name}_AO", node.outputs["AO"]),
+                         (f"{name}_Image", node.outputs["Image"])):
+        files.add(slot, socket)
+    return node
+
+
 class FileOutput:
     def __init__(self, compositor, node):
         self.compositor = compositor

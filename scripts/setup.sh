@@ -7,7 +7,7 @@
 set -euo pipefail
 
 # clang's runtime libraries (ASan, UBSan, libFuzzer) are packaged per LLVM
-# version: 14 on Debian 12, 19 on Debian 13.
+# version: 14 on Debian 12 (libclang-rt-14-dev), 19 on Debian 13 (libclang-rt-19-dev).
 case "$(cut -d. -f1 /etc/debian_version 2>/dev/null)" in
     12) LLVM=14 ;;
     13) LLVM=19 ;;

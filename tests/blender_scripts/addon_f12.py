@@ -20,18 +20,8 @@ import blender_scenes  # noqa: E402
 RENDER_TIMEOUT_S = 240.0
 
 scene = blender_scenes.build_corner_scene(bpy.context.scene, (96, 64), "CYCLES", 4)
-compositor = blender_scenes.Compositor(scene)
-layers = compositor.render_layers()
-hbao = compositor.node("CompositorNodeHBAO")
-hbao.name = "HBAO0"
+hbao = blender_scenes.hbao_test_tree(scene, out_dir)
 hbao.inputs["Radius"].default_value = 0.9
-for name in ("Image", "Depth", "Normal"):
-    compositor.link(layers.outputs[name], hbao.inputs[name])
-compositor.composite(hbao.outputs["Image"])
-files = compositor.file_output(out_dir, "nodes_")
-for name, socket in (("Render", layers.outputs["Image"]), ("HBAO0_AO", hbao.outputs["AO"]),
-                     ("HBAO0_Image", hbao.outputs["Image"])):
-    files.add(name, socket)
 os.makedirs(out_dir, exist_ok=True)
 bpy.context.view_layer.update()  # matrix_world of the new camera
 with open(os.path.join(out_dir, "camera_0001.json"), "w") as stream:

@@ -30,17 +30,7 @@ KEY = {"escape": "Escape", "undo": "ctrl+z"}[mode]
 KEY_AFTER_S = 3.0
 
 scene = blender_scenes.build_corner_scene(bpy.context.scene, (96, 64), "CYCLES", SLOW_SAMPLES)
-compositor = blender_scenes.Compositor(scene)
-layers = compositor.render_layers()
-hbao = compositor.node("CompositorNodeHBAO")
-hbao.name = "HBAO0"
-for name in ("Image", "Depth", "Normal"):
-    compositor.link(layers.outputs[name], hbao.inputs[name])
-compositor.composite(hbao.outputs["Image"])
-files = compositor.file_output(out_dir, "nodes_")
-for name, socket in (("Render", layers.outputs["Image"]), ("HBAO0_AO", hbao.outputs["AO"]),
-                     ("HBAO0_Image", hbao.outputs["Image"])):
-    files.add(name, socket)
+blender_scenes.hbao_test_tree(scene, out_dir)
 os.makedirs(out_dir, exist_ok=True)
 blender_scenes.compat.set_image_format(scene.render.image_settings, "PNG")
 
