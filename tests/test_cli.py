@@ -123,9 +123,10 @@ def exr_attribute(name, kind, payload):
 
 
 def scanline_exr(channels, width, height, claimed_size=None, display_window=None,
-                 data_origin=(0, 0)):
+                 data_origin=(0, 0), half=()):
     """A single-part, uncompressed scanline EXR of float channels (name ->
-    float32 array of shape (height, width)), written from the OpenEXR file
+    float32 array of shape (height, width); those named in `half` are stored
+    as half floats), written from the OpenEXR file
     layout so that tests can make inputs of any size, or a header whose
     claimed size (claimed_size=(w, h)) the file does not hold: then no chunk
     table and no chunks follow. The data window starts at `data_origin`
@@ -133,8 +134,8 @@ def scanline_exr(channels, width, height, claimed_size=None, display_window=None
     window unless given."""
     claimed_width, claimed_height = claimed_size or (width, height)
     names = sorted(channels)
-    # chlist: name, pixel type 2 (float), pLinear, 3 reserved, x/y sampling.
-    chlist = b"".join(n.encode() + b"\0" + struct.pack("<iB3xii", 2, 0, 1, 1)
+    # chlist: name, pixel type (1 half, 2 float), pLinear, 3 reserved, x/y sampling.
+    chlist = b"".join(n.encode() + b"\0" + struct.pack("<iB3xii", 1 if n in half else 2, 0, 1, 1)
                       for n in names) + b"\0"
     x0, y0 = data_origin
     box = struct.pack("<4i", x0, y0, x0 + claimed_width - 1, y0 + claimed_height - 1)
@@ -150,7 +151,8 @@ def scanline_exr(channels, width, height, claimed_size=None, display_window=None
               + exr_attribute("screenWindowWidth", "float", struct.pack("<f", 1.0)) + b"\0")
     if claimed_size is not None:
         return header
-    rows = [b"".join(np.ascontiguousarray(channels[n][y], dtype="<f4").tobytes()
+    rows = [b"".join(np.ascontiguousarray(channels[n][y], dtype="<f2" if n in half else "<f4")
+                     .tobytes()
                      for n in names) for y in range(height)]
     chunks = [struct.pack("<ii", y0 + y, len(row)) + row for y, row in enumerate(rows)]
     offsets, position = [], len(header) + 8 * height
@@ -928,3 +930,28 @@ def test_a_data_window_gets_the_camera_of_its_crop(hbao_tool, tmp_path):
                                      data_origin=(full_width - width // 2, 0)))
     assert_clean_error(run_tool(hbao_tool, outside, "-o", tmp_path / "outside_ao.exr",
                                 "--camera", camera), 1, "crop rectangle")
+
+
+@pytest.mark.parametrize("names", [("B", "G", "R", "Z"), ("G", "R", "Z")])
+def test_half_depth_beside_half_colour_channels(hbao_tool, tmp_path, names):
+    """A half-float Z among three or four half channels of which only Z is
+    read: OpenEXRCore 3.1's fast half-to-float unpackers for 3 and 4 channels
+    wrote the skipped channels through a NULL pointer (the tool crashed; found
+    by fuzz_exr_compute). The AO must equal that of the same depths stored
+    alone as float."""
+    from hbao import exr_passes
+    width, height = 40, 24
+    depth = _wavy_depth(width, height).astype(np.float16).astype(np.float32)
+    channels = {name: np.full((height, width), 0.5, np.float32) for name in names}
+    channels["Z"] = depth
+    mixed = tmp_path / "mixed.exr"
+    mixed.write_bytes(scanline_exr(channels, width, height, half=names))
+    alone = tmp_path / "alone.exr"
+    alone.write_bytes(scanline_exr({"Z": depth}, width, height))
+    ao = {}
+    for path in (mixed, alone):
+        output = tmp_path / f"{path.stem}_ao.exr"
+        run_ok(hbao_tool, path, "-o", output, "--radius", "0.2", "--threads", "1")
+        ao[path.stem] = exr_passes.read_channels(output, ["AO"])["AO"]
+    assert np.array_equal(ao["mixed"], ao["alone"])
+    assert np.mean(1.0 - ao["alone"]) > 0.01  # there is occlusion to compare

@@ -370,16 +370,32 @@ static const exr_channel_request *find_request(const exr_channel_request *reques
 }
 
 /* Decode the requests that name channels of `part`; the others are left to
- * the other parts (a name is in one part only). */
+ * the other parts (a name is in one part only).
+ *
+ * The part's channels that nobody asked for are decoded too, into one scratch
+ * chunk that is thrown away: OpenEXRCore 3.1 is told to skip a channel by a
+ * NULL destination, but its fast unpackers for 3 and 4 half channels converted
+ * to float write through the NULL (an RGB + Z half file whose Z alone is read
+ * crashed). Every channel with a real destination keeps the library on paths
+ * that need no such care; the cost is a copy of channels that are decompressed
+ * anyway. */
 static int read_part(exr_input *input, int part, const exr_channel_request *requests, int count,
                      tool_error *error) {
     int status = TOOL_EXIT_SUCCESS;
     exr_decode_pipeline_t decoder = EXR_DECODE_PIPELINE_INITIALIZER;
     bool decoder_ready = false;
+    uint8_t *scratch = NULL;
 
     int32_t lines_per_chunk = 0;
     status = part_lines_per_chunk(input, part, &lines_per_chunk, error);
     if (status != TOOL_EXIT_SUCCESS) goto fail;
+    /* 4 bytes: the widest pixel type (float, uint). */
+    const int64_t scratch_line = (int64_t)input->width * 4;
+    scratch = malloc((size_t)(scratch_line * lines_per_chunk));
+    if (scratch == NULL) {
+        status = tool_fail(error, TOOL_EXIT_RUNTIME, "out of memory");
+        goto fail;
+    }
 
     const pixel_rect *window = &input->data_window;
     for (int64_t y = window->min_y; y <= window->max_y; y += lines_per_chunk) {
@@ -400,7 +416,11 @@ static int read_part(exr_input *input, int part, const exr_channel_request *requ
             const exr_channel_request *request =
                 find_request(requests, count, channel->channel_name);
             if (request == NULL) {
-                channel->decode_to_ptr = NULL;
+                channel->decode_to_ptr = scratch;
+                channel->user_pixel_stride = channel->bytes_per_element;
+                channel->user_line_stride = (int32_t)(channel->bytes_per_element * input->width);
+                channel->user_data_type = channel->data_type;
+                channel->user_bytes_per_element = channel->bytes_per_element;
                 continue;
             }
             channel->decode_to_ptr = request->data + first_row * request->row_stride;
@@ -427,6 +447,7 @@ static int read_part(exr_input *input, int part, const exr_channel_request *requ
 
 fail:
     if (decoder_ready) exr_decoding_destroy(input->context, &decoder);
+    free(scratch);
     return status;
 }
 
