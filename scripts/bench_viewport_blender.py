@@ -55,7 +55,7 @@ def _median_ms(function, repeats):
 def run(options):
     draw = sys.modules["hbao.viewport.draw"]
     pipeline = sys.modules["hbao.viewport.pipeline"]
-    parameters = sys.modules["hbao.parameters"]
+    native = sys.modules["hbao.native"]
     print(f"renderer: {gpu.platform.renderer_get()} | {gpu.platform.vendor_get()} | "
           f"{gpu.platform.version_get()}")
     if options["backend_check"]:
@@ -70,7 +70,7 @@ def run(options):
     region = next(r for r in area.regions if r.type == "WINDOW")
     depsgraph = bpy.context.evaluated_depsgraph_get()
     view_matrix = scene.camera.matrix_world.inverted()
-    params = parameters.resolved({"radius": 0.6})
+    params = native.resolve_params({"radius": 0.6})
     rows = []
     for width, height in SIZES:
         projection_matrix = scene.camera.calc_matrix_camera(depsgraph, x=width, y=height)

@@ -11,7 +11,7 @@ from conftest import REPO
 PACKAGE = REPO / "addon" / "hbao"
 # What tests, benchmarks and scripts import without Blender.
 BPY_FREE_MODULES = ("hbao", "hbao.parameters", "hbao.library_loading", "hbao.native",
-                    "hbao.native_structs",
+                    "hbao.native_structs", "hbao.native_library", "hbao.native_params",
                     "hbao.exr_passes", "hbao.camera", "hbao.viewport",
                     "hbao.viewport.projection", "hbao.viewport.shader_sources",
                     "hbao.viewport.horizon_sources")

@@ -247,10 +247,57 @@ def test_incompatible_library_is_refused(monkeypatch, tmp_path):
         "int32_t hbao_compute(void) { return 0; }\n"
         "size_t hbao_view_size(void) { return 40; }\n"
         "int32_t hbao_camera_view(void) { return 0; }\n"
-        "int32_t hbao_camera_crop(void) { return 0; }\n")
+        "int32_t hbao_camera_crop(void) { return 0; }\n"
+        "int32_t hbao_params_resolve(void) { return 0; }\n"
+        "const char *hbao_param_field_name(uint32_t b) { (void)b; return 0; }\n")
     fake = tmp_path / "libfake.so"
     subprocess.run(["cc", "-shared", "-fPIC", "-o", str(fake), str(source)], check=True)
     monkeypatch.setenv("HBAO_LIBRARY", str(fake))
     module = _load_native()
     with pytest.raises(module.HBAOLibraryError, match="version 1.0.0"):
         module.load_library()
+
+
+def test_clamping_happens_once_and_says_so(native):
+    """The library's resolver, reached through the binding, clamps and names
+    each clamp in the words the node shows."""
+    warnings = []
+    resolved = native.resolve_params({"steps": 500, "directions": 0, "blur_size": 7.6,
+                                      "strength": 20.0}, warnings)
+    assert resolved["steps"] == 64  # HBAO_MAX_STEPS
+    assert resolved["directions"] == 1
+    assert resolved["blur_size"] == 8  # rounded, not clamped: no warning
+    assert resolved["strength"] == 16.0  # HBAO_MAX_STRENGTH
+    assert sorted(warnings) == sorted([
+        "Steps 500 is above the limit 64; using 64",
+        "Directions 0 is below the limit 1; using 1",
+        "Strength 20 is above the limit 16; using 16"])
+    untouched = []
+    native.resolve_params(native_module.default_params(), untouched)
+    assert untouched == []
+
+
+@pytest.mark.parametrize("params, message", [
+    ({"radius": float("nan")}, "Radius is not a number"),
+    ({"steps": float("inf")}, "Steps is not a number"),
+    ({"radius": -1.0}, "Radius -1 is negative"),
+    ({"falloff": "LINEAR"}, "falloff must be one of"),
+    ({"raduis": 1.0}, "unknown HBAO parameter 'raduis'"),
+])
+def test_unusable_values_are_rejected_with_their_name(native, params, message):
+    with pytest.raises(ValueError, match=message):
+        native.resolve_params(params)
+
+
+def test_values_beyond_the_binary_fields_are_clamped_not_wrapped(native):
+    """A Value node may feed 1e12 Steps or 1e300 Strength: the binding keeps
+    them inside int32 and float32 for the library, which clamps them; they do
+    not wrap around to small numbers or become infinities it refuses."""
+    warnings = []
+    resolved = native.resolve_params({"steps": 1e12, "directions": -1e12, "strength": 1e300},
+                                     warnings)
+    assert (resolved["steps"], resolved["directions"], resolved["strength"]) == (64, 1, 16.0)
+    assert sorted(warnings) == sorted([
+        "Steps 1e+12 is above the limit 64; using 64",
+        "Directions -1e+12 is below the limit 1; using 1",
+        "Strength 1e+300 is above the limit 16; using 16"])

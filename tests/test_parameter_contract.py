@@ -171,32 +171,3 @@ def test_the_glsl_constants_match_the_library():
     epsilon = library_pattern(r"np_length > ([\d.e-]+)f;",
                               "the normal-in-slice threshold (np_length > eps)")
     assert defines["NORMAL_IN_SLICE_EPSILON"] == float(epsilon.group(1))
-
-
-def test_clamping_happens_once_and_says_so():
-    warnings = []
-    resolved = parameters.resolved({"steps": 500, "directions": 0, "blur_size": 7.6,
-                                    "strength": 20.0}, warnings)
-    assert resolved["steps"] == parameters.MAX_STEPS
-    assert resolved["directions"] == 1
-    assert resolved["blur_size"] == 8  # rounded, not clamped: no warning
-    assert resolved["strength"] == parameters.MAX_STRENGTH
-    assert sorted(warnings) == sorted([
-        "Steps 500 is above the limit 64; using 64",
-        "Directions 0 is below the limit 1; using 1",
-        "Strength 20 is above the limit 16; using 16"])
-    untouched = []
-    parameters.resolved(parameters.DEFAULTS, untouched)
-    assert untouched == []
-
-
-@pytest.mark.parametrize("params, message", [
-    ({"radius": float("nan")}, "Radius is not a number"),
-    ({"steps": float("inf")}, "Steps is not a number"),
-    ({"radius": -1.0}, "Radius -1 is negative"),
-    ({"falloff": "LINEAR"}, "falloff must be one of"),
-    ({"raduis": 1.0}, "unknown HBAO parameters: raduis"),
-])
-def test_unusable_values_are_rejected_with_their_name(params, message):
-    with pytest.raises(ValueError, match=message):
-        parameters.resolved(params)

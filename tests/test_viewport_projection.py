@@ -144,9 +144,9 @@ def test_depth_coefficients_invert_projection(perspective):
         assert (a * ndc + b) / (c * ndc + d) == pytest.approx(depth, rel=1e-9)
 
 
-def test_parameters_clamp_like_the_library():
-    resolved = parameters.resolved({"directions": 100, "steps": 0, "blur_size": 99,
-                                    "angle_bias_degrees": 75.0, "strength": -1.0})
+def test_parameters_clamp_like_the_library(native):
+    resolved = native.resolve_params({"directions": 100, "steps": 0, "blur_size": 99,
+                                      "angle_bias_degrees": 75.0, "strength": -1.0})
     assert resolved["directions"] == parameters.MAX_DIRECTIONS
     assert resolved["steps"] == 1
     assert resolved["blur_size"] == parameters.MAX_BLUR_SIZE
@@ -158,7 +158,7 @@ def test_parameters_clamp_like_the_library():
     for bad in ({"radius": -1.0}, {"radius": math.nan}, {"falloff": "LINEAR"},
                 {"colour": 1}):
         with pytest.raises(ValueError):
-            parameters.resolved(bad)
+            native.resolve_params(bad)
 
 
 def test_defaults_match_header():

@@ -1,146 +1,40 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """ctypes binding of libhbao (csrc/include/hbao.h). Needs numpy, not bpy.
 
-The library is loaded once, lazily, on first use; the load checks that the
-library's major version and struct sizes match this binding, so that a stale
-or foreign libhbao.so fails with a message instead of corrupting memory.
+The library is loaded once, lazily, on first use (native_library.py); the
+parameters go through the library's own resolver (native_params.py).
 
     ao = compute_ao(depth, normal, params={"radius": 0.5}, camera=camera_dict)
 """
 import ctypes
-from pathlib import Path
 
 import numpy as np
 
-from . import library_loading
-from .native_structs import HBAOCamera, HBAOChannel, HBAOParams, HBAOView
+# Re-exported: the binding's public names live here (noqa: F401).
+from .native_library import (BINDING_VERSION_MAJOR, LIBRARY_ENVIRONMENT_VARIABLE,  # noqa: F401
+                             LIBRARY_FILE_NAME, HBAOError, HBAOLibraryError, check,
+                             library_path, library_version, load_library, unload_library)
+from .native_params import (PARAMETER_NAMES, default_params, params_struct,  # noqa: F401
+                            resolve_params)
+from .native_structs import HBAOCamera, HBAOChannel, HBAOParams, HBAOView  # noqa: F401
 from .parameters import (FALLOFF_VALUES, INTEGRATION_VALUES, PROJECTION_VALUES,
                          SENSOR_FIT_VALUES)
 
 __all__ = [
-    "HBAOError", "HBAOLibraryError", "compute_ao", "default_params", "camera_view", "camera_crop",
-    "library_path", "load_library", "library_version",
+    "HBAOError", "HBAOLibraryError", "compute_ao", "default_params", "resolve_params",
+    "camera_view", "camera_crop",
+    "library_path", "load_library", "unload_library", "library_version",
     "PARAMETER_NAMES", "FALLOFF_NAMES", "INTEGRATION_NAMES",
 ]
-
-#: The header's HBAO_VERSION_MAJOR this binding mirrors.
-BINDING_VERSION_MAJOR = 0
-#: Environment variable that names the library to load instead of lib/libhbao.so.
-LIBRARY_ENVIRONMENT_VARIABLE = "HBAO_LIBRARY"
-_FLOAT_SIZE = ctypes.sizeof(ctypes.c_float)
-_HBAO_SUCCESS = 0
-
-
-class HBAOError(RuntimeError):
-    """A libhbao call failed; carries the library's result code and message."""
-
-    def __init__(self, code, message):
-        super().__init__(f"libhbao: {message} (result {code})")
-        self.code = code
-        self.library_message = message
-
-
-class HBAOLibraryError(RuntimeError):
-    """libhbao could not be loaded, or it does not match this binding."""
-
 
 # Enum names as Blender spells them, mapped to the header's values (parameters.py).
 FALLOFF_NAMES = FALLOFF_VALUES
 INTEGRATION_NAMES = INTEGRATION_VALUES
 PROJECTION_NAMES = PROJECTION_VALUES
 SENSOR_FIT_NAMES = SENSOR_FIT_VALUES
-_ENUM_PARAMETERS = {"falloff": FALLOFF_NAMES, "integration": INTEGRATION_NAMES}
-PARAMETER_NAMES = tuple(name for name, _ in HBAOParams._fields_)
 _CAMERA_FLOAT_NAMES = ("lens", "sensor_width", "sensor_height", "shift_x", "shift_y",
                        "ortho_scale", "pixel_aspect_x", "pixel_aspect_y")
-
-# Every exported function: name -> (restype, argtypes). The one place they are declared.
-_PARAMS_P = ctypes.POINTER(HBAOParams)
-_CAMERA_P = ctypes.POINTER(HBAOCamera)
-_CHANNEL_P = ctypes.POINTER(HBAOChannel)
-_FUNCTIONS = {
-    "hbao_version": (ctypes.c_int32, []),
-    "hbao_result_message": (ctypes.c_char_p, [ctypes.c_int32]),
-    "hbao_params_default": (None, [_PARAMS_P]),
-    "hbao_camera_default": (None, [_CAMERA_P]),
-    "hbao_params_size": (ctypes.c_size_t, []),
-    "hbao_camera_size": (ctypes.c_size_t, []),
-    "hbao_view_size": (ctypes.c_size_t, []),
-    "hbao_camera_view": (ctypes.c_int32, [_CAMERA_P, ctypes.c_int32, ctypes.c_int32,
-                                          ctypes.POINTER(HBAOView)]),
-    "hbao_camera_crop": (ctypes.c_int32, [_CAMERA_P] + [ctypes.c_int32] * 6 + [_CAMERA_P]),
-    "hbao_compute": (ctypes.c_int32, [_PARAMS_P, _CAMERA_P, ctypes.c_int32, ctypes.c_int32,
-                                      _CHANNEL_P, _CHANNEL_P, ctypes.POINTER(ctypes.c_float),
-                                      ctypes.c_int64]),
-}
-
-
-def _version_text(packed):
-    return f"{packed // 10000}.{packed // 100 % 100}.{packed % 100}"
-
-
-_LIBRARY = library_loading.NativeLibrary(
-    "hbao", LIBRARY_ENVIRONMENT_VARIABLE, Path(__file__).resolve().parent / "lib",
-    _FUNCTIONS, HBAOLibraryError,
-    handshake=library_loading.Handshake(
-        "hbao_version", BINDING_VERSION_MAJOR,
-        [("hbao_params", "hbao_params_size", HBAOParams),
-         ("hbao_camera", "hbao_camera_size", HBAOCamera),
-         ("hbao_view", "hbao_view_size", HBAOView)],
-        version_key=lambda packed: packed // 10000,
-        describe=_version_text,
-        expected_text=f"{BINDING_VERSION_MAJOR}.x"),
-    load_hint="Rebuild it for this machine.")
-#: The platform's file name of the library (libhbao.so on Linux).
-LIBRARY_FILE_NAME = _LIBRARY.file_name
-
-
-# The file that load_library() loads: $LIBRARY_ENVIRONMENT_VARIABLE, else
-# lib/LIBRARY_FILE_NAME here; load_library() loads it once (raises HBAOLibraryError);
-# unload_library() forgets it, so that the next call loads library_path() again.
-library_path = _LIBRARY.path
-load_library = _LIBRARY.load
-unload_library = _LIBRARY.unload
-
-
-def library_version():
-    """The loaded library's version as 'major.minor.patch'."""
-    return _version_text(load_library().hbao_version())
-
-
-def _check(result):
-    if result != _HBAO_SUCCESS:
-        message = load_library().hbao_result_message(result)
-        raise HBAOError(result, message.decode("utf-8", "replace") if message else "unknown")
-
-
-def _params_struct(params):
-    library = load_library()
-    structure = HBAOParams()
-    library.hbao_params_default(ctypes.byref(structure))
-    for key, value in (params or {}).items():
-        if key not in PARAMETER_NAMES:
-            raise ValueError(f"unknown HBAO parameter {key!r}; known: {', '.join(PARAMETER_NAMES)}")
-        if key in _ENUM_PARAMETERS:
-            names = _ENUM_PARAMETERS[key]
-            if isinstance(value, str):
-                if value not in names:
-                    raise ValueError(f"{key} must be one of {', '.join(names)}, not {value!r}")
-                value = names[value]
-        field_type = dict(HBAOParams._fields_)[key]
-        setattr(structure, key, int(value) if field_type is ctypes.c_int32 else float(value))
-    return structure
-
-
-def default_params():
-    """The library's defaults as a params dict (enums by name)."""
-    structure = HBAOParams()
-    load_library().hbao_params_default(ctypes.byref(structure))
-    result = {name: getattr(structure, name) for name in PARAMETER_NAMES}
-    for key, names in _ENUM_PARAMETERS.items():
-        result[key] = next((n for n, v in names.items() if v == result[key]), result[key])
-    result["half_resolution"] = bool(result["half_resolution"])
-    return result
+_FLOAT_SIZE = ctypes.sizeof(ctypes.c_float)
 
 
 def _camera_struct(camera):
@@ -173,8 +67,8 @@ def camera_view(camera, width, height):
     """The HBAOView of camera dict `camera` on a `width` x `height` image: libhbao's
     sensor fit (hbao_camera_view). Raises HBAOError, HBAOLibraryError, ValueError."""
     view = HBAOView()
-    _check(load_library().hbao_camera_view(ctypes.byref(_camera_struct(camera)), width, height,
-                                           ctypes.byref(view)))
+    check(load_library().hbao_camera_view(ctypes.byref(_camera_struct(camera)), width, height,
+                                          ctypes.byref(view)))
     return view
 
 
@@ -183,8 +77,8 @@ def camera_crop(camera, full_width, full_height, x, y, width, height):
     top) of the full image seen by camera dict `camera`, with the same view rays
     (hbao_camera_crop). Raises HBAOError, HBAOLibraryError, ValueError."""
     structure = _camera_struct(camera)
-    _check(load_library().hbao_camera_crop(ctypes.byref(structure), full_width, full_height,
-                                           x, y, width, height, ctypes.byref(structure)))
+    check(load_library().hbao_camera_crop(ctypes.byref(structure), full_width, full_height,
+                                          x, y, width, height, ctypes.byref(structure)))
     fit = next(name for name, value in SENSOR_FIT_NAMES.items() if value == structure.sensor_fit)
     return dict(camera or {}, sensor_fit=fit,
                 **{name: getattr(structure, name) for name in _CAMERA_FLOAT_NAMES})
@@ -251,8 +145,8 @@ def compute_ao(depth, normal=None, *, params=None, camera=None, bottom_up=False,
         raise ValueError(f"out must be a writeable float32 ({height}, {width}) array with "
                          f"contiguous rows")
 
-    params_struct = _params_struct(params)
-    camera_struct = _camera_struct(camera)
+    params_structure = params_struct(params)
+    camera_structure = _camera_struct(camera)
 
     # A bottom-up image seen through [::-1] is a top-down view whose data pointer is
     # the last row and whose row stride is negative: no copy, the library's convention.
@@ -263,8 +157,8 @@ def compute_ao(depth, normal=None, *, params=None, camera=None, bottom_up=False,
     depth_channel = _channel(depth_view)
     normal_channel = _channel(normal_view) if normal_view is not None else None
     library = load_library()
-    _check(library.hbao_compute(
-        ctypes.byref(params_struct), ctypes.byref(camera_struct), width, height,
+    check(library.hbao_compute(
+        ctypes.byref(params_structure), ctypes.byref(camera_structure), width, height,
         ctypes.byref(depth_channel),
         ctypes.byref(normal_channel) if normal_channel is not None else None,
         out_view.ctypes.data_as(ctypes.POINTER(ctypes.c_float)),

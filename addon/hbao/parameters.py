@@ -1,15 +1,14 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """The HBAO parameters as artists set them: the C library's hbao_params
 (csrc/include/hbao.h) by the names addon/hbao/native.py uses, with the
-header's defaults, limits and enum values, the menus' items, and the one
-resolver every Python front end (node, viewport) passes its values through.
-No bpy and no imports from the package: the compositor node, the viewport
-preview, the tests and the benchmark share it.
+header's defaults, limits and enum values and the menus' items, for the
+sockets and settings the artist edits. Values are resolved (completed and
+clamped) in one place, the library's hbao_params_resolve, reached from Python
+through native.resolve_params. No bpy and no imports from the package: the
+compositor node, the viewport preview, the tests and the benchmark share it.
 
 tests/test_parameter_contract.py checks every number here against the header
 and csrc/lib/, so a copy cannot drift from the library."""
-import math
-
 # csrc/include/hbao.h, HBAO_DEFAULT_* (falloff and integration: the
 # HBAO_PARAMS_DEFAULT_INITIALIZER's enum values).
 DEFAULTS = {
@@ -40,8 +39,10 @@ INTEGRATION_VALUES = {"HBAO": 0, "COSINE": 1}
 PROJECTION_VALUES = {"PERSP": 0, "ORTHO": 1}
 SENSOR_FIT_VALUES = {"AUTO": 0, "HORIZONTAL": 1, "VERTICAL": 2}
 
-# The limits the library clamps to (hbao.h documents each field's range):
-# key -> (lowest, highest, whole number).
+# The limits the library clamps to (hbao.h documents each field's range), as
+# the node's sockets and the viewport's settings offer them: key -> (lowest,
+# highest, whole number). Values are resolved by the library itself
+# (native.resolve_params -> hbao_params_resolve), never by these numbers.
 LIMITS = {
     "angle_bias_degrees": (0.0, MAX_ANGLE_BIAS_DEGREES, False),
     "directions": (1, MAX_DIRECTIONS, True),
@@ -50,9 +51,6 @@ LIMITS = {
     "blur_sharpness": (0.0, MAX_BLUR_SHARPNESS, False),
     "strength": (0.0, MAX_STRENGTH, False),
 }
-# Keys passed through unchanged when given (not artist-facing parameters).
-PASS_THROUGH = ("half_resolution", "threads")
-
 # Each parameter as the node's sockets and the panel name it, for messages.
 LABELS = {
     "radius": "Radius",
@@ -84,58 +82,6 @@ INTEGRATION_ITEMS = [
 # exp(-2): wide enough to hide the 4x4 pattern, narrow enough to stay local.
 BLUR_SIGMA_PER_TAP = 0.5
 BLUR_SIGMA_TAP_OFFSET = 1
-
-
-def _number(value):
-    return f"{value:g}" if isinstance(value, float) else str(value)
-
-
-def resolved(params, warnings=None):
-    """`params` (any subset of DEFAULTS' keys, plus half_resolution and
-    threads) completed with the defaults and clamped to the header's limits,
-    as the C library clamps them; whole-number parameters are rounded to the
-    nearest integer. Each clamped value appends a message to `warnings` (a
-    list) when given. Raises ValueError where the library returns
-    HBAO_ERROR_INVALID_PARAMETER (not finite, negative radius, background
-    depth not above 0) or for an unknown key or enum name."""
-    unknown = set(params or {}) - set(DEFAULTS) - set(PASS_THROUGH)
-    if unknown:
-        raise ValueError(f"unknown HBAO parameters: {', '.join(sorted(unknown))}")
-    merged = dict(DEFAULTS)
-    merged.update(params or {})
-    for key, value in merged.items():
-        if key in ("falloff", "integration") or key in PASS_THROUGH:
-            continue
-        if not math.isfinite(float(value)):
-            raise ValueError(f"{LABELS[key]} is not a number")
-    if float(merged["radius"]) < 0.0:
-        raise ValueError(f"Radius {float(merged['radius']):g} is negative")
-    if float(merged["background_depth"]) <= 0.0:
-        raise ValueError(f"Background Depth {float(merged['background_depth']):g} "
-                         f"is not above 0")
-    for key, values in (("falloff", FALLOFF_VALUES), ("integration", INTEGRATION_VALUES)):
-        if merged[key] not in values:
-            raise ValueError(f"{key} must be one of {', '.join(values)}, not {merged[key]!r}")
-    result = {
-        "radius": float(merged["radius"]),
-        "falloff": merged["falloff"],
-        "integration": merged["integration"],
-        "background_depth": float(merged["background_depth"]),
-    }
-    for key, (low, high, whole) in LIMITS.items():
-        value = float(merged[key])
-        if whole:
-            value = int(round(value))
-        clamped = min(max(value, low), high)
-        if clamped != value and warnings is not None:
-            side, limit = ("below", low) if value < low else ("above", high)
-            warnings.append(f"{LABELS[key]} {_number(value)} is {side} the limit "
-                            f"{_number(limit)}; using {_number(clamped)}")
-        result[key] = int(clamped) if whole else float(clamped)
-    for key in PASS_THROUGH:
-        if key in merged:
-            result[key] = int(merged[key])
-    return result
 
 
 def blur_kernel_radius(blur_size):

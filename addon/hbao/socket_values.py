@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """An HBAO node's settings at the frame being rendered: its sockets' values,
 keyframed or fed by a Value node, resolved into library parameters."""
-from . import compat, parameters
+from . import compat, native, parameters
 from .node import VALUE_INPUTS
 from .report import NodeMessage
 
@@ -52,7 +52,7 @@ def socket_value(tree, socket, frame, warnings):
 
 
 def _label_of(message):
-    """The parameter a parameters.resolved() message is about (it starts with its label)."""
+    """The parameter a native.resolve_params() message is about (it starts with its label)."""
     return next((label for label in sorted(parameters.LABELS.values(), key=len, reverse=True)
                  if message.startswith(label)), "A value")
 
@@ -70,7 +70,7 @@ def _short_clamp(message):
 
 def node_params(node, frame, warnings):
     """The params dict for native.compute_ao() from the node at `frame`,
-    resolved (completed and clamped) once, by parameters.resolved; each
+    resolved (completed and clamped) once, by the library (native.resolve_params); each
     clamped value adds a NodeMessage. Raises ValueError when a value cannot
     be used at all (not a number, negative), its `short` attribute the form
     that fits the node's status line."""
@@ -85,7 +85,7 @@ def node_params(node, frame, warnings):
         raw[key] = float(socket_value(tree, node.inputs[name], frame, warnings))
     clamped = []
     try:
-        params = parameters.resolved(raw, clamped)
+        params = native.resolve_params(raw, clamped)
     except ValueError as error:
         unusable = ValueError(str(error))
         unusable.short = _short_error(str(error))

@@ -20,7 +20,6 @@ if str(REPO / "addon") not in sys.path:
     sys.path.insert(0, str(REPO / "addon"))
 
 from hbao import native  # noqa: E402
-from hbao import parameters  # noqa: E402
 from hbao.viewport import pipeline, projection  # noqa: E402
 
 if bpy.app.background and hasattr(gpu, "init"):
@@ -178,7 +177,7 @@ def main():
     report = {"renderer": gpu.platform.renderer_get(), "cases": {}}
     for name, camera, overrides, *scene in CASES:
         scene = scene[0] if scene else {}
-        params = parameters.resolved(overrides)
+        params = native.resolve_params(overrides)
         width, height = scene.get("size", (WIDTH, HEIGHT))
         frame = projection.frame_from_camera(camera, width, height)
         viewport_frame = blender_frame(camera, width, height)

@@ -18,7 +18,7 @@ from bpy.app.handlers import persistent
 from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty,
                        IntProperty)
 
-from .. import parameters
+from .. import native, parameters
 from ..parameters import FALLOFF_ITEMS, INTEGRATION_ITEMS
 
 COLLECTION_NAME = "hbao_viewport_views"
@@ -83,8 +83,8 @@ class HBAOViewSettings(bpy.types.PropertyGroup):
 
     def params(self):
         """These settings as the C library's parameters (native.compute_ao's dict)."""
-        return parameters.resolved({name: getattr(self, name) for name in parameters.DEFAULTS
-                                    if name != "background_depth"})
+        return native.resolve_params({name: getattr(self, name) for name in parameters.DEFAULTS
+                                      if name != "background_depth"})
 
 
 def _views(screen):
