@@ -68,7 +68,7 @@ class AOPipeline:
     def ambient_occlusion(self, depth_texture, frame, params,
                           depth_precision=shader_sources.FLOAT_DEPTH_PRECISION):
         """Blurred AO (before strength) of a planar-depth texture, as an R32F
-        texture the size of `frame`. `params` as parameters.resolved returns;
+        texture the size of `frame`. `params` as native.resolve_params returns;
         `depth_precision` bounds the depth's rounding relative to the depth
         (docs/algorithm.md, "Depth precision")."""
         width, height = frame.width, frame.height
