@@ -724,6 +724,29 @@ def test_sequence_skips_up_to_date_frames(hbao_tool, tmp_path):
     assert leftover_temporary_files(folder) == []
 
 
+def test_sequence_redoes_frames_computed_with_other_flags(hbao_tool, tmp_path):
+    """An output newer than its input is up to date only if its header holds
+    the settings this run would write (hbaoSettings): a farm task rerun with
+    another radius recomputes every frame, then skips them with the same
+    flags; an output without the attribute (another tool's file) is redone."""
+    folder, sources = sequence_folder(tmp_path)
+    run_sequence(hbao_tool, folder)
+    changed = run_sequence(hbao_tool, folder, "--radius", "0.5")
+    assert "is up to date" not in changed.stderr
+    for frame in sources:
+        single = tmp_path / f"single_{frame}.exr"
+        run_ok(hbao_tool, fixture_path(sources[frame]), "-o", single, "--no-normals",
+               "--radius", "0.5")
+        assert (folder / f"ao_{frame:04d}.exr").read_bytes() == single.read_bytes()
+    same = run_sequence(hbao_tool, folder, "--radius", "0.5", "--threads", "1")
+    assert same.stderr.count("is up to date, skipped") == 3  # threads change no value
+    foreign = folder / "ao_0001.exr"
+    foreign.write_bytes(fixture_path(sources[1]).read_bytes())  # newer, no hbaoSettings
+    redone = run_sequence(hbao_tool, folder, "--radius", "0.5")
+    assert redone.stderr.count("is up to date, skipped") == 2
+    assert "frame 1: " in redone.stderr and b"hbaoSettings" in foreign.read_bytes()
+
+
 @pytest.mark.parametrize("arguments, fragment", [
     (["in_####.exr", "-o", "ao.exr", "--frames", "1-3"], "-o (ao.exr) needs a '#'"),
     (["in.exr", "-o", "ao_#.exr", "--frames", "1-3"], "the input (in.exr) needs a '#'"),

@@ -13,6 +13,7 @@
 #include "exr_reader.h"
 #include "exr_writer.h"
 #include "png_writer.h"
+#include "run_settings.h"
 
 /* Refuse an output path that is the input file itself, through any name
  * (hard link, symbolic link, "./x" vs "x"): stat() identity, not strings.
@@ -156,7 +157,14 @@ static int write_outputs(const cli_options *options, const exr_input *input,
                                 input->screen_window_center,
                                 input->screen_window_width,
                                 options->compression,
-                                options->keep_input ? input->context : NULL};
+                                options->keep_input ? input->context : NULL,
+                                NULL,
+                                NULL};
+    char settings[RUN_SETTINGS_MAX];
+    if (run_settings_text(options, settings)) {
+        layout.stamp_name = RUN_SETTINGS_ATTRIBUTE;
+        layout.stamp_text = settings;
+    }
     int status = exr_write_image(files->exr.fd, options->output_path, &layout, channels,
                                  channel_count, error);
     if (status == TOOL_EXIT_SUCCESS && options->preview_path != NULL)

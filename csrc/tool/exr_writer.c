@@ -123,6 +123,9 @@ int exr_write_image(int fd, const char *name, const exr_output_layout *layout,
                                   channels[c].perceptual, 1, 1),
                   "cannot add a channel");
     }
+    if (layout->stamp_name != NULL)
+        CHECK_EXR(exr_attr_set_string(context, part, layout->stamp_name, layout->stamp_text),
+                  "cannot add the settings attribute");
     if (layout->copy_attributes_from != NULL) {
         CHECK_EXR(exr_copy_unset_attributes(context, part, layout->copy_attributes_from, 0),
                   "cannot copy the input's header attributes");

@@ -19,6 +19,10 @@ typedef struct exr_output_layout {
     /** When not NULL, part 0's other header attributes (Blender's
      *  BlenderMultiChannel, Camera, Frame, render stats ...) are copied. */
     exr_const_context_t copy_attributes_from;
+    /** When not NULL, a string attribute of this name and text (set before
+     *  the copied ones, so an input's attribute of the same name is replaced). */
+    const char *stamp_name;
+    const char *stamp_text;
 } exr_output_layout;
 
 /** One channel to write: `data` holds pixels of type `type` (the type it is

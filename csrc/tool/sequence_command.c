@@ -12,6 +12,7 @@
 #include "ao_command.h"
 #include "atomic_file.h"
 #include "frame_pattern.h"
+#include "run_settings.h"
 
 typedef struct frame_outcome {
     int32_t frame;
@@ -33,9 +34,9 @@ static bool newer_or_equal(const struct stat *a, const struct stat *b) {
     return a->st_mtim.tv_nsec >= b->st_mtim.tv_nsec;
 }
 
-/* Up to date, as make decides: every output exists and is at least as new
- * as the input and the camera file. Changed flags are not detected, hence
- * --force. */
+/* Up to date, as make decides, and computed with the same flags: every
+ * output exists and is at least as new as the input and the camera file, and
+ * the EXR's header holds the settings this run would write (run_settings.h). */
 static bool up_to_date(const cli_options *frame) {
     struct stat input, output, other;
     if (stat(frame->input_path, &input) != 0 || stat(frame->output_path, &output) != 0 ||
@@ -47,7 +48,8 @@ static bool up_to_date(const cli_options *frame) {
     if (frame->preview_path != NULL &&
         (stat(frame->preview_path, &other) != 0 || !newer_or_equal(&other, &input)))
         return false;
-    return true;
+    char settings[RUN_SETTINGS_MAX];
+    return run_settings_text(frame, settings) && run_settings_match(frame->output_path, settings);
 }
 
 static void report(sequence_run *run, const frame_outcome *outcome, const char *output,

@@ -1,0 +1,73 @@
+/* SPDX-License-Identifier: GPL-2.0-or-later */
+#include "run_settings.h"
+
+#include <openexr.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "exr_reader.h"
+
+/* Appends to text[*used ...]; *used past RUN_SETTINGS_MAX - 1 marks a text that
+ * did not fit. */
+static void append(char *text, size_t *used, const char *format, ...)
+    __attribute__((format(printf, 3, 4)));
+
+static void append(char *text, size_t *used, const char *format, ...) {
+    if (*used >= RUN_SETTINGS_MAX - 1) {
+        *used = RUN_SETTINGS_MAX;
+        return;
+    }
+    va_list arguments;
+    va_start(arguments, format);
+    const int written = vsnprintf(text + *used, RUN_SETTINGS_MAX - *used, format, arguments);
+    va_end(arguments);
+    *used = written < 0 ? RUN_SETTINGS_MAX : *used + (size_t)written;
+}
+
+bool run_settings_text(const cli_options *options, char text[RUN_SETTINGS_MAX]) {
+    const hbao_params *p = &options->params;
+    size_t used = 0;
+    text[0] = '\0';
+    /* %.9g: every float32 value prints to a text that reads back exactly. */
+    append(text, &used,
+           "hbao %d; radius %.9g; angle bias %.9g; directions %d; steps %d; falloff %d; "
+           "integration %d; blur size %d; blur sharpness %.9g; half resolution %d; "
+           "strength %.9g; background depth %.9g; ",
+           (int)HBAO_VERSION, (double)p->radius, (double)p->angle_bias_degrees, (int)p->directions,
+           (int)p->steps, (int)p->falloff, (int)p->integration, (int)p->blur_size,
+           (double)p->blur_sharpness, (int)p->half_resolution, (double)p->strength,
+           (double)p->background_depth);
+    append(text, &used, "keep input %d; no normals %d; compression %d; ", (int)options->keep_input,
+           (int)options->ignore_normals, (int)options->compression);
+    const camera_settings *flags = &options->camera_flags;
+    const hbao_camera *c = &flags->camera;
+    append(text, &used, "camera flags %u", (unsigned)flags->fields_set);
+    if (flags->fields_set != 0) {
+        append(text, &used, " %d %.9g %.9g %.9g %d %.9g %.9g %.9g %.9g %.9g", (int)c->projection,
+               (double)c->lens, (double)c->sensor_width, (double)c->sensor_height,
+               (int)c->sensor_fit, (double)c->shift_x, (double)c->shift_y, (double)c->ortho_scale,
+               (double)c->pixel_aspect_x, (double)c->pixel_aspect_y);
+        for (int i = 0; i < 16; ++i) append(text, &used, " %.9g", (double)c->world_to_camera[i]);
+    }
+    append(text, &used, "; layer %s; AO channel %s", options->layer ? options->layer : "(first)",
+           options->ao_channel);
+    return used < RUN_SETTINGS_MAX - 1;
+}
+
+bool run_settings_match(const char *path, const char *text) {
+    exr_context_t context = NULL;
+    exr_context_initializer_t initializer = exr_quiet_initializer();
+    if (exr_start_read(&context, path, &initializer) != EXR_ERR_SUCCESS) {
+        if (context != NULL) exr_finish(&context);
+        return false;
+    }
+    const char *stored = NULL;
+    int32_t length = 0;
+    const bool match = exr_attr_get_string(context, 0, RUN_SETTINGS_ATTRIBUTE, &length, &stored) ==
+                           EXR_ERR_SUCCESS &&
+                       stored != NULL && length >= 0 && (size_t)length == strlen(text) &&
+                       memcmp(stored, text, (size_t)length) == 0;
+    exr_finish(&context);
+    return match;
+}

@@ -1,0 +1,33 @@
+/* SPDX-License-Identifier: GPL-2.0-or-later */
+/* What an output EXR was computed with, as one line of text kept in its
+ * header, so that a sequence run can tell a frame that is up to date from one
+ * computed with other flags. */
+#ifndef HBAO_TOOL_RUN_SETTINGS_H
+#define HBAO_TOOL_RUN_SETTINGS_H
+
+#include <stdbool.h>
+
+#include "cli_options.h"
+
+/** The header attribute (a string) that holds the settings. */
+#define RUN_SETTINGS_ATTRIBUTE "hbaoSettings"
+/** Room for the longest text: 13 parameters, 27 camera numbers, a layer and a
+ *  channel name. */
+#define RUN_SETTINGS_MAX 2048
+
+/**
+ * Everything besides the input file and the camera file that decides the
+ * output EXR's content: the library version, the resolved parameters (but the
+ * thread count and the SIMD implementation, which change no value), the layer,
+ * the AO channel's name, --keep-input, --no-normals, the compression and the
+ * camera flags. Two runs with equal text write equal files from equal inputs.
+ * False when the text did not fit (a layer name of kilobytes): it is then cut
+ * and must not be used to skip work.
+ */
+bool run_settings_text(const cli_options *options, char text[RUN_SETTINGS_MAX]);
+
+/** Whether the EXR at `path` holds RUN_SETTINGS_ATTRIBUTE equal to `text`
+ *  (false when it cannot be read or has no such attribute). */
+bool run_settings_match(const char *path, const char *text);
+
+#endif /* HBAO_TOOL_RUN_SETTINGS_H */
