@@ -924,12 +924,81 @@ def test_a_data_window_gets_the_camera_of_its_crop(hbao_tool, tmp_path):
     assert differing <= CROP_AO_MAX_DIFFERING_FRACTION, differing
     assert np.mean(1.0 - same) > 0.05  # there is occlusion to compare
 
-    outside = tmp_path / "outside.exr"
-    outside.write_bytes(scanline_exr({"Depth.Z": depth[:height, :width]}, width, height,
-                                     display_window=(0, 0, full_width - 1, full_height - 1),
-                                     data_origin=(full_width - width // 2, 0)))
-    assert_clean_error(run_tool(hbao_tool, outside, "-o", tmp_path / "outside_ao.exr",
-                                "--camera", camera), 1, "crop rectangle")
+
+# The camera of the display window DATA_WINDOW of FULL_SIZE under test above's
+# full-frame camera (lens 35, sensor 36 fitted to the 192-pixel width, shift
+# (0.1, -0.05)), worked out by hand from docs/algorithm.md's crop rule: the
+# sensor spans 64 of 192 pixels, 36 * 64 / 192 = 12 mm; the window's left edge
+# lies at -96 + 0.1 * 192 + 64 = -12.8 pixels from the view axis, its centre
+# at 19.2 = 0.3 * 64; its bottom edge at -48 - 0.05 * 192 + (96 - 16 - 64) =
+# -41.6, its centre at -9.6 = -0.15 * 64.
+WINDOW_CAMERA = {"type": "PERSP", "lens": 35.0, "sensor_width": 12.0,
+                 "sensor_fit": "HORIZONTAL", "shift_x": 0.3, "shift_y": -0.15}
+
+
+def test_a_data_window_past_the_display_window_is_a_guard_band(hbao_tool, tmp_path):
+    """Overscan: a display window (the frame, whose camera is given) inside a
+    larger data window. The tool widens the frame's camera to the data window
+    (hbao_camera_crop with a negative origin) and computes AO over all of it,
+    so the frame's border pixels see the occluders outside the frame: the AO
+    equals that of the larger frame rendered with its own camera, while the
+    frame alone differs at its borders. The output keeps the input's windows;
+    --crop-to-display writes only the frame."""
+    from hbao import exr_passes
+    full_width, full_height = FULL_SIZE
+    x0, y0, width, height = DATA_WINDOW
+    depth = _wavy_depth(full_width, full_height)
+    full_camera = tmp_path / "full_camera.json"
+    full_camera.write_text(json.dumps({"type": "PERSP", "lens": 35.0, "shift_x": 0.1,
+                                       "shift_y": -0.05}))
+    window_camera = tmp_path / "window_camera.json"
+    window_camera.write_text(json.dumps(WINDOW_CAMERA))
+    full = tmp_path / "full.exr"
+    full.write_bytes(scanline_exr({"Depth.Z": depth}, full_width, full_height))
+    display = (0, 0, width - 1, height - 1)
+    overscan = tmp_path / "overscan.exr"
+    overscan.write_bytes(scanline_exr({"Depth.Z": depth}, full_width, full_height,
+                                      display_window=display, data_origin=(-x0, -y0)))
+    frame = tmp_path / "frame.exr"
+    frame.write_bytes(scanline_exr({"Depth.Z": depth[y0:y0 + height, x0:x0 + width]}, width,
+                                   height))
+    flags = ("--radius", "0.2", "--blur", "0", "--threads", "1")
+    runs = {"full": (full, full_camera), "overscan": (overscan, window_camera),
+            "frame": (frame, window_camera)}
+    ao = {}
+    for name, (path, camera) in runs.items():
+        output = tmp_path / f"{name}_ao.exr"
+        run_ok(hbao_tool, path, "-o", output, "--camera", camera, *flags)
+        ao[name] = exr_passes.read_channels(output, ["AO"])["AO"]
+    written = info(hbao_tool, tmp_path / "overscan_ao.exr")
+    assert written["data_window"] == info(hbao_tool, overscan)["data_window"]
+    assert written["display_window"] == info(hbao_tool, overscan)["display_window"]
+    # The same grid as the full frame, all of it: the cameras differ by float
+    # roundings only (CROP_AO_* above).
+    assert ao["overscan"].shape == (full_height, full_width)
+    differing = np.mean(np.abs(ao["overscan"] - ao["full"]) > CROP_AO_TOLERANCE)
+    assert differing <= CROP_AO_MAX_DIFFERING_FRACTION, differing
+    # Without the band the frame's border pixels miss occluders outside it
+    # (the radius reaches up to 9 pixels, see above): a band 9 pixels wide
+    # covers 26 % of the frame; here it counts.
+    in_frame = ao["full"][y0:y0 + height, x0:x0 + width]
+    assert np.mean(np.abs(ao["frame"] - in_frame) > CROP_AO_TOLERANCE) > 0.05
+
+    cropped = tmp_path / "cropped_ao.exr"
+    preview = tmp_path / "cropped_ao.png"
+    run_ok(hbao_tool, overscan, "-o", cropped, "--camera", window_camera, "--crop-to-display",
+           "--preview", preview, *flags)
+    assert info(hbao_tool, cropped)["data_window"] == info(hbao_tool, frame)["data_window"]
+    # The same computation, only written in part: bit-identical.
+    cropped_ao = exr_passes.read_channels(cropped, ["AO"])["AO"]
+    assert np.array_equal(cropped_ao, ao["overscan"][y0:y0 + height, x0:x0 + width])
+    assert png_header(preview)[:2] == (width, height)
+
+    apart = tmp_path / "apart.exr"
+    apart.write_bytes(scanline_exr({"Depth.Z": depth}, full_width, full_height,
+                                   display_window=display, data_origin=(width, 0)))
+    assert_clean_error(run_tool(hbao_tool, apart, "-o", tmp_path / "apart_ao.exr",
+                                "--crop-to-display"), 1, "does not overlap")
 
 
 @pytest.mark.parametrize("names", [("B", "G", "R", "Z"), ("G", "R", "Z")])

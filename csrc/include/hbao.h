@@ -67,8 +67,7 @@ extern "C" {
       "finite and > 0; the matrix must be finite and invertible)")                                 \
     X(HBAO_ERROR_OUT_OF_MEMORY, "out of memory")                                                   \
     X(HBAO_ERROR_THREAD, "could not start a worker thread")                                        \
-    X(HBAO_ERROR_INVALID_RECTANGLE,                                                                \
-      "the crop rectangle must be at least 1 x 1 and lie inside the image")
+    X(HBAO_ERROR_INVALID_RECTANGLE, "the crop rectangle's width and height must be in [1, 65536]")
 
 typedef enum hbao_result_code {
 #define HBAO_RESULT_ENUM_ENTRY(name, message) name,
@@ -329,17 +328,23 @@ HBAO_EXPORT hbao_result hbao_camera_view(const hbao_camera *camera, int32_t widt
                                          hbao_view *view);
 
 /**
- * The camera of the sub-rectangle (x, y, width, height) of a full_width x
+ * The camera of the rectangle (x, y, width, height) of a full_width x
  * full_height image (a border render, an EXR data window inside its display
  * window): each of its pixels gets the view ray the full camera gives the
- * same pixel. The sensor fit is made explicit (AUTO becomes the side it
- * fitted), the fitted sensor side and the ortho scale are scaled to the
- * crop and the lens shift moves the centre; lens, pixel aspect and matrix
- * are kept. A crop of the whole image returns the camera unchanged.
+ * same pixel. The rectangle may also reach past the image (overscan: a data
+ * window larger than the display window, a guard band of depth around the
+ * frame so that occluders just outside it count); its pixels there get the
+ * rays of the full camera's view plane extended. The sensor fit is made
+ * explicit (AUTO becomes the side it fitted), the fitted sensor side and
+ * the ortho scale are scaled to the rectangle and the lens shift moves the
+ * centre; lens, pixel aspect and matrix are kept. A crop of the whole image
+ * returns the camera unchanged.
  *
  * @param full_width, full_height  the full image, each in [1, 65536]
- * @param x, y           the crop's top-left pixel in the full image (y down)
- * @param width, height  the crop, >= 1, inside the full image
+ * @param x, y           the rectangle's top-left pixel in the full image's
+ *                       pixel grid (y down); negative or past the image for
+ *                       overscan
+ * @param width, height  the rectangle, each in [1, 65536]
  * @param cropped        output; may be `camera`
  * @return HBAO_ERROR_NULL_ARGUMENT, HBAO_ERROR_INVALID_SIZE,
  *         HBAO_ERROR_INVALID_RECTANGLE, HBAO_ERROR_INVALID_CAMERA (for the

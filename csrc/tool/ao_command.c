@@ -147,10 +147,40 @@ static void abort_outputs(output_files *files) {
     atomic_file_abort(&files->png);
 }
 
+/* --crop-to-display: the part of the data window inside the display window,
+ * and each channel's data moved to its top-left pixel. */
+static int crop_to_display(const cli_options *options, const exr_input *input,
+                           exr_output_channel *channels, int channel_count, pixel_rect *window,
+                           int64_t *ao_offset, tool_error *error) {
+    const pixel_rect *data = &input->data_window, *display = &input->display_window;
+    window->min_x = data->min_x > display->min_x ? data->min_x : display->min_x;
+    window->min_y = data->min_y > display->min_y ? data->min_y : display->min_y;
+    window->max_x = data->max_x < display->max_x ? data->max_x : display->max_x;
+    window->max_y = data->max_y < display->max_y ? data->max_y : display->max_y;
+    if (window->min_x > window->max_x || window->min_y > window->max_y)
+        return tool_fail(error, TOOL_EXIT_RUNTIME,
+                         "%s: --crop-to-display: the data window does not overlap the display "
+                         "window",
+                         options->input_path);
+    const int64_t columns = (int64_t)window->min_x - data->min_x;
+    const int64_t rows = (int64_t)window->min_y - data->min_y;
+    for (int c = 0; c < channel_count; ++c)
+        channels[c].data += rows * channels[c].row_stride + columns * channels[c].pixel_stride;
+    *ao_offset = rows * input->width + columns;
+    return TOOL_EXIT_SUCCESS;
+}
+
 static int write_outputs(const cli_options *options, const exr_input *input,
-                         const exr_output_channel *channels, int channel_count, const float *ao,
+                         exr_output_channel *channels, int channel_count, const float *ao,
                          output_files *files, tool_error *error) {
-    exr_output_layout layout = {input->data_window,
+    pixel_rect window = input->data_window;
+    int64_t ao_offset = 0;
+    if (options->crop_to_display) {
+        const int status =
+            crop_to_display(options, input, channels, channel_count, &window, &ao_offset, error);
+        if (status != TOOL_EXIT_SUCCESS) return status;
+    }
+    exr_output_layout layout = {window,
                                 input->display_window,
                                 input->pixel_aspect_ratio,
                                 input->screen_window_center,
@@ -160,8 +190,9 @@ static int write_outputs(const cli_options *options, const exr_input *input,
     int status = exr_write_image(files->exr.fd, options->output_path, &layout, channels,
                                  channel_count, error);
     if (status == TOOL_EXIT_SUCCESS && options->preview_path != NULL)
-        status = png_write_gray(files->png.fd, options->preview_path, ao, input->width,
-                                input->height, input->width, error);
+        status = png_write_gray(files->png.fd, options->preview_path, ao + ao_offset,
+                                window.max_x - window.min_x + 1, window.max_y - window.min_y + 1,
+                                input->width, error);
     /* Both files are complete: only now replace the destinations. */
     if (status == TOOL_EXIT_SUCCESS) status = atomic_file_commit(&files->exr, error);
     if (status == TOOL_EXIT_SUCCESS && options->preview_path != NULL)

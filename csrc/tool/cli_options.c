@@ -14,6 +14,7 @@ typedef enum option_id {
     OPTION_AO_CHANNEL,
     OPTION_KEEP_INPUT,
     OPTION_NO_NORMALS,
+    OPTION_CROP_TO_DISPLAY,
     OPTION_PREVIEW,
     OPTION_COMPRESSION,
     OPTION_RADIUS,
@@ -61,6 +62,7 @@ static const option_spec option_specs[] = {
     {"ao-channel", 0, OPTION_AO_CHANNEL, true},
     {"keep-input", 0, OPTION_KEEP_INPUT, false},
     {"no-normals", 0, OPTION_NO_NORMALS, false},
+    {"crop-to-display", 0, OPTION_CROP_TO_DISPLAY, false},
     {"preview", 0, OPTION_PREVIEW, true},
     {"compression", 0, OPTION_COMPRESSION, true},
     {"radius", 0, OPTION_RADIUS, true},
@@ -197,6 +199,9 @@ static int apply_option(const option_spec *spec, const char *value, cli_options 
             break;
         case OPTION_NO_NORMALS:
             options->ignore_normals = true;
+            break;
+        case OPTION_CROP_TO_DISPLAY:
+            options->crop_to_display = true;
             break;
         case OPTION_PREVIEW:
             options->preview_path = value;
@@ -534,6 +539,8 @@ void cli_print_help(FILE *stream) {
         "  --keep-input            also copy every input channel (same names and pixel\n"
         "                          types) and header attributes into the output; an input\n"
         "                          channel with the AO channel's name is replaced.\n"
+        "  --crop-to-display       write only the part of the data window inside the\n"
+        "                          display window (see Data window below).\n"
         "  --compression METHOD    none, rle, zips, zip (default) or piz (lossless only).\n"
         "  --preview FILE.png      also write the AO as an 8-bit grayscale PNG: the linear\n"
         "                          AO value 0..1 maps to 0..255, no gamma curve.\n"
@@ -607,7 +614,13 @@ void cli_print_help(FILE *stream) {
         "\n"
         "Data window: the tool works on the EXR's data window and writes the output with\n"
         "the same data and display windows; when the data window is a part of the\n"
-        "display window, the camera is adjusted to that part (same view rays). Blender\n"
+        "display window, the camera is adjusted to that part (same view rays). A data\n"
+        "window that reaches past the display window (overscan) is a guard band: the\n"
+        "camera describes the display window and is widened to the data window (same\n"
+        "view rays for the display window's pixels), so occluders just outside the\n"
+        "frame darken its borders; the whole data window gets AO, and viewers that show\n"
+        "the display window (Blender) show the frame. --crop-to-display keeps only the\n"
+        "frame's pixels (an error when the windows do not overlap). Blender\n"
         "itself always writes data window = display window: a border render without\n"
         "cropping is a full frame (unrendered pixels are background, AO 1); with\n"
         "\"Crop to Render Region\" nothing in the file says where the region was, so\n"
