@@ -4,7 +4,7 @@ inside the frame, today, with a guard band (overscan) around the frame, and
 with a finite occluder thickness.
 
     /usr/bin/python3 bench/guard_band.py [--scenes bunny,interior] \\
-        [--bands 0.125,0.25] [--thickness 0.05,0.1,0.25]
+        [--bands 0.125,0.25] [--thickness 0.25,0.5,1]
 
 Renders (cached like run_benchmark.py's, in the same folder): each scene's
 quick-mode reference (Cycles, 256 samples: the ground truth and today's
@@ -15,7 +15,8 @@ with the frame's camera widened by libhbao's hbao_camera_crop (negative
 origin: overscan), as the CLI does for an EXR whose data window extends past
 its display window, and then cropped to the frame. Every error is over the
 frame's foreground pixels, with the library's default settings and the
-scene's radius. Prints a Markdown table and writes .cache/bench/guard_band.json.
+scene's radius; thicknesses are given in units of that radius (no guard
+band). Prints a Markdown table and writes .cache/bench/guard_band.json.
 """
 import argparse
 import json
@@ -118,9 +119,11 @@ def measure_scene(native, renders, scene, mode, overscans, thicknesses):
             render_s=band_meta["time_s"], plain_render_s=plain_render_s,
             pixel_factor=(width + 2 * pixels) * (height + 2 * pixels) / (width * height),
             centre_matches_frame=float(np.mean(np.isclose(centre, depth, rtol=1e-6) | ~mask))))
-    for thickness in thicknesses:
+    for fraction in thicknesses:
+        thickness = fraction * radius
         ao, seconds = timed(native, depth, normal, camera, dict(params, thickness=thickness))
-        result["thickness"].append(dict(errors(ao), thickness=thickness, seconds=seconds))
+        result["thickness"].append(dict(errors(ao), thickness=thickness,
+                                        thickness_per_radius=fraction, seconds=seconds))
     return result
 
 
@@ -140,7 +143,8 @@ def table(results):
                          f"{band['seconds'] * 1e3:.1f} | {band['pixel_factor']:.2f}x | "
                          f"{band['render_s']:.2f} |")
         for entry in result["thickness"]:
-            lines.append(f"| {result['scene']} | thickness {entry['thickness']:g} | "
+            lines.append(f"| {result['scene']} | thickness {entry['thickness_per_radius']:g} "
+                         f"x radius ({entry['thickness']:g}) | "
                          f"{entry['rmse']:.4f} | {entry['inner_rmse']:.4f} | "
                          f"{entry['bias']:+.4f} | {entry['seconds'] * 1e3:.1f} | 1.00x | |")
     return "\n".join(lines)
@@ -151,7 +155,8 @@ def main():
     parser.add_argument("--scenes", default="bunny,interior,terrain")
     parser.add_argument("--bands", default=",".join(str(b) for b in DEFAULT_BANDS))
     parser.add_argument("--thickness", default="",
-                        help="comma-separated occluder thicknesses (scene units) to measure")
+                        help="comma-separated occluder thicknesses to measure, in units of "
+                             "each scene's AO radius")
     parser.add_argument("--cache", default=str(run_benchmark.REPO / ".cache/bench"))
     args = parser.parse_args()
     mode = config.QUICK

@@ -755,6 +755,8 @@ def test_a_frame_pattern_without_frames_gets_a_hint(hbao_tool, tmp_path):
     (["--radius", "inf"], "--radius"),
     (["--radius", "1e999"], "--radius"),
     (["--radius", "-1"], "--radius"),
+    (["--thickness", "-0.5"], "--thickness"),
+    (["--thickness", "inf"], "--thickness"),
     (["--radius", ""], "--radius"),
     (["--radius=2x"], "--radius"),
     (["--directions", "abc"], "--directions"),
@@ -999,6 +1001,28 @@ def test_a_data_window_past_the_display_window_is_a_guard_band(hbao_tool, tmp_pa
                                    display_window=display, data_origin=(width, 0)))
     assert_clean_error(run_tool(hbao_tool, apart, "-o", tmp_path / "apart_ao.exr",
                                 "--crop-to-display"), 1, "does not overlap")
+
+
+def test_thickness_lets_light_pass_behind_a_thin_occluder(hbao_tool, tmp_path):
+    """A strip 0.3 in front of a wall facing the camera (planar depths 4.7 and
+    5): with infinitely thick occluders (the default) the strip darkens the
+    wall beside it; --thickness 0.15 makes it a plate wholly in front of the
+    wall, and the wall is a bare plane again: AO 1 (to 1e-4, test_ao.c's
+    bound for a plane)."""
+    from hbao import exr_passes
+    width, height = 96, 64
+    depth = np.full((height, width), 5.0, np.float32)
+    depth[:, 40:56] = 4.7
+    source = tmp_path / "strip.exr"
+    source.write_bytes(scanline_exr({"Depth.Z": depth}, width, height))
+    ao = {}
+    for name, extra in (("thick", ()), ("thin", ("--thickness", "0.15"))):
+        output = tmp_path / f"{name}.exr"
+        run_ok(hbao_tool, source, "-o", output, "--radius", "0.8", "--blur", "0", *extra)
+        ao[name] = exr_passes.read_channels(output, ["AO"])["AO"]
+    wall = depth == 5.0
+    assert ao["thick"][wall].min() < 0.9
+    assert ao["thin"][wall].min() == pytest.approx(1.0, abs=1e-4)
 
 
 @pytest.mark.parametrize("names", [("B", "G", "R", "Z"), ("G", "R", "Z")])

@@ -55,7 +55,7 @@ MIN_OCCLUDED_FRACTION = 0.02
 UNOCCLUDED_CASES = {"grazing_hbao", "grazing_cosine", "one_row_hbao"}
 EXPECTED_CASES = {"persp_cosine", "persp_hbao", "persp_cosine_no_falloff", "shifted_hbao_bias",
                   "ortho_cosine", "persp_cosine_blur", "persp_hbao_blur_strength",
-                  "ortho_cosine_blur"} | UNOCCLUDED_CASES
+                  "ortho_cosine_blur", "persp_cosine_thickness"} | UNOCCLUDED_CASES
 
 # The preview multiplies the view by AO <= 1: it may only darken. 8-bit
 # screenshots: one code value of slack for rounding.

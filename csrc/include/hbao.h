@@ -147,6 +147,14 @@ typedef struct hbao_params {
     /** hbao_implementation: which code computes the horizons. All give
      *  bit-identical results; choosing one exists for tests and benchmarks. */
     int32_t implementation;
+    /** Occluder thickness in scene units; 0 (the default) = infinitely
+     *  thick (every surface a solid block reaching back from its depth: the
+     *  height-field model of every version before this field). Otherwise a surface seen at a sample is taken to
+     *  occupy depths [sample depth, sample depth + thickness] along its view
+     *  ray, and a sample whose block lies wholly in front of the pixel
+     *  (sample depth + thickness < the pixel's depth) does not raise the
+     *  horizon: light passes behind it. Must be finite and >= 0. */
+    float thickness;
 } hbao_params;
 
 /** The horizon search exists as a portable scalar reference and as SIMD
@@ -178,7 +186,7 @@ typedef enum hbao_implementation {
         HBAO_DEFAULT_RADIUS, HBAO_DEFAULT_ANGLE_BIAS_DEGREES, HBAO_DEFAULT_DIRECTIONS,             \
             HBAO_DEFAULT_STEPS, HBAO_FALLOFF_NONE, HBAO_INTEGRATION_COSINE,                        \
             HBAO_DEFAULT_BLUR_SIZE, HBAO_DEFAULT_BLUR_SHARPNESS, 0, HBAO_DEFAULT_STRENGTH, 0,      \
-            HBAO_DEFAULT_BACKGROUND_DEPTH, 0                                                       \
+            HBAO_DEFAULT_BACKGROUND_DEPTH, 0, 0.0f                                                 \
     }
 
 typedef enum hbao_projection {
@@ -264,7 +272,8 @@ typedef struct hbao_channel {
     X(HBAO_PARAM_FIELD_STRENGTH, 9, "strength")                                                    \
     X(HBAO_PARAM_FIELD_THREADS, 10, "threads")                                                     \
     X(HBAO_PARAM_FIELD_BACKGROUND_DEPTH, 11, "background_depth")                                   \
-    X(HBAO_PARAM_FIELD_IMPLEMENTATION, 12, "implementation")
+    X(HBAO_PARAM_FIELD_IMPLEMENTATION, 12, "implementation")                                       \
+    X(HBAO_PARAM_FIELD_THICKNESS, 13, "thickness")
 
 typedef enum hbao_param_field {
 #define HBAO_PARAM_FIELD_ENUM_ENTRY(name, bit, text) name = 1u << (bit),
@@ -279,8 +288,8 @@ typedef enum hbao_param_field {
  * nearest limit and their bits (hbao_param_field) set in *clamped_fields, so
  * the caller can warn; negative threads become 0 (one per core) and a
  * non-zero half_resolution becomes 1, without a bit. Values that have no
- * nearest legal value (NaN or infinite floats, a negative radius, a
- * background_depth <= 0, unknown enum values) give
+ * nearest legal value (NaN or infinite floats, a negative radius or
+ * thickness, a background_depth <= 0, unknown enum values) give
  * HBAO_ERROR_INVALID_PARAMETER, and then *clamped_fields holds the bits of
  * those invalid fields instead and *out is unchanged. `out` may be `in`;
  * clamped_fields may be NULL.

@@ -18,6 +18,7 @@ typedef enum option_id {
     OPTION_PREVIEW,
     OPTION_COMPRESSION,
     OPTION_RADIUS,
+    OPTION_THICKNESS,
     OPTION_ANGLE_BIAS,
     OPTION_DIRECTIONS,
     OPTION_STEPS,
@@ -66,6 +67,7 @@ static const option_spec option_specs[] = {
     {"preview", 0, OPTION_PREVIEW, true},
     {"compression", 0, OPTION_COMPRESSION, true},
     {"radius", 0, OPTION_RADIUS, true},
+    {"thickness", 0, OPTION_THICKNESS, true},
     {"angle-bias", 0, OPTION_ANGLE_BIAS, true},
     {"directions", 0, OPTION_DIRECTIONS, true},
     {"steps", 0, OPTION_STEPS, true},
@@ -218,6 +220,10 @@ static int apply_option(const option_spec *spec, const char *value, cli_options 
             status =
                 parse_float_flag(flag, value, -FLT_MAX, FLT_MAX, false, &params->radius, error);
             break;
+        case OPTION_THICKNESS:
+            status =
+                parse_float_flag(flag, value, -FLT_MAX, FLT_MAX, false, &params->thickness, error);
+            break;
         case OPTION_ANGLE_BIAS:
             status = parse_float_flag(flag, value, -FLT_MAX, FLT_MAX, false,
                                       &params->angle_bias_degrees, error);
@@ -353,6 +359,7 @@ static const struct {
     {HBAO_PARAM_FIELD_BLUR_SHARPNESS, "blur-sharpness"},
     {HBAO_PARAM_FIELD_STRENGTH, "strength"},
     {HBAO_PARAM_FIELD_THREADS, "threads"},
+    {HBAO_PARAM_FIELD_THICKNESS, "thickness"},
 };
 
 static double param_value(const hbao_params *params, uint32_t field) {
@@ -373,6 +380,8 @@ static double param_value(const hbao_params *params, uint32_t field) {
             return params->strength;
         case HBAO_PARAM_FIELD_THREADS:
             return params->threads;
+        case HBAO_PARAM_FIELD_THICKNESS:
+            return params->thickness;
         default:
             return NAN;
     }
@@ -568,6 +577,10 @@ void cli_print_help(FILE *stream) {
         "  --strength S            ao = ao^S, [0, %g] (default %g)\n"
         "  --threads N             worker threads, at most %d; 0 (or less) = one per\n"
         "                          core (default)\n"
+        "  --thickness T           occluder thickness in scene units (>= 0, else an\n"
+        "                          error): a sample more than T nearer than the pixel\n"
+        "                          does not occlude it (no halo on the background behind\n"
+        "                          an object). 0 = infinitely thick (default)\n"
         "\n"
         "Camera (Blender's camera model and names; flags override --camera):\n"
         "  --camera FILE.json      JSON object with Blender's property names: type\n"
