@@ -989,11 +989,13 @@ def test_a_data_window_past_the_display_window_is_a_guard_band(hbao_tool, tmp_pa
     cropped = tmp_path / "cropped_ao.exr"
     preview = tmp_path / "cropped_ao.png"
     run_ok(hbao_tool, overscan, "-o", cropped, "--camera", window_camera, "--crop-to-display",
-           "--preview", preview, *flags)
+           "--preview", preview, "--keep-input", *flags)
     assert info(hbao_tool, cropped)["data_window"] == info(hbao_tool, frame)["data_window"]
-    # The same computation, only written in part: bit-identical.
-    cropped_ao = exr_passes.read_channels(cropped, ["AO"])["AO"]
-    assert np.array_equal(cropped_ao, ao["overscan"][y0:y0 + height, x0:x0 + width])
+    # The same computation, only written in part: bit-identical; copied
+    # channels are cropped alike.
+    written = exr_passes.read_channels(cropped, ["AO", "Depth.Z"])
+    assert np.array_equal(written["AO"], ao["overscan"][y0:y0 + height, x0:x0 + width])
+    assert np.array_equal(written["Depth.Z"], depth[y0:y0 + height, x0:x0 + width])
     assert png_header(preview)[:2] == (width, height)
 
     apart = tmp_path / "apart.exr"
