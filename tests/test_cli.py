@@ -945,7 +945,9 @@ def test_a_data_window_past_the_display_window_is_a_guard_band(hbao_tool, tmp_pa
     so the frame's border pixels see the occluders outside the frame: the AO
     equals that of the larger frame rendered with its own camera, while the
     frame alone differs at its borders. The output keeps the input's windows;
-    --crop-to-display writes only the frame."""
+    --crop-to-display writes only the frame. --overscan N does the same for
+    a plain render widened by N pixels a side (Blender writes no overscan
+    windows), given with its own wide camera."""
     from hbao import exr_passes
     full_width, full_height = FULL_SIZE
     x0, y0, width, height = DATA_WINDOW
@@ -997,6 +999,24 @@ def test_a_data_window_past_the_display_window_is_a_guard_band(hbao_tool, tmp_pa
     assert np.array_equal(written["AO"], ao["overscan"][y0:y0 + height, x0:x0 + width])
     assert np.array_equal(written["Depth.Z"], depth[y0:y0 + height, x0:x0 + width])
     assert png_header(preview)[:2] == (width, height)
+
+    # --overscan: a plain render widened by a band on every side, with its own
+    # (wide) camera, written as its centre frame; the same computation as the
+    # full frame's, so bit-identical to its centre.
+    band = 16
+    centre = tmp_path / "centre_ao.exr"
+    run_ok(hbao_tool, full, "-o", centre, "--camera", full_camera, "--overscan", band, *flags)
+    assert info(hbao_tool, centre)["data_window"] == [0, 0, full_width - 2 * band - 1,
+                                                      full_height - 2 * band - 1]
+    assert info(hbao_tool, centre)["display_window"] == info(hbao_tool, centre)["data_window"]
+    assert np.array_equal(exr_passes.read_channels(centre, ["AO"])["AO"],
+                          ao["full"][band:-band, band:-band])
+    assert_clean_error(run_tool(hbao_tool, full, "-o", centre, "--overscan", full_height // 2),
+                       1, "leaves no frame")
+    assert_clean_error(run_tool(hbao_tool, overscan, "-o", centre, "--overscan", band),
+                       1, "must be the display window")
+    assert_clean_error(run_tool(hbao_tool, full, "-o", centre, "--overscan", band,
+                                "--crop-to-display"), 2, "give one")
 
     apart = tmp_path / "apart.exr"
     apart.write_bytes(scanline_exr({"Depth.Z": depth}, full_width, full_height,

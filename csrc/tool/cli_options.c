@@ -15,6 +15,7 @@ typedef enum option_id {
     OPTION_KEEP_INPUT,
     OPTION_NO_NORMALS,
     OPTION_CROP_TO_DISPLAY,
+    OPTION_OVERSCAN,
     OPTION_PREVIEW,
     OPTION_COMPRESSION,
     OPTION_RADIUS,
@@ -64,6 +65,7 @@ static const option_spec option_specs[] = {
     {"keep-input", 0, OPTION_KEEP_INPUT, false},
     {"no-normals", 0, OPTION_NO_NORMALS, false},
     {"crop-to-display", 0, OPTION_CROP_TO_DISPLAY, false},
+    {"overscan", 0, OPTION_OVERSCAN, true},
     {"preview", 0, OPTION_PREVIEW, true},
     {"compression", 0, OPTION_COMPRESSION, true},
     {"radius", 0, OPTION_RADIUS, true},
@@ -204,6 +206,9 @@ static int apply_option(const option_spec *spec, const char *value, cli_options 
             break;
         case OPTION_CROP_TO_DISPLAY:
             options->crop_to_display = true;
+            break;
+        case OPTION_OVERSCAN:
+            status = parse_int_flag(flag, value, 0, HBAO_MAX_IMAGE_SIZE, &options->overscan, error);
             break;
         case OPTION_PREVIEW:
             options->preview_path = value;
@@ -494,6 +499,9 @@ int cli_parse(int argc, char **argv, cli_options *options, tool_error *error) {
         return tool_fail(error, TOOL_EXIT_USAGE, "--jobs and --force go with --frames");
     if (options->info_json)
         return tool_fail(error, TOOL_EXIT_USAGE, "--json only goes with --info");
+    if (options->crop_to_display && options->overscan > 0)
+        return tool_fail(error, TOOL_EXIT_USAGE,
+                         "--overscan and --crop-to-display each choose what is written: give one");
     if (options->output_path == NULL)
         return tool_fail(error, TOOL_EXIT_USAGE, "no output file: give -o OUTPUT.exr");
     if (options->output_path[0] == '\0' ||
@@ -550,6 +558,12 @@ void cli_print_help(FILE *stream) {
         "                          channel with the AO channel's name is replaced.\n"
         "  --crop-to-display       write only the part of the data window inside the\n"
         "                          display window (see Data window below).\n"
+        "  --overscan N            the input is the frame rendered N pixels wider on every\n"
+        "                          side (resolution + 2N, sensor or ortho scale grown in\n"
+        "                          proportion; its own camera): the AO uses all of it, so\n"
+        "                          the frame's borders see occluders just outside, and the\n"
+        "                          output is the centre frame only. Not with\n"
+        "                          --crop-to-display.\n"
         "  --compression METHOD    none, rle, zips, zip (default) or piz (lossless only).\n"
         "  --preview FILE.png      also write the AO as an 8-bit grayscale PNG: the linear\n"
         "                          AO value 0..1 maps to 0..255, no gamma curve.\n"

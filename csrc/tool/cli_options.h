@@ -36,6 +36,7 @@ typedef struct cli_options {
     bool keep_input;
     bool ignore_normals;
     bool crop_to_display; /**< write only the data window's part inside the display window */
+    int32_t overscan;     /**< > 0: the input is a render widened by this many pixels a side */
     bool info_json;
     exr_compression_t compression;
     hbao_params params;
