@@ -778,6 +778,8 @@ def test_a_frame_pattern_without_frames_gets_a_hint(hbao_tool, tmp_path):
     (["--radius", "inf"], "--radius"),
     (["--radius", "1e999"], "--radius"),
     (["--radius", "-1"], "--radius"),
+    (["--thickness", "-0.5"], "--thickness"),
+    (["--thickness", "inf"], "--thickness"),
     (["--radius", ""], "--radius"),
     (["--radius=2x"], "--radius"),
     (["--directions", "abc"], "--directions"),
@@ -947,12 +949,125 @@ def test_a_data_window_gets_the_camera_of_its_crop(hbao_tool, tmp_path):
     assert differing <= CROP_AO_MAX_DIFFERING_FRACTION, differing
     assert np.mean(1.0 - same) > 0.05  # there is occlusion to compare
 
-    outside = tmp_path / "outside.exr"
-    outside.write_bytes(scanline_exr({"Depth.Z": depth[:height, :width]}, width, height,
-                                     display_window=(0, 0, full_width - 1, full_height - 1),
-                                     data_origin=(full_width - width // 2, 0)))
-    assert_clean_error(run_tool(hbao_tool, outside, "-o", tmp_path / "outside_ao.exr",
-                                "--camera", camera), 1, "crop rectangle")
+
+# The camera of the display window DATA_WINDOW of FULL_SIZE under test above's
+# full-frame camera (lens 35, sensor 36 fitted to the 192-pixel width, shift
+# (0.1, -0.05)), worked out by hand from docs/algorithm.md's crop rule: the
+# sensor spans 64 of 192 pixels, 36 * 64 / 192 = 12 mm; the window's left edge
+# lies at -96 + 0.1 * 192 + 64 = -12.8 pixels from the view axis, its centre
+# at 19.2 = 0.3 * 64; its bottom edge at -48 - 0.05 * 192 + (96 - 16 - 64) =
+# -41.6, its centre at -9.6 = -0.15 * 64.
+WINDOW_CAMERA = {"type": "PERSP", "lens": 35.0, "sensor_width": 12.0,
+                 "sensor_fit": "HORIZONTAL", "shift_x": 0.3, "shift_y": -0.15}
+
+
+def test_a_data_window_past_the_display_window_is_a_guard_band(hbao_tool, tmp_path):
+    """Overscan: a display window (the frame, whose camera is given) inside a
+    larger data window. The tool widens the frame's camera to the data window
+    (hbao_camera_crop with a negative origin) and computes AO over all of it,
+    so the frame's border pixels see the occluders outside the frame: the AO
+    equals that of the larger frame rendered with its own camera, while the
+    frame alone differs at its borders. The output keeps the input's windows;
+    --crop-to-display writes only the frame. --overscan N does the same for
+    a plain render widened by N pixels a side (Blender writes no overscan
+    windows), given with its own wide camera."""
+    from hbao import exr_passes
+    full_width, full_height = FULL_SIZE
+    x0, y0, width, height = DATA_WINDOW
+    depth = _wavy_depth(full_width, full_height)
+    full_camera = tmp_path / "full_camera.json"
+    full_camera.write_text(json.dumps({"type": "PERSP", "lens": 35.0, "shift_x": 0.1,
+                                       "shift_y": -0.05}))
+    window_camera = tmp_path / "window_camera.json"
+    window_camera.write_text(json.dumps(WINDOW_CAMERA))
+    full = tmp_path / "full.exr"
+    full.write_bytes(scanline_exr({"Depth.Z": depth}, full_width, full_height))
+    display = (0, 0, width - 1, height - 1)
+    overscan = tmp_path / "overscan.exr"
+    overscan.write_bytes(scanline_exr({"Depth.Z": depth}, full_width, full_height,
+                                      display_window=display, data_origin=(-x0, -y0)))
+    frame = tmp_path / "frame.exr"
+    frame.write_bytes(scanline_exr({"Depth.Z": depth[y0:y0 + height, x0:x0 + width]}, width,
+                                   height))
+    flags = ("--radius", "0.2", "--blur", "0", "--threads", "1")
+    runs = {"full": (full, full_camera), "overscan": (overscan, window_camera),
+            "frame": (frame, window_camera)}
+    ao = {}
+    for name, (path, camera) in runs.items():
+        output = tmp_path / f"{name}_ao.exr"
+        run_ok(hbao_tool, path, "-o", output, "--camera", camera, *flags)
+        ao[name] = exr_passes.read_channels(output, ["AO"])["AO"]
+    written = info(hbao_tool, tmp_path / "overscan_ao.exr")
+    assert written["data_window"] == info(hbao_tool, overscan)["data_window"]
+    assert written["display_window"] == info(hbao_tool, overscan)["display_window"]
+    # The same grid as the full frame, all of it: the cameras differ by float
+    # roundings only (CROP_AO_* above).
+    assert ao["overscan"].shape == (full_height, full_width)
+    differing = np.mean(np.abs(ao["overscan"] - ao["full"]) > CROP_AO_TOLERANCE)
+    assert differing <= CROP_AO_MAX_DIFFERING_FRACTION, differing
+    # Without the band the frame's border pixels miss occluders outside it
+    # (the radius reaches up to 9 pixels, see above): a band 9 pixels wide
+    # covers 26 % of the frame; here it counts.
+    in_frame = ao["full"][y0:y0 + height, x0:x0 + width]
+    assert np.mean(np.abs(ao["frame"] - in_frame) > CROP_AO_TOLERANCE) > 0.05
+
+    cropped = tmp_path / "cropped_ao.exr"
+    preview = tmp_path / "cropped_ao.png"
+    run_ok(hbao_tool, overscan, "-o", cropped, "--camera", window_camera, "--crop-to-display",
+           "--preview", preview, "--keep-input", *flags)
+    assert info(hbao_tool, cropped)["data_window"] == info(hbao_tool, frame)["data_window"]
+    # The same computation, only written in part: bit-identical; copied
+    # channels are cropped alike.
+    written = exr_passes.read_channels(cropped, ["AO", "Depth.Z"])
+    assert np.array_equal(written["AO"], ao["overscan"][y0:y0 + height, x0:x0 + width])
+    assert np.array_equal(written["Depth.Z"], depth[y0:y0 + height, x0:x0 + width])
+    assert png_header(preview)[:2] == (width, height)
+
+    # --overscan: a plain render widened by a band on every side, with its own
+    # (wide) camera, written as its centre frame; the same computation as the
+    # full frame's, so bit-identical to its centre.
+    band = 16
+    centre = tmp_path / "centre_ao.exr"
+    run_ok(hbao_tool, full, "-o", centre, "--camera", full_camera, "--overscan", band, *flags)
+    assert info(hbao_tool, centre)["data_window"] == [0, 0, full_width - 2 * band - 1,
+                                                      full_height - 2 * band - 1]
+    assert info(hbao_tool, centre)["display_window"] == info(hbao_tool, centre)["data_window"]
+    assert np.array_equal(exr_passes.read_channels(centre, ["AO"])["AO"],
+                          ao["full"][band:-band, band:-band])
+    assert_clean_error(run_tool(hbao_tool, full, "-o", centre, "--overscan", full_height // 2),
+                       1, "leaves no frame")
+    assert_clean_error(run_tool(hbao_tool, overscan, "-o", centre, "--overscan", band),
+                       1, "must be the display window")
+    assert_clean_error(run_tool(hbao_tool, full, "-o", centre, "--overscan", band,
+                                "--crop-to-display"), 2, "give one")
+
+    apart = tmp_path / "apart.exr"
+    apart.write_bytes(scanline_exr({"Depth.Z": depth}, full_width, full_height,
+                                   display_window=display, data_origin=(width, 0)))
+    assert_clean_error(run_tool(hbao_tool, apart, "-o", tmp_path / "apart_ao.exr",
+                                "--crop-to-display"), 1, "does not overlap")
+
+
+def test_thickness_lets_light_pass_behind_a_thin_occluder(hbao_tool, tmp_path):
+    """A strip 0.3 in front of a wall facing the camera (planar depths 4.7 and
+    5): with infinitely thick occluders (the default) the strip darkens the
+    wall beside it; --thickness 0.15 makes it a plate wholly in front of the
+    wall, and the wall is a bare plane again: AO 1 (to 1e-4, test_ao.c's
+    bound for a plane)."""
+    from hbao import exr_passes
+    width, height = 96, 64
+    depth = np.full((height, width), 5.0, np.float32)
+    depth[:, 40:56] = 4.7
+    source = tmp_path / "strip.exr"
+    source.write_bytes(scanline_exr({"Depth.Z": depth}, width, height))
+    ao = {}
+    for name, extra in (("thick", ()), ("thin", ("--thickness", "0.15"))):
+        output = tmp_path / f"{name}.exr"
+        run_ok(hbao_tool, source, "-o", output, "--radius", "0.8", "--blur", "0", *extra)
+        ao[name] = exr_passes.read_channels(output, ["AO"])["AO"]
+    wall = depth == 5.0
+    assert ao["thick"][wall].min() < 0.9
+    assert ao["thin"][wall].min() == pytest.approx(1.0, abs=1e-4)
 
 
 @pytest.mark.parametrize("names", [("B", "G", "R", "Z"), ("G", "R", "Z")])

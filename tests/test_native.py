@@ -212,7 +212,7 @@ def test_camera_crop_keeps_the_dict_and_the_rays(native):
 
 
 @pytest.mark.parametrize("call, fragment", [
-    (lambda n: n.camera_crop({}, 64, 48, 60, 0, 8, 8), "crop rectangle"),
+    (lambda n: n.camera_crop({}, 64, 48, -4, 0, 70000, 8), "crop rectangle"),
     (lambda n: n.camera_crop({}, 64, 48, 0, 0, 0, 8), "crop rectangle"),
     (lambda n: n.camera_crop({}, 0, 48, 0, 0, 8, 8), "image width and height"),
     (lambda n: n.camera_crop({"lens": -1.0}, 64, 48, 0, 0, 8, 8), "the camera is invalid"),

@@ -21,6 +21,7 @@ class HBAOParams(ctypes.Structure):
         ("threads", ctypes.c_int32),
         ("background_depth", ctypes.c_float),
         ("implementation", ctypes.c_int32),
+        ("thickness", ctypes.c_float),
     ]
 
 

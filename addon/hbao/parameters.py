@@ -63,6 +63,7 @@ LABELS = {
     "blur_sharpness": "Blur Sharpness",
     "strength": "Strength",
     "background_depth": "Background Depth",
+    "thickness": "Thickness",
 }
 
 # The menus of the node and of the viewport panel: (identifier, name, tip).

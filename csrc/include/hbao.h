@@ -67,8 +67,7 @@ extern "C" {
       "finite and > 0; the matrix must be finite and invertible)")                                 \
     X(HBAO_ERROR_OUT_OF_MEMORY, "out of memory")                                                   \
     X(HBAO_ERROR_THREAD, "could not start a worker thread")                                        \
-    X(HBAO_ERROR_INVALID_RECTANGLE,                                                                \
-      "the crop rectangle must be at least 1 x 1 and lie inside the image")
+    X(HBAO_ERROR_INVALID_RECTANGLE, "the crop rectangle's width and height must be in [1, 65536]")
 
 typedef enum hbao_result_code {
 #define HBAO_RESULT_ENUM_ENTRY(name, message) name,
@@ -148,6 +147,14 @@ typedef struct hbao_params {
     /** hbao_implementation: which code computes the horizons. All give
      *  bit-identical results; choosing one exists for tests and benchmarks. */
     int32_t implementation;
+    /** Occluder thickness in scene units; 0 (the default) = infinitely
+     *  thick (every surface a solid block reaching back from its depth: the
+     *  height-field model of every version before this field). Otherwise a surface seen at a sample is taken to
+     *  occupy depths [sample depth, sample depth + thickness] along its view
+     *  ray, and a sample whose block lies wholly in front of the pixel
+     *  (sample depth + thickness < the pixel's depth) does not raise the
+     *  horizon: light passes behind it. Must be finite and >= 0. */
+    float thickness;
 } hbao_params;
 
 /** The horizon search exists as a portable scalar reference and as SIMD
@@ -179,7 +186,7 @@ typedef enum hbao_implementation {
         HBAO_DEFAULT_RADIUS, HBAO_DEFAULT_ANGLE_BIAS_DEGREES, HBAO_DEFAULT_DIRECTIONS,             \
             HBAO_DEFAULT_STEPS, HBAO_FALLOFF_NONE, HBAO_INTEGRATION_COSINE,                        \
             HBAO_DEFAULT_BLUR_SIZE, HBAO_DEFAULT_BLUR_SHARPNESS, 0, HBAO_DEFAULT_STRENGTH, 0,      \
-            HBAO_DEFAULT_BACKGROUND_DEPTH, 0                                                       \
+            HBAO_DEFAULT_BACKGROUND_DEPTH, 0, 0.0f                                                 \
     }
 
 typedef enum hbao_projection {
@@ -265,7 +272,8 @@ typedef struct hbao_channel {
     X(HBAO_PARAM_FIELD_STRENGTH, 9, "strength")                                                    \
     X(HBAO_PARAM_FIELD_THREADS, 10, "threads")                                                     \
     X(HBAO_PARAM_FIELD_BACKGROUND_DEPTH, 11, "background_depth")                                   \
-    X(HBAO_PARAM_FIELD_IMPLEMENTATION, 12, "implementation")
+    X(HBAO_PARAM_FIELD_IMPLEMENTATION, 12, "implementation")                                       \
+    X(HBAO_PARAM_FIELD_THICKNESS, 13, "thickness")
 
 typedef enum hbao_param_field {
 #define HBAO_PARAM_FIELD_ENUM_ENTRY(name, bit, text) name = 1u << (bit),
@@ -280,8 +288,8 @@ typedef enum hbao_param_field {
  * nearest limit and their bits (hbao_param_field) set in *clamped_fields, so
  * the caller can warn; negative threads become 0 (one per core) and a
  * non-zero half_resolution becomes 1, without a bit. Values that have no
- * nearest legal value (NaN or infinite floats, a negative radius, a
- * background_depth <= 0, unknown enum values) give
+ * nearest legal value (NaN or infinite floats, a negative radius or
+ * thickness, a background_depth <= 0, unknown enum values) give
  * HBAO_ERROR_INVALID_PARAMETER, and then *clamped_fields holds the bits of
  * those invalid fields instead and *out is unchanged. `out` may be `in`;
  * clamped_fields may be NULL.
@@ -329,17 +337,23 @@ HBAO_EXPORT hbao_result hbao_camera_view(const hbao_camera *camera, int32_t widt
                                          hbao_view *view);
 
 /**
- * The camera of the sub-rectangle (x, y, width, height) of a full_width x
+ * The camera of the rectangle (x, y, width, height) of a full_width x
  * full_height image (a border render, an EXR data window inside its display
  * window): each of its pixels gets the view ray the full camera gives the
- * same pixel. The sensor fit is made explicit (AUTO becomes the side it
- * fitted), the fitted sensor side and the ortho scale are scaled to the
- * crop and the lens shift moves the centre; lens, pixel aspect and matrix
- * are kept. A crop of the whole image returns the camera unchanged.
+ * same pixel. The rectangle may also reach past the image (overscan: a data
+ * window larger than the display window, a guard band of depth around the
+ * frame so that occluders just outside it count); its pixels there get the
+ * rays of the full camera's view plane extended. The sensor fit is made
+ * explicit (AUTO becomes the side it fitted), the fitted sensor side and
+ * the ortho scale are scaled to the rectangle and the lens shift moves the
+ * centre; lens, pixel aspect and matrix are kept. A crop of the whole image
+ * returns the camera unchanged.
  *
  * @param full_width, full_height  the full image, each in [1, 65536]
- * @param x, y           the crop's top-left pixel in the full image (y down)
- * @param width, height  the crop, >= 1, inside the full image
+ * @param x, y           the rectangle's top-left pixel in the full image's
+ *                       pixel grid (y down); negative or past the image for
+ *                       overscan
+ * @param width, height  the rectangle, each in [1, 65536]
  * @param cropped        output; may be `camera`
  * @return HBAO_ERROR_NULL_ARGUMENT, HBAO_ERROR_INVALID_SIZE,
  *         HBAO_ERROR_INVALID_RECTANGLE, HBAO_ERROR_INVALID_CAMERA (for the

@@ -146,10 +146,11 @@ hbao_result hbao_camera_crop(const hbao_camera *camera, int32_t full_width, int3
                              hbao_camera *cropped) {
     if (camera == NULL || cropped == NULL) return HBAO_ERROR_NULL_ARGUMENT;
     if (!image_size_is_valid(full_width, full_height)) return HBAO_ERROR_INVALID_SIZE;
-    /* 64-bit sums: x + width must not wrap around for absurd arguments. */
-    if (x < 0 || y < 0 || width < 1 || height < 1 || (int64_t)x + width > full_width ||
-        (int64_t)y + height > full_height)
-        return HBAO_ERROR_INVALID_RECTANGLE;
+    /* The rectangle may reach past the image on any side (overscan: an EXR
+     * data window larger than its display window, a guard band): its pixels
+     * there get the view rays the full camera's plane continues with. Only
+     * its size is bounded, by the largest image hbao_compute takes. */
+    if (!image_size_is_valid(width, height)) return HBAO_ERROR_INVALID_RECTANGLE;
     hbao_result result = hbao_validate_camera(camera);
     if (result != HBAO_SUCCESS) return result;
     if (x == 0 && y == 0 && width == full_width && height == full_height) {

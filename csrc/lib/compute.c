@@ -27,6 +27,7 @@ static hbao_result make_settings(const hbao_params *params, hbao_settings *s) {
     s->threads = p.threads == 0 ? hbao_available_cores() : p.threads;
     s->background_depth = p.background_depth;
     s->implementation = p.implementation;
+    s->thickness = p.thickness;
     return HBAO_SUCCESS;
 }
 

@@ -30,6 +30,9 @@ typedef struct march {
      * of V's elevation above the tangent plane, dot(n, V). */
     float height_tolerance;
     float n_dot_v;
+    /* Samples nearer than this depth are occluders of finite thickness
+     * wholly in front of the pixel: skipped (hbao_near_limit). */
+    float near_limit;
 } march;
 
 enum { SAMPLE_END = -1, SAMPLE_SKIP = 0, SAMPLE_OK = 1 };
@@ -44,7 +47,7 @@ static inline int march_sample(const march *m, int step, float delta[3], float *
     if (si < 0 || sj < 0 || si >= g->width || sj >= g->height) return SAMPLE_END;
     if (ox == 0 && oy == 0) return SAMPLE_SKIP;
     const float zs = g->depth[(size_t)sj * g->width + si];
-    if (zs <= 0.0f) return SAMPLE_SKIP;
+    if (zs <= 0.0f || zs < m->near_limit) return SAMPLE_SKIP;
     float q[3];
     hbao_grid_position(g, si, sj, zs, q);
     delta[0] = q[0] - m->p[0];
@@ -273,6 +276,7 @@ float hbao_horizon_pixel(const horizon_job *job, int i, int j, float step_px) {
     const float *n = g->normal + 3 * ((size_t)j * g->width + i);
     m.n_dot_v = n[0] * v[0] + n[1] * v[1] + n[2] * v[2];
     m.height_tolerance = g->depth_precision * hbao_rounding_along_normal(g, n, m.p);
+    m.near_limit = hbao_near_limit(s, z);
     const int cosine = s->integration == HBAO_INTEGRATION_COSINE;
 
     float occlusion_sum = 0.0f;                /* HBAO */

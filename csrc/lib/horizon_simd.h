@@ -79,7 +79,7 @@ typedef struct SIMD_NAME(block) {
     float jitter, step_px, inv_ycor; /* shared by the block */
     VF p[3], v[3], n[3];
     VF radius2, inv_radius2;
-    VF height_tolerance, n_dot_v; /* as in horizon.c's march */
+    VF height_tolerance, n_dot_v, near_limit; /* as in horizon.c's march */
 } SIMD_NAME(block);
 
 /* The depth fetches of a direction's steps. They depend only on the steps'
@@ -140,7 +140,8 @@ static inline VM SIMD_NAME(sample)(const SIMD_NAME(block) * b, const SIMD_NAME(f
                                    VF delta[3], VF *dist2) {
     const hbao_grid *g = b->grid;
     const VF zs = f->zs;
-    const VM valid = M_AND(M_AND(f->candidate, live), V_GT(zs, V_SET(0.0f)));
+    const VM valid =
+        M_AND(M_AND(f->candidate, live), M_AND(V_GT(zs, V_SET(0.0f)), V_GE(zs, b->near_limit)));
     const VF column = V_MUL(V_ADD(I_TO_F(f->si), V_SET(g->x_offset)), V_SET(g->x_step));
     const VF row = V_SET(hbao_grid_y(g, f->sj));
     const VF q0 = g->orthographic ? column : V_MUL(column, zs);
@@ -359,6 +360,8 @@ static void SIMD_NAME(lanes_ao)(const hbao_horizon_job *job, int x0, int x1, int
                              : SIMD_NAME(dot3)(b.n[0], b.n[1], b.n[2], b.p[0], b.p[1], b.p[2]);
         b.height_tolerance = V_MUL(V_SET(g->depth_precision),
                                    V_SELECT(V_LT(along, V_SET(0.0f)), along, V_NEG(along)));
+        /* hbao_near_limit */
+        b.near_limit = s->thickness > 0.0f ? V_SUB(z, V_SET(s->thickness)) : V_SET(0.0f);
 
         const int cosine = s->integration == HBAO_INTEGRATION_COSINE;
         VF occlusion_sum = V_SET(0.0f), visible_sum = V_SET(0.0f), open_sum = V_SET(0.0f);

@@ -42,6 +42,7 @@ typedef struct hbao_settings {
     int threads;
     float background_depth;
     int implementation; /* hbao_implementation as asked for */
+    float thickness;    /* occluder thickness, 0 = infinite (hbao_params) */
 } hbao_settings;
 
 /* The image that horizons are searched on: the full image, or the
@@ -80,6 +81,16 @@ static inline float hbao_rounding_along_normal(const hbao_grid *grid, const floa
                             ? n[2] * position[2]
                             : n[0] * position[0] + n[1] * position[1] + n[2] * position[2];
     return along < 0.0f ? -along : along;
+}
+
+/* Finite occluder thickness (hbao_params.thickness, docs/algorithm.md
+ * "Thickness"): a sample at depth zs stands for a block over [zs, zs + t];
+ * when zs + t < z, written zs < z - t, the block lies wholly in front of the
+ * pixel at depth z and the sample is skipped. t = 0 (infinitely thick)
+ * skips nothing: the limit 0 is below every foreground depth. The SIMD
+ * kernels compute the same z - t lane by lane. */
+static inline float hbao_near_limit(const hbao_settings *settings, float z) {
+    return settings->thickness > 0.0f ? z - settings->thickness : 0.0f;
 }
 
 /* Loops written to auto-vectorize get one compiled copy per vector width,

@@ -31,6 +31,7 @@ hbao_result hbao_params_resolve(const hbao_params *in, hbao_params *out, uint32_
     hbao_params p = *in;
     uint32_t clamped = 0, invalid = 0;
     if (!isfinite(p.radius) || p.radius < 0.0f) invalid |= HBAO_PARAM_FIELD_RADIUS;
+    if (!isfinite(p.thickness) || p.thickness < 0.0f) invalid |= HBAO_PARAM_FIELD_THICKNESS;
     clamp_float(&p.angle_bias_degrees, 0.0f, HBAO_MAX_ANGLE_BIAS_DEGREES,
                 HBAO_PARAM_FIELD_ANGLE_BIAS_DEGREES, &clamped, &invalid);
     clamp_int(&p.directions, 1, HBAO_MAX_DIRECTIONS, HBAO_PARAM_FIELD_DIRECTIONS, &clamped);

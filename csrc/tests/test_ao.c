@@ -711,8 +711,11 @@ TEST_CASE(simd_paths_match_scalar_reference_bit_for_bit) {
     const size_t bytes = (size_t)view.width * view.height * sizeof(float);
     const int kernels[] = {HBAO_IMPLEMENTATION_AVX2, HBAO_IMPLEMENTATION_AVX512,
                            HBAO_IMPLEMENTATION_AUTO};
-    for (int variant = 0; variant < 16; variant++) {
+    /* Bit 4: a finite thickness (0.2, about a third of the box's height),
+     * which skips some samples in every kernel alike. */
+    for (int variant = 0; variant < 32; variant++) {
         hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+        p.thickness = (variant & 16) ? 0.2f : 0.0f;
         p.integration = variant & 1;
         p.falloff = (variant >> 1) & 1;
         p.half_resolution = (variant >> 2) & 1;
@@ -741,6 +744,66 @@ TEST_CASE(simd_paths_match_scalar_reference_bit_for_bit) {
     free(normal);
 }
 
+/* A plate (a vertical strip 1 unit wide) floating PLATE_GAP in front of a
+ * wall that faces the camera: its edges darken the wall beside its
+ * silhouette when occluders are infinitely thick (the halo of a foreground
+ * object on the background). */
+#define PLATE_GAP 0.3
+static void render_plate_before_wall(scene_view *view, float **depth, float **normal) {
+    scene s;
+    memset(&s, 0, sizeof s);
+    s.planes = 2;
+    s.plane[0] = scene_plane_make(0, 0, 0, 0, -1, 0);
+    s.plane[1] = scene_plane_make(0, -PLATE_GAP, 0, 0, -1, 0);
+    scene_plane_clip(&s.plane[1], 1, 0, 0, 0.5);
+    scene_plane_clip(&s.plane[1], -1, 0, 0, 0.5);
+    const double eye[3] = {0.3, -5.0, 0.2}, target[3] = {0, 0, 0};
+    *view = make_view(128, 96, eye, target);
+    scene_render(&s, view, depth, normal);
+}
+
+TEST_CASE(thin_occluders_do_not_darken_what_is_behind_them) {
+    scene_view view;
+    float *depth, *normal;
+    render_plate_before_wall(&view, &depth, &normal);
+    const int pixels = view.width * view.height;
+    for (int integration = 0; integration <= 1; integration++) {
+        for (int implementation = HBAO_IMPLEMENTATION_SCALAR;
+             implementation <= HBAO_IMPLEMENTATION_AVX512; implementation++) {
+            hbao_params p = exact_params(integration);
+            p.radius = 0.8f;
+            p.implementation = implementation;
+            float *thick = run(&p, &view, depth, normal);
+            /* thinner than the gap: the plate lies wholly in front of the wall */
+            p.thickness = (float)(0.5 * PLATE_GAP);
+            float *thin = run(&p, &view, depth, normal);
+            /* thicker than every depth difference within the radius: nothing
+             * is skipped, so the result is exactly the infinite thickness's */
+            p.thickness = (float)(2.0 * PLATE_GAP);
+            float *covering = run(&p, &view, depth, normal);
+            float darkest_wall_thick = 1.0f, darkest_wall_thin = 1.0f;
+            int wall_pixels = 0;
+            for (int k = 0; k < pixels; k++) {
+                CHECK(covering[k] == thick[k]);
+                if (depth[k] < 4.9f) continue; /* the plate (depth ~4.7) */
+                wall_pixels++;
+                darkest_wall_thick = fminf(darkest_wall_thick, thick[k]);
+                darkest_wall_thin = fminf(darkest_wall_thin, thin[k]);
+            }
+            CHECK(wall_pixels > pixels / 2);
+            /* The halo exists with infinite thickness, so the test can fail. */
+            CHECK(darkest_wall_thick < 0.9f);
+            /* The wall alone is a plane: AO 1 within plane_facing_camera's 1e-4. */
+            CHECK_NEAR(darkest_wall_thin, 1.0f, 1e-4);
+            free(thick);
+            free(thin);
+            free(covering);
+        }
+    }
+    free(depth);
+    free(normal);
+}
+
 TEST_MAIN(TEST_ENTRY(plane_facing_camera_is_unoccluded), TEST_ENTRY(tilted_plane_is_unoccluded),
           TEST_ENTRY(corner_matches_analytic_cosine), TEST_ENTRY(corner_matches_analytic_hbao),
           TEST_ENTRY(corner_value_at_the_crease_is_one_half),
@@ -753,4 +816,5 @@ TEST_MAIN(TEST_ENTRY(plane_facing_camera_is_unoccluded), TEST_ENTRY(tilted_plane
           TEST_ENTRY(half_resolution_is_close_to_full), TEST_ENTRY(blur_keeps_depth_edges),
           TEST_ENTRY(strength_is_a_power), TEST_ENTRY(background_never_occludes),
           TEST_ENTRY(tiny_projected_radius_gives_one),
-          TEST_ENTRY(simd_paths_match_scalar_reference_bit_for_bit))
+          TEST_ENTRY(simd_paths_match_scalar_reference_bit_for_bit),
+          TEST_ENTRY(thin_occluders_do_not_darken_what_is_behind_them))

@@ -279,8 +279,8 @@ TEST_CASE(params_resolve_rejects_what_cannot_be_clamped) {
     struct {
         uint32_t field;
         hbao_params params;
-    } cases[8];
-    for (int k = 0; k < 8; k++) cases[k].params = defaults;
+    } cases[10];
+    for (int k = 0; k < 10; k++) cases[k].params = defaults;
     cases[0].field = HBAO_PARAM_FIELD_RADIUS, cases[0].params.radius = -1.0f;
     cases[1].field = HBAO_PARAM_FIELD_RADIUS, cases[1].params.radius = NAN;
     cases[2].field = HBAO_PARAM_FIELD_ANGLE_BIAS_DEGREES,
@@ -291,7 +291,9 @@ TEST_CASE(params_resolve_rejects_what_cannot_be_clamped) {
     cases[6].field = HBAO_PARAM_FIELD_FALLOFF | HBAO_PARAM_FIELD_INTEGRATION;
     cases[6].params.falloff = 9, cases[6].params.integration = -1;
     cases[7].field = HBAO_PARAM_FIELD_IMPLEMENTATION, cases[7].params.implementation = 4;
-    for (int k = 0; k < 8; k++) {
+    cases[8].field = HBAO_PARAM_FIELD_THICKNESS, cases[8].params.thickness = -0.5f;
+    cases[9].field = HBAO_PARAM_FIELD_THICKNESS, cases[9].params.thickness = INFINITY;
+    for (int k = 0; k < 10; k++) {
         out = untouched;
         CHECK_RESULT(hbao_params_resolve(&cases[k].params, &out, &fields),
                      HBAO_ERROR_INVALID_PARAMETER);

@@ -68,9 +68,13 @@ static void camera_cases(camera_case cases[CASE_COUNT]) {
 static const int SIZES[][2] = {{64, 48}, {30, 90}, {40, 72}};
 #define SIZE_COUNT 3
 
-/* Rectangles (x, y, width, height from the top left) inside every size. */
-static const int RECTS[][4] = {{0, 0, 30, 48}, {5, 8, 16, 33}, {13, 1, 16, 17}, {4, 20, 1, 1}};
-#define RECT_COUNT 4
+/* Rectangles (x, y, width, height from the top left): inside every size,
+ * then overscan (around every size: a guard band), reaching past one side
+ * only, and wholly outside. */
+static const int RECTS[][4] = {{0, 0, 30, 48},    {5, 8, 16, 33},    {13, 1, 16, 17},
+                               {4, 20, 1, 1},     {-9, -7, 90, 110}, {-3, 10, 20, 90},
+                               {60, -40, 12, 30}, {-50, 100, 5, 5}};
+#define RECT_COUNT 8
 
 /* Camera-space point of pixel centre (i, j) at unit depth (perspective) or
  * on the view plane (orthographic), from a view. */
@@ -199,10 +203,14 @@ TEST_CASE(crop_rejects_bad_arguments) {
                  HBAO_ERROR_INVALID_SIZE);
     CHECK_RESULT(hbao_camera_crop(&camera, 64, INT32_MAX, 0, 0, 8, 8, &out),
                  HBAO_ERROR_INVALID_SIZE);
-    const int32_t bad_rects[][4] = {
-        {-1, 0, 8, 8},        {0, -1, 8, 8},        {0, 0, 0, 8},         {0, 0, 8, 0},
-        {0, 0, -8, 8},        {57, 0, 8, 8},        {0, 41, 8, 8},        {0, 0, 65, 48},
-        {1, 0, INT32_MAX, 8}, {INT32_MAX, 0, 8, 8}, {0, INT32_MIN, 8, 8}, {0, 0, 64, 49}};
+    /* Only the size is bounded: rectangles past the image are overscan. */
+    const int32_t bad_rects[][4] = {{0, 0, 0, 8},
+                                    {0, 0, 8, 0},
+                                    {0, 0, -8, 8},
+                                    {-4, 0, 8, INT32_MIN},
+                                    {1, 0, INT32_MAX, 8},
+                                    {0, 0, HBAO_MAX_IMAGE_SIZE + 1, 8},
+                                    {-1, -1, 8, HBAO_MAX_IMAGE_SIZE + 1}};
     for (size_t k = 0; k < sizeof bad_rects / sizeof bad_rects[0]; k++)
         CHECK_RESULT(hbao_camera_crop(&camera, 64, 48, bad_rects[k][0], bad_rects[k][1],
                                       bad_rects[k][2], bad_rects[k][3], &out),
@@ -250,7 +258,10 @@ TEST_CASE(view_rejects_bad_arguments) {
 #define AO_CROP_TOLERANCE 1e-3
 #define AO_CROP_MAX_FLIPPED_FRACTION 0.03
 
-TEST_CASE(ao_of_a_crop_equals_the_full_ao) {
+/* Three planes (a floor, a wall and a clipped fin before it) seen from above,
+ * rendered on view->width x view->height pixels with `camera`. */
+static void render_crease_scene(const hbao_camera *camera, scene_view *view, float **depth,
+                                float **normal) {
     scene s;
     memset(&s, 0, sizeof s);
     s.planes = 3;
@@ -259,23 +270,50 @@ TEST_CASE(ao_of_a_crop_equals_the_full_ao) {
     scene_plane_clip(&s.plane[1], 0, 0, -1, 0);
     s.plane[2] = scene_plane_make(-1.5, 0, 0, -1, 0, 0.2);
     scene_plane_clip(&s.plane[2], 0, 0, 1, 0.6);
+    view->camera = *camera;
+    const double eye[3] = {-5.0, -2.5, 3.5}, target[3] = {-0.8, 0, 0.3};
+    scene_look_at(view, eye, target);
+    if (view->camera.projection == HBAO_PROJECTION_ORTHOGRAPHIC) view->camera.ortho_scale = 8.0f;
+    scene_render(&s, view, depth, normal);
+}
+
+static hbao_params crop_test_params(void) {
+    hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+    p.radius = 0.3f;
+    p.blur_size = 0;
+    p.threads = 1;
+    return p;
+}
+
+/* Whether pixel (i, j) of a rect[2] x rect[3] window lies farther than its
+ * radius (in pixels, plus one) from the window's edges. */
+static int radius_inside_window(const hbao_view *frame, const hbao_params *p, double z, int i,
+                                int j, const int rect[4]) {
+    const double unit = frame->perspective ? z : 1.0;
+    const double reach_x = 1.0 + p->radius / (unit * frame->pixel_size_x);
+    const double reach_y = 1.0 + p->radius / (unit * frame->pixel_size_y);
+    return !(i < reach_x || i >= rect[2] - reach_x || j < reach_y || j >= rect[3] - reach_y);
+}
+
+#define FULL_WIDTH 160
+#define FULL_HEIGHT 96
+/* The window inside the full image: its corner at a multiple of 64 columns
+ * and 4 rows (see above). */
+static const int WINDOW[4] = {64, 12, 64, 72};
+
+TEST_CASE(ao_of_a_crop_equals_the_full_ao) {
     camera_case cases[CASE_COUNT];
     camera_cases(cases);
-    const int full_width = 160, full_height = 96, rect[4] = {64, 12, 64, 72};
+    const int full_width = FULL_WIDTH, full_height = FULL_HEIGHT;
+    const int *rect = WINDOW;
     float *crop_ao = malloc((size_t)rect[2] * rect[3] * sizeof(float));
     float *full_ao = malloc((size_t)full_width * full_height * sizeof(float));
     double total_occlusion = 0.0;
     for (int c = 0; c < CASE_COUNT; c++) {
         scene_view view = {full_width, full_height, cases[c].camera, {0}};
-        const double eye[3] = {-5.0, -2.5, 3.5}, target[3] = {-0.8, 0, 0.3};
-        scene_look_at(&view, eye, target);
-        if (view.camera.projection == HBAO_PROJECTION_ORTHOGRAPHIC) view.camera.ortho_scale = 8.0f;
         float *depth, *normal;
-        scene_render(&s, &view, &depth, &normal);
-        hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
-        p.radius = 0.3f;
-        p.blur_size = 0;
-        p.threads = 1;
+        render_crease_scene(&cases[c].camera, &view, &depth, &normal);
+        const hbao_params p = crop_test_params();
         hbao_camera cropped;
         CHECK_RESULT(hbao_camera_crop(&view.camera, full_width, full_height, rect[0], rect[1],
                                       rect[2], rect[3], &cropped),
@@ -296,11 +334,7 @@ TEST_CASE(ao_of_a_crop_equals_the_full_ao) {
         for (int j = 0; j < rect[3]; j++) {
             for (int i = 0; i < rect[2]; i++) {
                 const double z = depth[(size_t)(j + rect[1]) * full_width + i + rect[0]];
-                const double unit = frame.perspective ? z : 1.0;
-                const double reach_x = 1.0 + p.radius / (unit * frame.pixel_size_x);
-                const double reach_y = 1.0 + p.radius / (unit * frame.pixel_size_y);
-                if (i < reach_x || i >= rect[2] - reach_x || j < reach_y || j >= rect[3] - reach_y)
-                    continue;
+                if (!radius_inside_window(&frame, &p, z, i, j, rect)) continue;
                 const double a = crop_ao[(size_t)j * rect[2] + i];
                 const double b = full_ao[(size_t)(j + rect[1]) * full_width + i + rect[0]];
                 compared++;
@@ -323,8 +357,88 @@ TEST_CASE(ao_of_a_crop_equals_the_full_ao) {
     free(full_ao);
 }
 
+/* A pixel "sees the guard band" when its AO without the band differs from
+ * the full image's by more than the rounding tolerance. The window's edges
+ * cut the fin and the wall's foot, so border pixels do: in every case some
+ * (the orthographic ones, whose radius spans ~6 pixels, only a dozen), over
+ * all cases at least this fraction of the window (4 % when written), else
+ * the test would not show that the band is used. */
+#define GUARD_BAND_MIN_AFFECTED_FRACTION 0.02
+
+/* Guard band (overscan): the display window is WINDOW of the full image, and
+ * the depth is given for the whole full image, i.e. the data window reaches
+ * past the display window on every side. The display window's camera widened
+ * to the data window by hbao_camera_crop (a rectangle with a negative
+ * origin) must give every display pixel the AO of the full image's own
+ * camera, border pixels included, where the AO of the display window alone
+ * misses the occluders outside it. Same tolerances as above: the widened
+ * camera differs from the full one by float roundings. */
+TEST_CASE(ao_with_a_guard_band_equals_the_larger_frame) {
+    camera_case cases[CASE_COUNT];
+    camera_cases(cases);
+    const int full_width = FULL_WIDTH, full_height = FULL_HEIGHT;
+    const int *window = WINDOW;
+    const size_t full_pixels = (size_t)full_width * full_height;
+    float *full_ao = malloc(full_pixels * sizeof(float));
+    float *band_ao = malloc(full_pixels * sizeof(float));
+    float *window_ao = malloc((size_t)window[2] * window[3] * sizeof(float));
+    int all_compared = 0, all_affected = 0;
+    for (int c = 0; c < CASE_COUNT; c++) {
+        scene_view view = {full_width, full_height, cases[c].camera, {0}};
+        float *depth, *normal;
+        render_crease_scene(&cases[c].camera, &view, &depth, &normal);
+        const hbao_params p = crop_test_params();
+        /* What the renderer's display window was, and its data window
+         * (the full image) in the display window's pixel grid. */
+        hbao_camera display, widened;
+        CHECK_RESULT(hbao_camera_crop(&view.camera, full_width, full_height, window[0], window[1],
+                                      window[2], window[3], &display),
+                     HBAO_SUCCESS);
+        CHECK_RESULT(hbao_camera_crop(&display, window[2], window[3], -window[0], -window[1],
+                                      full_width, full_height, &widened),
+                     HBAO_SUCCESS);
+        const hbao_channel full_depth = {depth, 1, full_width};
+        const hbao_channel window_depth = {depth + (size_t)window[1] * full_width + window[0], 1,
+                                           full_width};
+        CHECK_RESULT(hbao_compute(&p, &view.camera, full_width, full_height, &full_depth, NULL,
+                                  full_ao, full_width),
+                     HBAO_SUCCESS);
+        CHECK_RESULT(hbao_compute(&p, &widened, full_width, full_height, &full_depth, NULL, band_ao,
+                                  full_width),
+                     HBAO_SUCCESS);
+        CHECK_RESULT(hbao_compute(&p, &display, window[2], window[3], &window_depth, NULL,
+                                  window_ao, window[2]),
+                     HBAO_SUCCESS);
+        int compared = 0, flipped = 0, affected = 0;
+        for (int j = 0; j < window[3]; j++) {
+            for (int i = 0; i < window[2]; i++) {
+                const size_t at = (size_t)(j + window[1]) * full_width + i + window[0];
+                const double expected = full_ao[at];
+                compared++;
+                if (!(fabs(band_ao[at] - expected) <= AO_CROP_TOLERANCE)) flipped++;
+                if (!(fabs(window_ao[(size_t)j * window[2] + i] - expected) <= AO_CROP_TOLERANCE))
+                    affected++;
+            }
+        }
+        if (!(flipped <= AO_CROP_MAX_FLIPPED_FRACTION * compared) || affected == 0)
+            fprintf(stderr, "%s: %d of %d pixels differ with the band, %d without\n", cases[c].name,
+                    flipped, compared, affected);
+        CHECK(flipped <= AO_CROP_MAX_FLIPPED_FRACTION * compared);
+        CHECK(affected > 0);
+        all_compared += compared;
+        all_affected += affected;
+        free(depth);
+        free(normal);
+    }
+    CHECK(all_affected >= GUARD_BAND_MIN_AFFECTED_FRACTION * all_compared);
+    free(full_ao);
+    free(band_ao);
+    free(window_ao);
+}
+
 TEST_MAIN(TEST_ENTRY(view_equals_the_scene_model), TEST_ENTRY(cropped_camera_keeps_the_view_rays),
           TEST_ENTRY(crop_of_a_crop_equals_the_direct_crop),
           TEST_ENTRY(crop_of_the_whole_image_is_the_camera),
           TEST_ENTRY(crop_may_write_over_its_input), TEST_ENTRY(crop_rejects_bad_arguments),
-          TEST_ENTRY(view_rejects_bad_arguments), TEST_ENTRY(ao_of_a_crop_equals_the_full_ao))
+          TEST_ENTRY(view_rejects_bad_arguments), TEST_ENTRY(ao_of_a_crop_equals_the_full_ao),
+          TEST_ENTRY(ao_with_a_guard_band_equals_the_larger_frame))

@@ -148,11 +148,73 @@ static void abort_outputs(output_files *files) {
     atomic_file_abort(&files->png);
 }
 
+/* What the output holds: `source`, the part of the input's data window
+ * written (input coordinates), and the output's data and display windows.
+ * By default all of it, with the input's windows; --crop-to-display: its
+ * part inside the display window; --overscan N: a render widened by N pixels
+ * on every side, written as the centre frame (its windows moved back to the
+ * input's origin, as the frame's own render would have them). */
+typedef struct output_windows {
+    pixel_rect source, data, display;
+} output_windows;
+
+static int choose_output_windows(const cli_options *options, const exr_input *input,
+                                 output_windows *out, tool_error *error) {
+    const pixel_rect *data = &input->data_window, *display = &input->display_window;
+    out->source = *data;
+    out->data = *data;
+    out->display = *display;
+    if (options->crop_to_display) {
+        pixel_rect *w = &out->source;
+        w->min_x = data->min_x > display->min_x ? data->min_x : display->min_x;
+        w->min_y = data->min_y > display->min_y ? data->min_y : display->min_y;
+        w->max_x = data->max_x < display->max_x ? data->max_x : display->max_x;
+        w->max_y = data->max_y < display->max_y ? data->max_y : display->max_y;
+        if (w->min_x > w->max_x || w->min_y > w->max_y)
+            return tool_fail(error, TOOL_EXIT_RUNTIME,
+                             "%s: --crop-to-display: the data window does not overlap the "
+                             "display window",
+                             options->input_path);
+        out->data = *w;
+    } else if (options->overscan > 0) {
+        const int64_t band = options->overscan;
+        if (memcmp(data, display, sizeof *data) != 0)
+            return tool_fail(error, TOOL_EXIT_RUNTIME,
+                             "%s: --overscan: the data window must be the display window (a "
+                             "plain render)",
+                             options->input_path);
+        if (2 * band >= input->width || 2 * band >= input->height)
+            return tool_fail(error, TOOL_EXIT_RUNTIME,
+                             "%s: --overscan %lld leaves no frame inside the %dx%d image",
+                             options->input_path, (long long)band, input->width, input->height);
+        out->source.min_x = (int32_t)(data->min_x + band);
+        out->source.min_y = (int32_t)(data->min_y + band);
+        out->source.max_x = (int32_t)(data->max_x - band);
+        out->source.max_y = (int32_t)(data->max_y - band);
+        out->data = out->source;
+        out->data.min_x = data->min_x;
+        out->data.min_y = data->min_y;
+        out->data.max_x = (int32_t)(data->max_x - 2 * band);
+        out->data.max_y = (int32_t)(data->max_y - 2 * band);
+        out->display = out->data;
+    }
+    return TOOL_EXIT_SUCCESS;
+}
+
 static int write_outputs(const cli_options *options, const exr_input *input,
-                         const exr_output_channel *channels, int channel_count, const float *ao,
+                         exr_output_channel *channels, int channel_count, const float *ao,
                          output_files *files, tool_error *error) {
-    exr_output_layout layout = {input->data_window,
-                                input->display_window,
+    output_windows windows;
+    int status = choose_output_windows(options, input, &windows, error);
+    if (status != TOOL_EXIT_SUCCESS) return status;
+    /* Each channel's data moved to the written part's top-left pixel. */
+    const int64_t columns = (int64_t)windows.source.min_x - input->data_window.min_x;
+    const int64_t rows = (int64_t)windows.source.min_y - input->data_window.min_y;
+    for (int c = 0; c < channel_count; ++c)
+        channels[c].data += rows * channels[c].row_stride + columns * channels[c].pixel_stride;
+    const pixel_rect *window = &windows.source;
+    exr_output_layout layout = {windows.data,
+                                windows.display,
                                 input->pixel_aspect_ratio,
                                 input->screen_window_center,
                                 input->screen_window_width,
@@ -165,11 +227,13 @@ static int write_outputs(const cli_options *options, const exr_input *input,
         layout.stamp_name = RUN_SETTINGS_ATTRIBUTE;
         layout.stamp_text = settings;
     }
-    int status = exr_write_image(files->exr.fd, options->output_path, &layout, channels,
-                                 channel_count, error);
+    status = exr_write_image(files->exr.fd, options->output_path, &layout, channels, channel_count,
+                             error);
     if (status == TOOL_EXIT_SUCCESS && options->preview_path != NULL)
-        status = png_write_gray(files->png.fd, options->preview_path, ao, input->width,
-                                input->height, input->width, error);
+        status =
+            png_write_gray(files->png.fd, options->preview_path, ao + rows * input->width + columns,
+                           window->max_x - window->min_x + 1, window->max_y - window->min_y + 1,
+                           input->width, error);
     /* Both files are complete: only now replace the destinations. */
     if (status == TOOL_EXIT_SUCCESS) status = atomic_file_commit(&files->exr, error);
     if (status == TOOL_EXIT_SUCCESS && options->preview_path != NULL)

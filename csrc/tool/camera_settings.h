@@ -41,9 +41,10 @@ void camera_settings_apply(camera_settings *base, const camera_settings *overrid
 
 /**
  * The camera for the data window `data` of the display window `display`
- * (Blender's cropped border render): hbao_camera_crop() with EXR's window
- * coordinates. Its result code: a data window that is not inside the
- * display window gives HBAO_ERROR_INVALID_RECTANGLE.
+ * (Blender's cropped border render, or overscan: a data window reaching past
+ * the display window, a guard band): hbao_camera_crop() with EXR's window
+ * coordinates. Its result code: HBAO_ERROR_INVALID_RECTANGLE where a
+ * window's size or offset does not fit hbao_camera_crop's int32 arguments.
  */
 hbao_result camera_for_data_window(const hbao_camera *camera, const pixel_rect *display,
                                    const pixel_rect *data, hbao_camera *cropped);

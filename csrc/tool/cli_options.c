@@ -14,9 +14,12 @@ typedef enum option_id {
     OPTION_AO_CHANNEL,
     OPTION_KEEP_INPUT,
     OPTION_NO_NORMALS,
+    OPTION_CROP_TO_DISPLAY,
+    OPTION_OVERSCAN,
     OPTION_PREVIEW,
     OPTION_COMPRESSION,
     OPTION_RADIUS,
+    OPTION_THICKNESS,
     OPTION_ANGLE_BIAS,
     OPTION_DIRECTIONS,
     OPTION_STEPS,
@@ -61,9 +64,12 @@ static const option_spec option_specs[] = {
     {"ao-channel", 0, OPTION_AO_CHANNEL, true},
     {"keep-input", 0, OPTION_KEEP_INPUT, false},
     {"no-normals", 0, OPTION_NO_NORMALS, false},
+    {"crop-to-display", 0, OPTION_CROP_TO_DISPLAY, false},
+    {"overscan", 0, OPTION_OVERSCAN, true},
     {"preview", 0, OPTION_PREVIEW, true},
     {"compression", 0, OPTION_COMPRESSION, true},
     {"radius", 0, OPTION_RADIUS, true},
+    {"thickness", 0, OPTION_THICKNESS, true},
     {"angle-bias", 0, OPTION_ANGLE_BIAS, true},
     {"directions", 0, OPTION_DIRECTIONS, true},
     {"steps", 0, OPTION_STEPS, true},
@@ -198,6 +204,12 @@ static int apply_option(const option_spec *spec, const char *value, cli_options 
         case OPTION_NO_NORMALS:
             options->ignore_normals = true;
             break;
+        case OPTION_CROP_TO_DISPLAY:
+            options->crop_to_display = true;
+            break;
+        case OPTION_OVERSCAN:
+            status = parse_int_flag(flag, value, 0, HBAO_MAX_IMAGE_SIZE, &options->overscan, error);
+            break;
         case OPTION_PREVIEW:
             options->preview_path = value;
             break;
@@ -212,6 +224,10 @@ static int apply_option(const option_spec *spec, const char *value, cli_options 
         case OPTION_RADIUS:
             status =
                 parse_float_flag(flag, value, -FLT_MAX, FLT_MAX, false, &params->radius, error);
+            break;
+        case OPTION_THICKNESS:
+            status =
+                parse_float_flag(flag, value, -FLT_MAX, FLT_MAX, false, &params->thickness, error);
             break;
         case OPTION_ANGLE_BIAS:
             status = parse_float_flag(flag, value, -FLT_MAX, FLT_MAX, false,
@@ -348,6 +364,7 @@ static const struct {
     {HBAO_PARAM_FIELD_BLUR_SHARPNESS, "blur-sharpness"},
     {HBAO_PARAM_FIELD_STRENGTH, "strength"},
     {HBAO_PARAM_FIELD_THREADS, "threads"},
+    {HBAO_PARAM_FIELD_THICKNESS, "thickness"},
 };
 
 static double param_value(const hbao_params *params, uint32_t field) {
@@ -368,6 +385,8 @@ static double param_value(const hbao_params *params, uint32_t field) {
             return params->strength;
         case HBAO_PARAM_FIELD_THREADS:
             return params->threads;
+        case HBAO_PARAM_FIELD_THICKNESS:
+            return params->thickness;
         default:
             return NAN;
     }
@@ -480,6 +499,9 @@ int cli_parse(int argc, char **argv, cli_options *options, tool_error *error) {
         return tool_fail(error, TOOL_EXIT_USAGE, "--jobs and --force go with --frames");
     if (options->info_json)
         return tool_fail(error, TOOL_EXIT_USAGE, "--json only goes with --info");
+    if (options->crop_to_display && options->overscan > 0)
+        return tool_fail(error, TOOL_EXIT_USAGE,
+                         "--overscan and --crop-to-display each choose what is written: give one");
     if (options->output_path == NULL)
         return tool_fail(error, TOOL_EXIT_USAGE, "no output file: give -o OUTPUT.exr");
     if (options->output_path[0] == '\0' ||
@@ -534,6 +556,14 @@ void cli_print_help(FILE *stream) {
         "  --keep-input            also copy every input channel (same names and pixel\n"
         "                          types) and header attributes into the output; an input\n"
         "                          channel with the AO channel's name is replaced.\n"
+        "  --crop-to-display       write only the part of the data window inside the\n"
+        "                          display window (see Data window below).\n"
+        "  --overscan N            the input is the frame rendered N pixels wider on every\n"
+        "                          side (resolution + 2N, sensor or ortho scale grown in\n"
+        "                          proportion; its own camera): the AO uses all of it, so\n"
+        "                          the frame's borders see occluders just outside, and the\n"
+        "                          output is the centre frame only. Not with\n"
+        "                          --crop-to-display.\n"
         "  --compression METHOD    none, rle, zips, zip (default) or piz (lossless only).\n"
         "  --preview FILE.png      also write the AO as an 8-bit grayscale PNG: the linear\n"
         "                          AO value 0..1 maps to 0..255, no gamma curve.\n"
@@ -561,6 +591,10 @@ void cli_print_help(FILE *stream) {
         "  --strength S            ao = ao^S, [0, %g] (default %g)\n"
         "  --threads N             worker threads, at most %d; 0 (or less) = one per\n"
         "                          core (default)\n"
+        "  --thickness T           occluder thickness in scene units (>= 0, else an\n"
+        "                          error): a sample more than T nearer than the pixel\n"
+        "                          does not occlude it (no halo on the background behind\n"
+        "                          an object). 0 = infinitely thick (default)\n"
         "\n"
         "Camera (Blender's camera model and names; flags override --camera):\n"
         "  --camera FILE.json      JSON object with Blender's property names: type\n"
@@ -607,7 +641,13 @@ void cli_print_help(FILE *stream) {
         "\n"
         "Data window: the tool works on the EXR's data window and writes the output with\n"
         "the same data and display windows; when the data window is a part of the\n"
-        "display window, the camera is adjusted to that part (same view rays). Blender\n"
+        "display window, the camera is adjusted to that part (same view rays). A data\n"
+        "window that reaches past the display window (overscan) is a guard band: the\n"
+        "camera describes the display window and is widened to the data window (same\n"
+        "view rays for the display window's pixels), so occluders just outside the\n"
+        "frame darken its borders; the whole data window gets AO, and viewers that show\n"
+        "the display window (Blender) show the frame. --crop-to-display keeps only the\n"
+        "frame's pixels (an error when the windows do not overlap). Blender\n"
         "itself always writes data window = display window: a border render without\n"
         "cropping is a full frame (unrendered pixels are background, AO 1); with\n"
         "\"Crop to Render Region\" nothing in the file says where the region was, so\n"

@@ -35,6 +35,8 @@ typedef struct cli_options {
     const char *ao_channel;   /**< name of the output channel, "AO" by default */
     bool keep_input;
     bool ignore_normals;
+    bool crop_to_display; /**< write only the data window's part inside the display window */
+    int32_t overscan;     /**< > 0: the input is a render widened by this many pixels a side */
     bool info_json;
     exr_compression_t compression;
     hbao_params params;

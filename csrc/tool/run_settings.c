@@ -33,13 +33,15 @@ bool run_settings_text(const cli_options *options, char text[RUN_SETTINGS_MAX]) 
     append(text, &used,
            "hbao %d; radius %.9g; angle bias %.9g; directions %d; steps %d; falloff %d; "
            "integration %d; blur size %d; blur sharpness %.9g; half resolution %d; "
-           "strength %.9g; background depth %.9g; ",
+           "strength %.9g; background depth %.9g; thickness %.9g; ",
            (int)HBAO_VERSION, (double)p->radius, (double)p->angle_bias_degrees, (int)p->directions,
            (int)p->steps, (int)p->falloff, (int)p->integration, (int)p->blur_size,
            (double)p->blur_sharpness, (int)p->half_resolution, (double)p->strength,
-           (double)p->background_depth);
-    append(text, &used, "keep input %d; no normals %d; compression %d; ", (int)options->keep_input,
-           (int)options->ignore_normals, (int)options->compression);
+           (double)p->background_depth, (double)p->thickness);
+    append(text, &used,
+           "keep input %d; no normals %d; compression %d; crop to display %d; overscan %d; ",
+           (int)options->keep_input, (int)options->ignore_normals, (int)options->compression,
+           (int)options->crop_to_display, (int)options->overscan);
     const camera_settings *flags = &options->camera_flags;
     const hbao_camera *c = &flags->camera;
     append(text, &used, "camera flags %u", (unsigned)flags->fields_set);

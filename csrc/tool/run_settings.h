@@ -19,8 +19,8 @@
  * Everything besides the input file and the camera file that decides the
  * output EXR's content: the library version, the resolved parameters (but the
  * thread count and the SIMD implementation, which change no value), the layer,
- * the AO channel's name, --keep-input, --no-normals, the compression and the
- * camera flags. Two runs with equal text write equal files from equal inputs.
+ * the AO channel's name, --keep-input, --no-normals, the compression,
+ * --crop-to-display, --overscan and the camera flags. Two runs with equal text write equal files from equal inputs.
  * False when the text did not fit (a layer name of kilobytes): it is then cut
  * and must not be used to skip work.
  */

@@ -48,6 +48,9 @@ CASES = [
     ("persp_hbao_blur_strength", PERSPECTIVE_CAMERA,
      {"integration": "HBAO", "blur_size": 15, "blur_sharpness": 4.0, "strength": 2.0}),
     ("ortho_cosine_blur", ORTHOGRAPHIC_CAMERA, {"blur_size": 7, "radius": 0.8}),
+    # Occluders 0.3 thick: the box and the sphere no longer darken the wall
+    # behind them, but still the floor they stand on.
+    ("persp_cosine_thickness", PERSPECTIVE_CAMERA, {"blur_size": 0, "thickness": 0.3}),
     # The eye 0.05 above the floor, V nearly in its plane: snapped samples on
     # the floor lie within gamma of V, and only "rising at least as steeply as
     # V" keeps them from counting as past the normal (docs/algorithm.md, "The

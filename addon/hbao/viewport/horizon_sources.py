@@ -137,6 +137,10 @@ float occlusion(ivec2 p)
      * raise a sample above the tangent plane. */
     float height_tolerance = depth_precision
                            * abs(perspective != 0 ? dot(normal, position) : normal.z * position.z);
+    /* docs/algorithm.md, "Thickness" (csrc/lib/internal_hbao.h,
+     * hbao_near_limit): samples nearer than this are occluders wholly in
+     * front of the pixel. */
+    float near_limit = thickness > 0.0 ? z - thickness : 0.0;
 
     float inv_ycor = pixel_size.x / pixel_size.y;
     float rotation = (float(PATTERN[(p.x & 3) + 4 * (p.y & 3)]) + 0.5) / 16.0;
@@ -183,7 +187,7 @@ float occlusion(ivec2 p)
                 continue;
             }
             float zs = depth_at(q);
-            if (is_background(zs)) {
+            if (is_background(zs) || zs < near_limit) {
                 continue;
             }
             vec3 delta = position_at(q, zs) - position;

@@ -100,6 +100,7 @@ class AOPipeline:
             shader.uniform_int("integration",
                                parameters.INTEGRATION_VALUES[params["integration"]])
             shader.uniform_float("depth_precision", depth_precision)
+            shader.uniform_float("thickness", params["thickness"])
             _draw_quad("ao")
         kernel_radius = parameters.blur_kernel_radius(params["blur_size"])
         if kernel_radius < 1:

@@ -41,7 +41,7 @@ _DEFINITIONS = {
         _CAMERA_CONSTANTS + [
             ("FLOAT", "radius"), ("FLOAT", "angle_bias"), ("INT", "directions"),
             ("INT", "steps"), ("INT", "falloff"), ("INT", "integration"),
-            ("FLOAT", "depth_precision")],
+            ("FLOAT", "depth_precision"), ("FLOAT", "thickness")],
         ["depth_texture", "normal_texture"],
         shader_sources.AO_DEFINES),
     "blur": lambda: _create_info(
