@@ -51,3 +51,14 @@ def test_add_filter_menu_offers_hbao(ui_report):
 
 def test_node_search_does_not_offer_the_internal_group(ui_report):
     assert ".HBAO" not in ui_report["search_labels_with_hbao"]
+
+
+def test_status_line_follows_each_f12_render(run_blender, tmp_path):
+    """After an F12 render (the job thread) the node's status line shows what
+    that render met, and the next render clears it: Depth linked, unlinked,
+    linked again."""
+    completed = run_blender(SCRIPTS / "ui_f12_status.py", tmp_path / "f12", ui=True)
+    assert "F12: DONE" in completed.stdout, completed.stdout[-3000:]
+    statuses = {int(line.split(" ", 2)[1]): json.loads(line.split(" ", 2)[2])
+                for line in completed.stdout.splitlines() if line.startswith("STATUS ")}
+    assert statuses == {0: "", 1: "Depth not linked: AO off", 2: ""}, statuses

@@ -176,23 +176,17 @@ def apply_node_messages():
                     area.tag_redraw()
 
 
-# While an F12 render job runs, its handlers run in the job's thread; this
-# timer, started from render_init (main thread), shows the messages once the
-# job has ended and nodes may be written again.
-_POLL_S = 0.2
+# During an F12 render every render handler runs in the job's thread, where
+# nodes may not be written and no timer may be started; this timer, running
+# while the add-on is enabled, shows what the render thread posted once no
+# render job runs. It costs a dictionary check per tick.
+_POLL_S = 0.25
 
 
-def _apply_when_render_ends():
-    if bpy.app.is_job_running("RENDER"):
-        return _POLL_S
-    apply_node_messages()
-    return None
-
-
-@bpy.app.handlers.persistent
-def _on_render_init(*_args):
-    if report.in_main_thread() and not bpy.app.background:
-        bpy.app.timers.register(_apply_when_render_ends, first_interval=_POLL_S)
+def _poll_node_messages():
+    if report.has_node_messages() and not bpy.app.is_job_running("RENDER"):
+        apply_node_messages()
+    return _POLL_S
 
 
 @bpy.app.handlers.persistent
@@ -205,7 +199,7 @@ def _on_load_post(*_args):
     upgrade_group_tree()
 
 
-_HANDLERS = (("render_init", _on_render_init), ("render_post", _on_render_done),
+_HANDLERS = (("render_post", _on_render_done),
              ("render_complete", _on_render_done), ("render_cancel", _on_render_done),
              ("load_post", _on_load_post))
 
@@ -227,9 +221,13 @@ def register():
     menu = compat.compositor_filter_menu()
     if menu is not None:
         menu.append(_draw_add_menu)
+    if not bpy.app.background:  # `-b` shows nothing: render_post applies the messages
+        bpy.app.timers.register(_poll_node_messages, first_interval=_POLL_S, persistent=True)
 
 
 def unregister():
+    if bpy.app.timers.is_registered(_poll_node_messages):
+        bpy.app.timers.unregister(_poll_node_messages)
     menu = compat.compositor_filter_menu()
     if menu is not None:
         menu.remove(_draw_add_menu)

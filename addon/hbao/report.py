@@ -48,6 +48,11 @@ def post_node_messages(scene_name, node_names, messages):
     _pending_node_messages[scene_name] = statuses
 
 
+def has_node_messages():
+    """Whether messages wait for take_node_messages."""
+    return bool(_pending_node_messages)
+
+
 def take_node_messages():
     """[(scene name, {node name: [NodeMessage]})] posted since the last call."""
     taken = []

@@ -1,0 +1,76 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Run in a real Blender window (xvfb) by tests/test_ui.py: three F12-style
+renders in the render job thread (render.render('INVOKE_DEFAULT') from a
+timer) of a tree whose HBAO node has Depth linked, then unlinked, then linked
+again; after each render has ended it waits up to STATUS_WAIT_S for the
+node's status line and prints it as 'STATUS <n> <json text>', so the test sees
+that the line appears after an F12 render and goes away with the next one.
+
+  blender --addons hbao --python ui_f12_status.py -- <out dir>
+"""
+import json
+import os
+import sys
+import time
+
+import bpy
+
+out_dir = sys.argv[sys.argv.index("--") + 1]
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(REPO, "scripts"))
+import blender_scenes  # noqa: E402
+
+RENDER_TIMEOUT_S = 240.0
+# The node shows the outcome shortly after the job ends (the add-on polls).
+STATUS_WAIT_S = 5.0
+
+scene = blender_scenes.build_corner_scene(bpy.context.scene, (48, 32), "CYCLES", 1)
+node = blender_scenes.hbao_test_tree(scene, out_dir)
+tree = node.id_data
+layers = next(n for n in tree.nodes if n.bl_idname == "CompositorNodeRLayers")
+os.makedirs(out_dir, exist_ok=True)
+
+# Per render: what to do to the tree before it.
+STEPS = [lambda: None,
+         lambda: tree.links.remove(node.inputs["Depth"].links[0]),
+         lambda: tree.links.new(layers.outputs["Depth"], node.inputs["Depth"])]
+state = {"step": 0, "phase": "start", "since": None, "done": False}
+
+
+def on_end(*_args):
+    state["done"] = True
+
+
+bpy.app.handlers.render_complete.append(on_end)
+bpy.app.handlers.render_cancel.append(on_end)
+
+
+def tick():
+    now = time.monotonic()
+    if state["phase"] == "start":
+        STEPS[state["step"]]()
+        state.update(phase="render", since=now, done=False)
+        print(f"F12: render {state['step']}", flush=True)
+        bpy.ops.render.render("INVOKE_DEFAULT")
+    elif state["phase"] == "render":
+        if now - state["since"] > RENDER_TIMEOUT_S:
+            print("F12: TIMEOUT", flush=True)
+            bpy.ops.wm.quit_blender()
+            return None
+        if state["done"] and not bpy.app.is_job_running("RENDER"):
+            state.update(phase="status", since=now)
+    elif state["phase"] == "status":
+        expect_message = state["step"] == 1
+        if bool(node.status) != expect_message and now - state["since"] < STATUS_WAIT_S:
+            return 0.1
+        print(f"STATUS {state['step']} {json.dumps(node.status)}", flush=True)
+        state["step"] += 1
+        if state["step"] == len(STEPS):
+            print("F12: DONE", flush=True)
+            bpy.ops.wm.quit_blender()
+            return None
+        state["phase"] = "start"
+    return 0.1
+
+
+bpy.app.timers.register(tick, first_interval=1.0)
