@@ -114,6 +114,18 @@ def test_node_ao_matches_library_cycles_and_composites_image_times_ao(
     assert error <= CYCLES_MEAN_ERROR_TOLERANCE
 
 
+def test_node_thickness_reaches_the_library(run_in_blender, tmp_path, native):
+    """The Thickness socket is the library's hbao_params.thickness: the node's
+    AO equals the library's with it, and differs from infinitely thick."""
+    spec = {"nodes": [{"radius": 0.7, "blur_size": 0, "thickness": 0.1}]}
+    out, _ = render(run_in_blender, tmp_path, spec)
+    ao = node_outputs(out, 1)["ao"]
+    expected = library_ao(native, out, 1, node_params(radius=0.7, blur_size=0, thickness=0.1))
+    assert np.abs(ao - expected).max() <= EXACT
+    thick = library_ao(native, out, 1, node_params(radius=0.7, blur_size=0))
+    assert np.abs(ao - thick).max() > 0.05  # the thickness changed the AO
+
+
 def test_node_ao_matches_cli(run_in_blender, tmp_path, hbao_tool):
     """The same passes through the command-line tool (its own OpenEXR reader)."""
     spec = {"nodes": [{"radius": 0.7, "blur_size": 0}]}

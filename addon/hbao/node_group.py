@@ -12,7 +12,8 @@ GROUP_TREE_NAME = ".HBAO"
 # Bumped when the group's sockets or contents change; older trees are rebuilt
 # and the nodes using them keep their values and links (upgrade_group_tree).
 # 2: Directions, Steps and Blur Size became integer sockets.
-GROUP_TREE_VERSION = 2
+# 3: a Thickness socket after Strength.
+GROUP_TREE_VERSION = 3
 GROUP_VERSION_KEY = "hbao_group_version"
 
 IMAGE_INPUT = "Image"
@@ -24,8 +25,9 @@ AO_PASS_INPUT = "HBAO Pass"
 IMAGE_OUTPUT = "Image"
 AO_OUTPUT = "AO"
 
-# The radius socket's upper end: far beyond any scene, but finite.
-MAX_RADIUS = 1.0e4
+# The upper end of the radius and thickness sockets (lengths the library
+# does not clamp): far beyond any scene, but finite.
+MAX_LENGTH = 1.0e4
 
 _D = parameters.DEFAULTS
 
@@ -34,8 +36,8 @@ def _value_input(key):
     """(params key, default, socket min, socket max, socket type) of a value
     socket: the library's limits (parameters.LIMITS); whole-number parameters
     get integer sockets, so the node shows 4, not 4.000."""
-    if key == "radius":
-        return key, float(_D[key]), 0.0, MAX_RADIUS, "NodeSocketFloat"
+    if key in ("radius", "thickness"):
+        return key, float(_D[key]), 0.0, MAX_LENGTH, "NodeSocketFloat"
     low, high, whole = parameters.LIMITS[key]
     if whole:
         return key, int(_D[key]), int(low), int(high), "NodeSocketInt"
@@ -47,7 +49,8 @@ def _value_input(key):
 # format: keyframes address sockets by index (nodes["HBAO"].inputs[3]).
 VALUE_INPUTS = {
     parameters.LABELS[key]: _value_input(key)
-    for key in ("radius", "angle_bias_degrees", "directions", "steps", "blur_size", "strength")
+    for key in ("radius", "angle_bias_degrees", "directions", "steps", "blur_size", "strength",
+                "thickness")
 }
 
 

@@ -22,6 +22,7 @@ DEFAULTS = {
     "blur_sharpness": 32.0,
     "strength": 1.0,
     "background_depth": 65504.0,
+    "thickness": 0.0,
 }
 # csrc/include/hbao.h, HBAO_MAX_*.
 MAX_DIRECTIONS = 64

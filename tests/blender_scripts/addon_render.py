@@ -16,7 +16,7 @@ AO pass), orthographic, border [min_x, max_x, min_y, max_y] (a border render
 cropped to it), save_blend (path: saved after the setup, before
 rendering), nodes: [{name, layer, normal (bool), radius, keyframes [[frame,
 radius], ..], radius_from_value_node, falloff, integration, blur_size,
-angle_bias, directions, steps, mute}], disable_normal_pass, disable_depth_pass,
+angle_bias, directions, steps, strength, thickness, mute}], disable_normal_pass, disable_depth_pass,
 output_format (the main output's file format, default OPEN_EXR_MULTILAYER),
 prepare [actions before rendering: sync, delete_helper, rename_helper,
 rename_node, second_scene_shares_the_tree]. Prints OUTPUT SETTINGS {json}
@@ -78,7 +78,8 @@ for index, node_spec in enumerate(spec.get("nodes", [{}])):
         compositor.link(source.outputs["Normal"], hbao.inputs["Normal"])
     for key, socket_name in (("radius", "Radius"), ("angle_bias", "Angle Bias"),
                              ("directions", "Directions"), ("steps", "Steps"),
-                             ("blur_size", "Blur Size"), ("strength", "Strength")):
+                             ("blur_size", "Blur Size"), ("strength", "Strength"),
+                             ("thickness", "Thickness")):
         if key in node_spec:
             hbao.inputs[socket_name].default_value = node_spec[key]
     for key in ("falloff", "integration", "half_resolution"):

@@ -50,6 +50,7 @@ class VIEW3D_PT_hbao_preview(bpy.types.Panel):
         column.prop(view_settings, "radius")
         column.prop(view_settings, "strength")
         column.prop(view_settings, "angle_bias_degrees")
+        column.prop(view_settings, "thickness")
         column.separator()
         column.prop(view_settings, "directions")
         column.prop(view_settings, "steps")

@@ -80,6 +80,11 @@ class HBAOViewSettings(bpy.types.PropertyGroup):
     strength: FloatProperty(
         name="Strength", default=_D["strength"], min=0.0, max=parameters.MAX_STRENGTH,
         soft_max=4.0, update=_redraw, description="AO is raised to this power")
+    thickness: FloatProperty(
+        name="Thickness", default=_D["thickness"], min=0.0, soft_max=2.0, unit="LENGTH",
+        update=_redraw,
+        description="Occluders are taken as this thick: a surface nearer than the pixel by "
+                    "more than this does not shade it. 0 = infinitely thick")
 
     def params(self):
         """These settings as the C library's parameters (native.compute_ao's dict)."""
