@@ -180,3 +180,14 @@ def test_unreadable_saved_passes_render_without_ao(run_in_blender, tmp_path, no_
     assert "Rendering without AO" in log, log[-3000:]
     assert output_settings(log)["file_format"] == "PNG"
     assert_no_ao_and_image_unchanged(out)
+
+
+def test_internal_engine_picked_by_the_artist_explains_itself(run_in_blender, tmp_path):
+    """The Render Engine menu lists the add-on's internal engine (Python
+    cannot hide it). Picked for a scene of the artist's, it renders nothing
+    and says what to choose instead, in the render's report; no traceback."""
+    out, log = render(run_in_blender, tmp_path, {"nodes": [{"radius": 1.0}],
+                                                 "prepare": ["pick_internal_engine"]})
+    assert "is the HBAO add-on's internal engine and renders nothing" in log, log[-3000:]
+    assert "Choose Cycles or EEVEE" in log
+    assert "Traceback" not in log and "not an HBAO helper scene" not in log

@@ -97,8 +97,19 @@ def _report_failure(engine, message):
     engine.report({"WARNING"}, f"HBAO: {message}")
 
 
+# What an artist who picked this engine for a scene of their own is told.
+NOT_FOR_RENDERING = ("HBAO: \"{label}\" is the HBAO add-on's internal engine and renders "
+                     "nothing. Choose Cycles or EEVEE as the Render Engine (Render Properties), "
+                     "and add the HBAO node in the Compositor.")
+
+
 def render_helper(engine, depsgraph):
     """HBAOPassEngine.render(): fill every registered AO pass, 1 where it failed."""
+    if scene_for_render(_original(depsgraph.scene)) is None:
+        message = NOT_FOR_RENDERING.format(label=HBAOPassEngine.bl_label)
+        log(message)
+        engine.report({"WARNING"}, message)
+        return
     start = time.perf_counter()
     engine.hbao_timings = {}
     # The result's own size: a border render cropped to its region is
@@ -136,7 +147,9 @@ def render_helper(engine, depsgraph):
 class HBAOPassEngine(bpy.types.RenderEngine):
     """Renders nothing itself: publishes the AO of the main scene's HBAO nodes."""
     bl_idname = ENGINE_IDNAME
-    bl_label = "HBAO Passes (internal)"
+    # The Render Engine menu lists every engine (Python cannot hide one):
+    # the label says it is not for the artist; render() says so too.
+    bl_label = "HBAO Passes (internal, do not use)"
     bl_use_postprocess = True
     bl_use_preview = False
 

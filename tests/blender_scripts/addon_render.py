@@ -18,7 +18,7 @@ rendering), nodes: [{name, layer, normal (bool), radius, keyframes [[frame,
 radius], ..], radius_from_value_node, falloff, integration, blur_size,
 angle_bias, directions, steps, strength, thickness, mute}], disable_normal_pass, disable_depth_pass,
 output_format (the main output's file format, default OPEN_EXR_MULTILAYER),
-prepare [actions before rendering: sync, delete_helper, rename_helper,
+prepare [actions before rendering: sync, delete_helper, rename_helper, pick_internal_engine,
 rename_node, second_scene_shares_the_tree]. Prints OUTPUT SETTINGS {json}
 (the main output's settings after the renders) and RENDERED.
 """
@@ -133,6 +133,9 @@ for action in spec.get("prepare", []):
         for node in tree.nodes:
             if node.bl_idname == "CompositorNodeHBAO":
                 node.name = node.label = "Renamed " + node.name
+    elif action == "pick_internal_engine":  # from the Render Engine menu
+        import hbao.helper_scene
+        scene.render.engine = hbao.helper_scene.ENGINE_IDNAME
     elif action == "second_scene_shares_the_tree":  # 5.0+: one node group, two scenes
         other = scene.copy()
         other.name = "Second"
