@@ -152,3 +152,16 @@ def test_preview_darkens_the_view(toggle_report):
 def test_turning_off_restores_the_view_exactly(toggle_report):
     # Same scene, same view, drawn by the same GPU: bit-identical pixels.
     assert toggle_report["off_vs_never_max_abs"] == 0.0
+
+
+def test_use_node_settings_previews_the_nodes_values(run_in_blender):
+    """'Use Node Settings' previews the scene's HBAO node at the current frame
+    (a keyframed Radius: 0.9 at frame 10), with no node the view's own."""
+    completed = run_in_blender(SCRIPTS / "viewport_node_settings.py")
+    cases = {line.split(" ", 2)[1]: json.loads(line.split(" ", 2)[2])
+             for line in completed.stdout.splitlines() if line.startswith("PARAMS ")}
+    own = {"radius": 2.5, "steps": 16, "thickness": 0.0, "falloff": "NONE"}
+    assert cases["own"] == own, cases
+    assert cases["node"] == pytest.approx(
+        {"radius": 0.9, "steps": 7, "thickness": 0.2, "falloff": "QUADRATIC"}, rel=1e-6), cases
+    assert cases["no_node"] == own, cases

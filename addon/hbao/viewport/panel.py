@@ -45,8 +45,14 @@ class VIEW3D_PT_hbao_preview(bpy.types.Panel):
             layout.label(text="Shows in Solid and Material Preview", icon="INFO")
         layout.use_property_split = True
         layout.use_property_decorate = False
+        layout.prop(view_settings, "use_node_settings")
+        node = view_settings.settings_node(context.scene) \
+            if view_settings.use_node_settings else None
+        if view_settings.use_node_settings:
+            layout.label(text=f"Node \"{node.name}\"" if node else "No HBAO node: using these",
+                         icon="NODE" if node else "INFO")
         column = layout.column()
-        column.active = view_settings.enabled
+        column.active = view_settings.enabled and node is None
         column.prop(view_settings, "radius")
         column.prop(view_settings, "strength")
         column.prop(view_settings, "angle_bias_degrees")

@@ -18,7 +18,8 @@ from bpy.app.handlers import persistent
 from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty,
                        IntProperty)
 
-from .. import native, parameters
+from .. import compat, native, parameters, socket_values
+from ..node import hbao_nodes
 from ..parameters import FALLOFF_ITEMS, INTEGRATION_ITEMS
 
 COLLECTION_NAME = "hbao_viewport_views"
@@ -52,6 +53,10 @@ class HBAOViewSettings(bpy.types.PropertyGroup):
         name="HBAO Preview", default=False, update=_enabled_changed,
         description="Multiply ambient occlusion over this 3D view (Solid and Material "
                     "Preview shading)")
+    use_node_settings: BoolProperty(
+        name="Use Node Settings", default=False, update=_redraw,
+        description="Preview with the settings of the scene's HBAO compositor node (its "
+                    "values at the current frame), so the view shows what the render will")
     radius: FloatProperty(
         name="Radius", default=_D["radius"], min=0.0, soft_max=10.0, unit="LENGTH",
         update=_redraw, description="AO radius in scene units")
@@ -86,10 +91,25 @@ class HBAOViewSettings(bpy.types.PropertyGroup):
         description="Occluders are taken as this thick: a surface nearer than the pixel by "
                     "more than this does not shade it. 0 = infinitely thick")
 
-    def params(self):
-        """These settings as the C library's parameters (native.compute_ao's dict)."""
+    def params(self, scene=None):
+        """The C library's parameters (native.compute_ao's dict) this view
+        previews with: those of `scene`'s (default: the context's) first HBAO
+        node when use_node_settings is on and there is one, else these
+        settings. Raises ValueError for a value the library refuses."""
+        node = self.settings_node(scene) if self.use_node_settings else None
+        if node is not None:
+            scene = scene or bpy.context.scene
+            return socket_values.node_params(node, scene.frame_current, [])
         return native.resolve_params({name: getattr(self, name) for name in parameters.DEFAULTS
                                       if name != "background_depth"})
+
+    @staticmethod
+    def settings_node(scene=None):
+        """The HBAO node "Use Node Settings" previews: the first of the scene's
+        compositor tree, or None."""
+        scene = scene or bpy.context.scene
+        nodes = hbao_nodes(compat.compositor_tree(scene)) if scene is not None else []
+        return nodes[0] if nodes else None
 
 
 def _views(screen):
