@@ -6,6 +6,7 @@ node search does not offer the internal group. (The node's status line after
 an F12 render is not applied yet: the console and the render's report carry
 the messages; see the closing note of this wave.)"""
 import json
+import struct
 
 import pytest
 
@@ -43,6 +44,21 @@ def test_old_file_gets_integer_sockets_and_keeps_values_links_keyframes(ui_repor
     assert upgrade["image_output_to"] == ["Composite"]
     # Keyframes 3 at frame 1 and 9 at frame 11: exact at the keys.
     assert upgrade["blur_at_1"] == 3.0 and upgrade["blur_at_11"] == 9.0
+
+
+def test_node_status_line_after_each_f12_render(ui_report):
+    """What the artist reads on the node (out/test-artifacts/ui_node_*.png):
+    the short form fits the node, the full text is the tooltip."""
+    renders = ui_report["renders"]
+    assert renders["depth_unlinked"]["status"] == "Depth not linked: AO off"
+    assert "Depth is not linked" in renders["depth_unlinked"]["details"]
+    assert renders["clamped"]["status"] == "Steps clamped to 64"
+    assert "Steps 100 is above the limit 64; using 64" in renders["clamped"]["details"]
+    assert renders["good"] == {"status": "", "details": ""}
+    for name in renders:
+        shot = ARTIFACTS / f"ui_node_{name}.png"
+        width, height = struct.unpack(">II", shot.read_bytes()[16:24])
+        assert (width, height) == (1280, 1024), (name, width, height)
 
 
 def test_add_filter_menu_offers_hbao(ui_report):

@@ -94,10 +94,16 @@ def menu_report(window, area):
 
 
 def screenshot(window, area, name):
+    """The whole window, the node editor zoomed to the HBAO node (Blender
+    3.4's screenshot_area gives a 1x1 image under Xvfb; the window's works)."""
+    for node in tree.nodes:
+        node.select = node == hbao
+    tree.nodes.active = hbao
     with override(window, area):
-        bpy.ops.node.view_all()
+        bpy.ops.node.view_selected()
         bpy.ops.wm.redraw_timer(type="DRAW_WIN_SWAP", iterations=2)
-        bpy.ops.screen.screenshot_area(filepath=str(SHOTS / name), check_existing=False)
+    with bpy.context.temp_override(window=window, screen=window.screen):
+        bpy.ops.screen.screenshot(filepath=str(SHOTS / name), check_existing=False)
 
 
 RENDERS = [
