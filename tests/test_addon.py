@@ -126,6 +126,22 @@ def test_node_thickness_reaches_the_library(run_in_blender, tmp_path, native):
     assert np.abs(ao - thick).max() > 0.05  # the thickness changed the AO
 
 
+def test_connect_passes_button_turns_passes_on_and_links_them(
+        run_in_blender, tmp_path, native):
+    """An artist adds the node to a view layer without Depth and Normal
+    passes (Render Layers then has no such outputs to link): the node's
+    Connect Passes button turns them on and links them, and the render has AO."""
+    spec = {"nodes": [{"radius": 0.8, "blur_size": 0, "connect_with_operator": True}],
+            "disable_depth_pass": True, "disable_normal_pass": True}
+    out, log = render(run_in_blender, tmp_path, spec)
+    assert "CONNECT HBAO0 {'FINISHED'}" in log, log[-3000:]
+    assert ("Turned on the Depth and Normal passes of view layer 'ViewLayer'; linked Image, "
+            "Depth, Normal from 'Render Layers'") in log, log[-3000:]
+    ao = node_outputs(out, 1)["ao"]
+    expected = library_ao(native, out, 1, node_params(radius=0.8, blur_size=0))
+    assert ao.min() < 0.9 and np.abs(ao - expected).max() <= EXACT
+
+
 def test_node_ao_matches_cli(run_in_blender, tmp_path, hbao_tool):
     """The same passes through the command-line tool (its own OpenEXR reader)."""
     spec = {"nodes": [{"radius": 0.7, "blur_size": 0}]}

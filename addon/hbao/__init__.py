@@ -51,8 +51,8 @@ def register():
         preferences.show(message)
         if not compat.version_is_new_enough():
             return  # the message says why; a traceback would not
-    from . import engine, handlers, node
-    for module in (node, engine, handlers):
+    from . import engine, handlers, node, node_setup
+    for module in (node, node_setup, engine, handlers):
         module.register()
         _registered.append(module)
     try:

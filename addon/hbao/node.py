@@ -107,6 +107,10 @@ class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
         _announce_change()
 
     def draw_buttons(self, context, layout):
+        if not self.inputs[DEPTH_INPUT].is_linked:
+            # Render Layers shows no Depth output until the pass is ticked.
+            button = layout.operator("hbao.connect_passes", icon="LINKED")
+            button.node_name = self.name
         layout.prop(self, "falloff")
         layout.prop(self, "integration")
         layout.prop(self, "half_resolution")

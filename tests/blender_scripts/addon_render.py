@@ -16,7 +16,9 @@ AO pass), orthographic, border [min_x, max_x, min_y, max_y] (a border render
 cropped to it), save_blend (path: saved after the setup, before
 rendering), nodes: [{name, layer, normal (bool), radius, keyframes [[frame,
 radius], ..], radius_from_value_node, falloff, integration, blur_size,
-angle_bias, directions, steps, strength, thickness, mute}], disable_normal_pass, disable_depth_pass,
+angle_bias, directions, steps, strength, thickness, mute, connect_with_operator (left
+unlinked, then linked by the node's Connect Passes operator after the passes are
+disabled)}], disable_normal_pass, disable_depth_pass,
 output_format (the main output's file format, default OPEN_EXR_MULTILAYER),
 prepare [actions before rendering: sync, delete_helper, rename_helper, pick_internal_engine,
 rename_node, second_scene_shares_the_tree]. Prints OUTPUT SETTINGS {json}
@@ -68,13 +70,17 @@ file_output.add("Render", render_layers[first_layer].outputs["Image"])
 if spec.get("ao_reference"):
     file_output.add("CyclesAO", blender_scenes.compat.pass_output(render_layers[first_layer], "AO"))
 
+connect_with_operator = []
 for index, node_spec in enumerate(spec.get("nodes", [{}])):
     hbao = compositor.node("CompositorNodeHBAO", (300, -400 * index))
     hbao.name = node_spec.get("name", f"HBAO{index}")
     source = render_layers[node_spec.get("layer", first_layer)]
-    compositor.link(source.outputs["Image"], hbao.inputs["Image"])
-    compositor.link(source.outputs["Depth"], hbao.inputs["Depth"])
-    if node_spec.get("normal", True):
+    if node_spec.get("connect_with_operator"):  # the node's Connect Passes button
+        connect_with_operator.append(hbao.name)
+    else:
+        compositor.link(source.outputs["Image"], hbao.inputs["Image"])
+        compositor.link(source.outputs["Depth"], hbao.inputs["Depth"])
+    if node_spec.get("normal", True) and not node_spec.get("connect_with_operator"):
         compositor.link(source.outputs["Normal"], hbao.inputs["Normal"])
     for key, socket_name in (("radius", "Radius"), ("angle_bias", "Angle Bias"),
                              ("directions", "Directions"), ("steps", "Steps"),
@@ -103,6 +109,8 @@ for view_layer in scene.view_layers:
         view_layer.use_pass_normal = False
     if spec.get("disable_depth_pass"):
         view_layer.use_pass_z = False
+for name in connect_with_operator:
+    print("CONNECT", name, bpy.ops.hbao.connect_passes(node_name=name), flush=True)
 
 # The main output: what the tests read back, or (output_format) an artist's
 # own choice, which the add-on must leave as it found it.
