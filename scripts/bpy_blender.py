@@ -81,4 +81,13 @@ def main(argv):
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))
+    status = main(sys.argv[1:])
+    # bpy 4.5's module can deadlock in its C++ static destructors at exit
+    # (its delayed file-close thread still waits on the condition variable
+    # being destroyed; seen after a render whose render_pre handler changed
+    # another scene's resolution). Blender itself exits through WM_exit; this
+    # stand-in has written everything by now, so it leaves without running
+    # the destructors, as Blender's own exit() after WM_exit would.
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(status)

@@ -191,3 +191,22 @@ def test_internal_engine_picked_by_the_artist_explains_itself(run_in_blender, tm
     assert "is the HBAO add-on's internal engine and renders nothing" in log, log[-3000:]
     assert "Choose Cycles or EEVEE" in log
     assert "Traceback" not in log and "not an HBAO helper scene" not in log
+
+
+def test_helper_resized_after_the_sync_still_renders_exact_ao(run_in_blender, tmp_path,
+                                                              native, no_leftovers):
+    """The helper scene is set to half size after the hook synced it (a
+    render_pre handler of the artist's), to make its pass smaller than the
+    Render Result. Blender renders the helper at the Render Result's size
+    anyway, so the AO is computed and exact (the engine's size check, AO = 1
+    with both sizes named, is not reached by this fault). Nothing is left in
+    the scratch folder, the output settings are kept, and the process ends
+    (bpy 4.5 deadlocked at exit after this render: scripts/bpy_blender.py)."""
+    out, log = render_with_fault(run_in_blender, tmp_path,
+                                 {"nodes": [{"radius": 1.0, "blur_size": 0}]},
+                                 "helper_resized")
+    assert "FAULT resized" in log, log[-3000:]
+    assert output_settings(log)["file_format"] == "OPEN_EXR_MULTILAYER"
+    assert "without AO" not in log, log[-3000:]
+    expected = library_ao(native, out, 1, node_params(radius=1.0, blur_size=0))
+    assert np.abs(node_outputs(out, 1)["ao"] - expected).max() <= EXACT
