@@ -210,3 +210,13 @@ def test_helper_resized_after_the_sync_still_renders_exact_ao(run_in_blender, tm
     assert "without AO" not in log, log[-3000:]
     expected = library_ao(native, out, 1, node_params(radius=1.0, blur_size=0))
     assert np.abs(node_outputs(out, 1)["ao"] - expected).max() <= EXACT
+
+
+def test_helper_scene_rendered_by_the_artist_explains_itself(run_in_blender, tmp_path):
+    """An artist makes the hidden helper scene active and renders it: it
+    renders nothing, and the report says which scene to render instead."""
+    out, log = render(run_in_blender, tmp_path, {"nodes": [{"radius": 1.0}],
+                                                 "prepare": ["render_the_helper"]})
+    assert ("\".HBAO passes Scene\" is the HBAO add-on's helper scene and renders nothing by "
+            "itself. Switch back to scene \"Scene\"") in log, log[-3000:]
+    assert "AO pass(es)" not in log and "Traceback" not in log

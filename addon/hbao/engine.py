@@ -12,7 +12,8 @@ import numpy as np
 
 from . import camera as camera_model
 from . import exr_passes, handover, native
-from .helper_scene import ENGINE_IDNAME, pass_names_for_helper, scene_for_render
+from .helper_scene import (ENGINE_IDNAME, is_helper, pass_names_for_helper,
+                           rendered_for_a_scene, scene_for_render)
 from .planning import plan
 from .report import log
 
@@ -97,6 +98,11 @@ def _report_failure(engine, message):
     engine.report({"WARNING"}, f"HBAO: {message}")
 
 
+# What an artist who renders the helper scene itself (made it the active
+# scene) is told.
+HELPER_NOT_FOR_RENDERING = ("HBAO: \"{helper}\" is the HBAO add-on's helper scene and "
+                            "renders nothing by itself. Switch back to scene \"{main}\" and "
+                            "render that.")
 # What an artist who picked this engine for a scene of their own is told.
 NOT_FOR_RENDERING = ("HBAO: \"{label}\" is the HBAO add-on's internal engine and renders "
                      "nothing. Choose Cycles or EEVEE as the Render Engine (Render Properties), "
@@ -105,8 +111,12 @@ NOT_FOR_RENDERING = ("HBAO: \"{label}\" is the HBAO add-on's internal engine and
 
 def render_helper(engine, depsgraph):
     """HBAOPassEngine.render(): fill every registered AO pass, 1 where it failed."""
-    if scene_for_render(_original(depsgraph.scene)) is None:
-        message = NOT_FOR_RENDERING.format(label=HBAOPassEngine.bl_label)
+    scene = _original(depsgraph.scene)
+    main = scene_for_render(scene) if is_helper(scene) else None
+    if main is None or not rendered_for_a_scene(scene):
+        message = (HELPER_NOT_FOR_RENDERING.format(helper=scene.name, main=main.name)
+                   if main is not None
+                   else NOT_FOR_RENDERING.format(label=HBAOPassEngine.bl_label))
         log(message)
         engine.report({"WARNING"}, message)
         return

@@ -61,6 +61,12 @@ def _on_render_pre(scene, *_args):
 
 
 @bpy.app.handlers.persistent
+def _on_render_end(scene, *_args):
+    if not helper_scene.is_helper(scene):
+        helper_scene.record_render_end(scene)
+
+
+@bpy.app.handlers.persistent
 def _on_depsgraph_update_post(scene, *_args):
     if helper_scene.is_helper(scene) or not in_main_thread():
         return
@@ -74,6 +80,8 @@ _HANDLERS = (
     (bpy.app.handlers.save_pre, _on_save_pre),
     (bpy.app.handlers.render_init, _on_render_pre),
     (bpy.app.handlers.render_pre, _on_render_pre),
+    (bpy.app.handlers.render_complete, _on_render_end),
+    (bpy.app.handlers.render_cancel, _on_render_end),
     (bpy.app.handlers.depsgraph_update_post, _on_depsgraph_update_post),
 )
 

@@ -12,9 +12,8 @@ node's hidden "HBAO Pass" input.
 
 The helper belongs to the tree, not to a scene: from Blender 5.0 one
 compositing node group may serve several scenes, and a managed node that
-pointed at each scene's helper in turn would flip with every sync. The
-scene being rendered is recorded by the render handlers (record_rendering)
-and read by the engine (scene_for_render)."""
+pointed at each scene's helper in turn would flip with every sync. The render
+handlers record the scene being rendered, which the engine reads."""
 import bpy
 
 from . import compat
@@ -41,8 +40,10 @@ SYNCED_RENDER_SETTINGS = (
     "pixel_aspect_y", "use_border", "use_crop_to_border", "border_min_x", "border_max_x",
     "border_min_y", "border_max_y", "fps", "fps_base")
 
-# Helper scene name -> name of the scene whose render is using it now.
+# Helper scene name -> name of the scene whose render is using it now; the
+# helpers whose scene's render job runs (record_rendering .. record_render_end).
 _rendering = {}
+_in_progress = set()
 
 
 def set_if_different(owner, attribute, value):
@@ -120,7 +121,18 @@ def record_rendering(scene):
     helper = helper_scene_of(scene)
     if helper is not None:
         _rendering[helper.name] = scene.name
+        _in_progress.add(helper.name)
         copy_render_settings(scene, helper)
+
+
+def record_render_end(scene):
+    """Called when `scene`'s render job ends (completed or cancelled)."""
+    _in_progress.discard(getattr(helper_scene_of(scene), "name", None))
+
+
+def rendered_for_a_scene(helper):
+    """False when an artist renders the helper scene itself."""
+    return helper.name in _in_progress
 
 
 def scene_for_render(helper):

@@ -21,6 +21,7 @@ unlinked, then linked by the node's Connect Passes operator after the passes are
 disabled)}], disable_normal_pass, disable_depth_pass,
 output_format (the main output's file format, default OPEN_EXR_MULTILAYER),
 prepare [actions before rendering: sync, delete_helper, rename_helper, pick_internal_engine,
+render_the_helper,
 rename_node, second_scene_shares_the_tree]. Prints OUTPUT SETTINGS {json}
 (the main output's settings after the renders) and RENDERED.
 """
@@ -127,6 +128,7 @@ def helper_scenes():
 
 
 # Faults and edits an artist may make before rendering (tests/test_faults.py).
+render_scene_name = None  # another scene to render than `scene`
 for action in spec.get("prepare", []):
     if action == "sync":  # what the UI does on its own after an edit
         import hbao
@@ -141,6 +143,10 @@ for action in spec.get("prepare", []):
         for node in tree.nodes:
             if node.bl_idname == "CompositorNodeHBAO":
                 node.name = node.label = "Renamed " + node.name
+    elif action == "render_the_helper":  # the helper made the active scene, then F12
+        import hbao
+        hbao.sync(scene)
+        render_scene_name = helper_scenes()[0].name
     elif action == "pick_internal_engine":  # from the Render Engine menu
         import hbao.helper_scene
         scene.render.engine = hbao.helper_scene.ENGINE_IDNAME
@@ -164,7 +170,11 @@ for frame in spec.get("frames", [1]):
         json.dump(blender_scenes.camera_description(scene), stream)
     # Still renders do not replace '#' in the path: name the frame here.
     scene.render.filepath = os.path.join(out_dir, f"frame_{frame:04d}")
-    bpy.ops.render.render(write_still=True)
+    if render_scene_name is None:
+        bpy.ops.render.render(write_still=True)
+    else:
+        bpy.data.scenes[render_scene_name].render.filepath = scene.render.filepath
+        bpy.ops.render.render(write_still=True, scene=render_scene_name)
 settings = scene.render.image_settings
 print("OUTPUT SETTINGS", json.dumps({
     "file_format": settings.file_format, "color_depth": settings.color_depth,
