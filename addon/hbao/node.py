@@ -111,8 +111,11 @@ class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
             # Render Layers shows no Depth output until the pass is ticked.
             button = layout.operator("hbao.connect_passes", icon="LINKED")
             button.node_name = self.name
-        layout.prop(self, "falloff")
-        layout.prop(self, "integration")
+        for name in ("falloff", "integration"):
+            # A label of its own: the default split cuts "Integration" short.
+            row = layout.split(factor=0.5)
+            row.label(text=self.bl_rna.properties[name].name)
+            row.prop(self, name, text="")
         layout.prop(self, "half_resolution")
         if self.status:
             # A borderless button: its tooltip (and a click: the Info editor)
