@@ -15,9 +15,16 @@ Scenes (each of a different character, for screen-space AO):
 import math
 from dataclasses import dataclass
 
+import os
+import sys
+
 import bpy
 import mathutils
 from mathutils import Vector
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                                "scripts"))
+import scene_parts  # noqa: E402  (scripts/: the parts every scene is built from)
 
 # Debian's assimp-testmodels: a robot arm (joints, struts, a clamp), binary
 # STL, which Blender 3.4 imports natively.
@@ -59,61 +66,24 @@ def _grey_material():
 
 
 def _link(obj):
-    bpy.context.scene.collection.objects.link(obj)
-    if obj.type == "MESH":
-        obj.data.materials.clear()
-        obj.data.materials.append(_grey_material())
-    return obj
+    return scene_parts.link(obj, bpy.context.scene.collection, _grey_material())
 
 
 def add_box(name, centre, size, rotation_z_degrees=0.0):
     """An axis-aligned (optionally turned about z) box with flat shading."""
-    mesh = bpy.data.meshes.new(name)
-    hx, hy, hz = (s / 2.0 for s in size)
-    vertices = [(x, y, z) for x in (-hx, hx) for y in (-hy, hy) for z in (-hz, hz)]
-    faces = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
-    mesh.from_pydata(vertices, [], faces)
-    mesh.update()
-    obj = bpy.data.objects.new(name, mesh)
-    obj.location = centre
-    obj.rotation_euler = (0.0, 0.0, math.radians(rotation_z_degrees))
-    return _link(obj)
+    return scene_parts.box(name, centre, size, bpy.context.scene.collection, _grey_material(),
+                           rotation=(0.0, 0.0, math.radians(rotation_z_degrees)))
 
 
 def add_cylinder(name, centre, radius, height, segments=24):
-    mesh = bpy.data.meshes.new(name)
-    vertices, faces = [], []
-    for k in range(segments):
-        a = 2.0 * math.pi * k / segments
-        vertices += [(radius * math.cos(a), radius * math.sin(a), -height / 2.0),
-                     (radius * math.cos(a), radius * math.sin(a), height / 2.0)]
-    for k in range(segments):
-        n = (k + 1) % segments
-        faces.append((2 * k, 2 * n, 2 * n + 1, 2 * k + 1))
-    faces.append(tuple(range(2 * segments - 2, -1, -2)))
-    faces.append(tuple(range(1, 2 * segments, 2)))
-    mesh.from_pydata(vertices, [], faces)
-    mesh.update()
-    obj = bpy.data.objects.new(name, mesh)
-    obj.location = centre
-    return _link(obj)
+    return scene_parts.cylinder(name, centre, radius, height, bpy.context.scene.collection,
+                                _grey_material(), segments)
 
 
 def add_camera(location, target, lens=35.0, ortho_scale=None):
-    data = bpy.data.cameras.new("BenchCamera")
-    data.lens = lens
-    data.clip_start = 0.05
-    data.clip_end = 500.0
-    if ortho_scale is not None:
-        data.type = "ORTHO"
-        data.ortho_scale = ortho_scale
-    camera = bpy.data.objects.new("BenchCamera", data)
-    camera.location = location
-    direction = Vector(target) - Vector(location)
-    camera.rotation_euler = direction.to_track_quat("-Z", "Y").to_euler()
-    bpy.context.scene.collection.objects.link(camera)
-    bpy.context.scene.camera = camera
-    return camera
+    scene = bpy.context.scene
+    return scene_parts.camera(scene, scene.collection, location, target, lens=lens,
+                              name="BenchCamera", ortho_scale=ortho_scale, clip=(0.05, 500.0))
 
 
 # --- interior ---------------------------------------------------------------

@@ -24,6 +24,8 @@ except ImportError:
 from hbao import camera as camera_model  # noqa: E402
 from hbao import compat  # noqa: E402
 
+import scene_parts  # noqa: E402  (beside this file: the parts every scene is built from)
+
 # Debian's Blender has no OpenImageDenoise; renders with denoising on fail.
 # Small sample counts keep test renders at a few seconds on 2 CPU cores.
 DEFAULT_SAMPLES = 16
@@ -78,22 +80,12 @@ def _material(name, colour, roughness=0.6):
     return material
 
 
-def _link(obj, collection, material=None):
-    """Moves a freshly added object from wherever bpy.ops put it into `collection`."""
-    for owner in list(obj.users_collection):
-        owner.objects.unlink(obj)
-    collection.objects.link(obj)
-    if material is not None:
-        obj.data.materials.clear()
-        obj.data.materials.append(material)
-    return obj
-
-
 def _add(operator, collection, material, name, **kwargs):
+    """An object made by a bpy.ops primitive (spheres, a torus), moved into `collection`."""
     operator(**kwargs)
     obj = bpy.context.active_object
     obj.name = name
-    return _link(obj, collection, material)
+    return scene_parts.link(obj, collection, material)
 
 
 def _smooth(obj):
@@ -103,27 +95,11 @@ def _smooth(obj):
 
 def _box(collection, material, name, size, location, rotation=(0.0, 0.0, 0.0)):
     """A box of `size` (x, y, z) metres whose centre is `location`."""
-    obj = _add(bpy.ops.mesh.primitive_cube_add, collection, material, name,
-               size=1.0, location=location, rotation=rotation)
-    obj.scale = size
-    return obj
-
-
-def _look_at(obj, target):
-    direction = Vector(target) - obj.location
-    obj.rotation_euler = direction.to_track_quat("-Z", "Y").to_euler()
+    return scene_parts.box(name, location, size, collection, material, rotation)
 
 
 def _camera(scene, collection, location, target, lens=35.0, name="Camera"):
-    data = bpy.data.cameras.new(name)
-    data.lens = lens
-    data.sensor_fit = "AUTO"
-    camera = bpy.data.objects.new(name, data)
-    collection.objects.link(camera)
-    camera.location = location
-    _look_at(camera, target)
-    scene.camera = camera
-    return camera
+    return scene_parts.camera(scene, collection, location, target, lens=lens, name=name)
 
 
 def _sun(collection, rotation_deg, strength=3.0, angle_deg=8.0):
