@@ -93,17 +93,6 @@ static inline float hbao_near_limit(const hbao_settings *settings, float z) {
     return settings->thickness > 0.0f ? z - settings->thickness : 0.0f;
 }
 
-/* Loops written to auto-vectorize get one compiled copy per vector width,
- * chosen when the library loads (GCC's target_clones). Their operations are
- * element-wise and never contracted into FMAs (ISO C mode), so every copy
- * computes the same floats. */
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) &&                             \
-    !defined(__SANITIZE_ADDRESS__)
-#define HBAO_VECTOR_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
-#else
-#define HBAO_VECTOR_CLONES
-#endif
-
 /* camera.c */
 hbao_result hbao_validate_camera(const hbao_camera *camera);
 /* Fill the grid's view-plane mapping, pixel_size, ycor, orthographic for a grid whose

@@ -7,13 +7,14 @@
 #include <stdatomic.h>
 #include <stdint.h>
 
-#include "internal_hbao.h"
+#include "internal_finish.h"
 
 typedef struct normal_job {
     const hbao_camera *camera;
     hbao_grid *grid;
     const hbao_channel *given; /* NULL: reconstruct everything */
     int scale;
+    int implementation; /* the compiled copy of given_normals_row to run */
 } normal_job;
 
 static void view_vector(const hbao_grid *grid, const float position[3], float v[3]) {
@@ -163,48 +164,127 @@ static int reconstruct_normal(const hbao_grid *grid, int i, int j, const float c
     return normalize3(n);
 }
 
-static int transform_given_normal(const normal_job *job, int i, int j, float n[3]) {
-    const hbao_channel *given = job->given;
-    const float *w = given->data + (int64_t)(j * job->scale) * given->row_stride +
-                     (int64_t)(i * job->scale) * given->pixel_stride;
-    const float wx = w[0], wy = w[1], wz = w[2];
-    const float world_length = sqrtf(wx * wx + wy * wy + wz * wz);
-    if (!isfinite(world_length) || world_length < HBAO_MIN_NORMAL_LENGTH) return 0;
-    const float *m = job->camera->world_to_camera;
-    n[0] = m[0] * wx + m[1] * wy + m[2] * wz;
-    n[1] = m[4] * wx + m[5] * wy + m[6] * wz;
-    n[2] = m[8] * wx + m[9] * wy + m[10] * wz;
-    const float length = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    if (!isfinite(length) || !(length > 0.0f)) return 0;
-    for (int c = 0; c < 3; c++) n[c] /= length;
-    return 1;
+/* A pixel without a usable given normal: the face normal from depth, or V. */
+static void fallback_normal(const normal_job *job, int i, int j, float n[3]) {
+    const hbao_grid *grid = job->grid;
+    const float z = grid->depth[(size_t)j * grid->width + i];
+    if (z <= 0.0f) {
+        n[0] = 0.0f;
+        n[1] = 0.0f;
+        n[2] = 1.0f;
+        return;
+    }
+    float p[3], v[3];
+    hbao_grid_position(grid, i, j, z, p);
+    view_vector(grid, p, v);
+    if (!reconstruct_normal(grid, i, j, p, v, n)) {
+        for (int c = 0; c < 3; c++) n[c] = v[c];
+    }
+    if (n[0] * v[0] + n[1] * v[1] + n[2] * v[2] < 0.0f) {
+        for (int c = 0; c < 3; c++) n[c] = -n[c];
+    }
 }
+
+/* The given normals of CHUNK pixels at a time, in lanes: the same float
+ * operations, in the same order, as view_vector and transform_given_normal
+ * (no FMA contraction: internal_finish.h), so every compiled copy gives the
+ * same normals. A pixel whose given normal is unusable, or that is
+ * background, is marked for fallback_normal. */
+#define CHUNK 64
+
+static HBAO_ALWAYS_INLINE void given_normals_row(const normal_job *job, int j) {
+    hbao_grid *grid = job->grid;
+    const hbao_channel *given = job->given;
+    const float *m = job->camera->world_to_camera;
+    const float y = hbao_grid_y(grid, j);
+    const int orthographic = grid->orthographic;
+    const float *source_row = given->data + (int64_t)(j * job->scale) * given->row_stride;
+    const int64_t pixel_step = (int64_t)job->scale * given->pixel_stride;
+    float *normal_row_out = grid->normal + 3 * (size_t)j * grid->width;
+    const float *depth_row = grid->depth + (size_t)j * grid->width;
+    for (int i0 = 0; i0 < grid->width; i0 += CHUNK) {
+        const int count = grid->width - i0 < CHUNK ? grid->width - i0 : CHUNK;
+        float wx[CHUNK], wy[CHUNK], wz[CHUNK], z[CHUNK];
+        float nx[CHUNK], ny[CHUNK], nz[CHUNK];
+        int usable[CHUNK];
+        for (int k = 0; k < count; k++) {
+            const float *w = source_row + (int64_t)(i0 + k) * pixel_step;
+            wx[k] = w[0];
+            wy[k] = w[1];
+            wz[k] = w[2];
+            z[k] = depth_row[i0 + k];
+        }
+        for (int k = 0; k < count; k++) {
+            /* view_vector */
+            const float x = ((float)(i0 + k) + grid->x_offset) * grid->x_step;
+            const float p0 = orthographic ? x : x * z[k];
+            const float p1 = orthographic ? y : y * z[k];
+            const float p2 = -z[k];
+            const float p_length = sqrtf(p0 * p0 + p1 * p1 + p2 * p2);
+            const float v0 = orthographic ? 0.0f : -p0 / p_length;
+            const float v1 = orthographic ? 0.0f : -p1 / p_length;
+            const float v2 = orthographic ? 1.0f : -p2 / p_length;
+            /* transform_given_normal */
+            const float world_length = sqrtf(wx[k] * wx[k] + wy[k] * wy[k] + wz[k] * wz[k]);
+            const float n0 = m[0] * wx[k] + m[1] * wy[k] + m[2] * wz[k];
+            const float n1 = m[4] * wx[k] + m[5] * wy[k] + m[6] * wz[k];
+            const float n2 = m[8] * wx[k] + m[9] * wy[k] + m[10] * wz[k];
+            const float length = sqrtf(n0 * n0 + n1 * n1 + n2 * n2);
+            const float u0 = n0 / length, u1 = n1 / length, u2 = n2 / length;
+            /* isfinite(x) as x <= FLT_MAX on |x|: NaN fails, and it vectorizes */
+            usable[k] = z[k] > 0.0f && fabsf(world_length) <= 3.40282347e38f &&
+                        world_length >= HBAO_MIN_NORMAL_LENGTH && fabsf(length) <= 3.40282347e38f &&
+                        length > 0.0f;
+            const int flip = u0 * v0 + u1 * v1 + u2 * v2 < 0.0f;
+            nx[k] = flip ? -u0 : u0;
+            ny[k] = flip ? -u1 : u1;
+            nz[k] = flip ? -u2 : u2;
+        }
+        float *out = normal_row_out + 3 * (size_t)i0;
+        for (int k = 0; k < count; k++) {
+            if (usable[k]) {
+                out[3 * k] = nx[k];
+                out[3 * k + 1] = ny[k];
+                out[3 * k + 2] = nz[k];
+            } else {
+                fallback_normal(job, i0 + k, j, out + 3 * k);
+            }
+        }
+    }
+}
+
+static void given_normals_row_portable(const normal_job *job, int j) {
+    given_normals_row(job, j);
+}
+
+#ifdef HBAO_FINISH_X86
+HBAO_TARGET_AVX2 static void given_normals_row_avx2(const normal_job *job, int j) {
+    given_normals_row(job, j);
+}
+
+HBAO_TARGET_AVX512 static void given_normals_row_avx512(const normal_job *job, int j) {
+    given_normals_row(job, j);
+}
+#endif
 
 static void normal_row(void *context, int j) {
     const normal_job *job = context;
-    hbao_grid *grid = job->grid;
-    for (int i = 0; i < grid->width; i++) {
-        const size_t index = (size_t)j * grid->width + i;
-        float *n = grid->normal + 3 * index;
-        const float z = grid->depth[index];
-        if (z <= 0.0f) {
-            n[0] = 0.0f;
-            n[1] = 0.0f;
-            n[2] = 1.0f;
-            continue;
+    if (job->given != NULL) {
+#ifdef HBAO_FINISH_X86
+        if (job->implementation == HBAO_IMPLEMENTATION_AVX512) {
+            given_normals_row_avx512(job, j);
+            return;
         }
-        float p[3], v[3];
-        hbao_grid_position(grid, i, j, z, p);
-        view_vector(grid, p, v);
-        int have = job->given != NULL && transform_given_normal(job, i, j, n);
-        if (!have) have = reconstruct_normal(grid, i, j, p, v, n);
-        if (!have) {
-            for (int c = 0; c < 3; c++) n[c] = v[c];
+        if (job->implementation == HBAO_IMPLEMENTATION_AVX2) {
+            given_normals_row_avx2(job, j);
+            return;
         }
-        if (n[0] * v[0] + n[1] * v[1] + n[2] * v[2] < 0.0f) {
-            for (int c = 0; c < 3; c++) n[c] = -n[c];
-        }
+#endif
+        given_normals_row_portable(job, j);
+        return;
     }
+    for (int i = 0; i < job->grid->width; i++)
+        fallback_normal(job, i, j, job->grid->normal + 3 * ((size_t)j * job->grid->width + i));
 }
 
 /* Whether a depth is exactly a half float: a normal one, in [2^-14, 65504]
@@ -254,6 +334,7 @@ static float detect_depth_precision(const hbao_settings *settings, const hbao_gr
 void hbao_compute_normals(const hbao_settings *settings, const hbao_camera *camera, hbao_grid *grid,
                           const hbao_channel *normal, int scale) {
     grid->depth_precision = detect_depth_precision(settings, grid);
-    normal_job job = {camera, grid, normal, scale};
+    normal_job job = {camera, grid, normal, scale,
+                      hbao_finish_implementation(settings->implementation)};
     hbao_parallel_rows(settings->threads, grid->height, normal_row, &job);
 }
