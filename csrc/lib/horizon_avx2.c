@@ -38,6 +38,10 @@
 #define I_LANES _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)
 #define I_TO_F _mm256_cvtepi32_ps
 
+#define V_CVTT _mm256_cvttps_epi32
+#define I_STOREU(p, v) _mm256_storeu_si256((__m256i *)(p), (v))
+#define M_BITS(m) _mm256_movemask_ps(m)
+
 #include "horizon_simd.h"
 
 int hbao_horizon_avx2_available(void) {

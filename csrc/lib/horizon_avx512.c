@@ -40,6 +40,10 @@
 #define I_LANES _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15)
 #define I_TO_F _mm512_cvtepi32_ps
 
+#define V_CVTT _mm512_cvttps_epi32
+#define I_STOREU(p, v) _mm512_storeu_si512((void *)(p), (v))
+#define M_BITS(m) ((int)(m))
+
 #include "horizon_simd.h"
 
 int hbao_horizon_avx512_available(void) {

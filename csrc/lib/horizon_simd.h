@@ -11,7 +11,8 @@
  * V_ADD V_SUB V_MUL V_DIV V_SQRT V_SET V_LOADU V_STOREU V_NEG V_MAX0 (max
  * with 0, NaN -> 0); comparisons V_GT V_GE V_LT V_LE -> VM; masks M_AND M_OR
  * M_ANDNOT(a, b) = ~a & b, M_ANY; V_SELECT(m, a, b) = m ? b : a;
- * V_ZERO_UNLESS(m, v); I_SET I_ADD I_MULLO I_LANES (0, 1, ...) I_TO_F;
+ * V_ZERO_UNLESS(m, v); I_SET I_ADD I_MULLO I_LANES (0, 1, ...) I_TO_F; V_CVTT
+ * (truncating float -> int32); I_STOREU; M_BITS(m) (lane k -> bit k);
  * SIMD_NAME(x) gives the instance's function names. */
 
 static inline VF SIMD_NAME(dot3)(VF a0, VF a1, VF a2, VF b0, VF b1, VF b2) {
@@ -93,17 +94,51 @@ typedef struct SIMD_NAME(fetch) {
     VM candidate; /* inside the image, on another pixel */
 } SIMD_NAME(fetch);
 
+/* hbao_step_offset for SIMD_LANES steps at once, each lane one step, with
+ * the same float operations: fills ox[0..steps) and oy[0..steps) (whole
+ * vectors are stored, so both hold steps + SIMD_LANES) and returns how many
+ * steps come before the first that lies a whole image away. */
+static inline VI SIMD_NAME(floor_to_int)(VF x) {
+    /* hbao_floor_in_range's truncation and correction, exact in range */
+    const VI truncated = V_CVTT(x);
+    const VF whole = I_TO_F(truncated);
+    return V_CVTT(V_SUB(whole, V_SELECT(V_GT(whole, x), V_SET(0.0f), V_SET(1.0f))));
+}
+
+static inline int SIMD_NAME(step_offsets)(const hbao_grid *g, float dc, float ds, float inv_ycor,
+                                          float jitter, float step_px, int steps, int *ox,
+                                          int *oy) {
+    for (int first = 0; first < steps; first += SIMD_LANES) {
+        const VF step = I_TO_F(I_ADD(I_SET(first), I_LANES));
+        const VF t = V_ADD(V_SET(1.0f), V_MUL(V_ADD(step, V_SET(jitter)), V_SET(step_px)));
+        const VF x = V_ADD(V_SET(0.5f), V_MUL(V_SET(dc), t));
+        const VF y = V_SUB(V_SET(0.5f), V_MUL(V_MUL(V_SET(ds), t), V_SET(inv_ycor)));
+        const VM inside =
+            M_AND(M_AND(V_GE(x, V_SET((float)(1 - g->width))), V_LT(x, V_SET((float)g->width))),
+                  M_AND(V_GE(y, V_SET((float)(1 - g->height))), V_LT(y, V_SET((float)g->height))));
+        I_STOREU(ox + first, SIMD_NAME(floor_to_int)(x));
+        I_STOREU(oy + first, SIMD_NAME(floor_to_int)(y));
+        const int count = steps - first < SIMD_LANES ? steps - first : SIMD_LANES;
+        const unsigned wanted = (count == 32 ? 0u : 1u << count) - 1u;
+        const unsigned outside = ~(unsigned)M_BITS(inside) & wanted;
+        if (outside != 0) return first + __builtin_ctz(outside);
+    }
+    return steps;
+}
+
 /* Fills fetches[0..n) and returns n, the steps before every lane has left
  * the image. */
 static inline int SIMD_NAME(fetch_steps)(const SIMD_NAME(block) * b, int steps, float dc, float ds,
                                          VM active, SIMD_NAME(fetch) * fetches) {
     const hbao_grid *g = b->grid;
     const int phase_width = b->job->phase_width;
+    int offset_x[HBAO_MAX_STEPS + SIMD_LANES], offset_y[HBAO_MAX_STEPS + SIMD_LANES];
+    const int offsets = SIMD_NAME(step_offsets)(g, dc, ds, b->inv_ycor, b->jitter, b->step_px,
+                                                steps, offset_x, offset_y);
     VM alive = active;
     int step = 0;
-    for (; step < steps && M_ANY(alive); step++) {
-        int ox, oy;
-        if (!hbao_step_offset(g, dc, ds, b->inv_ycor, b->jitter, b->step_px, step, &ox, &oy)) break;
+    for (; step < offsets && M_ANY(alive); step++) {
+        const int ox = offset_x[step], oy = offset_y[step];
         const int sj = b->j + oy;
         if (sj < 0 || sj >= g->height) break; /* every lane's sample leaves the image */
         const VI si = I_ADD(b->lane_i, I_SET(ox));
@@ -153,7 +188,7 @@ static inline VM SIMD_NAME(sample)(const SIMD_NAME(block) * b, const SIMD_NAME(f
     return M_AND(valid, M_AND(V_LT(*dist2, b->radius2), V_GT(*dist2, V_SET(0.0f))));
 }
 
-/* horizon.c's sample_elevation and past_the_normal */
+/* horizon.c's sample_elevation, and the angle to V of past_the_normal */
 static inline VF SIMD_NAME(sample_elevation)(const SIMD_NAME(block) * b, const VF delta[3],
                                              VF inv_dist) {
     const VF height = SIMD_NAME(dot3)(delta[0], delta[1], delta[2], b->n[0], b->n[1], b->n[2]);
@@ -164,12 +199,6 @@ static inline VF SIMD_NAME(cos_to_view)(const SIMD_NAME(block) * b, const VF del
                                         VF inv_dist) {
     return V_MUL(SIMD_NAME(dot3)(delta[0], delta[1], delta[2], b->v[0], b->v[1], b->v[2]),
                  inv_dist);
-}
-
-static inline VM SIMD_NAME(past_the_normal)(const SIMD_NAME(block) * b, const SIMD_NAME(slice) * sl,
-                                            const VF delta[3], VF inv_dist, VF sin_s) {
-    return M_AND(V_GT(SIMD_NAME(cos_to_view)(b, delta, inv_dist), sl->cos_gamma),
-                 V_GT(sin_s, b->n_dot_v));
 }
 
 static VF SIMD_NAME(direction_occlusion_hbao)(const hbao_settings *s, const SIMD_NAME(block) * b,
@@ -191,9 +220,13 @@ static VF SIMD_NAME(direction_occlusion_hbao)(const hbao_settings *s, const SIMD
         const VF inv_dist = V_DIV(V_SET(1.0f), V_SQRT(dist2));
         const VF sin_s = SIMD_NAME(sample_elevation)(b, delta, inv_dist);
         VM rest = ok;
-        if (any_check) {
-            const VM past = M_AND(M_AND(ok, check_past_normal),
-                                  SIMD_NAME(past_the_normal)(b, sl, delta, inv_dist, sin_s));
+        /* past_the_normal, its cheap half first: most samples rise less
+         * steeply than V, and then the angle to V is not needed */
+        const VM steep = any_check ? M_AND(M_AND(ok, check_past_normal), V_GT(sin_s, b->n_dot_v))
+                                   : M_ANDNOT(ok, ok);
+        if (M_ANY(steep)) {
+            const VM past =
+                M_AND(steep, V_GT(SIMD_NAME(cos_to_view)(b, delta, inv_dist), sl->cos_gamma));
             occlusion =
                 V_SELECT(M_AND(past, V_LT(occlusion, half_occluded)), occlusion, half_occluded);
             alive = M_ANDNOT(past, alive);
@@ -268,11 +301,13 @@ static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SI
         const VF inv_dist = V_DIV(V_SET(1.0f), V_SQRT(dist2));
         const VF sin_s = SIMD_NAME(sample_elevation)(b, delta, inv_dist);
         VM raised = M_ANDNOT(ok, ok); /* no lane */
-        if (any_check) {
+        /* past_the_normal, its cheap half first (see above) */
+        const VM steep =
+            any_check ? M_AND(M_AND(ok, check_past_normal), V_GT(sin_s, b->n_dot_v)) : raised;
+        if (M_ANY(steep)) {
             const VF cos_v = SIMD_NAME(cos_to_view)(b, delta, inv_dist);
-            const VM past = M_AND(V_GT(cos_v, sl->cos_gamma), V_GT(sin_s, b->n_dot_v));
             const VM newly =
-                M_AND(M_AND(M_AND(ok, check_past_normal), past), V_GT(cos_v, cos_past_max));
+                M_AND(M_AND(steep, V_GT(cos_v, sl->cos_gamma)), V_GT(cos_v, cos_past_max));
             past_normal = M_OR(past_normal, newly);
             cos_past_max = V_SELECT(newly, cos_past_max,
                                     V_SELECT(V_GT(cos_v, V_SET(1.0f)), cos_v, V_SET(1.0f)));
