@@ -13,7 +13,13 @@ node's hidden "HBAO Pass" input.
 The helper belongs to the tree, not to a scene: from Blender 5.0 one
 compositing node group may serve several scenes, and a managed node that
 pointed at each scene's helper in turn would flip with every sync. The render
-handlers record the scene being rendered, which the engine reads."""
+handlers record the scene being rendered, which the engine reads.
+
+Nothing points from the helper at the user's scene (an ID pointer would
+count as one more user of the scene in Blender's scene selector): the
+helper's scene is the one whose managed node points at the helper; the
+helper keeps that scene's name only to choose between several such scenes
+(a scene copied with its tree)."""
 import bpy
 
 from . import compat
@@ -23,7 +29,8 @@ from .report import in_main_thread, log
 
 ENGINE_IDNAME = "HBAO_PASSES"
 HELPER_SCENE_PREFIX = ".HBAO passes "
-# ID property on the helper scene: the scene it was made for.
+# ID property on the helper scene: the name of the scene it was made for
+# (files saved by the add-on before this change hold a pointer instead).
 MAIN_SCENE_KEY = "hbao_main_scene"
 # ID property on the helper scene (5.0+): the compositing node group it serves.
 MAIN_TREE_KEY = "hbao_main_tree"
@@ -68,10 +75,32 @@ def is_helper(scene):
     return MAIN_SCENE_KEY in scene.keys()
 
 
+def _scenes_pointing_at(helper):
+    """The user's scenes whose managed node points at `helper`."""
+    found = []
+    for scene in bpy.data.scenes:
+        if is_helper(scene):
+            continue
+        node = managed_node(compat.compositor_tree(scene))
+        if node is not None and node.scene == helper:
+            found.append(scene)
+    return found
+
+
 def main_scene_of(helper):
-    """The scene `helper` was made for, or None (not a helper, or deleted)."""
-    main = helper.get(MAIN_SCENE_KEY)
-    return main if isinstance(main, bpy.types.Scene) else None
+    """The scene `helper` was made for, or None (not a helper, or deleted):
+    of the scenes whose managed node points at it, the one of the name it
+    keeps, else the first (the scene was renamed)."""
+    if not is_helper(helper):
+        return None
+    kept = helper.get(MAIN_SCENE_KEY)
+    if isinstance(kept, bpy.types.Scene):  # a file saved by an older add-on
+        return kept
+    candidates = _scenes_pointing_at(helper)
+    for scene in candidates:
+        if scene.name == kept:
+            return scene
+    return candidates[0] if candidates else None
 
 
 def tree_of_helper(helper):
@@ -148,14 +177,30 @@ def scene_for_render(helper):
     return served[0] if served else None
 
 
-def _ensure_helper_scene(scene):
+def _find_or_make_helper_scene(scene):
+    """`scene`'s helper, made if it has none; and whether it is new."""
     helper = helper_scene_of(scene)
-    # Objects linked or unlinked, or a new scene: it must settle before a render.
-    restructured = helper is None
-    if helper is None:
-        helper = bpy.data.scenes.new(HELPER_SCENE_PREFIX + scene.name)
-        helper[MAIN_SCENE_KEY] = scene
-        log(f"created helper scene {helper.name!r} for {scene.name!r}")
+    if helper is not None:
+        return helper, False
+    # One made for this scene whose managed node was deleted by hand: reused,
+    # so that no second helper appears beside it.
+    for candidate in bpy.data.scenes:
+        if (is_helper(candidate) and candidate.library is None
+                and candidate.get(MAIN_SCENE_KEY) == scene.name
+                and not _scenes_pointing_at(candidate)):
+            return candidate, True
+    helper = bpy.data.scenes.new(HELPER_SCENE_PREFIX + scene.name)
+    helper[MAIN_SCENE_KEY] = scene.name
+    # before the managed node asks it for its passes
+    helper.render.engine = ENGINE_IDNAME
+    log(f"created helper scene {helper.name!r} for {scene.name!r}")
+    return helper, True
+
+
+def _configure_helper_scene(scene, helper, restructured):
+    """Settings, camera and objects of `helper`, once the managed node of
+    `scene`'s tree points at it. `restructured`: objects linked or unlinked,
+    or a new scene: it must settle before a render."""
     if compat.TREES_SHARED_BETWEEN_SCENES and helper.get(MAIN_TREE_KEY) is None:
         helper[MAIN_TREE_KEY] = compat.compositor_tree(scene)
     # Between renders the helper follows one scene, the one it was made for,
@@ -164,7 +209,11 @@ def _ensure_helper_scene(scene):
     # copies its own scene's settings (record_rendering).
     owner = main_scene_of(helper)
     if owner is None or not serves(helper, owner):
-        helper[MAIN_SCENE_KEY] = owner = scene
+        owner = scene
+    # The name, not a pointer (see the module's text); also replaces the
+    # pointer of a file saved by an older add-on, and follows a renamed scene.
+    if helper.library is None and helper.get(MAIN_SCENE_KEY) != owner.name:
+        helper[MAIN_SCENE_KEY] = owner.name
     set_if_different(helper.render, "engine", ENGINE_IDNAME)
     if not compat.HAS_COMPOSITING_NODE_GROUP and helper.use_nodes:
         helper.use_nodes = False
@@ -186,7 +235,6 @@ def _ensure_helper_scene(scene):
             restructured = True
     if restructured:
         compat.settle_new_scene(helper)
-    return helper
 
 
 def enable_needed_passes(scene, tree):
@@ -252,11 +300,12 @@ def sync(scene):
         return []
     nodes = hbao_nodes(tree)
     if not nodes:
+        # found through the managed node: before it goes
+        helper = helper_scene_of(scene)
         rlayers = managed_node(tree)
         if rlayers is not None:
             tree.nodes.remove(rlayers)
             log(f"removed the HBAO hook of {scene.name!r} (no HBAO node left)")
-        helper = helper_scene_of(scene)
         if helper is not None:
             bpy.data.scenes.remove(helper)
         return []
@@ -268,8 +317,9 @@ def sync(scene):
             node.pass_index = next_pass_index(tree, exclude=node)
         seen.add(node.pass_index)
 
-    helper = _ensure_helper_scene(scene)
+    helper, new = _find_or_make_helper_scene(scene)
     rlayers = _ensure_managed_node(tree, nodes, helper)
+    _configure_helper_scene(scene, helper, new)
     for node in nodes:
         output = rlayers.outputs.get(pass_name(node))
         target = node.inputs.get(AO_PASS_INPUT)

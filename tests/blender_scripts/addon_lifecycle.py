@@ -26,6 +26,7 @@ def managed():
     return next((n for n in tree.nodes if n.get("hbao_managed")), None)
 
 
+users_before = scene.users
 first = tree.nodes.new("CompositorNodeHBAO")
 second = tree.nodes.new("CompositorNodeHBAO")
 check(first.pass_index != second.pass_index, "each node gets its own pass")
@@ -44,6 +45,28 @@ for node in (first, second):
     check(socket.is_linked and socket.links[0].from_socket.name == f"HBAO {node.pass_index}",
           f"{node.name} is wired to its pass")
 
+# Nothing points from the helper at the scene: the scene selector shows the
+# scene's own users only.
+check(scene.users == users_before, f"the scene keeps {users_before} user(s): {scene.users}")
+check(helper.get("hbao_main_scene") == scene.name, "the helper keeps the scene's name")
+scene.name = "Renamed"
+hbao.sync(scene)
+check(managed().scene == helper and helper.get("hbao_main_scene") == "Renamed",
+      "a renamed scene keeps its helper, which follows the new name")
+check(len([s for s in bpy.data.scenes if s.get("hbao_main_scene")]) == 1, "one helper")
+# A file saved by an older add-on: the helper held a pointer to the scene.
+helper["hbao_main_scene"] = scene
+check(scene.users == users_before + 1, "the old pointer counts as a user")
+hbao.sync(scene)
+check(managed().scene == helper and helper.get("hbao_main_scene") == "Renamed"
+      and scene.users == users_before, "sync replaces an old pointer by the name")
+
+tree.nodes.remove(managed())
+hbao.sync(scene)
+check(managed() is not None and managed().scene == helper
+      and len([s for s in bpy.data.scenes if s.get("hbao_main_scene")]) == 1,
+      "a managed node deleted by hand comes back, pointing at the same helper")
+
 path = os.path.join(out_dir, "lifecycle.blend")
 bpy.ops.wm.save_as_mainfile(filepath=path)
 bpy.ops.wm.open_mainfile(filepath=path)
@@ -52,6 +75,7 @@ tree = compat.compositor_tree(scene)
 hbao.sync(scene)
 nodes = [n for n in tree.nodes if n.bl_idname == "CompositorNodeHBAO"]
 check(len(nodes) == 2, "both nodes survive save and reload")
+check(scene.users == users_before, f"after reload the scene keeps {users_before} user(s)")
 for node in nodes:
     socket = node.inputs["HBAO Pass"]
     check(socket.is_linked and socket.links[0].from_socket.enabled,
