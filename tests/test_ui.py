@@ -78,3 +78,22 @@ def test_status_line_follows_each_f12_render(run_blender, tmp_path):
     statuses = {int(line.split(" ", 2)[1]): json.loads(line.split(" ", 2)[2])
                 for line in completed.stdout.splitlines() if line.startswith("STATUS ")}
     assert statuses == {0: "", 1: "Depth not linked: AO off", 2: ""}, statuses
+
+
+def test_picking_the_internal_engine_keeps_the_artists_engine(run_blender):
+    """The Render Engine menu lists the internal engine (Blender cannot hide
+    it). Picked for the artist's scene, the scene keeps the engine it had and
+    a popup says why (out/test-artifacts/ui_engine_kept_*.png)."""
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
+    completed = run_blender(SCRIPTS / "ui_engine_guard.py", ARTIFACTS, ui=True)
+    log = completed.stdout
+    assert "GUARD: DONE" in log, log[-3000:]
+    engines = dict(line.split(" ")[1:3] for line in log.splitlines()
+                   if line.startswith("ENGINE "))
+    assert engines["0"] == "CYCLES", log[-3000:]
+    assert engines["1"].startswith("BLENDER_EEVEE"), log[-3000:]
+    assert 'so scene "Scene" keeps Cycles' in log, log[-3000:]
+    for attempt in (0, 1):
+        shot = ARTIFACTS / f"ui_engine_kept_{attempt}.png"
+        width, height = struct.unpack(">II", shot.read_bytes()[16:24])
+        assert (width, height) == (1280, 1024), (attempt, width, height)

@@ -9,7 +9,8 @@ viewport.projection/shader_sources work in plain Python (tests, benchmarks).
     bpy-free   parameters, library_loading, native, exr_passes, camera,
                viewport.projection, viewport.shader_sources
     Blender    compat (every version difference), preferences, node,
-               helper_scene, socket_values, planning, handover, engine, handlers,
+               helper_lookup, helper_scene, socket_values, planning, handover, engine,
+               engine_guard, handlers,
                viewport.*
 """
 
@@ -51,8 +52,8 @@ def register():
         preferences.show(message)
         if not compat.version_is_new_enough():
             return  # the message says why; a traceback would not
-    from . import engine, handlers, node, node_setup
-    for module in (node, node_setup, engine, handlers):
+    from . import engine, engine_guard, handlers, node, node_setup
+    for module in (node, node_setup, engine, engine_guard, handlers):
         module.register()
         _registered.append(module)
     try:

@@ -12,8 +12,8 @@ import numpy as np
 
 from . import camera as camera_model
 from . import exr_passes, handover, native
-from .helper_scene import (ENGINE_IDNAME, is_helper, pass_names_for_helper,
-                           rendered_for_a_scene, scene_for_render)
+from .helper_lookup import ENGINE_IDNAME, is_helper, pass_names_for_helper
+from .helper_scene import rendered_for_a_scene, scene_for_render
 from .planning import plan
 from .report import log
 

@@ -9,7 +9,7 @@ copy plain settings only. `blender -b ... -f N` runs them in the main thread,
 the only chance such a render has to build the hook."""
 import bpy
 
-from . import compat, helper_scene, node
+from . import compat, helper_lookup, helper_scene, node
 from .report import in_main_thread, log
 
 _sync_scheduled = False
@@ -44,7 +44,7 @@ def _on_save_pre(*_args):
 
 @bpy.app.handlers.persistent
 def _on_render_pre(scene, *_args):
-    if helper_scene.is_helper(scene):
+    if helper_lookup.is_helper(scene):
         return
     tree = compat.compositor_tree(scene)
     if not node.hbao_nodes(tree):
@@ -62,16 +62,16 @@ def _on_render_pre(scene, *_args):
 
 @bpy.app.handlers.persistent
 def _on_render_end(scene, *_args):
-    if not helper_scene.is_helper(scene):
+    if not helper_lookup.is_helper(scene):
         helper_scene.record_render_end(scene)
 
 
 @bpy.app.handlers.persistent
 def _on_depsgraph_update_post(scene, *_args):
-    if helper_scene.is_helper(scene) or not in_main_thread():
+    if helper_lookup.is_helper(scene) or not in_main_thread():
         return
     tree = compat.compositor_tree(scene)
-    if node.hbao_nodes(tree) or helper_scene.managed_node(tree) is not None:
+    if node.hbao_nodes(tree) or helper_lookup.managed_node(tree) is not None:
         schedule_sync()
 
 

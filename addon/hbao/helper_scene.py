@@ -13,29 +13,17 @@ node's hidden "HBAO Pass" input.
 The helper belongs to the tree, not to a scene: from Blender 5.0 one
 compositing node group may serve several scenes, and a managed node that
 pointed at each scene's helper in turn would flip with every sync. The render
-handlers record the scene being rendered, which the engine reads.
-
-Nothing points from the helper at the user's scene (an ID pointer would
-count as one more user of the scene in Blender's scene selector): the
-helper's scene is the one whose managed node points at the helper; the
-helper keeps that scene's name only to choose between several such scenes
-(a scene copied with its tree)."""
+handlers record the scene being rendered, which the engine reads."""
 import bpy
 
 from . import compat
+from .helper_lookup import (ENGINE_IDNAME, HELPER_SCENE_PREFIX, MAIN_SCENE_KEY, MAIN_TREE_KEY,
+                            MANAGED_NODE_KEY, helper_scene_of, is_helper, main_scene_of,
+                            managed_node, scenes_pointing_at, scenes_served_by, serves)
 from .node import (AO_PASS_INPUT, DEPTH_INPUT, NORMAL_INPUT, hbao_nodes, next_pass_index,
                    pass_name)
 from .report import in_main_thread, log
 
-ENGINE_IDNAME = "HBAO_PASSES"
-HELPER_SCENE_PREFIX = ".HBAO passes "
-# ID property on the helper scene: the name of the scene it was made for
-# (files saved by the add-on before this change hold a pointer instead).
-MAIN_SCENE_KEY = "hbao_main_scene"
-# ID property on the helper scene (5.0+): the compositing node group it serves.
-MAIN_TREE_KEY = "hbao_main_tree"
-# ID property on the Render Layers node the add-on manages.
-MANAGED_NODE_KEY = "hbao_managed"
 MANAGED_NODE_NAME = "HBAO Passes"
 # How far below the first HBAO node the managed node goes (node editor units):
 # the HBAO node is about 420 units tall with its options.
@@ -59,84 +47,6 @@ def set_if_different(owner, attribute, value):
         setattr(owner, attribute, value)
         return True
     return False
-
-
-def managed_node(tree):
-    if tree is None:
-        return None
-    for node in tree.nodes:
-        if node.bl_idname == "CompositorNodeRLayers" and node.get(MANAGED_NODE_KEY):
-            return node
-    return None
-
-
-def is_helper(scene):
-    # The key stays when the scene it names is deleted (its value becomes None).
-    return MAIN_SCENE_KEY in scene.keys()
-
-
-def _scenes_pointing_at(helper):
-    """The user's scenes whose managed node points at `helper`."""
-    found = []
-    for scene in bpy.data.scenes:
-        if is_helper(scene):
-            continue
-        node = managed_node(compat.compositor_tree(scene))
-        if node is not None and node.scene == helper:
-            found.append(scene)
-    return found
-
-
-def main_scene_of(helper):
-    """The scene `helper` was made for, or None (not a helper, or deleted):
-    of the scenes whose managed node points at it, the one of the name it
-    keeps, else the first (the scene was renamed)."""
-    if not is_helper(helper):
-        return None
-    kept = helper.get(MAIN_SCENE_KEY)
-    if isinstance(kept, bpy.types.Scene):  # a file saved by an older add-on
-        return kept
-    candidates = _scenes_pointing_at(helper)
-    for scene in candidates:
-        if scene.name == kept:
-            return scene
-    return candidates[0] if candidates else None
-
-
-def tree_of_helper(helper):
-    """The compositor tree whose HBAO nodes the helper serves."""
-    tree = helper.get(MAIN_TREE_KEY) if compat.TREES_SHARED_BETWEEN_SCENES else None
-    if isinstance(tree, bpy.types.NodeTree):
-        return tree
-    main = main_scene_of(helper)
-    return compat.compositor_tree(main) if main is not None else None
-
-
-def serves(helper, scene):
-    """Whether `helper` publishes the AO of `scene`'s compositor tree."""
-    if not is_helper(helper) or is_helper(scene):
-        return False
-    tree = compat.compositor_tree(scene)
-    return tree is not None and tree_of_helper(helper) == tree
-
-
-def helper_scene_of(scene):
-    node = managed_node(compat.compositor_tree(scene))
-    if node is not None and node.scene is not None and serves(node.scene, scene):
-        return node.scene
-    for candidate in bpy.data.scenes:
-        if serves(candidate, scene):
-            return candidate
-    return None
-
-
-def scenes_served_by(helper):
-    return [scene for scene in bpy.data.scenes if serves(helper, scene)]
-
-
-def pass_names_for_helper(helper):
-    """The AO passes the helper scene's engine publishes (one per HBAO node)."""
-    return [pass_name(node) for node in hbao_nodes(tree_of_helper(helper))]
 
 
 def copy_render_settings(scene, helper):
@@ -187,7 +97,7 @@ def _find_or_make_helper_scene(scene):
     for candidate in bpy.data.scenes:
         if (is_helper(candidate) and candidate.library is None
                 and candidate.get(MAIN_SCENE_KEY) == scene.name
-                and not _scenes_pointing_at(candidate)):
+                and not scenes_pointing_at(candidate)):
             return candidate, True
     helper = bpy.data.scenes.new(HELPER_SCENE_PREFIX + scene.name)
     helper[MAIN_SCENE_KEY] = scene.name

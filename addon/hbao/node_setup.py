@@ -6,7 +6,7 @@ node's "Connect Passes" button turns the passes on and links them."""
 import bpy
 
 from . import compat
-from .helper_scene import MANAGED_NODE_KEY
+from .helper_lookup import MANAGED_NODE_KEY
 from .node import hbao_nodes
 from .node_group import DEPTH_INPUT, IMAGE_INPUT, NORMAL_INPUT
 

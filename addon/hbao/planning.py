@@ -3,7 +3,7 @@
 someone looks at, with the view layer its passes come from and its
 parameters at that frame."""
 from . import compat
-from .helper_scene import MANAGED_NODE_KEY
+from .helper_lookup import MANAGED_NODE_KEY
 from .node import DEPTH_INPUT, NORMAL_INPUT, hbao_nodes, pass_name
 from .report import NodeMessage, post_node_messages
 from .socket_values import node_params, upstream

@@ -148,8 +148,8 @@ for action in spec.get("prepare", []):
         hbao.sync(scene)
         render_scene_name = helper_scenes()[0].name
     elif action == "pick_internal_engine":  # from the Render Engine menu
-        import hbao.helper_scene
-        scene.render.engine = hbao.helper_scene.ENGINE_IDNAME
+        import hbao.helper_lookup
+        scene.render.engine = hbao.helper_lookup.ENGINE_IDNAME
     elif action == "second_scene_shares_the_tree":  # 5.0+: one node group, two scenes
         other = scene.copy()
         other.name = "Second"
