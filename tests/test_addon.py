@@ -300,6 +300,40 @@ def test_border_crop_render_matches_the_full_frame(run_in_blender, tmp_path):
     assert np.abs(inner_crop - inner_full).max() <= 1e-3
 
 
+def test_guard_band_sees_occluders_outside_the_frame(run_in_blender, tmp_path, native):
+    """Two nodes, one with a guard band of 12.5 % (an extra 1-sample Cycles
+    render through a camera 1.25 times as wide). The truth: the library on a
+    real render 1.25 times as large through that wider camera (120x80, the
+    same pixel scale), cropped to the frame. Near the frame's edges the node
+    without a band is too bright (no samples outside); the band's AO is far
+    closer to the truth there, and no worse inside."""
+    width, height, scale = 96, 64, 1.25
+    columns, rows = 12, 8  # 12.5 % of 96 and 64
+    node = {"radius": 1.0}
+    out, log = render(run_in_blender, tmp_path,
+                      {"resolution": [width, height],
+                       "nodes": [dict(node, name="HBAO0"),
+                                 dict(node, name="HBAO1", guard_band=12.5)]})
+    assert "guard band" in log and "no guard band" not in log, log[-3000:]
+    wide_out, _ = render(run_in_blender, tmp_path,
+                         {"resolution": [int(width * scale), int(height * scale)],
+                          "widen_camera": scale, "nodes": [node]}, name="wide")
+    wide = library_ao(native, wide_out, 1, node_params(radius=1.0))
+    truth = wide[rows:rows + height, columns:columns + width]
+    without = node_outputs(out, 1, "HBAO0")["ao"]
+    with_band = node_outputs(out, 1, "HBAO1")["ao"]
+    edge = np.ones((height, width), bool)
+    edge[6:-6, 6:-6] = False
+    error_without = np.abs(without - truth)[edge].mean()
+    error_with = np.abs(with_band - truth)[edge].mean()
+    print(f"mean |AO - truth| within 6 px of the edges: without a band {error_without:.4f}, "
+          f"with {error_with:.4f}; everywhere {np.abs(without - truth).mean():.4f}, "
+          f"{np.abs(with_band - truth).mean():.4f}")
+    assert error_without > 0.006  # the borders are too bright without: the test can fail
+    assert error_with < 0.5 * error_without
+    assert np.abs(with_band - truth).mean() < np.abs(without - truth).mean()
+
+
 @pytest.mark.parametrize("how", ["append", "link"])
 def test_appended_or_linked_scene_renders_with_ao(run_in_blender, blender,
                                                   blender_user_scripts, tmp_path, native, how):

@@ -33,42 +33,44 @@ def _scratch_path():
     return os.path.join(folder, f"hbao-passes-{os.getpid()}-{threading.get_ident()}.exr")
 
 
-def save_main_passes(main, path):
-    """Write the main scene's current Render Result to `path`, uncompressed
-    32-bit multilayer EXR, leaving the user's output settings as they were."""
+def save_passes(scene, path):
+    """Write `scene`'s current Render Result to `path`, uncompressed 32-bit
+    multilayer EXR, leaving the scene's output settings as they were."""
     image = _render_result_image()
     if image is None:
         raise RuntimeError("Blender has no Render Result image to read the passes from")
-    settings = main.render.image_settings
+    settings = scene.render.image_settings
     saved = compat.saved_image_settings(settings)
     try:
         compat.set_multilayer_exr(settings)
         settings.color_depth = "32"
         settings.exr_codec = "NONE"
-        image.save_render(path, scene=main)
+        # The Render Result of the scene given, not only its settings.
+        image.save_render(path, scene=scene)
     finally:
         # The media type and format first, so that their options are valid
         # when they are set; the user's PNG output stays PNG.
         compat.restore_image_settings(settings, saved)
 
 
-def read_main_passes(main, jobs):
+def read_passes(scene, layers):
     """{("depth", layer): (H, W), ("normal", layer): (H, W, 3)} float32, top
-    row first, for the view layers `jobs` read, from the main Render Result;
-    and the seconds the save and the read took."""
+    row first, of `scene`'s Render Result, for `layers` {view layer name:
+    whether its normal is wanted}; and the seconds the save and the read
+    took."""
     path = _scratch_path()
     timings = {}
     try:
         start = _clock()
-        save_main_passes(main, path)
+        save_passes(scene, path)
         timings["save"] = _clock() - start
         # One decode pass: each layer's depth, and its normal as one
         # interleaved (height, width, 3) image, as libhbao reads it.
         groups = {}
-        for job in jobs:
-            groups[("depth", job.layer)] = [f"{job.layer}.Depth.Z"]
-            if job.with_normal:
-                groups[("normal", job.layer)] = [f"{job.layer}.Normal.{axis}" for axis in "XYZ"]
+        for layer, with_normal in layers.items():
+            groups[("depth", layer)] = [f"{layer}.Depth.Z"]
+            if with_normal:
+                groups[("normal", layer)] = [f"{layer}.Normal.{axis}" for axis in "XYZ"]
         read_start = _clock()
         channels = exr_passes.read_channel_groups(path, groups)
         timings["read"] = _clock() - read_start
@@ -76,3 +78,11 @@ def read_main_passes(main, jobs):
         if os.path.exists(path):
             os.remove(path)
     return channels, timings
+
+
+def read_main_passes(main, jobs):
+    """read_passes() of the view layers and normals that `jobs` read."""
+    layers = {}
+    for job in jobs:
+        layers[job.layer] = layers.get(job.layer, False) or job.with_normal
+    return read_passes(main, layers)

@@ -16,13 +16,15 @@ pointed at each scene's helper in turn would flip with every sync. The render
 handlers record the scene being rendered, which the engine reads."""
 import bpy
 
-from . import compat
+from . import compat, guard_scene
+from .data_edits import set_if_different
 from .helper_lookup import (ENGINE_IDNAME, HELPER_SCENE_PREFIX, MAIN_SCENE_KEY, MAIN_TREE_KEY,
                             MANAGED_NODE_KEY, helper_scene_of, is_helper, main_scene_of,
                             managed_node, scenes_pointing_at, scenes_served_by, serves)
 from .node import (AO_PASS_INPUT, DEPTH_INPUT, NORMAL_INPUT, hbao_nodes, next_pass_index,
                    pass_name)
 from .report import in_main_thread, log
+from .socket_values import upstream
 
 MANAGED_NODE_NAME = "HBAO Passes"
 # How far below the first HBAO node the managed node goes (node editor units):
@@ -41,14 +43,6 @@ _rendering = {}
 _in_progress = set()
 
 
-def set_if_different(owner, attribute, value):
-    """Assign only real changes: every assignment tags Blender data for update."""
-    if getattr(owner, attribute) != value:
-        setattr(owner, attribute, value)
-        return True
-    return False
-
-
 def copy_render_settings(scene, helper):
     """Only plain values: allowed in the render job's thread too."""
     for attribute in SYNCED_RENDER_SETTINGS:
@@ -62,6 +56,9 @@ def record_rendering(scene):
         _rendering[helper.name] = scene.name
         _in_progress.add(helper.name)
         copy_render_settings(scene, helper)
+        guard = guard_scene.guard_of(helper)
+        if guard is not None:
+            guard_scene.copy_camera(scene, guard)
 
 
 def record_render_end(scene):
@@ -202,6 +199,17 @@ def _ensure_managed_node(tree, nodes, helper):
     return rlayers
 
 
+def _guard_view_layer(scene, nodes):
+    """The view layer whose collections the guard band render mirrors: that
+    of the Depth pass of the first node with a guard band."""
+    for node in nodes:
+        if node.guard_band > 0.0 and not node.mute:
+            source = upstream(node.inputs[DEPTH_INPUT])
+            if source is not None and source.node.bl_idname == "CompositorNodeRLayers":
+                return scene.view_layers.get(source.node.layer)
+    return scene.view_layers[0] if len(scene.view_layers) else None
+
+
 def sync(scene):
     """Create, update or remove the hook of `scene` to match its HBAO nodes.
     Main thread only; returns a list of messages."""
@@ -212,6 +220,8 @@ def sync(scene):
     if not nodes:
         # found through the managed node: before it goes
         helper = helper_scene_of(scene)
+        if helper is not None:
+            guard_scene.remove(helper, tree)
         rlayers = managed_node(tree)
         if rlayers is not None:
             tree.nodes.remove(rlayers)
@@ -228,6 +238,9 @@ def sync(scene):
         seen.add(node.pass_index)
 
     helper, new = _find_or_make_helper_scene(scene)
+    if guard_scene.sync(scene, tree, nodes, helper, _guard_view_layer(scene, nodes)):
+        # made again below, after the guard's node: Blender renders in node order
+        tree.nodes.remove(managed_node(tree))
     rlayers = _ensure_managed_node(tree, nodes, helper)
     _configure_helper_scene(scene, helper, new)
     for node in nodes:
@@ -248,6 +261,11 @@ def sync(scene):
 def sync_all():
     """sync() every scene with HBAO nodes or a hook; drop helpers nobody uses."""
     for scene in list(bpy.data.scenes):
+        if guard_scene.is_guard(scene):
+            if not any(guard_scene.guard_of(helper) == scene for helper in bpy.data.scenes
+                       if is_helper(helper)):
+                bpy.data.scenes.remove(scene)
+            continue
         if is_helper(scene):
             if not scenes_served_by(scene):
                 bpy.data.scenes.remove(scene)

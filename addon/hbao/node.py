@@ -10,7 +10,7 @@ nothing of the hook: it announces that nodes came or went through
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 
-from . import compat, parameters, report
+from . import compat, guard_geometry, parameters, report
 from .node_group import (AO_OUTPUT, AO_PASS_INPUT, DEPTH_INPUT, GROUP_TREE_NAME,  # noqa: F401
                          IMAGE_INPUT, IMAGE_OUTPUT, NORMAL_INPUT, VALUE_INPUTS, group_tree,
                          upgrade_group_tree)
@@ -59,6 +59,12 @@ def _settings_changed(node, _context):
     node.id_data.update_tag()
 
 
+def _guard_band_changed(node, _context):
+    # The hook makes or removes the extra render on its next sync.
+    node.id_data.update_tag()
+    _announce_change()
+
+
 class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
     """Horizon-based ambient occlusion from the Depth (and Normal) pass"""
     bl_idname = NODE_IDNAME
@@ -73,6 +79,12 @@ class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
     half_resolution: BoolProperty(
         name="Half Resolution", default=False, update=_settings_changed,
         description="Compute AO at half resolution and upsample it, depth-aware (faster)")
+    guard_band: FloatProperty(
+        name="Guard Band", default=0.0, min=0.0, max=100.0 * guard_geometry.MAX_GUARD_BAND,
+        subtype="PERCENTAGE", update=_guard_band_changed,
+        description="Occluders outside the frame: an extra Cycles render (1 sample, Depth and "
+                    "Normal only) through a wider camera sees this far past each side, in % of "
+                    "the frame. Darkens borders that come out too bright. 0 = off")
     blur_sharpness: FloatProperty(
         name="Blur Sharpness", default=_D["blur_sharpness"], min=0.0,
         max=parameters.MAX_BLUR_SHARPNESS, soft_max=64.0,
@@ -117,6 +129,7 @@ class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
             row.label(text=self.bl_rna.properties[name].name)
             row.prop(self, name, text="")
         layout.prop(self, "half_resolution")
+        layout.prop(self, "guard_band")
         if self.status:
             # A borderless button: its tooltip (and a click: the Info editor)
             # gives the full text that the short status line stands for.

@@ -16,6 +16,8 @@ class Job:
         self.layer = layer
         self.with_normal = with_normal
         self.params = params
+        # of the frame on each side, guard_geometry's
+        self.guard_band = node.guard_band / 100.0
 
 
 def pass_source(socket, scene, expected):

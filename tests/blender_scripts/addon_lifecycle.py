@@ -67,6 +67,30 @@ check(managed() is not None and managed().scene == helper
       and len([s for s in bpy.data.scenes if s.get("hbao_main_scene")]) == 1,
       "a managed node deleted by hand comes back, pointing at the same helper")
 
+# The guard band's extra render: made with the setting, before the helper's
+# node in the tree (Blender renders them in node order), gone without it.
+first.guard_band = 10.0
+hbao.sync(scene)
+guards = [s for s in bpy.data.scenes if s.get("hbao_guard_for")]
+order = [n for n in tree.nodes if n.bl_idname == "CompositorNodeRLayers"]
+check(len(guards) == 1 and guards[0].render.engine == "CYCLES"
+      and guards[0].camera is not None and abs(guards[0].camera.data.sensor_width
+                                               - scene.camera.data.sensor_width * 1.2) < 1e-4,
+      "a guard band scene with a camera 1.2x as wide")
+guard_node = next(n for n in order if n.get("hbao_guard_node"))
+check(order.index(guard_node) < order.index(managed()) and guard_node.scene == guards[0],
+      "its Render Layers node comes before the helper's")
+for node in (first, second):
+    socket = node.inputs["HBAO Pass"]
+    check(socket.is_linked and socket.links[0].from_socket.name == f"HBAO {node.pass_index}",
+          f"{node.name} is still wired to its pass")
+camera_name = guards[0].camera.name
+first.guard_band = 0.0
+hbao.sync(scene)
+check(not any(s.get("hbao_guard_for") for s in bpy.data.scenes)
+      and not any(n.get("hbao_guard_node") for n in tree.nodes)
+      and bpy.data.objects.get(camera_name) is None, "all of it goes with the setting")
+
 path = os.path.join(out_dir, "lifecycle.blend")
 bpy.ops.wm.save_as_mainfile(filepath=path)
 bpy.ops.wm.open_mainfile(filepath=path)

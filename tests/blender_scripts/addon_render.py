@@ -12,11 +12,11 @@ both uncompressed 32-bit float. Usage:
 
 Spec keys (all optional): resolution [w, h], samples, engine, scene
 ("corner" | "two_layers"), frames [..], ao_reference (distance: adds Cycles'
-AO pass), orthographic, border [min_x, max_x, min_y, max_y] (a border render
+AO pass), orthographic, widen_camera (factor), border [min_x, max_x, min_y, max_y] (a border render
 cropped to it), save_blend (path: saved after the setup, before
 rendering), nodes: [{name, layer, normal (bool), radius, keyframes [[frame,
 radius], ..], radius_from_value_node, falloff, integration, blur_size,
-angle_bias, directions, steps, strength, thickness, mute, connect_with_operator (left
+angle_bias, directions, steps, strength, thickness, guard_band, mute, connect_with_operator (left
 unlinked, then linked by the node's Connect Passes operator after the passes are
 disabled)}], disable_normal_pass, disable_depth_pass,
 output_format (the main output's file format, default OPEN_EXR_MULTILAYER),
@@ -51,6 +51,12 @@ if spec.get("ao_reference"):
     blender_scenes.configure_ao_reference(scene, spec["ao_reference"])
 if spec.get("orthographic"):
     blender_scenes.make_orthographic(scene)
+if spec.get("widen_camera"):  # a view `widen_camera` times as wide about its centre
+    lens = scene.camera.data
+    for name in ("sensor_width", "sensor_height", "ortho_scale"):
+        setattr(lens, name, getattr(lens, name) * spec["widen_camera"])
+    lens.shift_x /= spec["widen_camera"]
+    lens.shift_y /= spec["widen_camera"]
 if spec.get("border"):
     render_settings = scene.render
     (render_settings.border_min_x, render_settings.border_max_x,
@@ -89,7 +95,7 @@ for index, node_spec in enumerate(spec.get("nodes", [{}])):
                              ("thickness", "Thickness")):
         if key in node_spec:
             hbao.inputs[socket_name].default_value = node_spec[key]
-    for key in ("falloff", "integration", "half_resolution"):
+    for key in ("falloff", "integration", "half_resolution", "guard_band"):
         if key in node_spec:
             setattr(hbao, key, node_spec[key])
     if node_spec.get("radius_from_value_node") is not None:
