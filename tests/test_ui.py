@@ -97,3 +97,15 @@ def test_picking_the_internal_engine_keeps_the_artists_engine(run_blender):
         shot = ARTIFACTS / f"ui_engine_kept_{attempt}.png"
         width, height = struct.unpack(">II", shot.read_bytes()[16:24])
         assert (width, height) == (1280, 1024), (attempt, width, height)
+
+
+def test_f12_problem_reaches_the_info_editor(run_blender, tmp_path):
+    """After an F12 render whose HBAO node has Depth unlinked, the Info
+    editor lists the add-on's warning with what it means (read as Ctrl+C in
+    the Info editor copies it; out/test-artifacts/ui_info_report.png)."""
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
+    completed = run_blender(SCRIPTS / "ui_info_report.py", tmp_path / "f12", ARTIFACTS, ui=True)
+    assert "INFO: DONE" in completed.stdout, completed.stdout[-3000:]
+    line = next(text for text in completed.stdout.splitlines() if text.startswith("INFO \""))
+    reports = json.loads(line[len("INFO "):])
+    assert 'HBAO node "HBAO0": Depth is not linked; AO off' in reports, reports

@@ -10,7 +10,7 @@ viewport.projection/shader_sources work in plain Python (tests, benchmarks).
                viewport.projection, viewport.shader_sources
     Blender    compat (every version difference), preferences, node,
                helper_lookup, helper_scene, socket_values, planning, handover, engine,
-               engine_guard, handlers,
+               engine_guard, render_reports, handlers,
                viewport.*
 """
 
@@ -52,8 +52,8 @@ def register():
         preferences.show(message)
         if not compat.version_is_new_enough():
             return  # the message says why; a traceback would not
-    from . import engine, engine_guard, handlers, node, node_setup
-    for module in (node, node_setup, engine, engine_guard, handlers):
+    from . import engine, engine_guard, handlers, node, node_setup, render_reports
+    for module in (node, node_setup, engine, engine_guard, render_reports, handlers):
         module.register()
         _registered.append(module)
     try:

@@ -15,7 +15,7 @@ from . import exr_passes, guard_passes, handover, native
 from .helper_lookup import ENGINE_IDNAME, is_helper, pass_names_for_helper
 from .helper_scene import rendered_for_a_scene, scene_for_render
 from .planning import plan
-from .report import log
+from .report import log, post_render_report
 
 # The prefix of the passes this engine fills (node.pass_name's).
 PASS_PREFIX = "HBAO "
@@ -44,7 +44,7 @@ def compute_passes(engine, depsgraph, width, height):
     frame = main.frame_current + main.frame_subframe
     jobs, warnings = plan(main, frame)
     for warning in warnings:
-        engine.report({"WARNING"}, f"HBAO {warning}")
+        _report(engine, f"HBAO {warning}")
         log(warning)
     if not jobs:
         return {}
@@ -55,7 +55,7 @@ def compute_passes(engine, depsgraph, width, height):
     channels, timings = handover.read_main_passes(main, jobs)
     guard, guard_warnings = guard_passes.read(helper, main, jobs, timings)
     for warning in guard_warnings:
-        engine.report({"WARNING"}, f"HBAO {warning}")
+        _report(engine, f"HBAO {warning}")
         log(warning)
 
     results = {}
@@ -98,9 +98,16 @@ def _timing_line(count, width, height, total, timings):
     return line
 
 
+def _report(engine, text):
+    """A warning in the render's report, and (report.py) in the Info editor."""
+    engine.report({"WARNING"}, text)
+    if not bpy.app.background:  # `-b`: the console has it; nothing would take it
+        post_render_report(text)
+
+
 def _report_failure(engine, message):
     log(message)
-    engine.report({"WARNING"}, f"HBAO: {message}")
+    _report(engine, f"HBAO: {message}")
 
 
 # What an artist who renders the helper scene itself (made it the active
@@ -123,7 +130,7 @@ def render_helper(engine, depsgraph):
                    if main is not None
                    else NOT_FOR_RENDERING.format(label=HBAOPassEngine.bl_label))
         log(message)
-        engine.report({"WARNING"}, message)
+        _report(engine, message)
         return
     start = time.perf_counter()
     engine.hbao_timings = {}

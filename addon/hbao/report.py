@@ -14,6 +14,30 @@ LOG_PREFIX = "HBAO:"
 _pending_node_messages = {}
 
 
+# What the engine reported during a render, waiting for the main thread to
+# add it to Blender's reports (render_reports.py): Blender 3.4 drops the
+# reports of a scene that the compositor renders (the helper), so without
+# this the Info editor never shows them. Appended by the render thread.
+_pending_render_reports = []
+
+
+def post_render_report(text):
+    """Queue `text` for the Info editor and status bar. Any thread."""
+    _pending_render_reports.append(text)
+
+
+def has_render_reports():
+    return bool(_pending_render_reports)
+
+
+def take_render_reports():
+    """The texts posted since the last call, oldest first."""
+    taken = []
+    while _pending_render_reports:
+        taken.append(_pending_render_reports.pop(0))
+    return taken
+
+
 def log(message):
     print(f"{LOG_PREFIX} {message}", flush=True)
 

@@ -1,0 +1,60 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The engine's warnings in the Info editor and the status bar after an F12
+render. Blender 3.4 drops the reports of a scene that the compositor renders
+(the helper scene), so the engine also posts them (report.py) and a timer
+re-reports them once no render job runs. Only the reports of an operator
+that the event system finishes reach Blender's window manager (those of an
+operator run from Python stay with the caller), so the operator is modal:
+it reports on its first timer event."""
+import bpy
+
+from . import report
+
+_POLL_S = 0.25
+
+
+class HBAO_OT_render_report(bpy.types.Operator):
+    """What the HBAO add-on met during the last render"""
+    bl_idname = "hbao.render_report"
+    bl_label = "HBAO Render Report"
+    bl_options = {"INTERNAL"}
+
+    def invoke(self, context, _event):
+        self._timer = context.window_manager.event_timer_add(0.01, window=context.window)
+        context.window_manager.modal_handler_add(self)
+        return {"RUNNING_MODAL"}
+
+    def modal(self, context, event):
+        if event.type != "TIMER":
+            return {"PASS_THROUGH"}
+        context.window_manager.event_timer_remove(self._timer)
+        for text in report.take_render_reports():
+            self.report({"WARNING"}, text)
+        return {"FINISHED"}
+
+
+def _poll():
+    if report.has_render_reports() and not bpy.app.is_job_running("RENDER"):
+        windows = bpy.context.window_manager.windows
+        try:
+            with bpy.context.temp_override(window=windows[0], screen=windows[0].screen):
+                bpy.ops.hbao.render_report("INVOKE_DEFAULT")
+        except (RuntimeError, IndexError, AttributeError) as error:
+            # never break the artist's session; the console has the messages
+            report.log(f"could not show the render's reports in the Info editor: {error}")
+            report.take_render_reports()
+    return _POLL_S
+
+
+def register():
+    bpy.utils.register_class(HBAO_OT_render_report)
+    # `-b` has no Info editor: the console has every message already.
+    if not bpy.app.background:
+        bpy.app.timers.register(_poll, first_interval=_POLL_S, persistent=True)
+
+
+def unregister():
+    if bpy.app.timers.is_registered(_poll):
+        bpy.app.timers.unregister(_poll)
+    bpy.utils.unregister_class(HBAO_OT_render_report)
+    report.take_render_reports()

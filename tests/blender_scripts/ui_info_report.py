@@ -1,0 +1,79 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Run in a real Blender window (xvfb) by tests/test_ui.py: an F12-style
+render (the render job's thread) of a tree whose HBAO node has Depth
+unlinked; once it has ended, one area of the window becomes the Info editor,
+its reports are copied (info.select_all + info.report_copy, what Ctrl+C does
+there) and read from the clipboard, and printed as 'INFO <json text>'; a
+screenshot of the window shows the Info editor.
+
+  blender --addons hbao --python ui_info_report.py -- <out dir> <shot dir>
+"""
+import json
+import os
+import sys
+import time
+
+import bpy
+
+out_dir, shot_dir = sys.argv[sys.argv.index("--") + 1:][:2]
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(REPO, "scripts"))
+import blender_scenes  # noqa: E402
+
+RENDER_TIMEOUT_S = 240.0
+SETTLE_S = 1.0
+
+scene = blender_scenes.build_corner_scene(bpy.context.scene, (48, 32), "CYCLES", 1)
+node = blender_scenes.hbao_test_tree(scene, out_dir)
+node.id_data.links.remove(node.inputs["Depth"].links[0])
+os.makedirs(out_dir, exist_ok=True)
+state = {"phase": "start", "since": time.monotonic(), "done": False}
+
+
+def on_end(*_args):
+    state["done"] = True
+
+
+bpy.app.handlers.render_complete.append(on_end)
+bpy.app.handlers.render_cancel.append(on_end)
+
+
+def info_reports():
+    """The Info editor's reports, as Ctrl+C in it copies them."""
+    window = bpy.context.window_manager.windows[0]
+    area = max(window.screen.areas, key=lambda a: a.width * a.height)
+    area.type = "INFO"
+    region = next(r for r in area.regions if r.type == "WINDOW")
+    bpy.context.window_manager.clipboard = ""
+    with bpy.context.temp_override(window=window, screen=window.screen, area=area,
+                                   region=region):
+        bpy.ops.info.select_all(action="SELECT")
+        bpy.ops.info.report_copy()
+        bpy.ops.wm.redraw_timer(type="DRAW_WIN_SWAP", iterations=2)
+    with bpy.context.temp_override(window=window, screen=window.screen):
+        bpy.ops.screen.screenshot(filepath=os.path.join(shot_dir, "ui_info_report.png"),
+                                  check_existing=False)
+    return bpy.context.window_manager.clipboard
+
+
+def tick():
+    now = time.monotonic()
+    if state["phase"] == "start":
+        state.update(phase="render", since=now)
+        bpy.ops.render.render("INVOKE_DEFAULT")
+    elif state["phase"] == "render":
+        if now - state["since"] > RENDER_TIMEOUT_S:
+            print("INFO: TIMEOUT", flush=True)
+            bpy.ops.wm.quit_blender()
+            return None
+        if state["done"] and not bpy.app.is_job_running("RENDER"):
+            state.update(phase="settle", since=now)
+    elif state["phase"] == "settle" and now - state["since"] > SETTLE_S:
+        print(f"INFO {json.dumps(info_reports())}", flush=True)
+        print("INFO: DONE", flush=True)
+        bpy.ops.wm.quit_blender()
+        return None
+    return 0.1
+
+
+bpy.app.timers.register(tick, first_interval=1.0)
