@@ -405,6 +405,20 @@ def test_eevee_main_engine(run_in_blender, tmp_path, native):
     assert np.abs(ao - expected).max() <= EXACT
 
 
+def test_add_filter_menu_of_each_blender_lists_hbao(run_in_blender):
+    """Each Blender names its Add > Filter menu differently (3.4:
+    NODE_MT_category_CMP_OP_FILTER, 4.x/5.x: NODE_MT_category_compositor_filter):
+    the add-on's entry is drawn by the one this Blender has, adding the HBAO
+    node. (Debian's Blender also opens the menu in its window: test_ui.py.)"""
+    completed = run_in_blender(SCRIPTS / "addon_menu.py")
+    line = next(text for text in completed.stdout.splitlines() if text.startswith("MENU "))
+    menu = json.loads(line[len("MENU "):])
+    assert menu["menu"] in ("NODE_MT_category_CMP_OP_FILTER",
+                            "NODE_MT_category_compositor_filter"), menu
+    assert menu["ours"] == ["_draw_add_menu"], menu
+    assert menu["entries"] == [["node.add_node", "HBAO", "CompositorNodeHBAO"]], menu
+
+
 def test_hook_lifecycle(run_in_blender, tmp_path):
     completed = run_in_blender(SCRIPTS / "addon_lifecycle.py", tmp_path)
     assert "LIFECYCLE OK" in completed.stdout, completed.stdout[-3000:]
