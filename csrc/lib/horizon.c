@@ -309,15 +309,18 @@ float hbao_horizon_pixel(const horizon_job *job, int i, int j, float step_px) {
 float hbao_block_step(const horizon_job *job, int x0, int x1, int j, int a) {
     const hbao_settings *s = job->settings;
     const hbao_grid *g = job->grid;
-    float largest = 0.0f;
+    /* The largest projected radius, as hbao_horizon_pixel and the SIMD
+     * kernels compute it per pixel, is the nearest pixel's: pixel_size * z
+     * and the division round monotonically, so radius / (pixel_size * z) is
+     * largest, to the bit, where z is smallest. One division per block. */
+    float nearest = INFINITY;
     for (int i = x0 + a; i < x1; i += 4) {
         const float z = g->depth[(size_t)j * g->width + i];
-        if (z <= 0.0f) continue;
-        /* as hbao_horizon_pixel and the SIMD kernels compute it */
-        const float radius_px =
-            g->orthographic ? s->radius / g->pixel_size : s->radius / (g->pixel_size * z);
-        if (radius_px >= 1.0f && radius_px > largest) largest = radius_px;
+        if (z > 0.0f && z < nearest) nearest = z;
     }
+    if (nearest == INFINITY) return 0.0f;
+    const float largest =
+        g->orthographic ? s->radius / g->pixel_size : s->radius / (g->pixel_size * nearest);
     return largest >= 1.0f ? (largest - 1.0f) / (float)s->steps : 0.0f;
 }
 
