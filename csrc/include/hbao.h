@@ -144,13 +144,15 @@ typedef struct hbao_params {
     int32_t threads;
     /** Depths at or beyond this are background. Must be > 0. */
     float background_depth;
-    /** hbao_implementation: which code computes the horizons. All give
-     *  bit-identical results; choosing one exists for tests and benchmarks. */
+    /** hbao_implementation: which compiled code runs: the horizon kernel
+     *  and the copies of the vectorized stages (given normals, upsample,
+     *  blur). All give bit-identical results; choosing one exists for tests
+     *  and benchmarks. */
     int32_t implementation;
     /** Occluder thickness in scene units; 0 (the default) = infinitely
      *  thick (every surface a solid block reaching back from its depth: the
-     *  height-field model of every version before this field). Otherwise a surface seen at a sample is taken to
-     *  occupy depths [sample depth, sample depth + thickness] along its view
+     *  height-field model of every version before this field). Otherwise a
+     *  surface seen at a sample is taken to occupy depths [sample depth, sample depth + thickness] along its view
      *  ray, and a sample whose block lies wholly in front of the pixel
      *  (sample depth + thickness < the pixel's depth) does not raise the
      *  horizon: light passes behind it. Must be finite and >= 0. */
