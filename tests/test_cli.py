@@ -1070,6 +1070,40 @@ def test_thickness_lets_light_pass_behind_a_thin_occluder(hbao_tool, tmp_path):
     assert ao["thin"][wall].min() == pytest.approx(1.0, abs=1e-4)
 
 
+def test_back_layer_lets_light_pass_behind_a_thin_occluder(hbao_tool, tmp_path, native):
+    """The strip before the wall again, now with a second view layer holding
+    the back faces: the strip is 0.1 thick (back depth 4.8), the wall has no
+    back face (0). With --back-layer the wall beside the strip is a bare
+    plane (AO 1 to 1e-4); the AO is exactly the library's
+    (hbao_compute_layers through the binding); the back layer must differ
+    from the front one, and a missing one is an error."""
+    from hbao import exr_passes
+    width, height = 96, 64
+    depth = np.full((height, width), 5.0, np.float32)
+    depth[:, 40:56] = 4.7
+    back = np.where(depth < 5.0, np.float32(4.8), np.float32(0.0)).astype(np.float32)
+    source = tmp_path / "strip_layers.exr"
+    layers = {"Front.Depth.Z": depth, "BackFaces.Depth.Z": back}
+    source.write_bytes(scanline_exr(layers, width, height))
+    flags = ("--radius", "0.8", "--blur", "0", "--threads", "1", "--layer", "Front")
+    ao = {}
+    for name, extra in (("front", ()), ("layers", ("--back-layer", "BackFaces"))):
+        output = tmp_path / f"{name}.exr"
+        run_ok(hbao_tool, source, "-o", output, *flags, *extra)
+        ao[name] = exr_passes.read_channels(output, ["AO"])["AO"]
+    wall = depth == 5.0
+    assert ao["front"][wall].min() < 0.9
+    assert ao["layers"][wall].min() == pytest.approx(1.0, abs=1e-4)
+    params = {"radius": 0.8, "blur_size": 0, "threads": 1}
+    expected = native.compute_ao(depth, None, params=params, back_depth=back)
+    assert np.array_equal(ao["layers"], expected)
+    for layer, fragment in (("Front", "is the layer the AO is computed from"),
+                            ("Missing", "Missing")):
+        completed = run_tool(hbao_tool, source, "-o", tmp_path / "bad.exr", *flags,
+                             "--back-layer", layer)
+        assert completed.returncode != 0 and fragment in completed.stderr, completed.stderr
+
+
 @pytest.mark.parametrize("names", [("B", "G", "R", "Z"), ("G", "R", "Z")])
 def test_half_depth_beside_half_colour_channels(hbao_tool, tmp_path, names):
     """A half-float Z among three or four half channels of which only Z is

@@ -105,7 +105,7 @@ def _channel(array):
 
 
 def compute_ao(depth, normal=None, *, params=None, camera=None, bottom_up=False, out=None,
-               shape=None):
+               shape=None, back_depth=None):
     """Ambient occlusion from a planar depth image; returns (H, W) float32, 1 = unoccluded.
 
     depth: (H, W) float32 (or a flat buffer with shape=(H, W)); normal: world-space
@@ -113,7 +113,8 @@ def compute_ao(depth, normal=None, *, params=None, camera=None, bottom_up=False,
     params: dict of hbao_params fields (falloff/integration by name, missing keys =
     library defaults); camera: camera dict (see camera_from_blender); bottom_up: row 0
     is the bottom image row (Blender's pass order), the result keeps that order; out:
-    optional (H, W) float32 array to write into (returned). Raises HBAOError with the
+    optional (H, W) float32 array to write into (returned); back_depth: (H, W) float32
+    depth of the back faces (hbao_compute_layers), same row order as depth. Raises HBAOError with the
     library's message, HBAOLibraryError when the library is missing, ValueError for
     malformed arguments.
     """
@@ -156,11 +157,18 @@ def compute_ao(depth, normal=None, *, params=None, camera=None, bottom_up=False,
 
     depth_channel = _channel(depth_view)
     normal_channel = _channel(normal_view) if normal_view is not None else None
+    back_channel = None
+    if back_depth is not None:
+        back_depth = _as_float32(np.asarray(back_depth))
+        if back_depth.shape != (height, width):
+            raise ValueError(f"back_depth must be ({height}, {width}), not {back_depth.shape}")
+        back_channel = _channel(back_depth[::-1] if bottom_up else back_depth)
     library = load_library()
-    check(library.hbao_compute(
+    check(library.hbao_compute_layers(
         ctypes.byref(params_structure), ctypes.byref(camera_structure), width, height,
         ctypes.byref(depth_channel),
         ctypes.byref(normal_channel) if normal_channel is not None else None,
+        ctypes.byref(back_channel) if back_channel is not None else None,
         out_view.ctypes.data_as(ctypes.POINTER(ctypes.c_float)),
         out_view.strides[0] // _FLOAT_SIZE))
     return out

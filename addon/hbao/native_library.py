@@ -52,6 +52,9 @@ _FUNCTIONS = {
     "hbao_compute": (ctypes.c_int32, [_PARAMS_P, _CAMERA_P, ctypes.c_int32, ctypes.c_int32,
                                       _CHANNEL_P, _CHANNEL_P, ctypes.POINTER(ctypes.c_float),
                                       ctypes.c_int64]),
+    "hbao_compute_layers": (ctypes.c_int32, [_PARAMS_P, _CAMERA_P, ctypes.c_int32, ctypes.c_int32,
+                                             _CHANNEL_P, _CHANNEL_P, _CHANNEL_P,
+                                             ctypes.POINTER(ctypes.c_float), ctypes.c_int64]),
 }
 
 

@@ -385,6 +385,30 @@ HBAO_EXPORT hbao_result hbao_compute(const hbao_params *params, const hbao_camer
                                      int32_t width, int32_t height, const hbao_channel *depth,
                                      const hbao_channel *normal, float *ao, int64_t ao_row_stride);
 
+/**
+ * hbao_compute() with a second depth layer, of back faces.
+ *
+ * @param back_depth  per pixel, the planar depth of the first back face
+ *                    behind the visible surface (Blender: a render whose
+ *                    front faces are transparent, e.g. a view layer with a
+ *                    material override, 1 sample, Depth only); NULL (or
+ *                    data NULL) = hbao_compute(). A surface seen at a sample
+ *                    then occupies [depth, back depth] along its view ray,
+ *                    and a sample whose back depth is nearer than the pixel
+ *                    (the occluder lies wholly in front of it) does not
+ *                    raise the pixel's horizon: light passes behind it.
+ *                    Where no back face is known (0, not finite, not behind
+ *                    the visible surface, or at or beyond background_depth)
+ *                    the surface is infinitely thick, as without the layer.
+ *                    params.thickness still applies: a sample is skipped
+ *                    when either rule says so.
+ */
+HBAO_EXPORT hbao_result hbao_compute_layers(const hbao_params *params, const hbao_camera *camera,
+                                            int32_t width, int32_t height,
+                                            const hbao_channel *depth, const hbao_channel *normal,
+                                            const hbao_channel *back_depth, float *ao,
+                                            int64_t ao_row_stride);
+
 #ifdef __cplusplus
 }
 #endif

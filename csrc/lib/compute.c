@@ -59,6 +59,29 @@ static void convert_depth_row(void *context, int j) {
     }
 }
 
+typedef struct back_job {
+    const hbao_channel *source;
+    const float *front; /* the converted depth, dense */
+    float background_depth;
+    int width;
+    float *back;
+} back_job;
+
+/* The back layer, dense, INFINITY where no back face is known: not finite,
+ * not behind the visible surface, background, or the pixel is background. */
+static void convert_back_row(void *context, int j) {
+    const back_job *job = context;
+    const float *row = job->source->data + (int64_t)j * job->source->row_stride;
+    const float *front = job->front + (size_t)j * job->width;
+    float *out = job->back + (size_t)j * job->width;
+    for (int i = 0; i < job->width; i++) {
+        const float b = row[(int64_t)i * job->source->pixel_stride];
+        const int known =
+            front[i] > 0.0f && isfinite(b) && b > front[i] && b < job->background_depth;
+        out[i] = known ? b : INFINITY;
+    }
+}
+
 typedef struct half_depth_job {
     const float *full;
     int full_width;
@@ -72,6 +95,19 @@ static void half_depth_row(void *context, int j) {
     for (int i = 0; i < job->half->width; i++) out[i] = source[2 * i];
 }
 
+typedef struct half_back_job {
+    const float *full;
+    int full_width, width;
+    float *half;
+} half_back_job;
+
+static void half_back_row(void *context, int j) {
+    const half_back_job *job = context;
+    const float *source = job->full + (size_t)(2 * j) * job->full_width;
+    float *out = job->half + (size_t)j * job->width;
+    for (int i = 0; i < job->width; i++) out[i] = source[2 * i];
+}
+
 static void fill_ones(float *ao, int64_t row_stride, int width, int height) {
     for (int j = 0; j < height; j++) {
         float *row = ao + (int64_t)j * row_stride;
@@ -82,14 +118,25 @@ static void fill_ones(float *ao, int64_t row_stride, int width, int height) {
 hbao_result hbao_compute(const hbao_params *params, const hbao_camera *camera, int32_t width,
                          int32_t height, const hbao_channel *depth, const hbao_channel *normal,
                          float *ao, int64_t ao_row_stride) {
+    return hbao_compute_layers(params, camera, width, height, depth, normal, NULL, ao,
+                               ao_row_stride);
+}
+
+hbao_result hbao_compute_layers(const hbao_params *params, const hbao_camera *camera, int32_t width,
+                                int32_t height, const hbao_channel *depth,
+                                const hbao_channel *normal, const hbao_channel *back_depth,
+                                float *ao, int64_t ao_row_stride) {
     if (params == NULL || camera == NULL || depth == NULL || depth->data == NULL || ao == NULL)
         return HBAO_ERROR_NULL_ARGUMENT;
     if (width < 1 || height < 1 || width > HBAO_MAX_IMAGE_SIZE || height > HBAO_MAX_IMAGE_SIZE)
         return HBAO_ERROR_INVALID_SIZE;
     if (normal != NULL && normal->data == NULL) normal = NULL;
+    if (back_depth != NULL && back_depth->data == NULL) back_depth = NULL;
     if (!stride_fits(depth->pixel_stride, depth->row_stride, width, height, 1) ||
         (normal != NULL &&
          !stride_fits(normal->pixel_stride, normal->row_stride, width, height, 3)) ||
+        (back_depth != NULL &&
+         !stride_fits(back_depth->pixel_stride, back_depth->row_stride, width, height, 1)) ||
         !stride_fits(1, ao_row_stride, width, height, 1))
         return HBAO_ERROR_INVALID_STRIDE;
     hbao_settings s;
@@ -114,9 +161,14 @@ hbao_result hbao_compute(const hbao_params *params, const hbao_camera *camera, i
     float *full_depth = malloc(pixels * sizeof(float));
     float *grid_ao = malloc(grid_pixels * sizeof(float));
     float *half_depth = s.half_resolution ? malloc(grid_pixels * sizeof(float)) : NULL;
+    float *full_back = back_depth != NULL ? malloc(pixels * sizeof(float)) : NULL;
+    float *half_back =
+        back_depth != NULL && s.half_resolution ? malloc(grid_pixels * sizeof(float)) : NULL;
     grid.normal = malloc(grid_pixels * 3 * sizeof(float));
+    grid.back = NULL;
     if (full_depth == NULL || grid_ao == NULL || grid.normal == NULL ||
-        (s.half_resolution && half_depth == NULL)) {
+        (s.half_resolution && half_depth == NULL) || (back_depth != NULL && full_back == NULL) ||
+        (back_depth != NULL && s.half_resolution && half_back == NULL)) {
         result = HBAO_ERROR_OUT_OF_MEMORY;
         goto done;
     }
@@ -124,13 +176,24 @@ hbao_result hbao_compute(const hbao_params *params, const hbao_camera *camera, i
     depth_job convert = {depth, s.background_depth, width, full_depth};
     hbao_parallel_rows(s.threads, height, convert_depth_row, &convert);
 
+    if (back_depth != NULL) {
+        back_job backs = {back_depth, full_depth, s.background_depth, width, full_back};
+        hbao_parallel_rows(s.threads, height, convert_back_row, &backs);
+    }
+
     hbao_grid_set_projection(&grid, camera, width, height, scale);
     if (s.half_resolution) {
         grid.depth = half_depth;
         half_depth_job halve = {full_depth, width, &grid};
         hbao_parallel_rows(s.threads, grid.height, half_depth_row, &halve);
+        if (back_depth != NULL) {
+            half_back_job halve_back = {full_back, width, grid.width, half_back};
+            hbao_parallel_rows(s.threads, grid.height, half_back_row, &halve_back);
+            grid.back = half_back;
+        }
     } else {
         grid.depth = full_depth;
+        grid.back = full_back;
     }
     hbao_compute_normals(&s, camera, &grid, normal, scale);
 
@@ -141,6 +204,8 @@ done:
     free(full_depth);
     free(grid_ao);
     free(half_depth);
+    free(full_back);
+    free(half_back);
     free(grid.normal);
     return result;
 }

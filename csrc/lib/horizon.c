@@ -33,6 +33,7 @@ typedef struct march {
     /* Samples nearer than this depth are occluders of finite thickness
      * wholly in front of the pixel: skipped (hbao_near_limit). */
     float near_limit;
+    float z; /* the pixel's depth: a sample whose back face is nearer is skipped */
 } march;
 
 enum { SAMPLE_END = -1, SAMPLE_SKIP = 0, SAMPLE_OK = 1 };
@@ -48,6 +49,8 @@ static inline int march_sample(const march *m, int step, float delta[3], float *
     if (ox == 0 && oy == 0) return SAMPLE_SKIP;
     const float zs = g->depth[(size_t)sj * g->width + si];
     if (zs <= 0.0f || zs < m->near_limit) return SAMPLE_SKIP;
+    /* the back layer: an occluder wholly in front of the pixel */
+    if (g->back != NULL && g->back[(size_t)sj * g->width + si] < m->z) return SAMPLE_SKIP;
     float q[3];
     hbao_grid_position(g, si, sj, zs, q);
     delta[0] = q[0] - m->p[0];
@@ -277,6 +280,7 @@ float hbao_horizon_pixel(const horizon_job *job, int i, int j, float step_px) {
     m.n_dot_v = n[0] * v[0] + n[1] * v[1] + n[2] * v[2];
     m.height_tolerance = g->depth_precision * hbao_rounding_along_normal(g, n, m.p);
     m.near_limit = hbao_near_limit(s, z);
+    m.z = z;
     const int cosine = s->integration == HBAO_INTEGRATION_COSINE;
 
     float occlusion_sum = 0.0f;                /* HBAO */
@@ -359,24 +363,32 @@ static void horizon_tile(void *context, int tile) {
     }
 }
 
-/* hbao_horizon_job.phase_depth, row by row. */
+/* hbao_horizon_job.phase_depth (and phase_back), row by row. */
 typedef struct deinterleave_job {
     const hbao_grid *grid;
     int phase_width;
     float *phase_depth;
+    float *phase_back; /* NULL without the back layer */
 } deinterleave_job;
+
+static void deinterleave(const hbao_grid *g, const float *row, int j, int phase_width, float beyond,
+                         float *phases) {
+    for (int a = 0; a < 4; a++) {
+        float *out = phases + ((size_t)a * g->height + j) * phase_width;
+        for (int x = 0; x < phase_width; x++) {
+            const int i = 4 * x + a;
+            out[x] = i < g->width ? row[i] : beyond;
+        }
+    }
+}
 
 static void deinterleave_row(void *context, int j) {
     const deinterleave_job *job = context;
     const hbao_grid *g = job->grid;
-    const float *row = g->depth + (size_t)j * g->width;
-    for (int a = 0; a < 4; a++) {
-        float *out = job->phase_depth + ((size_t)a * g->height + j) * job->phase_width;
-        for (int x = 0; x < job->phase_width; x++) {
-            const int i = 4 * x + a;
-            out[x] = i < g->width ? row[i] : 0.0f;
-        }
-    }
+    deinterleave(g, g->depth + (size_t)j * g->width, j, job->phase_width, 0.0f, job->phase_depth);
+    if (job->phase_back != NULL)
+        deinterleave(g, g->back + (size_t)j * g->width, j, job->phase_width, INFINITY,
+                     job->phase_back);
 }
 
 /* The kernel asked for, or the best one below it that this CPU runs. */
@@ -416,23 +428,33 @@ void hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *grid,
     tiled.job = &job;
     tiled.tiles_across = (grid->width + TILE_SIZE - 1) / TILE_SIZE;
     tiled.simd = choose_kernel(settings->implementation);
-    float *phase_depth = NULL;
+    float *phase_depth = NULL, *phase_back = NULL;
     job.phase_depth = NULL;
+    job.phase_back = NULL;
     /* whole blocks, so that a block's depths are always one full load */
     job.phase_width =
         ((grid->width + 3) / 4 + HBAO_BLOCK_PIXELS - 1) / HBAO_BLOCK_PIXELS * HBAO_BLOCK_PIXELS;
     if (tiled.simd != NULL) {
-        phase_depth = malloc((size_t)4 * grid->height * job.phase_width * sizeof(float));
-        /* Without memory for the copy the scalar reference computes the same
-         * result, only slower. */
-        if (phase_depth == NULL) tiled.simd = NULL;
+        const size_t bytes = (size_t)4 * grid->height * job.phase_width * sizeof(float);
+        phase_depth = malloc(bytes);
+        if (grid->back != NULL) phase_back = malloc(bytes);
+        /* Without memory for the copies the scalar reference computes the
+         * same result, only slower. */
+        if (phase_depth == NULL || (grid->back != NULL && phase_back == NULL)) {
+            tiled.simd = NULL;
+            free(phase_depth);
+            free(phase_back);
+            phase_depth = phase_back = NULL;
+        }
     }
     if (phase_depth != NULL) {
-        deinterleave_job deinterleave = {grid, job.phase_width, phase_depth};
-        hbao_parallel_rows(settings->threads, grid->height, deinterleave_row, &deinterleave);
+        deinterleave_job split = {grid, job.phase_width, phase_depth, phase_back};
+        hbao_parallel_rows(settings->threads, grid->height, deinterleave_row, &split);
         job.phase_depth = phase_depth;
+        job.phase_back = phase_back;
     }
     const int tiles_down = (grid->height + TILE_SIZE - 1) / TILE_SIZE;
     hbao_parallel_rows(settings->threads, tiled.tiles_across * tiles_down, horizon_tile, &tiled);
     free(phase_depth);
+    free(phase_back);
 }

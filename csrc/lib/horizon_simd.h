@@ -81,6 +81,7 @@ typedef struct SIMD_NAME(block) {
     VF p[3], v[3], n[3];
     VF radius2, inv_radius2;
     VF height_tolerance, n_dot_v, near_limit; /* as in horizon.c's march */
+    VF z;                                     /* the lanes' depths */
 } SIMD_NAME(block);
 
 /* The depth fetches of a direction's steps. They depend only on the steps'
@@ -89,6 +90,7 @@ typedef struct SIMD_NAME(block) {
  * one contiguous load from the phase_depth row of the lanes' new phase. */
 typedef struct SIMD_NAME(fetch) {
     VF zs;
+    VM in_front;  /* the back layer: the sample's occluder lies wholly in front */
     VI si;        /* the samples' columns */
     int sj;       /* and their row, the same for all lanes */
     VM candidate; /* inside the image, on another pixel */
@@ -151,9 +153,11 @@ static inline int SIMD_NAME(fetch_steps)(const SIMD_NAME(block) * b, int steps, 
         const int moved = b->phase + ox;
         const int new_phase = ((moved % 4) + 4) % 4;
         const int first = b->first_x + (moved - new_phase) / 4;
-        const float *row = b->job->phase_depth + ((size_t)new_phase * g->height + sj) * phase_width;
+        const size_t row_start = ((size_t)new_phase * g->height + sj) * phase_width;
+        const float *row = b->job->phase_depth + row_start;
+        const int whole = first >= 0 && first + SIMD_LANES <= phase_width;
         VF zs;
-        if (first >= 0 && first + SIMD_LANES <= phase_width) {
+        if (whole) {
             zs = V_LOADU(row + first);
         } else { /* at the image's side: only the lanes inside read */
             float lanes[SIMD_LANES];
@@ -162,6 +166,21 @@ static inline int SIMD_NAME(fetch_steps)(const SIMD_NAME(block) * b, int steps, 
             zs = V_LOADU(lanes);
         }
         fetches[step].zs = V_ZERO_UNLESS(candidate, zs);
+        fetches[step].in_front = M_ANDNOT(alive, alive); /* no lane */
+        if (b->job->phase_back != NULL) {                /* horizon.c's march_sample */
+            const float *back = b->job->phase_back + row_start;
+            VF zb;
+            if (whole) {
+                zb = V_LOADU(back + first);
+            } else {
+                float lanes[SIMD_LANES];
+                for (int k = 0; k < SIMD_LANES; k++)
+                    lanes[k] =
+                        first + k >= 0 && first + k < phase_width ? back[first + k] : INFINITY;
+                zb = V_LOADU(lanes);
+            }
+            fetches[step].in_front = V_LT(zb, b->z);
+        }
         fetches[step].si = si;
         fetches[step].sj = sj;
         fetches[step].candidate = candidate;
@@ -176,7 +195,8 @@ static inline VM SIMD_NAME(sample)(const SIMD_NAME(block) * b, const SIMD_NAME(f
     const hbao_grid *g = b->grid;
     const VF zs = f->zs;
     const VM valid =
-        M_AND(M_AND(f->candidate, live), M_AND(V_GT(zs, V_SET(0.0f)), V_GE(zs, b->near_limit)));
+        M_ANDNOT(f->in_front, M_AND(M_AND(f->candidate, live),
+                                    M_AND(V_GT(zs, V_SET(0.0f)), V_GE(zs, b->near_limit))));
     const VF column = V_MUL(V_ADD(I_TO_F(f->si), V_SET(g->x_offset)), V_SET(g->x_step));
     const VF row = V_SET(hbao_grid_y(g, f->sj));
     const VF q0 = g->orthographic ? column : V_MUL(column, zs);
@@ -397,6 +417,7 @@ static void SIMD_NAME(lanes_ao)(const hbao_horizon_job *job, int x0, int x1, int
                                    V_SELECT(V_LT(along, V_SET(0.0f)), along, V_NEG(along)));
         /* hbao_near_limit */
         b.near_limit = s->thickness > 0.0f ? V_SUB(z, V_SET(s->thickness)) : V_SET(0.0f);
+        b.z = z;
 
         const int cosine = s->integration == HBAO_INTEGRATION_COSINE;
         VF occlusion_sum = V_SET(0.0f), visible_sum = V_SET(0.0f), open_sum = V_SET(0.0f);

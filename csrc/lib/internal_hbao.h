@@ -49,7 +49,10 @@ typedef struct hbao_settings {
  * half-resolution grid. Depth is dense and positive; 0 marks background. */
 typedef struct hbao_grid {
     int width, height;
-    float *depth;  /* width * height */
+    float *depth; /* width * height */
+    /* width * height: the back faces' depth (hbao_compute_layers), INFINITY
+     * where unknown; NULL without the layer */
+    const float *back;
     float *normal; /* width * height * 3, camera space, facing the viewer */
     /* View-plane coordinates (per unit depth if perspective) of column i and
      * row j: (i + x_offset) * x_step and (j + y_offset) * y_step. Computed,
@@ -149,6 +152,8 @@ typedef struct hbao_horizon_job {
      * the scalar reference): phase_depth[(a * height + j) * phase_width + X]
      * is grid depth (4 X + a, j), 0 beyond the row's end. */
     const float *phase_depth;
+    /* grid->back deinterleaved the same way (NULL without the layer) */
+    const float *phase_back;
     int phase_width;
 } hbao_horizon_job;
 

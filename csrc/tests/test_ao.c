@@ -810,6 +810,72 @@ TEST_CASE(thin_occluders_do_not_darken_what_is_behind_them) {
     free(normal);
 }
 
+static float *run_layers(const hbao_params *p, const scene_view *view, const float *depth,
+                         const float *normal, const float *back) {
+    float *ao = malloc((size_t)view->width * view->height * sizeof(float));
+    hbao_channel d = {depth, 1, view->width};
+    hbao_channel n = {normal, 3, 3 * (int64_t)view->width};
+    hbao_channel b = {back, 1, view->width};
+    CHECK_RESULT(hbao_compute_layers(p, &view->camera, view->width, view->height, &d,
+                                     normal ? &n : NULL, back ? &b : NULL, ao, view->width),
+                 HBAO_SUCCESS);
+    return ao;
+}
+
+TEST_CASE(back_face_layer_lets_light_pass_behind_a_thin_plate) {
+    /* The plate before the wall again, now with a back-face layer: the
+     * plate is PLATE_GAP / 4 thick (its back faces that far behind it), the
+     * wall has no back face (0: unknown, infinitely thick). The wall beside
+     * the plate loses its halo, as with params.thickness; an unknown back
+     * everywhere gives exactly hbao_compute()'s result; every kernel gives
+     * the scalar reference's floats. */
+    scene_view view;
+    float *depth, *normal;
+    render_plate_before_wall(&view, &depth, &normal);
+    const int pixels = view.width * view.height;
+    float *back = malloc((size_t)pixels * sizeof(float));
+    float *unknown = malloc((size_t)pixels * sizeof(float));
+    for (int k = 0; k < pixels; k++) {
+        back[k] = depth[k] < 4.9f ? depth[k] + (float)(0.25 * PLATE_GAP) : 0.0f;
+        unknown[k] = k % 3 == 0 ? 0.0f : (k % 3 == 1 ? NAN : depth[k] * 0.5f);
+    }
+    for (int integration = 0; integration <= 1; integration++) {
+        for (int half = 0; half <= 1; half++) {
+            hbao_params p = exact_params(integration);
+            p.radius = 0.8f;
+            p.half_resolution = half;
+            p.implementation = HBAO_IMPLEMENTATION_SCALAR;
+            float *plain = run(&p, &view, depth, normal);
+            float *no_back = run_layers(&p, &view, depth, normal, unknown);
+            float *layered = run_layers(&p, &view, depth, normal, back);
+            CHECK(memcmp(plain, no_back, (size_t)pixels * sizeof(float)) == 0);
+            float darkest_plain = 1.0f, darkest_layered = 1.0f;
+            for (int k = 0; k < pixels; k++) {
+                if (depth[k] < 4.9f) continue; /* the plate */
+                darkest_plain = fminf(darkest_plain, plain[k]);
+                darkest_layered = fminf(darkest_layered, layered[k]);
+            }
+            CHECK(darkest_plain < 0.9f); /* the halo is there without the layer */
+            if (!half) CHECK_NEAR(darkest_layered, 1.0f, 1e-4);
+            CHECK(darkest_layered > darkest_plain + 0.05f);
+            for (int implementation = HBAO_IMPLEMENTATION_AVX2;
+                 implementation <= HBAO_IMPLEMENTATION_AVX512; implementation++) {
+                p.implementation = implementation;
+                float *fast = run_layers(&p, &view, depth, normal, back);
+                CHECK(memcmp(layered, fast, (size_t)pixels * sizeof(float)) == 0);
+                free(fast);
+            }
+            free(plain);
+            free(no_back);
+            free(layered);
+        }
+    }
+    free(back);
+    free(unknown);
+    free(depth);
+    free(normal);
+}
+
 TEST_MAIN(TEST_ENTRY(plane_facing_camera_is_unoccluded), TEST_ENTRY(tilted_plane_is_unoccluded),
           TEST_ENTRY(corner_matches_analytic_cosine), TEST_ENTRY(corner_matches_analytic_hbao),
           TEST_ENTRY(corner_value_at_the_crease_is_one_half),
@@ -823,4 +889,5 @@ TEST_MAIN(TEST_ENTRY(plane_facing_camera_is_unoccluded), TEST_ENTRY(tilted_plane
           TEST_ENTRY(strength_is_a_power), TEST_ENTRY(background_never_occludes),
           TEST_ENTRY(tiny_projected_radius_gives_one),
           TEST_ENTRY(simd_paths_match_scalar_reference_bit_for_bit),
-          TEST_ENTRY(thin_occluders_do_not_darken_what_is_behind_them))
+          TEST_ENTRY(thin_occluders_do_not_darken_what_is_behind_them),
+          TEST_ENTRY(back_face_layer_lets_light_pass_behind_a_thin_plate))

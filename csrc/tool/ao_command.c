@@ -54,6 +54,7 @@ static int resolve_camera(const cli_options *options, const exr_input *input,
 void ao_buffers_free(ao_buffers *buffers) {
     free(buffers->depth);
     free(buffers->normal);
+    free(buffers->back);
     free(buffers->ao);
     for (int c = 0; c < buffers->copy_count; ++c) free(buffers->copies[c]);
     free(buffers->copies);
@@ -69,17 +70,25 @@ static exr_channel_request float_request(const char *name, float *data, int comp
 }
 
 static int read_passes(exr_input *input, const blender_passes *passes, bool use_normals,
-                       ao_buffers *buffers, tool_error *error) {
+                       const blender_passes *back, ao_buffers *buffers, tool_error *error) {
     const size_t pixel_count = (size_t)input->width * (size_t)input->height;
     buffers->depth = malloc(pixel_count * sizeof(float));
     buffers->ao = malloc(pixel_count * sizeof(float));
     if (use_normals) buffers->normal = malloc(3 * pixel_count * sizeof(float));
-    if (buffers->depth == NULL || buffers->ao == NULL || (use_normals && buffers->normal == NULL))
+    if (back != NULL) buffers->back = malloc(pixel_count * sizeof(float));
+    if (buffers->depth == NULL || buffers->ao == NULL || (use_normals && buffers->normal == NULL) ||
+        (back != NULL && buffers->back == NULL))
         return tool_fail(error, TOOL_EXIT_RUNTIME, "out of memory for a %dx%d image", input->width,
                          input->height);
-    exr_channel_request requests[4];
+    exr_channel_request requests[5];
     int count = 0;
     requests[count++] = float_request(passes->depth, buffers->depth, 1, input->width);
+    if (back != NULL) {
+        if (strcmp(back->depth, passes->depth) == 0)
+            return tool_fail(error, TOOL_EXIT_USAGE,
+                             "--back-layer: %s is the layer the AO is computed from", back->depth);
+        requests[count++] = float_request(back->depth, buffers->back, 1, input->width);
+    }
     for (int axis = 0; axis < 3 && use_normals; ++axis)
         requests[count++] =
             float_request(passes->normal[axis], buffers->normal + axis, 3, input->width);
@@ -258,7 +267,13 @@ int ao_compute_input(const cli_options *options, exr_input *input, ao_buffers *b
         return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: cannot compute AO: %s", options->input_path,
                          hbao_result_message(cropping));
 
-    status = read_passes(input, &passes, use_normals, buffers, error);
+    blender_passes back_passes;
+    if (options->back_layer != NULL) {
+        status = blender_find_passes(input, options->back_layer, &back_passes, error);
+        if (status != TOOL_EXIT_SUCCESS) return status;
+    }
+    status = read_passes(input, &passes, use_normals,
+                         options->back_layer != NULL ? &back_passes : NULL, buffers, error);
     if (status != TOOL_EXIT_SUCCESS) return status;
     if (use_normals && !(camera.fields_set & CAMERA_FIELD_WORLD_TO_CAMERA))
         tool_warn("the Normal pass (%s) is in world space but no world-to-camera matrix was "
@@ -269,9 +284,11 @@ int ao_compute_input(const cli_options *options, exr_input *input, ao_buffers *b
 
     hbao_channel depth = {buffers->depth, 1, input->width};
     hbao_channel normal = {buffers->normal, 3, (int64_t)input->width * 3};
+    hbao_channel back = {buffers->back, 1, input->width};
     hbao_result result =
-        hbao_compute(&options->params, &cropped, input->width, input->height, &depth,
-                     use_normals ? &normal : NULL, buffers->ao, input->width);
+        hbao_compute_layers(&options->params, &cropped, input->width, input->height, &depth,
+                            use_normals ? &normal : NULL, buffers->back != NULL ? &back : NULL,
+                            buffers->ao, input->width);
     if (result != HBAO_SUCCESS)
         return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: cannot compute AO: %s", options->input_path,
                          hbao_result_message(result));

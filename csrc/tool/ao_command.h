@@ -11,6 +11,7 @@
 typedef struct ao_buffers {
     float *depth;
     float *normal;    /**< X Y Z interleaved; NULL when not used */
+    float *back;      /**< --back-layer's depth; NULL when not used */
     float *ao;        /**< width x height, rows top first */
     uint8_t **copies; /**< --keep-input: one native-type buffer per input channel */
     int copy_count;

@@ -11,6 +11,7 @@
 typedef enum option_id {
     OPTION_OUTPUT,
     OPTION_LAYER,
+    OPTION_BACK_LAYER,
     OPTION_AO_CHANNEL,
     OPTION_KEEP_INPUT,
     OPTION_NO_NORMALS,
@@ -61,6 +62,7 @@ typedef struct option_spec {
 static const option_spec option_specs[] = {
     {"output", 'o', OPTION_OUTPUT, true},
     {"layer", 0, OPTION_LAYER, true},
+    {"back-layer", 0, OPTION_BACK_LAYER, true},
     {"ao-channel", 0, OPTION_AO_CHANNEL, true},
     {"keep-input", 0, OPTION_KEEP_INPUT, false},
     {"no-normals", 0, OPTION_NO_NORMALS, false},
@@ -192,6 +194,9 @@ static int apply_option(const option_spec *spec, const char *value, cli_options 
             break;
         case OPTION_LAYER:
             options->layer = value;
+            break;
+        case OPTION_BACK_LAYER:
+            options->back_layer = value;
             break;
         case OPTION_AO_CHANNEL:
             if (value[0] == '\0')
@@ -550,6 +555,10 @@ void cli_print_help(FILE *stream) {
         "                          present, NAME.Normal.X/Y/Z). Default: the first layer,\n"
         "                          in channel-name order, that has a Depth pass; a plain\n"
         "                          `Depth.Z` or `Z` channel is used if no layer has one.\n"
+        "  --back-layer NAME       view layer whose Depth pass holds the back faces (a\n"
+        "                          layer rendered with front faces transparent, e.g. a\n"
+        "                          material override, 1 sample): an occluder whose back\n"
+        "                          lies in front of a pixel lets light pass behind it.\n"
         "  --no-normals            ignore the Normal pass; reconstruct normals from depth.\n"
         "  --ao-channel NAME       name of the output channel (default AO). `Y` makes\n"
         "                          image viewers and Blender show the AO as grayscale.\n"

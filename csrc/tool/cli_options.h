@@ -32,6 +32,7 @@ typedef struct cli_options {
     const char *preview_path; /**< NULL: no PNG */
     const char *camera_path;  /**< NULL: no camera JSON */
     const char *layer;        /**< NULL: first view layer with a Depth pass */
+    const char *back_layer;   /**< NULL: no back-face layer (hbao_compute_layers) */
     const char *ao_channel;   /**< name of the output channel, "AO" by default */
     bool keep_input;
     bool ignore_normals;

@@ -52,8 +52,9 @@ bool run_settings_text(const cli_options *options, char text[RUN_SETTINGS_MAX]) 
                (double)c->pixel_aspect_x, (double)c->pixel_aspect_y);
         for (int i = 0; i < 16; ++i) append(text, &used, " %.9g", (double)c->world_to_camera[i]);
     }
-    append(text, &used, "; layer %s; AO channel %s", options->layer ? options->layer : "(first)",
-           options->ao_channel);
+    append(text, &used, "; layer %s; back layer %s; AO channel %s",
+           options->layer ? options->layer : "(first)",
+           options->back_layer ? options->back_layer : "(none)", options->ao_channel);
     return used < RUN_SETTINGS_MAX - 1;
 }
 
