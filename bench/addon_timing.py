@@ -7,7 +7,7 @@ and without an HBAO compositor node. Run by run_benchmark.py:
 
 Spec: scene, width, height, samples, repeats, node (the HBAO node's settings:
 radius, directions, steps, blur_size, falloff, integration, half_resolution,
-guard_band).
+guard_band, back_faces).
 Prints one line `bench-addon: {json}` with the render times in seconds; the
 add-on's own console line ("... pass hand-over N ms ...") is parsed by the
 driver from the same output.
@@ -28,7 +28,7 @@ import scene_library  # noqa: E402
 
 SOCKETS = {"radius": "Radius", "directions": "Directions", "steps": "Steps",
            "blur_size": "Blur Size", "angle_bias_degrees": "Angle Bias"}
-PROPERTIES = ("falloff", "integration", "half_resolution", "guard_band")
+PROPERTIES = ("falloff", "integration", "half_resolution", "guard_band", "back_faces")
 
 
 def configure(scene, spec):

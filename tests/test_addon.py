@@ -334,6 +334,33 @@ def test_guard_band_sees_occluders_outside_the_frame(run_in_blender, tmp_path, n
     assert np.abs(with_band - truth).mean() < np.abs(without - truth).mean()
 
 
+def test_back_faces_give_each_occluder_its_thickness(run_in_blender, tmp_path, native):
+    """Two nodes, one with Back Faces (an extra 1-sample Cycles render whose
+    front faces are transparent). The back render sees the far side of the
+    cube and the sphere, behind their front (thickness > 0), and the floor
+    and wall through nothing (unknown). The node's AO is exactly the
+    library's with that layer; the cube stands 5 cm off the back wall, so the
+    wall beside it gets lighter (its halo), and no pixel gets darker."""
+    node = {"radius": 1.0}
+    out, log = render(run_in_blender, tmp_path,
+                      {"resolution": [96, 64], "dump_back_faces": True,
+                       "nodes": [dict(node, name="HBAO0"),
+                                 dict(node, name="HBAO1", back_faces=True)]})
+    assert "back faces passes" in log and "no back faces" not in log, log[-3000:]
+    back = np.load(out / "back_0001.npy")
+    depth, normal = frame_passes(out, 1)
+    known = (back > depth) & (back < 1e4)
+    assert known.mean() > 0.05  # the cube and the sphere have far sides
+    assert np.all(back[known] - depth[known] < 1.5)  # within the props' size
+    expected = native.compute_ao(depth, normal, params=node_params(radius=1.0),
+                                 camera=camera(out, 1), back_depth=back)
+    plain = node_outputs(out, 1, "HBAO0")["ao"]
+    layered = node_outputs(out, 1, "HBAO1")["ao"]
+    assert np.abs(layered - expected).max() <= EXACT
+    assert (layered - plain).max() > 0.02  # light passes behind the props somewhere
+    assert (layered - plain).min() >= -EXACT  # a back layer only removes occluders
+
+
 @pytest.mark.parametrize("how", ["append", "link"])
 def test_appended_or_linked_scene_renders_with_ao(run_in_blender, blender,
                                                   blender_user_scripts, tmp_path, native, how):

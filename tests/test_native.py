@@ -245,6 +245,7 @@ def test_incompatible_library_is_refused(monkeypatch, tmp_path):
         "size_t hbao_params_size(void) { return 48; }\n"
         "size_t hbao_camera_size(void) { return 104; }\n"
         "int32_t hbao_compute(void) { return 0; }\n"
+        "int32_t hbao_compute_layers(void) { return 0; }\n"
         "size_t hbao_view_size(void) { return 40; }\n"
         "int32_t hbao_camera_view(void) { return 0; }\n"
         "int32_t hbao_camera_crop(void) { return 0; }\n"

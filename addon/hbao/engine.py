@@ -11,7 +11,7 @@ import bpy
 import numpy as np
 
 from . import camera as camera_model
-from . import exr_passes, guard_passes, handover, native
+from . import exr_passes, handover, layer_passes, native
 from .helper_lookup import ENGINE_IDNAME, is_helper, pass_names_for_helper
 from .helper_scene import rendered_for_a_scene, scene_for_render
 from .planning import plan
@@ -53,8 +53,8 @@ def compute_passes(engine, depsgraph, width, height):
     exr_passes.load_library()
     camera = camera_model.camera_for_render_result(main, _evaluated_camera(main, depsgraph))
     channels, timings = handover.read_main_passes(main, jobs)
-    guard, guard_warnings = guard_passes.read(helper, main, jobs, timings)
-    for warning in guard_warnings:
+    extra, extra_warnings = layer_passes.read(helper, main, jobs, timings)
+    for warning in extra_warnings:
         _report(engine, f"HBAO {warning}")
         log(warning)
 
@@ -76,7 +76,7 @@ def compute_passes(engine, depsgraph, width, height):
                                f"helper scene renders {width}x{height}")
         normal = channels[("normal", job.layer)] if job.with_normal else None
         compute_start = time.perf_counter()
-        results[job.pass_name] = guard_passes.compute(job, depth, normal, camera, guard)
+        results[job.pass_name] = layer_passes.compute(job, depth, normal, camera, extra)
         compute_time += time.perf_counter() - compute_start
         engine.update_progress((index + 1) / len(jobs))
     timings["ao"] = compute_time
@@ -85,16 +85,17 @@ def compute_passes(engine, depsgraph, width, height):
 
 
 def _timing_line(count, width, height, total, timings):
-    milliseconds = {name: timings.get(name, 0.0) * 1000
-                    for name in ("save", "read", "write", "ao", "guard save", "guard read")}
+    milliseconds = {name: timings.get(name, 0.0) * 1000 for name in ("save", "read", "write",
+                                                                     "ao")}
     handover_ms = milliseconds["save"] + milliseconds["read"] + milliseconds["write"]
     line = (f"{count} AO pass(es) {width}x{height} in {total * 1000:.0f} ms: AO "
             f"{milliseconds['ao']:.0f} ms, pass hand-over {handover_ms:.0f} ms "
             f"(save {milliseconds['save']:.0f}, read {milliseconds['read']:.0f}, write "
             f"{milliseconds['write']:.0f})")
-    if "guard save" in timings:
-        guard_ms = milliseconds["guard save"] + milliseconds["guard read"]
-        line += f", guard band passes {guard_ms:.0f} ms"
+    for kind in ("guard band", "back faces"):  # extra_renders' kinds
+        if f"{kind} save" in timings:
+            seconds = timings[f"{kind} save"] + timings.get(f"{kind} read", 0.0)
+            line += f", {kind} passes {seconds * 1000:.0f} ms"
     return line
 
 

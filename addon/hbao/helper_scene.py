@@ -16,7 +16,7 @@ pointed at each scene's helper in turn would flip with every sync. The render
 handlers record the scene being rendered, which the engine reads."""
 import bpy
 
-from . import compat, guard_scene
+from . import compat, extra_renders
 from .data_edits import set_if_different
 from .helper_lookup import (ENGINE_IDNAME, HELPER_SCENE_PREFIX, MAIN_SCENE_KEY, MAIN_TREE_KEY,
                             MANAGED_NODE_KEY, helper_scene_of, is_helper, main_scene_of,
@@ -56,9 +56,7 @@ def record_rendering(scene):
         _rendering[helper.name] = scene.name
         _in_progress.add(helper.name)
         copy_render_settings(scene, helper)
-        guard = guard_scene.guard_of(helper)
-        if guard is not None:
-            guard_scene.copy_camera(scene, guard)
+        extra_renders.record_rendering(scene, helper)
 
 
 def record_render_end(scene):
@@ -199,11 +197,11 @@ def _ensure_managed_node(tree, nodes, helper):
     return rlayers
 
 
-def _guard_view_layer(scene, nodes):
-    """The view layer whose collections the guard band render mirrors: that
-    of the Depth pass of the first node with a guard band."""
+def _extra_view_layer(scene, nodes):
+    """The view layer whose collections the extra renders mirror: that of
+    the Depth pass of the first node that asks for one."""
     for node in nodes:
-        if node.guard_band > 0.0 and not node.mute:
+        if (node.guard_band > 0.0 or node.back_faces) and not node.mute:
             source = upstream(node.inputs[DEPTH_INPUT])
             if source is not None and source.node.bl_idname == "CompositorNodeRLayers":
                 return scene.view_layers.get(source.node.layer)
@@ -221,7 +219,7 @@ def sync(scene):
         # found through the managed node: before it goes
         helper = helper_scene_of(scene)
         if helper is not None:
-            guard_scene.remove(helper, tree)
+            extra_renders.remove_all(helper, tree)
         rlayers = managed_node(tree)
         if rlayers is not None:
             tree.nodes.remove(rlayers)
@@ -238,7 +236,7 @@ def sync(scene):
         seen.add(node.pass_index)
 
     helper, new = _find_or_make_helper_scene(scene)
-    if guard_scene.sync(scene, tree, nodes, helper, _guard_view_layer(scene, nodes)):
+    if extra_renders.sync(scene, tree, nodes, helper, _extra_view_layer(scene, nodes)):
         # made again below, after the guard's node: Blender renders in node order
         tree.nodes.remove(managed_node(tree))
     rlayers = _ensure_managed_node(tree, nodes, helper)
@@ -261,9 +259,10 @@ def sync(scene):
 def sync_all():
     """sync() every scene with HBAO nodes or a hook; drop helpers nobody uses."""
     for scene in list(bpy.data.scenes):
-        if guard_scene.is_guard(scene):
-            if not any(guard_scene.guard_of(helper) == scene for helper in bpy.data.scenes
-                       if is_helper(helper)):
+        if extra_renders.is_extra(scene):
+            if not any(extra_renders.scene_of(helper, kind) == scene
+                       for helper in bpy.data.scenes if is_helper(helper)
+                       for kind in extra_renders.KINDS):
                 bpy.data.scenes.remove(scene)
             continue
         if is_helper(scene):

@@ -114,9 +114,9 @@ def compute_ao(depth, normal=None, *, params=None, camera=None, bottom_up=False,
     library defaults); camera: camera dict (see camera_from_blender); bottom_up: row 0
     is the bottom image row (Blender's pass order), the result keeps that order; out:
     optional (H, W) float32 array to write into (returned); back_depth: (H, W) float32
-    depth of the back faces (hbao_compute_layers), same row order as depth. Raises HBAOError with the
-    library's message, HBAOLibraryError when the library is missing, ValueError for
-    malformed arguments.
+    depth of the back faces (hbao_compute_layers), same row order as depth. Raises
+    HBAOError with the library's message, HBAOLibraryError when the library is missing,
+    ValueError for malformed arguments.
     """
     depth = np.asarray(depth) if not isinstance(depth, np.ndarray) else depth
     if depth.ndim == 1 or shape is not None:

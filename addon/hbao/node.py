@@ -59,7 +59,7 @@ def _settings_changed(node, _context):
     node.id_data.update_tag()
 
 
-def _guard_band_changed(node, _context):
+def _extra_render_changed(node, _context):
     # The hook makes or removes the extra render on its next sync.
     node.id_data.update_tag()
     _announce_change()
@@ -81,10 +81,15 @@ class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
         description="Compute AO at half resolution and upsample it, depth-aware (faster)")
     guard_band: FloatProperty(
         name="Guard Band", default=0.0, min=0.0, max=100.0 * guard_geometry.MAX_GUARD_BAND,
-        subtype="PERCENTAGE", update=_guard_band_changed,
+        subtype="PERCENTAGE", update=_extra_render_changed,
         description="Occluders outside the frame: an extra Cycles render (1 sample, Depth and "
                     "Normal only) through a wider camera sees this far past each side, in % of "
                     "the frame. Darkens borders that come out too bright. 0 = off")
+    back_faces: BoolProperty(
+        name="Back Faces", default=False, update=_extra_render_changed,
+        description="Thickness from an extra Cycles render of the back faces (1 sample, Depth "
+                    "only): an object lying wholly in front of a surface no longer darkens it "
+                    "(the halo around foreground objects)")
     blur_sharpness: FloatProperty(
         name="Blur Sharpness", default=_D["blur_sharpness"], min=0.0,
         max=parameters.MAX_BLUR_SHARPNESS, soft_max=64.0,
@@ -130,6 +135,7 @@ class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
             row.prop(self, name, text="")
         layout.prop(self, "half_resolution")
         layout.prop(self, "guard_band")
+        layout.prop(self, "back_faces")
         if self.status:
             # A borderless button: its tooltip (and a click: the Info editor)
             # gives the full text that the short status line stands for.

@@ -18,6 +18,7 @@ class Job:
         self.params = params
         # of the frame on each side, guard_geometry's
         self.guard_band = node.guard_band / 100.0
+        self.back_faces = node.back_faces
 
 
 def pass_source(socket, scene, expected):

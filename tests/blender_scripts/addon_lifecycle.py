@@ -85,8 +85,21 @@ for node in (first, second):
     check(socket.is_linked and socket.links[0].from_socket.name == f"HBAO {node.pass_index}",
           f"{node.name} is still wired to its pass")
 camera_name = guards[0].camera.name
+second.back_faces = True
+hbao.sync(scene)
+backs = [s for s in bpy.data.scenes if s.name.startswith(".HBAO back faces")]
+order = [n for n in tree.nodes if n.bl_idname == "CompositorNodeRLayers"]
+back_node = next((n for n in order if n.get("hbao_back_node")), None)
+check(len(backs) == 1 and backs[0].camera == scene.camera
+      and backs[0].view_layers[0].material_override is not None
+      and back_node is not None and back_node.scene == backs[0]
+      and order.index(back_node) < order.index(managed()),
+      "a back faces scene: the scene camera, a material override, its node before the helper's")
+second.back_faces = False
 first.guard_band = 0.0
 hbao.sync(scene)
+check(not any(s.name.startswith(".HBAO back faces") for s in bpy.data.scenes)
+      and not any(n.get("hbao_back_node") for n in tree.nodes), "the back faces render goes too")
 check(not any(s.get("hbao_guard_for") for s in bpy.data.scenes)
       and not any(n.get("hbao_guard_node") for n in tree.nodes)
       and bpy.data.objects.get(camera_name) is None, "all of it goes with the setting")

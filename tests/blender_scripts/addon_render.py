@@ -12,17 +12,18 @@ both uncompressed 32-bit float. Usage:
 
 Spec keys (all optional): resolution [w, h], samples, engine, scene
 ("corner" | "two_layers"), frames [..], ao_reference (distance: adds Cycles'
-AO pass), orthographic, widen_camera (factor), border [min_x, max_x, min_y, max_y] (a border render
-cropped to it), save_blend (path: saved after the setup, before
-rendering), nodes: [{name, layer, normal (bool), radius, keyframes [[frame,
-radius], ..], radius_from_value_node, falloff, integration, blur_size,
-angle_bias, directions, steps, strength, thickness, guard_band, mute, connect_with_operator (left
-unlinked, then linked by the node's Connect Passes operator after the passes are
-disabled)}], disable_normal_pass, disable_depth_pass,
-output_format (the main output's file format, default OPEN_EXR_MULTILAYER),
-prepare [actions before rendering: sync, delete_helper, rename_helper, pick_internal_engine,
-render_the_helper,
-rename_node, second_scene_shares_the_tree]. Prints OUTPUT SETTINGS {json}
+AO pass), orthographic, widen_camera (factor), dump_back_faces (writes
+<out>/back_<NNNN>.npy: the back faces render's Depth, top row first), border
+[min_x, max_x, min_y, max_y] (a border render cropped to it), save_blend
+(path: saved after the setup, before rendering), nodes: [{name, layer, normal
+(bool), radius, keyframes [[frame, radius], ..], radius_from_value_node,
+falloff, integration, blur_size, angle_bias, directions, steps, strength,
+thickness, guard_band, back_faces, mute, connect_with_operator (left unlinked,
+then linked by the node's Connect Passes operator after the passes are
+disabled)}], disable_normal_pass, disable_depth_pass, output_format (the main
+output's file format, default OPEN_EXR_MULTILAYER), prepare [actions before
+rendering: sync, delete_helper, rename_helper, pick_internal_engine,
+render_the_helper, rename_node, second_scene_shares_the_tree]. Prints OUTPUT SETTINGS {json}
 (the main output's settings after the renders) and RENDERED.
 """
 import json
@@ -95,7 +96,7 @@ for index, node_spec in enumerate(spec.get("nodes", [{}])):
                              ("thickness", "Thickness")):
         if key in node_spec:
             hbao.inputs[socket_name].default_value = node_spec[key]
-    for key in ("falloff", "integration", "half_resolution", "guard_band"):
+    for key in ("falloff", "integration", "half_resolution", "guard_band", "back_faces"):
         if key in node_spec:
             setattr(hbao, key, node_spec[key])
     if node_spec.get("radius_from_value_node") is not None:
@@ -181,6 +182,14 @@ for frame in spec.get("frames", [1]):
     else:
         bpy.data.scenes[render_scene_name].render.filepath = scene.render.filepath
         bpy.ops.render.render(write_still=True, scene=render_scene_name)
+    if spec.get("dump_back_faces"):  # the back faces render's Depth, as the engine read it
+        import numpy as np
+        from hbao import extra_renders, handover
+        helper = next(s for s in bpy.data.scenes if s.get("hbao_main_scene"))
+        back = extra_renders.scene_of(helper, extra_renders.BACK)
+        layer = back.view_layers[0].name
+        channels, _timings = handover.read_passes(back, {layer: False})
+        np.save(os.path.join(out_dir, f"back_{frame:04d}.npy"), channels[("depth", layer)])
 settings = scene.render.image_settings
 print("OUTPUT SETTINGS", json.dumps({
     "file_format": settings.file_format, "color_depth": settings.color_depth,

@@ -1,0 +1,299 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The extra renders a node may ask for, each a hidden scene that holds the
+artist's collections (linked, not copied), rendered by Cycles at 1 sample,
+with a managed Render Layers node pointing at it: the guard band
+(guard_geometry.py), a camera that follows the scene camera with a view
+widened about the frame's centre, Depth and Normal; the back faces, the scene
+camera and a material override that makes front faces transparent, so that
+Cycles writes the Depth of the first back face behind the visible surface
+(it writes data passes only at surfaces at least as opaque as the view
+layer's alpha threshold).
+
+Blender renders the scenes of a compositor tree's Render Layers nodes in the
+order of the tree's nodes, at the main render's size, so these nodes come
+before the helper's: when the helper's engine runs, their Render Results
+hold this frame's passes (docs/blender-integration.md)."""
+import bpy
+
+from . import compat, guard_geometry
+from .data_edits import set_if_different
+from .report import log
+
+
+class Kind:
+    """What tells one extra render from the other."""
+
+    def __init__(self, name, prefix, helper_key, node_key, node_name, wants_normal):
+        self.name = name
+        self.prefix = prefix
+        self.helper_key = helper_key  # ID property on the helper: its scene
+        self.node_key = node_key      # ID property on its Render Layers node
+        self.node_name = node_name
+        self.wants_normal = wants_normal
+
+
+GUARD = Kind("guard band", ".HBAO guard band ", "hbao_guard_scene", "hbao_guard_node",
+             "HBAO Guard Band", True)
+BACK = Kind("back faces", ".HBAO back faces ", "hbao_back_scene", "hbao_back_node",
+            "HBAO Back Faces", False)
+KINDS = (GUARD, BACK)
+# ID property on an extra scene: it is one (the helper's name, for people).
+EXTRA_KEY = "hbao_guard_for"
+# ID property on the guard scene: how much wider its camera sees.
+SCALE_KEY = "hbao_guard_scale"
+CAMERA_SETTINGS = ("type", "lens", "sensor_width", "sensor_height", "sensor_fit", "shift_x",
+                   "shift_y", "ortho_scale", "clip_start", "clip_end")
+BACK_MATERIAL = ".HBAO back faces only"
+
+
+def is_extra(scene):
+    return EXTRA_KEY in scene.keys()
+
+
+def scene_of(helper, kind):
+    scene = helper.get(kind.helper_key) if helper is not None else None
+    return scene if isinstance(scene, bpy.types.Scene) else None
+
+
+def wanted_fraction(nodes):
+    """The widest band the tree's unmuted HBAO nodes ask for (fraction)."""
+    return max([node.guard_band / 100.0 for node in nodes if not node.mute] or [0.0])
+
+
+def _wanted(kind, nodes):
+    if kind is GUARD:
+        return wanted_fraction(nodes) > 0.0
+    return any(node.back_faces for node in nodes if not node.mute)
+
+
+def node_of(tree, kind):
+    if tree is None:
+        return None
+    for node in tree.nodes:
+        if node.bl_idname == "CompositorNodeRLayers" and node.get(kind.node_key):
+            return node
+    return None
+
+
+# --- the guard band's camera ------------------------------------------------
+
+def copy_camera(main, guard):
+    """The guard camera's settings from the scene camera's, widened. Plain
+    values only: allowed in the render job's thread."""
+    source = main.camera
+    target = guard.camera
+    if source is None or target is None or source.type != "CAMERA":
+        return
+    values = {name: getattr(source.data, name) for name in CAMERA_SETTINGS}
+    widened = guard_geometry.widened_camera(values, guard.get(SCALE_KEY, 1.0))
+    for name in CAMERA_SETTINGS:
+        set_if_different(target.data, name, widened[name])
+    set_if_different(target.data.dof, "use_dof", False)
+    for name in ("pixel_aspect_x", "pixel_aspect_y"):
+        set_if_different(guard.render, name, getattr(main.render, name))
+
+
+def _guard_camera(main, guard):
+    camera = guard.camera
+    if camera is None or camera == main.camera:
+        data = bpy.data.cameras.new(GUARD.prefix + main.name)
+        camera = bpy.data.objects.new(GUARD.prefix + main.name, data)
+        camera.constraints.new("COPY_TRANSFORMS")
+        guard.camera = camera
+    constraint = camera.constraints[0] if camera.constraints else None
+    if constraint is not None and constraint.target != main.camera:
+        constraint.target = main.camera
+    return camera
+
+
+# --- the back faces' material -------------------------------------------------
+
+def _back_material():
+    """Transparent where a ray meets a front face, opaque at a back face."""
+    material = bpy.data.materials.get(BACK_MATERIAL)
+    if material is not None:
+        return material
+    material = bpy.data.materials.new(BACK_MATERIAL)
+    material.use_nodes = True
+    nodes = material.node_tree.nodes
+    nodes.clear()
+    geometry = nodes.new("ShaderNodeNewGeometry")
+    mix = nodes.new("ShaderNodeMixShader")
+    transparent = nodes.new("ShaderNodeBsdfTransparent")
+    opaque = nodes.new("ShaderNodeBsdfDiffuse")
+    output = nodes.new("ShaderNodeOutputMaterial")
+    links = material.node_tree.links
+    links.new(geometry.outputs["Backfacing"], mix.inputs[0])
+    links.new(transparent.outputs[0], mix.inputs[1])
+    links.new(opaque.outputs[0], mix.inputs[2])
+    links.new(mix.outputs[0], output.inputs["Surface"])
+    return material
+
+
+# --- shared -------------------------------------------------------------------
+
+def _configure_render(scene, kind):
+    render = scene.render
+    set_if_different(render, "engine", "CYCLES")
+    cycles = getattr(scene, "cycles", None)
+    if cycles is not None:
+        for name, value in (("samples", 1), ("use_denoising", False),
+                            ("use_adaptive_sampling", False), ("max_bounces", 0),
+                            ("transparent_max_bounces", 64), ("filter_width", 0.01)):
+            if hasattr(cycles, name):
+                set_if_different(cycles, name, value)
+    set_if_different(render, "use_motion_blur", False)
+    settings = render.image_settings
+    if settings.file_format != "OPEN_EXR_MULTILAYER":
+        compat.set_multilayer_exr(settings)
+        settings.color_depth = "32"
+        settings.exr_codec = "NONE"
+    view_layer = scene.view_layers[0]
+    set_if_different(view_layer, "use_pass_z", True)
+    set_if_different(view_layer, "use_pass_normal", kind.wants_normal)
+    if kind is BACK:
+        if view_layer.material_override is None:
+            view_layer.material_override = _back_material()
+        set_if_different(view_layer, "pass_alpha_threshold", 0.5)
+    if not compat.HAS_COMPOSITING_NODE_GROUP and scene.use_nodes:
+        scene.use_nodes = False
+
+
+def _link_contents(main, scene, extra_objects):
+    """The artist's collections and loose objects, linked; nothing else.
+    Returns whether anything was linked or unlinked."""
+    changed = False
+    children = list(main.collection.children)
+    for collection in children:
+        if scene.collection.children.get(collection.name) != collection:
+            scene.collection.children.link(collection)
+            changed = True
+    for collection in list(scene.collection.children):
+        if collection not in children:
+            scene.collection.children.unlink(collection)
+            changed = True
+    objects = list(main.collection.objects) + extra_objects
+    for obj in objects:
+        if scene.collection.objects.get(obj.name) != obj:
+            scene.collection.objects.link(obj)
+            changed = True
+    for obj in list(scene.collection.objects):
+        if obj not in objects:
+            scene.collection.objects.unlink(obj)
+            changed = True
+    return changed
+
+
+def _mirror_exclusions(source, target):
+    """The extra scene's view layer leaves out what the node's view layer does."""
+    by_collection = {child.collection: child for child in target.children}
+    for child in source.children:
+        mirror = by_collection.get(child.collection)
+        if mirror is not None:
+            set_if_different(mirror, "exclude", child.exclude)
+            _mirror_exclusions(child, mirror)
+
+
+def remove(helper, tree, kind):
+    node = node_of(tree, kind)
+    if node is not None:
+        tree.nodes.remove(node)
+    scene = scene_of(helper, kind)
+    if scene is None:
+        return
+    camera = scene.camera if kind is GUARD else None
+    del helper[kind.helper_key]
+    bpy.data.scenes.remove(scene)
+    if camera is not None and camera.users == 0:
+        data = camera.data
+        bpy.data.objects.remove(camera)
+        if data is not None and data.users == 0:
+            bpy.data.cameras.remove(data)
+    material = bpy.data.materials.get(BACK_MATERIAL) if kind is BACK else None
+    if material is not None and material.users == 0:
+        bpy.data.materials.remove(material)
+    log(f"removed the {kind.name} render of {helper.name!r}")
+
+
+def remove_all(helper, tree):
+    for kind in KINDS:
+        remove(helper, tree, kind)
+
+
+def _sync_kind(main, tree, nodes, helper, view_layer, kind):
+    """Create or update the extra scene and node of `kind`; returns the node."""
+    scene = scene_of(helper, kind)
+    if scene is None:
+        scene = bpy.data.scenes.new(kind.prefix + main.name)
+        scene[EXTRA_KEY] = helper.name
+        helper[kind.helper_key] = scene
+        log(f"created the {kind.name} render {scene.name!r} for {main.name!r}")
+    _configure_render(scene, kind)
+    if kind is GUARD:
+        scale = guard_geometry.guard_scale(wanted_fraction(nodes))
+        if scene.get(SCALE_KEY) != scale:
+            scene[SCALE_KEY] = scale
+        extra_objects = [_guard_camera(main, scene)]
+    else:
+        if scene.camera != main.camera:
+            scene.camera = main.camera
+        extra_objects = []
+    layers = scene.view_layers[0]
+    if _link_contents(main, scene, extra_objects) or layers.layer_collection is None:
+        # 5.3 syncs a new scene's layer collections only when asked
+        compat.settle_new_scene(scene)
+    if view_layer is not None and layers.layer_collection is not None:
+        _mirror_exclusions(view_layer.layer_collection, layers.layer_collection)
+    if kind is GUARD:
+        copy_camera(main, scene)
+    node = node_of(tree, kind)
+    if node is None:
+        node = tree.nodes.new("CompositorNodeRLayers")
+        node[kind.node_key] = True
+        node.name = kind.node_name
+        node.label = f"{kind.node_name} (managed by the HBAO add-on)"
+        node.hide = True
+        node.location = (nodes[0].location.x,
+                         nodes[0].location.y - 520 - 40 * KINDS.index(kind))
+    if node.scene != scene:
+        node.scene = scene
+    for output in node.outputs:
+        set_if_different(output, "hide", True)
+    return node
+
+
+def sync(main, tree, nodes, helper, view_layer):
+    """Create, update or remove the extra renders of `helper` for `main`'s
+    HBAO nodes; `view_layer` is the one whose collections they mirror. Main
+    thread only. Returns True when the helper's managed node must be made
+    again, after theirs (render order)."""
+    extra_nodes = []
+    for kind in KINDS:
+        if main.camera is None or not _wanted(kind, nodes):
+            remove(helper, tree, kind)
+        else:
+            extra_nodes.append(_sync_kind(main, tree, nodes, helper, view_layer, kind))
+    order = list(tree.nodes)
+    managed = [n for n in order if n.bl_idname == "CompositorNodeRLayers"
+               and n.get("hbao_managed")]
+    return bool(managed) and any(order.index(managed[0]) < order.index(node)
+                                 for node in extra_nodes)
+
+
+def record_rendering(main, helper):
+    """At the start of `main`'s render (any thread): the guard camera follows
+    the scene camera's settings, which may be animated."""
+    guard = scene_of(helper, GUARD)
+    if guard is not None:
+        copy_camera(main, guard)
+
+
+def for_render(main, helper, kind):
+    """(the extra scene, None) when its render can be used for `main`'s
+    render now, else (None, why not)."""
+    scene = scene_of(helper, kind)
+    if scene is None:
+        return None, "its render is not set up yet (it is made when the setting changes)"
+    if main.render.use_border:
+        return None, "border renders have none"
+    return scene, None
