@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """Accuracy past one depth layer (issue 12): HBAO's error against Cycles' AO
-inside the frame, today, with a guard band (overscan) around the frame, and
-with a finite occluder thickness.
+inside the frame, today, with a guard band (overscan) around the frame, with
+a finite occluder thickness, and with a layer of back faces.
 
     /usr/bin/python3 bench/guard_band.py [--scenes bunny,interior] \\
         [--bands 0.125,0.25] [--thickness 0.25,0.5,1]
@@ -35,6 +35,8 @@ import run_benchmark
 import sweep
 
 DEFAULT_BANDS = (0.03125, 0.0625, 0.125, 0.25)
+# Back faces are measured alone and with this guard band.
+BACK_FACE_BANDS = (0.0, 0.0625)
 # Median of this many compute_ao calls per timing.
 TIMING_RUNS = 3
 # Threads per compute_ao call (the benchmark machine has 2 shared cores).
@@ -52,6 +54,20 @@ def overscan_jobs(mode, bands):
                         "engine": "CYCLES", "width": mode.width, "height": mode.height,
                         "samples": config.PASS_SAMPLES, "seed": 0, "threads": THREADS,
                         "passes": ["depth", "normal"], "repeats": 3, "overscan": pixels}
+    return jobs
+
+
+def back_face_jobs(mode):
+    """Depth of the back faces (every material overridden so that front faces
+    are transparent; 1 sample), without and with a guard band."""
+    jobs = {}
+    for band in BACK_FACE_BANDS:
+        pixels = int(round(band * mode.width))
+        jobs[pixels] = {"id": f"backfaces{pixels}-{mode.width}x{mode.height}-s1-seed0",
+                        "engine": "CYCLES", "width": mode.width, "height": mode.height,
+                        "samples": config.PASS_SAMPLES, "seed": 0, "threads": THREADS,
+                        "passes": ["depth"], "repeats": 3, "overscan": pixels,
+                        "back_faces": True}
     return jobs
 
 
@@ -73,16 +89,17 @@ def load(cache, job_id):
         return meta, {key: data[key] for key in data.files}
 
 
-def timed(native, depth, normal, camera, params):
+def timed(native, depth, normal, camera, params, back_depth=None):
     times, ao = [], None
     for _ in range(TIMING_RUNS):
         start = time.perf_counter()
-        ao = native.compute_ao(depth, normal, params=params, camera=camera)
+        ao = native.compute_ao(depth, normal, params=params, camera=camera,
+                               back_depth=back_depth)
         times.append(time.perf_counter() - start)
     return ao, statistics.median(times)
 
 
-def measure_scene(native, renders, scene, mode, overscans, thicknesses):
+def measure_scene(native, renders, scene, mode, overscans, thicknesses, backs):
     reference_id = run_benchmark.accuracy_jobs(mode)["reference"]["id"]
     meta, reference = load(renders / scene, reference_id)
     depth, normal, truth = reference["depth"], reference["normal"], reference["ao"]
@@ -101,7 +118,8 @@ def measure_scene(native, renders, scene, mode, overscans, thicknesses):
 
     ao, seconds = timed(native, depth, normal, camera, params)
     result = {"scene": scene, "radius": radius, "width": width, "height": height,
-              "today": dict(errors(ao), seconds=seconds), "bands": [], "thickness": []}
+              "today": dict(errors(ao), seconds=seconds), "bands": [], "thickness": [],
+              "back_faces": []}
     plain_render_s = None
     for pixels, job in sorted(overscans.items()):
         band_meta, passes = load(renders / f"{scene}-overscan", job["id"])
@@ -121,6 +139,19 @@ def measure_scene(native, renders, scene, mode, overscans, thicknesses):
             render_s=band_meta["time_s"], plain_render_s=plain_render_s,
             pixel_factor=(width + 2 * pixels) * (height + 2 * pixels) / (width * height),
             centre_matches_frame=float(np.mean(np.isclose(centre, depth, rtol=1e-6) | ~mask))))
+    for pixels, job in sorted(backs.items()):
+        back_meta, back = load(renders / f"{scene}-overscan", job["id"])
+        if pixels == 0:
+            ao, seconds = timed(native, depth, normal, camera, params, back["depth"])
+        else:
+            _meta, passes = load(renders / f"{scene}-overscan", overscans[pixels]["id"])
+            wide = native.camera_crop(camera, width, height, -pixels, -pixels,
+                                      width + 2 * pixels, height + 2 * pixels)
+            wide_ao, seconds = timed(native, passes["depth"], passes["normal"], wide, params,
+                                     back["depth"])
+            ao = wide_ao[pixels:pixels + height, pixels:pixels + width]
+        result["back_faces"].append(dict(errors(ao), band_pixels=pixels, seconds=seconds,
+                                         render_s=back_meta["time_s"]))
     for fraction in thicknesses:
         thickness = fraction * radius
         ao, seconds = timed(native, depth, normal, camera, dict(params, thickness=thickness))
@@ -144,6 +175,12 @@ def table(results):
                          f"{band['inner_rmse']:.4f} | {band['bias']:+.4f} | "
                          f"{band['seconds'] * 1e3:.1f} | {band['pixel_factor']:.2f}x | "
                          f"{band['render_s']:.2f} |")
+        for entry in result["back_faces"]:
+            band = (f" + guard band {entry['band_pixels']} px" if entry["band_pixels"]
+                    else "")
+            lines.append(f"| {result['scene']} | back faces{band} | {entry['rmse']:.4f} | "
+                         f"{entry['inner_rmse']:.4f} | {entry['bias']:+.4f} | "
+                         f"{entry['seconds'] * 1e3:.1f} | | {entry['render_s']:.2f} |")
         for entry in result["thickness"]:
             lines.append(f"| {result['scene']} | thickness {entry['thickness_per_radius']:g} "
                          f"x radius ({entry['thickness']:g}) | "
@@ -171,6 +208,9 @@ def summary(results):
             text += (f"; a guard band of {enough['band_pixels']} px "
                      f"({enough['band_fraction']:.3f} of the width, {enough['pixel_factor']:.2f}x "
                      f"the pixels) reaches {enough['rmse']:.4f} ({enough['rmse'] - today:+.4f})")
+        for entry in result["back_faces"]:
+            band = f" with a {entry['band_pixels']} px band" if entry["band_pixels"] else ""
+            text += f"; back faces{band} {entry['rmse']:.4f} ({entry['rmse'] - today:+.4f})"
         if result["thickness"]:
             best = min(result["thickness"], key=lambda entry: entry["rmse"])
             if best["rmse"] < today:
@@ -201,7 +241,11 @@ window past the display window) and cropped to the frame. *Pixels*: the render's
 the frame's, what its passes cost to render and HBAO to compute; *passes render s* is the
 1-sample Depth/Normal render (mostly Blender's fixed cost per render at this size). *Thickness*
 (hbao_params.thickness, in units of the scene's radius; no guard band): samples whose block
-[z_s, z_s + thickness] lies wholly in front of the pixel are skipped. HBAO ms: median of
+[z_s, z_s + thickness] lies wholly in front of the pixel are skipped. *Back faces*: a second
+1-sample render whose materials are all overridden by the add-on's back-face material (front
+faces transparent), whose Depth is the first back face behind each visible surface, passed to
+`hbao_compute_layers` (samples whose back lies in front of the pixel are skipped); alone, and
+with the guard band of the same width (its back faces rendered with the band). HBAO ms: median of
 {TIMING_RUNS} runs, {THREADS} threads, on shared cores (noisy).
 
 {summary(results)}
@@ -231,16 +275,19 @@ def main():
     renders = cache / "renders" / run_benchmark.scene_sources_digest()
     reference = run_benchmark.accuracy_jobs(mode)["reference"]
     overscans = overscan_jobs(mode, bands)
+    backs = back_face_jobs(mode)
     native = sweep.load_native()
     results = []
     for scene in (s for s in args.scenes.split(",") if s):
         started = time.perf_counter()
         render(run_benchmark.BENCH / "render_jobs.py", scene, [reference], renders / scene, env,
                cache / "bunny.json")
-        render(run_benchmark.BENCH / "render_overscan.py", scene, overscans.values(),
+        render(run_benchmark.BENCH / "render_overscan.py", scene,
+               list(overscans.values()) + list(backs.values()),
                renders / f"{scene}-overscan", env, cache / "bunny.json")
         run_benchmark.log(f"{scene}: renders in {time.perf_counter() - started:.0f} s")
-        results.append(measure_scene(native, renders, scene, mode, overscans, thicknesses))
+        results.append(measure_scene(native, renders, scene, mode, overscans, thicknesses,
+                                     backs))
     (cache / "guard_band.json").write_text(json.dumps(results, indent=1))
     command = "/usr/bin/python3 bench/guard_band.py " + " ".join(sys.argv[1:])
     Path(args.docs).write_text(report(results, command.strip(),

@@ -5,7 +5,9 @@ frame plus a guard band of `overscan` pixels on every side (guard_band.py).
     blender -b --factory-startup -noaudio --python bench/render_overscan.py -- \\
         --scene bunny --jobs jobs.json --cache DIR [--bunny-json FILE]
 
-The jobs are render_jobs.py's, each with an "overscan" key (pixels). The
+The jobs are render_jobs.py's, each with an "overscan" key (pixels) and
+optionally "back_faces" (true: every material overridden by the add-on's
+back-face material, so Depth holds the first back face; extra_renders.py). The
 frame grows by 2 * overscan in both directions and the camera's fitted sensor
 side (or ortho scale) grows with it, so that every pixel of the frame keeps
 its view ray: the frame is the centre of the wider render. Each job's .json
@@ -17,12 +19,21 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import render_jobs  # noqa: E402  (needs the path above)
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                                "addon"))
+
 _frame_output = render_jobs.configure_output
 
 
 def _widened_output(scene, job, scratch):
     """render_jobs.configure_output, then the frame widened by the guard band."""
     _frame_output(scene, job, scratch)
+    if job.get("back_faces"):
+        from hbao import extra_renders
+        layer = scene.view_layers[0]
+        layer.material_override = extra_renders.back_material()
+        layer.pass_alpha_threshold = 0.5
+        scene.cycles.transparent_max_bounces = 64
     band = job["overscan"]
     camera = scene.camera.data
     if band == 0:
@@ -52,6 +63,7 @@ def _run_overscan_job(scene, spec, job, cache):
         _run_job(scene, spec, job, cache)
     finally:
         camera.sensor_width, camera.ortho_scale = saved
+        scene.view_layers[0].material_override = None
 
 
 if __name__ == "__main__":

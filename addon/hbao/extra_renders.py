@@ -108,7 +108,7 @@ def _guard_camera(main, guard):
 
 # --- the back faces' material -------------------------------------------------
 
-def _back_material():
+def back_material():
     """Transparent where a ray meets a front face, opaque at a back face."""
     material = bpy.data.materials.get(BACK_MATERIAL)
     if material is not None:
@@ -153,7 +153,7 @@ def _configure_render(scene, kind):
     set_if_different(view_layer, "use_pass_normal", kind.wants_normal)
     if kind is BACK:
         if view_layer.material_override is None:
-            view_layer.material_override = _back_material()
+            view_layer.material_override = back_material()
         set_if_different(view_layer, "pass_alpha_threshold", 0.5)
     if not compat.HAS_COMPOSITING_NODE_GROUP and scene.use_nodes:
         scene.use_nodes = False
