@@ -1,9 +1,10 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
 /*
  * Fuzz target: an EXR file through the tool's whole reading path (header
- * checks, Blender pass lookup, camera from the header, Depth/Normal decode)
- * and hbao_compute. Oracle, besides the sanitizers: whenever the computation
- * succeeds, every AO value is finite and in [0, 1] (hbao.h's contract).
+ * checks, Blender pass lookup, camera from the header, Depth/Normal decode,
+ * a back-face layer) and hbao_compute_layers. Oracle, besides the
+ * sanitizers: whenever the computation succeeds, every AO value is finite
+ * and in [0, 1] (hbao.h's contract).
  */
 #include <math.h>
 #include <stdio.h>
@@ -14,11 +15,14 @@
 #include "fuzz_input_file.h"
 
 /* Small settings keep an execution short; the size of the input picks one
- * of four variants so that each of the library's paths (half resolution,
- * blur, both integrations and falloffs) gets inputs. The blur is small and
- * in two variants only: instrumented for coverage, its per-tap comparisons
- * took a third of the time. */
-static char *variants[4][20] = {
+ * of five variants so that each of the library's paths (half resolution,
+ * blur, both integrations and falloffs, a back-face layer) gets inputs. The
+ * blur is small and in two variants only: instrumented for coverage, its
+ * per-tap comparisons took a third of the time. The back-face variant reads
+ * the layers of tests/fixtures/two_layers.exr (Front, Back); other inputs
+ * take its error path. */
+#define VARIANTS 5
+static char *variants[VARIANTS][20] = {
     {"hbao", "IN", "-o", "unused.exr", "--directions", "2", "--steps", "3", "--threads", "1",
      "--blur", "0", NULL},
     {"hbao", "IN", "-o", "unused.exr", "--directions", "3", "--steps", "2", "--threads", "1",
@@ -27,12 +31,14 @@ static char *variants[4][20] = {
      "--falloff", "quadratic", "--blur", "0", "--no-normals", NULL},
     {"hbao", "IN", "-o", "unused.exr", "--directions", "2", "--steps", "2", "--threads", "1",
      "--blur", "3", "--strength", "3", "--angle-bias", "0", NULL},
+    {"hbao", "IN", "-o", "unused.exr", "--directions", "2", "--steps", "3", "--threads", "1",
+     "--blur", "0", "--layer", "Front", "--back-layer", "Back", NULL},
 };
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
-    char **argv = variants[size % 4];
+    char **argv = variants[size % VARIANTS];
     int argc = 0;
     while (argv[argc] != NULL) ++argc;
     argv[1] = (char *)fuzz_input_file(data, size);
