@@ -31,8 +31,12 @@ import numpy as np
 
 import config
 import metrics
+import report as figures
 import run_benchmark
 import sweep
+
+# The comparison images (not in docs/benchmark/, which report.py empties).
+FIGURES = run_benchmark.REPO / "docs" / "benchmark-layers"
 
 DEFAULT_BANDS = (0.03125, 0.0625, 0.125, 0.25)
 # Back faces are measured alone and with this guard band.
@@ -117,6 +121,7 @@ def measure_scene(native, renders, scene, mode, overscans, thicknesses, backs):
                 "inner_rmse": metrics.error_stats(ao, truth, mask & inner)["rmse"]}
 
     ao, seconds = timed(native, depth, normal, camera, params)
+    images = {"today": ao}
     result = {"scene": scene, "radius": radius, "width": width, "height": height,
               "today": dict(errors(ao), seconds=seconds), "bands": [], "thickness": [],
               "back_faces": []}
@@ -133,6 +138,7 @@ def measure_scene(native, renders, scene, mode, overscans, thicknesses, backs):
                                   height + 2 * pixels)
         wide_ao, seconds = timed(native, passes["depth"], passes["normal"], wide, params)
         frame_ao = wide_ao[pixels:pixels + height, pixels:pixels + width]
+        images[f"band{pixels}"] = frame_ao
         centre = passes["depth"][pixels:pixels + height, pixels:pixels + width]
         result["bands"].append(dict(
             errors(frame_ao), band_pixels=pixels, band_fraction=pixels / width, seconds=seconds,
@@ -150,8 +156,15 @@ def measure_scene(native, renders, scene, mode, overscans, thicknesses, backs):
             wide_ao, seconds = timed(native, passes["depth"], passes["normal"], wide, params,
                                      back["depth"])
             ao = wide_ao[pixels:pixels + height, pixels:pixels + width]
+        images[f"back{pixels}"] = ao
         result["back_faces"].append(dict(errors(ao), band_pixels=pixels, seconds=seconds,
                                          render_s=back_meta["time_s"]))
+    band = int(round(BACK_FACE_BANDS[-1] * width))
+    columns = [images["today"], images.get(f"band{band}"), images.get(f"back{band}")]
+    if all(column is not None for column in columns):
+        FIGURES.mkdir(parents=True, exist_ok=True)
+        figures.write_comparison(truth, mask, columns, FIGURES / f"{scene}_layers.png")
+        result["figure"] = f"benchmark-layers/{scene}_layers.png"
     for fraction in thicknesses:
         thickness = fraction * radius
         ao, seconds = timed(native, depth, normal, camera, dict(params, thickness=thickness))
@@ -222,6 +235,11 @@ def summary(results):
     return "\n".join(lines)
 
 
+def images(results):
+    return "\n\n".join(f"**{result['scene']}**\n\n![{result['scene']}]({result['figure']})"
+                       for result in results if result.get("figure"))
+
+
 def report(results, command, seconds):
     """docs/benchmark-layers.md: the table, how it was made and what it says."""
     return f"""<!-- SPDX-License-Identifier: GPL-2.0-or-later -->
@@ -251,6 +269,12 @@ with the guard band of the same width (its back faces rendered with the band). H
 {summary(results)}
 
 {table(results)}
+
+Images per scene, top row: Cycles' AO (the truth) | today | guard band of 1/16 of the width |
+back faces with that band; bottom row: each one's signed error against the truth (blue: darker,
+red: brighter, saturated at {figures.ERROR_MAP_RANGE}).
+
+{images(results)}
 """
 
 

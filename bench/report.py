@@ -134,6 +134,25 @@ def write_strip(data, ao, path):
     plt.imsave(path, (strip * 255).round().astype(np.uint8))
 
 
+def write_comparison(truth, mask, columns, path):
+    """Top row: reference | each AO of `columns`; bottom row, under each AO,
+    its signed error map (blue: darker than the reference, red: brighter)."""
+    height, width = truth.shape
+    gap_column = np.ones((height, STRIP_GAP, 3))
+    top = [_grey_rgb(truth, mask)]
+    bottom = [np.ones((height, width, 3))]
+    for ao in columns:
+        error = np.clip((ao - truth) / ERROR_MAP_RANGE, -1.0, 1.0)
+        error_rgb = plt.get_cmap("RdBu_r")((error + 1.0) / 2.0)[..., :3]
+        error_rgb[~mask] = (0.0, 0.0, 0.0)
+        top += [gap_column, _grey_rgb(ao, mask)]
+        bottom += [gap_column, error_rgb]
+    rows = [np.concatenate(top, axis=1), np.concatenate(bottom, axis=1)]
+    gap_row = np.ones((STRIP_GAP, rows[0].shape[1], 3))
+    image = np.concatenate([rows[0], gap_row, rows[1]], axis=0)
+    plt.imsave(path, (image * 255).round().astype(np.uint8))
+
+
 def _setting_table(entries):
     lines = ["| setting | ms | RMSE | MAE | bias | PSNR dB | sampling RMSE | RMSE w/o border |",
              "|---|---:|---:|---:|---:|---:|---:|---:|"]
