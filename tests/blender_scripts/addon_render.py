@@ -22,7 +22,7 @@ thickness, guard_band, back_faces, mute, connect_with_operator (left unlinked,
 then linked by the node's Connect Passes operator after the passes are
 disabled)}], disable_normal_pass, disable_depth_pass, output_format (the main
 output's file format, default OPEN_EXR_MULTILAYER), prepare [actions before
-rendering: sync, delete_helper, rename_helper, pick_internal_engine,
+rendering: sync, delete_helper, delete_extra_renders, rename_helper, pick_internal_engine,
 render_the_helper, rename_node, second_scene_shares_the_tree]. Prints OUTPUT SETTINGS {json}
 (the main output's settings after the renders) and RENDERED.
 """
@@ -143,6 +143,9 @@ for action in spec.get("prepare", []):
     elif action == "delete_helper":
         for helper in helper_scenes():
             bpy.data.scenes.remove(helper)
+    elif action == "delete_extra_renders":  # the guard band's and back faces' scenes
+        for extra in [s for s in bpy.data.scenes if s.get("hbao_guard_for")]:
+            bpy.data.scenes.remove(extra)
     elif action == "rename_helper":
         for helper in helper_scenes():
             helper.name = "Renamed by the artist"
