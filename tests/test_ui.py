@@ -109,3 +109,15 @@ def test_f12_problem_reaches_the_info_editor(run_blender, tmp_path):
     line = next(text for text in completed.stdout.splitlines() if text.startswith("INFO \""))
     reports = json.loads(line[len("INFO "):])
     assert 'HBAO node "HBAO0": Depth is not linked; AO off' in reports, reports
+
+
+def test_f12_with_guard_band_and_back_faces(run_blender, tmp_path):
+    """Set in the UI, both extra renders are built by the add-on's timer and
+    read back during an F12 render (the render job's thread)."""
+    completed = run_blender(SCRIPTS / "ui_f12_extra_renders.py", tmp_path / "f12", ui=True)
+    log = completed.stdout
+    assert "F12: DONE" in log, log[-3000:]
+    assert ".HBAO guard band Scene" in log and ".HBAO back faces Scene" in log, log[-3000:]
+    line = next(text for text in log.splitlines() if "AO pass(es)" in text)
+    assert "guard band passes" in line and "back faces passes" in line, line
+    assert "no guard band" not in log and "no back faces" not in log, log[-3000:]

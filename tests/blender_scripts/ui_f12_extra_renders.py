@@ -1,0 +1,57 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Run in a real Blender window (xvfb) by tests/test_ui.py: a node with a
+guard band and back faces, set as an artist would (the add-on's timer builds
+the extra renders), then an F12 render in the render job's thread. The
+add-on's console line names the passes it read ('guard band passes', 'back
+faces passes'); the script prints 'F12: DONE' once the job has ended.
+
+  blender --addons hbao --python ui_f12_extra_renders.py -- <out dir>
+"""
+import os
+import sys
+import time
+
+import bpy
+
+out_dir = sys.argv[sys.argv.index("--") + 1]
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(REPO, "scripts"))
+import blender_scenes  # noqa: E402
+
+RENDER_TIMEOUT_S = 120.0
+# The add-on syncs from a timer after a setting changes: far less than this.
+SYNC_WAIT_S = 1.5
+
+scene = blender_scenes.build_corner_scene(bpy.context.scene, (48, 32), "CYCLES", 1)
+node = blender_scenes.hbao_test_tree(scene, out_dir)
+node.guard_band = 10.0
+node.back_faces = True
+state = {"phase": "sync", "since": time.monotonic(), "done": False}
+
+
+def on_end(*_args):
+    state["done"] = True
+
+
+bpy.app.handlers.render_complete.append(on_end)
+
+
+def tick():
+    now = time.monotonic()
+    if state["phase"] == "sync" and now - state["since"] > SYNC_WAIT_S:
+        print("SCENES", sorted(s.name for s in bpy.data.scenes), flush=True)
+        state.update(phase="render", since=now)
+        bpy.ops.render.render("INVOKE_DEFAULT")
+    elif state["phase"] == "render":
+        if state["done"] and not bpy.app.is_job_running("RENDER"):
+            print("F12: DONE", flush=True)
+            bpy.ops.wm.quit_blender()
+            return None
+        if now - state["since"] > RENDER_TIMEOUT_S:
+            print("F12: TIMEOUT", flush=True)
+            bpy.ops.wm.quit_blender()
+            return None
+    return 0.2
+
+
+bpy.app.timers.register(tick, first_interval=0.5)
