@@ -159,29 +159,28 @@ def _configure_render(scene, kind):
         scene.use_nodes = False
 
 
+def _link_exactly(links, wanted):
+    """Link each of `wanted` into `links` (a collection's children or
+    objects) and unlink the rest; returns whether anything changed."""
+    changed = False
+    for item in wanted:
+        if links.get(item.name) != item:
+            links.link(item)
+            changed = True
+    for item in list(links):
+        if item not in wanted:
+            links.unlink(item)
+            changed = True
+    return changed
+
+
 def _link_contents(main, scene, extra_objects):
     """The artist's collections and loose objects, linked; nothing else.
     Returns whether anything was linked or unlinked."""
-    changed = False
-    children = list(main.collection.children)
-    for collection in children:
-        if scene.collection.children.get(collection.name) != collection:
-            scene.collection.children.link(collection)
-            changed = True
-    for collection in list(scene.collection.children):
-        if collection not in children:
-            scene.collection.children.unlink(collection)
-            changed = True
-    objects = list(main.collection.objects) + extra_objects
-    for obj in objects:
-        if scene.collection.objects.get(obj.name) != obj:
-            scene.collection.objects.link(obj)
-            changed = True
-    for obj in list(scene.collection.objects):
-        if obj not in objects:
-            scene.collection.objects.unlink(obj)
-            changed = True
-    return changed
+    collections = _link_exactly(scene.collection.children, list(main.collection.children))
+    objects = _link_exactly(scene.collection.objects,
+                            list(main.collection.objects) + extra_objects)
+    return collections or objects
 
 
 def _mirror_exclusions(source, target):

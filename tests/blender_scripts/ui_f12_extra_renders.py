@@ -14,26 +14,18 @@ import time
 import bpy
 
 out_dir = sys.argv[sys.argv.index("--") + 1]
-REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, os.path.join(REPO, "scripts"))
-import blender_scenes  # noqa: E402
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import f12_job  # noqa: E402
 
 RENDER_TIMEOUT_S = 120.0
 # The add-on syncs from a timer after a setting changes: far less than this.
 SYNC_WAIT_S = 1.5
 
-scene = blender_scenes.build_corner_scene(bpy.context.scene, (48, 32), "CYCLES", 1)
-node = blender_scenes.hbao_test_tree(scene, out_dir)
+scene, node = f12_job.corner_scene_with_node(out_dir)
 node.guard_band = 10.0
 node.back_faces = True
-state = {"phase": "sync", "since": time.monotonic(), "done": False}
-
-
-def on_end(*_args):
-    state["done"] = True
-
-
-bpy.app.handlers.render_complete.append(on_end)
+state = {"phase": "sync", "since": time.monotonic()}
+job = f12_job.F12Job()
 
 
 def tick():
@@ -41,9 +33,9 @@ def tick():
     if state["phase"] == "sync" and now - state["since"] > SYNC_WAIT_S:
         print("SCENES", sorted(s.name for s in bpy.data.scenes), flush=True)
         state.update(phase="render", since=now)
-        bpy.ops.render.render("INVOKE_DEFAULT")
+        job.start()
     elif state["phase"] == "render":
-        if state["done"] and not bpy.app.is_job_running("RENDER"):
+        if job.finished():
             print("F12: DONE", flush=True)
             bpy.ops.wm.quit_blender()
             return None

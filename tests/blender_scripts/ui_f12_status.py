@@ -16,48 +16,38 @@ import time
 import bpy
 
 out_dir = sys.argv[sys.argv.index("--") + 1]
-REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, os.path.join(REPO, "scripts"))
-import blender_scenes  # noqa: E402
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import f12_job  # noqa: E402
 
 RENDER_TIMEOUT_S = 240.0
 # The node shows the outcome shortly after the job ends (the add-on polls).
 STATUS_WAIT_S = 5.0
 
-scene = blender_scenes.build_corner_scene(bpy.context.scene, (48, 32), "CYCLES", 1)
-node = blender_scenes.hbao_test_tree(scene, out_dir)
+scene, node = f12_job.corner_scene_with_node(out_dir)
 tree = node.id_data
 layers = next(n for n in tree.nodes if n.bl_idname == "CompositorNodeRLayers")
-os.makedirs(out_dir, exist_ok=True)
 
 # Per render: what to do to the tree before it.
 STEPS = [lambda: None,
          lambda: tree.links.remove(node.inputs["Depth"].links[0]),
          lambda: tree.links.new(layers.outputs["Depth"], node.inputs["Depth"])]
-state = {"step": 0, "phase": "start", "since": None, "done": False}
-
-
-def on_end(*_args):
-    state["done"] = True
-
-
-bpy.app.handlers.render_complete.append(on_end)
-bpy.app.handlers.render_cancel.append(on_end)
+state = {"step": 0, "phase": "start", "since": None}
+job = f12_job.F12Job()
 
 
 def tick():
     now = time.monotonic()
     if state["phase"] == "start":
         STEPS[state["step"]]()
-        state.update(phase="render", since=now, done=False)
+        state.update(phase="render", since=now)
         print(f"F12: render {state['step']}", flush=True)
-        bpy.ops.render.render("INVOKE_DEFAULT")
+        job.start()
     elif state["phase"] == "render":
         if now - state["since"] > RENDER_TIMEOUT_S:
             print("F12: TIMEOUT", flush=True)
             bpy.ops.wm.quit_blender()
             return None
-        if state["done"] and not bpy.app.is_job_running("RENDER"):
+        if job.finished():
             state.update(phase="status", since=now)
     elif state["phase"] == "status":
         expect_message = state["step"] == 1

@@ -16,26 +16,16 @@ import time
 import bpy
 
 out_dir, shot_dir = sys.argv[sys.argv.index("--") + 1:][:2]
-REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, os.path.join(REPO, "scripts"))
-import blender_scenes  # noqa: E402
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import f12_job  # noqa: E402
 
 RENDER_TIMEOUT_S = 240.0
 SETTLE_S = 1.0
 
-scene = blender_scenes.build_corner_scene(bpy.context.scene, (48, 32), "CYCLES", 1)
-node = blender_scenes.hbao_test_tree(scene, out_dir)
+scene, node = f12_job.corner_scene_with_node(out_dir)
 node.id_data.links.remove(node.inputs["Depth"].links[0])
-os.makedirs(out_dir, exist_ok=True)
-state = {"phase": "start", "since": time.monotonic(), "done": False}
-
-
-def on_end(*_args):
-    state["done"] = True
-
-
-bpy.app.handlers.render_complete.append(on_end)
-bpy.app.handlers.render_cancel.append(on_end)
+state = {"phase": "start", "since": time.monotonic()}
+job = f12_job.F12Job()
 
 
 def info_reports():
@@ -60,13 +50,13 @@ def tick():
     now = time.monotonic()
     if state["phase"] == "start":
         state.update(phase="render", since=now)
-        bpy.ops.render.render("INVOKE_DEFAULT")
+        job.start()
     elif state["phase"] == "render":
         if now - state["since"] > RENDER_TIMEOUT_S:
             print("INFO: TIMEOUT", flush=True)
             bpy.ops.wm.quit_blender()
             return None
-        if state["done"] and not bpy.app.is_job_running("RENDER"):
+        if job.finished():
             state.update(phase="settle", since=now)
     elif state["phase"] == "settle" and now - state["since"] > SETTLE_S:
         print(f"INFO {json.dumps(info_reports())}", flush=True)

@@ -1,0 +1,44 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""F12 from a script in a real Blender window (the ui_* scripts): an
+INVOKE render runs in the render job's thread, as the F12 key's does; this
+tracks when that job has ended. Also the corner test scene with its HBAO
+tree, which those scripts render.
+
+  sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+  import f12_job
+"""
+import os
+import sys
+
+import bpy
+
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(REPO, "scripts"))
+import blender_scenes  # noqa: E402  (needs the path above)
+
+
+def corner_scene_with_node(out_dir):
+    """The small corner scene (48x32, Cycles, 1 sample) and its HBAO node,
+    whose File Output writes into out_dir."""
+    scene = blender_scenes.build_corner_scene(bpy.context.scene, (48, 32), "CYCLES", 1)
+    os.makedirs(out_dir, exist_ok=True)
+    return scene, blender_scenes.hbao_test_tree(scene, out_dir)
+
+
+class F12Job:
+    def __init__(self):
+        self.ended = False
+        bpy.app.handlers.render_complete.append(self._end)
+        bpy.app.handlers.render_cancel.append(self._end)
+
+    def _end(self, *_args):
+        self.ended = True
+
+    def start(self):
+        self.ended = False
+        bpy.ops.render.render("INVOKE_DEFAULT")
+
+    def finished(self):
+        """Whether the job started last has ended (its handlers ran and no
+        render job runs any more)."""
+        return self.ended and not bpy.app.is_job_running("RENDER")
