@@ -334,6 +334,25 @@ def test_guard_band_sees_occluders_outside_the_frame(run_in_blender, tmp_path, n
     assert np.abs(with_band - truth).mean() < np.abs(without - truth).mean()
 
 
+def test_border_render_gets_no_guard_band_and_says_so(run_in_blender, tmp_path, native):
+    """A border render (cropped) with a guard band asked for: the extra
+    render cannot be used; the AO is exactly the library's on the cropped
+    render without a band, the render's report says why and the node shows
+    it."""
+    node = {"radius": 0.8, "blur_size": 0}
+    out, log = render(run_in_blender, tmp_path, {"border": [0.25, 0.75, 0.25, 0.75],
+                                                 "nodes": [dict(node, guard_band=10.0)]})
+    assert "no guard band: border renders have none" in log, log[-3000:]
+    statuses = [json.loads(line[len("STATUS "):]) for line in log.splitlines()
+                if line.startswith("STATUS ")]
+    assert statuses == [{"node": "HBAO0", "status": "No guard band"}], statuses
+    # The border is pixels 24-72 of 96 and 16-48 of 64 (from the bottom).
+    cropped = native.camera_crop(camera(out, 1), 96, 64, 24, 64 - 48, 48, 32)
+    depth, normal = frame_passes(out, 1)
+    expected = native.compute_ao(depth, normal, params=node_params(**node), camera=cropped)
+    assert np.abs(node_outputs(out, 1)["ao"] - expected).max() <= EXACT
+
+
 def test_back_faces_give_each_occluder_its_thickness(run_in_blender, tmp_path, native):
     """Two nodes, one with Back Faces (an extra 1-sample Cycles render whose
     front faces are transparent). The back render sees the far side of the

@@ -14,8 +14,8 @@ from . import camera as camera_model
 from . import exr_passes, handover, layer_passes, native
 from .helper_lookup import ENGINE_IDNAME, is_helper, pass_names_for_helper
 from .helper_scene import rendered_for_a_scene, scene_for_render
-from .planning import plan
-from .report import log, post_render_report
+from .planning import node_names, plan
+from .report import log, post_node_messages, post_render_report
 
 # The prefix of the passes this engine fills (node.pass_name's).
 PASS_PREFIX = "HBAO "
@@ -57,6 +57,8 @@ def compute_passes(engine, depsgraph, width, height):
     for warning in extra_warnings:
         _report(engine, f"HBAO {warning}")
         log(warning)
+    if extra_warnings:  # the nodes' status lines show them with the plan's
+        post_node_messages(main.name, node_names(main), warnings + extra_warnings)
 
     results = {}
     # Esc: Blender asks through test_break(); the passes are left at 1 and

@@ -21,16 +21,18 @@ class ExtraPasses:
 
 
 def _read_kind(helper, main, kind, wanting, timings, messages):
+    """(the extra scene, {"depth": ..., "normal": ...}) of `kind`, or None
+    with a message for each job in `wanting`."""
     scene, reason = extra_renders.for_render(main, helper, kind)
     if scene is None:
         messages += [NodeMessage(job.node_name, f"no {kind.name}: {reason}",
                                  f"No {kind.name}") for job in wanting]
-        return None, None, None
+        return None
     layer = scene.view_layers[0].name
     channels, kind_timings = handover.read_passes(scene, {layer: kind.wants_normal})
     for name, seconds in kind_timings.items():
         timings[f"{kind.name} {name}"] = seconds
-    return scene, channels, layer
+    return scene, {key: channels[(key, layer)] for key, _layer in channels}
 
 
 def read(helper, main, jobs, timings):
@@ -40,17 +42,15 @@ def read(helper, main, jobs, timings):
     wanting = [job for job in jobs if job.guard_band > 0.0]
     if wanting:
         found = _read_kind(helper, main, extra_renders.GUARD, wanting, timings, messages)
-        if found[0] is not None:
-            scene, channels, layer = found
-            extra.guard_depth = channels[("depth", layer)]
-            extra.guard_normal = channels[("normal", layer)]
+        if found is not None:
+            scene, passes = found
+            extra.guard_depth, extra.guard_normal = passes["depth"], passes["normal"]
             extra.guard_scale = scene.get(extra_renders.SCALE_KEY, 1.0)
     wanting = [job for job in jobs if job.back_faces]
     if wanting:
         found = _read_kind(helper, main, extra_renders.BACK, wanting, timings, messages)
-        if found[0] is not None:
-            _scene, channels, layer = found
-            extra.back_depth = channels[("depth", layer)]
+        if found is not None:
+            extra.back_depth = found[1]["depth"]
     if extra.guard_depth is None and extra.back_depth is None:
         return None, messages
     return extra, messages

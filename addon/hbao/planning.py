@@ -67,6 +67,11 @@ def _plan_node(node, main, frame, warnings):
     return Job(node, depth_layer, normal_layer == depth_layer, params)
 
 
+def node_names(main):
+    """The names of the HBAO nodes of `main`'s compositor tree."""
+    return [node.name for node in hbao_nodes(compat.compositor_tree(main))]
+
+
 def plan(main, frame):
     """The AO computations `main` needs at `frame`: ([Job], [NodeMessage]).
     The messages are also posted for the nodes' status lines (each node of
@@ -81,5 +86,5 @@ def plan(main, frame):
         job = _plan_node(node, main, frame, warnings)
         if job is not None:
             jobs.append(job)
-    post_node_messages(main.name, [node.name for node in nodes], warnings)
+    post_node_messages(main.name, node_names(main), warnings)
     return jobs, warnings

@@ -24,7 +24,8 @@ disabled)}], disable_normal_pass, disable_depth_pass, output_format (the main
 output's file format, default OPEN_EXR_MULTILAYER), prepare [actions before
 rendering: sync, delete_helper, delete_extra_renders, rename_helper, pick_internal_engine,
 render_the_helper, rename_node, second_scene_shares_the_tree]. Prints OUTPUT SETTINGS {json}
-(the main output's settings after the renders) and RENDERED.
+(the main output's settings after the renders), STATUS {json} (each node's
+status line) and RENDERED.
 """
 import json
 import os
@@ -193,6 +194,9 @@ for frame in spec.get("frames", [1]):
         layer = back.view_layers[0].name
         channels, _timings = handover.read_passes(back, {layer: False})
         np.save(os.path.join(out_dir, f"back_{frame:04d}.npy"), channels[("depth", layer)])
+for node in tree.nodes:  # what each node's status line says after the renders
+    if node.bl_idname == "CompositorNodeHBAO":
+        print("STATUS", json.dumps({"node": node.name, "status": node.status}))
 settings = scene.render.image_settings
 print("OUTPUT SETTINGS", json.dumps({
     "file_format": settings.file_format, "color_depth": settings.color_depth,
