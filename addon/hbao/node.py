@@ -54,8 +54,8 @@ def _announce_change():
 
 
 def _settings_changed(node, _context):
-    # Nothing to rebuild: the hook reads the node at render time. Re-running
-    # the compositor shows the new result in the backdrop.
+    # Nothing to rebuild: the hook reads the node when Blender renders; the
+    # AO of an existing render is not computed again (README, Limits).
     node.id_data.update_tag()
 
 
