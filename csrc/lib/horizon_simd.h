@@ -128,8 +128,13 @@ static inline int SIMD_NAME(step_offsets)(const hbao_grid *g, float dc, float ds
     return steps;
 }
 
-/* Fills fetches[0..n) and returns n, the steps before every lane has left
- * the image. */
+/* Fills fetches[0..n) and returns n: the steps before every lane has left
+ * the image, less the steps that repeat the previous step's pixel. Where
+ * the projected radius spans fewer pixels than there are steps, steps snap
+ * to the same pixel; a repeated sample cannot raise a horizon that its
+ * first visit set (every test compares with > or reaches the same stop), so
+ * leaving it out changes no result, and the step count adapts to the
+ * projected radius. */
 static inline int SIMD_NAME(fetch_steps)(const SIMD_NAME(block) * b, int steps, float dc, float ds,
                                          VM active, SIMD_NAME(fetch) * fetches) {
     const hbao_grid *g = b->grid;
@@ -138,9 +143,10 @@ static inline int SIMD_NAME(fetch_steps)(const SIMD_NAME(block) * b, int steps, 
     const int offsets = SIMD_NAME(step_offsets)(g, dc, ds, b->inv_ycor, b->jitter, b->step_px,
                                                 steps, offset_x, offset_y);
     VM alive = active;
-    int step = 0;
-    for (; step < offsets && M_ANY(alive); step++) {
+    int fetched = 0;
+    for (int step = 0; step < offsets && M_ANY(alive); step++) {
         const int ox = offset_x[step], oy = offset_y[step];
+        if (step > 0 && ox == offset_x[step - 1] && oy == offset_y[step - 1]) continue;
         const int sj = b->j + oy;
         if (sj < 0 || sj >= g->height) break; /* every lane's sample leaves the image */
         const VI si = I_ADD(b->lane_i, I_SET(ox));
@@ -165,9 +171,9 @@ static inline int SIMD_NAME(fetch_steps)(const SIMD_NAME(block) * b, int steps, 
                 lanes[k] = first + k >= 0 && first + k < phase_width ? row[first + k] : 0.0f;
             zs = V_LOADU(lanes);
         }
-        fetches[step].zs = V_ZERO_UNLESS(candidate, zs);
-        fetches[step].in_front = M_ANDNOT(alive, alive); /* no lane */
-        if (b->job->phase_back != NULL) {                /* horizon.c's march_sample */
+        fetches[fetched].zs = V_ZERO_UNLESS(candidate, zs);
+        fetches[fetched].in_front = M_ANDNOT(alive, alive); /* no lane */
+        if (b->job->phase_back != NULL) {                   /* horizon.c's march_sample */
             const float *back = b->job->phase_back + row_start;
             VF zb;
             if (whole) {
@@ -179,13 +185,14 @@ static inline int SIMD_NAME(fetch_steps)(const SIMD_NAME(block) * b, int steps, 
                         first + k >= 0 && first + k < phase_width ? back[first + k] : INFINITY;
                 zb = V_LOADU(lanes);
             }
-            fetches[step].in_front = V_LT(zb, b->z);
+            fetches[fetched].in_front = V_LT(zb, b->z);
         }
-        fetches[step].si = si;
-        fetches[step].sj = sj;
-        fetches[step].candidate = candidate;
+        fetches[fetched].si = si;
+        fetches[fetched].sj = sj;
+        fetches[fetched].candidate = candidate;
+        fetched++;
     }
-    return step;
+    return fetched;
 }
 
 /* A fetched step's sample vector and squared length, and which lanes have a

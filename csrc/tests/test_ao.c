@@ -718,8 +718,10 @@ TEST_CASE(simd_paths_match_scalar_reference_bit_for_bit) {
     const int kernels[] = {HBAO_IMPLEMENTATION_AVX2, HBAO_IMPLEMENTATION_AVX512,
                            HBAO_IMPLEMENTATION_AUTO};
     /* Bit 4: a finite thickness (0.2, about a third of the box's height),
-     * which skips some samples in every kernel alike. */
-    for (int variant = 0; variant < 32; variant++) {
+     * which skips some samples in every kernel alike. Bit 5: 40 steps over a
+     * radius of 10 to 20 pixels, so consecutive steps snap to the same pixel
+     * (the SIMD kernels fetch such a pixel once). */
+    for (int variant = 0; variant < 64; variant++) {
         hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
         p.thickness = (variant & 16) ? 0.2f : 0.0f;
         p.integration = variant & 1;
@@ -727,8 +729,8 @@ TEST_CASE(simd_paths_match_scalar_reference_bit_for_bit) {
         p.half_resolution = (variant >> 2) & 1;
         p.angle_bias_degrees = (variant & 8) ? 0.0f : 20.0f;
         p.directions = 7;
-        p.steps = 5;
-        p.radius = 0.9f;
+        p.steps = (variant & 32) ? 40 : 5;
+        p.radius = (variant & 32) ? 0.3f : 0.9f;
         view.camera.projection =
             (variant & 8) ? HBAO_PROJECTION_ORTHOGRAPHIC : HBAO_PROJECTION_PERSPECTIVE;
         p.implementation = HBAO_IMPLEMENTATION_SCALAR;
