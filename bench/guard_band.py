@@ -262,7 +262,8 @@ the frame's, what its passes cost to render and HBAO to compute; *passes render 
 [z_s, z_s + thickness] lies wholly in front of the pixel are skipped. *Back faces*: a second
 1-sample render whose materials are all overridden by the add-on's back-face material (front
 faces transparent), whose Depth is the first back face behind each visible surface, passed to
-`hbao_compute_layers` (samples whose back lies in front of the pixel are skipped); alone, and
+`hbao_compute_layers` (an occluder covers only the angles between its front and its back point,
+at least half the radius behind; docs/algorithm.md, "Two depth layers"); alone, and
 with the guard band of the same width (its back faces rendered with the band). HBAO ms: median of
 {TIMING_RUNS} runs, {THREADS} threads, on shared cores (noisy).
 

@@ -1071,17 +1071,18 @@ def test_thickness_lets_light_pass_behind_a_thin_occluder(hbao_tool, tmp_path):
 
 
 def test_back_layer_lets_light_pass_behind_a_thin_occluder(hbao_tool, tmp_path, native):
-    """The strip before the wall again, now with a second view layer holding
-    the back faces: the strip is 0.1 thick (back depth 4.8), the wall has no
-    back face (0). With --back-layer the wall beside the strip is a bare
-    plane (AO 1 to 1e-4); the AO is exactly the library's
+    """A strip 0.7 in front of a wall, with a second view layer holding the
+    back faces: the strip is 0.1 thick (back depth 4.4; the library takes
+    it as at least half the radius thick, to 4.7), the wall has no back face
+    (0). With --back-layer light passes between strip and wall, so the wall
+    beside the strip gets lighter, and the AO is exactly the library's
     (hbao_compute_layers through the binding); the back layer must differ
     from the front one, and a missing one is an error."""
     from hbao import exr_passes
     width, height = 96, 64
     depth = np.full((height, width), 5.0, np.float32)
-    depth[:, 40:56] = 4.7
-    back = np.where(depth < 5.0, np.float32(4.8), np.float32(0.0)).astype(np.float32)
+    depth[:, 40:56] = 4.3
+    back = np.where(depth < 5.0, np.float32(4.4), np.float32(0.0)).astype(np.float32)
     source = tmp_path / "strip_layers.exr"
     layers = {"Front.Depth.Z": depth, "BackFaces.Depth.Z": back}
     source.write_bytes(scanline_exr(layers, width, height))
@@ -1092,8 +1093,11 @@ def test_back_layer_lets_light_pass_behind_a_thin_occluder(hbao_tool, tmp_path, 
         run_ok(hbao_tool, source, "-o", output, *flags, *extra)
         ao[name] = exr_passes.read_channels(output, ["AO"])["AO"]
     wall = depth == 5.0
+    print("darkest wall pixel: %.4f without the back layer, %.4f with it"
+          % (ao["front"][wall].min(), ao["layers"][wall].min()))
     assert ao["front"][wall].min() < 0.9
-    assert ao["layers"][wall].min() == pytest.approx(1.0, abs=1e-4)
+    assert ao["layers"][wall].min() > ao["front"][wall].min() + 0.05
+    assert (ao["layers"] - ao["front"]).min() > -0.02  # the sectors' rounding at most
     params = {"radius": 0.8, "blur_size": 0, "threads": 1}
     expected = native.compute_ao(depth, None, params=params, back_depth=back)
     assert np.array_equal(ao["layers"], expected)

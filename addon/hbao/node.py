@@ -88,8 +88,8 @@ class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
     back_faces: BoolProperty(
         name="Back Faces", default=False, update=_extra_render_changed,
         description="Thickness from an extra Cycles render of the back faces (1 sample, Depth "
-                    "only): an object lying wholly in front of a surface no longer darkens it "
-                    "(the halo around foreground objects)")
+                    "only): light passes between an object and the surface behind it, which "
+                    "removes the dark halo around foreground objects")
     blur_sharpness: FloatProperty(
         name="Blur Sharpness", default=_D["blur_sharpness"], min=0.0,
         max=parameters.MAX_BLUR_SHARPNESS, soft_max=64.0,

@@ -393,15 +393,18 @@ HBAO_EXPORT hbao_result hbao_compute(const hbao_params *params, const hbao_camer
  *                    front faces are transparent, e.g. a view layer with a
  *                    material override, 1 sample, Depth only); NULL (or
  *                    data NULL) = hbao_compute(). A surface seen at a sample
- *                    then occupies [depth, back depth] along its view ray,
- *                    and a sample whose back depth is nearer than the pixel
- *                    (the occluder lies wholly in front of it) does not
- *                    raise the pixel's horizon: light passes behind it.
- *                    Where no back face is known (0, not finite, not behind
- *                    the visible surface, or at or beyond background_depth)
- *                    the surface is infinitely thick, as without the layer.
- *                    params.thickness still applies: a sample is skipped
- *                    when either rule says so.
+ *                    then occupies [depth, back depth] along its view ray
+ *                    (at least half the radius deep), and it occludes only
+ *                    the angles between its front and its back point, so
+ *                    light passes between a floating object and the
+ *                    surface behind it. Each direction keeps a mask of 32
+ *                    sectors for this (docs/algorithm.md, "Two depth
+ *                    layers"). Where no back face is known (0, not finite,
+ *                    not behind the visible surface, or at or beyond
+ *                    background_depth) the surface is infinitely thick; a
+ *                    layer with no back face known anywhere gives exactly
+ *                    hbao_compute()'s result. params.thickness still
+ *                    applies: it skips samples as without the layer.
  */
 HBAO_EXPORT hbao_result hbao_compute_layers(const hbao_params *params, const hbao_camera *camera,
                                             int32_t width, int32_t height,

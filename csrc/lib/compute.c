@@ -108,6 +108,12 @@ static void half_back_row(void *context, int j) {
     for (int i = 0; i < job->width; i++) out[i] = source[2 * i];
 }
 
+static int any_finite(const float *values, size_t count) {
+    for (size_t k = 0; k < count; k++)
+        if (values[k] < INFINITY) return 1;
+    return 0;
+}
+
 static void fill_ones(float *ao, int64_t row_stride, int width, int height) {
     for (int j = 0; j < height; j++) {
         float *row = ao + (int64_t)j * row_stride;
@@ -195,6 +201,10 @@ hbao_result hbao_compute_layers(const hbao_params *params, const hbao_camera *ca
         grid.depth = full_depth;
         grid.back = full_back;
     }
+    /* A layer with no back face known anywhere is no layer: the result is
+     * hbao_compute()'s, exactly, not its sector-quantised twin. */
+    if (grid.back != NULL && !any_finite(grid.back, (size_t)grid.width * grid.height))
+        grid.back = NULL;
     hbao_compute_normals(&s, camera, &grid, normal, scale);
 
     hbao_compute_horizons(&s, &grid, grid_ao);

@@ -3,6 +3,7 @@
  * jittered steps inside the projected radius and integrate the occlusion of
  * the highest horizon found, per docs/algorithm.md. */
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 
 #include "internal_hbao.h"
@@ -33,13 +34,14 @@ typedef struct march {
     /* Samples nearer than this depth are occluders of finite thickness
      * wholly in front of the pixel: skipped (hbao_near_limit). */
     float near_limit;
-    float z; /* the pixel's depth: a sample whose back face is nearer is skipped */
+    float min_thickness; /* the back layer: HBAO_MIN_BACK_THICKNESS radii */
 } march;
 
 enum { SAMPLE_END = -1, SAMPLE_SKIP = 0, SAMPLE_OK = 1 };
 
-/* The vector to the sample of a step and its squared length. */
-static inline int march_sample(const march *m, int step, float delta[3], float *dist2) {
+/* The vector to the sample of a step and its squared length; *at receives
+ * the sample's index in the grid. */
+static inline int march_sample(const march *m, int step, float delta[3], float *dist2, size_t *at) {
     const hbao_grid *g = m->grid;
     int ox, oy;
     if (!hbao_step_offset(g, m->dc, m->ds, m->inv_ycor, m->jitter, m->step_px, step, &ox, &oy))
@@ -47,10 +49,9 @@ static inline int march_sample(const march *m, int step, float delta[3], float *
     const int si = m->i + ox, sj = m->j + oy;
     if (si < 0 || sj < 0 || si >= g->width || sj >= g->height) return SAMPLE_END;
     if (ox == 0 && oy == 0) return SAMPLE_SKIP;
-    const float zs = g->depth[(size_t)sj * g->width + si];
+    *at = (size_t)sj * g->width + si;
+    const float zs = g->depth[*at];
     if (zs <= 0.0f || zs < m->near_limit) return SAMPLE_SKIP;
-    /* the back layer: an occluder wholly in front of the pixel */
-    if (g->back != NULL && g->back[(size_t)sj * g->width + si] < m->z) return SAMPLE_SKIP;
     float q[3];
     hbao_grid_position(g, si, sj, zs, q);
     delta[0] = q[0] - m->p[0];
@@ -125,7 +126,8 @@ static float direction_occlusion_hbao(const hbao_settings *s, const march *m, co
     float occlusion = 0.0f;
     for (int step = 0; step < s->steps; step++) {
         float delta[3], dist2;
-        const int status = march_sample(m, step, delta, &dist2);
+        size_t at;
+        const int status = march_sample(m, step, delta, &dist2, &at);
         if (status == SAMPLE_END) break;
         if (status == SAMPLE_SKIP) continue;
         const float inv_dist = 1.0f / sqrtf(dist2);
@@ -214,7 +216,8 @@ static float direction_occlusion_cosine(const hbao_settings *s, const march *m, 
 
     for (int step = 0; step < s->steps; step++) {
         float delta[3], dist2;
-        const int status = march_sample(m, step, delta, &dist2);
+        size_t at;
+        const int status = march_sample(m, step, delta, &dist2, &at);
         if (status == SAMPLE_END) break;
         if (status == SAMPLE_SKIP) continue;
         const float inv_dist = 1.0f / sqrtf(dist2);
@@ -251,6 +254,157 @@ static float direction_occlusion_cosine(const hbao_settings *s, const march *m, 
     return occlusion;
 }
 
+/* --- Two depth layers: sector masks ------------------------------------
+ * With the back faces known (grid->back), an occluder covers only the
+ * angles between its front point and its back point (the point behind it
+ * on the same view ray), as in Bavoil & Sainz's multi-layer SSAO: light
+ * passes below a floating occluder, between it and the surface. A horizon
+ * (everything below the highest sample is dark) cannot hold such a gap, so
+ * each direction keeps a mask of HBAO_SECTORS sectors of equal weight, as
+ * visibility bitmasks do: equal visibility (cosine integration) or equal
+ * rise of the elevation's sine (HBAO), from the top of the direction's
+ * range down to its bias-lowered tangent plane. A sample marks the sectors
+ * whose centres its interval covers; where its back is unknown, the
+ * interval reaches the tangent plane, the one-layer rule at the sectors'
+ * resolution. An occluder is taken as at least HBAO_MIN_BACK_THICKNESS
+ * radii thick: steps sample a thin occluder (a shelf, a table top) at a few
+ * points, and between their thin intervals light would leak through it.
+ * With quadratic falloff, each newly marked sector costs the attenuation
+ * of the sample that marked it. */
+/* The sectors whose centres lie in [lo, hi], fractions of the range (from
+ * its top); NaN counts as 0. */
+static inline uint32_t sector_bits(float lo, float hi) {
+    const float n = (float)HBAO_SECTORS;
+    const float first = ceilf(fminf(fmaxf(lo, 0.0f), 1.0f) * n - 0.5f);
+    const float end = floorf(fminf(fmaxf(hi, 0.0f), 1.0f) * n - 0.5f) + 1.0f;
+    if (!(end > first)) return 0u;
+    const int a = (int)first, b = (int)end; /* 0 <= a < b <= 32 */
+    const uint32_t below_end = b >= 32 ? 0xffffffffu : (1u << b) - 1u;
+    return below_end & ~((1u << a) - 1u);
+}
+
+/* Marks the sectors between fractions a and b (either order) in *marked:
+ * the count of newly marked ones, times the sample's weight. */
+static inline float mark_sectors(uint32_t *marked, float a, float b, float weight) {
+    const uint32_t fresh = sector_bits(fminf(a, b), fmaxf(a, b)) & ~*marked;
+    if (fresh == 0u) return 0.0f;
+    *marked |= fresh;
+    return weight * (float)__builtin_popcount(fresh);
+}
+
+/* The fraction of the cosine-weighted range [0, T_bias] of visibility
+ * lying above (nearer V than) the point at delta. */
+static inline float sector_fraction_cosine(const march *m, const slice *sl, const float n[3],
+                                           const float v[3], const float delta[3], float dist2,
+                                           float gamma, int check_past_normal, float sin_bias,
+                                           float inv_bias) {
+    const float inv_dist = 1.0f / sqrtf(dist2);
+    const float sin_s = sample_elevation(m, n, delta, inv_dist);
+    float h, cos_h, sin_h;
+    if (check_past_normal && past_the_normal(m, sl, v, delta, inv_dist, sin_s)) {
+        float cos_v = (delta[0] * v[0] + delta[1] * v[1] + delta[2] * v[2]) * inv_dist;
+        cos_v = cos_v > 1.0f ? 1.0f : cos_v;
+        horizon_state(1, cos_v, 0.0f, gamma, sl, &h, &cos_h, &sin_h);
+    } else {
+        /* below the bias the visibility integral turns back: the end */
+        float elevation = sin_s * sl->inv_np;
+        if (!(elevation > sin_bias)) return 1.0f;
+        elevation = elevation > 1.0f ? 1.0f : elevation;
+        horizon_state(0, 0.0f, elevation, gamma, sl, &h, &cos_h, &sin_h);
+    }
+    return half_slice_visibility(h, cos_h, sin_h, sl) * inv_bias;
+}
+
+/* A sample's back point, where its back face is known: the view ray
+ * through the sample's pixel (grid index at) at its back depth, as a vector
+ * from the pixel and its squared length. Returns 0 where unknown. */
+static inline int back_point(const march *m, size_t at, float delta[3], float *dist2) {
+    const hbao_grid *g = m->grid;
+    if (!(g->back[at] < INFINITY)) return 0;
+    float q[3];
+    hbao_grid_position(g, (int)(at % (size_t)g->width), (int)(at / (size_t)g->width),
+                       hbao_back_depth(g, at, m->min_thickness), q);
+    delta[0] = q[0] - m->p[0];
+    delta[1] = q[1] - m->p[1];
+    delta[2] = q[2] - m->p[2];
+    *dist2 = delta[0] * delta[0] + delta[1] * delta[1] + delta[2] * delta[2];
+    return *dist2 > 0.0f;
+}
+
+/* direction_occlusion_cosine with the back layer. */
+static float direction_occlusion_cosine_layers(const hbao_settings *s, const march *m,
+                                               const float n[3], const float v[3], const slice *sl,
+                                               float *open_part) {
+    const float gamma = HALF_PI - hbao_acos(sl->sin_gamma);
+    *open_part = 0.25f * (2.0f * sl->cos_gamma + (2.0f * gamma + HBAO_PI) * sl->sin_gamma);
+    const int check_past_normal = sl->sin_gamma > 0.0f;
+    const int quadratic = s->falloff == HBAO_FALLOFF_QUADRATIC;
+    const float inv_radius2 = 1.0f / m->radius2;
+    float h, cos_h, sin_h;
+    horizon_from_elevation(s->sin_bias, gamma, sl, &h, &cos_h, &sin_h);
+    const float visibility_bias = half_slice_visibility(h, cos_h, sin_h, sl);
+    if (!(visibility_bias > 0.0f)) return 0.0f;
+    const float inv_bias = 1.0f / visibility_bias;
+    uint32_t marked = 0u;
+    float occlusion = 0.0f; /* in sectors */
+    for (int step = 0; step < s->steps; step++) {
+        float delta[3], dist2;
+        size_t at;
+        const int status = march_sample(m, step, delta, &dist2, &at);
+        if (status == SAMPLE_END) break;
+        if (status == SAMPLE_SKIP) continue;
+        const float front = sector_fraction_cosine(m, sl, n, v, delta, dist2, gamma,
+                                                   check_past_normal, s->sin_bias, inv_bias);
+        float delta_back[3], dist2_back;
+        const float behind =
+            back_point(m, at, delta_back, &dist2_back)
+                ? sector_fraction_cosine(m, sl, n, v, delta_back, dist2_back, gamma,
+                                         check_past_normal, s->sin_bias, inv_bias)
+                : 1.0f;
+        occlusion +=
+            mark_sectors(&marked, front, behind, quadratic ? 1.0f - dist2 * inv_radius2 : 1.0f);
+    }
+    return occlusion * (visibility_bias / (float)HBAO_SECTORS);
+}
+
+/* direction_occlusion_hbao with the back layer: sectors of equal rise of the
+ * elevation's sine, from 1 down to the bias. */
+static float direction_occlusion_hbao_layers(const hbao_settings *s, const march *m,
+                                             const float n[3], const float v[3], const slice *sl) {
+    const int quadratic = s->falloff == HBAO_FALLOFF_QUADRATIC;
+    const float inv_radius2 = 1.0f / m->radius2;
+    const float range = 1.0f - s->sin_bias;
+    const float inv_range = 1.0f / range;
+    const float half_occluded = 0.5f * range;
+    const int check_past_normal = sl->usable && sl->sin_gamma > 0.0f;
+    uint32_t marked = 0u;
+    float occlusion = 0.0f; /* in sectors */
+    float past = 0.0f;
+    for (int step = 0; step < s->steps; step++) {
+        float delta[3], dist2;
+        size_t at;
+        const int status = march_sample(m, step, delta, &dist2, &at);
+        if (status == SAMPLE_END) break;
+        if (status == SAMPLE_SKIP) continue;
+        const float inv_dist = 1.0f / sqrtf(dist2);
+        const float sin_s = sample_elevation(m, n, delta, inv_dist);
+        if (check_past_normal && past_the_normal(m, sl, v, delta, inv_dist, sin_s)) {
+            past = half_occluded;
+            break;
+        }
+        const float front = (1.0f - sin_s) * inv_range;
+        float delta_back[3], dist2_back;
+        const float behind =
+            back_point(m, at, delta_back, &dist2_back)
+                ? (1.0f - sample_elevation(m, n, delta_back, 1.0f / sqrtf(dist2_back))) * inv_range
+                : 1.0f;
+        occlusion +=
+            mark_sectors(&marked, front, behind, quadratic ? 1.0f - dist2 * inv_radius2 : 1.0f);
+    }
+    occlusion *= range / (float)HBAO_SECTORS;
+    return occlusion > past ? occlusion : past;
+}
+
 float hbao_horizon_pixel(const horizon_job *job, int i, int j, float step_px) {
     const hbao_settings *s = job->settings;
     const hbao_grid *g = job->grid;
@@ -280,8 +434,9 @@ float hbao_horizon_pixel(const horizon_job *job, int i, int j, float step_px) {
     m.n_dot_v = n[0] * v[0] + n[1] * v[1] + n[2] * v[2];
     m.height_tolerance = g->depth_precision * hbao_rounding_along_normal(g, n, m.p);
     m.near_limit = hbao_near_limit(s, z);
-    m.z = z;
+    m.min_thickness = HBAO_MIN_BACK_THICKNESS * s->radius;
     const int cosine = s->integration == HBAO_INTEGRATION_COSINE;
+    const int layers = g->back != NULL;
 
     float occlusion_sum = 0.0f;                /* HBAO */
     float visible_sum = 0.0f, open_sum = 0.0f; /* COSINE */
@@ -293,11 +448,14 @@ float hbao_horizon_pixel(const horizon_job *job, int i, int j, float step_px) {
         if (cosine) {
             if (!sl.usable) continue; /* weight |np| = 0 */
             float open;
-            const float occlusion = direction_occlusion_cosine(s, &m, n, v, &sl, &open);
+            const float occlusion = layers
+                                        ? direction_occlusion_cosine_layers(s, &m, n, v, &sl, &open)
+                                        : direction_occlusion_cosine(s, &m, n, v, &sl, &open);
             visible_sum += sl.np_length * (open - occlusion);
             open_sum += sl.np_length * open;
         } else {
-            occlusion_sum += direction_occlusion_hbao(s, &m, n, v, &sl);
+            occlusion_sum += layers ? direction_occlusion_hbao_layers(s, &m, n, v, &sl)
+                                    : direction_occlusion_hbao(s, &m, n, v, &sl);
         }
     }
 

@@ -42,6 +42,17 @@
 #define I_STOREU(p, v) _mm256_storeu_si256((__m256i *)(p), (v))
 #define M_BITS(m) _mm256_movemask_ps(m)
 
+#define V_MIN _mm256_min_ps
+#define V_CEIL(a) _mm256_round_ps((a), _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC)
+#define V_FLOOR(a) _mm256_round_ps((a), _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC)
+#define I_SUB _mm256_sub_epi32
+#define I_AND _mm256_and_si256
+#define I_OR _mm256_or_si256
+#define I_ANDNOT _mm256_andnot_si256
+#define I_SLLV _mm256_sllv_epi32
+#define I_SRLI _mm256_srli_epi32
+#define I_ZERO_UNLESS(m, v) _mm256_castps_si256(_mm256_and_ps((m), _mm256_castsi256_ps(v)))
+
 #include "horizon_simd.h"
 
 int hbao_horizon_avx2_available(void) {

@@ -44,6 +44,17 @@
 #define I_STOREU(p, v) _mm512_storeu_si512((void *)(p), (v))
 #define M_BITS(m) ((int)(m))
 
+#define V_MIN _mm512_min_ps
+#define V_CEIL(a) _mm512_roundscale_ps((a), _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC)
+#define V_FLOOR(a) _mm512_roundscale_ps((a), _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC)
+#define I_SUB _mm512_sub_epi32
+#define I_AND _mm512_and_si512
+#define I_OR _mm512_or_si512
+#define I_ANDNOT _mm512_andnot_si512
+#define I_SLLV _mm512_sllv_epi32
+#define I_SRLI _mm512_srli_epi32
+#define I_ZERO_UNLESS(m, v) _mm512_maskz_mov_epi32((m), (v))
+
 #include "horizon_simd.h"
 
 int hbao_horizon_avx512_available(void) {

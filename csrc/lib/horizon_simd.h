@@ -13,7 +13,9 @@
  * M_ANDNOT(a, b) = ~a & b, M_ANY; V_SELECT(m, a, b) = m ? b : a;
  * V_ZERO_UNLESS(m, v); I_SET I_ADD I_MULLO I_LANES (0, 1, ...) I_TO_F; V_CVTT
  * (truncating float -> int32); I_STOREU; M_BITS(m) (lane k -> bit k);
- * SIMD_NAME(x) gives the instance's function names. */
+ * for the back layer's sector masks: V_MIN V_CEIL V_FLOOR, I_SUB I_AND I_OR
+ * I_ANDNOT(a, b) = ~a & b, I_SLLV (per-lane shift, 0 from 32 on) I_SRLI,
+ * I_ZERO_UNLESS(m, v); SIMD_NAME(x) gives the instance's function names. */
 
 static inline VF SIMD_NAME(dot3)(VF a0, VF a1, VF a2, VF b0, VF b1, VF b2) {
     return V_ADD(V_ADD(V_MUL(a0, b0), V_MUL(a1, b1)), V_MUL(a2, b2));
@@ -81,7 +83,7 @@ typedef struct SIMD_NAME(block) {
     VF p[3], v[3], n[3];
     VF radius2, inv_radius2;
     VF height_tolerance, n_dot_v, near_limit; /* as in horizon.c's march */
-    VF z;                                     /* the lanes' depths */
+    VF min_thickness;                         /* the back layer's, as in march */
 } SIMD_NAME(block);
 
 /* The depth fetches of a direction's steps. They depend only on the steps'
@@ -90,7 +92,7 @@ typedef struct SIMD_NAME(block) {
  * one contiguous load from the phase_depth row of the lanes' new phase. */
 typedef struct SIMD_NAME(fetch) {
     VF zs;
-    VM in_front;  /* the back layer: the sample's occluder lies wholly in front */
+    VF zb;        /* the back layer's depth there (INFINITY: unknown) */
     VI si;        /* the samples' columns */
     int sj;       /* and their row, the same for all lanes */
     VM candidate; /* inside the image, on another pixel */
@@ -172,8 +174,7 @@ static inline int SIMD_NAME(fetch_steps)(const SIMD_NAME(block) * b, int steps, 
             zs = V_LOADU(lanes);
         }
         fetches[fetched].zs = V_ZERO_UNLESS(candidate, zs);
-        fetches[fetched].in_front = M_ANDNOT(alive, alive); /* no lane */
-        if (b->job->phase_back != NULL) {                   /* horizon.c's march_sample */
+        if (b->job->phase_back != NULL) {
             const float *back = b->job->phase_back + row_start;
             VF zb;
             if (whole) {
@@ -185,7 +186,7 @@ static inline int SIMD_NAME(fetch_steps)(const SIMD_NAME(block) * b, int steps, 
                         first + k >= 0 && first + k < phase_width ? back[first + k] : INFINITY;
                 zb = V_LOADU(lanes);
             }
-            fetches[fetched].in_front = V_LT(zb, b->z);
+            fetches[fetched].zb = zb;
         }
         fetches[fetched].si = si;
         fetches[fetched].sj = sj;
@@ -202,8 +203,7 @@ static inline VM SIMD_NAME(sample)(const SIMD_NAME(block) * b, const SIMD_NAME(f
     const hbao_grid *g = b->grid;
     const VF zs = f->zs;
     const VM valid =
-        M_ANDNOT(f->in_front, M_AND(M_AND(f->candidate, live),
-                                    M_AND(V_GT(zs, V_SET(0.0f)), V_GE(zs, b->near_limit))));
+        M_AND(M_AND(f->candidate, live), M_AND(V_GT(zs, V_SET(0.0f)), V_GE(zs, b->near_limit)));
     const VF column = V_MUL(V_ADD(I_TO_F(f->si), V_SET(g->x_offset)), V_SET(g->x_step));
     const VF row = V_SET(hbao_grid_y(g, f->sj));
     const VF q0 = g->orthographic ? column : V_MUL(column, zs);
@@ -363,6 +363,170 @@ static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SI
     return occlusion;
 }
 
+/* --- The back layer: sector masks (horizon.c, "Two depth layers") --- */
+
+/* sector_bits, lane by lane: the same clamps and roundings; a shift by 32
+ * gives 0, so an empty interval needs no test. */
+static inline VI SIMD_NAME(sector_bits)(VF lo, VF hi) {
+    const VF n = V_SET((float)HBAO_SECTORS);
+    const VF first = V_CEIL(V_SUB(V_MUL(V_MIN(V_MAX0(lo), V_SET(1.0f)), n), V_SET(0.5f)));
+    const VF end =
+        V_ADD(V_FLOOR(V_SUB(V_MUL(V_MIN(V_MAX0(hi), V_SET(1.0f)), n), V_SET(0.5f))), V_SET(1.0f));
+    const VI one = I_SET(1);
+    const VI below_end = I_SUB(I_SLLV(one, V_CVTT(end)), one);
+    const VI below_first = I_SUB(I_SLLV(one, V_CVTT(first)), one);
+    return I_ANDNOT(below_first, below_end);
+}
+
+static inline VI SIMD_NAME(popcount)(VI x) {
+    x = I_SUB(x, I_AND(I_SRLI(x, 1), I_SET(0x55555555)));
+    x = I_ADD(I_AND(x, I_SET(0x33333333)), I_AND(I_SRLI(x, 2), I_SET(0x33333333)));
+    x = I_AND(I_ADD(x, I_SRLI(x, 4)), I_SET(0x0f0f0f0f));
+    return I_SRLI(I_MULLO(x, I_SET(0x01010101)), 24);
+}
+
+/* horizon.c's mark_sectors, in the lanes of ok: occlusion plus the newly
+ * marked sectors times weight. */
+static inline VF SIMD_NAME(mark_sectors)(VI *marked, VM ok, VF a, VF b, VF weight, VF occlusion) {
+    const VI fresh = I_ZERO_UNLESS(
+        ok, I_ANDNOT(*marked, SIMD_NAME(sector_bits)(V_MIN(a, b), V_SELECT(V_GT(a, b), b, a))));
+    *marked = I_OR(*marked, fresh);
+    return V_SELECT(ok, occlusion,
+                    V_ADD(occlusion, V_MUL(weight, I_TO_F(SIMD_NAME(popcount)(fresh)))));
+}
+
+/* The back point of a fetched step: the view ray through each lane's sample
+ * pixel at the back depth (made at least min_thickness thick); *known:
+ * lanes whose back is known. Returns the squared length of delta. */
+static inline VF SIMD_NAME(back_point)(const SIMD_NAME(block) * b, const SIMD_NAME(fetch) * f,
+                                       VF delta[3], VM *known) {
+    const hbao_grid *g = b->grid;
+    const VF thinnest = V_ADD(f->zs, b->min_thickness);
+    const VF zb = V_SELECT(V_GT(f->zb, thinnest), thinnest, f->zb);
+    *known = V_LT(f->zb, V_SET(INFINITY));
+    const VF column = V_MUL(V_ADD(I_TO_F(f->si), V_SET(g->x_offset)), V_SET(g->x_step));
+    const VF row = V_SET(hbao_grid_y(g, f->sj));
+    delta[0] = V_SUB(g->orthographic ? column : V_MUL(column, zb), b->p[0]);
+    delta[1] = V_SUB(g->orthographic ? row : V_MUL(row, zb), b->p[1]);
+    delta[2] = V_SUB(V_NEG(zb), b->p[2]);
+    return SIMD_NAME(dot3)(delta[0], delta[1], delta[2], delta[0], delta[1], delta[2]);
+}
+
+/* horizon.c's sector_fraction_cosine */
+static inline VF SIMD_NAME(sector_fraction_cosine)(const SIMD_NAME(block) * b,
+                                                   const SIMD_NAME(slice) * sl, const VF delta[3],
+                                                   VF dist2, VF gamma, VM check_past_normal,
+                                                   int any_check, VF sin_bias, VF inv_bias) {
+    const VF inv_dist = V_DIV(V_SET(1.0f), V_SQRT(dist2));
+    const VF sin_s = SIMD_NAME(sample_elevation)(b, delta, inv_dist);
+    VM past = V_LT(sin_bias, sin_bias); /* no lane */
+    VF cos_v = V_SET(1.0f);
+    if (any_check) {
+        const VM steep = M_AND(check_past_normal, V_GT(sin_s, b->n_dot_v));
+        if (M_ANY(steep)) {
+            cos_v = SIMD_NAME(cos_to_view)(b, delta, inv_dist);
+            past = M_AND(steep, V_GT(cos_v, sl->cos_gamma));
+            cos_v = V_SELECT(V_GT(cos_v, V_SET(1.0f)), cos_v, V_SET(1.0f));
+        }
+    }
+    VF elevation = V_MUL(sin_s, sl->inv_np);
+    const VM above = V_GT(elevation, sin_bias);
+    elevation = V_SELECT(V_GT(elevation, V_SET(1.0f)), elevation, V_SET(1.0f));
+    const VF fraction =
+        V_MUL(SIMD_NAME(horizon_visibility)(past, cos_v, elevation, gamma, sl), inv_bias);
+    return V_SELECT(M_OR(past, above), V_SET(1.0f), fraction);
+}
+
+static VF SIMD_NAME(direction_occlusion_cosine_layers)(const hbao_settings *s,
+                                                       const SIMD_NAME(block) * b, VM active,
+                                                       float dc, float ds,
+                                                       const SIMD_NAME(slice) * sl, VF *open_part) {
+    const VF gamma = V_SUB(V_SET(0.5f * HBAO_PI), SIMD_NAME(acos)(sl->sin_gamma));
+    *open_part =
+        V_MUL(V_SET(0.25f),
+              V_ADD(V_MUL(V_SET(2.0f), sl->cos_gamma),
+                    V_MUL(V_ADD(V_MUL(V_SET(2.0f), gamma), V_SET(HBAO_PI)), sl->sin_gamma)));
+    const VM check_past_normal = V_GT(sl->sin_gamma, V_SET(0.0f));
+    const int any_check = M_ANY(M_AND(check_past_normal, active));
+    const int quadratic = s->falloff == HBAO_FALLOFF_QUADRATIC;
+    const VF sin_bias = V_SET(s->sin_bias);
+    const VF visibility_bias =
+        SIMD_NAME(horizon_visibility)(V_LT(sin_bias, sin_bias), sl->cos_gamma, sin_bias, gamma, sl);
+    const VM lanes = M_AND(active, V_GT(visibility_bias, V_SET(0.0f)));
+    const VF inv_bias = V_DIV(V_SET(1.0f), visibility_bias);
+    VI marked = I_SET(0);
+    VF occlusion = V_SET(0.0f); /* in sectors */
+    SIMD_NAME(fetch) fetches[HBAO_MAX_STEPS];
+    const int fetched = SIMD_NAME(fetch_steps)(b, s->steps, dc, ds, lanes, fetches);
+    for (int step = 0; step < fetched; step++) {
+        VF delta[3], dist2;
+        const VM ok = SIMD_NAME(sample)(b, &fetches[step], lanes, delta, &dist2);
+        if (!M_ANY(ok)) continue;
+        const VF front = SIMD_NAME(sector_fraction_cosine)(
+            b, sl, delta, dist2, gamma, check_past_normal, any_check, sin_bias, inv_bias);
+        VF delta_back[3];
+        VM known;
+        const VF dist2_back = SIMD_NAME(back_point)(b, &fetches[step], delta_back, &known);
+        const VF behind = V_SELECT(
+            M_AND(known, V_GT(dist2_back, V_SET(0.0f))), V_SET(1.0f),
+            SIMD_NAME(sector_fraction_cosine)(b, sl, delta_back, dist2_back, gamma,
+                                              check_past_normal, any_check, sin_bias, inv_bias));
+        occlusion = SIMD_NAME(mark_sectors)(
+            &marked, ok, front, behind,
+            quadratic ? V_SUB(V_SET(1.0f), V_MUL(dist2, b->inv_radius2)) : V_SET(1.0f), occlusion);
+    }
+    return V_ZERO_UNLESS(lanes,
+                         V_MUL(occlusion, V_DIV(visibility_bias, V_SET((float)HBAO_SECTORS))));
+}
+
+static VF SIMD_NAME(direction_occlusion_hbao_layers)(const hbao_settings *s,
+                                                     const SIMD_NAME(block) * b, VM active,
+                                                     float dc, float ds,
+                                                     const SIMD_NAME(slice) * sl) {
+    const int quadratic = s->falloff == HBAO_FALLOFF_QUADRATIC;
+    const float range = 1.0f - s->sin_bias;
+    const VF inv_range = V_SET(1.0f / range);
+    const VF half_occluded = V_SET(0.5f * range);
+    const VM check_past_normal = M_AND(sl->usable, V_GT(sl->sin_gamma, V_SET(0.0f)));
+    const int any_check = M_ANY(M_AND(check_past_normal, active));
+    VI marked = I_SET(0);
+    VF occlusion = V_SET(0.0f); /* in sectors */
+    VF past = V_SET(0.0f);
+    SIMD_NAME(fetch) fetches[HBAO_MAX_STEPS];
+    const int fetched = SIMD_NAME(fetch_steps)(b, s->steps, dc, ds, active, fetches);
+    VM alive = active; /* lanes that have not stopped past the normal */
+    for (int step = 0; step < fetched && M_ANY(alive); step++) {
+        VF delta[3], dist2;
+        VM ok = SIMD_NAME(sample)(b, &fetches[step], alive, delta, &dist2);
+        if (!M_ANY(ok)) continue;
+        const VF inv_dist = V_DIV(V_SET(1.0f), V_SQRT(dist2));
+        const VF sin_s = SIMD_NAME(sample_elevation)(b, delta, inv_dist);
+        if (any_check) {
+            const VM steep = M_AND(M_AND(ok, check_past_normal), V_GT(sin_s, b->n_dot_v));
+            if (M_ANY(steep)) {
+                const VM beyond =
+                    M_AND(steep, V_GT(SIMD_NAME(cos_to_view)(b, delta, inv_dist), sl->cos_gamma));
+                past = V_SELECT(beyond, past, half_occluded);
+                alive = M_ANDNOT(beyond, alive);
+                ok = M_ANDNOT(beyond, ok);
+            }
+        }
+        const VF front = V_MUL(V_SUB(V_SET(1.0f), sin_s), inv_range);
+        VF delta_back[3];
+        VM known;
+        const VF dist2_back = SIMD_NAME(back_point)(b, &fetches[step], delta_back, &known);
+        const VF sin_back =
+            SIMD_NAME(sample_elevation)(b, delta_back, V_DIV(V_SET(1.0f), V_SQRT(dist2_back)));
+        const VF behind = V_SELECT(M_AND(known, V_GT(dist2_back, V_SET(0.0f))), V_SET(1.0f),
+                                   V_MUL(V_SUB(V_SET(1.0f), sin_back), inv_range));
+        occlusion = SIMD_NAME(mark_sectors)(
+            &marked, ok, front, behind,
+            quadratic ? V_SUB(V_SET(1.0f), V_MUL(dist2, b->inv_radius2)) : V_SET(1.0f), occlusion);
+    }
+    occlusion = V_MUL(occlusion, V_SET(range / (float)HBAO_SECTORS));
+    return V_SELECT(V_GT(occlusion, past), past, occlusion);
+}
+
 /* Lanes first_lane .. first_lane + SIMD_LANES - 1 of the block of phase a
  * at x0 in row j, with the block's step step_px. */
 static void SIMD_NAME(lanes_ao)(const hbao_horizon_job *job, int x0, int x1, int j, int a,
@@ -424,9 +588,10 @@ static void SIMD_NAME(lanes_ao)(const hbao_horizon_job *job, int x0, int x1, int
                                    V_SELECT(V_LT(along, V_SET(0.0f)), along, V_NEG(along)));
         /* hbao_near_limit */
         b.near_limit = s->thickness > 0.0f ? V_SUB(z, V_SET(s->thickness)) : V_SET(0.0f);
-        b.z = z;
+        b.min_thickness = V_SET(HBAO_MIN_BACK_THICKNESS * s->radius);
 
         const int cosine = s->integration == HBAO_INTEGRATION_COSINE;
+        const int layers = job->phase_back != NULL;
         VF occlusion_sum = V_SET(0.0f), visible_sum = V_SET(0.0f), open_sum = V_SET(0.0f);
         for (int d = 0; d < s->directions; d++) {
             const float dc = job->direction_cos[cell][d], ds = job->direction_sin[cell][d];
@@ -437,14 +602,19 @@ static void SIMD_NAME(lanes_ao)(const hbao_horizon_job *job, int x0, int x1, int
                 if (!M_ANY(lanes)) continue;
                 VF open;
                 const VF occlusion =
-                    SIMD_NAME(direction_occlusion_cosine)(s, &b, lanes, dc, ds, &sl, &open);
+                    layers
+                        ? SIMD_NAME(direction_occlusion_cosine_layers)(s, &b, lanes, dc, ds, &sl,
+                                                                       &open)
+                        : SIMD_NAME(direction_occlusion_cosine)(s, &b, lanes, dc, ds, &sl, &open);
                 visible_sum =
                     V_SELECT(lanes, visible_sum,
                              V_ADD(visible_sum, V_MUL(sl.np_length, V_SUB(open, occlusion))));
                 open_sum = V_SELECT(lanes, open_sum, V_ADD(open_sum, V_MUL(sl.np_length, open)));
             } else {
                 occlusion_sum = V_ADD(
-                    occlusion_sum, SIMD_NAME(direction_occlusion_hbao)(s, &b, active, dc, ds, &sl));
+                    occlusion_sum,
+                    layers ? SIMD_NAME(direction_occlusion_hbao_layers)(s, &b, active, dc, ds, &sl)
+                           : SIMD_NAME(direction_occlusion_hbao)(s, &b, active, dc, ds, &sl));
             }
         }
         VF ao;

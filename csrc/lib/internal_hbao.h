@@ -96,6 +96,19 @@ static inline float hbao_near_limit(const hbao_settings *settings, float z) {
     return settings->thickness > 0.0f ? z - settings->thickness : 0.0f;
 }
 
+/* The back layer (grid->back): an occluder is taken as at least this many
+ * radii thick (horizon.c, "Two depth layers"; chosen with
+ * bench/guard_band.py: 0.1 to 1 tried, 0.5 best on three of four scenes). */
+#define HBAO_MIN_BACK_THICKNESS 0.5f
+/* ... and each direction's sector mask has this many sectors (bits). */
+#define HBAO_SECTORS 32
+
+/* The back depth used for the sample at grid index `at` (finite: known). */
+static inline float hbao_back_depth(const hbao_grid *grid, size_t at, float min_thickness) {
+    const float thinnest = grid->depth[at] + min_thickness;
+    return grid->back[at] > thinnest ? grid->back[at] : thinnest;
+}
+
 /* camera.c */
 hbao_result hbao_validate_camera(const hbao_camera *camera);
 /* Fill the grid's view-plane mapping, pixel_size, ycor, orthographic for a grid whose
