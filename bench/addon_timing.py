@@ -8,9 +8,11 @@ and without an HBAO compositor node. Run by run_benchmark.py:
 Spec: scene, width, height, samples, repeats, node (the HBAO node's settings:
 radius, directions, steps, blur_size, falloff, integration, half_resolution,
 guard_band, back_faces).
-Prints one line `bench-addon: {json}` with the render times in seconds; the
-add-on's own console line ("... pass hand-over N ms ...") is parsed by the
-driver from the same output.
+Prints one line `bench-addon: {json}` with the render times in seconds
+(without the node; with it, the AO computed each time; with it, the same
+frame rendered again unchanged, the AO reused); the add-on's own console
+line ("... pass hand-over N ms ...") is parsed by the driver from the same
+output.
 """
 import json
 import os
@@ -53,7 +55,7 @@ def build_tree(scene, node_settings):
     layers = compositor.render_layers()
     if node_settings is None:
         compositor.composite(layers.outputs["Image"])
-        return
+        return None
     hbao = compositor.node("CompositorNodeHBAO")
     for output in ("Image", "Depth", "Normal"):
         compositor.link(layers.outputs[output], hbao.inputs[output])
@@ -64,13 +66,20 @@ def build_tree(scene, node_settings):
         if key in node_settings:
             setattr(hbao, key, node_settings[key])
     compositor.composite(hbao.outputs["Image"])
+    return hbao
 
 
-def timed_renders(scene, node_settings, repeats):
-    build_tree(scene, node_settings)
+def timed_renders(scene, node_settings, repeats, nudge=False):
+    """Render times after a warm-up. nudge: change the HBAO node's radius by
+    a millionth before each render, so that the add-on computes the AO
+    instead of reusing the last render's (ao_cache.py)."""
+    hbao = build_tree(scene, node_settings)
     bpy.ops.render.render()  # warm-up: kernels, and the add-on's helper scene
     times = []
-    for _ in range(repeats):
+    for repeat in range(repeats):
+        if nudge:
+            nudged = node_settings["radius"] * (1 + 1e-6 * (repeat + 1))
+            hbao.inputs["Radius"].default_value = nudged
         start = time.perf_counter()
         bpy.ops.render.render()
         times.append(time.perf_counter() - start)
@@ -84,11 +93,14 @@ def main():
     configure(scene, spec)
     node = dict(spec["node"], radius=spec_scene.radius)
     without = timed_renders(scene, None, spec["repeats"])
-    with_node = timed_renders(scene, node, spec["repeats"])
+    with_node = timed_renders(scene, node, spec["repeats"], nudge=True)
+    # The same frame again, nothing changed: the AO is reused.
+    unchanged = timed_renders(scene, node, spec["repeats"])
     print("bench-addon: " + json.dumps({
-        "without_node_s": without, "with_node_s": with_node,
+        "without_node_s": without, "with_node_s": with_node, "unchanged_s": unchanged,
         "without_node_median_s": statistics.median(without),
-        "with_node_median_s": statistics.median(with_node)}), flush=True)
+        "with_node_median_s": statistics.median(with_node),
+        "unchanged_median_s": statistics.median(unchanged)}), flush=True)
 
 
 main()

@@ -445,7 +445,11 @@ def write(results, images, native, docs):
               f"| of which AO computation (add-on's console line) | "
               f"{addon['ao_median_s']:.3f} |",
               f"| of which pass hand-over (save + read + write) | "
-              f"{addon['handover_median_s']:.3f} |", ""]
+              f"{addon['handover_median_s']:.3f} |"]
+    if "unchanged_median_s" in addon:
+        lines.append(f"| render with the node, the same frame again unchanged (AO reused, "
+                     f"addon/hbao/ao_cache.py) | {addon['unchanged_median_s']:.3f} |")
+    lines.append("")
 
     lines += ["## Per scene", ""]
     for s in scenes:

@@ -173,6 +173,32 @@ def test_keyframed_radius_and_value_node(run_in_blender, tmp_path, native):
     assert np.abs(valued - expected).max() <= EXACT
 
 
+def test_unchanged_frame_reuses_its_ao(run_in_blender, tmp_path, native):
+    """Frames 1 and 2 render the same passes with the same settings: frame 2
+    reuses frame 1's AO (ao_cache.py; the console line says so) and it is
+    still exactly the library's. Frame 3 changes one node's radius: that
+    node's AO is computed anew, the other node's reused. Two nodes reading
+    the same passes with different radii each keep their own AO."""
+    spec = {"frames": [1, 2, 3], "nodes": [
+        {"name": "Keyed", "keyframes": [[1, 0.6], [2, 0.6], [3, 1.1]], "blur_size": 0},
+        {"name": "Fixed", "radius": 0.3, "blur_size": 0}]}
+    out, log = render(run_in_blender, tmp_path, spec)
+    lines = [line for line in log.splitlines() if line.startswith("HBAO: 2 AO pass(es) ")]
+    assert len(lines) == 3, log[-3000:]
+    assert "unchanged: reused" not in lines[0], lines
+    assert "(2 of 2 unchanged: reused)" in lines[1], lines
+    assert "(1 of 2 unchanged: reused)" in lines[2], lines
+    passes = [frame_passes(out, frame) for frame in (1, 2, 3)]
+    assert all(np.array_equal(a, b) for a, b in zip(passes[0], passes[1]))
+    for frame, radius in ((1, 0.6), (2, 0.6), (3, 1.1)):
+        keyed = node_outputs(out, frame, "Keyed")["ao"]
+        expected = library_ao(native, out, frame, node_params(radius=radius, blur_size=0))
+        assert np.abs(keyed - expected).max() <= EXACT
+        fixed = node_outputs(out, frame, "Fixed")["ao"]
+        expected = library_ao(native, out, frame, node_params(radius=0.3, blur_size=0))
+        assert np.abs(fixed - expected).max() <= EXACT
+
+
 def test_two_nodes_two_view_layers_and_muted_node(run_in_blender, tmp_path, native):
     spec = {"scene": "two_layers", "nodes": [
         {"name": "Small", "layer": "Front", "radius": 0.2},

@@ -11,7 +11,7 @@ import bpy
 import numpy as np
 
 from . import camera as camera_model
-from . import exr_passes, handover, layer_passes, native
+from . import ao_cache, exr_passes, handover, layer_passes, native
 from .helper_lookup import ENGINE_IDNAME, is_helper, pass_names_for_helper
 from .helper_scene import rendered_for_a_scene, scene_for_render
 from .planning import node_names, plan
@@ -19,6 +19,9 @@ from .report import log, post_node_messages, post_render_report
 
 # The prefix of the passes this engine fills (node.pass_name's).
 PASS_PREFIX = "HBAO "
+
+# The last render's AO, reused for the same passes and settings.
+_cache = ao_cache.AOCache()
 
 
 def _evaluated_camera(main, depsgraph):
@@ -67,6 +70,7 @@ def compute_passes(engine, depsgraph, width, height):
         log("render cancelled: no AO computed")
         return {}
     compute_time = 0.0
+    fresh = {}
     for index, job in enumerate(jobs):
         if engine.test_break():
             log("render cancelled: AO left out")
@@ -78,9 +82,19 @@ def compute_passes(engine, depsgraph, width, height):
                                f"helper scene renders {width}x{height}")
         normal = channels[("normal", job.layer)] if job.with_normal else None
         compute_start = time.perf_counter()
-        results[job.pass_name] = layer_passes.compute(job, depth, normal, camera, extra)
+        key = (main.name, job.pass_name)
+        inputs = ao_cache.AOInputs(job.params, camera, layer_passes.settings_of(job, extra),
+                                   (depth, normal) + layer_passes.arrays_of(job, extra))
+        ao = _cache.get(key, inputs)
+        if ao is None:
+            ao = layer_passes.compute(job, depth, normal, camera, extra)
+        else:
+            timings["cached"] = timings.get("cached", 0) + 1
+        results[job.pass_name] = ao
+        fresh[key] = (inputs, ao)
         compute_time += time.perf_counter() - compute_start
         engine.update_progress((index + 1) / len(jobs))
+    _cache.keep_only(fresh)
     timings["ao"] = compute_time
     engine.hbao_timings = timings
     return results
@@ -90,8 +104,9 @@ def _timing_line(count, width, height, total, timings):
     milliseconds = {name: timings.get(name, 0.0) * 1000 for name in ("save", "read", "write",
                                                                      "ao")}
     handover_ms = milliseconds["save"] + milliseconds["read"] + milliseconds["write"]
+    cached = f" ({timings['cached']} of {count} unchanged: reused)" if "cached" in timings else ""
     line = (f"{count} AO pass(es) {width}x{height} in {total * 1000:.0f} ms: AO "
-            f"{milliseconds['ao']:.0f} ms, pass hand-over {handover_ms:.0f} ms "
+            f"{milliseconds['ao']:.0f} ms{cached}, pass hand-over {handover_ms:.0f} ms "
             f"(save {milliseconds['save']:.0f}, read {milliseconds['read']:.0f}, write "
             f"{milliseconds['write']:.0f})")
     for kind in ("guard band", "back faces"):  # extra_renders' kinds
@@ -192,4 +207,5 @@ def register():
 
 
 def unregister():
+    _cache.clear()
     bpy.utils.unregister_class(HBAOPassEngine)

@@ -56,6 +56,21 @@ def read(helper, main, jobs, timings):
     return extra, messages
 
 
+def settings_of(job, extra):
+    """What else than its arrays a job's AO depends on (ao_cache)."""
+    guard_scale = extra.guard_scale if extra is not None else None
+    return (job.with_normal, job.guard_band, job.back_faces, guard_scale)
+
+
+def arrays_of(job, extra):
+    """The extra renders' arrays a job's AO reads (ao_cache)."""
+    if extra is None:
+        return ()
+    back = extra.back_depth if job.back_faces else None
+    guard = (extra.guard_depth, extra.guard_normal) if job.guard_band > 0.0 else (None, None)
+    return (back,) + guard
+
+
 def _flipped(array):
     return None if array is None else array[::-1]
 

@@ -1,0 +1,52 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The AO of the last render, reused when the next render hands over the
+same passes with the same settings: an artist re-rendering a frame after
+changing lights or materials gets the AO without computing it again.
+
+Inputs are compared exactly (numpy.array_equal on the passes, == on the
+parameters and camera), never hashed: a reused AO is the AO those inputs
+give. Only the last render's results are kept, so the cache holds at most
+one frame's passes and AO per node."""
+import numpy as np
+
+
+class AOInputs:
+    """Everything a node's AO depends on: its parameters, the camera, the
+    settings of its extra renders and the arrays the library reads."""
+
+    def __init__(self, params, camera, settings, arrays):
+        self.params = params
+        self.camera = camera
+        self.settings = settings
+        self.arrays = tuple(arrays)
+
+    def same_as(self, other):
+        if (self.params != other.params or self.camera != other.camera
+                or self.settings != other.settings or len(self.arrays) != len(other.arrays)):
+            return False
+        for mine, theirs in zip(self.arrays, other.arrays):
+            if mine is None or theirs is None:
+                if mine is not theirs:
+                    return False
+            elif mine.shape != theirs.shape or not np.array_equal(mine, theirs):
+                return False
+        return True
+
+
+class AOCache:
+    def __init__(self):
+        self._entries = {}
+
+    def get(self, key, inputs):
+        """The AO stored under `key` for the same inputs, or None."""
+        entry = self._entries.get(key)
+        if entry is None or not entry[0].same_as(inputs):
+            return None
+        return entry[1]
+
+    def keep_only(self, entries):
+        """Forget everything but `entries` {key: (AOInputs, ao)}: this render's."""
+        self._entries = dict(entries)
+
+    def clear(self):
+        self._entries = {}

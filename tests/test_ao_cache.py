@@ -1,0 +1,48 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""addon/hbao/ao_cache.py without Blender: a stored AO comes back only for
+inputs equal in every part (tests/test_addon.py renders with it)."""
+import sys
+
+import numpy as np
+
+from conftest import REPO
+
+# The add-on imports as a package without Blender.
+sys.path.insert(0, str(REPO / "addon"))
+from hbao.ao_cache import AOCache, AOInputs  # noqa: E402
+
+PARAMS = {"radius": 0.5, "steps": 16}
+CAMERA = {"lens": 50.0}
+
+
+def inputs(depth, normal=None, params=PARAMS, camera=CAMERA, settings=(True, 0.0)):
+    return AOInputs(dict(params), dict(camera), settings, (depth, normal))
+
+
+def test_only_equal_inputs_get_the_stored_ao():
+    depth = np.linspace(1.0, 2.0, 12, dtype=np.float32).reshape(3, 4)
+    ao = np.full((3, 4), 0.5, np.float32)
+    cache = AOCache()
+    assert cache.get("node", inputs(depth)) is None
+    cache.keep_only({"node": (inputs(depth), ao)})
+    assert cache.get("node", inputs(depth.copy())) is ao
+    assert cache.get("other node", inputs(depth)) is None
+    changed = depth.copy()
+    changed[1, 2] = np.nextafter(changed[1, 2], np.float32(3))
+    differing = [inputs(changed), inputs(depth, normal=np.zeros((3, 4, 3), np.float32)),
+                 inputs(depth.reshape(4, 3)), inputs(depth, params=dict(PARAMS, steps=8)),
+                 inputs(depth, camera={"lens": 35.0}), inputs(depth, settings=(True, 0.1))]
+    for other in differing:
+        assert cache.get("node", other) is None
+
+
+def test_nan_never_matches_and_keep_only_forgets():
+    depth = np.ones((2, 2), np.float32)
+    depth[0, 0] = np.nan
+    cache = AOCache()
+    cache.keep_only({"node": (inputs(depth), np.ones((2, 2), np.float32))})
+    assert cache.get("node", inputs(depth)) is None  # NaN != NaN: computed again
+    plain = np.ones((2, 2), np.float32)
+    cache.keep_only({"node": (inputs(plain), plain)})
+    cache.keep_only({})
+    assert cache.get("node", inputs(plain)) is None
