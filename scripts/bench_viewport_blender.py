@@ -114,20 +114,26 @@ def run(options):
             preview_ms = _median_ms(preview, options["repeats"])
             state["params"] = dict(params, blur_size=0)
             preview_no_blur_ms = _median_ms(preview, options["repeats"])
+            state["params"] = dict(params, half_resolution=True)
+            preview_half_ms = _median_ms(preview, options["repeats"])
         rows.append({"size": f"{width}x{height}", "scene_ms": scene_ms,
                      "depth_read_upload_ms": round_trip_ms, "preview_ms": preview_ms,
                      "preview_no_blur_ms": preview_no_blur_ms,
+                     "preview_half_ms": preview_half_ms,
                      "background_fraction": state.get("background")})
         offscreen.free()
     for row in rows:
         print(f"{row['size']}: background share of the depth buffer "
               f"{row['background_fraction']:.2f}")
+    blur = f"blur {params['blur_size']}"
     print(f"{'size':>10} {'scene draw':>11} {'depth read+upload':>18} "
-          f"{'preview (blur 9)':>17} {'preview (no blur)':>18}   (median ms, "
-          f"{options['repeats']} draws; defaults, radius 0.6)")
+          f"{'preview (' + blur + ')':>17} {'preview (no blur)':>18} "
+          f"{'half resolution':>16}   (median ms, {options['repeats']} draws; defaults, "
+          f"radius 0.6; half resolution with {blur})")
     for row in rows:
         print(f"{row['size']:>10} {row['scene_ms']:>11.1f} {row['depth_read_upload_ms']:>18.1f} "
-              f"{row['preview_ms']:>17.1f} {row['preview_no_blur_ms']:>18.1f}")
+              f"{row['preview_ms']:>17.1f} {row['preview_no_blur_ms']:>18.1f} "
+              f"{row['preview_half_ms']:>16.1f}")
     return rows
 
 

@@ -58,7 +58,8 @@ MIN_OCCLUDED_FRACTION = 0.02
 UNOCCLUDED_CASES = {"grazing_hbao", "grazing_cosine", "one_row_hbao"}
 EXPECTED_CASES = {"persp_cosine", "persp_hbao", "persp_cosine_no_falloff", "shifted_hbao_bias",
                   "ortho_cosine", "persp_cosine_blur", "persp_hbao_blur_strength",
-                  "ortho_cosine_blur", "persp_cosine_thickness"} | UNOCCLUDED_CASES
+                  "ortho_cosine_blur", "persp_cosine_thickness", "persp_cosine_half",
+                  "persp_hbao_half_blur", "ortho_cosine_half_odd"} | UNOCCLUDED_CASES
 
 # The preview multiplies the view by AO <= 1: it may only darken. 8-bit
 # screenshots: one code value of slack for rounding.
@@ -112,6 +113,8 @@ _LIBRARY_CONSTANTS = [
      "HBAO_BLUR_NORMAL_SHARPNESS"),
     ("FLOAT_DEPTH_PRECISION", shader_sources.FLOAT_DEPTH_PRECISION, "internal_hbao.h",
      "HBAO_FLOAT_DEPTH_PRECISION"),
+    ("UPSAMPLE_SHARPNESS", shader_sources.UPSAMPLE_DEFINES["UPSAMPLE_SHARPNESS"],
+     "internal_hbao.h", "HBAO_UPSAMPLE_SHARPNESS"),
 ]
 
 

@@ -66,6 +66,15 @@ CASES = [
     # perpendicular to the row's tangent (docs/algorithm.md, "Normals").
     ("one_row_hbao", PERSPECTIVE_CAMERA, {"integration": "HBAO", "blur_size": 0},
      {"size": (WIDTH, 1)}),
+    # Half resolution: the search on every other pixel of every other row,
+    # then the depth-aware upsample (csrc/lib/upsample.c), with and without
+    # the blur that its guide normals steer; odd sizes give the half grid a
+    # last column and row with no neighbour to the right or below.
+    ("persp_cosine_half", PERSPECTIVE_CAMERA, {"blur_size": 0, "half_resolution": 1}),
+    ("persp_hbao_half_blur", PERSPECTIVE_CAMERA,
+     {"integration": "HBAO", "blur_size": 9, "blur_sharpness": 8.0, "half_resolution": 1}),
+    ("ortho_cosine_half_odd", ORTHOGRAPHIC_CAMERA,
+     {"blur_size": 5, "radius": 0.8, "half_resolution": 1}, {"size": (WIDTH + 1, HEIGHT + 1)}),
 ]
 # The floor's height (camera space) in the cases that do not give their own.
 FLOOR_Y = -1.0

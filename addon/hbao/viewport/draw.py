@@ -66,12 +66,27 @@ def _draw():
         ao_pipeline = _pipelines.get(key)
         if ao_pipeline is None:
             ao_pipeline = _pipelines[key] = pipeline.AOPipeline()
+        if len(_pipelines) > 1:
+            _forget_closed_views(context.window_manager)
         draw_preview(ao_pipeline, region_3d.window_matrix, view_settings.params())
     except Exception as error:  # never let the preview break the viewport
         message = f"{type(error).__name__}: {error}"
         if message not in _reported_errors:
             _reported_errors.add(message)
             print(f"HBAO viewport preview failed: {message}")
+
+
+def _forget_closed_views(window_manager):
+    """Drop the targets of regions that no longer exist (a closed 3D view,
+    another workspace's screen). Run while more than one view has targets;
+    the last view's are dropped when the preview is turned off."""
+    open_regions = {region.as_pointer()
+                    for window in getattr(window_manager, "windows", ())
+                    for area in window.screen.areas if area.type == "VIEW_3D"
+                    for region in area.regions if region.type == "WINDOW"}
+    for key in list(_pipelines):
+        if key not in open_regions:
+            del _pipelines[key]
 
 
 def draw_preview(ao_pipeline, matrix, params):
@@ -94,7 +109,8 @@ def draw_preview(ao_pipeline, matrix, params):
     gpu.state.depth_mask_set(False)
     try:
         linear_depth = ao_pipeline.linearize(depth_buffer_texture,
-                                             projection.depth_coefficients(matrix))
+                                             projection.depth_coefficients(matrix),
+                                             half=bool(params.get("half_resolution")))
         ao_texture = ao_pipeline.ambient_occlusion(linear_depth, frame, params)
         # Our passes bound their own framebuffers; draw back into the view.
         gpu.state.viewport_set(x, y, width, height)

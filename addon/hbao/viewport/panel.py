@@ -62,6 +62,7 @@ class VIEW3D_PT_hbao_preview(bpy.types.Panel):
         column.prop(view_settings, "steps")
         column.prop(view_settings, "falloff")
         column.prop(view_settings, "integration")
+        column.prop(view_settings, "half_resolution")
         column.separator()
         column.prop(view_settings, "blur_size")
         row = column.row()

@@ -1,14 +1,14 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
-"""The preview's GPU passes: viewport depth -> planar depth -> normals -> AO ->
-blur -> composite. One AOPipeline per 3D view region keeps its targets and re-creates
-them when the region's size changes."""
+"""The preview's GPU passes: viewport depth -> planar depth -> [half grid] ->
+normals -> AO -> [upsample] -> blur -> composite. One AOPipeline per 3D view
+region keeps its targets and re-creates them when the region's size changes."""
 import math
 
 import gpu
 from gpu_extras.batch import batch_for_shader
 
 from .. import parameters
-from . import shader_sources, shaders
+from . import projection, shader_sources, shaders
 
 # Two triangles covering normalised device coordinates.
 _QUAD = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
@@ -39,24 +39,38 @@ class _Target:
 
 
 class AOPipeline:
+    """The targets of one view: full-size ones, and the half grid's when the
+    preview runs at half resolution; kept while the view's size (and
+    resolution mode) stays, so that a frame allocates only its depth upload."""
+
     def __init__(self):
         self.size = None
         self._linear_depth = self._normals = self._ao = self._blurred_rows = None
+        self._half_depth = self._half_normals = self._half_ao = None
 
-    def _ensure_size(self, width, height):
-        if self.size == (width, height):
+    def _ensure_size(self, width, height, half=False):
+        if self.size == (width, height, half):
             return
         self._linear_depth = _Target(width, height)
-        # Camera-space normals, full float: the AO pass and the blur read them.
+        # Camera-space normals (at half resolution: the upsampled guide
+        # normals), full float: the blur reads them, and the AO pass at full
+        # resolution.
         self._normals = _Target(width, height, "RGBA32F")
         self._ao = _Target(width, height)
         self._blurred_rows = _Target(width, height)
-        self.size = (width, height)
+        if half:
+            half_width, half_height = (width + 1) // 2, (height + 1) // 2
+            self._half_depth = _Target(half_width, half_height)
+            self._half_normals = _Target(half_width, half_height, "RGBA32F")
+            self._half_ao = _Target(half_width, half_height)
+        else:
+            self._half_depth = self._half_normals = self._half_ao = None
+        self.size = (width, height, half)
 
-    def linearize(self, buffer_depth_texture, coefficients):
+    def linearize(self, buffer_depth_texture, coefficients, half=False):
         """Planar depth (background 0) from a [0, 1] depth-buffer texture;
         coefficients from projection.depth_coefficients."""
-        self._ensure_size(buffer_depth_texture.width, buffer_depth_texture.height)
+        self._ensure_size(buffer_depth_texture.width, buffer_depth_texture.height, half)
         shader = shaders.get("linearize")
         with self._linear_depth.framebuffer.bind():
             shader.bind()
@@ -65,33 +79,28 @@ class AOPipeline:
             _draw_quad("linearize")
         return self._linear_depth.texture
 
-    def ambient_occlusion(self, depth_texture, frame, params,
-                          depth_precision=shader_sources.FLOAT_DEPTH_PRECISION):
-        """Blurred AO (before strength) of a planar-depth texture, as an R32F
-        texture the size of `frame`. `params` as native.resolve_params returns;
-        `depth_precision` bounds the depth's rounding relative to the depth
-        (docs/algorithm.md, "Depth precision")."""
-        width, height = frame.width, frame.height
-        self._ensure_size(width, height)
+    def _search(self, depth_texture, frame, params, depth_precision, normals, ao):
+        """The normal and AO passes over `frame`'s grid into targets `normals`
+        and `ao`."""
 
         def bind_camera(shader):
             shader.uniform_sampler("depth_texture", depth_texture)
-            shader.uniform_int("image_size", (width, height))
+            shader.uniform_int("image_size", (frame.width, frame.height))
             shader.uniform_float("pixel_size", (frame.pixel_size_x, frame.pixel_size_y))
             shader.uniform_float("origin", (frame.origin_x, frame.origin_y))
             shader.uniform_int("perspective", 1 if frame.perspective else 0)
             shader.uniform_float("background_depth", params["background_depth"])
 
         shader = shaders.get("normals")
-        with self._normals.framebuffer.bind():
+        with normals.framebuffer.bind():
             shader.bind()
             bind_camera(shader)
             _draw_quad("normals")
         shader = shaders.get("ao")
-        with self._ao.framebuffer.bind():
+        with ao.framebuffer.bind():
             shader.bind()
             bind_camera(shader)
-            shader.uniform_sampler("normal_texture", self._normals.texture)
+            shader.uniform_sampler("normal_texture", normals.texture)
             shader.uniform_float("radius", params["radius"])
             shader.uniform_float("angle_bias", math.radians(params["angle_bias_degrees"]))
             shader.uniform_int("directions", params["directions"])
@@ -102,6 +111,49 @@ class AOPipeline:
             shader.uniform_float("depth_precision", depth_precision)
             shader.uniform_float("thickness", params["thickness"])
             _draw_quad("ao")
+
+    def _half_resolution(self, depth_texture, frame, params, depth_precision):
+        """Halve the depth, search on the half grid, upsample the AO into
+        self._ao and the guide normals into self._normals."""
+        grid = projection.half_frame(frame)
+        sizes = {"full_size": (frame.width, frame.height), "half_size": (grid.width, grid.height)}
+        shader = shaders.get("halve")
+        with self._half_depth.framebuffer.bind():
+            shader.bind()
+            shader.uniform_sampler("depth_texture", depth_texture)
+            for name, value in sizes.items():
+                shader.uniform_int(name, value)
+            _draw_quad("halve")
+        self._search(self._half_depth.texture, grid, params, depth_precision,
+                     self._half_normals, self._half_ao)
+        shader = shaders.get("upsample")
+        for target, output_normal in ((self._ao, 0), (self._normals, 1)):
+            with target.framebuffer.bind():
+                shader.bind()
+                shader.uniform_sampler("depth_texture", depth_texture)
+                shader.uniform_sampler("half_depth_texture", self._half_depth.texture)
+                shader.uniform_sampler("half_ao_texture", self._half_ao.texture)
+                shader.uniform_sampler("half_normal_texture", self._half_normals.texture)
+                for name, value in sizes.items():
+                    shader.uniform_int(name, value)
+                shader.uniform_int("output_normal", output_normal)
+                shader.uniform_float("background_depth", params["background_depth"])
+                _draw_quad("upsample")
+
+    def ambient_occlusion(self, depth_texture, frame, params,
+                          depth_precision=shader_sources.FLOAT_DEPTH_PRECISION):
+        """Blurred AO (before strength) of a planar-depth texture, as an R32F
+        texture the size of `frame`. `params` as native.resolve_params returns
+        (half_resolution: the search on the half grid, as the library does);
+        `depth_precision` bounds the depth's rounding relative to the depth
+        (docs/algorithm.md, "Depth precision")."""
+        width, height = frame.width, frame.height
+        half = bool(params.get("half_resolution"))
+        self._ensure_size(width, height, half)
+        if half:
+            self._half_resolution(depth_texture, frame, params, depth_precision)
+        else:
+            self._search(depth_texture, frame, params, depth_precision, self._normals, self._ao)
         kernel_radius = parameters.blur_kernel_radius(params["blur_size"])
         if kernel_radius < 1:
             return self._ao.texture

@@ -72,6 +72,19 @@ def frame_from_projection_matrix(matrix, width, height):
         origin_x=origin_x, origin_y=origin_y)
 
 
+def half_frame(frame):
+    """The frame of the half-resolution grid of `frame` (csrc/lib/camera.c,
+    hbao_grid_set_projection with scale 2): its pixel (i, j), j from the
+    top, is `frame`'s pixel (2 i, 2 j); the grid has ceil(W / 2) x
+    ceil(H / 2) pixels."""
+    width, height = (frame.width + 1) // 2, (frame.height + 1) // 2
+    return ViewFrame(
+        width=width, height=height, perspective=frame.perspective,
+        pixel_size_x=2.0 * frame.pixel_size_x, pixel_size_y=2.0 * frame.pixel_size_y,
+        origin_x=frame.origin_x - 0.5 * frame.pixel_size_x,
+        origin_y=frame.origin_y + (frame.height + 0.5 - 2 * height) * frame.pixel_size_y)
+
+
 def is_perspective_matrix(matrix):
     """A perspective projection puts -z into w (row 3 = 0 0 -1 0); an orthographic one
     keeps w = 1."""

@@ -90,6 +90,10 @@ class HBAOViewSettings(bpy.types.PropertyGroup):
         update=_redraw,
         description="Occluders are taken as this thick: a surface nearer than the pixel by "
                     "more than this does not shade it. 0 = infinitely thick")
+    half_resolution: BoolProperty(
+        name="Half Resolution", default=False, update=_redraw,
+        description="Search the horizons on every other pixel of every other row and "
+                    "upsample, as the node's Half Resolution does: about 3 times faster")
 
     def params(self, scene=None):
         """The C library's parameters (native.compute_ao's dict) this view
@@ -100,8 +104,10 @@ class HBAOViewSettings(bpy.types.PropertyGroup):
         if node is not None:
             scene = scene or bpy.context.scene
             return socket_values.node_params(node, scene.frame_current, [])
-        return native.resolve_params({name: getattr(self, name) for name in parameters.DEFAULTS
-                                      if name != "background_depth"})
+        values = {name: getattr(self, name) for name in parameters.DEFAULTS
+                  if name != "background_depth"}
+        values["half_resolution"] = int(self.half_resolution)
+        return native.resolve_params(values)
 
     @staticmethod
     def settings_node(scene=None):

@@ -13,7 +13,10 @@ csrc/lib/normals.c) -> AO (csrc/lib/horizon.c) -> blur along rows, then
 columns (csrc/lib/blur.c) -> composite. The normals are a texture of their
 own because both the AO pass and the blur read them, as both read the
 library's grid->normal. The normal and AO passes' GLSL is in
-horizon_sources.py.
+horizon_sources.py. At half resolution (csrc/lib/compute.c): linearize ->
+halve (every other pixel of every other row) -> normals and AO on the half
+grid -> upsample (csrc/lib/upsample.c: the AO, and the blur's guide normals)
+-> blur at full resolution -> composite.
 """
 from ..parameters import FALLOFF_VALUES, INTEGRATION_VALUES
 from . import horizon_sources
@@ -123,6 +126,94 @@ void main()
 }
 """
 
+# The half-resolution grid (csrc/lib/compute.c): its pixel (i, j), j from
+# the top, is full-resolution pixel (2 i, 2 j); rows are bottom-up here.
+HALVE_FRAGMENT = """
+void main()
+{
+    ivec2 p = ivec2(gl_FragCoord.xy);
+    int j = half_size.y - 1 - p.y;
+    ivec2 source = ivec2(2 * p.x, full_size.y - 1 - 2 * j);
+    frag_output = vec4(texelFetch(depth_texture, source, 0).r, 0.0, 0.0, 1.0);
+}
+"""
+
+# Joint bilateral upsampling of the half grid's AO to full resolution,
+# csrc/lib/upsample.c operation for operation: a pixel's candidates are the
+# half-grid pixels around it with bilinear weights (even columns and rows sit
+# on the grid), each weighed by its depth's similarity; the candidates'
+# normals, averaged with the same weights, guide the blur. output_normal = 0
+# writes the AO, 1 the guide normal (the blur reads them from two textures).
+UPSAMPLE_FRAGMENT = COMMON + """
+#define LARGEST_FLOAT 3.402823466e38
+
+float sum, weight_sum, nearest_ao, nearest_difference;
+vec3 normal_sum, nearest_normal;
+
+void add_candidate(float bilinear, int k, int r, float z)
+{
+    ivec2 texel = ivec2(k, half_size.y - 1 - r);
+    float zs = texelFetch(half_depth_texture, texel, 0).r;
+    float ao = texelFetch(half_ao_texture, texel, 0).r;
+    vec3 normal = texelFetch(half_normal_texture, texel, 0).xyz;
+    bool usable = bilinear > 0.0 && !is_background(zs);
+    float difference = abs(zs - z) / z;
+    float scaled = UPSAMPLE_SHARPNESS * difference;
+    float weight = usable ? bilinear * exp(-(scaled * scaled)) : 0.0;
+    sum += weight * ao;
+    weight_sum += weight;
+    normal_sum += weight * normal;
+    if (usable && difference < nearest_difference) {
+        nearest_ao = ao;
+        nearest_difference = difference;
+        nearest_normal = normal;
+    }
+}
+
+void main()
+{
+    ivec2 p = ivec2(gl_FragCoord.xy);
+    int i = p.x, j = full_size.y - 1 - p.y;
+    float z = texelFetch(depth_texture, p, 0).r;
+    int r0 = j / 2, k = i / 2;
+    bool two_rows = (j & 1) != 0 && r0 + 1 < half_size.y;
+    int r1 = two_rows ? r0 + 1 : r0;
+    float top_weight = two_rows ? 0.5 : 1.0, bottom_weight = 1.0 - top_weight;
+    sum = 0.0;
+    weight_sum = 0.0;
+    nearest_ao = 1.0;
+    nearest_difference = LARGEST_FLOAT; /* the library's INFINITY: no finite difference is larger */
+    normal_sum = vec3(0.0);
+    nearest_normal = texelFetch(half_normal_texture, ivec2(k, half_size.y - 1 - r0), 0).xyz;
+    if ((i & 1) == 0) {
+        add_candidate(top_weight, k, r0, z);
+        if (two_rows) {
+            add_candidate(bottom_weight, k, r1, z);
+        }
+    } else {
+        /* between half columns k and k + 1, if there is one */
+        int odd_inner = min(full_size.x / 2, half_size.x - 1);
+        int right = k < odd_inner ? k + 1 : k;
+        float right_weight = k < odd_inner ? 0.5 : 0.0, left_weight = 1.0 - right_weight;
+        add_candidate(left_weight * top_weight, k, r0, z);
+        add_candidate(right_weight * top_weight, right, r0, z);
+        if (two_rows) {
+            add_candidate(left_weight * bottom_weight, k, r1, z);
+            add_candidate(right_weight * bottom_weight, right, r1, z);
+        }
+    }
+    bool weighted = weight_sum > 1e-6;
+    float blended = weighted ? sum / weight_sum : nearest_ao;
+    float length_sum = length(normal_sum);
+    vec3 guide = weighted && length_sum > 0.0 ? normal_sum / length_sum : nearest_normal;
+    if (output_normal != 0) {
+        frag_output = vec4(guide, 0.0);
+    } else {
+        frag_output = vec4(is_background(z) ? 1.0 : blended, 0.0, 0.0, 1.0);
+    }
+}
+"""
+
 # Strength, then "multiply over the viewport": premultiplied black with alpha
 # 1 - ao leaves dst * ao. In POST_VIEW Blender draws into its overlay buffer,
 # which is composited premultiplied over the scene (out = overlay + scene *
@@ -157,6 +248,12 @@ AO_DEFINES = {
     # csrc/lib/internal_hbao.h, HBAO_BLOCK_PIXELS: the pixels of a block,
     # which share one step length (tests/test_viewport.py compares the two).
     "BLOCK_PIXELS": 16,
+}
+
+UPSAMPLE_DEFINES = {
+    # csrc/lib/internal_hbao.h, HBAO_UPSAMPLE_SHARPNESS
+    # (tests/test_viewport.py compares the two).
+    "UPSAMPLE_SHARPNESS": 16.0,
 }
 
 BLUR_DEFINES = {

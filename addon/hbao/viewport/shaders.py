@@ -44,6 +44,16 @@ _DEFINITIONS = {
             ("FLOAT", "depth_precision"), ("FLOAT", "thickness")],
         ["depth_texture", "normal_texture"],
         shader_sources.AO_DEFINES),
+    "halve": lambda: _create_info(
+        shader_sources.HALVE_FRAGMENT,
+        [("IVEC2", "full_size"), ("IVEC2", "half_size")],
+        ["depth_texture"]),
+    "upsample": lambda: _create_info(
+        shader_sources.UPSAMPLE_FRAGMENT,
+        [("IVEC2", "full_size"), ("IVEC2", "half_size"), ("INT", "output_normal"),
+         ("FLOAT", "background_depth")],
+        ["depth_texture", "half_depth_texture", "half_ao_texture", "half_normal_texture"],
+        shader_sources.UPSAMPLE_DEFINES),
     "blur": lambda: _create_info(
         shader_sources.BLUR_FRAGMENT,
         [("IVEC2", "image_size"), ("IVEC2", "blur_step"), ("INT", "kernel_radius"),
@@ -58,7 +68,8 @@ _DEFINITIONS = {
 
 
 def get(name):
-    """The compiled shader `name` (linearize, normals, ao, blur, composite)."""
+    """The compiled shader `name` (linearize, halve, normals, ao, upsample, blur,
+    composite)."""
     shader = _shaders.get(name)
     if shader is None:
         shader = gpu.shader.create_from_info(_DEFINITIONS[name]())
