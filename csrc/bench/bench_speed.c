@@ -379,6 +379,53 @@ int main(int argc, char **argv) {
         free(b.normal);
     }
 
+    /* What a frame does not need is skipped: the same frame with and
+     * without the thing that lets the library skip work. */
+    {
+        bench_scene b;
+        bench_scene_make(&b, 1920, 1080);
+        const size_t pixels = (size_t)1920 * 1080;
+        float *ao = malloc(pixels * sizeof(float)), *sky = malloc(pixels * sizeof(float));
+        double *wall = malloc((size_t)runs * sizeof(double));
+        if (ao == NULL || sky == NULL || wall == NULL) return 1;
+        memcpy(sky, b.depth, pixels * sizeof(float));
+        for (size_t k = 0; k < pixels / 2; k++) sky[k] = 1e10f; /* the upper half: background */
+        float *const full_depth = b.depth;
+        printf("\n## Skips, 1920x1080, defaults, %s, median wall ms\n\n",
+               all_columns[last_column].name);
+        printf("| what is skipped | frame | ms |\n|---|---|---|\n");
+        const struct {
+            const char *what, *frame;
+            float radius;
+            int sky;
+        } cases[] = {
+            {"nothing (reference)", "every pixel geometry, radius 0.5", 0.5f, 0},
+            {"background pixels and blocks", "upper half background, radius 0.5", 0.5f, 1},
+            {"steps that land on the same pixel", "radius 0.02 (about 10 pixels)", 0.02f, 0},
+            {"the horizon search (radius under a pixel)", "radius 1e-4", 1e-4f, 0},
+        };
+        for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+            hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+            p.radius = cases[c].radius;
+            p.implementation = all_columns[last_column].implementation;
+            p.threads = all_columns[last_column].threads;
+            b.depth = cases[c].sky ? sky : full_depth;
+            for (int round = -1; round < runs; round++) {
+                timing t;
+                if (!time_call(&p, &b, ao, &t)) return 1;
+                if (round >= 0) wall[round] = t.wall;
+            }
+            printf("| %s | %s | %.1f |\n", cases[c].what, cases[c].frame,
+                   1e3 * median_of(wall, runs));
+        }
+        b.depth = full_depth;
+        free(ao);
+        free(sky);
+        free(wall);
+        free(b.depth);
+        free(b.normal);
+    }
+
     /* The targets beside the measurements of this run. */
     printf("\n## Issue 11 targets (%s)\n\n", all_columns[last_column].name);
     printf("| target | limit | measured median | met | speed-up over scalar, 1 thread |\n");
