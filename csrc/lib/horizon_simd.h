@@ -216,10 +216,27 @@ static inline VM SIMD_NAME(sample)(const SIMD_NAME(block) * b, const SIMD_NAME(f
 }
 
 /* horizon.c's sample_elevation, and the angle to V of past_the_normal */
+static inline VF SIMD_NAME(sample_height)(const SIMD_NAME(block) * b, const VF delta[3]) {
+    const VF height = SIMD_NAME(dot3)(delta[0], delta[1], delta[2], b->n[0], b->n[1], b->n[2]);
+    return V_SUB(height, b->height_tolerance);
+}
+
 static inline VF SIMD_NAME(sample_elevation)(const SIMD_NAME(block) * b, const VF delta[3],
                                              VF inv_dist) {
-    const VF height = SIMD_NAME(dot3)(delta[0], delta[1], delta[2], b->n[0], b->n[1], b->n[2]);
-    return V_MUL(V_SUB(height, b->height_tolerance), inv_dist);
+    return V_MUL(SIMD_NAME(sample_height)(b, delta), inv_dist);
+}
+
+/* The lanes of `ok` whose sample can change a one-layer horizon: one above
+ * the tangent plane (height > 0), or any where V lies below it (a sample
+ * then can be past the normal with a negative elevation). Every horizon
+ * starts at the bias, sin_bias >= 0, and rises only past a larger
+ * elevation; a sample at or below the tangent plane has elevation <= 0 and,
+ * where dot(n, V) >= 0, cannot rise more steeply than V. So a step whose
+ * samples all lie on or below the tangent plane (most of them, on a flat
+ * surface) is skipped before its square root and division, and the result
+ * is that of the scalar reference, which computes them. */
+static inline VM SIMD_NAME(above_tangent)(const SIMD_NAME(block) * b, VM ok, VF height) {
+    return M_AND(ok, M_OR(V_GT(height, V_SET(0.0f)), V_LT(b->n_dot_v, V_SET(0.0f))));
 }
 
 static inline VF SIMD_NAME(cos_to_view)(const SIMD_NAME(block) * b, const VF delta[3],
@@ -243,9 +260,10 @@ static VF SIMD_NAME(direction_occlusion_hbao)(const hbao_settings *s, const SIMD
     for (int step = 0; step < fetched && M_ANY(alive); step++) {
         VF delta[3], dist2;
         const VM ok = SIMD_NAME(sample)(b, &fetches[step], alive, delta, &dist2);
-        if (!M_ANY(ok)) continue;
+        const VF height = SIMD_NAME(sample_height)(b, delta);
+        if (!M_ANY(SIMD_NAME(above_tangent)(b, ok, height))) continue;
         const VF inv_dist = V_DIV(V_SET(1.0f), V_SQRT(dist2));
-        const VF sin_s = SIMD_NAME(sample_elevation)(b, delta, inv_dist);
+        const VF sin_s = V_MUL(height, inv_dist);
         VM rest = ok;
         /* past_the_normal, its cheap half first: most samples rise less
          * steeply than V, and then the angle to V is not needed */
@@ -324,9 +342,10 @@ static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SI
     for (int step = 0; step < fetched; step++) {
         VF delta[3], dist2;
         const VM ok = SIMD_NAME(sample)(b, &fetches[step], active, delta, &dist2);
-        if (!M_ANY(ok)) continue;
+        const VF height = SIMD_NAME(sample_height)(b, delta);
+        if (!M_ANY(SIMD_NAME(above_tangent)(b, ok, height))) continue;
         const VF inv_dist = V_DIV(V_SET(1.0f), V_SQRT(dist2));
-        const VF sin_s = SIMD_NAME(sample_elevation)(b, delta, inv_dist);
+        const VF sin_s = V_MUL(height, inv_dist);
         VM raised = M_ANDNOT(ok, ok); /* no lane */
         /* past_the_normal, its cheap half first (see above) */
         const VM steep =
