@@ -263,7 +263,8 @@ the frame's, what its passes cost to render and HBAO to compute; *passes render 
 1-sample render whose materials are all overridden by the add-on's back-face material (front
 faces transparent), whose Depth is the first back face behind each visible surface, passed to
 `hbao_compute_layers` (an occluder covers only the angles between its front and its back point,
-at least half the radius behind; docs/algorithm.md, "Two depth layers"); alone, and
+at least half the radius behind, and one beyond the radius whose view ray enters the radius
+before its back occludes from there; docs/algorithm.md, "Two depth layers"); alone, and
 with the guard band of the same width (its back faces rendered with the band). HBAO ms: median of
 {TIMING_RUNS} runs, {THREADS} threads, on shared cores (noisy).
 

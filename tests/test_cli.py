@@ -1097,7 +1097,6 @@ def test_back_layer_lets_light_pass_behind_a_thin_occluder(hbao_tool, tmp_path, 
           % (ao["front"][wall].min(), ao["layers"][wall].min()))
     assert ao["front"][wall].min() < 0.9
     assert ao["layers"][wall].min() > ao["front"][wall].min() + 0.05
-    assert (ao["layers"] - ao["front"]).min() > -0.02  # the sectors' rounding at most
     params = {"radius": 0.8, "blur_size": 0, "threads": 1}
     expected = native.compute_ao(depth, None, params=params, back_depth=back)
     assert np.array_equal(ao["layers"], expected)

@@ -399,7 +399,8 @@ HBAO_EXPORT hbao_result hbao_compute(const hbao_params *params, const hbao_camer
  *                    light passes between a floating object and the
  *                    surface behind it. Each direction keeps a mask of 32
  *                    sectors for this (docs/algorithm.md, "Two depth
- *                    layers"). Where no back face is known (0, not finite,
+ *                    layers"). A sample beyond the radius whose occluder
+ *                    reaches into the radius occludes from where it enters. Where no back face is known (0, not finite,
  *                    not behind the visible surface, or at or beyond
  *                    background_depth) the surface is infinitely thick; a
  *                    layer with no back face known anywhere gives exactly

@@ -37,7 +37,7 @@ typedef struct march {
     float min_thickness; /* the back layer: HBAO_MIN_BACK_THICKNESS radii */
 } march;
 
-enum { SAMPLE_END = -1, SAMPLE_SKIP = 0, SAMPLE_OK = 1 };
+enum { SAMPLE_END = -1, SAMPLE_SKIP = 0, SAMPLE_OK = 1, SAMPLE_FAR = 2 };
 
 /* The vector to the sample of a step and its squared length; *at receives
  * the sample's index in the grid. */
@@ -58,7 +58,8 @@ static inline int march_sample(const march *m, int step, float delta[3], float *
     delta[1] = q[1] - m->p[1];
     delta[2] = q[2] - m->p[2];
     *dist2 = delta[0] * delta[0] + delta[1] * delta[1] + delta[2] * delta[2];
-    if (!(*dist2 < m->radius2) || !(*dist2 > 0.0f)) return SAMPLE_SKIP;
+    if (!(*dist2 > 0.0f)) return SAMPLE_SKIP;
+    if (!(*dist2 < m->radius2)) return *dist2 < INFINITY ? SAMPLE_FAR : SAMPLE_SKIP;
     return SAMPLE_OK;
 }
 
@@ -129,7 +130,7 @@ static float direction_occlusion_hbao(const hbao_settings *s, const march *m, co
         size_t at;
         const int status = march_sample(m, step, delta, &dist2, &at);
         if (status == SAMPLE_END) break;
-        if (status == SAMPLE_SKIP) continue;
+        if (status != SAMPLE_OK) continue;
         const float inv_dist = 1.0f / sqrtf(dist2);
         const float sin_s = sample_elevation(m, n, delta, inv_dist);
         if (check_past_normal && past_the_normal(m, sl, v, delta, inv_dist, sin_s)) {
@@ -219,7 +220,7 @@ static float direction_occlusion_cosine(const hbao_settings *s, const march *m, 
         size_t at;
         const int status = march_sample(m, step, delta, &dist2, &at);
         if (status == SAMPLE_END) break;
-        if (status == SAMPLE_SKIP) continue;
+        if (status != SAMPLE_OK) continue;
         const float inv_dist = 1.0f / sqrtf(dist2);
         const float sin_s = sample_elevation(m, n, delta, inv_dist);
         int raised = 0;
@@ -331,6 +332,32 @@ static inline int back_point(const march *m, size_t at, float delta[3], float *d
     return *dist2 > 0.0f;
 }
 
+/* A sample beyond the radius still occludes within it where its occluder,
+ * [its depth, its back depth] along its view ray (infinitely deep where the
+ * back is unknown), reaches into the radius: the part of the surface hidden
+ * behind it (a pit's near wall behind its rim) lies there. *delta becomes
+ * the point where the view ray enters the radius (*dist2 its squared
+ * length, about radius^2). Returns 0 where it does not enter before the back
+ * depth. (Without the layer a sample beyond the radius is ignored, as
+ * before: the layer is what tells a thin object from a solid one.) */
+static inline int enter_the_ball(const march *m, size_t at, float delta[3], float *dist2) {
+    const hbao_grid *g = m->grid;
+    const float q[3] = {delta[0] + m->p[0], delta[1] + m->p[1], delta[2] + m->p[2]};
+    float d[3] = {0.0f, 0.0f, -1.0f};
+    if (!g->orthographic) {
+        const float inv = 1.0f / sqrtf(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+        for (int c = 0; c < 3; c++) d[c] = q[c] * inv;
+    }
+    const float b = delta[0] * d[0] + delta[1] * d[1] + delta[2] * d[2];
+    const float disc = b * b - (*dist2 - m->radius2);
+    if (!(b < 0.0f) || !(disc >= 0.0f)) return 0;
+    const float t = -b - sqrtf(disc);
+    if (!(-(q[2] + t * d[2]) <= g->back[at])) return 0;
+    for (int c = 0; c < 3; c++) delta[c] += t * d[c];
+    *dist2 = delta[0] * delta[0] + delta[1] * delta[1] + delta[2] * delta[2];
+    return *dist2 > 0.0f;
+}
+
 /* direction_occlusion_cosine with the back layer. */
 static float direction_occlusion_cosine_layers(const hbao_settings *s, const march *m,
                                                const float n[3], const float v[3], const slice *sl,
@@ -352,7 +379,9 @@ static float direction_occlusion_cosine_layers(const hbao_settings *s, const mar
         size_t at;
         const int status = march_sample(m, step, delta, &dist2, &at);
         if (status == SAMPLE_END) break;
-        if (status == SAMPLE_SKIP) continue;
+        if (status == SAMPLE_SKIP ||
+            (status == SAMPLE_FAR && !enter_the_ball(m, at, delta, &dist2)))
+            continue;
         const float front = sector_fraction_cosine(m, sl, n, v, delta, dist2, gamma,
                                                    check_past_normal, s->sin_bias, inv_bias);
         float delta_back[3], dist2_back;
@@ -361,8 +390,8 @@ static float direction_occlusion_cosine_layers(const hbao_settings *s, const mar
                 ? sector_fraction_cosine(m, sl, n, v, delta_back, dist2_back, gamma,
                                          check_past_normal, s->sin_bias, inv_bias)
                 : 1.0f;
-        occlusion +=
-            mark_sectors(&marked, front, behind, quadratic ? 1.0f - dist2 * inv_radius2 : 1.0f);
+        occlusion += mark_sectors(&marked, front, behind,
+                                  quadratic ? fmaxf(0.0f, 1.0f - dist2 * inv_radius2) : 1.0f);
     }
     return occlusion * (visibility_bias / (float)HBAO_SECTORS);
 }
@@ -385,7 +414,9 @@ static float direction_occlusion_hbao_layers(const hbao_settings *s, const march
         size_t at;
         const int status = march_sample(m, step, delta, &dist2, &at);
         if (status == SAMPLE_END) break;
-        if (status == SAMPLE_SKIP) continue;
+        if (status == SAMPLE_SKIP ||
+            (status == SAMPLE_FAR && !enter_the_ball(m, at, delta, &dist2)))
+            continue;
         const float inv_dist = 1.0f / sqrtf(dist2);
         const float sin_s = sample_elevation(m, n, delta, inv_dist);
         if (check_past_normal && past_the_normal(m, sl, v, delta, inv_dist, sin_s)) {
@@ -398,8 +429,8 @@ static float direction_occlusion_hbao_layers(const hbao_settings *s, const march
             back_point(m, at, delta_back, &dist2_back)
                 ? (1.0f - sample_elevation(m, n, delta_back, 1.0f / sqrtf(dist2_back))) * inv_range
                 : 1.0f;
-        occlusion +=
-            mark_sectors(&marked, front, behind, quadratic ? 1.0f - dist2 * inv_radius2 : 1.0f);
+        occlusion += mark_sectors(&marked, front, behind,
+                                  quadratic ? fmaxf(0.0f, 1.0f - dist2 * inv_radius2) : 1.0f);
     }
     occlusion *= range / (float)HBAO_SECTORS;
     return occlusion > past ? occlusion : past;

@@ -215,6 +215,44 @@ static inline VM SIMD_NAME(sample)(const SIMD_NAME(block) * b, const SIMD_NAME(f
     return M_AND(valid, M_AND(V_LT(*dist2, b->radius2), V_GT(*dist2, V_SET(0.0f))));
 }
 
+/* SIMD_NAME(sample) with the back layer: the lanes beyond the radius whose
+ * occluder reaches into it (horizon.c's enter_the_ball) join, at the point
+ * where their view ray enters the radius. */
+static inline VM SIMD_NAME(sample_layers)(const SIMD_NAME(block) * b, const SIMD_NAME(fetch) * f,
+                                          VM live, VF delta[3], VF *dist2) {
+    const hbao_grid *g = b->grid;
+    const VM ok = SIMD_NAME(sample)(b, f, live, delta, dist2);
+    const VF zs = f->zs;
+    const VM valid =
+        M_AND(M_AND(f->candidate, live), M_AND(V_GT(zs, V_SET(0.0f)), V_GE(zs, b->near_limit)));
+    const VM far =
+        M_ANDNOT(V_LT(*dist2, b->radius2),
+                 M_AND(valid, M_AND(V_GT(*dist2, V_SET(0.0f)), V_LT(*dist2, V_SET(INFINITY)))));
+    if (!M_ANY(far)) return ok;
+    const VF q[3] = {V_ADD(delta[0], b->p[0]), V_ADD(delta[1], b->p[1]), V_ADD(delta[2], b->p[2])};
+    VF d[3] = {V_SET(0.0f), V_SET(0.0f), V_SET(-1.0f)};
+    if (!g->orthographic) {
+        const VF inv =
+            V_DIV(V_SET(1.0f), V_SQRT(SIMD_NAME(dot3)(q[0], q[1], q[2], q[0], q[1], q[2])));
+        for (int c = 0; c < 3; c++) d[c] = V_MUL(q[c], inv);
+    }
+    const VF along = SIMD_NAME(dot3)(delta[0], delta[1], delta[2], d[0], d[1], d[2]);
+    const VF disc = V_SUB(V_MUL(along, along), V_SUB(*dist2, b->radius2));
+    VM enter = M_AND(far, M_AND(V_LT(along, V_SET(0.0f)), V_GE(disc, V_SET(0.0f))));
+    if (!M_ANY(enter)) return ok;
+    const VF t = V_SUB(V_NEG(along), V_SQRT(V_MAX0(disc)));
+    const VF entry_depth = V_NEG(V_ADD(q[2], V_MUL(t, d[2])));
+    enter = M_AND(enter, V_LE(entry_depth, f->zb)); /* INFINITY: unknown, any depth */
+    VF entered[3];
+    for (int c = 0; c < 3; c++) entered[c] = V_ADD(delta[c], V_MUL(t, d[c]));
+    const VF entered2 =
+        SIMD_NAME(dot3)(entered[0], entered[1], entered[2], entered[0], entered[1], entered[2]);
+    enter = M_AND(enter, V_GT(entered2, V_SET(0.0f)));
+    for (int c = 0; c < 3; c++) delta[c] = V_SELECT(enter, delta[c], entered[c]);
+    *dist2 = V_SELECT(enter, *dist2, entered2);
+    return M_OR(ok, enter);
+}
+
 /* horizon.c's sample_elevation, and the angle to V of past_the_normal */
 static inline VF SIMD_NAME(sample_height)(const SIMD_NAME(block) * b, const VF delta[3]) {
     const VF height = SIMD_NAME(dot3)(delta[0], delta[1], delta[2], b->n[0], b->n[1], b->n[2]);
@@ -479,7 +517,7 @@ static VF SIMD_NAME(direction_occlusion_cosine_layers)(const hbao_settings *s,
     const int fetched = SIMD_NAME(fetch_steps)(b, s->steps, dc, ds, lanes, fetches);
     for (int step = 0; step < fetched; step++) {
         VF delta[3], dist2;
-        const VM ok = SIMD_NAME(sample)(b, &fetches[step], lanes, delta, &dist2);
+        const VM ok = SIMD_NAME(sample_layers)(b, &fetches[step], lanes, delta, &dist2);
         if (!M_ANY(ok)) continue;
         const VF front = SIMD_NAME(sector_fraction_cosine)(
             b, sl, delta, dist2, gamma, check_past_normal, any_check, sin_bias, inv_bias);
@@ -492,7 +530,8 @@ static VF SIMD_NAME(direction_occlusion_cosine_layers)(const hbao_settings *s,
                                               check_past_normal, any_check, sin_bias, inv_bias));
         occlusion = SIMD_NAME(mark_sectors)(
             &marked, ok, front, behind,
-            quadratic ? V_SUB(V_SET(1.0f), V_MUL(dist2, b->inv_radius2)) : V_SET(1.0f), occlusion);
+            quadratic ? V_MAX0(V_SUB(V_SET(1.0f), V_MUL(dist2, b->inv_radius2))) : V_SET(1.0f),
+            occlusion);
     }
     return V_ZERO_UNLESS(lanes,
                          V_MUL(occlusion, V_DIV(visibility_bias, V_SET((float)HBAO_SECTORS))));
@@ -516,7 +555,7 @@ static VF SIMD_NAME(direction_occlusion_hbao_layers)(const hbao_settings *s,
     VM alive = active; /* lanes that have not stopped past the normal */
     for (int step = 0; step < fetched && M_ANY(alive); step++) {
         VF delta[3], dist2;
-        VM ok = SIMD_NAME(sample)(b, &fetches[step], alive, delta, &dist2);
+        VM ok = SIMD_NAME(sample_layers)(b, &fetches[step], alive, delta, &dist2);
         if (!M_ANY(ok)) continue;
         const VF inv_dist = V_DIV(V_SET(1.0f), V_SQRT(dist2));
         const VF sin_s = SIMD_NAME(sample_elevation)(b, delta, inv_dist);
@@ -540,7 +579,8 @@ static VF SIMD_NAME(direction_occlusion_hbao_layers)(const hbao_settings *s,
                                    V_MUL(V_SUB(V_SET(1.0f), sin_back), inv_range));
         occlusion = SIMD_NAME(mark_sectors)(
             &marked, ok, front, behind,
-            quadratic ? V_SUB(V_SET(1.0f), V_MUL(dist2, b->inv_radius2)) : V_SET(1.0f), occlusion);
+            quadratic ? V_MAX0(V_SUB(V_SET(1.0f), V_MUL(dist2, b->inv_radius2))) : V_SET(1.0f),
+            occlusion);
     }
     occlusion = V_MUL(occlusion, V_SET(range / (float)HBAO_SECTORS));
     return V_SELECT(V_GT(occlusion, past), past, occlusion);
