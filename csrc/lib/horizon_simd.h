@@ -469,6 +469,18 @@ static inline VF SIMD_NAME(back_point)(const SIMD_NAME(block) * b, const SIMD_NA
     return SIMD_NAME(dot3)(delta[0], delta[1], delta[2], delta[0], delta[1], delta[2]);
 }
 
+/* Whether any lane of `ok` can mark a sector: as above_tangent, with the
+ * back point too (a sample whose front and known back both lie on or below
+ * the tangent plane has both fractions at 1, an empty interval). */
+static inline int SIMD_NAME(layer_step_matters)(const SIMD_NAME(block) * b, VM ok,
+                                                const VF delta[3], const VF delta_back[3],
+                                                VM known) {
+    const VM front = SIMD_NAME(above_tangent)(b, ok, SIMD_NAME(sample_height)(b, delta));
+    const VM back =
+        M_AND(M_AND(ok, known), V_GT(SIMD_NAME(sample_height)(b, delta_back), V_SET(0.0f)));
+    return M_ANY(M_OR(front, back));
+}
+
 /* horizon.c's sector_fraction_cosine */
 static inline VF SIMD_NAME(sector_fraction_cosine)(const SIMD_NAME(block) * b,
                                                    const SIMD_NAME(slice) * sl, const VF delta[3],
@@ -519,11 +531,12 @@ static VF SIMD_NAME(direction_occlusion_cosine_layers)(const hbao_settings *s,
         VF delta[3], dist2;
         const VM ok = SIMD_NAME(sample_layers)(b, &fetches[step], lanes, delta, &dist2);
         if (!M_ANY(ok)) continue;
-        const VF front = SIMD_NAME(sector_fraction_cosine)(
-            b, sl, delta, dist2, gamma, check_past_normal, any_check, sin_bias, inv_bias);
         VF delta_back[3];
         VM known;
         const VF dist2_back = SIMD_NAME(back_point)(b, &fetches[step], delta_back, &known);
+        if (!SIMD_NAME(layer_step_matters)(b, ok, delta, delta_back, known)) continue;
+        const VF front = SIMD_NAME(sector_fraction_cosine)(
+            b, sl, delta, dist2, gamma, check_past_normal, any_check, sin_bias, inv_bias);
         const VF behind = V_SELECT(
             M_AND(known, V_GT(dist2_back, V_SET(0.0f))), V_SET(1.0f),
             SIMD_NAME(sector_fraction_cosine)(b, sl, delta_back, dist2_back, gamma,
@@ -557,6 +570,10 @@ static VF SIMD_NAME(direction_occlusion_hbao_layers)(const hbao_settings *s,
         VF delta[3], dist2;
         VM ok = SIMD_NAME(sample_layers)(b, &fetches[step], alive, delta, &dist2);
         if (!M_ANY(ok)) continue;
+        VF delta_back[3];
+        VM known;
+        const VF dist2_back = SIMD_NAME(back_point)(b, &fetches[step], delta_back, &known);
+        if (!SIMD_NAME(layer_step_matters)(b, ok, delta, delta_back, known)) continue;
         const VF inv_dist = V_DIV(V_SET(1.0f), V_SQRT(dist2));
         const VF sin_s = SIMD_NAME(sample_elevation)(b, delta, inv_dist);
         if (any_check) {
@@ -570,9 +587,6 @@ static VF SIMD_NAME(direction_occlusion_hbao_layers)(const hbao_settings *s,
             }
         }
         const VF front = V_MUL(V_SUB(V_SET(1.0f), sin_s), inv_range);
-        VF delta_back[3];
-        VM known;
-        const VF dist2_back = SIMD_NAME(back_point)(b, &fetches[step], delta_back, &known);
         const VF sin_back =
             SIMD_NAME(sample_elevation)(b, delta_back, V_DIV(V_SET(1.0f), V_SQRT(dist2_back)));
         const VF behind = V_SELECT(M_AND(known, V_GT(dist2_back, V_SET(0.0f))), V_SET(1.0f),
