@@ -358,6 +358,15 @@ static inline int enter_the_ball(const march *m, size_t at, float delta[3], floa
     return *dist2 > 0.0f;
 }
 
+/* march_sample with the back layer: a sample beyond the radius whose
+ * occluder enters it is a sample at the entry point (enter_the_ball). */
+static inline int march_layer_sample(const march *m, int step, float delta[3], float *dist2,
+                                     size_t *at) {
+    const int status = march_sample(m, step, delta, dist2, at);
+    if (status != SAMPLE_FAR) return status;
+    return enter_the_ball(m, *at, delta, dist2) ? SAMPLE_OK : SAMPLE_SKIP;
+}
+
 /* direction_occlusion_cosine with the back layer. */
 static float direction_occlusion_cosine_layers(const hbao_settings *s, const march *m,
                                                const float n[3], const float v[3], const slice *sl,
@@ -377,11 +386,9 @@ static float direction_occlusion_cosine_layers(const hbao_settings *s, const mar
     for (int step = 0; step < s->steps; step++) {
         float delta[3], dist2;
         size_t at;
-        const int status = march_sample(m, step, delta, &dist2, &at);
+        const int status = march_layer_sample(m, step, delta, &dist2, &at);
         if (status == SAMPLE_END) break;
-        if (status == SAMPLE_SKIP ||
-            (status == SAMPLE_FAR && !enter_the_ball(m, at, delta, &dist2)))
-            continue;
+        if (status != SAMPLE_OK) continue;
         const float front = sector_fraction_cosine(m, sl, n, v, delta, dist2, gamma,
                                                    check_past_normal, s->sin_bias, inv_bias);
         float delta_back[3], dist2_back;
@@ -412,11 +419,9 @@ static float direction_occlusion_hbao_layers(const hbao_settings *s, const march
     for (int step = 0; step < s->steps; step++) {
         float delta[3], dist2;
         size_t at;
-        const int status = march_sample(m, step, delta, &dist2, &at);
+        const int status = march_layer_sample(m, step, delta, &dist2, &at);
         if (status == SAMPLE_END) break;
-        if (status == SAMPLE_SKIP ||
-            (status == SAMPLE_FAR && !enter_the_ball(m, at, delta, &dist2)))
-            continue;
+        if (status != SAMPLE_OK) continue;
         const float inv_dist = 1.0f / sqrtf(dist2);
         const float sin_s = sample_elevation(m, n, delta, inv_dist);
         if (check_past_normal && past_the_normal(m, sl, v, delta, inv_dist, sin_s)) {
