@@ -33,9 +33,7 @@ import numpy as np
 import metrics
 import run_benchmark
 import sweep
-
-sys.path.insert(0, str(run_benchmark.REPO / "addon"))
-from hbao.parameters import DEFAULTS  # noqa: E402  (bpy-free)
+from report import SHIPPED_DEFAULT
 
 WIDTH, HEIGHT = 1920, 1080
 THREADS = 2
@@ -65,10 +63,7 @@ def main():
     quick = json.loads(results_path.read_text())
     # The defaults the library ships (not the quick run's own recommendation,
     # which follows that run's timings).
-    setting = {"directions": DEFAULTS["directions"], "steps": DEFAULTS["steps"],
-               "half_resolution": False, "blur_size": DEFAULTS["blur_size"],
-               "integration": DEFAULTS["integration"], "falloff": DEFAULTS["falloff"],
-               "angle_bias_degrees": DEFAULTS["angle_bias_degrees"]}
+    setting = dict(SHIPPED_DEFAULT)
     recommended_key = sweep.setting_key(setting)
     native = sweep.load_native()
     user_scripts = Path(tempfile.mkdtemp(prefix="hbao-bench-scripts-"))

@@ -19,6 +19,11 @@ REPO = Path(__file__).resolve().parent.parent
 BORDER_FRACTION = 0.125
 
 
+# The add-on's bpy-free modules (the binding, the parameters) import from here.
+if str(REPO / "addon") not in sys.path:
+    sys.path.insert(0, str(REPO / "addon"))
+
+
 def load_native():
     """The add-on's binding (the package imports without bpy). Loads this
     checkout's build unless HBAO_LIBRARY names another library."""
