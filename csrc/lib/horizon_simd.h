@@ -198,8 +198,8 @@ static inline int SIMD_NAME(fetch_steps)(const SIMD_NAME(block) * b, int steps, 
 
 /* A fetched step's sample vector and squared length, and which lanes have a
  * usable sample (returned), among the lanes in `live`. */
-static inline VM SIMD_NAME(sample)(const SIMD_NAME(block) * b, const SIMD_NAME(fetch) * f, VM live,
-                                   VF delta[3], VF *dist2) {
+static inline VM SIMD_NAME(sample_far)(const SIMD_NAME(block) * b, const SIMD_NAME(fetch) * f,
+                                       VM live, VF delta[3], VF *dist2, VM *far) {
     const hbao_grid *g = b->grid;
     const VF zs = f->zs;
     const VM valid =
@@ -212,7 +212,17 @@ static inline VM SIMD_NAME(sample)(const SIMD_NAME(block) * b, const SIMD_NAME(f
     delta[1] = V_SUB(q1, b->p[1]);
     delta[2] = V_SUB(V_NEG(zs), b->p[2]);
     *dist2 = SIMD_NAME(dot3)(delta[0], delta[1], delta[2], delta[0], delta[1], delta[2]);
-    return M_AND(valid, M_AND(V_LT(*dist2, b->radius2), V_GT(*dist2, V_SET(0.0f))));
+    const VM near = V_LT(*dist2, b->radius2);
+    const VM positive = M_AND(valid, V_GT(*dist2, V_SET(0.0f)));
+    /* horizon.c's SAMPLE_FAR: usable but beyond the radius (finite) */
+    *far = M_ANDNOT(near, M_AND(positive, V_LT(*dist2, V_SET(INFINITY))));
+    return M_AND(positive, near);
+}
+
+static inline VM SIMD_NAME(sample)(const SIMD_NAME(block) * b, const SIMD_NAME(fetch) * f, VM live,
+                                   VF delta[3], VF *dist2) {
+    VM far;
+    return SIMD_NAME(sample_far)(b, f, live, delta, dist2, &far);
 }
 
 /* SIMD_NAME(sample) with the back layer: the lanes beyond the radius whose
@@ -221,13 +231,8 @@ static inline VM SIMD_NAME(sample)(const SIMD_NAME(block) * b, const SIMD_NAME(f
 static inline VM SIMD_NAME(sample_layers)(const SIMD_NAME(block) * b, const SIMD_NAME(fetch) * f,
                                           VM live, VF delta[3], VF *dist2) {
     const hbao_grid *g = b->grid;
-    const VM ok = SIMD_NAME(sample)(b, f, live, delta, dist2);
-    const VF zs = f->zs;
-    const VM valid =
-        M_AND(M_AND(f->candidate, live), M_AND(V_GT(zs, V_SET(0.0f)), V_GE(zs, b->near_limit)));
-    const VM far =
-        M_ANDNOT(V_LT(*dist2, b->radius2),
-                 M_AND(valid, M_AND(V_GT(*dist2, V_SET(0.0f)), V_LT(*dist2, V_SET(INFINITY)))));
+    VM far;
+    const VM ok = SIMD_NAME(sample_far)(b, f, live, delta, dist2, &far);
     if (!M_ANY(far)) return ok;
     const VF q[3] = {V_ADD(delta[0], b->p[0]), V_ADD(delta[1], b->p[1]), V_ADD(delta[2], b->p[2])};
     VF d[3] = {V_SET(0.0f), V_SET(0.0f), V_SET(-1.0f)};
