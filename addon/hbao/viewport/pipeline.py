@@ -38,6 +38,13 @@ class _Target:
         self.framebuffer = gpu.types.GPUFrameBuffer(color_slots=self.texture)
 
 
+class _TwoTargets:
+    """Two textures one pass draws into (fragment outputs 0 and 1)."""
+
+    def __init__(self, first, second):
+        self.framebuffer = gpu.types.GPUFrameBuffer(color_slots=(first.texture, second.texture))
+
+
 class AOPipeline:
     """The targets of one view: full-size ones, and the half grid's when the
     preview runs at half resolution; kept while the view's size (and
@@ -47,6 +54,7 @@ class AOPipeline:
         self.size = None
         self._linear_depth = self._normals = self._ao = self._blurred_rows = None
         self._half_depth = self._half_normals = self._half_ao = None
+        self._upsampled = None
 
     def _ensure_size(self, width, height, half=False):
         if self.size == (width, height, half):
@@ -63,8 +71,10 @@ class AOPipeline:
             self._half_depth = _Target(half_width, half_height)
             self._half_normals = _Target(half_width, half_height, "RGBA32F")
             self._half_ao = _Target(half_width, half_height)
+            self._upsampled = _TwoTargets(self._ao, self._normals)
         else:
             self._half_depth = self._half_normals = self._half_ao = None
+            self._upsampled = None
         self.size = (width, height, half)
 
     def linearize(self, buffer_depth_texture, coefficients, half=False):
@@ -127,18 +137,16 @@ class AOPipeline:
         self._search(self._half_depth.texture, grid, params, depth_precision,
                      self._half_normals, self._half_ao)
         shader = shaders.get("upsample")
-        for target, output_normal in ((self._ao, 0), (self._normals, 1)):
-            with target.framebuffer.bind():
-                shader.bind()
-                shader.uniform_sampler("depth_texture", depth_texture)
-                shader.uniform_sampler("half_depth_texture", self._half_depth.texture)
-                shader.uniform_sampler("half_ao_texture", self._half_ao.texture)
-                shader.uniform_sampler("half_normal_texture", self._half_normals.texture)
-                for name, value in sizes.items():
-                    shader.uniform_int(name, value)
-                shader.uniform_int("output_normal", output_normal)
-                shader.uniform_float("background_depth", params["background_depth"])
-                _draw_quad("upsample")
+        with self._upsampled.framebuffer.bind():
+            shader.bind()
+            shader.uniform_sampler("depth_texture", depth_texture)
+            shader.uniform_sampler("half_depth_texture", self._half_depth.texture)
+            shader.uniform_sampler("half_ao_texture", self._half_ao.texture)
+            shader.uniform_sampler("half_normal_texture", self._half_normals.texture)
+            for name, value in sizes.items():
+                shader.uniform_int(name, value)
+            shader.uniform_float("background_depth", params["background_depth"])
+            _draw_quad("upsample")
 
     def ambient_occlusion(self, depth_texture, frame, params,
                           depth_precision=shader_sources.FLOAT_DEPTH_PRECISION):

@@ -142,8 +142,9 @@ void main()
 # csrc/lib/upsample.c operation for operation: a pixel's candidates are the
 # half-grid pixels around it with bilinear weights (even columns and rows sit
 # on the grid), each weighed by its depth's similarity; the candidates'
-# normals, averaged with the same weights, guide the blur. output_normal = 0
-# writes the AO, 1 the guide normal (the blur reads them from two textures).
+# normals, averaged with the same weights, guide the blur. One pass writes
+# both: the AO to frag_output, the guide normal to guide_output (two targets;
+# the blur reads them from two textures).
 UPSAMPLE_FRAGMENT = COMMON + """
 #define LARGEST_FLOAT 3.402823466e38
 
@@ -206,11 +207,8 @@ void main()
     float blended = weighted ? sum / weight_sum : nearest_ao;
     float length_sum = length(normal_sum);
     vec3 guide = weighted && length_sum > 0.0 ? normal_sum / length_sum : nearest_normal;
-    if (output_normal != 0) {
-        frag_output = vec4(guide, 0.0);
-    } else {
-        frag_output = vec4(is_background(z) ? 1.0 : blended, 0.0, 0.0, 1.0);
-    }
+    frag_output = vec4(is_background(z) ? 1.0 : blended, 0.0, 0.0, 1.0);
+    guide_output = vec4(guide, 0.0);
 }
 """
 

@@ -8,14 +8,16 @@ from . import shader_sources
 _shaders = {}
 
 
-def _create_info(fragment_source, push_constants, samplers, defines=None):
+def _create_info(fragment_source, push_constants, samplers, defines=None,
+                 outputs=("frag_output",)):
     info = gpu.types.GPUShaderCreateInfo()
     for glsl_type, name in push_constants:
         info.push_constant(glsl_type, name)
     for slot, name in enumerate(samplers):
         info.sampler(slot, "FLOAT_2D", name)
     info.vertex_in(0, "VEC2", "position")
-    info.fragment_out(0, "VEC4", "frag_output")
+    for slot, name in enumerate(outputs):
+        info.fragment_out(slot, "VEC4", name)
     info.vertex_source(shader_sources.FULL_SCREEN_VERTEX)
     # Plain #define lines rather than GPUShaderCreateInfo.define, which 3.4 lacks.
     define_lines = "".join(f"#define {name} {value}\n" for name, value in (defines or {}).items())
@@ -50,10 +52,9 @@ _DEFINITIONS = {
         ["depth_texture"]),
     "upsample": lambda: _create_info(
         shader_sources.UPSAMPLE_FRAGMENT,
-        [("IVEC2", "full_size"), ("IVEC2", "half_size"), ("INT", "output_normal"),
-         ("FLOAT", "background_depth")],
+        [("IVEC2", "full_size"), ("IVEC2", "half_size"), ("FLOAT", "background_depth")],
         ["depth_texture", "half_depth_texture", "half_ao_texture", "half_normal_texture"],
-        shader_sources.UPSAMPLE_DEFINES),
+        shader_sources.UPSAMPLE_DEFINES, outputs=("frag_output", "guide_output")),
     "blur": lambda: _create_info(
         shader_sources.BLUR_FRAGMENT,
         [("IVEC2", "image_size"), ("IVEC2", "blur_step"), ("INT", "kernel_radius"),
