@@ -75,6 +75,9 @@ CASES = [
      {"integration": "HBAO", "blur_size": 9, "blur_sharpness": 8.0, "half_resolution": 1}),
     ("ortho_cosine_half_odd", ORTHOGRAPHIC_CAMERA,
      {"blur_size": 5, "radius": 0.8, "half_resolution": 1}, {"size": (WIDTH + 1, HEIGHT + 1)}),
+    # A view one pixel tall at half resolution: a half grid of one row.
+    ("one_row_hbao_half", PERSPECTIVE_CAMERA,
+     {"integration": "HBAO", "blur_size": 0, "half_resolution": 1}, {"size": (WIDTH + 1, 1)}),
 ]
 # The floor's height (camera space) in the cases that do not give their own.
 FLOOR_Y = -1.0
