@@ -76,6 +76,7 @@ typedef struct SIMD_NAME(block) {
     const hbao_horizon_job *job;
     const hbao_grid *grid;
     VI lane_i;   /* the lanes' columns: first_i + 4 k */
+    int first_i; /* lane 0's column */
     int phase;   /* first_i & 3: the lanes' column phase */
     int first_x; /* lane 0's index in its phase_depth row: first_i / 4 */
     int j;
@@ -93,8 +94,8 @@ typedef struct SIMD_NAME(block) {
 typedef struct SIMD_NAME(fetch) {
     VF zs;
     VF zb;        /* the back layer's depth there (INFINITY: unknown) */
-    VI si;        /* the samples' columns */
-    int sj;       /* and their row, the same for all lanes */
+    VF column;    /* the samples' hbao_grid x (view x per unit depth) */
+    float row;    /* and y, the same for all lanes */
     VM candidate; /* inside the image, on another pixel */
 } SIMD_NAME(fetch);
 
@@ -151,16 +152,17 @@ static inline int SIMD_NAME(fetch_steps)(const SIMD_NAME(block) * b, int steps, 
         if (step > 0 && ox == offset_x[step - 1] && oy == offset_y[step - 1]) continue;
         const int sj = b->j + oy;
         if (sj < 0 || sj >= g->height) break; /* every lane's sample leaves the image */
-        const VI si = I_ADD(b->lane_i, I_SET(ox));
-        const VF column = I_TO_F(si); /* exact: |si| < 2^24 */
-        alive =
-            M_AND(alive, M_AND(V_GE(column, V_SET(0.0f)), V_LT(column, V_SET((float)g->width))));
+        const VF si = I_TO_F(I_ADD(b->lane_i, I_SET(ox))); /* exact: |si| < 2^24 */
+        /* lanes whose column leaves the image stop; the lanes' columns
+         * first_i + ox + 4 k all lie inside unless the block is at a side */
+        if (b->first_i + ox < 0 || b->first_i + ox + 4 * (SIMD_LANES - 1) >= g->width)
+            alive = M_AND(alive, M_AND(V_GE(si, V_SET(0.0f)), V_LT(si, V_SET((float)g->width))));
         const VM candidate = (ox == 0 && oy == 0) ? M_ANDNOT(alive, alive) : alive;
         /* lane k samples column first_i + 4 k + ox: phase (phase + ox) mod 4,
          * index first_x + k + floor((phase + ox) / 4) of that phase's row */
         const int moved = b->phase + ox;
-        const int new_phase = ((moved % 4) + 4) % 4;
-        const int first = b->first_x + (moved - new_phase) / 4;
+        const int new_phase = moved & 3;                        /* moved mod 4, two's complement */
+        const int first = b->first_x + (moved - new_phase) / 4; /* exact */
         const size_t row_start = ((size_t)new_phase * g->height + sj) * phase_width;
         const float *row = b->job->phase_depth + row_start;
         const int whole = first >= 0 && first + SIMD_LANES <= phase_width;
@@ -188,8 +190,8 @@ static inline int SIMD_NAME(fetch_steps)(const SIMD_NAME(block) * b, int steps, 
             }
             fetches[fetched].zb = zb;
         }
-        fetches[fetched].si = si;
-        fetches[fetched].sj = sj;
+        fetches[fetched].column = V_MUL(V_ADD(si, V_SET(g->x_offset)), V_SET(g->x_step));
+        fetches[fetched].row = hbao_grid_y(g, sj);
         fetches[fetched].candidate = candidate;
         fetched++;
     }
@@ -204,8 +206,8 @@ static inline VM SIMD_NAME(sample_far)(const SIMD_NAME(block) * b, const SIMD_NA
     const VF zs = f->zs;
     const VM valid =
         M_AND(M_AND(f->candidate, live), M_AND(V_GT(zs, V_SET(0.0f)), V_GE(zs, b->near_limit)));
-    const VF column = V_MUL(V_ADD(I_TO_F(f->si), V_SET(g->x_offset)), V_SET(g->x_step));
-    const VF row = V_SET(hbao_grid_y(g, f->sj));
+    const VF column = f->column;
+    const VF row = V_SET(f->row);
     const VF q0 = g->orthographic ? column : V_MUL(column, zs);
     const VF q1 = g->orthographic ? row : V_MUL(row, zs);
     delta[0] = V_SUB(q0, b->p[0]);
@@ -466,8 +468,8 @@ static inline VF SIMD_NAME(back_point)(const SIMD_NAME(block) * b, const SIMD_NA
     const VF thinnest = V_ADD(f->zs, b->min_thickness);
     const VF zb = V_SELECT(V_GT(f->zb, thinnest), thinnest, f->zb);
     *known = V_LT(f->zb, V_SET(INFINITY));
-    const VF column = V_MUL(V_ADD(I_TO_F(f->si), V_SET(g->x_offset)), V_SET(g->x_step));
-    const VF row = V_SET(hbao_grid_y(g, f->sj));
+    const VF column = f->column;
+    const VF row = V_SET(f->row);
     delta[0] = V_SUB(g->orthographic ? column : V_MUL(column, zb), b->p[0]);
     delta[1] = V_SUB(g->orthographic ? row : V_MUL(row, zb), b->p[1]);
     delta[2] = V_SUB(V_NEG(zb), b->p[2]);
@@ -616,6 +618,7 @@ static void SIMD_NAME(lanes_ao)(const hbao_horizon_job *job, int x0, int x1, int
     b.grid = g;
     b.j = j;
     const int first_i = x0 + a + 4 * first_lane;
+    b.first_i = first_i;
     b.phase = a;
     b.first_x = first_i / 4;
     /* phase_depth rows are padded to whole blocks with zeros: background */
