@@ -199,6 +199,39 @@ def test_unchanged_frame_reuses_its_ao(run_in_blender, tmp_path, native):
         assert np.abs(fixed - expected).max() <= EXACT
 
 
+def test_node_says_when_its_settings_changed_since_the_render(run_in_blender, tmp_path):
+    """Re-compositing an existing render keeps the AO of the settings it was
+    rendered with (README, Limits): after a render the node says when its
+    settings no longer match (render_record.py, drawn under the settings),
+    and stops saying it when they match again. The render's own frame
+    counts: the keyframed radius differs at frame 5, but frame 1 was
+    rendered."""
+    spec = {"frames": [1], "nodes": [
+        {"name": "Hinted", "keyframes": [[1, 0.6], [5, 1.1]], "blur_size": 0}],
+        "after_render": [
+            {"label": "as rendered"},
+            {"label": "other frame", "frame": 5},
+            {"label": "blur size", "socket": ["Blur Size", 3]},
+            {"label": "blur size back", "socket": ["Blur Size", 0]},
+            {"label": "integration", "integration": "HBAO"},
+            {"label": "integration back", "integration": "COSINE"},
+            {"label": "back faces", "back_faces": True},
+            {"label": "back faces off", "back_faces": False},
+            {"label": "blur size, muted", "socket": ["Blur Size", 5], "mute": True}]}
+    _out, log = render(run_in_blender, tmp_path, spec)
+    hints = {}
+    for line in log.splitlines():
+        if line.startswith("HINT "):
+            said = json.loads(line[len("HINT "):])
+            hints[said["label"]] = said["hint"][0] if said["hint"] else None
+    changed = "Changed: render to update"
+    assert hints == {"as rendered": None, "other frame": None,
+                     "blur size": changed, "blur size back": None,
+                     "integration": changed, "integration back": None,
+                     "back faces": changed, "back faces off": None,
+                     "blur size, muted": None}, log[-3000:]
+
+
 def test_two_nodes_two_view_layers_and_muted_node(run_in_blender, tmp_path, native):
     spec = {"scene": "two_layers", "nodes": [
         {"name": "Small", "layer": "Front", "radius": 0.2},

@@ -2,9 +2,9 @@
 """The HBAO node as an artist meets it, in Debian's Blender with a window
 (xvfb): a file saved with the old float sockets opens with integer sockets
 and keeps its values, links and keyframes; Add > Filter offers HBAO and the
-node search does not offer the internal group. (The node's status line after
-an F12 render is not applied yet: the console and the render's report carry
-the messages; see the closing note of this wave.)"""
+node search does not offer the internal group; after an F12 render the
+node's status line says what the render met, and once a setting changes the
+node says that the AO shown is still the render's."""
 import json
 import struct
 
@@ -48,14 +48,19 @@ def test_old_file_gets_integer_sockets_and_keeps_values_links_keyframes(ui_repor
 
 def test_node_status_line_after_each_f12_render(ui_report):
     """What the artist reads on the node (out/test-artifacts/ui_node_*.png):
-    the short form fits the node, the full text is the tooltip."""
+    the short form fits the node, the full text is the tooltip; and, once a
+    setting changed after the render, that the AO shown is the render's."""
     renders = ui_report["renders"]
     assert renders["depth_unlinked"]["status"] == "Depth not linked: AO off"
     assert "Depth is not linked" in renders["depth_unlinked"]["details"]
     assert renders["clamped"]["status"] == "Steps clamped to 64"
     assert "Steps 100 is above the limit 64; using 64" in renders["clamped"]["details"]
     assert renders["good"] == {"status": "", "details": ""}
-    for name in renders:
+    # Steps changed after the last render: the node says the AO is old.
+    changed = ui_report["changed_after_render"]
+    assert changed["hint"] == "Changed: render to update"
+    assert "render again (F12)" in changed["details"]
+    for name in list(renders) + ["changed"]:
         shot = ARTIFACTS / f"ui_node_{name}.png"
         width, height = struct.unpack(">II", shot.read_bytes()[16:24])
         assert (width, height) == (1280, 1024), (name, width, height)

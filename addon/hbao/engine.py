@@ -11,7 +11,7 @@ import bpy
 import numpy as np
 
 from . import camera as camera_model
-from . import ao_cache, exr_passes, handover, layer_passes, native
+from . import ao_cache, exr_passes, handover, layer_passes, native, render_record
 from .helper_lookup import ENGINE_IDNAME, is_helper, pass_names_for_helper
 from .helper_scene import rendered_for_a_scene, scene_for_render
 from .planning import node_names, plan
@@ -46,6 +46,7 @@ def compute_passes(engine, depsgraph, width, height):
         raise RuntimeError(f"scene {helper.name!r} is not an HBAO helper scene")
     frame = main.frame_current + main.frame_subframe
     jobs, warnings = plan(main, frame)
+    render_record.remember(main.name, frame, jobs, node_names(main))
     for warning in warnings:
         _report(engine, f"HBAO {warning}")
         log(warning)

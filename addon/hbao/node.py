@@ -24,6 +24,10 @@ MAX_STATUS_CHARACTERS = 30
 # Called with no arguments when an HBAO node is added, copied or deleted
 # (the hook's handlers subscribe: node callbacks must not edit the tree).
 changed_callbacks = []
+# Called with no arguments by the add-on's timer, in the main thread when no
+# render runs, to bring the nodes' hint lines (hint, hint_details) up to
+# date; each returns whether it changed one (render_record.apply_hints).
+hint_refreshers = []
 
 
 def is_hbao_node(node):
@@ -55,7 +59,8 @@ def _announce_change():
 
 def _settings_changed(node, _context):
     # Nothing to rebuild: the hook reads the node when Blender renders; the
-    # AO of an existing render is not computed again (README, Limits).
+    # AO of an existing render is not computed again (README, Limits), and
+    # the node says so (hint_refreshers).
     node.id_data.update_tag()
 
 
@@ -102,6 +107,9 @@ class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
                            description="Last message from the render hook about this node")
     status_details: StringProperty(name="Status Details", default="",
                                    description="The full text of the render hook's messages")
+    hint: StringProperty(name="Hint", default="",
+                         description="Whether the AO shown is still the last render's")
+    hint_details: StringProperty(name="Hint Details", default="")
 
     @classmethod
     def poll(cls, tree):
@@ -145,6 +153,10 @@ class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
             button = layout.operator(HBAO_OT_node_status.bl_idname, text=text, icon="ERROR",
                                      emboss=False)
             button.details = self.status_details or self.status
+        if self.hint:
+            button = layout.operator(HBAO_OT_node_status.bl_idname, text=self.hint, icon="INFO",
+                                     emboss=False)
+            button.details = self.hint_details or self.hint
 
     def draw_buttons_ext(self, context, layout):
         self.draw_buttons(context, layout)
@@ -196,22 +208,30 @@ def apply_node_messages():
                 show_messages(node, statuses[node.name])
                 changed = True
     if changed:
-        for window in getattr(bpy.context.window_manager, "windows", ()):
-            for area in window.screen.areas:
-                if area.type == "NODE_EDITOR":
-                    area.tag_redraw()
+        _redraw_node_editors()
+
+
+def _redraw_node_editors():
+    for window in getattr(bpy.context.window_manager, "windows", ()):
+        for area in window.screen.areas:
+            if area.type == "NODE_EDITOR":
+                area.tag_redraw()
 
 
 # During an F12 render every render handler runs in the job's thread, where
 # nodes may not be written and no timer may be started; this timer, running
 # while the add-on is enabled, shows what the render thread posted once no
-# render job runs. It costs a dictionary check per tick.
+# render job runs, and keeps the hint lines current. It costs a dictionary
+# check and, per HBAO node of a rendered scene, a comparison per tick.
 _POLL_S = 0.25
 
 
 def _poll_node_messages():
-    if report.has_node_messages() and not bpy.app.is_job_running("RENDER"):
-        apply_node_messages()
+    if not bpy.app.is_job_running("RENDER"):
+        if report.has_node_messages():
+            apply_node_messages()
+        if any([refresh() for refresh in hint_refreshers]):
+            _redraw_node_editors()
     return _POLL_S
 
 

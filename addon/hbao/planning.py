@@ -40,7 +40,7 @@ def pass_source(socket, scene, expected):
     return node.layer, None, None
 
 
-def _plan_node(node, main, frame, warnings):
+def plan_node(node, main, frame, warnings):
     """The Job of one HBAO node, or None when it computes nothing."""
     depth_layer, error, short = pass_source(node.inputs[DEPTH_INPUT], main, "Depth")
     if depth_layer is None:
@@ -83,7 +83,7 @@ def plan(main, frame):
             continue
         if not any(output.is_linked for output in node.outputs):
             continue  # nobody looks at it: costs nothing
-        job = _plan_node(node, main, frame, warnings)
+        job = plan_node(node, main, frame, warnings)
         if job is not None:
             jobs.append(job)
     post_node_messages(main.name, node_names(main), warnings)

@@ -194,6 +194,20 @@ for frame in spec.get("frames", [1]):
         layer = back.view_layers[0].name
         channels, _timings = handover.read_passes(back, {layer: False})
         np.save(os.path.join(out_dir, f"back_{frame:04d}.npy"), channels[("depth", layer)])
+# After the renders: change the first node step by step and print what its
+# "changed since the last render" line says after each step.
+hinted = next(n for n in tree.nodes if n.bl_idname == "CompositorNodeHBAO")
+for step in spec.get("after_render", []):
+    from hbao import render_record
+    for key, value in step.items():
+        if key == "socket":
+            hinted.inputs[value[0]].default_value = value[1]
+        elif key == "frame":
+            scene.frame_set(value)
+        elif key != "label":
+            setattr(hinted, key, value)
+    print("HINT", json.dumps({"label": step["label"],
+                              "hint": render_record.changed_since_render(hinted)}))
 for node in tree.nodes:  # what each node's status line says after the renders
     if node.bl_idname == "CompositorNodeHBAO":
         print("STATUS", json.dumps({"node": node.name, "status": node.status}))

@@ -6,7 +6,9 @@ ui_old_file.py saved: what an artist meets on the HBAO node.
 - Add > Filter draws "HBAO"; the node search items do not offer ".HBAO";
 - F12 renders (the render job's thread) with a fault, then with a clamped
   value, then with nothing wrong: the node's status after each, and
-  screenshots of the node editor showing it.
+  screenshots of the node editor showing it;
+- after the last render, a changed Steps value: the node's line saying that
+  the AO shown is the last render's, and a screenshot of it.
 
   blender --addons hbao --python ui_node.py OLD.blend -- OUT.json SHOT_DIR
 """
@@ -146,8 +148,17 @@ def run_renders():
     state["index"] += 1
     state["started"] = None
     if state["index"] == len(RENDERS):
-        return finish()
+        tree.nodes["Steps Value"].outputs[0].default_value = 9.0
+        bpy.app.timers.register(changed_after_render, first_interval=SETTLE_S)
+        return None
     return 0.25
+
+
+def changed_after_render():
+    """The node's line once the add-on's timer has seen the change."""
+    report["changed_after_render"] = {"hint": hbao.hint, "details": hbao.hint_details}
+    screenshot(bpy.context.window_manager.windows[0], state.get("area"), "ui_node_changed.png")
+    return finish()
 
 
 def finish():
