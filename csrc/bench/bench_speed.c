@@ -16,8 +16,8 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench_common.h"
 #include "hbao.h"
-#include "scene.h"
 
 /* Issue 11's targets, all for 1920x1080 on 2 threads (the medians of the
  * fastest implementation), and the speed-up over the scalar reference on 1
@@ -47,61 +47,6 @@ static const bench_column all_columns[] = {
     {"AVX-512, 2 threads", HBAO_IMPLEMENTATION_AVX512, 2},
 };
 #define COLUMN_COUNT ((int)(sizeof all_columns / sizeof all_columns[0]))
-
-static int compare_doubles(const void *a, const void *b) {
-    const double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double clock_seconds(clockid_t clock) {
-    struct timespec t;
-    clock_gettime(clock, &t);
-    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
-}
-
-static double median_of(double *values, int count) {
-    qsort(values, (size_t)count, sizeof(double), compare_doubles);
-    return count % 2 ? values[count / 2] : 0.5 * (values[count / 2 - 1] + values[count / 2]);
-}
-
-static void print_load(const char *when) {
-    FILE *f = fopen("/proc/loadavg", "r");
-    double one = 0.0, five = 0.0;
-    if (f != NULL && fscanf(f, "%lf %lf", &one, &five) == 2)
-        printf("Load average %s: %.2f (1 min), %.2f (5 min).\n", when, one, five);
-    if (f != NULL) fclose(f);
-}
-
-/* A room corner (floor, two walls) with a box: every pixel is geometry. */
-typedef struct bench_scene {
-    scene_view view;
-    float *depth, *normal;
-} bench_scene;
-
-static void bench_scene_make(bench_scene *b, int width, int height) {
-    scene s;
-    memset(&s, 0, sizeof s);
-    s.plane[s.planes] = scene_plane_make(0, 0, 0, 0, 0, 1);
-    scene_plane_clip(&s.plane[s.planes++], 1, 0, 0, 0);
-    s.plane[s.planes] = scene_plane_make(0, 0, 0, -1, 0, 0);
-    scene_plane_clip(&s.plane[s.planes++], 0, 0, -1, 0);
-    s.plane[s.planes++] = scene_plane_make(0, 4, 0, 0, -1, 0);
-    scene_plane front = scene_plane_make(-1.5, 0, 0, -1, 0, 0);
-    scene_plane_clip(&front, 0, 0, 1, 0.6);
-    scene_plane_clip(&front, 0, 1, 0, 0.5);
-    s.plane[s.planes++] = front;
-    scene_plane top = scene_plane_make(0, 0, 0.6, 0, 0, 1);
-    scene_plane_clip(&top, -1, 0, 0, 1.5);
-    scene_plane_clip(&top, 0, 1, 0, 0.5);
-    s.plane[s.planes++] = top;
-    memset(&b->view, 0, sizeof b->view);
-    b->view.width = width;
-    b->view.height = height;
-    hbao_camera_default(&b->view.camera);
-    const double eye[3] = {-5.0, -2.0, 2.5}, target[3] = {-0.5, 1.0, 0.4};
-    scene_look_at(&b->view, eye, target);
-    scene_render(&s, &b->view, &b->depth, &b->normal);
-}
 
 /* One call's wall-clock and process CPU seconds (all threads together; on
  * a loaded machine the steadier of the two). Returns 0 on error. */

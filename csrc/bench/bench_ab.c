@@ -1,0 +1,132 @@
+/* SPDX-License-Identifier: GPL-2.0-or-later */
+/* Two builds of libhbao timed against each other in the same run: "before"
+ * and "after" a change, on bench_speed's 1080p scene at the defaults (or
+ * --half, --radius). On a shared machine the time of one build moves by
+ * 10 % between minutes, so the builds alternate: a round makes --calls calls
+ * with each, and prints each build's fastest call and lower quartile (the
+ * steadiest figures under load: CPU ms on 1 thread, wall ms on more). Also
+ * says whether the two builds' AO is bit-identical, which a lossless change
+ * must keep. Not a test: it asserts nothing.
+ *
+ *   bench_ab BEFORE/libhbao.so AFTER/libhbao.so [--rounds R] [--calls N]
+ *            [--threads T] [--half] [--radius R] */
+#define _GNU_SOURCE /* RTLD_DEEPBIND */
+#include <dlfcn.h>
+
+#include "bench_common.h"
+
+typedef hbao_result (*compute_function)(const hbao_params *, const hbao_camera *, int32_t, int32_t,
+                                        const hbao_channel *, const hbao_channel *, float *,
+                                        int64_t);
+
+typedef struct build {
+    const char *path;
+    compute_function compute;
+    float *ao;
+    double best_sum, quartile_sum;
+} build;
+
+static int load(build *b, int width, int height) {
+    /* By path: two files are two libraries, whatever their soname. This
+     * program is linked with a third (for the scene's camera): DEEPBIND
+     * makes each loaded library call its own functions, not that one's. */
+    void *library = dlopen(b->path, RTLD_NOW | RTLD_LOCAL | RTLD_DEEPBIND);
+    if (library == NULL) {
+        fprintf(stderr, "bench_ab: %s\n", dlerror());
+        return 0;
+    }
+    b->compute = (compute_function)(uintptr_t)dlsym(library, "hbao_compute");
+    b->ao = malloc(sizeof(float) * (size_t)width * (size_t)height);
+    if (b->compute == NULL || b->ao == NULL) {
+        fprintf(stderr, "bench_ab: %s has no hbao_compute\n", b->path);
+        return 0;
+    }
+    return 1;
+}
+
+static void usage(const char *program) {
+    fprintf(stderr,
+            "usage: %s BEFORE_LIBRARY AFTER_LIBRARY [--rounds R] [--calls N] [--threads T] "
+            "[--half] [--radius R]\n",
+            program);
+}
+
+int main(int argc, char **argv) {
+    int rounds = 3, calls = 15, threads = 1, half = 0;
+    float radius = 0.5f;
+    if (argc < 3) {
+        usage(argv[0]);
+        return 2;
+    }
+    for (int a = 3; a < argc; a++) {
+        if (!strcmp(argv[a], "--rounds") && a + 1 < argc)
+            rounds = atoi(argv[++a]);
+        else if (!strcmp(argv[a], "--calls") && a + 1 < argc)
+            calls = atoi(argv[++a]);
+        else if (!strcmp(argv[a], "--threads") && a + 1 < argc)
+            threads = atoi(argv[++a]);
+        else if (!strcmp(argv[a], "--radius") && a + 1 < argc)
+            radius = (float)atof(argv[++a]);
+        else if (!strcmp(argv[a], "--half"))
+            half = 1;
+        else {
+            usage(argv[0]);
+            return 2;
+        }
+    }
+    if (rounds < 1 || rounds > 100 || calls < 1 || calls > 1000 || threads < 1 || threads > 64 ||
+        !(radius > 0.0f)) {
+        fprintf(stderr, "bench_ab: --rounds 1-100, --calls 1-1000, --threads 1-64, radius > 0\n");
+        return 2;
+    }
+    const int width = 1920, height = 1080;
+    build builds[2] = {{argv[1], NULL, NULL, 0.0, 0.0}, {argv[2], NULL, NULL, 0.0, 0.0}};
+    for (int k = 0; k < 2; k++)
+        if (!load(&builds[k], width, height)) return 1;
+    bench_scene frame;
+    bench_scene_make(&frame, width, height);
+    hbao_params params = HBAO_PARAMS_DEFAULT_INITIALIZER;
+    params.radius = radius;
+    params.threads = threads;
+    params.half_resolution = half;
+    const hbao_channel depth = {frame.depth, 1, width};
+    const hbao_channel normal = {frame.normal, 3, 3 * (int64_t)width};
+    double *times = malloc(sizeof(double) * (size_t)calls);
+    if (times == NULL) return 1;
+    const char *unit = threads == 1 ? "CPU ms" : "wall ms";
+    printf("1920x1080, defaults%s, radius %g, %d thread(s); per round and build: fastest and "
+           "lower-quartile %s of %d calls\n",
+           half ? ", half resolution" : "", radius, threads, unit, calls);
+    print_load("before");
+    for (int round = 0; round < rounds; round++) {
+        for (int k = 0; k < 2; k++) {
+            build *b = &builds[k];
+            for (int call = 0; call < calls; call++) {
+                const clockid_t clock = threads == 1 ? CLOCK_PROCESS_CPUTIME_ID : CLOCK_MONOTONIC;
+                const double start = clock_seconds(clock);
+                const hbao_result result = b->compute(&params, &frame.view.camera, width, height,
+                                                      &depth, &normal, b->ao, width);
+                times[call] = 1e3 * (clock_seconds(clock) - start);
+                if (result != HBAO_SUCCESS) {
+                    fprintf(stderr, "bench_ab: %s failed (%d)\n", b->path, (int)result);
+                    return 1;
+                }
+            }
+            qsort(times, (size_t)calls, sizeof(double), compare_doubles);
+            b->best_sum += times[0];
+            b->quartile_sum += times[calls / 4];
+            printf("round %d  %-6s %7.1f %7.1f  %s\n", round + 1, k == 0 ? "before" : "after",
+                   times[0], times[calls / 4], b->path);
+        }
+    }
+    print_load("after");
+    printf("mean over rounds, fastest / lower quartile: before %.1f / %.1f, after %.1f / %.1f "
+           "%s; after / before %.3f / %.3f\n",
+           builds[0].best_sum / rounds, builds[0].quartile_sum / rounds,
+           builds[1].best_sum / rounds, builds[1].quartile_sum / rounds, unit,
+           builds[1].best_sum / builds[0].best_sum,
+           builds[1].quartile_sum / builds[0].quartile_sum);
+    const int same = !memcmp(builds[0].ao, builds[1].ao, sizeof(float) * (size_t)width * height);
+    printf("AO of the two builds: %s\n", same ? "bit-identical" : "DIFFERENT");
+    return 0;
+}

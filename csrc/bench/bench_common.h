@@ -1,0 +1,70 @@
+/* SPDX-License-Identifier: GPL-2.0-or-later */
+/* What the speed benchmarks share: clocks, medians, the load line and the
+ * synthetic 1080p scene (bench_speed.c, bench_ab.c). */
+#ifndef HBAO_BENCH_COMMON_H
+#define HBAO_BENCH_COMMON_H
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "hbao.h"
+#include "scene.h"
+
+static inline int compare_doubles(const void *a, const void *b) {
+    const double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static inline double clock_seconds(clockid_t clock) {
+    struct timespec t;
+    clock_gettime(clock, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static inline double median_of(double *values, int count) {
+    qsort(values, (size_t)count, sizeof(double), compare_doubles);
+    return count % 2 ? values[count / 2] : 0.5 * (values[count / 2 - 1] + values[count / 2]);
+}
+
+static inline void print_load(const char *when) {
+    FILE *f = fopen("/proc/loadavg", "r");
+    double one = 0.0, five = 0.0;
+    if (f != NULL && fscanf(f, "%lf %lf", &one, &five) == 2)
+        printf("Load average %s: %.2f (1 min), %.2f (5 min).\n", when, one, five);
+    if (f != NULL) fclose(f);
+}
+
+/* A room corner (floor, two walls) with a box: every pixel is geometry. */
+typedef struct bench_scene {
+    scene_view view;
+    float *depth, *normal;
+} bench_scene;
+
+static inline void bench_scene_make(bench_scene *b, int width, int height) {
+    scene s;
+    memset(&s, 0, sizeof s);
+    s.plane[s.planes] = scene_plane_make(0, 0, 0, 0, 0, 1);
+    scene_plane_clip(&s.plane[s.planes++], 1, 0, 0, 0);
+    s.plane[s.planes] = scene_plane_make(0, 0, 0, -1, 0, 0);
+    scene_plane_clip(&s.plane[s.planes++], 0, 0, -1, 0);
+    s.plane[s.planes++] = scene_plane_make(0, 4, 0, 0, -1, 0);
+    scene_plane front = scene_plane_make(-1.5, 0, 0, -1, 0, 0);
+    scene_plane_clip(&front, 0, 0, 1, 0.6);
+    scene_plane_clip(&front, 0, 1, 0, 0.5);
+    s.plane[s.planes++] = front;
+    scene_plane top = scene_plane_make(0, 0, 0.6, 0, 0, 1);
+    scene_plane_clip(&top, -1, 0, 0, 1.5);
+    scene_plane_clip(&top, 0, 1, 0, 0.5);
+    s.plane[s.planes++] = top;
+    memset(&b->view, 0, sizeof b->view);
+    b->view.width = width;
+    b->view.height = height;
+    hbao_camera_default(&b->view.camera);
+    const double eye[3] = {-5.0, -2.0, 2.5}, target[3] = {-0.5, 1.0, 0.4};
+    scene_look_at(&b->view, eye, target);
+    scene_render(&s, &b->view, &b->depth, &b->normal);
+}
+
+#endif
