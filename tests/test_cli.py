@@ -881,7 +881,7 @@ def test_help_and_version(hbao_tool):
                  "--keep-input", "--layer", "--preview", "--info", "identity"):
         assert flag in shown.stdout
     version = run_ok(hbao_tool, "--version").stdout
-    assert version.startswith("hbao 0.2.0") and "libhbao 0.2.0" in version
+    assert version.startswith("hbao 0.3.0") and "libhbao 0.3.0" in version
 
 
 def test_info_lists_layers_and_types(hbao_tool):

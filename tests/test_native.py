@@ -145,6 +145,23 @@ def test_occluders_darken(native):
     assert np.all(ao[5:8, 50:60] == 1.0)  # background
 
 
+def test_kept_working_memory_changes_no_result(native):
+    """The library keeps its buffers between calls; a larger frame in
+    between and release_memory() (what the add-on calls after a render)
+    change nothing. Releasing without a loaded library loads none."""
+    depth = _bumpy_depth()
+    params = {"radius": 1.0}
+    first = native.compute_ao(depth, params=params)
+    native.compute_ao(np.tile(depth, (2, 3)) * 1.3, params=params)
+    assert np.array_equal(native.compute_ao(depth, params=params), first)
+    native.release_memory()
+    assert np.array_equal(native.compute_ao(depth, params=params), first)
+    native.unload_library()
+    native.release_memory()
+    from hbao import native_library
+    assert native_library._LIBRARY.loaded() is None
+
+
 def test_bottom_up_flips_consistently(native):
     depth = _bumpy_depth()
     normal = np.zeros((HEIGHT, WIDTH, 4), np.float32)
@@ -246,6 +263,7 @@ def test_incompatible_library_is_refused(monkeypatch, tmp_path):
         "size_t hbao_camera_size(void) { return 104; }\n"
         "int32_t hbao_compute(void) { return 0; }\n"
         "int32_t hbao_compute_layers(void) { return 0; }\n"
+        "void hbao_release_memory(void) {}\n"
         "size_t hbao_view_size(void) { return 40; }\n"
         "int32_t hbao_camera_view(void) { return 0; }\n"
         "int32_t hbao_camera_crop(void) { return 0; }\n"

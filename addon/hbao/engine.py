@@ -203,10 +203,27 @@ class HBAOPassEngine(bpy.types.RenderEngine):
         render_helper(self, depsgraph)
 
 
+@bpy.app.handlers.persistent
+def _on_render_end(*_args):
+    # The library keeps its working memory from frame to frame of a render
+    # (a fifth of a frame's time); between renders it is given back.
+    native.release_memory()
+
+
+_HANDLERS = (bpy.app.handlers.render_complete, bpy.app.handlers.render_cancel)
+
+
 def register():
     bpy.utils.register_class(HBAOPassEngine)
+    for handlers in _HANDLERS:
+        if _on_render_end not in handlers:
+            handlers.append(_on_render_end)
 
 
 def unregister():
+    for handlers in _HANDLERS:
+        if _on_render_end in handlers:
+            handlers.remove(_on_render_end)
     _cache.clear()
+    native.release_memory()
     bpy.utils.unregister_class(HBAOPassEngine)

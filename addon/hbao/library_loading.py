@@ -83,6 +83,11 @@ class NativeLibrary:
                 self._library = self._open(self.path())
             return self._library
 
+    def loaded(self):
+        """The library if load() has loaded it, else None (loads nothing)."""
+        with self._lock:
+            return self._library
+
     def unload(self):
         """Forget the loaded library so that the next load() reads path() again."""
         with self._lock:

@@ -13,7 +13,8 @@ import numpy as np
 # Re-exported: the binding's public names live here (noqa: F401).
 from .native_library import (BINDING_VERSION_MAJOR, LIBRARY_ENVIRONMENT_VARIABLE,  # noqa: F401
                              LIBRARY_FILE_NAME, HBAOError, HBAOLibraryError, check,
-                             library_path, library_version, load_library, unload_library)
+                             library_path, library_version, load_library, release_memory,
+                             unload_library)
 from .native_params import (PARAMETER_NAMES, default_params, params_struct,  # noqa: F401
                             resolve_params)
 from .native_structs import HBAOCamera, HBAOChannel, HBAOParams, HBAOView  # noqa: F401
@@ -23,7 +24,7 @@ from .parameters import (FALLOFF_VALUES, INTEGRATION_VALUES, PROJECTION_VALUES,
 __all__ = [
     "HBAOError", "HBAOLibraryError", "compute_ao", "default_params", "resolve_params",
     "camera_view", "camera_crop",
-    "library_path", "load_library", "unload_library", "library_version",
+    "library_path", "load_library", "unload_library", "library_version", "release_memory",
     "PARAMETER_NAMES", "FALLOFF_NAMES", "INTEGRATION_NAMES",
 ]
 

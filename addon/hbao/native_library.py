@@ -52,6 +52,7 @@ _FUNCTIONS = {
     "hbao_compute": (ctypes.c_int32, [_PARAMS_P, _CAMERA_P, ctypes.c_int32, ctypes.c_int32,
                                       _CHANNEL_P, _CHANNEL_P, ctypes.POINTER(ctypes.c_float),
                                       ctypes.c_int64]),
+    "hbao_release_memory": (None, []),
     "hbao_compute_layers": (ctypes.c_int32, [_PARAMS_P, _CAMERA_P, ctypes.c_int32, ctypes.c_int32,
                                              _CHANNEL_P, _CHANNEL_P, _CHANNEL_P,
                                              ctypes.POINTER(ctypes.c_float), ctypes.c_int64]),
@@ -84,6 +85,14 @@ LIBRARY_FILE_NAME = _LIBRARY.file_name
 library_path = _LIBRARY.path
 load_library = _LIBRARY.load
 unload_library = _LIBRARY.unload
+
+
+def release_memory():
+    """Let the library free the working memory it keeps between calls
+    (hbao_release_memory); does not load it to do so."""
+    library = _LIBRARY.loaded()
+    if library is not None:
+        library.hbao_release_memory()
 
 
 def library_version():

@@ -45,7 +45,7 @@ extern "C" {
 #endif
 
 #define HBAO_VERSION_MAJOR 0
-#define HBAO_VERSION_MINOR 2
+#define HBAO_VERSION_MINOR 3
 #define HBAO_VERSION_PATCH 0
 /** Packed version: major * 10000 + minor * 100 + patch. */
 #define HBAO_VERSION (HBAO_VERSION_MAJOR * 10000 + HBAO_VERSION_MINOR * 100 + HBAO_VERSION_PATCH)
@@ -320,6 +320,13 @@ HBAO_EXPORT void hbao_camera_default(hbao_camera *camera);
 
 /** The hbao_implementation that HBAO_IMPLEMENTATION_AUTO runs on this CPU. */
 HBAO_EXPORT int32_t hbao_best_implementation(void);
+
+/** hbao_compute and hbao_compute_layers keep their large working buffers
+ *  (about 24 bytes per pixel at full resolution, at most 512 MiB in all) for
+ *  the next call, which then skips faulting fresh pages in: a fifth of a
+ *  1080p frame's time (csrc/bench/bench_ab.c). This frees them, say after
+ *  the last frame of a render. Thread-safe; results never depend on it. */
+HBAO_EXPORT void hbao_release_memory(void);
 
 /** sizeof(hbao_params) and sizeof(hbao_camera) as compiled into the library,
  *  so that bindings (ctypes) can check their struct layouts on load. */

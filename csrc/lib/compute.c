@@ -164,13 +164,14 @@ hbao_result hbao_compute_layers(const hbao_params *params, const hbao_camera *ca
 
     /* The raw AO on the grid; the later stages (blur.c) turn it into the
      * output row by row, with no other full-size buffer. */
-    float *full_depth = malloc(pixels * sizeof(float));
-    float *grid_ao = malloc(grid_pixels * sizeof(float));
-    float *half_depth = s.half_resolution ? malloc(grid_pixels * sizeof(float)) : NULL;
-    float *full_back = back_depth != NULL ? malloc(pixels * sizeof(float)) : NULL;
-    float *half_back =
-        back_depth != NULL && s.half_resolution ? malloc(grid_pixels * sizeof(float)) : NULL;
-    grid.normal = malloc(grid_pixels * 3 * sizeof(float));
+    float *full_depth = hbao_scratch_take(pixels * sizeof(float));
+    float *grid_ao = hbao_scratch_take(grid_pixels * sizeof(float));
+    float *half_depth = s.half_resolution ? hbao_scratch_take(grid_pixels * sizeof(float)) : NULL;
+    float *full_back = back_depth != NULL ? hbao_scratch_take(pixels * sizeof(float)) : NULL;
+    float *half_back = back_depth != NULL && s.half_resolution
+                           ? hbao_scratch_take(grid_pixels * sizeof(float))
+                           : NULL;
+    grid.normal = hbao_scratch_take(grid_pixels * 3 * sizeof(float));
     grid.back = NULL;
     if (full_depth == NULL || grid_ao == NULL || grid.normal == NULL ||
         (s.half_resolution && half_depth == NULL) || (back_depth != NULL && full_back == NULL) ||
@@ -211,11 +212,11 @@ hbao_result hbao_compute_layers(const hbao_params *params, const hbao_camera *ca
     result = hbao_finish(&s, &grid, grid_ao, full_depth, width, height, ao, ao_row_stride);
 
 done:
-    free(full_depth);
-    free(grid_ao);
-    free(half_depth);
-    free(full_back);
-    free(half_back);
-    free(grid.normal);
+    hbao_scratch_give(full_depth);
+    hbao_scratch_give(grid_ao);
+    hbao_scratch_give(half_depth);
+    hbao_scratch_give(full_back);
+    hbao_scratch_give(half_back);
+    hbao_scratch_give(grid.normal);
     return result;
 }

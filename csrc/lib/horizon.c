@@ -630,14 +630,14 @@ void hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *grid,
         ((grid->width + 3) / 4 + HBAO_BLOCK_PIXELS - 1) / HBAO_BLOCK_PIXELS * HBAO_BLOCK_PIXELS;
     if (tiled.simd != NULL) {
         const size_t bytes = (size_t)4 * grid->height * job.phase_width * sizeof(float);
-        phase_depth = malloc(bytes);
-        if (grid->back != NULL) phase_back = malloc(bytes);
+        phase_depth = hbao_scratch_take(bytes);
+        if (grid->back != NULL) phase_back = hbao_scratch_take(bytes);
         /* Without memory for the copies the scalar reference computes the
          * same result, only slower. */
         if (phase_depth == NULL || (grid->back != NULL && phase_back == NULL)) {
             tiled.simd = NULL;
-            free(phase_depth);
-            free(phase_back);
+            hbao_scratch_give(phase_depth);
+            hbao_scratch_give(phase_back);
             phase_depth = phase_back = NULL;
         }
     }
@@ -649,6 +649,6 @@ void hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *grid,
     }
     const int tiles_down = (grid->height + TILE_SIZE - 1) / TILE_SIZE;
     hbao_parallel_rows(settings->threads, tiled.tiles_across * tiles_down, horizon_tile, &tiled);
-    free(phase_depth);
-    free(phase_back);
+    hbao_scratch_give(phase_depth);
+    hbao_scratch_give(phase_back);
 }

@@ -142,6 +142,11 @@ static inline void hbao_grid_position(const hbao_grid *grid, int i, int j, float
  * started, the threads that did start do its rows. */
 typedef void (*hbao_row_job)(void *context, int row);
 void hbao_parallel_rows(int threads, int rows, hbao_row_job job, void *context);
+
+/* Large working buffers (scratch.c): like malloc and free, but a given
+ * buffer is kept for the next call (hbao_release_memory frees them). */
+void *hbao_scratch_take(size_t bytes);
+void hbao_scratch_give(void *memory);
 int hbao_available_cores(void);
 
 /* normals.c: grid->normal from the given normals (world space, sampled at

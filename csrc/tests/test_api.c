@@ -383,8 +383,9 @@ static void *call_in_thread(void *argument) {
 }
 
 TEST_CASE(concurrent_calls_agree) {
-    /* No global state: four threads calling at once get what one call alone
-     * gets (run under ThreadSanitizer or ASan to see races, if any). */
+    /* The only shared state is the kept working memory (scratch.c): four
+     * threads calling at once get what one call alone gets (run under
+     * ThreadSanitizer or ASan to see races, if any). */
     fill_inputs();
     static concurrent_call calls[5];
     memset(calls, 0, sizeof calls);
@@ -399,10 +400,58 @@ TEST_CASE(concurrent_calls_agree) {
     }
 }
 
+TEST_CASE(kept_memory_changes_no_result) {
+    /* A call takes the buffers an earlier call left (scratch.c): a larger
+     * frame with other values before it, in every layout (full and half
+     * resolution, the back layer), and hbao_release_memory between calls,
+     * change nothing. */
+    enum { BW = 2 * W + 3, BH = 2 * H + 1 };
+    static float big_depth[BW * BH], big_normal[BW * BH * 3], big_back[BW * BH], big_ao[BW * BH];
+    for (int k = 0; k < BW * BH; k++) {
+        big_depth[k] = 1.0f + 0.37f * (float)(k % 7);
+        big_back[k] = big_depth[k] + 0.2f;
+        big_normal[3 * k] = 0.6f;
+        big_normal[3 * k + 1] = 0.0f;
+        big_normal[3 * k + 2] = 0.8f;
+    }
+    fill_inputs();
+    static float back[W * H], first[W * H], again[W * H];
+    for (int k = 0; k < W * H; k++) back[k] = depth[k] + 0.5f;
+    hbao_camera c;
+    hbao_camera_default(&c);
+    const hbao_channel d = {depth, 1, W}, n = {normal, 3, 3 * W}, b = {back, 1, W};
+    const hbao_channel bd = {big_depth, 1, BW}, bn = {big_normal, 3, 3 * BW};
+    const hbao_channel bb = {big_back, 1, BW};
+    for (int layout = 0; layout < 4; layout++) {
+        hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+        p.radius = 2.0f;
+        p.half_resolution = layout & 1;
+        const int layers = layout >> 1;
+        hbao_release_memory();
+        CHECK_RESULT(layers ? hbao_compute_layers(&p, &c, W, H, &d, &n, &b, first, W)
+                            : hbao_compute(&p, &c, W, H, &d, &n, first, W),
+                     HBAO_SUCCESS);
+        CHECK_RESULT(layers ? hbao_compute_layers(&p, &c, BW, BH, &bd, &bn, &bb, big_ao, BW)
+                            : hbao_compute(&p, &c, BW, BH, &bd, &bn, big_ao, BW),
+                     HBAO_SUCCESS);
+        CHECK_RESULT(layers ? hbao_compute_layers(&p, &c, W, H, &d, &n, &b, again, W)
+                            : hbao_compute(&p, &c, W, H, &d, &n, again, W),
+                     HBAO_SUCCESS);
+        CHECK(memcmp(first, again, sizeof first) == 0);
+        hbao_release_memory();
+        hbao_release_memory(); /* twice: nothing left to free */
+        CHECK_RESULT(layers ? hbao_compute_layers(&p, &c, W, H, &d, &n, &b, again, W)
+                            : hbao_compute(&p, &c, W, H, &d, &n, again, W),
+                     HBAO_SUCCESS);
+        CHECK(memcmp(first, again, sizeof first) == 0);
+    }
+}
+
 TEST_MAIN(TEST_ENTRY(null_arguments_are_rejected), TEST_ENTRY(sizes_and_strides_are_checked),
           TEST_ENTRY(invalid_parameters_are_rejected), TEST_ENTRY(invalid_cameras_are_rejected),
           TEST_ENTRY(world_to_camera_check_is_scale_free),
           TEST_ENTRY(params_resolve_clamps_each_field_and_names_it),
           TEST_ENTRY(params_resolve_rejects_what_cannot_be_clamped),
           TEST_ENTRY(out_of_range_counts_are_clamped), TEST_ENTRY(zero_radius_gives_ones),
-          TEST_ENTRY(messages_version_and_sizes), TEST_ENTRY(concurrent_calls_agree))
+          TEST_ENTRY(messages_version_and_sizes), TEST_ENTRY(concurrent_calls_agree),
+          TEST_ENTRY(kept_memory_changes_no_result))
