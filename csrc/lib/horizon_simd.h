@@ -85,6 +85,7 @@ typedef struct SIMD_NAME(block) {
     VF radius2, inv_radius2;
     VF height_tolerance, n_dot_v, near_limit; /* as in horizon.c's march */
     VF min_thickness;                         /* the back layer's, as in march */
+    VF bias_sine, bias_acos;                  /* the bias elevation's, for horizon_visibility_of */
 } SIMD_NAME(block);
 
 /* The depth fetches of a direction's steps. They depend only on the steps'
@@ -341,12 +342,15 @@ static inline VF SIMD_NAME(half_slice_visibility)(VF h, VF cos_h, VF sin_h,
                                      V_MUL(V_MUL(V_SET(2.0f), h), sl->sin_gamma)));
 }
 
-static inline VF SIMD_NAME(horizon_visibility)(VM past_normal, VF cos_past_max, VF elevation_max,
-                                               VF gamma, const SIMD_NAME(slice) * sl) {
+/* horizon_visibility with the elevation's sine (sin_a) and arc cosine
+ * (acos_a) given: the start of every direction has the same elevation, the
+ * bias, and the block computes them once. */
+static inline VF SIMD_NAME(horizon_visibility_of)(VM past_normal, VF cos_past_max, VF elevation_max,
+                                                  VF sin_a, VF acos_a, VF gamma,
+                                                  const SIMD_NAME(slice) * sl) {
     /* horizon_from_elevation */
     const VF cos_a = elevation_max;
-    const VF sin_a = V_SQRT(V_MAX0(V_SUB(V_SET(1.0f), V_MUL(elevation_max, elevation_max))));
-    const VF angle = V_ADD(gamma, SIMD_NAME(acos)(elevation_max));
+    const VF angle = V_ADD(gamma, acos_a);
     const VM flat = V_LE(angle, V_SET(0.0f));
     VF h = V_SELECT(flat, angle, V_SET(0.0f));
     VF cos_h = V_SELECT(flat, V_SUB(V_MUL(sl->cos_gamma, cos_a), V_MUL(sl->sin_gamma, sin_a)),
@@ -360,6 +364,17 @@ static inline VF SIMD_NAME(horizon_visibility)(VM past_normal, VF cos_past_max, 
         sin_h = V_SELECT(past_normal, sin_h, past_sin);
     }
     return SIMD_NAME(half_slice_visibility)(h, cos_h, sin_h, sl);
+}
+
+static inline VF SIMD_NAME(elevation_sine)(VF elevation) {
+    return V_SQRT(V_MAX0(V_SUB(V_SET(1.0f), V_MUL(elevation, elevation))));
+}
+
+static inline VF SIMD_NAME(horizon_visibility)(VM past_normal, VF cos_past_max, VF elevation_max,
+                                               VF gamma, const SIMD_NAME(slice) * sl) {
+    return SIMD_NAME(horizon_visibility_of)(past_normal, cos_past_max, elevation_max,
+                                            SIMD_NAME(elevation_sine)(elevation_max),
+                                            SIMD_NAME(acos)(elevation_max), gamma, sl);
 }
 
 static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SIMD_NAME(block) * b,
@@ -378,8 +393,8 @@ static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SI
     VF elevation_max = V_SET(s->sin_bias);
     VM past_normal = M_ANDNOT(active, active); /* no lane */
     VF cos_past_max = sl->cos_gamma;
-    const VF visibility_start =
-        SIMD_NAME(horizon_visibility)(past_normal, cos_past_max, elevation_max, gamma, sl);
+    const VF visibility_start = SIMD_NAME(horizon_visibility_of)(
+        past_normal, cos_past_max, elevation_max, b->bias_sine, b->bias_acos, gamma, sl);
     VF visibility_at_max = visibility_start;
     VF occlusion = V_SET(0.0f);
     SIMD_NAME(fetch) fetches[HBAO_MAX_STEPS];
@@ -526,8 +541,8 @@ static VF SIMD_NAME(direction_occlusion_cosine_layers)(const hbao_settings *s,
     const int any_check = M_ANY(M_AND(check_past_normal, active));
     const int quadratic = s->falloff == HBAO_FALLOFF_QUADRATIC;
     const VF sin_bias = V_SET(s->sin_bias);
-    const VF visibility_bias =
-        SIMD_NAME(horizon_visibility)(V_LT(sin_bias, sin_bias), sl->cos_gamma, sin_bias, gamma, sl);
+    const VF visibility_bias = SIMD_NAME(horizon_visibility_of)(
+        V_LT(sin_bias, sin_bias), sl->cos_gamma, sin_bias, b->bias_sine, b->bias_acos, gamma, sl);
     const VM lanes = M_AND(active, V_GT(visibility_bias, V_SET(0.0f)));
     const VF inv_bias = V_DIV(V_SET(1.0f), visibility_bias);
     VI marked = I_SET(0);
@@ -670,6 +685,8 @@ static void SIMD_NAME(lanes_ao)(const hbao_horizon_job *job, int x0, int x1, int
         /* hbao_near_limit */
         b.near_limit = s->thickness > 0.0f ? V_SUB(z, V_SET(s->thickness)) : V_SET(0.0f);
         b.min_thickness = V_SET(HBAO_MIN_BACK_THICKNESS * s->radius);
+        b.bias_sine = SIMD_NAME(elevation_sine)(V_SET(s->sin_bias));
+        b.bias_acos = SIMD_NAME(acos)(V_SET(s->sin_bias));
 
         const int cosine = s->integration == HBAO_INTEGRATION_COSINE;
         const int layers = job->phase_back != NULL;
