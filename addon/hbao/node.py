@@ -70,6 +70,19 @@ def _extra_render_changed(node, _context):
     _announce_change()
 
 
+def _draw_line(layout, short, details, icon):
+    """A line under the node's settings, if `short` says anything: a
+    borderless button whose tooltip (and a click: the Info editor) gives the
+    full text that the short line stands for."""
+    if not short:
+        return
+    text = short
+    if len(text) > MAX_STATUS_CHARACTERS:
+        text = text[:MAX_STATUS_CHARACTERS - 1] + "\u2026"
+    button = layout.operator(HBAO_OT_node_status.bl_idname, text=text, icon=icon, emboss=False)
+    button.details = details or short
+
+
 class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
     """Horizon-based ambient occlusion from the Depth (and Normal) pass"""
     bl_idname = NODE_IDNAME
@@ -144,19 +157,8 @@ class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
         layout.prop(self, "half_resolution")
         layout.prop(self, "guard_band")
         layout.prop(self, "back_faces")
-        if self.status:
-            # A borderless button: its tooltip (and a click: the Info editor)
-            # gives the full text that the short status line stands for.
-            text = self.status
-            if len(text) > MAX_STATUS_CHARACTERS:
-                text = text[:MAX_STATUS_CHARACTERS - 1] + "\u2026"
-            button = layout.operator(HBAO_OT_node_status.bl_idname, text=text, icon="ERROR",
-                                     emboss=False)
-            button.details = self.status_details or self.status
-        if self.hint:
-            button = layout.operator(HBAO_OT_node_status.bl_idname, text=self.hint, icon="INFO",
-                                     emboss=False)
-            button.details = self.hint_details or self.hint
+        _draw_line(layout, self.status, self.status_details, "ERROR")
+        _draw_line(layout, self.hint, self.hint_details, "INFO")
 
     def draw_buttons_ext(self, context, layout):
         self.draw_buttons(context, layout)
