@@ -9,7 +9,8 @@
  * must keep. Not a test: it asserts nothing.
  *
  *   bench_ab BEFORE/libhbao.so AFTER/libhbao.so [--rounds R] [--calls N]
- *            [--threads T] [--half] [--radius R] */
+ *            [--threads T] [--half] [--radius R] [--directions D] [--steps S]
+ *            [--blur B] */
 #define _GNU_SOURCE /* RTLD_DEEPBIND */
 #include <dlfcn.h>
 
@@ -47,12 +48,13 @@ static int load(build *b, int width, int height) {
 static void usage(const char *program) {
     fprintf(stderr,
             "usage: %s BEFORE_LIBRARY AFTER_LIBRARY [--rounds R] [--calls N] [--threads T] "
-            "[--half] [--radius R]\n",
+            "[--half] [--radius R] [--directions D] [--steps S] [--blur B]\n",
             program);
 }
 
 int main(int argc, char **argv) {
     int rounds = 3, calls = 15, threads = 1, half = 0;
+    hbao_params params = HBAO_PARAMS_DEFAULT_INITIALIZER;
     float radius = 0.5f;
     if (argc < 3) {
         usage(argv[0]);
@@ -67,6 +69,12 @@ int main(int argc, char **argv) {
             threads = atoi(argv[++a]);
         else if (!strcmp(argv[a], "--radius") && a + 1 < argc)
             radius = (float)atof(argv[++a]);
+        else if (!strcmp(argv[a], "--directions") && a + 1 < argc)
+            params.directions = atoi(argv[++a]);
+        else if (!strcmp(argv[a], "--steps") && a + 1 < argc)
+            params.steps = atoi(argv[++a]);
+        else if (!strcmp(argv[a], "--blur") && a + 1 < argc)
+            params.blur_size = atoi(argv[++a]);
         else if (!strcmp(argv[a], "--half"))
             half = 1;
         else {
@@ -85,7 +93,6 @@ int main(int argc, char **argv) {
         if (!load(&builds[k], width, height)) return 1;
     bench_scene frame;
     bench_scene_make(&frame, width, height);
-    hbao_params params = HBAO_PARAMS_DEFAULT_INITIALIZER;
     params.radius = radius;
     params.threads = threads;
     params.half_resolution = half;
@@ -94,9 +101,10 @@ int main(int argc, char **argv) {
     double *times = malloc(sizeof(double) * (size_t)calls);
     if (times == NULL) return 1;
     const char *unit = threads == 1 ? "CPU ms" : "wall ms";
-    printf("1920x1080, defaults%s, radius %g, %d thread(s); per round and build: fastest and "
-           "lower-quartile %s of %d calls\n",
-           half ? ", half resolution" : "", radius, threads, unit, calls);
+    printf("1920x1080, %d x %d, blur %d%s, radius %g, %d thread(s); per round and build: "
+           "fastest and lower-quartile %s of %d calls\n",
+           params.directions, params.steps, params.blur_size, half ? ", half resolution" : "",
+           radius, threads, unit, calls);
     print_load("before");
     for (int round = 0; round < rounds; round++) {
         for (int k = 0; k < 2; k++) {
