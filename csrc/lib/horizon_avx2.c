@@ -51,6 +51,7 @@
 #define I_ANDNOT _mm256_andnot_si256
 #define I_SLLV _mm256_sllv_epi32
 #define I_SRLI _mm256_srli_epi32
+#define I_SRAI _mm256_srai_epi32
 #define I_ZERO_UNLESS(m, v) _mm256_castps_si256(_mm256_and_ps((m), _mm256_castsi256_ps(v)))
 
 #include "horizon_simd.h"

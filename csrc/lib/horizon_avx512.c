@@ -53,6 +53,7 @@
 #define I_ANDNOT _mm512_andnot_si512
 #define I_SLLV _mm512_sllv_epi32
 #define I_SRLI _mm512_srli_epi32
+#define I_SRAI _mm512_srai_epi32
 #define I_ZERO_UNLESS(m, v) _mm512_maskz_mov_epi32((m), (v))
 
 #include "horizon_simd.h"

@@ -15,7 +15,7 @@
  * (truncating float -> int32); I_STOREU; M_BITS(m) (lane k -> bit k);
  * for the back layer's sector masks: V_MIN V_CEIL V_FLOOR, I_SUB I_AND I_OR
  * I_ANDNOT(a, b) = ~a & b, I_SLLV (per-lane shift, 0 from 32 on) I_SRLI,
- * I_ZERO_UNLESS(m, v); SIMD_NAME(x) gives the instance's function names. */
+ * I_ZERO_UNLESS(m, v); I_SRAI (arithmetic shift) for the steps' indices; SIMD_NAME(x) gives the instance's function names. */
 
 static inline VF SIMD_NAME(dot3)(VF a0, VF a1, VF a2, VF b0, VF b1, VF b2) {
     return V_ADD(V_ADD(V_MUL(a0, b0), V_MUL(a1, b1)), V_MUL(a2, b2));
@@ -75,17 +75,18 @@ static inline void SIMD_NAME(slice_setup)(const VF v[3], const VF n[3], VF dc, V
 typedef struct SIMD_NAME(block) {
     const hbao_horizon_job *job;
     const hbao_grid *grid;
-    VI lane_i;   /* the lanes' columns: first_i + 4 k */
-    int first_i; /* lane 0's column */
-    int phase;   /* first_i & 3: the lanes' column phase */
-    int first_x; /* lane 0's index in its phase_depth row: first_i / 4 */
+    VI lane_i;         /* the lanes' columns: first_i + 4 k */
+    VF lane_float;     /* and as floats (exact) */
+    int plain_indices; /* whether every phase_depth index fits an int */
+    int first_i;       /* lane 0's column */
+    int phase;         /* first_i & 3: the lanes' column phase */
+    int first_x;       /* lane 0's index in its phase_depth row: first_i / 4 */
     int j;
     float jitter, step_px, inv_ycor; /* shared by the block */
     VF p[3], v[3], n[3];
     VF radius2, inv_radius2;
     VF height_tolerance, n_dot_v, near_limit; /* as in horizon.c's march */
     VF min_thickness;                         /* the back layer's, as in march */
-    VF bias_sine, bias_acos;                  /* the bias elevation's, for horizon_visibility_of */
 } SIMD_NAME(block);
 
 /* The depth fetches of a direction's steps. They depend only on the steps'
@@ -100,10 +101,20 @@ typedef struct SIMD_NAME(fetch) {
     VM candidate; /* inside the image, on another pixel */
 } SIMD_NAME(fetch);
 
-/* hbao_step_offset for SIMD_LANES steps at once, each lane one step, with
- * the same float operations: fills ox[0..steps) and oy[0..steps) (whole
- * vectors are stored, so both hold steps + SIMD_LANES) and returns how many
- * steps come before the first that lies a whole image away. */
+/* A direction's steps, worked out SIMD_LANES steps at a time: each step's
+ * pixel offset from lane 0 (ox, oy), and for a step whose lanes all lie
+ * inside the image (a `plain` step, the common case) what its fetch needs:
+ * the index of its depths in phase_depth, its grid row and ox as a float.
+ * Arrays hold whole vectors: HBAO_MAX_STEPS + SIMD_LANES entries. */
+#define SIMD_STEP_ROOM (HBAO_MAX_STEPS + SIMD_LANES)
+typedef struct SIMD_NAME(steps) {
+    int count; /* the steps before the first that lies a whole image away */
+    int ox[SIMD_STEP_ROOM], oy[SIMD_STEP_ROOM], index[SIMD_STEP_ROOM];
+    float row[SIMD_STEP_ROOM], ox_float[SIMD_STEP_ROOM];
+    unsigned
+        plain[SIMD_STEP_ROOM / SIMD_LANES]; /* step k: bit k % SIMD_LANES of word k / SIMD_LANES */
+} SIMD_NAME(steps);
+
 static inline VI SIMD_NAME(floor_to_int)(VF x) {
     /* hbao_floor_in_range's truncation and correction, exact in range */
     const VI truncated = V_CVTT(x);
@@ -111,25 +122,86 @@ static inline VI SIMD_NAME(floor_to_int)(VF x) {
     return V_CVTT(V_SUB(whole, V_SELECT(V_GT(whole, x), V_SET(0.0f), V_SET(1.0f))));
 }
 
-static inline int SIMD_NAME(step_offsets)(const hbao_grid *g, float dc, float ds, float inv_ycor,
-                                          float jitter, float step_px, int steps, int *ox,
-                                          int *oy) {
+/* hbao_step_offset for SIMD_LANES steps at once, each lane one step, with
+ * the same float operations, and the plain steps' fetch data. */
+static inline void SIMD_NAME(plan_steps)(const SIMD_NAME(block) * b, float dc, float ds, int steps,
+                                         SIMD_NAME(steps) * t) {
+    const hbao_grid *g = b->grid;
+    const int phase_width = b->job->phase_width;
+    t->count = steps;
     for (int first = 0; first < steps; first += SIMD_LANES) {
         const VF step = I_TO_F(I_ADD(I_SET(first), I_LANES));
-        const VF t = V_ADD(V_SET(1.0f), V_MUL(V_ADD(step, V_SET(jitter)), V_SET(step_px)));
-        const VF x = V_ADD(V_SET(0.5f), V_MUL(V_SET(dc), t));
-        const VF y = V_SUB(V_SET(0.5f), V_MUL(V_MUL(V_SET(ds), t), V_SET(inv_ycor)));
+        const VF along =
+            V_ADD(V_SET(1.0f), V_MUL(V_ADD(step, V_SET(b->jitter)), V_SET(b->step_px)));
+        const VF x = V_ADD(V_SET(0.5f), V_MUL(V_SET(dc), along));
+        const VF y = V_SUB(V_SET(0.5f), V_MUL(V_MUL(V_SET(ds), along), V_SET(b->inv_ycor)));
         const VM inside =
             M_AND(M_AND(V_GE(x, V_SET((float)(1 - g->width))), V_LT(x, V_SET((float)g->width))),
                   M_AND(V_GE(y, V_SET((float)(1 - g->height))), V_LT(y, V_SET((float)g->height))));
-        I_STOREU(ox + first, SIMD_NAME(floor_to_int)(x));
-        I_STOREU(oy + first, SIMD_NAME(floor_to_int)(y));
+        const VI ox = SIMD_NAME(floor_to_int)(x), oy = SIMD_NAME(floor_to_int)(y);
+        I_STOREU(t->ox + first, ox);
+        I_STOREU(t->oy + first, oy);
+        /* plain: the sample row inside, and lane 0's and the last lane's
+         * columns (exact small integers as floats) */
+        const VI sj = I_ADD(I_SET(b->j), oy);
+        const VF sj_float = I_TO_F(sj);
+        const VF ox_float = I_TO_F(ox);
+        const VF column0 = V_ADD(V_SET((float)b->first_i), ox_float);
+        const VM plain =
+            M_AND(M_AND(V_GE(sj_float, V_SET(0.0f)), V_LT(sj_float, V_SET((float)g->height))),
+                  M_AND(V_GE(column0, V_SET(0.0f)),
+                        V_LT(V_ADD(column0, V_SET((float)(4 * (SIMD_LANES - 1)))),
+                             V_SET((float)g->width))));
+        /* lane k samples column first_i + 4 k + ox: phase (phase + ox) mod
+         * 4, index first_x + k + floor((phase + ox) / 4) of that phase's row */
+        const VI moved = I_ADD(I_SET(b->phase), ox);
+        const VI row_index = I_ADD(I_MULLO(I_AND(moved, I_SET(3)), I_SET(g->height)), sj);
+        I_STOREU(t->index + first, I_ADD(I_MULLO(row_index, I_SET(phase_width)),
+                                         I_ADD(I_SET(b->first_x), I_SRAI(moved, 2))));
+        V_STOREU(t->row + first, V_MUL(V_ADD(sj_float, V_SET(g->y_offset)), V_SET(g->y_step)));
+        V_STOREU(t->ox_float + first, ox_float);
+        t->plain[first / SIMD_LANES] = b->plain_indices ? (unsigned)M_BITS(plain) : 0u;
         const int count = steps - first < SIMD_LANES ? steps - first : SIMD_LANES;
         const unsigned wanted = (count == 32 ? 0u : 1u << count) - 1u;
         const unsigned outside = ~(unsigned)M_BITS(inside) & wanted;
-        if (outside != 0) return first + __builtin_ctz(outside);
+        if (outside != 0) {
+            t->count = first + __builtin_ctz(outside);
+            return;
+        }
     }
-    return steps;
+}
+
+/* A step that is not plain: lanes whose column leaves the image stop (in
+ * *alive), and only the lanes inside read. Returns 0 where every lane's
+ * sample row has left the image: the direction's search ends there. */
+static int SIMD_NAME(fetch_at_side)(const SIMD_NAME(block) * b, int ox, int oy, VM *alive,
+                                    SIMD_NAME(fetch) * f) {
+    const hbao_grid *g = b->grid;
+    const int phase_width = b->job->phase_width;
+    const int sj = b->j + oy;
+    if (sj < 0 || sj >= g->height) return 0;
+    const VF si = I_TO_F(I_ADD(b->lane_i, I_SET(ox))); /* exact: |si| < 2^24 */
+    *alive = M_AND(*alive, M_AND(V_GE(si, V_SET(0.0f)), V_LT(si, V_SET((float)g->width))));
+    const VM candidate = (ox == 0 && oy == 0) ? M_ANDNOT(*alive, *alive) : *alive;
+    const int moved = b->phase + ox;
+    const int new_phase = moved & 3;                        /* moved mod 4, two's complement */
+    const int first = b->first_x + (moved - new_phase) / 4; /* exact */
+    const size_t row_start = ((size_t)new_phase * g->height + sj) * phase_width;
+    const float *row = b->job->phase_depth + row_start;
+    float lanes[SIMD_LANES];
+    for (int k = 0; k < SIMD_LANES; k++)
+        lanes[k] = first + k >= 0 && first + k < phase_width ? row[first + k] : 0.0f;
+    f->zs = V_ZERO_UNLESS(candidate, V_LOADU(lanes));
+    if (b->job->phase_back != NULL) {
+        const float *back = b->job->phase_back + row_start;
+        for (int k = 0; k < SIMD_LANES; k++)
+            lanes[k] = first + k >= 0 && first + k < phase_width ? back[first + k] : INFINITY;
+        f->zb = V_LOADU(lanes);
+    }
+    f->column = V_MUL(V_ADD(si, V_SET(g->x_offset)), V_SET(g->x_step));
+    f->row = hbao_grid_y(g, sj);
+    f->candidate = candidate;
+    return 1;
 }
 
 /* Fills fetches[0..n) and returns n: the steps before every lane has left
@@ -142,67 +214,38 @@ static inline int SIMD_NAME(step_offsets)(const hbao_grid *g, float dc, float ds
 static inline int SIMD_NAME(fetch_steps)(const SIMD_NAME(block) * b, int steps, float dc, float ds,
                                          VM active, SIMD_NAME(fetch) * fetches) {
     const hbao_grid *g = b->grid;
-    const int phase_width = b->job->phase_width;
-    int offset_x[HBAO_MAX_STEPS + SIMD_LANES], offset_y[HBAO_MAX_STEPS + SIMD_LANES];
-    const int offsets = SIMD_NAME(step_offsets)(g, dc, ds, b->inv_ycor, b->jitter, b->step_px,
-                                                steps, offset_x, offset_y);
+    const float *phase_depth = b->job->phase_depth, *phase_back = b->job->phase_back;
+    SIMD_NAME(steps) t;
+    SIMD_NAME(plan_steps)(b, dc, ds, steps, &t);
+    const VF x_offset = V_SET(g->x_offset), x_step = V_SET(g->x_step);
     VM alive = active;
     int fetched = 0;
-    for (int step = 0; step < offsets && M_ANY(alive); step++) {
-        const int ox = offset_x[step], oy = offset_y[step];
-        if (step > 0 && ox == offset_x[step - 1] && oy == offset_y[step - 1]) continue;
-        const int sj = b->j + oy;
-        if (sj < 0 || sj >= g->height) break; /* every lane's sample leaves the image */
-        const VF si = I_TO_F(I_ADD(b->lane_i, I_SET(ox))); /* exact: |si| < 2^24 */
-        /* lanes whose column leaves the image stop; the lanes' columns
-         * first_i + ox + 4 k all lie inside unless the block is at a side */
-        if (b->first_i + ox < 0 || b->first_i + ox + 4 * (SIMD_LANES - 1) >= g->width)
-            alive = M_AND(alive, M_AND(V_GE(si, V_SET(0.0f)), V_LT(si, V_SET((float)g->width))));
-        const VM candidate = (ox == 0 && oy == 0) ? M_ANDNOT(alive, alive) : alive;
-        /* lane k samples column first_i + 4 k + ox: phase (phase + ox) mod 4,
-         * index first_x + k + floor((phase + ox) / 4) of that phase's row */
-        const int moved = b->phase + ox;
-        const int new_phase = moved & 3;                        /* moved mod 4, two's complement */
-        const int first = b->first_x + (moved - new_phase) / 4; /* exact */
-        const size_t row_start = ((size_t)new_phase * g->height + sj) * phase_width;
-        const float *row = b->job->phase_depth + row_start;
-        const int whole = first >= 0 && first + SIMD_LANES <= phase_width;
-        VF zs;
-        if (whole) {
-            zs = V_LOADU(row + first);
-        } else { /* at the image's side: only the lanes inside read */
-            float lanes[SIMD_LANES];
-            for (int k = 0; k < SIMD_LANES; k++)
-                lanes[k] = first + k >= 0 && first + k < phase_width ? row[first + k] : 0.0f;
-            zs = V_LOADU(lanes);
+    for (int step = 0; step < t.count && M_ANY(alive); step++) {
+        const int ox = t.ox[step], oy = t.oy[step];
+        if (step > 0 && ox == t.ox[step - 1] && oy == t.oy[step - 1]) continue;
+        SIMD_NAME(fetch) *f = &fetches[fetched];
+        if ((t.plain[step / SIMD_LANES] >> (step % SIMD_LANES)) & 1u) {
+            const VM candidate = (ox | oy) == 0 ? M_ANDNOT(alive, alive) : alive;
+            const int index = t.index[step];
+            f->zs = V_ZERO_UNLESS(candidate, V_LOADU(phase_depth + index));
+            if (phase_back != NULL) f->zb = V_LOADU(phase_back + index);
+            /* b->lane_float + ox is exact, as I_TO_F(lane_i + ox) */
+            f->column =
+                V_MUL(V_ADD(V_ADD(b->lane_float, V_SET(t.ox_float[step])), x_offset), x_step);
+            f->row = t.row[step];
+            f->candidate = candidate;
+        } else if (!SIMD_NAME(fetch_at_side)(b, ox, oy, &alive, f)) {
+            break; /* every lane's sample leaves the image */
         }
-        fetches[fetched].zs = V_ZERO_UNLESS(candidate, zs);
-        if (b->job->phase_back != NULL) {
-            const float *back = b->job->phase_back + row_start;
-            VF zb;
-            if (whole) {
-                zb = V_LOADU(back + first);
-            } else {
-                float lanes[SIMD_LANES];
-                for (int k = 0; k < SIMD_LANES; k++)
-                    lanes[k] =
-                        first + k >= 0 && first + k < phase_width ? back[first + k] : INFINITY;
-                zb = V_LOADU(lanes);
-            }
-            fetches[fetched].zb = zb;
-        }
-        fetches[fetched].column = V_MUL(V_ADD(si, V_SET(g->x_offset)), V_SET(g->x_step));
-        fetches[fetched].row = hbao_grid_y(g, sj);
-        fetches[fetched].candidate = candidate;
         fetched++;
     }
     return fetched;
 }
 
-/* A fetched step's sample vector and squared length, and which lanes have a
- * usable sample (returned), among the lanes in `live`. */
-static inline VM SIMD_NAME(sample_far)(const SIMD_NAME(block) * b, const SIMD_NAME(fetch) * f,
-                                       VM live, VF delta[3], VF *dist2, VM *far) {
+/* A fetched step's sample vector (delta, from the pixel's point) and the
+ * lanes among `live` whose sample has a usable depth (returned). */
+static inline VM SIMD_NAME(sample_point)(const SIMD_NAME(block) * b, const SIMD_NAME(fetch) * f,
+                                         VM live, VF delta[3]) {
     const hbao_grid *g = b->grid;
     const VF zs = f->zs;
     const VM valid =
@@ -214,6 +257,13 @@ static inline VM SIMD_NAME(sample_far)(const SIMD_NAME(block) * b, const SIMD_NA
     delta[0] = V_SUB(q0, b->p[0]);
     delta[1] = V_SUB(q1, b->p[1]);
     delta[2] = V_SUB(V_NEG(zs), b->p[2]);
+    return valid;
+}
+
+/* The squared length of delta, and which lanes of `valid` have a sample
+ * within the radius (returned) and which beyond it (*far). */
+static inline VM SIMD_NAME(sample_reach)(const SIMD_NAME(block) * b, VM valid, const VF delta[3],
+                                         VF *dist2, VM *far) {
     *dist2 = SIMD_NAME(dot3)(delta[0], delta[1], delta[2], delta[0], delta[1], delta[2]);
     const VM near = V_LT(*dist2, b->radius2);
     const VM positive = M_AND(valid, V_GT(*dist2, V_SET(0.0f)));
@@ -222,13 +272,14 @@ static inline VM SIMD_NAME(sample_far)(const SIMD_NAME(block) * b, const SIMD_NA
     return M_AND(positive, near);
 }
 
-static inline VM SIMD_NAME(sample)(const SIMD_NAME(block) * b, const SIMD_NAME(fetch) * f, VM live,
-                                   VF delta[3], VF *dist2) {
-    VM far;
-    return SIMD_NAME(sample_far)(b, f, live, delta, dist2, &far);
+/* Both: the lanes with a usable sample within the radius. */
+static inline VM SIMD_NAME(sample_far)(const SIMD_NAME(block) * b, const SIMD_NAME(fetch) * f,
+                                       VM live, VF delta[3], VF *dist2, VM *far) {
+    return SIMD_NAME(sample_reach)(b, SIMD_NAME(sample_point)(b, f, live, delta), delta, dist2,
+                                   far);
 }
 
-/* SIMD_NAME(sample) with the back layer: the lanes beyond the radius whose
+/* SIMD_NAME(sample_far) with the back layer: the lanes beyond the radius whose
  * occluder reaches into it (horizon.c's enter_the_ball) join, at the point
  * where their view ray enters the radius. */
 static inline VM SIMD_NAME(sample_layers)(const SIMD_NAME(block) * b, const SIMD_NAME(fetch) * f,
@@ -285,6 +336,22 @@ static inline VM SIMD_NAME(above_tangent)(const SIMD_NAME(block) * b, VM ok, VF 
     return M_AND(ok, M_OR(V_GT(height, V_SET(0.0f)), V_LT(b->n_dot_v, V_SET(0.0f))));
 }
 
+/* The one-layer search's sample: the lanes of sample_far's result, or no
+ * lane where none of them lies above the tangent plane (above_tangent:
+ * the step cannot change a horizon). The tangent test comes first, so
+ * such a step (most of them) skips the squared length too. */
+static inline VM SIMD_NAME(sample_rising)(const SIMD_NAME(block) * b, const SIMD_NAME(fetch) * f,
+                                          VM live, VF delta[3], VF *dist2, VF *height) {
+    const VM valid = SIMD_NAME(sample_point)(b, f, live, delta);
+    const VM none = M_ANDNOT(valid, valid);
+    *height = SIMD_NAME(sample_height)(b, delta);
+    *dist2 = V_SET(0.0f); /* unused where no lane returns */
+    if (!M_ANY(SIMD_NAME(above_tangent)(b, valid, *height))) return none;
+    VM far;
+    const VM ok = SIMD_NAME(sample_reach)(b, valid, delta, dist2, &far);
+    return M_ANY(SIMD_NAME(above_tangent)(b, ok, *height)) ? ok : none;
+}
+
 static inline VF SIMD_NAME(cos_to_view)(const SIMD_NAME(block) * b, const VF delta[3],
                                         VF inv_dist) {
     return V_MUL(SIMD_NAME(dot3)(delta[0], delta[1], delta[2], b->v[0], b->v[1], b->v[2]),
@@ -305,9 +372,9 @@ static VF SIMD_NAME(direction_occlusion_hbao)(const hbao_settings *s, const SIMD
     VM alive = active; /* lanes that have not stopped past the normal */
     for (int step = 0; step < fetched && M_ANY(alive); step++) {
         VF delta[3], dist2;
-        const VM ok = SIMD_NAME(sample)(b, &fetches[step], alive, delta, &dist2);
-        const VF height = SIMD_NAME(sample_height)(b, delta);
-        if (!M_ANY(SIMD_NAME(above_tangent)(b, ok, height))) continue;
+        VF height;
+        const VM ok = SIMD_NAME(sample_rising)(b, &fetches[step], alive, delta, &dist2, &height);
+        if (!M_ANY(ok)) continue;
         const VF inv_dist = V_DIV(V_SET(1.0f), V_SQRT(dist2));
         const VF sin_s = V_MUL(height, inv_dist);
         VM rest = ok;
@@ -394,16 +461,18 @@ static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SI
     VM past_normal = M_ANDNOT(active, active); /* no lane */
     VF cos_past_max = sl->cos_gamma;
     const VF visibility_start = SIMD_NAME(horizon_visibility_of)(
-        past_normal, cos_past_max, elevation_max, b->bias_sine, b->bias_acos, gamma, sl);
+        past_normal, cos_past_max, elevation_max, V_SET(s->bias_elevation_sine),
+        V_SET(s->bias_elevation_acos), gamma, sl);
     VF visibility_at_max = visibility_start;
     VF occlusion = V_SET(0.0f);
+    int any_raised = 0;
     SIMD_NAME(fetch) fetches[HBAO_MAX_STEPS];
     const int fetched = SIMD_NAME(fetch_steps)(b, s->steps, dc, ds, active, fetches);
     for (int step = 0; step < fetched; step++) {
         VF delta[3], dist2;
-        const VM ok = SIMD_NAME(sample)(b, &fetches[step], active, delta, &dist2);
-        const VF height = SIMD_NAME(sample_height)(b, delta);
-        if (!M_ANY(SIMD_NAME(above_tangent)(b, ok, height))) continue;
+        VF height;
+        const VM ok = SIMD_NAME(sample_rising)(b, &fetches[step], active, delta, &dist2, &height);
+        if (!M_ANY(ok)) continue;
         const VF inv_dist = V_DIV(V_SET(1.0f), V_SQRT(dist2));
         const VF sin_s = V_MUL(height, inv_dist);
         VM raised = M_ANDNOT(ok, ok); /* no lane */
@@ -425,6 +494,7 @@ static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SI
         elevation_max = V_SELECT(rise, elevation_max,
                                  V_SELECT(V_GT(elevation, V_SET(1.0f)), elevation, V_SET(1.0f)));
         raised = M_OR(raised, rise);
+        any_raised |= M_ANY(raised);
         if (quadratic && M_ANY(raised)) {
             const VF visibility =
                 SIMD_NAME(horizon_visibility)(past_normal, cos_past_max, elevation_max, gamma, sl);
@@ -435,10 +505,13 @@ static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SI
             visibility_at_max = V_SELECT(raised, visibility_at_max, visibility);
         }
     }
+    /* Where no lane's horizon rose or passed the normal, the end is the
+     * start: visibility_start - visibility_start, without recomputing it. */
     if (!quadratic)
-        occlusion =
-            V_SUB(visibility_start, SIMD_NAME(horizon_visibility)(past_normal, cos_past_max,
-                                                                  elevation_max, gamma, sl));
+        occlusion = V_SUB(visibility_start,
+                          any_raised ? SIMD_NAME(horizon_visibility)(past_normal, cos_past_max,
+                                                                     elevation_max, gamma, sl)
+                                     : visibility_start);
     return occlusion;
 }
 
@@ -542,7 +615,8 @@ static VF SIMD_NAME(direction_occlusion_cosine_layers)(const hbao_settings *s,
     const int quadratic = s->falloff == HBAO_FALLOFF_QUADRATIC;
     const VF sin_bias = V_SET(s->sin_bias);
     const VF visibility_bias = SIMD_NAME(horizon_visibility_of)(
-        V_LT(sin_bias, sin_bias), sl->cos_gamma, sin_bias, b->bias_sine, b->bias_acos, gamma, sl);
+        V_LT(sin_bias, sin_bias), sl->cos_gamma, sin_bias, V_SET(s->bias_elevation_sine),
+        V_SET(s->bias_elevation_acos), gamma, sl);
     const VM lanes = M_AND(active, V_GT(visibility_bias, V_SET(0.0f)));
     const VF inv_bias = V_DIV(V_SET(1.0f), visibility_bias);
     VI marked = I_SET(0);
@@ -640,6 +714,8 @@ static void SIMD_NAME(lanes_ao)(const hbao_horizon_job *job, int x0, int x1, int
     const VF z =
         V_LOADU(job->phase_depth + ((size_t)a * g->height + j) * job->phase_width + b.first_x);
     b.lane_i = I_ADD(I_SET(first_i), I_MULLO(I_LANES, I_SET(4)));
+    b.lane_float = I_TO_F(b.lane_i);
+    b.plain_indices = 4.0 * (double)g->height * (double)job->phase_width < 2147483647.0;
     const VF column = V_MUL(V_ADD(I_TO_F(b.lane_i), V_SET(g->x_offset)), V_SET(g->x_step));
     const VF row = V_SET(hbao_grid_y(g, j));
     b.p[0] = g->orthographic ? column : V_MUL(column, z);
@@ -685,16 +761,18 @@ static void SIMD_NAME(lanes_ao)(const hbao_horizon_job *job, int x0, int x1, int
         /* hbao_near_limit */
         b.near_limit = s->thickness > 0.0f ? V_SUB(z, V_SET(s->thickness)) : V_SET(0.0f);
         b.min_thickness = V_SET(HBAO_MIN_BACK_THICKNESS * s->radius);
-        b.bias_sine = SIMD_NAME(elevation_sine)(V_SET(s->sin_bias));
-        b.bias_acos = SIMD_NAME(acos)(V_SET(s->sin_bias));
 
         const int cosine = s->integration == HBAO_INTEGRATION_COSINE;
         const int layers = job->phase_back != NULL;
         VF occlusion_sum = V_SET(0.0f), visible_sum = V_SET(0.0f), open_sum = V_SET(0.0f);
+        SIMD_NAME(slice) slices[HBAO_MAX_DIRECTIONS];
+        for (int d = 0; d < s->directions; d++)
+            SIMD_NAME(slice_setup)
+            (b.v, b.n, V_SET(job->direction_cos[cell][d]), V_SET(job->direction_sin[cell][d]),
+             &slices[d]);
         for (int d = 0; d < s->directions; d++) {
             const float dc = job->direction_cos[cell][d], ds = job->direction_sin[cell][d];
-            SIMD_NAME(slice) sl;
-            SIMD_NAME(slice_setup)(b.v, b.n, V_SET(dc), V_SET(ds), &sl);
+            const SIMD_NAME(slice) sl = slices[d];
             if (cosine) {
                 const VM lanes = M_AND(active, sl.usable);
                 if (!M_ANY(lanes)) continue;

@@ -31,6 +31,9 @@ typedef struct hbao_settings {
     float bias_rad; /* angle bias */
     float sin_bias;
     float cos_bias;
+    /* the bias elevation's (sin_bias as an elevation) sine and arc cosine,
+     * as horizon_from_elevation computes them: where every horizon starts */
+    float bias_elevation_sine, bias_elevation_acos;
     int directions;
     int steps;
     int falloff;
