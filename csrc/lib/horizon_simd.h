@@ -794,10 +794,10 @@ static void SIMD_NAME(lanes_ao)(const hbao_horizon_job *job, int x0, int x1, int
             const int count = s->directions - first < SIMD_DIRECTION_GROUP ? s->directions - first
                                                                            : SIMD_DIRECTION_GROUP;
             SIMD_NAME(slice) slices[SIMD_DIRECTION_GROUP];
-            for (int k = 0; k < count; k++)
-                SIMD_NAME(slice_setup)
-                (b.v, b.n, V_SET(direction_cos[first + k]), V_SET(direction_sin[first + k]),
-                 &slices[k]);
+            for (int k = 0; k < count; k++) {
+                const VF dc = V_SET(direction_cos[first + k]), ds = V_SET(direction_sin[first + k]);
+                SIMD_NAME(slice_setup)(b.v, b.n, dc, ds, &slices[k]);
+            }
             for (int k = 0; k < count; k++) {
                 const float dc = direction_cos[first + k], ds = direction_sin[first + k];
                 const SIMD_NAME(slice) *sl = &slices[k];
