@@ -516,10 +516,10 @@ float hbao_block_step(const horizon_job *job, int x0, int x1, int j, int a) {
         const float z = g->depth[(size_t)j * g->width + i];
         if (z > 0.0f && z < nearest) nearest = z;
     }
-    if (nearest == INFINITY) return 0.0f;
+    if (nearest == INFINITY) return HBAO_BLOCK_UNSAMPLED;
     const float largest =
         g->orthographic ? s->radius / g->pixel_size : s->radius / (g->pixel_size * nearest);
-    return largest >= 1.0f ? (largest - 1.0f) / (float)s->steps : 0.0f;
+    return largest >= 1.0f ? (largest - 1.0f) / (float)s->steps : HBAO_BLOCK_UNSAMPLED;
 }
 
 /* Pixels are visited tile by tile: a pixel's samples spread over the whole

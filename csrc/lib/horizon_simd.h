@@ -844,6 +844,11 @@ static void SIMD_NAME(lanes_ao)(const hbao_horizon_job *job, int x0, int x1, int
 static void SIMD_NAME(span)(const hbao_horizon_job *job, int x0, int x1, int j) {
     for (int a = 0; a < 4; a++) {
         const float step_px = hbao_block_step(job, x0, x1, j, a);
+        if (step_px < 0.0f) { /* no lane active: lanes_ao's result, without its set-up */
+            float *out = job->ao + (size_t)j * job->grid->width;
+            for (int i = x0 + a; i < x1; i += 4) out[i] = 1.0f;
+            continue;
+        }
         for (int first_lane = 0; first_lane < HBAO_BLOCK_PIXELS; first_lane += SIMD_LANES)
             SIMD_NAME(lanes_ao)(job, x0, x1, j, a, first_lane, step_px);
     }

@@ -189,8 +189,10 @@ typedef struct hbao_horizon_job {
 #define HBAO_BLOCK_SPAN (4 * HBAO_BLOCK_PIXELS) /* columns a block spans */
 
 /* The step length in pixels, (R_block - 1) / steps, of the block of phase a
- * that starts at column x0 of row j (pixels before x1 only); 0 when no pixel
- * of it is sampled. */
+ * that starts at column x0 of row j (pixels before x1 only); negative
+ * (HBAO_BLOCK_UNSAMPLED) when no pixel of it is sampled: all background, or
+ * every projected radius under a pixel, so every AO there is 1. */
+#define HBAO_BLOCK_UNSAMPLED (-1.0f)
 float hbao_block_step(const hbao_horizon_job *job, int x0, int x1, int j, int a);
 
 /* The pixel offset (ox, oy) of step `step` along direction (dc, ds) of a
