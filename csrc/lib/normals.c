@@ -310,11 +310,16 @@ typedef struct precision_job {
 
 static void precision_row(void *context, int j) {
     precision_job *job = context;
+    /* One depth that is no half float decides: float depth (Cycles') is
+     * told from its first row, and the other rows stop at once. */
+    if (atomic_load_explicit(&job->not_half, memory_order_relaxed)) return;
     const float *row = job->grid->depth + (size_t)j * job->grid->width;
-    int half = 1;
-    for (int i = 0; i < job->grid->width; i++)
-        half &= row[i] <= 0.0f || is_half_float(row[i]); /* background is 0 */
-    if (!half) atomic_store_explicit(&job->not_half, 1, memory_order_relaxed);
+    for (int i = 0; i < job->grid->width; i++) {
+        if (!(row[i] <= 0.0f || is_half_float(row[i]))) { /* background is 0 */
+            atomic_store_explicit(&job->not_half, 1, memory_order_relaxed);
+            return;
+        }
+    }
 }
 
 /* The depth's format, told from its values: half floats (EEVEE's Depth pass)
