@@ -601,6 +601,45 @@ def slow_input(path):
                                   SLOW_SIZE, SLOW_SIZE))
 
 
+# The signals after which the tool removes its temporary files.
+CLEANUP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+
+
+def default_signal_actions():
+    """For the tool's process: the suite may itself run with some of these
+    signals ignored (under `nohup`, or started with `&` by a script), and the
+    tool leaves an ignored signal ignored (test below)."""
+    for number in CLEANUP_SIGNALS:
+        signal.signal(number, signal.SIG_DFL)
+
+
+def ignore_hangup():
+    default_signal_actions()
+    signal.signal(signal.SIGHUP, signal.SIG_IGN)
+
+
+def signal_during_run(command, outputs, temporaries, signal_number, preexec_fn):
+    """Starts the tool, waits until its `temporaries` temporary files exist
+    (so that the signal falls inside the run), sends the signal and returns
+    the finished process."""
+    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                               preexec_fn=preexec_fn)
+    try:
+        deadline = time.monotonic() + TOOL_TIMEOUT_S
+        while len(leftover_temporary_files(outputs)) < temporaries and process.poll() is None:
+            assert time.monotonic() < deadline
+            time.sleep(0.005)
+        # All temporary files existed while the tool was still running:
+        # otherwise the signal below would test nothing.
+        assert process.poll() is None, "the run ended before it could be interrupted"
+        process.send_signal(signal_number)
+        process.wait(TOOL_TIMEOUT_S)
+    finally:
+        process.kill()
+        process.wait()
+    return process
+
+
 @pytest.mark.parametrize("signal_number, frames", [
     (signal.SIGINT, 1), (signal.SIGTERM, 1), (signal.SIGHUP, 1),
     # Two frames at once (--jobs 2): four temporary files, from two threads.
@@ -618,23 +657,24 @@ def test_signal_removes_the_temporary_files(hbao_tool, tmp_path, signal_number, 
         command = [str(hbao_tool), str(tmp_path / "big_#.exr"), "-o", str(outputs / "ao_#.exr"),
                    "--preview", str(outputs / "ao_#.png"), "--frames", f"1-{frames}",
                    "--jobs", str(frames)] + SLOW_RUN
-    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    try:
-        deadline = time.monotonic() + TOOL_TIMEOUT_S
-        while len(leftover_temporary_files(outputs)) < 2 * frames and process.poll() is None:
-            assert time.monotonic() < deadline
-            time.sleep(0.005)
-        # All temporary files existed while the tool was still running:
-        # otherwise the signal below would test nothing.
-        assert process.poll() is None, "the run ended before it could be interrupted"
-        process.send_signal(signal_number)
-        process.wait(TOOL_TIMEOUT_S)
-    finally:
-        process.kill()
-        process.wait()
+    process = signal_during_run(command, outputs, 2 * frames, signal_number,
+                                default_signal_actions)
     # The exit status says the signal ended the run.
     assert process.returncode == -signal_number, process.stderr.read()
     assert list(outputs.iterdir()) == []
+
+
+def test_an_ignored_hangup_stays_ignored(hbao_tool, tmp_path):
+    """Started under nohup (SIGHUP ignored), the tool is not ended by a hangup:
+    it finishes and writes its outputs, and leaves no temporary file."""
+    outputs = tmp_path / "out"
+    outputs.mkdir()
+    slow_input(tmp_path / "big.exr")
+    command = [str(hbao_tool), str(tmp_path / "big.exr"), "-o", str(outputs / "ao.exr"),
+               "--preview", str(outputs / "ao.png")] + SLOW_RUN
+    process = signal_during_run(command, outputs, 2, signal.SIGHUP, ignore_hangup)
+    assert process.returncode == 0, process.stderr.read()
+    assert sorted(p.name for p in outputs.iterdir()) == ["ao.exr", "ao.png"]
 
 
 def test_size_claim_is_checked_against_the_file_before_allocating(hbao_tool, tmp_path):
