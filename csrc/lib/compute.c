@@ -16,7 +16,7 @@ static hbao_result make_settings(const hbao_params *params, hbao_settings *s) {
     s->bias_rad = p.angle_bias_degrees * (HBAO_PI / 180.0f);
     s->sin_bias = sinf(s->bias_rad);
     s->cos_bias = cosf(s->bias_rad);
-    s->bias_elevation_sine = sqrtf(fmaxf(0.0f, 1.0f - s->sin_bias * s->sin_bias));
+    s->bias_elevation_sine = hbao_sine_from_cosine(s->sin_bias);
     s->bias_elevation_acos = hbao_acos(s->sin_bias);
     s->directions = p.directions;
     s->steps = p.steps;

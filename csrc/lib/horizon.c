@@ -161,7 +161,7 @@ static inline float half_slice_visibility(float h, float cos_h, float sin_h, con
  * with its cosine and sine. */
 static inline void horizon_from_elevation(float elevation, float gamma, const slice *sl, float *h,
                                           float *cos_h, float *sin_h) {
-    const float cos_a = elevation, sin_a = sqrtf(fmaxf(0.0f, 1.0f - elevation * elevation));
+    const float cos_a = elevation, sin_a = hbao_sine_from_cosine(elevation);
     *h = gamma + hbao_acos(elevation);
     if (*h <= 0.0f) {
         *h = 0.0f;
@@ -178,7 +178,7 @@ static inline void horizon_state(int past_normal, float cos_past_max, float elev
                                  float *sin_h) {
     if (past_normal) {
         *cos_h = cos_past_max;
-        *sin_h = sqrtf(fmaxf(0.0f, 1.0f - cos_past_max * cos_past_max));
+        *sin_h = hbao_sine_from_cosine(cos_past_max);
         *h = hbao_acos(cos_past_max);
     } else {
         horizon_from_elevation(elevation_max, gamma, sl, h, cos_h, sin_h);
@@ -628,6 +628,7 @@ void hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *grid,
     /* whole blocks, so that a block's depths are always one full load */
     job.phase_width =
         ((grid->width + 3) / 4 + HBAO_BLOCK_PIXELS - 1) / HBAO_BLOCK_PIXELS * HBAO_BLOCK_PIXELS;
+    job.int_indices = (int64_t)4 * grid->height * job.phase_width <= INT32_MAX;
     if (tiled.simd != NULL) {
         const size_t bytes = (size_t)4 * grid->height * job.phase_width * sizeof(float);
         phase_depth = hbao_scratch_take(bytes);

@@ -15,7 +15,8 @@
  * (truncating float -> int32); I_STOREU; M_BITS(m) (lane k -> bit k);
  * for the back layer's sector masks: V_MIN V_CEIL V_FLOOR, I_SUB I_AND I_OR
  * I_ANDNOT(a, b) = ~a & b, I_SLLV (per-lane shift, 0 from 32 on) I_SRLI,
- * I_ZERO_UNLESS(m, v); I_SRAI (arithmetic shift) for the steps' indices; SIMD_NAME(x) gives the instance's function names. */
+ * I_ZERO_UNLESS(m, v); I_SRAI (arithmetic shift) for the steps' indices;
+ * SIMD_NAME(x) gives the instance's function names. */
 
 static inline VF SIMD_NAME(dot3)(VF a0, VF a1, VF a2, VF b0, VF b1, VF b2) {
     return V_ADD(V_ADD(V_MUL(a0, b0), V_MUL(a1, b1)), V_MUL(a2, b2));
@@ -75,12 +76,11 @@ static inline void SIMD_NAME(slice_setup)(const VF v[3], const VF n[3], VF dc, V
 typedef struct SIMD_NAME(block) {
     const hbao_horizon_job *job;
     const hbao_grid *grid;
-    VI lane_i;         /* the lanes' columns: first_i + 4 k */
-    VF lane_float;     /* and as floats (exact) */
-    int plain_indices; /* whether every phase_depth index fits an int */
-    int first_i;       /* lane 0's column */
-    int phase;         /* first_i & 3: the lanes' column phase */
-    int first_x;       /* lane 0's index in its phase_depth row: first_i / 4 */
+    VI lane_i;     /* the lanes' columns: first_i + 4 k */
+    VF lane_float; /* and as floats (exact) */
+    int first_i;   /* lane 0's column */
+    int phase;     /* first_i & 3: the lanes' column phase */
+    int first_x;   /* lane 0's index in its phase_depth row: first_i / 4 */
     int j;
     float jitter, step_px, inv_ycor; /* shared by the block */
     VF p[3], v[3], n[3];
@@ -112,8 +112,8 @@ typedef struct SIMD_NAME(steps) {
     int count; /* the steps before the first that lies a whole image away */
     int ox[SIMD_STEP_ROOM], oy[SIMD_STEP_ROOM], index[SIMD_STEP_ROOM];
     float row[SIMD_STEP_ROOM], ox_float[SIMD_STEP_ROOM];
-    unsigned
-        plain[SIMD_STEP_ROOM / SIMD_LANES]; /* step k: bit k % SIMD_LANES of word k / SIMD_LANES */
+    /* whether step k is plain: bit k % SIMD_LANES of word k / SIMD_LANES */
+    unsigned plain[SIMD_STEP_ROOM / SIMD_LANES];
 } SIMD_NAME(steps);
 
 static inline VI SIMD_NAME(floor_to_int)(VF x) {
@@ -161,7 +161,7 @@ static inline void SIMD_NAME(plan_steps)(const SIMD_NAME(block) * b, float dc, f
                                          I_ADD(I_SET(b->first_x), I_SRAI(moved, 2))));
         V_STOREU(t->row + first, V_MUL(V_ADD(sj_float, V_SET(g->y_offset)), V_SET(g->y_step)));
         V_STOREU(t->ox_float + first, ox_float);
-        t->plain[first / SIMD_LANES] = b->plain_indices ? (unsigned)M_BITS(plain) : 0u;
+        t->plain[first / SIMD_LANES] = b->job->int_indices ? (unsigned)M_BITS(plain) : 0u;
         const int count = steps - first < SIMD_LANES ? steps - first : SIMD_LANES;
         const unsigned wanted = (count == 32 ? 0u : 1u << count) - 1u;
         const unsigned outside = ~(unsigned)M_BITS(inside) & wanted;
@@ -364,7 +364,7 @@ static inline VM SIMD_NAME(sample_rising)(const SIMD_NAME(block) * b, const SIMD
     if (!M_ANY(M_AND(valid, tangent))) return none;
     VM far;
     const VM ok = SIMD_NAME(sample_reach)(b, valid, delta, dist2, &far);
-    return M_ANY(SIMD_NAME(above_tangent)(b, ok, *height)) ? ok : none;
+    return M_ANY(M_AND(ok, tangent)) ? ok : none; /* above_tangent(b, ok, height) */
 }
 
 static inline VF SIMD_NAME(cos_to_view)(const SIMD_NAME(block) * b, const VF delta[3],
@@ -424,9 +424,14 @@ static inline VF SIMD_NAME(half_slice_visibility)(VF h, VF cos_h, VF sin_h,
                                      V_MUL(V_MUL(V_SET(2.0f), h), sl->sin_gamma)));
 }
 
+/* hbao_sine_from_cosine, lane by lane (V_MAX0 is fmaxf(0, x)) */
+static inline VF SIMD_NAME(sine_from_cosine)(VF c) {
+    return V_SQRT(V_MAX0(V_SUB(V_SET(1.0f), V_MUL(c, c))));
+}
+
 /* horizon_visibility with the elevation's sine (sin_a) and arc cosine
- * (acos_a) given: the start of every direction has the same elevation, the
- * bias, and the block computes them once. */
+ * (acos_a) given: every direction starts at the same elevation, the bias,
+ * whose sine and arc cosine hbao_settings holds (compute.c). */
 static inline VF SIMD_NAME(horizon_visibility_of)(VM past_normal, VF cos_past_max, VF elevation_max,
                                                   VF sin_a, VF acos_a, VF gamma,
                                                   const SIMD_NAME(slice) * sl) {
@@ -440,7 +445,7 @@ static inline VF SIMD_NAME(horizon_visibility_of)(VM past_normal, VF cos_past_ma
     VF sin_h = V_SELECT(flat, V_ADD(V_MUL(sl->sin_gamma, cos_a), V_MUL(sl->cos_gamma, sin_a)),
                         V_SET(0.0f));
     if (M_ANY(past_normal)) {
-        const VF past_sin = V_SQRT(V_MAX0(V_SUB(V_SET(1.0f), V_MUL(cos_past_max, cos_past_max))));
+        const VF past_sin = SIMD_NAME(sine_from_cosine)(cos_past_max);
         h = V_SELECT(past_normal, h, SIMD_NAME(acos)(cos_past_max));
         cos_h = V_SELECT(past_normal, cos_h, cos_past_max);
         sin_h = V_SELECT(past_normal, sin_h, past_sin);
@@ -448,14 +453,10 @@ static inline VF SIMD_NAME(horizon_visibility_of)(VM past_normal, VF cos_past_ma
     return SIMD_NAME(half_slice_visibility)(h, cos_h, sin_h, sl);
 }
 
-static inline VF SIMD_NAME(elevation_sine)(VF elevation) {
-    return V_SQRT(V_MAX0(V_SUB(V_SET(1.0f), V_MUL(elevation, elevation))));
-}
-
 static inline VF SIMD_NAME(horizon_visibility)(VM past_normal, VF cos_past_max, VF elevation_max,
                                                VF gamma, const SIMD_NAME(slice) * sl) {
     return SIMD_NAME(horizon_visibility_of)(past_normal, cos_past_max, elevation_max,
-                                            SIMD_NAME(elevation_sine)(elevation_max),
+                                            SIMD_NAME(sine_from_cosine)(elevation_max),
                                             SIMD_NAME(acos)(elevation_max), gamma, sl);
 }
 
@@ -734,8 +735,7 @@ static void SIMD_NAME(lanes_ao)(const hbao_horizon_job *job, int x0, int x1, int
         V_LOADU(job->phase_depth + ((size_t)a * g->height + j) * job->phase_width + b.first_x);
     b.lane_i = I_ADD(I_SET(first_i), I_MULLO(I_LANES, I_SET(4)));
     b.lane_float = I_TO_F(b.lane_i);
-    b.plain_indices = 4.0 * (double)g->height * (double)job->phase_width < 2147483647.0;
-    const VF column = V_MUL(V_ADD(I_TO_F(b.lane_i), V_SET(g->x_offset)), V_SET(g->x_step));
+    const VF column = V_MUL(V_ADD(b.lane_float, V_SET(g->x_offset)), V_SET(g->x_step));
     const VF row = V_SET(hbao_grid_y(g, j));
     b.p[0] = g->orthographic ? column : V_MUL(column, z);
     b.p[1] = g->orthographic ? row : V_MUL(row, z);

@@ -176,6 +176,9 @@ typedef struct hbao_horizon_job {
     /* grid->back deinterleaved the same way (NULL without the layer) */
     const float *phase_back;
     int phase_width;
+    /* whether every index into phase_depth fits an int32 (4 * height *
+     * phase_width < 2^31): the SIMD kernels' step plan then computes them */
+    int int_indices;
 } hbao_horizon_job;
 
 /* The horizon search works on blocks: the HBAO_BLOCK_PIXELS pixels
@@ -262,6 +265,12 @@ static inline float hbao_exp_negative(float x) {
     out.f = p * scale.f;
     out.u &= keep;
     return out.f;
+}
+
+/* sqrt(1 - c^2), 0 where rounding takes c past 1: the sine of an angle
+ * from its cosine (a horizon's, from its elevation or its angle to V). */
+static inline float hbao_sine_from_cosine(float c) {
+    return sqrtf(fmaxf(0.0f, 1.0f - c * c));
 }
 
 /* acos(x) for x in [-1, 1] to 2e-8 absolute (Abramowitz & Stegun 4.4.46):
