@@ -28,7 +28,7 @@ __all__ = ["EXRFormatError", "EXRFileError", "EXRLibraryError", "read_channels",
            "unload_library", "library_path"]
 
 #: The header's HBAO_EXR_INTERFACE_VERSION this binding mirrors.
-BINDING_INTERFACE_VERSION = 1
+BINDING_INTERFACE_VERSION = 2
 #: Environment variable that names the library to load instead of lib/libhbao_exr.so.
 LIBRARY_ENVIRONMENT_VARIABLE = "HBAO_EXR_LIBRARY"
 # hbao_exr.h: HBAO_EXR_MESSAGE_SIZE holds every message the library writes.
@@ -78,6 +78,7 @@ _FUNCTIONS = {
     "hbao_exr_open": (ctypes.c_int32, [ctypes.c_char_p, ctypes.POINTER(_FILE_P),
                                        ctypes.c_char_p, ctypes.c_int32]),
     "hbao_exr_size": (None, [_FILE_P, _INT32_P, _INT32_P]),
+    "hbao_exr_set_threads": (None, [_FILE_P, ctypes.c_int32]),
     "hbao_exr_channel_count": (ctypes.c_int32, [_FILE_P]),
     "hbao_exr_channel_name": (ctypes.c_char_p, [_FILE_P, ctypes.c_int32]),
     "hbao_exr_has_channel": (ctypes.c_int32, [_FILE_P, ctypes.c_char_p]),
@@ -179,11 +180,12 @@ def image_size(path):
         return exr_file.size()
 
 
-def read_channel_groups(path, groups):
+def read_channel_groups(path, groups, threads=0):
     """{key: float32 array, top row first} for `groups` {key: [channel names]}:
     a group of one name gives a (height, width) array, a group of n names an
     interleaved (height, width, n) array (Normal.X/Y/Z as one normal image),
-    all decoded in one pass over the file. Raises EXRFileError, EXRFormatError,
+    all decoded in one pass over the file by `threads` threads (0: one per
+    core; the values do not depend on it). Raises EXRFileError, EXRFormatError,
     KeyError naming a missing channel and the channels the file has, or
     EXRLibraryError when libhbao_exr cannot be loaded."""
     groups = {key: [names] if isinstance(names, str) else list(names)
@@ -202,13 +204,15 @@ def read_channel_groups(path, groups):
         if duplicates:
             raise ValueError(f"channels requested twice: {', '.join(sorted(duplicates))}")
         if requests:
+            exr_file.library.hbao_exr_set_threads(exr_file.handle, threads)
             exr_file.read(requests)
     return result
 
 
-def read_channels(path, names):
+def read_channels(path, names, threads=0):
     """{name: (height, width) float32 array, top row first} for the channels
-    `names` of the EXR at `path` (each channel once, whatever `names` repeats).
-    Raises EXRFileError, EXRFormatError, KeyError naming a missing channel and
-    the channels the file has, or EXRLibraryError."""
-    return read_channel_groups(path, {name: [name] for name in dict.fromkeys(names)})
+    `names` of the EXR at `path` (each channel once, whatever `names` repeats),
+    decoded by `threads` threads as in read_channel_groups. Raises
+    EXRFileError, EXRFormatError, KeyError naming a missing channel and the
+    channels the file has, or EXRLibraryError."""
+    return read_channel_groups(path, {name: [name] for name in dict.fromkeys(names)}, threads)

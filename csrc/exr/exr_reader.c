@@ -2,10 +2,13 @@
 #include "exr_reader.h"
 
 #include <limits.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "hbao.h"
 
@@ -273,6 +276,7 @@ static int check_chunks(exr_input *input, tool_error *error) {
 int exr_input_open(exr_input *input, const char *path, tool_error *error) {
     memset(input, 0, sizeof *input);
     input->path = path;
+    input->threads = 1;
     exr_clear_last_error();
     exr_context_initializer_t initializer = exr_quiet_initializer();
     int status = TOOL_EXIT_SUCCESS;
@@ -356,6 +360,11 @@ fail:
     return status;
 }
 
+int exr_online_cores(void) {
+    const long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    return cores < 1 ? 1 : cores > INT_MAX ? INT_MAX : (int)cores;
+}
+
 int exr_input_find_channel(const exr_input *input, const char *name) {
     for (int c = 0; c < input->channels->num_channels; ++c)
         if (strcmp(input->channels->entries[c].name.str, name) == 0) return c;
@@ -369,8 +378,10 @@ static const exr_channel_request *find_request(const exr_channel_request *reques
     return NULL;
 }
 
-/* Decode the requests that name channels of `part`; the others are left to
- * the other parts (a name is in one part only).
+/* Decode the requests that name channels of `part`, for the chunks that
+ * start at rows first_y .. last_y of the file (a band; every chunk of the
+ * part when the band is the whole data window); the other requests are left
+ * to the other parts (a name is in one part only).
  *
  * The part's channels that nobody asked for are decoded too, into one scratch
  * chunk that is thrown away: OpenEXRCore 3.1 is told to skip a channel by a
@@ -379,8 +390,8 @@ static const exr_channel_request *find_request(const exr_channel_request *reques
  * crashed). Every channel with a real destination keeps the library on paths
  * that need no such care; the cost is a copy of channels that are decompressed
  * anyway. */
-static int read_part(exr_input *input, int part, const exr_channel_request *requests, int count,
-                     tool_error *error) {
+static int read_band(exr_input *input, int part, const exr_channel_request *requests, int count,
+                     int64_t first_y, int64_t last_y, atomic_bool *stop, tool_error *error) {
     int status = TOOL_EXIT_SUCCESS;
     exr_decode_pipeline_t decoder = EXR_DECODE_PIPELINE_INITIALIZER;
     bool decoder_ready = false;
@@ -398,7 +409,8 @@ static int read_part(exr_input *input, int part, const exr_channel_request *requ
     }
 
     const pixel_rect *window = &input->data_window;
-    for (int64_t y = window->min_y; y <= window->max_y; y += lines_per_chunk) {
+    for (int64_t y = first_y; y <= last_y; y += lines_per_chunk) {
+        if (atomic_load(stop)) break; /* another band failed: its message is the one */
         exr_chunk_info_t chunk;
         status = read_chunk_info(input, part, lines_per_chunk, y, input->file_size, &chunk, error);
         if (status != TOOL_EXIT_SUCCESS) goto fail;
@@ -446,9 +458,87 @@ static int read_part(exr_input *input, int part, const exr_channel_request *requ
     }
 
 fail:
+    if (status != TOOL_EXIT_SUCCESS) atomic_store(stop, true);
     if (decoder_ready) exr_decoding_destroy(input->context, &decoder);
     free(scratch);
     return status;
+}
+
+/* One band of a part, decoded by one thread. */
+typedef struct band_job {
+    exr_input *input;
+    int part;
+    const exr_channel_request *requests;
+    int count;
+    int64_t first_y, last_y;
+    atomic_bool *stop;
+    int status;
+    tool_error error;
+} band_job;
+
+static void *run_band(void *argument) {
+    band_job *band = argument;
+    exr_clear_last_error(); /* this thread's copy of OpenEXRCore's detail */
+    band->status = read_band(band->input, band->part, band->requests, band->count, band->first_y,
+                             band->last_y, band->stop, &band->error);
+    return NULL;
+}
+
+/* The part's chunks in input->threads bands of whole chunks (at most one
+ * band per chunk), one thread each (OpenEXRCore reads one context from several threads; each band has
+ * its own decoder). Every chunk is decoded into its own rows, so the result
+ * does not depend on the number of threads. The first band that fails, from
+ * the top, gives the message. */
+static int read_part(exr_input *input, int part, const exr_channel_request *requests, int count,
+                     tool_error *error) {
+    int32_t lines_per_chunk = 0;
+    int status = part_lines_per_chunk(input, part, &lines_per_chunk, error);
+    if (status != TOOL_EXIT_SUCCESS) return status;
+    const pixel_rect *window = &input->data_window;
+    const int64_t chunks = ((int64_t)input->height + lines_per_chunk - 1) / lines_per_chunk;
+    int64_t threads = input->threads < 1 ? 1 : input->threads;
+    if (threads > EXR_MAX_READ_THREADS) threads = EXR_MAX_READ_THREADS;
+    if (threads > chunks) threads = chunks;
+    atomic_bool stop;
+    atomic_init(&stop, false);
+    if (threads <= 1)
+        return read_band(input, part, requests, count, window->min_y, window->max_y, &stop, error);
+
+    band_job bands[EXR_MAX_READ_THREADS];
+    pthread_t workers[EXR_MAX_READ_THREADS];
+    bool started[EXR_MAX_READ_THREADS] = {false};
+    for (int64_t b = 0; b < threads; ++b) {
+        const int64_t first_chunk = chunks * b / threads, end_chunk = chunks * (b + 1) / threads;
+        band_job job = {input,
+                        part,
+                        requests,
+                        count,
+                        window->min_y + first_chunk * lines_per_chunk,
+                        window->min_y + end_chunk * lines_per_chunk - 1,
+                        &stop,
+                        TOOL_EXIT_SUCCESS,
+                        {{0}}};
+        if (job.last_y > window->max_y) job.last_y = window->max_y;
+        bands[b] = job;
+    }
+    /* The calling thread decodes band 0; a band whose thread cannot start is
+     * decoded here too, after it. */
+    for (int64_t b = 1; b < threads; ++b)
+        started[b] = pthread_create(&workers[b], NULL, run_band, &bands[b]) == 0;
+    run_band(&bands[0]);
+    for (int64_t b = 1; b < threads; ++b) {
+        if (started[b])
+            pthread_join(workers[b], NULL);
+        else
+            run_band(&bands[b]);
+    }
+    for (int64_t b = 0; b < threads; ++b) {
+        if (bands[b].status != TOOL_EXIT_SUCCESS) {
+            *error = bands[b].error;
+            return bands[b].status;
+        }
+    }
+    return TOOL_EXIT_SUCCESS;
 }
 
 int exr_input_read(exr_input *input, const exr_channel_request *requests, int count,

@@ -30,11 +30,18 @@ typedef struct exr_input {
     exr_lineorder_t line_order;
     int64_t file_size; /**< in bytes, when opened */
     int part_count;
+    /** Threads exr_input_read decodes with (each part in bands of rows): 1
+     *  after exr_input_open; the caller may raise it, up to
+     *  EXR_MAX_READ_THREADS. The values read do not depend on it. */
+    int threads;
     /** Every part's channels, sorted by name; names are unique across parts. */
     const exr_attr_chlist_t *channels;
     int *channel_parts;              /**< the part that holds channels->entries[c] */
     exr_attr_chlist_t channel_union; /* storage behind `channels`; names owned by the context */
 } exr_input;
+
+/** The most threads exr_input_read uses. */
+#define EXR_MAX_READ_THREADS 16
 
 /** Where one channel's pixels go. Strides are in bytes. */
 typedef struct exr_channel_request {
@@ -61,6 +68,10 @@ int exr_input_open(exr_input *input, const char *path, tool_error *error);
  *  from whichever parts hold them. */
 int exr_input_read(exr_input *input, const exr_channel_request *requests, int count,
                    tool_error *error);
+
+/** The cores online (at least 1): the threads a caller reads and computes
+ *  with when nobody asked for a number. */
+int exr_online_cores(void);
 
 /** Index of the channel called `name`, or -1. */
 int exr_input_find_channel(const exr_input *input, const char *name);

@@ -103,6 +103,7 @@ int32_t hbao_exr_open(const char *path, hbao_exr_file **file, char *message, int
         free(opened);
         return result;
     }
+    hbao_exr_set_threads(opened, 0);
     *file = opened;
     return HBAO_EXR_SUCCESS;
 }
@@ -110,6 +111,12 @@ int32_t hbao_exr_open(const char *path, hbao_exr_file **file, char *message, int
 void hbao_exr_size(const hbao_exr_file *file, int32_t *width, int32_t *height) {
     if (width != NULL) *width = file != NULL ? file->input.width : 0;
     if (height != NULL) *height = file != NULL ? file->input.height : 0;
+}
+
+void hbao_exr_set_threads(hbao_exr_file *file, int32_t threads) {
+    if (file == NULL) return;
+    /* exr_input_read caps it at EXR_MAX_READ_THREADS and at the rows */
+    file->input.threads = threads > 0 ? threads : exr_online_cores();
 }
 
 int32_t hbao_exr_channel_count(const hbao_exr_file *file) {

@@ -42,7 +42,7 @@ extern "C" {
 
 /** Version of this interface; bumped whenever a signature or struct changes,
  *  so that a binding can refuse a library it was not written for. */
-#define HBAO_EXR_INTERFACE_VERSION 1
+#define HBAO_EXR_INTERFACE_VERSION 2
 
 /** A message buffer of this size holds every message the library writes. */
 #define HBAO_EXR_MESSAGE_SIZE 1024
@@ -107,6 +107,11 @@ HBAO_EXR_EXPORT const char *hbao_exr_channel_name(const hbao_exr_file *file, int
 
 /** 1 when the file has a channel called `name`, else 0. */
 HBAO_EXR_EXPORT int32_t hbao_exr_has_channel(const hbao_exr_file *file, const char *name);
+
+/** The threads hbao_exr_read_channels decodes `file` with, each taking a band
+ *  of rows: 0 (or less), the default, is one per core; more than 16 is 16.
+ *  The values read are the same for any number. Ignored for a NULL file. */
+HBAO_EXR_EXPORT void hbao_exr_set_threads(hbao_exr_file *file, int32_t threads);
 
 /**
  * Decode the `count` requested channels (each name at most once, each must

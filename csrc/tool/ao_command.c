@@ -272,6 +272,8 @@ int ao_compute_input(const cli_options *options, exr_input *input, ao_buffers *b
         status = blender_find_passes(input, options->back_layer, &back_passes, error);
         if (status != TOOL_EXIT_SUCCESS) return status;
     }
+    /* The passes are decoded with as many threads as the AO is computed. */
+    input->threads = options->params.threads > 0 ? options->params.threads : exr_online_cores();
     status = read_passes(input, &passes, use_normals,
                          options->back_layer != NULL ? &back_passes : NULL, buffers, error);
     if (status != TOOL_EXIT_SUCCESS) return status;

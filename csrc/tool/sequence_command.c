@@ -129,11 +129,6 @@ static int summarize(const sequence_run *run, tool_error *error) {
                      (long long)run->count, list);
 }
 
-static int available_cores(void) {
-    long cores = sysconf(_SC_NPROCESSORS_ONLN);
-    return cores < 1 ? 1 : (int)cores;
-}
-
 int sequence_command(const cli_options *options, tool_error *error) {
     sequence_run run = {0};
     run.count = frame_list_count(&options->frames);
@@ -148,7 +143,7 @@ int sequence_command(const cli_options *options, tool_error *error) {
     /* Frames at once share the cores: each frame's computation gets its
      * part, unless --threads says otherwise. */
     if (shared.params.threads == 0 && jobs > 1) {
-        shared.params.threads = available_cores() / jobs;
+        shared.params.threads = exr_online_cores() / jobs;
         if (shared.params.threads < 1) shared.params.threads = 1;
     }
     run.options = &shared;
