@@ -155,6 +155,13 @@ def test_the_blur_formulas_match_the_library():
     for kernel_radius in range(1, 33):
         assert parameters.blur_sigma(kernel_radius) == \
             float(sigma.group(1)) * (kernel_radius + int(sigma.group(2)))
+    grid = library_pattern(r"grid_blur_radius = s->half_resolution \? \(s->blur_radius \+ (\d+)\) "
+                           r"/ (\d+) : s->blur_radius;",
+                           "the half grid's blur radius rule (half ? (r + 1) / 2 : r)")
+    for kernel_radius in range(parameters.blur_kernel_radius(parameters.MAX_BLUR_SIZE) + 1):
+        assert parameters.grid_blur_radius(kernel_radius, half=True) == \
+            (kernel_radius + int(grid.group(1))) // int(grid.group(2)), kernel_radius
+        assert parameters.grid_blur_radius(kernel_radius, half=False) == kernel_radius
     # The spatial weight has the same Gaussian form in C and GLSL; sigma itself
     # comes into the shader as a uniform (parameters.blur_sigma), never recomputed.
     library_pattern(r"expf\(-\(float\)\(k \* k\) / \(2\.0f \* sigma \* sigma\)\)",

@@ -91,6 +91,13 @@ def blur_kernel_radius(blur_size):
     return (blur_size - 1) // 2 if blur_size >= 2 else 0
 
 
+def grid_blur_radius(kernel_radius, half):
+    """Taps each side of the blur on the grid it runs on: at half
+    resolution it runs on the half grid before the upsample, with half the
+    taps (rounded up), so that it reaches as far."""
+    return (kernel_radius + 1) // 2 if half else kernel_radius
+
+
 def blur_sigma(kernel_radius):
     """The blur Gaussian's sigma, in pixels, for a kernel of `kernel_radius` taps each side."""
     return BLUR_SIGMA_PER_TAP * (kernel_radius + BLUR_SIGMA_TAP_OFFSET)

@@ -1,16 +1,18 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
-/* Everything after the horizon search: [half-resolution upsample] ->
- * cross-bilateral blur weighted by depth and normal, applied separably (rows,
- * then columns; Bavoil & Sainz: the filter is not separable, but the
- * separable version is close and costs 2r+1 taps instead of (2r+1)^2) ->
- * strength -> the caller's output.
+/* Everything after the horizon search, on the grid the horizons were
+ * searched on: cross-bilateral blur weighted by depth and normal, applied
+ * separably (rows, then columns; Bavoil & Sainz: the filter is not
+ * separable, but the separable version is close and costs 2r+1 taps instead
+ * of (2r+1)^2) -> [half-resolution upsample (upsample.c)] -> strength -> the
+ * caller's output. At half resolution the blur runs on the half grid, a
+ * quarter of the pixels, with half the taps (the same reach); the upsample,
+ * guided by the full-resolution depth, then keeps edges sharp.
  *
- * The stages are fused per band of rows: a thread walks down its band,
- * makes each row (upsampled AO, guide normals, blurred along the row) into a
- * ring of the last 2r+1 rows, and as soon as the rows a column tap needs are
- * there, blurs down the column and writes the finished output row. Each row
- * of the image is thus read from memory once and no full-size intermediate
- * image is written. A band recomputes the r rows above and below it that its
+ * The blur's stages are fused per band of rows: a thread walks down its
+ * band, makes each row (blurred along the row) into a ring of the last 2r+1
+ * rows, and as soon as the rows a column tap needs are there, blurs down the
+ * column and writes the finished row. Each row of the grid is thus read from
+ * memory once. A band recomputes the r rows above and below it that its
  * neighbours also make; every row's values depend only on the input, so the
  * result is the same for any number of threads and any band height. */
 #include <float.h>
@@ -31,13 +33,13 @@
 #define BANDS_PER_THREAD 8
 #define MIN_BAND_ROWS 16
 
+/* The blur over the grid, row bands in parallel. */
 typedef struct finish_job {
     const hbao_grid *grid; /* the horizon grid: its normals guide the blur */
     const float *grid_ao;  /* raw AO on the grid */
-    const float *depth;    /* full resolution, 0 = background */
-    int width, height;
-    int half_resolution;
-    int radius; /* taps on each side; 0 = no blur */
+    const float *depth;    /* the grid's, 0 = background */
+    int width, height;     /* the grid's */
+    int radius;            /* taps on each side; 0 = no blur */
     int band_rows;
     int implementation; /* resolved: which compiled copy runs */
     float sharpness;
@@ -178,20 +180,18 @@ static HBAO_ALWAYS_INLINE void blur_pass(const tap_set *taps, const centre_row *
     for (; i < width; i++) target[i] = blur_pixel(taps, c, sharpness, width, i);
 }
 
-/* Scratch of one band: the ring, the raw (upsampled) row and the finished
- * row, width floats each. */
+/* Scratch of one band: the ring and the finished row, width floats each. */
 typedef struct band_memory {
     float *block;
-    float *raw, *finished;
+    float *finished;
     ring_row ring[2 * MAX_BLUR_RADIUS + 1];
 } band_memory;
 
 static int band_memory_make(band_memory *m, int width, int slots) {
     const size_t row = (size_t)width;
-    m->block = malloc((2 + 4 * (size_t)slots) * row * sizeof(float));
+    m->block = malloc((1 + 4 * (size_t)slots) * row * sizeof(float));
     if (m->block == NULL) return 0;
-    m->raw = m->block;
-    m->finished = m->raw + row;
+    m->finished = m->block;
     for (int s = 0; s < slots; s++) {
         float *base = m->finished + row + 4 * (size_t)s * row;
         m->ring[s] = (ring_row){base, base + row, base + 2 * row, base + 3 * row};
@@ -199,26 +199,19 @@ static int band_memory_make(band_memory *m, int width, int slots) {
     return 1;
 }
 
-/* Row j into its ring slot: its raw AO (upsampled if need be) and guide
- * normals, then blurred along the row. */
+/* Row j into its ring slot: its guide normals, and its raw AO blurred
+ * along the row. */
 static HBAO_ALWAYS_INLINE void make_row(const finish_job *job, band_memory *m, int j) {
     const int width = job->width, radius = job->radius;
     const ring_row *slot = &m->ring[j % (2 * radius + 1)];
-    const float *raw;
-    if (job->half_resolution) {
-        hbao_upsample_row(job->implementation, job->grid, job->grid_ao, job->depth, width, j,
-                          m->raw, slot->nx, slot->ny, slot->nz);
-        raw = m->raw;
-    } else {
-        raw = job->grid_ao + (size_t)j * width;
-        if (radius > 0) {
-            const float *n = job->grid->normal + 3 * (size_t)j * width;
-            float *restrict nx = slot->nx, *restrict ny = slot->ny, *restrict nz = slot->nz;
-            for (int i = 0; i < width; i++) {
-                nx[i] = n[3 * i];
-                ny[i] = n[3 * i + 1];
-                nz[i] = n[3 * i + 2];
-            }
+    const float *raw = job->grid_ao + (size_t)j * width;
+    if (radius > 0) {
+        const float *n = job->grid->normal + 3 * (size_t)j * width;
+        float *restrict nx = slot->nx, *restrict ny = slot->ny, *restrict nz = slot->nz;
+        for (int i = 0; i < width; i++) {
+            nx[i] = n[3 * i];
+            ny[i] = n[3 * i + 1];
+            nz[i] = n[3 * i + 2];
         }
     }
     if (radius == 0) {
@@ -244,7 +237,25 @@ static HBAO_ALWAYS_INLINE void make_row(const finish_job *job, band_memory *m, i
     blur_pass(&taps, &centre, job->sharpness, width, radius, slot->ao);
 }
 
-/* Output row j: rows j - r .. j + r of the ring blurred down the column,
+/* A finished row of AO (1 on background, where zc <= 0) to the output:
+ * strength, then the clamp to [0, 1]. ao may be out itself. */
+static HBAO_ALWAYS_INLINE void write_output(const float *zc, const float *ao, int width,
+                                            float strength, float *out) {
+    if (strength != 1.0f) {
+        for (int i = 0; i < width; i++) {
+            const float value = powf(zc[i] > 0.0f ? ao[i] : 1.0f, strength);
+            /* Written so that a NaN could never pass through. */
+            out[i] = value > 0.0f ? (value < 1.0f ? value : 1.0f) : 0.0f;
+        }
+        return;
+    }
+    for (int i = 0; i < width; i++) {
+        const float value = zc[i] > 0.0f ? ao[i] : 1.0f;
+        out[i] = value > 0.0f ? (value < 1.0f ? value : 1.0f) : 0.0f;
+    }
+}
+
+/* Finished row j: rows j - r .. j + r of the ring blurred down the column,
  * then strength and the clamp to [0, 1]. */
 static HBAO_ALWAYS_INLINE void finish_row(const finish_job *job, band_memory *m, int j) {
     const int width = job->width, radius = job->radius, slots = 2 * radius + 1;
@@ -271,20 +282,7 @@ static HBAO_ALWAYS_INLINE void finish_row(const finish_job *job, band_memory *m,
         blur_pass(&taps, &c, job->sharpness, width, radius, m->finished);
         blurred = m->finished;
     }
-    float *out = job->out + (int64_t)j * job->out_row_stride;
-    const float strength = job->strength;
-    if (strength != 1.0f) {
-        for (int i = 0; i < width; i++) {
-            const float ao = powf(zc[i] > 0.0f ? blurred[i] : 1.0f, strength);
-            /* Written so that a NaN could never pass through. */
-            out[i] = ao > 0.0f ? (ao < 1.0f ? ao : 1.0f) : 0.0f;
-        }
-        return;
-    }
-    for (int i = 0; i < width; i++) {
-        const float ao = zc[i] > 0.0f ? blurred[i] : 1.0f;
-        out[i] = ao > 0.0f ? (ao < 1.0f ? ao : 1.0f) : 0.0f;
-    }
+    write_output(zc, blurred, width, job->strength, job->out + (int64_t)j * job->out_row_stride);
 }
 
 /* One band of output rows, each row made once it is needed. */
@@ -321,20 +319,20 @@ HBAO_TARGET_AVX512 static void finish_band_avx512(void *context, int band) {
 }
 #endif
 
-hbao_result hbao_finish(const hbao_settings *settings, const hbao_grid *grid, const float *grid_ao,
-                        const float *full_depth, int width, int height, float *out,
-                        int64_t out_row_stride) {
+/* The blur of grid_ao over the grid, with `strength`, into out. */
+static hbao_result blur_grid(const hbao_settings *settings, const hbao_grid *grid,
+                             const float *grid_ao, float strength, float *out,
+                             int64_t out_row_stride) {
     finish_job job;
     job.grid = grid;
     job.grid_ao = grid_ao;
-    job.depth = full_depth;
-    job.width = width;
-    job.height = height;
-    job.half_resolution = settings->half_resolution;
-    job.radius = settings->blur_radius;
+    job.depth = grid->depth;
+    job.width = grid->width;
+    job.height = grid->height;
+    job.radius = settings->grid_blur_radius;
     job.implementation = hbao_finish_implementation(settings->implementation);
     job.sharpness = settings->blur_sharpness;
-    job.strength = settings->strength;
+    job.strength = strength;
     job.out = out;
     job.out_row_stride = out_row_stride;
     atomic_init(&job.out_of_memory, 0);
@@ -342,6 +340,7 @@ hbao_result hbao_finish(const hbao_settings *settings, const hbao_grid *grid, co
     for (int k = 0; k <= job.radius; k++)
         job.spatial[k] = expf(-(float)(k * k) / (2.0f * sigma * sigma));
 
+    const int height = job.height;
     const int bands_wanted = BANDS_PER_THREAD * settings->threads;
     int band_rows = (height + bands_wanted - 1) / bands_wanted;
     if (band_rows < MIN_BAND_ROWS) band_rows = MIN_BAND_ROWS;
@@ -355,4 +354,53 @@ hbao_result hbao_finish(const hbao_settings *settings, const hbao_grid *grid, co
 #endif
     hbao_parallel_rows(settings->threads, bands, run, &job);
     return atomic_load(&job.out_of_memory) ? HBAO_ERROR_OUT_OF_MEMORY : HBAO_SUCCESS;
+}
+
+/* The upsample of the (blurred) half-grid AO into the output, row by row. */
+typedef struct upsample_job {
+    const hbao_grid *grid;
+    const float *grid_ao;
+    const float *depth; /* full resolution */
+    int width;
+    int implementation;
+    float strength;
+    float *out;
+    int64_t out_row_stride;
+} upsample_job;
+
+static void upsample_output_row(void *context, int j) {
+    const upsample_job *job = context;
+    float *out = job->out + (int64_t)j * job->out_row_stride;
+    hbao_upsample_row(job->implementation, job->grid, job->grid_ao, job->depth, job->width, j, out);
+    write_output(job->depth + (size_t)j * job->width, out, job->width, job->strength, out);
+}
+
+hbao_result hbao_finish(const hbao_settings *settings, const hbao_grid *grid, const float *grid_ao,
+                        const float *full_depth, int width, int height, float *out,
+                        int64_t out_row_stride) {
+    if (!settings->half_resolution)
+        return blur_grid(settings, grid, grid_ao, settings->strength, out, out_row_stride);
+    const float *upsampled_from = grid_ao;
+    float *blurred = NULL;
+    if (settings->grid_blur_radius > 0) {
+        blurred = hbao_scratch_take((size_t)grid->width * grid->height * sizeof(float));
+        if (blurred == NULL) return HBAO_ERROR_OUT_OF_MEMORY;
+        const hbao_result result = blur_grid(settings, grid, grid_ao, 1.0f, blurred, grid->width);
+        if (result != HBAO_SUCCESS) {
+            hbao_scratch_give(blurred);
+            return result;
+        }
+        upsampled_from = blurred;
+    }
+    upsample_job job = {grid,
+                        upsampled_from,
+                        full_depth,
+                        width,
+                        hbao_finish_implementation(settings->implementation),
+                        settings->strength,
+                        out,
+                        out_row_stride};
+    hbao_parallel_rows(settings->threads, height, upsample_output_row, &job);
+    hbao_scratch_give(blurred);
+    return HBAO_SUCCESS;
 }

@@ -25,6 +25,7 @@ static hbao_result make_settings(const hbao_params *params, hbao_settings *s) {
     s->blur_radius = p.blur_size >= 2 ? (p.blur_size - 1) / 2 : 0;
     s->blur_sharpness = p.blur_sharpness;
     s->half_resolution = p.half_resolution;
+    s->grid_blur_radius = s->half_resolution ? (s->blur_radius + 1) / 2 : s->blur_radius;
     s->strength = p.strength;
     s->threads = p.threads == 0 ? hbao_available_cores() : p.threads;
     s->background_depth = p.background_depth;

@@ -50,19 +50,18 @@ static inline int hbao_finish_implementation(int requested) {
 }
 
 /* blur.c: AO on the full image from the raw AO on the grid (grid_ao, dense,
- * grid->width wide): [upsample] -> cross-bilateral blur on depth and normals
- * (rows, then columns) -> strength -> clamp to [0, 1], written to out.
- * HBAO_ERROR_OUT_OF_MEMORY if its row buffers cannot be allocated. */
+ * grid->width wide): cross-bilateral blur on depth and normals (rows, then
+ * columns) on the grid -> [upsample] -> strength -> clamp to [0, 1],
+ * written to out. HBAO_ERROR_OUT_OF_MEMORY if its buffers cannot be
+ * allocated. */
 hbao_result hbao_finish(const hbao_settings *settings, const hbao_grid *grid, const float *grid_ao,
                         const float *full_depth, int width, int height, float *out,
                         int64_t out_row_stride);
 
-/* upsample.c: full-resolution row j of the half-resolution AO (ao, width
- * floats) and the blur's guide normal of each pixel (normal_x/_y/_z): the
- * normal of the half-grid sample nearest in depth. implementation: as
+/* upsample.c: full-resolution row j (width floats, into ao) of the
+ * half-resolution AO half_ao (half->width wide). implementation: as
  * resolved by hbao_finish_implementation(). */
 void hbao_upsample_row(int implementation, const hbao_grid *half, const float *half_ao,
-                       const float *full_depth, int width, int j, float *ao, float *normal_x,
-                       float *normal_y, float *normal_z);
+                       const float *full_depth, int width, int j, float *ao);
 
 #endif /* HBAO_INTERNAL_FINISH_H */

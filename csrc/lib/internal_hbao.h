@@ -39,6 +39,10 @@ typedef struct hbao_settings {
     int falloff;
     int integration;
     int blur_radius; /* taps on each side; 0 = no blur */
+    /* the blur's taps on each side on the grid it runs on: blur_radius at
+     * full resolution; at half resolution, where the blur runs on the half
+     * grid before the upsample, half of it rounded up (same reach) */
+    int grid_blur_radius;
     float blur_sharpness;
     int half_resolution;
     float strength;

@@ -1,7 +1,9 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """The preview's GPU passes: viewport depth -> planar depth -> [half grid] ->
-normals -> AO -> [upsample] -> blur -> composite. One AOPipeline per 3D view
-region keeps its targets and re-creates them when the region's size changes."""
+normals -> AO -> blur -> [upsample] -> composite, as the library orders them
+(csrc/lib/blur.c: at half resolution the blur runs on the half grid). One
+AOPipeline per 3D view region keeps its targets and re-creates them when the
+region's size changes."""
 import math
 
 import gpu
@@ -38,13 +40,6 @@ class _Target:
         self.framebuffer = gpu.types.GPUFrameBuffer(color_slots=self.texture)
 
 
-class _TwoTargets:
-    """Two textures one pass draws into (fragment outputs 0 and 1)."""
-
-    def __init__(self, first, second):
-        self.framebuffer = gpu.types.GPUFrameBuffer(color_slots=(first.texture, second.texture))
-
-
 class AOPipeline:
     """The targets of one view: full-size ones, and the half grid's when the
     preview runs at half resolution; kept while the view's size (and
@@ -53,28 +48,28 @@ class AOPipeline:
     def __init__(self):
         self.size = None
         self._linear_depth = self._normals = self._ao = self._blurred_rows = None
-        self._half_depth = self._half_normals = self._half_ao = None
-        self._upsampled = None
+        self._half_depth = self._half_normals = self._half_ao = self._half_blurred_rows = None
 
     def _ensure_size(self, width, height, half=False):
         if self.size == (width, height, half):
             return
         self._linear_depth = _Target(width, height)
-        # Camera-space normals (at half resolution: the upsampled guide
-        # normals), full float: the blur reads them, and the AO pass at full
-        # resolution.
-        self._normals = _Target(width, height, "RGBA32F")
         self._ao = _Target(width, height)
-        self._blurred_rows = _Target(width, height)
         if half:
+            # The search, its normals and the blur on the half grid; the
+            # upsample writes self._ao.
             half_width, half_height = (width + 1) // 2, (height + 1) // 2
             self._half_depth = _Target(half_width, half_height)
             self._half_normals = _Target(half_width, half_height, "RGBA32F")
             self._half_ao = _Target(half_width, half_height)
-            self._upsampled = _TwoTargets(self._ao, self._normals)
+            self._half_blurred_rows = _Target(half_width, half_height)
+            self._normals = self._blurred_rows = None
         else:
+            # Camera-space normals, full float: the AO pass and the blur read them.
+            self._normals = _Target(width, height, "RGBA32F")
+            self._blurred_rows = _Target(width, height)
             self._half_depth = self._half_normals = self._half_ao = None
-            self._upsampled = None
+            self._half_blurred_rows = None
         self.size = (width, height, half)
 
     def linearize(self, buffer_depth_texture, coefficients, half=False):
@@ -122,9 +117,28 @@ class AOPipeline:
             shader.uniform_float("thickness", params["thickness"])
             _draw_quad("ao")
 
+    def _blur(self, depth_texture, normals, ao, blurred_rows, size, kernel_radius, params):
+        """The cross-bilateral blur of target `ao` in place (rows into
+        `blurred_rows`, then columns back), guided by `depth_texture` and
+        target `normals`, on an image of `size`."""
+        shader = shaders.get("blur")
+        for source, target, step in ((ao, blurred_rows, (1, 0)), (blurred_rows, ao, (0, 1))):
+            with target.framebuffer.bind():
+                shader.bind()
+                shader.uniform_sampler("depth_texture", depth_texture)
+                shader.uniform_sampler("normal_texture", normals.texture)
+                shader.uniform_sampler("ao_texture", source.texture)
+                shader.uniform_int("image_size", size)
+                shader.uniform_int("blur_step", step)
+                shader.uniform_int("kernel_radius", kernel_radius)
+                shader.uniform_float("sigma", parameters.blur_sigma(kernel_radius))
+                shader.uniform_float("sharpness", params["blur_sharpness"])
+                shader.uniform_float("background_depth", params["background_depth"])
+                _draw_quad("blur")
+
     def _half_resolution(self, depth_texture, frame, params, depth_precision):
-        """Halve the depth, search on the half grid, upsample the AO into
-        self._ao and the guide normals into self._normals."""
+        """Halve the depth, search and blur on the half grid, upsample the AO
+        into self._ao."""
         grid = projection.half_frame(frame)
         sizes = {"full_size": (frame.width, frame.height), "half_size": (grid.width, grid.height)}
         shader = shaders.get("halve")
@@ -136,13 +150,17 @@ class AOPipeline:
             _draw_quad("halve")
         self._search(self._half_depth.texture, grid, params, depth_precision,
                      self._half_normals, self._half_ao)
+        kernel_radius = parameters.grid_blur_radius(
+            parameters.blur_kernel_radius(params["blur_size"]), half=True)
+        if kernel_radius >= 1:
+            self._blur(self._half_depth.texture, self._half_normals, self._half_ao,
+                       self._half_blurred_rows, (grid.width, grid.height), kernel_radius, params)
         shader = shaders.get("upsample")
-        with self._upsampled.framebuffer.bind():
+        with self._ao.framebuffer.bind():
             shader.bind()
             shader.uniform_sampler("depth_texture", depth_texture)
             shader.uniform_sampler("half_depth_texture", self._half_depth.texture)
             shader.uniform_sampler("half_ao_texture", self._half_ao.texture)
-            shader.uniform_sampler("half_normal_texture", self._half_normals.texture)
             for name, value in sizes.items():
                 shader.uniform_int(name, value)
             shader.uniform_float("background_depth", params["background_depth"])
@@ -160,26 +178,12 @@ class AOPipeline:
         self._ensure_size(width, height, half)
         if half:
             self._half_resolution(depth_texture, frame, params, depth_precision)
-        else:
-            self._search(depth_texture, frame, params, depth_precision, self._normals, self._ao)
-        kernel_radius = parameters.blur_kernel_radius(params["blur_size"])
-        if kernel_radius < 1:
             return self._ao.texture
-        shader = shaders.get("blur")
-        for source, target, step in ((self._ao, self._blurred_rows, (1, 0)),
-                                     (self._blurred_rows, self._ao, (0, 1))):
-            with target.framebuffer.bind():
-                shader.bind()
-                shader.uniform_sampler("depth_texture", depth_texture)
-                shader.uniform_sampler("normal_texture", self._normals.texture)
-                shader.uniform_sampler("ao_texture", source.texture)
-                shader.uniform_int("image_size", (width, height))
-                shader.uniform_int("blur_step", step)
-                shader.uniform_int("kernel_radius", kernel_radius)
-                shader.uniform_float("sigma", parameters.blur_sigma(kernel_radius))
-                shader.uniform_float("sharpness", params["blur_sharpness"])
-                shader.uniform_float("background_depth", params["background_depth"])
-                _draw_quad("blur")
+        self._search(depth_texture, frame, params, depth_precision, self._normals, self._ao)
+        kernel_radius = parameters.blur_kernel_radius(params["blur_size"])
+        if kernel_radius >= 1:
+            self._blur(depth_texture, self._normals, self._ao, self._blurred_rows,
+                       (width, height), kernel_radius, params)
         return self._ao.texture
 
 

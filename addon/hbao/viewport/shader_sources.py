@@ -15,8 +15,8 @@ own because both the AO pass and the blur read them, as both read the
 library's grid->normal. The normal and AO passes' GLSL is in
 horizon_sources.py. At half resolution (csrc/lib/compute.c): linearize ->
 halve (every other pixel of every other row) -> normals and AO on the half
-grid -> upsample (csrc/lib/upsample.c: the AO, and the blur's guide normals)
--> blur at full resolution -> composite.
+grid -> blur on the half grid (half the taps, csrc/lib/blur.c) -> upsample
+(csrc/lib/upsample.c) -> composite.
 """
 from ..parameters import FALLOFF_VALUES, INTEGRATION_VALUES
 from . import horizon_sources
@@ -141,33 +141,27 @@ void main()
 # Joint bilateral upsampling of the half grid's AO to full resolution,
 # csrc/lib/upsample.c operation for operation: a pixel's candidates are the
 # half-grid pixels around it with bilinear weights (even columns and rows sit
-# on the grid), each weighed by its depth's similarity; the candidates'
-# normals, averaged with the same weights, guide the blur. One pass writes
-# both: the AO to frag_output, the guide normal to guide_output (two targets;
-# the blur reads them from two textures).
+# on the grid), each weighed by its depth's similarity. The half grid's AO
+# arrives already blurred.
 UPSAMPLE_FRAGMENT = COMMON + """
 #define LARGEST_FLOAT 3.402823466e38
 
 float sum, weight_sum, nearest_ao, nearest_difference;
-vec3 normal_sum, nearest_normal;
 
 void add_candidate(float bilinear, int k, int r, float z)
 {
     ivec2 texel = ivec2(k, half_size.y - 1 - r);
     float zs = texelFetch(half_depth_texture, texel, 0).r;
     float ao = texelFetch(half_ao_texture, texel, 0).r;
-    vec3 normal = texelFetch(half_normal_texture, texel, 0).xyz;
     bool usable = bilinear > 0.0 && !is_background(zs);
     float difference = abs(zs - z) / z;
     float scaled = UPSAMPLE_SHARPNESS * difference;
     float weight = usable ? bilinear * exp(-(scaled * scaled)) : 0.0;
     sum += weight * ao;
     weight_sum += weight;
-    normal_sum += weight * normal;
     if (usable && difference < nearest_difference) {
         nearest_ao = ao;
         nearest_difference = difference;
-        nearest_normal = normal;
     }
 }
 
@@ -184,8 +178,6 @@ void main()
     weight_sum = 0.0;
     nearest_ao = 1.0;
     nearest_difference = LARGEST_FLOAT; /* the library's INFINITY: no finite difference is larger */
-    normal_sum = vec3(0.0);
-    nearest_normal = texelFetch(half_normal_texture, ivec2(k, half_size.y - 1 - r0), 0).xyz;
     if ((i & 1) == 0) {
         add_candidate(top_weight, k, r0, z);
         if (two_rows) {
@@ -203,12 +195,8 @@ void main()
             add_candidate(right_weight * bottom_weight, right, r1, z);
         }
     }
-    bool weighted = weight_sum > 1e-6;
-    float blended = weighted ? sum / weight_sum : nearest_ao;
-    float length_sum = length(normal_sum);
-    vec3 guide = weighted && length_sum > 0.0 ? normal_sum / length_sum : nearest_normal;
+    float blended = weight_sum > 1e-6 ? sum / weight_sum : nearest_ao;
     frag_output = vec4(is_background(z) ? 1.0 : blended, 0.0, 0.0, 1.0);
-    guide_output = vec4(guide, 0.0);
 }
 """
 

@@ -53,8 +53,8 @@ _DEFINITIONS = {
     "upsample": lambda: _create_info(
         shader_sources.UPSAMPLE_FRAGMENT,
         [("IVEC2", "full_size"), ("IVEC2", "half_size"), ("FLOAT", "background_depth")],
-        ["depth_texture", "half_depth_texture", "half_ao_texture", "half_normal_texture"],
-        shader_sources.UPSAMPLE_DEFINES, outputs=("frag_output", "guide_output")),
+        ["depth_texture", "half_depth_texture", "half_ao_texture"],
+        shader_sources.UPSAMPLE_DEFINES),
     "blur": lambda: _create_info(
         shader_sources.BLUR_FRAGMENT,
         [("IVEC2", "image_size"), ("IVEC2", "blur_step"), ("INT", "kernel_radius"),
