@@ -232,6 +232,46 @@ def test_node_says_when_its_settings_changed_since_the_render(run_in_blender, tm
                      "blur size, muted": None}, log[-3000:]
 
 
+def test_new_node_settings_reach_the_ao_without_a_render(run_in_blender, tmp_path, native):
+    """After a render, a node whose AO parameters changed gets its AO from
+    the passes that render handed over (recomposite.py: in a window the
+    add-on's timer does this, then Blender composites again): no save, no
+    read, the node's hint cleared. Rendering the frame again then finds
+    that AO in the cache, so it is the AO a render computes; it is exactly
+    the library's. A change that needs other passes (Normal unlinked) is
+    left to the next render, and the node keeps saying so."""
+    spec = {"frames": [1], "nodes": [{"name": "Hinted", "radius": 0.6, "blur_size": 0}],
+            "after_render": [
+                {"label": "radius", "socket": ["Radius", 1.1]},
+                {"label": "refreshed", "refresh": True},
+                {"label": "rendered again", "render": 1},
+                {"label": "unchanged", "refresh": True},
+                {"label": "normal unlinked", "unlink": "Normal"},
+                {"label": "not refreshed", "refresh": True}]}
+    out, log = render(run_in_blender, tmp_path, spec)
+    lines = [line for line in log.splitlines() if line.startswith("HBAO: 1 AO pass(es) ")]
+    assert len(lines) == 3, log[-3000:]
+    assert "re-composited with new settings from the last render's passes" in lines[1], lines
+    assert "(save 0, read 0, write" in lines[1], lines
+    assert "(1 of 1 unchanged: reused)" in lines[2], lines
+    refreshed = [line.split()[1] for line in log.splitlines() if line.startswith("REFRESHED ")]
+    assert refreshed == ["True", "False", "False"], log[-3000:]
+    hints = {}
+    for line in log.splitlines():
+        if line.startswith("HINT "):
+            said = json.loads(line[len("HINT "):])
+            hints[said["label"]] = said["hint"][0] if said["hint"] else None
+    changed = "Changed: render to update"
+    assert hints == {"radius": changed, "refreshed": None, "rendered again": None,
+                     "unchanged": None, "normal unlinked": changed,
+                     "not refreshed": changed}, log[-3000:]
+    assert (out / "frame_0001_again.exr").is_file(), log[-3000:]
+    # The File Output of the second render (radius 1.1) replaced the first's.
+    ao = node_outputs(out, 1, "Hinted")["ao"]
+    expected = library_ao(native, out, 1, node_params(radius=1.1, blur_size=0))
+    assert np.abs(ao - expected).max() <= EXACT
+
+
 def test_two_nodes_two_view_layers_and_muted_node(run_in_blender, tmp_path, native):
     spec = {"scene": "two_layers", "nodes": [
         {"name": "Small", "layer": "Front", "radius": 0.2},

@@ -56,7 +56,7 @@ def test_node_status_line_after_each_f12_render(ui_report):
     assert renders["clamped"]["status"] == "Steps clamped to 64"
     assert "Steps 100 is above the limit 64; using 64" in renders["clamped"]["details"]
     assert renders["good"] == {"status": "", "details": ""}
-    # Steps changed after the last render: the node says the AO is old.
+    # Normal unlinked after the last render: the node says the AO is old.
     changed = ui_report["changed_after_render"]
     assert changed["hint"] == "Changed: render to update"
     assert "render again (F12)" in changed["details"]
@@ -83,6 +83,27 @@ def test_status_line_follows_each_f12_render(run_blender, tmp_path):
     statuses = {int(line.split(" ", 2)[1]): json.loads(line.split(" ", 2)[2])
                 for line in completed.stdout.splitlines() if line.startswith("STATUS ")}
     assert statuses == {0: "", 1: "Depth not linked: AO off", 2: ""}, statuses
+
+
+def test_recompositing_follows_new_settings_without_a_render(run_blender, tmp_path):
+    """With the compositor open as an artist has it: after F12, a node's Radius
+    quadrupled; the add-on's timer renders the helper alone from the kept
+    passes and Blender composites again. The composite is then, to the bit,
+    the one an F12 render with the new Radius gives, and the node's hint is
+    gone. Unlinking Normal needs other passes: the composite stays and the
+    node says to render again."""
+    completed = run_blender(SCRIPTS / "ui_recomposite.py", tmp_path / "recomposite", ui=True)
+    log = completed.stdout
+    assert "RECOMPOSITE: DONE" in log, log[-3000:]
+    images = {line.split()[1]: line.split()[3] for line in log.splitlines()
+              if line.startswith("IMAGE ")}
+    hints = [json.loads(line[len("HINT "):]) for line in log.splitlines()
+             if line.startswith("HINT ")]
+    assert images["recomposited"] != images["first_render"], log[-3000:]
+    assert images["recomposited"] == images["rendered_with_new_radius"], log[-3000:]
+    assert images["normal_unlinked"] == images["rendered_with_new_radius"], log[-3000:]
+    assert hints == ["", "Changed: render to update"], log[-3000:]
+    assert "re-composited with new settings from the last render's passes" in log, log[-3000:]
 
 
 def test_picking_the_internal_engine_keeps_the_artists_engine(run_blender):

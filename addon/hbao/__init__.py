@@ -52,10 +52,10 @@ def register():
         preferences.show(message)
         if not compat.version_is_new_enough():
             return  # the message says why; a traceback would not
-    from . import (engine, engine_guard, handlers, node, node_setup, render_record,
-                   render_reports)
-    for module in (node, node_setup, render_record, engine, engine_guard, render_reports,
-                   handlers):
+    from . import (engine, engine_guard, handlers, node, node_setup, recomposite,
+                   render_record, render_reports)
+    for module in (node, node_setup, render_record, recomposite, engine, engine_guard,
+                   render_reports, handlers):
         module.register()
         _registered.append(module)
     try:

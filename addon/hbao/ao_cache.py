@@ -50,6 +50,10 @@ class AOCache:
     def __init__(self):
         self._entries = {}
 
+    def entry(self, key):
+        """(AOInputs, ao) stored under `key`, or None."""
+        return self._entries.get(key)
+
     def get(self, key, inputs):
         """The AO stored under `key` for the same inputs, or None."""
         entry = self._entries.get(key)
@@ -63,3 +67,9 @@ class AOCache:
 
     def clear(self):
         self._entries = {}
+
+
+# The last render's passes and AO of every node, keyed (main scene name, pass
+# name): the render engine fills it (engine.py), re-compositing reads it
+# (recomposite.py).
+last_render = AOCache()

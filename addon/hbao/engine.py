@@ -11,7 +11,7 @@ import bpy
 import numpy as np
 
 from . import camera as camera_model
-from . import ao_cache, exr_passes, handover, layer_passes, native, render_record
+from . import ao_cache, exr_passes, handover, layer_passes, native, recomposite, render_record
 from .helper_lookup import ENGINE_IDNAME, is_helper, pass_names_for_helper
 from .helper_scene import rendered_for_a_scene, scene_for_render
 from .planning import node_names, plan
@@ -20,8 +20,9 @@ from .report import log, post_node_messages, post_render_report
 # The prefix of the passes this engine fills (node.pass_name's).
 PASS_PREFIX = "HBAO "
 
-# The last render's AO, reused for the same passes and settings.
-_cache = ao_cache.AOCache()
+# The last render's passes and AO, reused for the same passes and settings,
+# and by re-compositing (recomposite.py).
+_cache = ao_cache.last_render
 
 
 def _evaluated_camera(main, depsgraph):
@@ -38,22 +39,11 @@ def _original(scene):
     return scene.original if hasattr(scene, "original") else scene
 
 
-def compute_passes(engine, depsgraph, width, height):
-    """{pass name: bottom-up (height, width) AO} for the helper being rendered."""
-    helper = _original(depsgraph.scene)
-    main = scene_for_render(helper)
-    if main is None:
-        raise RuntimeError(f"scene {helper.name!r} is not an HBAO helper scene")
-    frame = main.frame_current + main.frame_subframe
-    jobs, warnings = plan(main, frame)
-    render_record.remember(main.name, frame, jobs, node_names(main))
-    for warning in warnings:
-        _report(engine, f"HBAO {warning}")
-        log(warning)
-    if not jobs:
-        return {}
+def _handed_over(engine, depsgraph, helper, main, jobs, warnings):
+    """(inputs_of, timings): the passes of the render that has just ended,
+    saved and read back; inputs_of(job) gives a job's (AOInputs, depth,
+    normal, ExtraPasses or None)."""
     # Fail early, before the save, if a library is missing.
-    native.load_library()
     exr_passes.load_library()
     camera = camera_model.camera_for_render_result(main, _evaluated_camera(main, depsgraph))
     channels, timings = handover.read_main_passes(main, jobs)
@@ -63,6 +53,56 @@ def compute_passes(engine, depsgraph, width, height):
         log(warning)
     if extra_warnings:  # the nodes' status lines show them with the plan's
         post_node_messages(main.name, node_names(main), warnings + extra_warnings)
+
+    def inputs_of(job):
+        depth = channels[("depth", job.layer)]
+        normal = channels[("normal", job.layer)] if job.with_normal else None
+        inputs = ao_cache.AOInputs(job.params, camera, layer_passes.settings_of(job, extra),
+                                   (depth, normal) + layer_passes.arrays_of(job, extra))
+        return inputs, depth, normal, extra
+
+    return inputs_of, timings
+
+
+def _kept(main):
+    """(inputs_of, timings) as _handed_over's, from the passes that the last
+    render handed over (re-compositing with new settings, recomposite.py):
+    no save and no read."""
+
+    def inputs_of(job):
+        entry = _cache.entry((main.name, job.pass_name))
+        if entry is None:
+            raise RuntimeError(f"the passes of {job.node_name!r} are no longer kept: render "
+                               f"again")
+        kept = entry[0]
+        inputs = ao_cache.AOInputs(job.params, kept.camera, kept.settings, kept.arrays)
+        extra = layer_passes.extra_of(kept.settings, kept.arrays)
+        return inputs, kept.arrays[0], kept.arrays[1], extra
+
+    return inputs_of, {"kept": True}
+
+
+def compute_passes(engine, depsgraph, width, height, request=None):
+    """{pass name: bottom-up (height, width) AO} for the helper being
+    rendered: for the render of its main scene, or for `request`
+    (recomposite.Request) from the passes of the last render."""
+    helper = _original(depsgraph.scene)
+    main = bpy.data.scenes.get(request.main) if request else scene_for_render(helper)
+    if main is None:
+        raise RuntimeError(f"scene {helper.name!r} is not an HBAO helper scene")
+    frame = request.frame if request else main.frame_current + main.frame_subframe
+    jobs, warnings = plan(main, frame)
+    render_record.remember(main.name, frame, jobs, node_names(main))
+    for warning in warnings:
+        _report(engine, f"HBAO {warning}")
+        log(warning)
+    if not jobs:
+        return {}
+    native.load_library()
+    if request:
+        inputs_of, timings = _kept(main)
+    else:
+        inputs_of, timings = _handed_over(engine, depsgraph, helper, main, jobs, warnings)
 
     results = {}
     # Esc: Blender asks through test_break(); the passes are left at 1 and
@@ -77,18 +117,15 @@ def compute_passes(engine, depsgraph, width, height):
             log("render cancelled: AO left out")
             return {}
         engine.update_stats("HBAO", f"{job.node_name}: computing AO ({index + 1}/{len(jobs)})")
-        depth = channels[("depth", job.layer)]
+        inputs, depth, normal, extra = inputs_of(job)
         if depth.shape != (height, width):
             raise RuntimeError(f"the Render Result is {depth.shape[1]}x{depth.shape[0]}, the "
                                f"helper scene renders {width}x{height}")
-        normal = channels[("normal", job.layer)] if job.with_normal else None
         compute_start = time.perf_counter()
         key = (main.name, job.pass_name)
-        inputs = ao_cache.AOInputs(job.params, camera, layer_passes.settings_of(job, extra),
-                                   (depth, normal) + layer_passes.arrays_of(job, extra))
         ao = _cache.get(key, inputs)
         if ao is None:
-            ao = layer_passes.compute(job, depth, normal, camera, extra)
+            ao = layer_passes.compute(job, depth, normal, inputs.camera, extra)
         else:
             timings["cached"] = timings.get("cached", 0) + 1
         results[job.pass_name] = ao
@@ -110,6 +147,8 @@ def _timing_line(count, width, height, total, timings):
             f"{milliseconds['ao']:.0f} ms{cached}, pass hand-over {handover_ms:.0f} ms "
             f"(save {milliseconds['save']:.0f}, read {milliseconds['read']:.0f}, write "
             f"{milliseconds['write']:.0f})")
+    if timings.get("kept"):
+        line += ", re-composited with new settings from the last render's passes"
     for kind in ("guard band", "back faces"):  # extra_renders' kinds
         if f"{kind} save" in timings:
             seconds = timings[f"{kind} save"] + timings.get(f"{kind} read", 0.0)
@@ -143,8 +182,9 @@ NOT_FOR_RENDERING = ("HBAO: \"{label}\" is the HBAO add-on's internal engine and
 def render_helper(engine, depsgraph):
     """HBAOPassEngine.render(): fill every registered AO pass, 1 where it failed."""
     scene = _original(depsgraph.scene)
+    request = recomposite.request_for(scene)
     main = scene_for_render(scene) if is_helper(scene) else None
-    if main is None or not rendered_for_a_scene(scene):
+    if request is None and (main is None or not rendered_for_a_scene(scene)):
         message = (HELPER_NOT_FOR_RENDERING.format(helper=scene.name, main=main.name)
                    if main is not None
                    else NOT_FOR_RENDERING.format(label=HBAOPassEngine.bl_label))
@@ -159,7 +199,7 @@ def render_helper(engine, depsgraph):
     width, height = result.resolution_x, result.resolution_y
     try:
         try:
-            results = compute_passes(engine, depsgraph, width, height)
+            results = compute_passes(engine, depsgraph, width, height, request)
         except (native.HBAOLibraryError, exr_passes.EXRLibraryError) as error:
             results = {}
             _report_failure(engine, f"{error} Rendering without AO.")

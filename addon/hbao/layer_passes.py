@@ -71,6 +71,17 @@ def arrays_of(job, extra):
     return (back,) + guard
 
 
+def extra_of(settings, arrays):
+    """The ExtraPasses a job's AO read, back from its settings_of and its
+    (depth, normal) + arrays_of (re-compositing from the AO cache)."""
+    if len(arrays) <= 2:
+        return None
+    extra = ExtraPasses()
+    extra.back_depth, extra.guard_depth, extra.guard_normal = arrays[2:5]
+    extra.guard_scale = settings[3]
+    return extra
+
+
 def _flipped(array):
     return None if array is None else array[::-1]
 

@@ -3,7 +3,8 @@
 a node whose settings changed since can say so: the AO is computed while
 Blender renders, and re-compositing an existing render (what Blender does
 when a node's value changes) shows the AO of the old settings until the
-next render (README, Limits).
+next render, unless recomposite.py can bring it up to date from the kept
+passes (README, Limits).
 
 The render thread records (`remember`, plain Python objects only); the
 add-on's timer compares (`apply_hints`, main thread, no render running) and
@@ -17,7 +18,9 @@ from .planning import plan_node
 # (short, full): the node's line and its tooltip
 HINT = ("Changed: render to update",
         "This node's settings changed since the last render. The AO in the compositor is "
-        "still the last render's: render again (F12) to update it.")
+        "still the last render's: render again (F12) to update it. (Changes to the AO "
+        "settings alone follow by themselves while the compositor is open; this one needs "
+        "passes the last render did not hand over.)")
 
 # {main scene name: (frame, {node name: signature})}; replaced whole per
 # render, so the main thread never reads a half-written record.
@@ -40,6 +43,22 @@ def remember(main_name, frame, jobs, node_names):
     records = dict(_records)
     records[main_name] = (frame, signatures)
     _records = records
+
+
+def last_render(main_name):
+    """(frame, {node name: signature or None}) of `main_name`'s last render, or None."""
+    return _records.get(main_name)
+
+
+def signature_of(job):
+    """What a render records of a job (None: the node computed nothing)."""
+    return _signature(job)
+
+
+def same_passes(recorded, current):
+    """Whether two signatures read the same passes (view layer, normals,
+    guard band, back faces) and so differ at most in the AO parameters."""
+    return recorded is not None and current is not None and recorded[1:] == current[1:]
 
 
 def forget():

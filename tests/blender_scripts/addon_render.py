@@ -198,12 +198,19 @@ for frame in spec.get("frames", [1]):
 # "changed since the last render" line says after each step.
 hinted = next(n for n in tree.nodes if n.bl_idname == "CompositorNodeHBAO")
 for step in spec.get("after_render", []):
-    from hbao import render_record
+    from hbao import recomposite, render_record
     for key, value in step.items():
         if key == "socket":
             hinted.inputs[value[0]].default_value = value[1]
         elif key == "frame":
             scene.frame_set(value)
+        elif key == "refresh":  # what the add-on's timer does in a window
+            print("REFRESHED", recomposite.refresh_changed(in_background=True), flush=True)
+        elif key == "unlink":
+            tree.links.remove(hinted.inputs[value].links[0])
+        elif key == "render":  # the frame rendered again, as frame_<n>_again
+            scene.render.filepath = os.path.join(out_dir, f"frame_{value:04d}_again")
+            bpy.ops.render.render(write_still=True)
         elif key != "label":
             setattr(hinted, key, value)
     print("HINT", json.dumps({"label": step["label"],

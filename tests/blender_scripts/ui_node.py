@@ -7,8 +7,10 @@ ui_old_file.py saved: what an artist meets on the HBAO node.
 - F12 renders (the render job's thread) with a fault, then with a clamped
   value, then with nothing wrong: the node's status after each, and
   screenshots of the node editor showing it;
-- after the last render, a changed Steps value: the node's line saying that
-  the AO shown is the last render's, and a screenshot of it.
+- after the last render, the Normal input unlinked (a change that needs
+  other passes, which re-compositing cannot bring: recomposite.py): the
+  node's line saying that the AO shown is the last render's, and a
+  screenshot of it.
 
   blender --addons hbao --python ui_node.py OLD.blend -- OUT.json SHOT_DIR
 """
@@ -148,7 +150,7 @@ def run_renders():
     state["index"] += 1
     state["started"] = None
     if state["index"] == len(RENDERS):
-        tree.nodes["Steps Value"].outputs[0].default_value = 9.0
+        tree.links.remove(hbao.inputs["Normal"].links[0])
         bpy.app.timers.register(changed_after_render, first_interval=SETTLE_S)
         return None
     return 0.25
