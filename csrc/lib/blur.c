@@ -372,7 +372,9 @@ static void upsample_output_row(void *context, int j) {
     const upsample_job *job = context;
     float *out = job->out + (int64_t)j * job->out_row_stride;
     hbao_upsample_row(job->implementation, job->grid, job->grid_ao, job->depth, job->width, j, out);
-    write_output(job->depth + (size_t)j * job->width, out, job->width, job->strength, out);
+    /* already clamped, and 1 on background: only a strength is left to apply */
+    if (job->strength != 1.0f)
+        write_output(job->depth + (size_t)j * job->width, out, job->width, job->strength, out);
 }
 
 hbao_result hbao_finish(const hbao_settings *settings, const hbao_grid *grid, const float *grid_ao,

@@ -58,9 +58,9 @@ hbao_result hbao_finish(const hbao_settings *settings, const hbao_grid *grid, co
                         const float *full_depth, int width, int height, float *out,
                         int64_t out_row_stride);
 
-/* upsample.c: full-resolution row j (width floats, into ao) of the
- * half-resolution AO half_ao (half->width wide). implementation: as
- * resolved by hbao_finish_implementation(). */
+/* upsample.c: full-resolution row j (width floats, into ao, in [0, 1] and 1
+ * on background) of the half-resolution AO half_ao (half->width wide).
+ * implementation: as resolved by hbao_finish_implementation(). */
 void hbao_upsample_row(int implementation, const hbao_grid *half, const float *half_ao,
                        const float *full_depth, int width, int j, float *ao);
 
