@@ -199,6 +199,16 @@ def test_unchanged_frame_reuses_its_ao(run_in_blender, tmp_path, native):
         assert np.abs(fixed - expected).max() <= EXACT
 
 
+def printed_hints(log):
+    """{step label: the node's hint line, or None} from addon_render.py's HINT lines."""
+    hints = {}
+    for line in log.splitlines():
+        if line.startswith("HINT "):
+            said = json.loads(line[len("HINT "):])
+            hints[said["label"]] = said["hint"][0] if said["hint"] else None
+    return hints
+
+
 def test_node_says_when_its_settings_changed_since_the_render(run_in_blender, tmp_path):
     """Re-compositing an existing render keeps the AO of the settings it was
     rendered with (README, Limits): after a render the node says when its
@@ -219,11 +229,7 @@ def test_node_says_when_its_settings_changed_since_the_render(run_in_blender, tm
             {"label": "back faces off", "back_faces": False},
             {"label": "blur size, muted", "socket": ["Blur Size", 5], "mute": True}]}
     _out, log = render(run_in_blender, tmp_path, spec)
-    hints = {}
-    for line in log.splitlines():
-        if line.startswith("HINT "):
-            said = json.loads(line[len("HINT "):])
-            hints[said["label"]] = said["hint"][0] if said["hint"] else None
+    hints = printed_hints(log)
     changed = "Changed: render to update"
     assert hints == {"as rendered": None, "other frame": None,
                      "blur size": changed, "blur size back": None,
@@ -256,11 +262,7 @@ def test_new_node_settings_reach_the_ao_without_a_render(run_in_blender, tmp_pat
     assert "(1 of 1 unchanged: reused)" in lines[2], lines
     refreshed = [line.split()[1] for line in log.splitlines() if line.startswith("REFRESHED ")]
     assert refreshed == ["True", "False", "False"], log[-3000:]
-    hints = {}
-    for line in log.splitlines():
-        if line.startswith("HINT "):
-            said = json.loads(line[len("HINT "):])
-            hints[said["label"]] = said["hint"][0] if said["hint"] else None
+    hints = printed_hints(log)
     changed = "Changed: render to update"
     assert hints == {"radius": changed, "refreshed": None, "rendered again": None,
                      "unchanged": None, "normal unlinked": changed,
