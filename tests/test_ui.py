@@ -66,6 +66,16 @@ def test_node_status_line_after_each_f12_render(ui_report):
         assert (width, height) == (1280, 1024), (name, width, height)
 
 
+def test_managed_node_lies_clear_of_the_hbao_node(ui_report):
+    """The add-on's Render Layers node for the AO passes goes below the HBAO
+    node, with its status and hint lines showing, not over its sockets."""
+    layout = ui_report["layout"]
+    hbao, managed = layout["hbao"], layout["managed"]
+    assert hbao["dimensions"][1] > 100, layout  # drawn: Blender knows its size
+    hbao_bottom = hbao["location"][1] - hbao["dimensions"][1]
+    assert managed["location"][1] < hbao_bottom, layout
+
+
 def test_add_filter_menu_offers_hbao(ui_report):
     assert "HBAO" in ui_report["menu_texts"], ui_report["menu"]
 

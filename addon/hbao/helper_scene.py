@@ -28,8 +28,9 @@ from .socket_values import upstream
 
 MANAGED_NODE_NAME = "HBAO Passes"
 # How far below the first HBAO node the managed node goes (node editor units):
-# the HBAO node is about 420 units tall with its options.
-HBAO_NODE_CLEARANCE = 480
+# the HBAO node is about 555 units tall with its options and a hint line
+# (tests/test_ui.py measures it), a status line adds about 25.
+HBAO_NODE_CLEARANCE = 660
 # Render settings copied from the main scene so that the helper's result has
 # the main Render Result's size.
 SYNCED_RENDER_SETTINGS = (

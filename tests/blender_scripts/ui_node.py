@@ -157,8 +157,13 @@ def run_renders():
 
 
 def changed_after_render():
-    """The node's line once the add-on's timer has seen the change."""
+    """The node's line once the add-on's timer has seen the change; where
+    the HBAO node and the add-on's managed Render Layers node lie (drawn,
+    so their dimensions are known)."""
     report["changed_after_render"] = {"hint": hbao.hint, "details": hbao.hint_details}
+    managed = next(n for n in tree.nodes if n.get("hbao_managed"))
+    report["layout"] = {name: {"location": list(n.location), "dimensions": list(n.dimensions)}
+                        for name, n in (("hbao", hbao), ("managed", managed))}
     screenshot(bpy.context.window_manager.windows[0], state.get("area"), "ui_node_changed.png")
     return finish()
 
