@@ -245,10 +245,13 @@ def test_new_node_settings_reach_the_ao_without_a_render(run_in_blender, tmp_pat
     read, the node's hint cleared. Rendering the frame again then finds
     that AO in the cache, so it is the AO a render computes; it is exactly
     the library's. A change that needs other passes (Normal unlinked) is
-    left to the next render, and the node keeps saying so."""
+    left to the next render, and the node keeps saying so; so is a frame
+    whose helper would render at another size than the kept passes."""
     spec = {"frames": [1], "nodes": [{"name": "Hinted", "radius": 0.6, "blur_size": 0}],
             "after_render": [
                 {"label": "radius", "socket": ["Radius", 1.1]},
+                {"label": "half size", "resolution_percentage": 50, "refresh": True},
+                {"label": "full size", "resolution_percentage": 100},
                 {"label": "refreshed", "refresh": True},
                 {"label": "rendered again", "render": 1},
                 {"label": "unchanged", "refresh": True},
@@ -261,10 +264,11 @@ def test_new_node_settings_reach_the_ao_without_a_render(run_in_blender, tmp_pat
     assert "(save 0, read 0, write" in lines[1], lines
     assert "(1 of 1 unchanged: reused)" in lines[2], lines
     refreshed = [line.split()[1] for line in log.splitlines() if line.startswith("REFRESHED ")]
-    assert refreshed == ["True", "False", "False"], log[-3000:]
+    assert refreshed == ["False", "True", "False", "False"], log[-3000:]
     hints = printed_hints(log)
     changed = "Changed: render to update"
-    assert hints == {"radius": changed, "refreshed": None, "rendered again": None,
+    assert hints == {"radius": changed, "half size": changed, "full size": changed,
+                     "refreshed": None, "rendered again": None,
                      "unchanged": None, "normal unlinked": changed,
                      "not refreshed": changed}, log[-3000:]
     assert (out / "frame_0001_again.exr").is_file(), log[-3000:]

@@ -41,11 +41,22 @@ def request_for(helper):
     return request if request is not None and request.helper == helper.name else None
 
 
-def _needs_refresh(main):
+def _render_size(scene):
+    """(height, width) of a render of `scene` without a border, as Blender
+    sizes it (resolution times the percentage, rounded down)."""
+    settings = scene.render
+    percent = settings.resolution_percentage
+    return (settings.resolution_y * percent // 100, settings.resolution_x * percent // 100)
+
+
+def _needs_refresh(main, helper):
     """(frame, what was compared) when `main`'s last render can be brought
-    up to its nodes' current settings from the cached passes, else None."""
+    up to its nodes' current settings from the cached passes, else None.
+    The helper's render must come out the size of those passes: its old
+    pass is gone once it renders again, so a mismatch found then would
+    leave the compositor without AO."""
     record = render_record.last_render(main.name)
-    if record is None:
+    if record is None or helper.render.use_border:
         return None
     frame, signatures = record
     changed, current_signatures = False, []
@@ -58,8 +69,10 @@ def _needs_refresh(main):
             job = plan_node(hbao_node, main, frame, [])
         except Exception:  # the next render says what is wrong
             return None
-        if job is not None and ao_cache.last_render.entry((main.name, job.pass_name)) is None:
-            return None
+        if job is not None:
+            kept = ao_cache.last_render.entry((main.name, job.pass_name))
+            if kept is None or kept[0].arrays[0].shape != _render_size(helper):
+                return None
         recorded, current = signatures[hbao_node.name], render_record.signature_of(job)
         current_signatures.append((hbao_node.name, current))
         if current == recorded:
@@ -99,7 +112,7 @@ def refresh_changed(in_background=False):
         helper = helper_scene.helper_scene_of(main)
         if helper is None:
             continue
-        due = _needs_refresh(main)
+        due = _needs_refresh(main, helper)
         if due is None:
             continue
         frame, compared = due

@@ -206,6 +206,10 @@ for step in spec.get("after_render", []):
             scene.frame_set(value)
         elif key == "refresh":  # what the add-on's timer does in a window
             print("REFRESHED", recomposite.refresh_changed(in_background=True), flush=True)
+        elif key == "resolution_percentage":
+            scene.render.resolution_percentage = value
+            import hbao
+            hbao.sync(scene)  # as the add-on's timer does in a window: the helper follows
         elif key == "unlink":
             tree.links.remove(hinted.inputs[value].links[0])
         elif key == "render":  # the frame rendered again, as frame_<n>_again
