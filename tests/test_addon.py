@@ -241,12 +241,13 @@ def test_node_says_when_its_settings_changed_since_the_render(run_in_blender, tm
 def test_new_node_settings_reach_the_ao_without_a_render(run_in_blender, tmp_path, native):
     """After a render, a node whose AO parameters changed gets its AO from
     the passes that render handed over (recomposite.py: in a window the
-    add-on's timer does this, then Blender composites again): no save, no
-    read, the node's hint cleared. Rendering the frame again then finds
-    that AO in the cache, so it is the AO a render computes; it is exactly
-    the library's. A change that needs other passes (Normal unlinked) is
-    left to the next render, and the node keeps saying so; so is a frame
-    whose helper would render at another size than the kept passes."""
+    add-on's timer does this, the AO in a worker thread, then Blender
+    composites again): no save, no read, the node's hint cleared.
+    Rendering the frame again then finds that AO in the cache, so it is the
+    AO a render computes; it is exactly the library's. A change that needs
+    other passes (Normal unlinked) is left to the next render, and the node
+    keeps saying so; so is a frame whose helper would render at another
+    size than the kept passes."""
     spec = {"frames": [1], "nodes": [{"name": "Hinted", "radius": 0.6, "blur_size": 0}],
             "after_render": [
                 {"label": "radius", "socket": ["Radius", 1.1]},
@@ -260,7 +261,10 @@ def test_new_node_settings_reach_the_ao_without_a_render(run_in_blender, tmp_pat
     out, log = render(run_in_blender, tmp_path, spec)
     lines = [line for line in log.splitlines() if line.startswith("HBAO: 1 AO pass(es) ")]
     assert len(lines) == 3, log[-3000:]
-    assert "re-composited with new settings from the last render's passes" in lines[1], lines
+    assert "re-composited with new settings from the last render's passes (their AO " \
+        "computed beforehand in" in lines[1], lines
+    # The helper's render finds the AO computed from the kept passes in the cache.
+    assert "(1 of 1 unchanged: reused)" in lines[1], lines
     assert "(save 0, read 0, write" in lines[1], lines
     assert "(1 of 1 unchanged: reused)" in lines[2], lines
     refreshed = [line.split()[1] for line in log.splitlines() if line.startswith("REFRESHED ")]

@@ -61,6 +61,12 @@ class AOCache:
             return None
         return entry[1]
 
+    def put(self, key, inputs, ao):
+        """Store `ao` as the AO of `inputs` under `key`, replacing what was there."""
+        entries = dict(self._entries)
+        entries[key] = (inputs, ao)
+        self._entries = entries
+
     def keep_only(self, entries):
         """Forget everything but `entries` {key: (AOInputs, ao)}: this render's."""
         self._entries = dict(entries)

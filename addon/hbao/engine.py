@@ -64,10 +64,10 @@ def _handed_over(engine, depsgraph, helper, main, jobs, warnings):
     return inputs_of, timings
 
 
-def _kept(main):
+def _kept(main, request):
     """(inputs_of, timings) as _handed_over's, from the passes that the last
     render handed over (re-compositing with new settings, recomposite.py):
-    no save and no read."""
+    no save and no read; the changed nodes' AO is in the cache already."""
 
     def inputs_of(job):
         entry = _cache.entry((main.name, job.pass_name))
@@ -79,7 +79,7 @@ def _kept(main):
         extra = layer_passes.extra_of(kept.settings, kept.arrays)
         return inputs, kept.arrays[0], kept.arrays[1], extra
 
-    return inputs_of, {"kept": True}
+    return inputs_of, {"kept": request.ao_seconds}
 
 
 def compute_passes(engine, depsgraph, width, height, request=None):
@@ -100,7 +100,7 @@ def compute_passes(engine, depsgraph, width, height, request=None):
         return {}
     native.load_library()
     if request:
-        inputs_of, timings = _kept(main)
+        inputs_of, timings = _kept(main, request)
     else:
         inputs_of, timings = _handed_over(engine, depsgraph, helper, main, jobs, warnings)
 
@@ -147,8 +147,9 @@ def _timing_line(count, width, height, total, timings):
             f"{milliseconds['ao']:.0f} ms{cached}, pass hand-over {handover_ms:.0f} ms "
             f"(save {milliseconds['save']:.0f}, read {milliseconds['read']:.0f}, write "
             f"{milliseconds['write']:.0f})")
-    if timings.get("kept"):
-        line += ", re-composited with new settings from the last render's passes"
+    if "kept" in timings:
+        line += (f", re-composited with new settings from the last render's passes (their AO "
+                 f"computed beforehand in {timings['kept'] * 1000:.0f} ms)")
     for kind in ("guard band", "back faces"):  # extra_renders' kinds
         if f"{kind} save" in timings:
             seconds = timings[f"{kind} save"] + timings.get(f"{kind} read", 0.0)

@@ -8,31 +8,67 @@ Render Results again but renders no scene (docs/blender-integration.md,
 settings. When the changes since the last render are only in the nodes' AO
 parameters (radius, directions, steps, blur, falloff, ...) and the AO cache
 still holds the passes that render handed over, the add-on's timer (main
-thread, no render or compositor job running) renders the helper scene
-alone: its engine computes each node's AO from the cached passes, with no
-save and no read of the Render Result, and the compositor then runs again.
+thread, no render or compositor job running) computes each changed node's
+AO from the cached passes in a worker thread (the UI stays responsive while
+a value is dragged), then renders the helper scene alone, whose engine
+finds that AO in the cache (no save and no read of the Render Result), and
+makes the compositor run again.
 A change that needs other passes (another view layer, the Normal link, the
 guard band, back faces, a node added since) still needs a render, and the
 node says so (render_record)."""
+import threading
+import time
+
 import bpy
 
-from . import ao_cache, compat, helper_scene, node, render_record
+from . import ao_cache, compat, helper_scene, layer_passes, node, render_record
 from .planning import plan_node
 from .report import log
 
 
 class Request:
     """The refresh being rendered: `helper` computes for `main` at `frame`
-    from the cached passes."""
+    from the cached passes, where the changed nodes' AO already is (computed
+    in `ao_seconds`)."""
 
-    def __init__(self, main, helper, frame):
+    def __init__(self, main, helper, frame, ao_seconds=0.0):
         self.main, self.helper, self.frame = main, helper, frame
+        self.ao_seconds = ao_seconds
 
 
 _request = None
 # Main scene name -> the record and settings whose refresh failed: not tried
 # again (every tick) until one of them changes.
 _failed = {}
+
+
+class _Computation:
+    """The AO of a refresh's changed jobs, computed in a worker thread from
+    the kept passes: {cache key: (AOInputs, ao)}, or the error."""
+
+    def __init__(self, compared, work):
+        self.compared = compared
+        self.results, self.error, self.seconds = {}, None, 0.0
+        self.thread = threading.Thread(target=self._run, args=(work,), daemon=True)
+        self.thread.start()
+
+    def _run(self, work):
+        start = time.perf_counter()
+        try:
+            for key, job, inputs, extra in work:
+                depth, normal = inputs.arrays[0], inputs.arrays[1]
+                self.results[key] = (inputs, layer_passes.compute(job, depth, normal,
+                                                                  inputs.camera, extra))
+        except Exception as error:  # reported by the main thread
+            self.error = error
+        self.seconds = time.perf_counter() - start
+
+    def done(self):
+        return not self.thread.is_alive()
+
+
+# Main scene name -> its refresh's computation, while it runs or waits.
+_computing = {}
 
 
 def request_for(helper):
@@ -50,8 +86,9 @@ def _render_size(scene):
 
 
 def _needs_refresh(main, helper):
-    """(frame, what was compared) when `main`'s last render can be brought
-    up to its nodes' current settings from the cached passes, else None.
+    """(frame, what was compared, [changed Job]) when `main`'s last render
+    can be brought up to its nodes' current settings from the cached
+    passes, else None.
     The helper's render must come out the size of those passes: its old
     pass is gone once it renders again, so a mismatch found then would
     leave the compositor without AO."""
@@ -59,7 +96,7 @@ def _needs_refresh(main, helper):
     if record is None or helper.render.use_border:
         return None
     frame, signatures = record
-    changed, current_signatures = False, []
+    changed, current_signatures = [], []
     for hbao_node in node.hbao_nodes(compat.compositor_tree(main)):
         if hbao_node.mute or not any(output.is_linked for output in hbao_node.outputs):
             continue  # the compositor shows those at once
@@ -79,13 +116,27 @@ def _needs_refresh(main, helper):
             continue
         if current is not None and not render_record.same_passes(recorded, current):
             return None
-        changed = True
-    return (frame, (record, tuple(current_signatures))) if changed else None
+        changed.append(job)
+    return (frame, (record, tuple(current_signatures)), changed) if changed else None
 
 
-def _render_helper(main, helper, frame):
+def _work(main, jobs):
+    """(cache key, job, AOInputs, ExtraPasses) of each job that computes,
+    its passes those the last render kept."""
+    work = []
+    for job in jobs:
+        if job is None:
+            continue
+        key = (main.name, job.pass_name)
+        kept = ao_cache.last_render.entry(key)[0]
+        inputs = ao_cache.AOInputs(job.params, kept.camera, kept.settings, kept.arrays)
+        work.append((key, job, inputs, layer_passes.extra_of(kept.settings, kept.arrays)))
+    return work
+
+
+def _render_helper(main, helper, frame, ao_seconds):
     global _request
-    _request = Request(main.name, helper.name, frame)
+    _request = Request(main.name, helper.name, frame, ao_seconds)
     try:
         windows = bpy.context.window_manager.windows
         override = {"window": windows[0]} if windows else {}
@@ -98,11 +149,13 @@ def _render_helper(main, helper, frame):
 
 def refresh_changed(in_background=False):
     """For each scene whose nodes changed since its render in AO parameters
-    only: the helper rendered alone from the cached passes, then the
-    compositor run again. A node.hint_refreshers entry (main thread, no
-    render running); returns whether it rendered. Without a window (`-b`)
-    nothing composites again, so it does nothing unless told to
-    (`in_background`, for the tests)."""
+    only: the changed AO computed in a worker thread from the cached
+    passes (a first call starts it, a later one finds it done), then the
+    helper rendered alone and the compositor run again. A
+    node.hint_refreshers entry (main thread, no render running); returns
+    whether it rendered. Without a window (`-b`) nothing composites again,
+    so it does nothing unless told to (`in_background`, for the tests and
+    the benchmark: then it waits for the computation)."""
     if bpy.app.is_job_running("COMPOSITE"):
         return False
     if not bpy.context.window_manager.windows and not in_background:
@@ -110,16 +163,29 @@ def refresh_changed(in_background=False):
     rendered = False
     for main in list(bpy.data.scenes):
         helper = helper_scene.helper_scene_of(main)
-        if helper is None:
-            continue
-        due = _needs_refresh(main, helper)
+        due = _needs_refresh(main, helper) if helper is not None else None
         if due is None:
+            _computing.pop(main.name, None)  # a running one's result is dropped
             continue
-        frame, compared = due
+        frame, compared, changed = due
         if _failed.get(main.name) == compared:
             continue
         try:
-            if not _render_helper(main, helper, frame):
+            computation = _computing.get(main.name)
+            if computation is None or computation.compared != compared:
+                # Started now; settings that change while it runs start another.
+                computation = _computing[main.name] = _Computation(compared,
+                                                                   _work(main, changed))
+            if in_background:
+                computation.thread.join()
+            if not computation.done():
+                continue
+            del _computing[main.name]
+            if computation.error is not None:
+                raise computation.error
+            for key, entry in computation.results.items():
+                ao_cache.last_render.put(key, *entry)
+            if not _render_helper(main, helper, frame, computation.seconds):
                 raise RuntimeError("the helper scene's render did not finish")
             _composite_again(main)
         except Exception as error:  # the node keeps saying "render to update"
