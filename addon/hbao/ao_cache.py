@@ -25,10 +25,11 @@ class AOInputs:
                 or self.settings != other.settings or len(self.arrays) != len(other.arrays)):
             return False
         for mine, theirs in zip(self.arrays, other.arrays):
+            if mine is theirs:
+                continue  # re-compositing reuses the kept arrays themselves
             if mine is None or theirs is None:
-                if mine is not theirs:
-                    return False
-            elif mine.shape != theirs.shape or not _equal(mine, theirs):
+                return False
+            if mine.shape != theirs.shape or not _equal(mine, theirs):
                 return False
         return True
 
@@ -40,10 +41,12 @@ _PROBE_STRIDE = 4099
 
 
 def _equal(mine, theirs):
+    # NaN equals NaN: the library reads every NaN depth the same way.
     mine_flat, theirs_flat = mine.reshape(-1), theirs.reshape(-1)
-    if not np.array_equal(mine_flat[::_PROBE_STRIDE], theirs_flat[::_PROBE_STRIDE]):
+    if not np.array_equal(mine_flat[::_PROBE_STRIDE], theirs_flat[::_PROBE_STRIDE],
+                          equal_nan=True):
         return False
-    return np.array_equal(mine_flat, theirs_flat)
+    return np.array_equal(mine_flat, theirs_flat, equal_nan=True)
 
 
 class AOCache:

@@ -92,11 +92,13 @@ def compute_passes(engine, depsgraph, width, height, request=None):
         raise RuntimeError(f"scene {helper.name!r} is not an HBAO helper scene")
     frame = request.frame if request else main.frame_current + main.frame_subframe
     jobs, warnings = plan(main, frame)
-    render_record.remember(main.name, frame, jobs, node_names(main))
+    render_record.remember(main.name, frame, jobs, node_names(main), main.as_pointer())
     for warning in warnings:
         _report(engine, f"HBAO {warning}")
         log(warning)
     if not jobs:
+        if request is not None:
+            request.completed = True
         return {}
     native.load_library()
     if request:
@@ -109,12 +111,14 @@ def compute_passes(engine, depsgraph, width, height, request=None):
     # the render ends as Blender decides (the scratch file is already gone).
     if engine.test_break():
         log("render cancelled: no AO computed")
+        _cache.clear()
         return {}
     compute_time = 0.0
     fresh = {}
     for index, job in enumerate(jobs):
         if engine.test_break():
             log("render cancelled: AO left out")
+            _cache.clear()
             return {}
         engine.update_stats("HBAO", f"{job.node_name}: computing AO ({index + 1}/{len(jobs)})")
         inputs, depth, normal, extra = inputs_of(job)
@@ -135,6 +139,8 @@ def compute_passes(engine, depsgraph, width, height, request=None):
     _cache.keep_only(fresh)
     timings["ao"] = compute_time
     engine.hbao_timings = timings
+    if request is not None:
+        request.completed = True
     return results
 
 
@@ -203,9 +209,11 @@ def render_helper(engine, depsgraph):
             results = compute_passes(engine, depsgraph, width, height, request)
         except (native.HBAOLibraryError, exr_passes.EXRLibraryError) as error:
             results = {}
+            _cache.clear()  # nothing kept that this render's record would not match
             _report_failure(engine, f"{error} Rendering without AO.")
         except Exception as error:  # the render must complete: AO = 1
             results = {}
+            _cache.clear()
             _report_failure(engine, f"{type(error).__name__}: {error}. Rendering without AO.")
         write_start = time.perf_counter()
         for layer in result.layers:

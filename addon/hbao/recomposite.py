@@ -29,16 +29,33 @@ from .report import log
 class Request:
     """The refresh being rendered: `helper` computes for `main` at `frame`
     from the cached passes, where the changed nodes' AO already is (computed
-    in `ao_seconds`)."""
+    in `ao_seconds`). The engine sets `completed` once every pass is
+    computed: a failed refresh still finishes rendering, with AO 1."""
 
     def __init__(self, main, helper, frame, ao_seconds=0.0):
         self.main, self.helper, self.frame = main, helper, frame
         self.ao_seconds = ao_seconds
+        self.completed = False
 
 
 _request = None
-# Main scene name -> the record and settings whose refresh failed: not tried
-# again (every tick) until one of them changes.
+
+
+class _Due:
+    """A scene whose last render can be brought up to its nodes' settings:
+    the render's record (the object itself: a new render makes a new one),
+    the nodes' current signatures, and the jobs whose AO changed."""
+
+    def __init__(self, record, signatures, changed):
+        self.record, self.signatures, self.changed = record, signatures, changed
+
+    def same_as(self, other):
+        return (other is not None and self.record is other.record
+                and self.signatures == other.signatures)
+
+
+# Main scene name -> the _Due whose refresh failed: not tried again (every
+# tick) until the settings change or the scene renders again.
 _failed = {}
 
 
@@ -46,8 +63,8 @@ class _Computation:
     """The AO of a refresh's changed jobs, computed in a worker thread from
     the kept passes: {cache key: (AOInputs, ao)}, or the error."""
 
-    def __init__(self, compared, work):
-        self.compared = compared
+    def __init__(self, due, work):
+        self.due = due
         self.results, self.error, self.seconds = {}, None, 0.0
         self.thread = threading.Thread(target=self._run, args=(work,), daemon=True)
         self.thread.start()
@@ -67,7 +84,8 @@ class _Computation:
         return not self.thread.is_alive()
 
 
-# Main scene name -> its refresh's computation, while it runs or waits.
+# Main scene name -> its refresh's computation: one at a time per scene; a
+# change while it runs waits for it, and then starts another.
 _computing = {}
 
 
@@ -86,16 +104,18 @@ def _render_size(scene):
 
 
 def _needs_refresh(main, helper):
-    """(frame, what was compared, [changed Job]) when `main`'s last render
-    can be brought up to its nodes' current settings from the cached
-    passes, else None.
-    The helper's render must come out the size of those passes: its old
+    """A _Due when `main`'s last render can be brought up to its nodes'
+    current settings from the cached passes, else None. The record must be
+    this scene's (not one renamed to its name; a file load clears them), and
+    the helper's render must come out the size of the kept passes: its old
     pass is gone once it renders again, so a mismatch found then would
     leave the compositor without AO."""
     record = render_record.last_render(main.name)
     if record is None or helper.render.use_border:
         return None
-    frame, signatures = record
+    frame, signatures, identity = record
+    if identity != main.as_pointer():
+        return None
     changed, current_signatures = [], []
     for hbao_node in node.hbao_nodes(compat.compositor_tree(main)):
         if hbao_node.mute or not any(output.is_linked for output in hbao_node.outputs):
@@ -117,7 +137,7 @@ def _needs_refresh(main, helper):
         if current is not None and not render_record.same_passes(recorded, current):
             return None
         changed.append(job)
-    return (frame, (record, tuple(current_signatures)), changed) if changed else None
+    return _Due(record, tuple(current_signatures), changed) if changed else None
 
 
 def _work(main, jobs):
@@ -135,16 +155,58 @@ def _work(main, jobs):
 
 
 def _render_helper(main, helper, frame, ao_seconds):
+    """Whether the helper rendered every pass for `main` (Request.completed)."""
     global _request
-    _request = Request(main.name, helper.name, frame, ao_seconds)
+    request = _request = Request(main.name, helper.name, frame, ao_seconds)
     try:
         windows = bpy.context.window_manager.windows
         override = {"window": windows[0]} if windows else {}
         with bpy.context.temp_override(scene=main, **override):
-            result = bpy.ops.render.render(scene=helper.name)
+            bpy.ops.render.render(scene=helper.name)
     finally:
         _request = None
-    return "FINISHED" in result
+    return request.completed
+
+
+def _install(computation):
+    """Put a finished computation's AO in the cache; False when the cache
+    no longer holds the arrays it was computed from (a render since)."""
+    for key, (inputs, _ao) in computation.results.items():
+        entry = ao_cache.last_render.entry(key)
+        if entry is None or entry[0].arrays is not inputs.arrays:
+            return False
+    for key, (inputs, ao) in computation.results.items():
+        ao_cache.last_render.put(key, inputs, ao)
+    return True
+
+
+def _refresh(main, helper, due, in_background):
+    """One tick of `main`'s refresh: start its computation, or, once it is
+    done, render the helper and composite again. Returns whether it
+    rendered; raises when the refresh failed."""
+    computation = _computing.get(main.name)
+    if computation is None:
+        computation = _computing[main.name] = _Computation(due, _work(main, due.changed))
+    if in_background:
+        computation.thread.join()
+    if not computation.done():
+        return False
+    del _computing[main.name]
+    if not computation.due.same_as(due):
+        return False  # the settings or the render changed meanwhile: the next tick starts over
+    if computation.error is not None:
+        raise computation.error
+    if not _install(computation):
+        return False
+    record = render_record.last_render(main.name)
+    if not _render_helper(main, helper, due.record[0], computation.seconds):
+        # The engine recorded the new settings before it failed: the node
+        # says again that its AO is not up to date.
+        render_record.put_back(main.name, record)
+        raise RuntimeError("the helper scene's render did not compute the AO (see the Info "
+                           "editor)")
+    _composite_again(main)
+    return True
 
 
 def refresh_changed(in_background=False):
@@ -160,39 +222,28 @@ def refresh_changed(in_background=False):
         return False
     if not bpy.context.window_manager.windows and not in_background:
         return False
-    rendered = False
+    rendered, helpers_rendered = False, set()
     for main in list(bpy.data.scenes):
         helper = helper_scene.helper_scene_of(main)
         due = _needs_refresh(main, helper) if helper is not None else None
         if due is None:
-            _computing.pop(main.name, None)  # a running one's result is dropped
+            computation = _computing.get(main.name)
+            if computation is not None and computation.done():
+                del _computing[main.name]  # its result is of no use now
             continue
-        frame, compared, changed = due
-        if _failed.get(main.name) == compared:
+        # A helper that serves several scenes (5.x) holds one scene's AO at a
+        # time: the others wait for the next tick, after this composite.
+        if helper.name in helpers_rendered or due.same_as(_failed.get(main.name)):
             continue
         try:
-            computation = _computing.get(main.name)
-            if computation is None or computation.compared != compared:
-                # Started now; settings that change while it runs start another.
-                computation = _computing[main.name] = _Computation(compared,
-                                                                   _work(main, changed))
-            if in_background:
-                computation.thread.join()
-            if not computation.done():
+            if not _refresh(main, helper, due, in_background):
                 continue
-            del _computing[main.name]
-            if computation.error is not None:
-                raise computation.error
-            for key, entry in computation.results.items():
-                ao_cache.last_render.put(key, *entry)
-            if not _render_helper(main, helper, frame, computation.seconds):
-                raise RuntimeError("the helper scene's render did not finish")
-            _composite_again(main)
         except Exception as error:  # the node keeps saying "render to update"
-            _failed[main.name] = compared
+            _failed[main.name] = due
             log(f"could not bring the AO of {main.name!r} up to its node settings: {error}")
             continue
         _failed.pop(main.name, None)
+        helpers_rendered.add(helper.name)
         rendered = True
     return rendered
 
@@ -210,13 +261,29 @@ def _composite_again(main):
                 return
 
 
+@bpy.app.handlers.persistent
+def _on_load_pre(*_args):
+    # What the last renders kept belongs to the file being closed: scenes
+    # of the next file may have the same names.
+    _computing.clear()
+    _failed.clear()
+    ao_cache.last_render.clear()
+    render_record.forget()
+
+
 def register():
     # Before render_record's hint refresher, which then finds the record up
     # to date and clears the nodes' hints.
     if refresh_changed not in node.hint_refreshers:
         node.hint_refreshers.insert(0, refresh_changed)
+    if _on_load_pre not in bpy.app.handlers.load_pre:
+        bpy.app.handlers.load_pre.append(_on_load_pre)
 
 
 def unregister():
+    if _on_load_pre in bpy.app.handlers.load_pre:
+        bpy.app.handlers.load_pre.remove(_on_load_pre)
     if refresh_changed in node.hint_refreshers:
         node.hint_refreshers.remove(refresh_changed)
+    _computing.clear()
+    _failed.clear()

@@ -22,8 +22,10 @@ HINT = ("Changed: render to update",
         "settings alone follow by themselves while the compositor is open; this one needs "
         "passes the last render did not hand over.)")
 
-# {main scene name: (frame, {node name: signature})}; replaced whole per
-# render, so the main thread never reads a half-written record.
+# {main scene name: (frame, {node name: signature}, the scene's as_pointer())};
+# replaced whole per render, so the main thread never reads a half-written
+# record. A new record is a new object: recomposite.py tells renders apart
+# by it.
 _records = {}
 
 
@@ -33,20 +35,29 @@ def _signature(job):
     return (job.params, job.layer, job.with_normal, job.guard_band, job.back_faces)
 
 
-def remember(main_name, frame, jobs, node_names):
-    """Called by the hook for each render of `main_name`: the nodes in
-    `node_names` were rendered at `frame`, those with a job with its
-    settings, the others without AO."""
+def remember(main_name, frame, jobs, node_names, main_uid=None):
+    """Called by the hook for each render of `main_name` (whose
+    as_pointer() is `main_uid`): the nodes in `node_names` were rendered at `frame`, those
+    with a job with its settings, the others without AO."""
     signatures = {name: None for name in node_names}
     signatures.update({job.node_name: _signature(job) for job in jobs})
+    put_back(main_name, (frame, signatures, main_uid))
+
+
+def put_back(main_name, record):
+    """Make `record` (a last_render() value, or None) `main_name`'s again."""
     global _records
     records = dict(_records)
-    records[main_name] = (frame, signatures)
+    if record is None:
+        records.pop(main_name, None)
+    else:
+        records[main_name] = record
     _records = records
 
 
 def last_render(main_name):
-    """(frame, {node name: signature or None}) of `main_name`'s last render, or None."""
+    """(frame, {node name: signature or None}, the scene's as_pointer()) of
+    `main_name`'s last render, or None."""
     return _records.get(main_name)
 
 
@@ -80,7 +91,7 @@ def changed_since_render(hbao_node, main=None):
         return None
     if hbao_node.mute or not any(output.is_linked for output in hbao_node.outputs):
         return None
-    frame, signatures = record
+    frame, signatures, _uid = record
     if hbao_node.name not in signatures:
         return HINT  # added since
     try:
