@@ -247,7 +247,8 @@ def test_new_node_settings_reach_the_ao_without_a_render(run_in_blender, tmp_pat
     AO a render computes; it is exactly the library's. A change that needs
     other passes (Normal unlinked) is left to the next render, and the node
     keeps saying so; so is a frame whose helper would render at another
-    size than the kept passes."""
+    size than the kept passes. A file opened again keeps nothing of the
+    render before it."""
     spec = {"frames": [1], "nodes": [{"name": "Hinted", "radius": 0.6, "blur_size": 0}],
             "after_render": [
                 {"label": "radius", "socket": ["Radius", 1.1]},
@@ -257,7 +258,9 @@ def test_new_node_settings_reach_the_ao_without_a_render(run_in_blender, tmp_pat
                 {"label": "rendered again", "render": 1},
                 {"label": "unchanged", "refresh": True},
                 {"label": "normal unlinked", "unlink": "Normal"},
-                {"label": "not refreshed", "refresh": True}]}
+                {"label": "not refreshed", "refresh": True},
+                {"label": "reopened", "reopen": True},
+                {"label": "radius after reopening", "socket": ["Radius", 0.8], "refresh": True}]}
     out, log = render(run_in_blender, tmp_path, spec)
     lines = [line for line in log.splitlines() if line.startswith("HBAO: 1 AO pass(es) ")]
     assert len(lines) == 3, log[-3000:]
@@ -268,13 +271,15 @@ def test_new_node_settings_reach_the_ao_without_a_render(run_in_blender, tmp_pat
     assert "(save 0, read 0, write" in lines[1], lines
     assert "(1 of 1 unchanged: reused)" in lines[2], lines
     refreshed = [line.split()[1] for line in log.splitlines() if line.startswith("REFRESHED ")]
-    assert refreshed == ["False", "True", "False", "False"], log[-3000:]
+    # After the file is opened again, nothing of the render before is kept.
+    assert refreshed == ["False", "True", "False", "False", "False"], log[-3000:]
     hints = printed_hints(log)
     changed = "Changed: render to update"
     assert hints == {"radius": changed, "half size": changed, "full size": changed,
                      "refreshed": None, "rendered again": None,
                      "unchanged": None, "normal unlinked": changed,
-                     "not refreshed": changed}, log[-3000:]
+                     "not refreshed": changed, "reopened": None,
+                     "radius after reopening": None}, log[-3000:]
     assert (out / "frame_0001_again.exr").is_file(), log[-3000:]
     # The File Output of the second render (radius 1.1) replaced the first's.
     ao = node_outputs(out, 1, "Hinted")["ao"]

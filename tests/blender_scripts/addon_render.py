@@ -210,6 +210,13 @@ for step in spec.get("after_render", []):
             scene.render.resolution_percentage = value
             import hbao
             hbao.sync(scene)  # as the add-on's timer does in a window: the helper follows
+        elif key == "reopen":  # the file saved and opened again
+            path = os.path.join(out_dir, "reopened.blend")
+            bpy.ops.wm.save_as_mainfile(filepath=path)
+            bpy.ops.wm.open_mainfile(filepath=path)
+            scene = bpy.context.scene
+            tree = blender_scenes.compat.compositor_tree(scene)
+            hinted = next(n for n in tree.nodes if n.bl_idname == "CompositorNodeHBAO")
         elif key == "unlink":
             tree.links.remove(hinted.inputs[value].links[0])
         elif key == "render":  # the frame rendered again, as frame_<n>_again
