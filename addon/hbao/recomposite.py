@@ -22,6 +22,7 @@ import time
 import bpy
 
 from . import ao_cache, compat, helper_scene, layer_passes, node, render_record
+from . import camera as camera_model
 from .planning import plan_node
 from .report import log
 
@@ -95,14 +96,6 @@ def request_for(helper):
     return request if request is not None and request.helper == helper.name else None
 
 
-def _render_size(scene):
-    """(height, width) of a render of `scene` without a border, as Blender
-    sizes it (resolution times the percentage, rounded down)."""
-    settings = scene.render
-    percent = settings.resolution_percentage
-    return (settings.resolution_y * percent // 100, settings.resolution_x * percent // 100)
-
-
 def _needs_refresh(main, helper):
     """A _Due when `main`'s last render can be brought up to its nodes'
     current settings from the cached passes, else None. The record must be
@@ -128,7 +121,8 @@ def _needs_refresh(main, helper):
             return None
         if job is not None:
             kept = ao_cache.last_render.entry((main.name, job.pass_name))
-            if kept is None or kept[0].arrays[0].shape != _render_size(helper):
+            width, height = camera_model.render_size(helper)
+            if kept is None or kept[0].arrays[0].shape != (height, width):
                 return None
         recorded, current = signatures[hbao_node.name], render_record.signature_of(job)
         current_signatures.append((hbao_node.name, current))

@@ -243,15 +243,12 @@ static HBAO_ALWAYS_INLINE void write_output(const float *zc, const float *ao, in
                                             float strength, float *out) {
     if (strength != 1.0f) {
         for (int i = 0; i < width; i++) {
-            const float value = powf(zc[i] > 0.0f ? ao[i] : 1.0f, strength);
-            /* Written so that a NaN could never pass through. */
-            out[i] = value > 0.0f ? (value < 1.0f ? value : 1.0f) : 0.0f;
+            out[i] = hbao_clamp_ao(powf(zc[i] > 0.0f ? ao[i] : 1.0f, strength));
         }
         return;
     }
     for (int i = 0; i < width; i++) {
-        const float value = zc[i] > 0.0f ? ao[i] : 1.0f;
-        out[i] = value > 0.0f ? (value < 1.0f ? value : 1.0f) : 0.0f;
+        out[i] = hbao_clamp_ao(zc[i] > 0.0f ? ao[i] : 1.0f);
     }
 }
 

@@ -49,6 +49,12 @@ static inline int hbao_finish_implementation(int requested) {
 #endif
 }
 
+/* The output's clamp to [0, 1], written so that a NaN could never pass
+ * through (it gives 0). */
+static inline float hbao_clamp_ao(float value) {
+    return value > 0.0f ? (value < 1.0f ? value : 1.0f) : 0.0f;
+}
+
 /* blur.c: AO on the full image from the raw AO on the grid (grid_ao, dense,
  * grid->width wide): cross-bilateral blur on depth and normals (rows, then
  * columns) on the grid -> [upsample] -> strength -> clamp to [0, 1],

@@ -25,13 +25,12 @@ static HBAO_ALWAYS_INLINE void add_candidate(float bilinear, float zs, float ao,
 
 /* One pixel's AO from its candidates' sums; with no sample at a similar
  * depth, the candidate nearest in depth (1 if none is usable). Clamped to
- * [0, 1] as the output is (blur.c's write_output): a weighted mean of values
+ * [0, 1] as the output is (hbao_clamp_ao): a weighted mean of values
  * in [0, 1] can round past 1. */
 static HBAO_ALWAYS_INLINE float finish_pixel(float z, float sum, float weight_sum,
                                              float nearest_ao) {
     const float blended = weight_sum > 1e-6f ? sum / weight_sum : nearest_ao;
-    const float value = z > 0.0f ? blended : 1.0f;
-    return value > 0.0f ? (value < 1.0f ? value : 1.0f) : 0.0f;
+    return hbao_clamp_ao(z > 0.0f ? blended : 1.0f);
 }
 
 /* One full-resolution row; candidates in the order (left, top), (right,
