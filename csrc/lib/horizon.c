@@ -34,14 +34,17 @@ typedef struct march {
     /* Samples nearer than this depth are occluders of finite thickness
      * wholly in front of the pixel: skipped (hbao_near_limit). */
     float near_limit;
-    float min_thickness; /* the back layer: HBAO_MIN_BACK_THICKNESS radii */
+    float min_thickness;      /* the back layer: HBAO_MIN_BACK_THICKNESS radii */
+    hbao_height_plane height; /* the one-layer search's sample heights */
 } march;
 
 enum { SAMPLE_END = -1, SAMPLE_SKIP = 0, SAMPLE_OK = 1, SAMPLE_FAR = 2 };
 
 /* The vector to the sample of a step and its squared length; *at receives
- * the sample's index in the grid. */
-static inline int march_sample(const march *m, int step, float delta[3], float *dist2, size_t *at) {
+ * the sample's index in the grid, and *height (where not NULL) the sample's
+ * height above the tangent plane (hbao_sample_height). */
+static inline int march_sample(const march *m, int step, float delta[3], float *dist2, size_t *at,
+                               float *height) {
     const hbao_grid *g = m->grid;
     int ox, oy;
     if (!hbao_step_offset(g, m->dc, m->ds, m->inv_ycor, m->jitter, m->step_px, step, &ox, &oy))
@@ -52,6 +55,8 @@ static inline int march_sample(const march *m, int step, float delta[3], float *
     *at = (size_t)sj * g->width + si;
     const float zs = g->depth[*at];
     if (zs <= 0.0f || zs < m->near_limit) return SAMPLE_SKIP;
+    if (height != NULL)
+        *height = hbao_sample_height(g, &m->height, zs, (float)ox, hbao_grid_y(g, sj));
     float q[3];
     hbao_grid_position(g, si, sj, zs, q);
     delta[0] = q[0] - m->p[0];
@@ -117,8 +122,8 @@ static inline int past_the_normal(const march *m, const slice *sl, const float v
 
 /* HBAO integration of one direction: sum of W * (increase of the sine of the
  * elevation above the tangent plane), Bavoil & Sainz with the half-occluded rule past the normal. */
-static float direction_occlusion_hbao(const hbao_settings *s, const march *m, const float n[3],
-                                      const float v[3], const slice *sl) {
+static float direction_occlusion_hbao(const hbao_settings *s, const march *m, const float v[3],
+                                      const slice *sl) {
     const int quadratic = s->falloff == HBAO_FALLOFF_QUADRATIC;
     const float inv_radius2 = 1.0f / m->radius2;
     const float half_occluded = 0.5f * (1.0f - s->sin_bias);
@@ -128,11 +133,12 @@ static float direction_occlusion_hbao(const hbao_settings *s, const march *m, co
     for (int step = 0; step < s->steps; step++) {
         float delta[3], dist2;
         size_t at;
-        const int status = march_sample(m, step, delta, &dist2, &at);
+        float height;
+        const int status = march_sample(m, step, delta, &dist2, &at, &height);
         if (status == SAMPLE_END) break;
         if (status != SAMPLE_OK) continue;
         const float inv_dist = 1.0f / sqrtf(dist2);
-        const float sin_s = sample_elevation(m, n, delta, inv_dist);
+        const float sin_s = height * inv_dist;
         if (check_past_normal && past_the_normal(m, sl, v, delta, inv_dist, sin_s)) {
             /* Beyond the normal inside the slice: the screen-space march
              * has no proper data here; count the direction half occluded. */
@@ -194,8 +200,8 @@ static inline void horizon_state(int past_normal, float cos_past_max, float elev
  * (0) for snapped samples that lie on the tangent plane but off the slice.
  * Past the normal (past_the_normal) the elevation turns back, so there the
  * angle to V is used. */
-static float direction_occlusion_cosine(const hbao_settings *s, const march *m, const float n[3],
-                                        const float v[3], const slice *sl, float *open_part) {
+static float direction_occlusion_cosine(const hbao_settings *s, const march *m, const float v[3],
+                                        const slice *sl, float *open_part) {
     const float gamma = HALF_PI - hbao_acos(sl->sin_gamma); /* asin; cos_gamma >= 0 */
     *open_part = 0.25f * (2.0f * sl->cos_gamma + (2.0f * gamma + HBAO_PI) * sl->sin_gamma);
     const float inv_np = sl->inv_np;
@@ -218,11 +224,12 @@ static float direction_occlusion_cosine(const hbao_settings *s, const march *m, 
     for (int step = 0; step < s->steps; step++) {
         float delta[3], dist2;
         size_t at;
-        const int status = march_sample(m, step, delta, &dist2, &at);
+        float height;
+        const int status = march_sample(m, step, delta, &dist2, &at, &height);
         if (status == SAMPLE_END) break;
         if (status != SAMPLE_OK) continue;
         const float inv_dist = 1.0f / sqrtf(dist2);
-        const float sin_s = sample_elevation(m, n, delta, inv_dist);
+        const float sin_s = height * inv_dist;
         int raised = 0;
         if (check_past_normal && past_the_normal(m, sl, v, delta, inv_dist, sin_s)) {
             const float cos_v = (delta[0] * v[0] + delta[1] * v[1] + delta[2] * v[2]) * inv_dist;
@@ -362,7 +369,7 @@ static inline int enter_the_ball(const march *m, size_t at, float delta[3], floa
  * occluder enters it is a sample at the entry point (enter_the_ball). */
 static inline int march_layer_sample(const march *m, int step, float delta[3], float *dist2,
                                      size_t *at) {
-    const int status = march_sample(m, step, delta, dist2, at);
+    const int status = march_sample(m, step, delta, dist2, at, NULL);
     if (status != SAMPLE_FAR) return status;
     return enter_the_ball(m, *at, delta, dist2) ? SAMPLE_OK : SAMPLE_SKIP;
 }
@@ -469,6 +476,7 @@ float hbao_horizon_pixel(const horizon_job *job, int i, int j, float step_px) {
     const float *n = g->normal + 3 * ((size_t)j * g->width + i);
     m.n_dot_v = n[0] * v[0] + n[1] * v[1] + n[2] * v[2];
     m.height_tolerance = g->depth_precision * hbao_rounding_along_normal(g, n, m.p);
+    hbao_height_plane_setup(g, n, m.p, hbao_grid_x(g, i), m.height_tolerance, &m.height);
     m.near_limit = hbao_near_limit(s, z);
     m.min_thickness = HBAO_MIN_BACK_THICKNESS * s->radius;
     const int cosine = s->integration == HBAO_INTEGRATION_COSINE;
@@ -486,12 +494,12 @@ float hbao_horizon_pixel(const horizon_job *job, int i, int j, float step_px) {
             float open;
             const float occlusion = layers
                                         ? direction_occlusion_cosine_layers(s, &m, n, v, &sl, &open)
-                                        : direction_occlusion_cosine(s, &m, n, v, &sl, &open);
+                                        : direction_occlusion_cosine(s, &m, v, &sl, &open);
             visible_sum += sl.np_length * (open - occlusion);
             open_sum += sl.np_length * open;
         } else {
             occlusion_sum += layers ? direction_occlusion_hbao_layers(s, &m, n, v, &sl)
-                                    : direction_occlusion_hbao(s, &m, n, v, &sl);
+                                    : direction_occlusion_hbao(s, &m, v, &sl);
         }
     }
 

@@ -21,6 +21,7 @@
 #define V_LOADU _mm256_loadu_ps
 #define V_STOREU _mm256_storeu_ps
 #define V_NEG(a) _mm256_xor_ps((a), _mm256_set1_ps(-0.0f))
+#define V_ABS(a) _mm256_andnot_ps(_mm256_set1_ps(-0.0f), (a))
 #define V_MAX0(a) _mm256_max_ps((a), _mm256_setzero_ps()) /* NaN -> 0, like fmaxf(0, a) */
 #define V_GT(a, b) _mm256_cmp_ps((a), (b), _CMP_GT_OQ)
 #define V_GE(a, b) _mm256_cmp_ps((a), (b), _CMP_GE_OQ)

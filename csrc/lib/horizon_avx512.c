@@ -23,6 +23,8 @@
 #define V_NEG(a)                                                                                   \
     _mm512_castsi512_ps(                                                                           \
         _mm512_xor_si512(_mm512_castps_si512(a), _mm512_set1_epi32((int)0x80000000u)))
+#define V_ABS(a)                                                                                   \
+    _mm512_castsi512_ps(_mm512_and_si512(_mm512_castps_si512(a), _mm512_set1_epi32(0x7fffffff)))
 #define V_MAX0(a) _mm512_max_ps((a), _mm512_setzero_ps()) /* NaN -> 0, like fmaxf(0, a) */
 #define V_GT(a, b) _mm512_cmp_ps_mask((a), (b), _CMP_GT_OQ)
 #define V_GE(a, b) _mm512_cmp_ps_mask((a), (b), _CMP_GE_OQ)

@@ -8,7 +8,7 @@
  * scalar code leaves a loop with break or continue, lanes are masked instead.
  *
  * Vocabulary: VF float vector, VI int32 vector, VM lane mask;
- * V_ADD V_SUB V_MUL V_DIV V_SQRT V_SET V_LOADU V_STOREU V_NEG V_MAX0 (max
+ * V_ADD V_SUB V_MUL V_DIV V_SQRT V_SET V_LOADU V_STOREU V_NEG V_ABS V_MAX0 (max
  * with 0, NaN -> 0); comparisons V_GT V_GE V_LT V_LE -> VM; masks M_AND M_OR
  * M_ANDNOT(a, b) = ~a & b, M_ANY; V_SELECT(m, a, b) = m ? b : a;
  * V_ZERO_UNLESS(m, v); I_SET I_ADD I_MULLO I_LANES (0, 1, ...) I_TO_F; V_CVTT
@@ -87,18 +87,22 @@ typedef struct SIMD_NAME(block) {
     VF radius2, inv_radius2;
     VF height_tolerance, n_dot_v, near_limit; /* as in horizon.c's march */
     VM view_below;                            /* n_dot_v < 0: V below the tangent plane */
-    VF min_thickness;                         /* the back layer's, as in march */
+    /* hbao_height_plane, lane by lane */
+    VF height_across, height_per_pixel, height_per_row, height_depth, height_offset;
+    VF min_thickness; /* the back layer's, as in march */
 } SIMD_NAME(block);
 
-/* The depth fetches of a direction's steps. They depend only on the steps'
- * positions, so all of them are issued first and the horizon logic runs
- * afterwards. A step is one pixel offset for every lane, so its depths are
- * one contiguous load from the phase_depth row of the lanes' new phase. */
+/* The depth fetch of one step. A step is one pixel offset for every lane,
+ * so its depths are one contiguous load from the phase_depth row of the
+ * lanes' new phase. The one-layer search fetches each step in its loop: a
+ * skipped step (below the tangent plane) is a dozen instructions, so the
+ * processor runs many steps ahead and their loads overlap; the two-layer
+ * search fetches a direction's steps first (fetch_steps). */
 typedef struct SIMD_NAME(fetch) {
     VF zs;
     VF zb;        /* the back layer's depth there (INFINITY: unknown) */
-    VF column;    /* the samples' hbao_grid x (view x per unit depth) */
-    float row;    /* and y, the same for all lanes */
+    float row;    /* the samples' hbao_grid y, the same for all lanes */
+    float ox;     /* the step's pixel offset along the row, as a float */
     VM candidate; /* inside the image, on another pixel */
 } SIMD_NAME(fetch);
 
@@ -199,48 +203,58 @@ static int SIMD_NAME(fetch_at_side)(const SIMD_NAME(block) * b, int ox, int oy, 
             lanes[k] = first + k >= 0 && first + k < phase_width ? back[first + k] : INFINITY;
         f->zb = V_LOADU(lanes);
     }
-    f->column = V_MUL(V_ADD(si, V_SET(g->x_offset)), V_SET(g->x_step));
     f->row = hbao_grid_y(g, sj);
+    f->ox = (float)ox;
     f->candidate = candidate;
     return 1;
 }
 
+/* Step `step` of plan t into *f: 1, or 0 where it repeats the previous
+ * step's pixel, or -1 where the direction's search ends because every lane
+ * has left the image (*alive: the lanes still inside). Where the projected
+ * radius spans fewer pixels than there are steps, steps snap to the same
+ * pixel; a repeated sample cannot raise a horizon that its first visit set
+ * (every test compares with > or reaches the same stop), so leaving it out
+ * changes no result, and the step count adapts to the projected radius. */
+static inline int SIMD_NAME(fetch_step)(const SIMD_NAME(block) * b, const SIMD_NAME(steps) * t,
+                                        int step, VM *alive, SIMD_NAME(fetch) * f) {
+    if (!M_ANY(*alive)) return -1;
+    const int ox = t->ox[step], oy = t->oy[step];
+    if (step > 0 && ox == t->ox[step - 1] && oy == t->oy[step - 1]) return 0;
+    if ((t->plain[step / SIMD_LANES] >> (step % SIMD_LANES)) & 1u) {
+        const VM candidate = (ox | oy) == 0 ? M_ANDNOT(*alive, *alive) : *alive;
+        const int index = t->index[step];
+        f->zs = V_ZERO_UNLESS(candidate, V_LOADU(b->job->phase_depth + index));
+        if (b->job->phase_back != NULL) f->zb = V_LOADU(b->job->phase_back + index);
+        f->row = t->row[step];
+        f->ox = t->ox_float[step];
+        f->candidate = candidate;
+        return 1;
+    }
+    return SIMD_NAME(fetch_at_side)(b, ox, oy, alive, f) ? 1 : -1;
+}
+
 /* Fills fetches[0..n) and returns n: the steps before every lane has left
- * the image, less the steps that repeat the previous step's pixel. Where
- * the projected radius spans fewer pixels than there are steps, steps snap
- * to the same pixel; a repeated sample cannot raise a horizon that its
- * first visit set (every test compares with > or reaches the same stop), so
- * leaving it out changes no result, and the step count adapts to the
- * projected radius. */
+ * the image, less the steps that repeat the previous step's pixel. */
 static inline int SIMD_NAME(fetch_steps)(const SIMD_NAME(block) * b, int steps, float dc, float ds,
                                          VM active, SIMD_NAME(fetch) * fetches) {
-    const hbao_grid *g = b->grid;
-    const float *phase_depth = b->job->phase_depth, *phase_back = b->job->phase_back;
     SIMD_NAME(steps) t;
     SIMD_NAME(plan_steps)(b, dc, ds, steps, &t);
-    const VF x_offset = V_SET(g->x_offset), x_step = V_SET(g->x_step);
     VM alive = active;
     int fetched = 0;
-    for (int step = 0; step < t.count && M_ANY(alive); step++) {
-        const int ox = t.ox[step], oy = t.oy[step];
-        if (step > 0 && ox == t.ox[step - 1] && oy == t.oy[step - 1]) continue;
-        SIMD_NAME(fetch) *f = &fetches[fetched];
-        if ((t.plain[step / SIMD_LANES] >> (step % SIMD_LANES)) & 1u) {
-            const VM candidate = (ox | oy) == 0 ? M_ANDNOT(alive, alive) : alive;
-            const int index = t.index[step];
-            f->zs = V_ZERO_UNLESS(candidate, V_LOADU(phase_depth + index));
-            if (phase_back != NULL) f->zb = V_LOADU(phase_back + index);
-            /* b->lane_float + ox is exact, as I_TO_F(lane_i + ox) */
-            f->column =
-                V_MUL(V_ADD(V_ADD(b->lane_float, V_SET(t.ox_float[step])), x_offset), x_step);
-            f->row = t.row[step];
-            f->candidate = candidate;
-        } else if (!SIMD_NAME(fetch_at_side)(b, ox, oy, &alive, f)) {
-            break; /* every lane's sample leaves the image */
-        }
-        fetched++;
+    for (int step = 0; step < t.count; step++) {
+        const int got = SIMD_NAME(fetch_step)(b, &t, step, &alive, &fetches[fetched]);
+        if (got < 0) break;
+        fetched += got;
     }
     return fetched;
+}
+
+/* The samples' hbao_grid x (view x per unit depth): lane_float + ox is
+ * exact, as I_TO_F(lane_i + ox). */
+static inline VF SIMD_NAME(sample_column)(const SIMD_NAME(block) * b, const SIMD_NAME(fetch) * f) {
+    const hbao_grid *g = b->grid;
+    return V_MUL(V_ADD(V_ADD(b->lane_float, V_SET(f->ox)), V_SET(g->x_offset)), V_SET(g->x_step));
 }
 
 /* The lanes among `live` whose fetched sample has a usable depth. */
@@ -255,7 +269,7 @@ static inline void SIMD_NAME(sample_delta)(const SIMD_NAME(block) * b, const SIM
                                            VF delta[3]) {
     const hbao_grid *g = b->grid;
     const VF zs = f->zs;
-    const VF column = f->column;
+    const VF column = SIMD_NAME(sample_column)(b, f);
     const VF row = V_SET(f->row);
     const VF q0 = g->orthographic ? column : V_MUL(column, zs);
     const VF q1 = g->orthographic ? row : V_MUL(row, zs);
@@ -354,14 +368,20 @@ static inline VM SIMD_NAME(above_tangent)(const SIMD_NAME(block) * b, VM ok, VF 
  * the usable-depth test and the squared length. */
 static inline VM SIMD_NAME(sample_rising)(const SIMD_NAME(block) * b, const SIMD_NAME(fetch) * f,
                                           VM live, VF delta[3], VF *dist2, VF *height) {
-    SIMD_NAME(sample_delta)(b, f, delta);
-    *height = SIMD_NAME(sample_height)(b, delta);
-    *dist2 = V_SET(0.0f); /* unused where no lane returns */
+    /* hbao_sample_height */
+    const VF across = V_ADD(V_ADD(b->height_across, V_MUL(V_SET(f->ox), b->height_per_pixel)),
+                            V_MUL(V_SET(f->row), b->height_per_row));
+    *height = V_SUB(b->grid->orthographic ? V_SUB(across, V_MUL(f->zs, b->height_depth))
+                                          : V_MUL(f->zs, across),
+                    b->height_offset);
+    *dist2 = V_SET(0.0f); /* these unused where no lane returns */
+    for (int c = 0; c < 3; c++) delta[c] = *dist2;
     const VM tangent = M_OR(V_GT(*height, V_SET(0.0f)), b->view_below);
     const VM none = M_ANDNOT(tangent, tangent);
     if (!M_ANY(tangent)) return none;
     const VM valid = SIMD_NAME(sample_valid)(b, f, live);
     if (!M_ANY(M_AND(valid, tangent))) return none;
+    SIMD_NAME(sample_delta)(b, f, delta);
     VM far;
     const VM ok = SIMD_NAME(sample_reach)(b, valid, delta, dist2, &far);
     return M_ANY(M_AND(ok, tangent)) ? ok : none; /* above_tangent(b, ok, height) */
@@ -382,13 +402,18 @@ static VF SIMD_NAME(direction_occlusion_hbao)(const hbao_settings *s, const SIMD
     const int any_check = M_ANY(M_AND(check_past_normal, active));
     VF sin_max = V_SET(s->sin_bias);
     VF occlusion = V_SET(0.0f);
-    SIMD_NAME(fetch) fetches[HBAO_MAX_STEPS];
-    const int fetched = SIMD_NAME(fetch_steps)(b, s->steps, dc, ds, active, fetches);
+    SIMD_NAME(steps) t;
+    SIMD_NAME(plan_steps)(b, dc, ds, s->steps, &t);
+    VM inside = active;
     VM alive = active; /* lanes that have not stopped past the normal */
-    for (int step = 0; step < fetched && M_ANY(alive); step++) {
+    for (int step = 0; step < t.count && M_ANY(alive); step++) {
+        SIMD_NAME(fetch) f;
+        const int got = SIMD_NAME(fetch_step)(b, &t, step, &inside, &f);
+        if (got < 0) break;
+        if (got == 0) continue;
         VF delta[3], dist2;
         VF height;
-        const VM ok = SIMD_NAME(sample_rising)(b, &fetches[step], alive, delta, &dist2, &height);
+        const VM ok = SIMD_NAME(sample_rising)(b, &f, alive, delta, &dist2, &height);
         if (!M_ANY(ok)) continue;
         const VF inv_dist = V_DIV(V_SET(1.0f), V_SQRT(dist2));
         const VF sin_s = V_MUL(height, inv_dist);
@@ -482,12 +507,17 @@ static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SI
     VF visibility_at_max = visibility_start;
     VF occlusion = V_SET(0.0f);
     int any_raised = 0;
-    SIMD_NAME(fetch) fetches[HBAO_MAX_STEPS];
-    const int fetched = SIMD_NAME(fetch_steps)(b, s->steps, dc, ds, active, fetches);
-    for (int step = 0; step < fetched; step++) {
+    SIMD_NAME(steps) t;
+    SIMD_NAME(plan_steps)(b, dc, ds, s->steps, &t);
+    VM inside = active;
+    for (int step = 0; step < t.count; step++) {
+        SIMD_NAME(fetch) f;
+        const int got = SIMD_NAME(fetch_step)(b, &t, step, &inside, &f);
+        if (got < 0) break;
+        if (got == 0) continue;
         VF delta[3], dist2;
         VF height;
-        const VM ok = SIMD_NAME(sample_rising)(b, &fetches[step], active, delta, &dist2, &height);
+        const VM ok = SIMD_NAME(sample_rising)(b, &f, active, delta, &dist2, &height);
         if (!M_ANY(ok)) continue;
         const VF inv_dist = V_DIV(V_SET(1.0f), V_SQRT(dist2));
         const VF sin_s = V_MUL(height, inv_dist);
@@ -572,7 +602,7 @@ static inline VF SIMD_NAME(back_point)(const SIMD_NAME(block) * b, const SIMD_NA
     const VF thinnest = V_ADD(f->zs, b->min_thickness);
     const VF zb = V_SELECT(V_GT(f->zb, thinnest), thinnest, f->zb);
     *known = V_LT(f->zb, V_SET(INFINITY));
-    const VF column = f->column;
+    const VF column = SIMD_NAME(sample_column)(b, f);
     const VF row = V_SET(f->row);
     delta[0] = V_SUB(g->orthographic ? column : V_MUL(column, zb), b->p[0]);
     delta[1] = V_SUB(g->orthographic ? row : V_MUL(row, zb), b->p[1]);
@@ -778,6 +808,19 @@ static void SIMD_NAME(lanes_ao)(const hbao_horizon_job *job, int x0, int x1, int
                              : SIMD_NAME(dot3)(b.n[0], b.n[1], b.n[2], b.p[0], b.p[1], b.p[2]);
         b.height_tolerance = V_MUL(V_SET(g->depth_precision),
                                    V_SELECT(V_LT(along, V_SET(0.0f)), along, V_NEG(along)));
+        /* hbao_height_plane_setup */
+        b.height_across =
+            g->orthographic ? V_MUL(column, b.n[0]) : V_SUB(V_MUL(column, b.n[0]), b.n[2]);
+        b.height_per_pixel = V_MUL(V_SET(g->x_step), b.n[0]);
+        b.height_per_row = b.n[1];
+        b.height_depth = b.n[2];
+        {
+            const VF pn0 = V_MUL(b.p[0], b.n[0]), pn1 = V_MUL(b.p[1], b.n[1]);
+            const VF pn2 = V_MUL(b.p[2], b.n[2]);
+            const VF rounding = V_ADD(V_ADD(V_ABS(pn0), V_ABS(pn1)), V_ABS(pn2));
+            b.height_offset = V_ADD(V_ADD(V_ADD(V_ADD(pn0, pn1), pn2), b.height_tolerance),
+                                    V_MUL(V_SET(HBAO_HEIGHT_ROUNDING), rounding));
+        }
         /* hbao_near_limit */
         b.near_limit = s->thickness > 0.0f ? V_SUB(z, V_SET(s->thickness)) : V_SET(0.0f);
         b.min_thickness = V_SET(HBAO_MIN_BACK_THICKNESS * s->radius);

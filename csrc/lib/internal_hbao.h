@@ -144,6 +144,49 @@ static inline void hbao_grid_position(const hbao_grid *grid, int i, int j, float
     position[2] = -depth;
 }
 
+/* A sample's height above the pixel's tangent plane, dot(n, Q - P) lowered
+ * by the depth's rounding tolerance, written as a plane in the sample's
+ * pixel offset ox and grid row y: in perspective Q = zs (x, y, -1), so the
+ * height is zs (x n0 + y n1 - n2) - (dot(n, P) + tolerance), and x n0 is
+ * the pixel's own column term plus ox x_step n0. Three products and sums
+ * per sample instead of the vector Q - P: the one-layer search computes it
+ * for every step and the vector only for samples above the plane. The
+ * SIMD kernels perform the same operations in the same order. */
+typedef struct hbao_height_plane {
+    float across;    /* x n0 - n2 at the pixel's column (x n0 if orthographic) */
+    float per_pixel; /* x_step n0: the change of across per column */
+    float per_row;   /* n1 */
+    float depth;     /* n2, orthographic only: Q = (x, y, -zs) */
+    float offset;    /* dot(n, P) + tolerance + HBAO_HEIGHT_ROUNDING sum |P_c n_c| */
+} hbao_height_plane;
+
+/* The rounding of hbao_sample_height's eight operations, relative to
+ * sum |P_c n_c| (to zs (|x n0| + |y n1| + |n2|) for the sample): 8 ulps of
+ * 1 (2^-24 each). Samples on the tangent plane then never come out above
+ * it, so they are skipped before any square root, as with the exact
+ * difference Q - P; what it hides is an elevation of under 0.1 degrees one
+ * pixel away at 1080p with a 50 mm lens. */
+#define HBAO_HEIGHT_ROUNDING 4.7683716e-7f
+
+static inline void hbao_height_plane_setup(const hbao_grid *grid, const float n[3],
+                                           const float position[3], float column, float tolerance,
+                                           hbao_height_plane *plane) {
+    plane->across = grid->orthographic ? column * n[0] : column * n[0] - n[2];
+    plane->per_pixel = grid->x_step * n[0];
+    plane->per_row = n[1];
+    plane->depth = n[2];
+    const float rounding =
+        fabsf(position[0] * n[0]) + fabsf(position[1] * n[1]) + fabsf(position[2] * n[2]);
+    plane->offset = position[0] * n[0] + position[1] * n[1] + position[2] * n[2] + tolerance +
+                    HBAO_HEIGHT_ROUNDING * rounding;
+}
+
+static inline float hbao_sample_height(const hbao_grid *grid, const hbao_height_plane *plane,
+                                       float zs, float ox, float row) {
+    const float across = plane->across + ox * plane->per_pixel + row * plane->per_row;
+    return (grid->orthographic ? across - zs * plane->depth : zs * across) - plane->offset;
+}
+
 /* parallel.c: run job(context, row) for every row in [0, rows), on up to
  * `threads` threads (the calling thread included). If a thread cannot be
  * started, the threads that did start do its rows. */
