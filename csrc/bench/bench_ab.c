@@ -48,7 +48,8 @@ static int load(build *b, int width, int height) {
 static void usage(const char *program) {
     fprintf(stderr,
             "usage: %s BEFORE_LIBRARY AFTER_LIBRARY [--rounds R] [--calls N] [--threads T] "
-            "[--half] [--radius R] [--directions D] [--steps S] [--blur B]\n",
+            "[--half] [--radius R] [--directions D] [--steps S] [--blur B]\n"
+            "  [--implementation scalar|avx2|avx512] (default: the best this CPU has)\n",
             program);
 }
 
@@ -77,14 +78,17 @@ int main(int argc, char **argv) {
             params.blur_size = atoi(argv[++a]);
         else if (!strcmp(argv[a], "--half"))
             half = 1;
+        else if (!strcmp(argv[a], "--implementation") && a + 1 < argc)
+            params.implementation = bench_implementation(argv[++a]);
         else {
             usage(argv[0]);
             return 2;
         }
     }
     if (rounds < 1 || rounds > 100 || calls < 1 || calls > 1000 || threads < 1 || threads > 64 ||
-        !(radius > 0.0f)) {
-        fprintf(stderr, "bench_ab: --rounds 1-100, --calls 1-1000, --threads 1-64, radius > 0\n");
+        !(radius > 0.0f) || params.implementation < 0) {
+        fprintf(stderr, "bench_ab: --rounds 1-100, --calls 1-1000, --threads 1-64, radius > 0, "
+                        "--implementation scalar, avx2 or avx512\n");
         return 2;
     }
     const int width = 1920, height = 1080;

@@ -17,6 +17,14 @@ static inline int compare_doubles(const void *a, const void *b) {
     return (x > y) - (x < y);
 }
 
+/* hbao_implementation by name (scalar, avx2, avx512); -1 if none */
+static inline int bench_implementation(const char *name) {
+    if (!strcmp(name, "scalar")) return HBAO_IMPLEMENTATION_SCALAR;
+    if (!strcmp(name, "avx2")) return HBAO_IMPLEMENTATION_AVX2;
+    if (!strcmp(name, "avx512")) return HBAO_IMPLEMENTATION_AVX512;
+    return -1;
+}
+
 static inline double clock_seconds(clockid_t clock) {
     struct timespec t;
     clock_gettime(clock, &t);

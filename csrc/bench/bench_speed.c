@@ -75,15 +75,8 @@ static int parse_implementations(const char *list, int wanted[COLUMN_COUNT]) {
     char copy[256];
     snprintf(copy, sizeof copy, "%s", list);
     for (char *token = strtok(copy, ","); token != NULL; token = strtok(NULL, ",")) {
-        int implementation;
-        if (!strcmp(token, "scalar"))
-            implementation = HBAO_IMPLEMENTATION_SCALAR;
-        else if (!strcmp(token, "avx2"))
-            implementation = HBAO_IMPLEMENTATION_AVX2;
-        else if (!strcmp(token, "avx512"))
-            implementation = HBAO_IMPLEMENTATION_AVX512;
-        else
-            return 0;
+        const int implementation = bench_implementation(token);
+        if (implementation < 0) return 0;
         for (int c = 0; c < COLUMN_COUNT; c++)
             if (all_columns[c].implementation == implementation) wanted[c] = 1;
     }
