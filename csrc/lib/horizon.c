@@ -512,22 +512,26 @@ float hbao_horizon_pixel(const horizon_job *job, int i, int j, float step_px) {
     return ao < 1.0f ? ao : 1.0f;
 }
 
-float hbao_block_step(const horizon_job *job, int x0, int x1, int j, int a) {
-    const hbao_settings *s = job->settings;
-    const hbao_grid *g = job->grid;
+float hbao_block_step_at(const hbao_settings *s, const hbao_grid *g, float nearest) {
     /* The largest projected radius, as hbao_horizon_pixel and the SIMD
      * kernels compute it per pixel, is the nearest pixel's: pixel_size * z
      * and the division round monotonically, so radius / (pixel_size * z) is
      * largest, to the bit, where z is smallest. One division per block. */
+    if (nearest == INFINITY) return HBAO_BLOCK_UNSAMPLED;
+    const float largest =
+        g->orthographic ? s->radius / g->pixel_size : s->radius / (g->pixel_size * nearest);
+    return largest >= 1.0f ? (largest - 1.0f) / (float)s->steps : HBAO_BLOCK_UNSAMPLED;
+}
+
+float hbao_block_step(const horizon_job *job, int x0, int x1, int j, int a) {
+    const hbao_settings *s = job->settings;
+    const hbao_grid *g = job->grid;
     float nearest = INFINITY;
     for (int i = x0 + a; i < x1; i += 4) {
         const float z = g->depth[(size_t)j * g->width + i];
         if (z > 0.0f && z < nearest) nearest = z;
     }
-    if (nearest == INFINITY) return HBAO_BLOCK_UNSAMPLED;
-    const float largest =
-        g->orthographic ? s->radius / g->pixel_size : s->radius / (g->pixel_size * nearest);
-    return largest >= 1.0f ? (largest - 1.0f) / (float)s->steps : HBAO_BLOCK_UNSAMPLED;
+    return hbao_block_step_at(s, g, nearest);
 }
 
 /* Pixels are visited tile by tile: a pixel's samples spread over the whole

@@ -31,6 +31,7 @@
 #define M_OR _mm256_or_ps
 #define M_ANDNOT(a, b) _mm256_andnot_ps((a), (b))
 #define M_ANY(m) (_mm256_movemask_ps(m) != 0)
+#define M_NONE() _mm256_setzero_ps()
 #define V_SELECT(m, a, b) _mm256_blendv_ps((a), (b), (m))
 #define V_ZERO_UNLESS(m, v) _mm256_and_ps((m), (v))
 #define I_SET _mm256_set1_epi32

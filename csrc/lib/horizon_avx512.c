@@ -34,6 +34,7 @@
 #define M_OR(a, b) ((__mmask16)((a) | (b)))
 #define M_ANDNOT(a, b) ((__mmask16)(~(a) & (b)))
 #define M_ANY(m) ((m) != 0)
+#define M_NONE() ((__mmask16)0)
 #define V_SELECT(m, a, b) _mm512_mask_blend_ps((m), (a), (b))
 #define V_ZERO_UNLESS(m, v) _mm512_maskz_mov_ps((m), (v))
 #define I_SET _mm512_set1_epi32

@@ -10,13 +10,20 @@
  * Vocabulary: VF float vector, VI int32 vector, VM lane mask;
  * V_ADD V_SUB V_MUL V_DIV V_SQRT V_SET V_LOADU V_STOREU V_NEG V_ABS V_MAX0 (max
  * with 0, NaN -> 0); comparisons V_GT V_GE V_LT V_LE -> VM; masks M_AND M_OR
- * M_ANDNOT(a, b) = ~a & b, M_ANY; V_SELECT(m, a, b) = m ? b : a;
+ * M_ANDNOT(a, b) = ~a & b, M_ANY, M_NONE() (no lane); V_SELECT(m, a, b) = m ? b : a;
  * V_ZERO_UNLESS(m, v); I_SET I_ADD I_MULLO I_LANES (0, 1, ...) I_TO_F; V_CVTT
  * (truncating float -> int32); I_STOREU; M_BITS(m) (lane k -> bit k);
  * for the back layer's sector masks: V_MIN V_CEIL V_FLOOR, I_SUB I_AND I_OR
  * I_ANDNOT(a, b) = ~a & b, I_SLLV (per-lane shift, 0 from 32 on) I_SRLI,
  * I_ZERO_UNLESS(m, v); I_SRAI (arithmetic shift) for the steps' indices;
  * SIMD_NAME(x) gives the instance's function names. */
+
+/* sample_rising leaves a sample's delta unset where it returns no lane,
+ * and its callers read it only where a lane is returned; GCC cannot see
+ * that through the masks, and zeroing it cost 4 instructions per step. */
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 
 static inline VF SIMD_NAME(dot3)(VF a0, VF a1, VF a2, VF b0, VF b1, VF b2) {
     return V_ADD(V_ADD(V_MUL(a0, b0), V_MUL(a1, b1)), V_MUL(a2, b2));
@@ -187,7 +194,7 @@ static int SIMD_NAME(fetch_at_side)(const SIMD_NAME(block) * b, int ox, int oy, 
     if (sj < 0 || sj >= g->height) return 0;
     const VF si = I_TO_F(I_ADD(b->lane_i, I_SET(ox))); /* exact: |si| < 2^24 */
     *alive = M_AND(*alive, M_AND(V_GE(si, V_SET(0.0f)), V_LT(si, V_SET((float)g->width))));
-    const VM candidate = (ox == 0 && oy == 0) ? M_ANDNOT(*alive, *alive) : *alive;
+    const VM candidate = (ox == 0 && oy == 0) ? M_NONE() : *alive;
     const int moved = b->phase + ox;
     const int new_phase = moved & 3;                        /* moved mod 4, two's complement */
     const int first = b->first_x + (moved - new_phase) / 4; /* exact */
@@ -222,7 +229,7 @@ static inline int SIMD_NAME(fetch_step)(const SIMD_NAME(block) * b, const SIMD_N
     const int ox = t->ox[step], oy = t->oy[step];
     if (step > 0 && ox == t->ox[step - 1] && oy == t->oy[step - 1]) return 0;
     if ((t->plain[step / SIMD_LANES] >> (step % SIMD_LANES)) & 1u) {
-        const VM candidate = (ox | oy) == 0 ? M_ANDNOT(*alive, *alive) : *alive;
+        const VM candidate = (ox | oy) == 0 ? M_NONE() : *alive;
         const int index = t->index[step];
         f->zs = V_ZERO_UNLESS(candidate, V_LOADU(b->job->phase_depth + index));
         if (b->job->phase_back != NULL) f->zb = V_LOADU(b->job->phase_back + index);
@@ -374,10 +381,8 @@ static inline VM SIMD_NAME(sample_rising)(const SIMD_NAME(block) * b, const SIMD
     *height = V_SUB(b->grid->orthographic ? V_SUB(across, V_MUL(f->zs, b->height_depth))
                                           : V_MUL(f->zs, across),
                     b->height_offset);
-    *dist2 = V_SET(0.0f); /* these unused where no lane returns */
-    for (int c = 0; c < 3; c++) delta[c] = *dist2;
     const VM tangent = M_OR(V_GT(*height, V_SET(0.0f)), b->view_below);
-    const VM none = M_ANDNOT(tangent, tangent);
+    const VM none = M_NONE(); /* delta and dist2 are left unset */
     if (!M_ANY(tangent)) return none;
     const VM valid = SIMD_NAME(sample_valid)(b, f, live);
     if (!M_ANY(M_AND(valid, tangent))) return none;
@@ -420,8 +425,8 @@ static VF SIMD_NAME(direction_occlusion_hbao)(const hbao_settings *s, const SIMD
         VM rest = ok;
         /* past_the_normal, its cheap half first: most samples rise less
          * steeply than V, and then the angle to V is not needed */
-        const VM steep = any_check ? M_AND(M_AND(ok, check_past_normal), V_GT(sin_s, b->n_dot_v))
-                                   : M_ANDNOT(ok, ok);
+        const VM steep =
+            any_check ? M_AND(M_AND(ok, check_past_normal), V_GT(sin_s, b->n_dot_v)) : M_NONE();
         if (M_ANY(steep)) {
             const VM past =
                 M_AND(steep, V_GT(SIMD_NAME(cos_to_view)(b, delta, inv_dist), sl->cos_gamma));
@@ -499,7 +504,7 @@ static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SI
     const int quadratic = s->falloff == HBAO_FALLOFF_QUADRATIC;
 
     VF elevation_max = V_SET(s->sin_bias);
-    VM past_normal = M_ANDNOT(active, active); /* no lane */
+    VM past_normal = M_NONE(); /* no lane */
     VF cos_past_max = sl->cos_gamma;
     const VF visibility_start = SIMD_NAME(horizon_visibility_of)(
         past_normal, cos_past_max, elevation_max, V_SET(s->bias_elevation_sine),
@@ -521,7 +526,7 @@ static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SI
         if (!M_ANY(ok)) continue;
         const VF inv_dist = V_DIV(V_SET(1.0f), V_SQRT(dist2));
         const VF sin_s = V_MUL(height, inv_dist);
-        VM raised = M_ANDNOT(ok, ok); /* no lane */
+        VM raised = M_NONE(); /* no lane */
         /* past_the_normal, its cheap half first (see above) */
         const VM steep =
             any_check ? M_AND(M_AND(ok, check_past_normal), V_GT(sin_s, b->n_dot_v)) : raised;
@@ -629,7 +634,7 @@ static inline VF SIMD_NAME(sector_fraction_cosine)(const SIMD_NAME(block) * b,
                                                    int any_check, VF sin_bias, VF inv_bias) {
     const VF inv_dist = V_DIV(V_SET(1.0f), V_SQRT(dist2));
     const VF sin_s = SIMD_NAME(sample_elevation)(b, delta, inv_dist);
-    VM past = V_LT(sin_bias, sin_bias); /* no lane */
+    VM past = M_NONE(); /* no lane */
     VF cos_v = V_SET(1.0f);
     if (any_check) {
         const VM steep = M_AND(check_past_normal, V_GT(sin_s, b->n_dot_v));
@@ -661,7 +666,7 @@ static VF SIMD_NAME(direction_occlusion_cosine_layers)(const hbao_settings *s,
     const int quadratic = s->falloff == HBAO_FALLOFF_QUADRATIC;
     const VF sin_bias = V_SET(s->sin_bias);
     const VF visibility_bias = SIMD_NAME(horizon_visibility_of)(
-        V_LT(sin_bias, sin_bias), sl->cos_gamma, sin_bias, V_SET(s->bias_elevation_sine),
+        M_NONE(), sl->cos_gamma, sin_bias, V_SET(s->bias_elevation_sine),
         V_SET(s->bias_elevation_acos), gamma, sl);
     const VM lanes = M_AND(active, V_GT(visibility_bias, V_SET(0.0f)));
     const VF inv_bias = V_DIV(V_SET(1.0f), visibility_bias);
@@ -884,9 +889,27 @@ static void SIMD_NAME(lanes_ao)(const hbao_horizon_job *job, int x0, int x1, int
     }
 }
 
+/* hbao_block_step, its minimum taken over the block's row of phase_depth
+ * (the same depths, padded with background beyond the image's width): two
+ * loads instead of 16 strided ones. */
+static float SIMD_NAME(block_step)(const hbao_horizon_job *job, int x0, int j, int a) {
+    const hbao_grid *g = job->grid;
+    const float *row = job->phase_depth + ((size_t)a * g->height + j) * job->phase_width + x0 / 4;
+    VF nearest = V_SET(INFINITY);
+    for (int first = 0; first < HBAO_BLOCK_PIXELS; first += SIMD_LANES) {
+        const VF z = V_LOADU(row + first);
+        nearest = V_SELECT(M_AND(V_GT(z, V_SET(0.0f)), V_LT(z, nearest)), nearest, z);
+    }
+    float lanes[SIMD_LANES];
+    V_STOREU(lanes, nearest);
+    float least = lanes[0];
+    for (int k = 1; k < SIMD_LANES; k++) least = lanes[k] < least ? lanes[k] : least;
+    return hbao_block_step_at(job->settings, g, least);
+}
+
 static void SIMD_NAME(span)(const hbao_horizon_job *job, int x0, int x1, int j) {
     for (int a = 0; a < 4; a++) {
-        const float step_px = hbao_block_step(job, x0, x1, j, a);
+        const float step_px = SIMD_NAME(block_step)(job, x0, j, a);
         if (step_px < 0.0f) { /* no lane active: lanes_ao's result, without its set-up */
             float *out = job->ao + (size_t)j * job->grid->width;
             for (int i = x0 + a; i < x1; i += 4) out[i] = 1.0f;

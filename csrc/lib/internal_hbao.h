@@ -244,6 +244,8 @@ typedef struct hbao_horizon_job {
  * every projected radius under a pixel, so every AO there is 1. */
 #define HBAO_BLOCK_UNSAMPLED (-1.0f)
 float hbao_block_step(const hbao_horizon_job *job, int x0, int x1, int j, int a);
+/* ... from the block's nearest foreground depth (INFINITY: none) */
+float hbao_block_step_at(const hbao_settings *settings, const hbao_grid *grid, float nearest);
 
 /* The pixel offset (ox, oy) of step `step` along direction (dc, ds) of a
  * block: floor(0.5 + dc t), floor(0.5 - ds t / ycor), t = 1 + (step +
