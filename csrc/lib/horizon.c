@@ -68,9 +68,8 @@ static inline int march_sample(const march *m, int step, float delta[3], float *
     return SAMPLE_OK;
 }
 
-/* The slice of a direction: its axes and the normal projected into it. */
+/* The slice of a direction: the normal projected into it. */
 typedef struct slice {
-    float e[3];      /* in-slice axis perpendicular to V, marching side */
     float np_length; /* |normal projected into the slice| */
     float inv_np;    /* 1 / np_length */
     float cos_gamma; /* angle of the projected normal from V towards e */
@@ -78,21 +77,26 @@ typedef struct slice {
     int usable;
 } slice;
 
-static inline void slice_setup(const float v[3], const float n[3], float dc, float ds, slice *sl) {
+/* The slice of direction d = (dc, ds, 0) through V has the in-plane axis
+ * e = (d - V dot(d, V)) / |d - V dot(d, V)| (perpendicular to V, on the
+ * marching side) and the normal m = V x e. With |n| = |V| = |d| = 1 (to
+ * rounding) no vector needs building: |d - V dot(d, V)|^2 = 1 - dot(d, V)^2,
+ * dot(n, m) = dot(d, n x V) / |d - V dot(d, V)|, and the projected normal
+ * np = n - m dot(n, m) has |np|^2 = 1 - dot(n, m)^2, dot(np, V) = dot(n, V)
+ * and dot(np, e) = (dot(n, d) - dot(d, V) dot(n, V)) / |d - V dot(d, V)|.
+ * n_cross_v holds the x and y of n x V, which every slice of the pixel
+ * shares. */
+static inline void slice_setup(const float v[3], const float n[3], const float n_cross_v[2],
+                               float n_dot_v, float dc, float ds, slice *sl) {
     const float dir_dot_v = dc * v[0] + ds * v[1];
-    float e[3] = {dc - v[0] * dir_dot_v, ds - v[1] * dir_dot_v, -v[2] * dir_dot_v};
-    const float e_inv = 1.0f / sqrtf(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
-    for (int c = 0; c < 3; c++) sl->e[c] = e[c] * e_inv;
-    const float m[3] = {v[1] * sl->e[2] - v[2] * sl->e[1], v[2] * sl->e[0] - v[0] * sl->e[2],
-                        v[0] * sl->e[1] - v[1] * sl->e[0]};
-    const float n_dot_m = n[0] * m[0] + n[1] * m[1] + n[2] * m[2];
-    const float np[3] = {n[0] - m[0] * n_dot_m, n[1] - m[1] * n_dot_m, n[2] - m[2] * n_dot_m};
-    sl->np_length = sqrtf(np[0] * np[0] + np[1] * np[1] + np[2] * np[2]);
+    const float e_inv = 1.0f / sqrtf(1.0f - dir_dot_v * dir_dot_v);
+    const float n_dot_m = (dc * n_cross_v[0] + ds * n_cross_v[1]) * e_inv;
+    sl->np_length = sqrtf(fmaxf(0.0f, 1.0f - n_dot_m * n_dot_m));
     sl->usable = sl->np_length > 1e-6f;
     sl->inv_np = 1.0f / sl->np_length;
     if (sl->usable) {
-        sl->cos_gamma = (np[0] * v[0] + np[1] * v[1] + np[2] * v[2]) * sl->inv_np;
-        sl->sin_gamma = (np[0] * sl->e[0] + np[1] * sl->e[1] + np[2] * sl->e[2]) * sl->inv_np;
+        sl->cos_gamma = n_dot_v * sl->inv_np;
+        sl->sin_gamma = (dc * n[0] + ds * n[1] - dir_dot_v * n_dot_v) * e_inv * sl->inv_np;
     } else {
         sl->cos_gamma = 1.0f;
         sl->sin_gamma = 0.0f;
@@ -482,13 +486,14 @@ float hbao_horizon_pixel(const horizon_job *job, int i, int j, float step_px) {
     const int cosine = s->integration == HBAO_INTEGRATION_COSINE;
     const int layers = g->back != NULL;
 
+    const float n_cross_v[2] = {n[1] * v[2] - n[2] * v[1], n[2] * v[0] - n[0] * v[2]};
     float occlusion_sum = 0.0f;                /* HBAO */
     float visible_sum = 0.0f, open_sum = 0.0f; /* COSINE */
     for (int d = 0; d < s->directions; d++) {
         m.dc = job->direction_cos[cell][d];
         m.ds = job->direction_sin[cell][d];
         slice sl;
-        slice_setup(v, n, m.dc, m.ds, &sl);
+        slice_setup(v, n, n_cross_v, m.n_dot_v, m.dc, m.ds, &sl);
         if (cosine) {
             if (!sl.usable) continue; /* weight |np| = 0 */
             float open;

@@ -52,30 +52,19 @@ typedef struct SIMD_NAME(slice) {
     VM usable;
 } SIMD_NAME(slice);
 
-static inline void SIMD_NAME(slice_setup)(const VF v[3], const VF n[3], VF dc, VF ds,
-                                          SIMD_NAME(slice) * sl) {
+/* horizon.c's slice_setup; n_cross_v: the x and y of n x V */
+static inline void SIMD_NAME(slice_setup)(const VF v[3], const VF n[3], const VF n_cross_v[2],
+                                          VF n_dot_v, VF dc, VF ds, SIMD_NAME(slice) * sl) {
     const VF dir_dot_v = V_ADD(V_MUL(dc, v[0]), V_MUL(ds, v[1]));
-    VF e0 = V_SUB(dc, V_MUL(v[0], dir_dot_v));
-    VF e1 = V_SUB(ds, V_MUL(v[1], dir_dot_v));
-    VF e2 = V_MUL(V_NEG(v[2]), dir_dot_v);
-    const VF e_inv = V_DIV(V_SET(1.0f), V_SQRT(SIMD_NAME(dot3)(e0, e1, e2, e0, e1, e2)));
-    e0 = V_MUL(e0, e_inv);
-    e1 = V_MUL(e1, e_inv);
-    e2 = V_MUL(e2, e_inv);
-    const VF m0 = V_SUB(V_MUL(v[1], e2), V_MUL(v[2], e1));
-    const VF m1 = V_SUB(V_MUL(v[2], e0), V_MUL(v[0], e2));
-    const VF m2 = V_SUB(V_MUL(v[0], e1), V_MUL(v[1], e0));
-    const VF n_dot_m = SIMD_NAME(dot3)(n[0], n[1], n[2], m0, m1, m2);
-    const VF np0 = V_SUB(n[0], V_MUL(m0, n_dot_m));
-    const VF np1 = V_SUB(n[1], V_MUL(m1, n_dot_m));
-    const VF np2 = V_SUB(n[2], V_MUL(m2, n_dot_m));
-    sl->np_length = V_SQRT(SIMD_NAME(dot3)(np0, np1, np2, np0, np1, np2));
+    const VF e_inv = V_DIV(V_SET(1.0f), V_SQRT(V_SUB(V_SET(1.0f), V_MUL(dir_dot_v, dir_dot_v))));
+    const VF n_dot_m = V_MUL(V_ADD(V_MUL(dc, n_cross_v[0]), V_MUL(ds, n_cross_v[1])), e_inv);
+    sl->np_length = V_SQRT(V_MAX0(V_SUB(V_SET(1.0f), V_MUL(n_dot_m, n_dot_m))));
     sl->usable = V_GT(sl->np_length, V_SET(1e-6f));
     sl->inv_np = V_DIV(V_SET(1.0f), sl->np_length);
-    sl->cos_gamma = V_SELECT(sl->usable, V_SET(1.0f),
-                             V_MUL(SIMD_NAME(dot3)(np0, np1, np2, v[0], v[1], v[2]), sl->inv_np));
-    sl->sin_gamma = V_SELECT(sl->usable, V_SET(0.0f),
-                             V_MUL(SIMD_NAME(dot3)(np0, np1, np2, e0, e1, e2), sl->inv_np));
+    sl->cos_gamma = V_SELECT(sl->usable, V_SET(1.0f), V_MUL(n_dot_v, sl->inv_np));
+    const VF n_dot_e =
+        V_MUL(V_SUB(V_ADD(V_MUL(dc, n[0]), V_MUL(ds, n[1])), V_MUL(dir_dot_v, n_dot_v)), e_inv);
+    sl->sin_gamma = V_SELECT(sl->usable, V_SET(0.0f), V_MUL(n_dot_e, sl->inv_np));
 }
 
 /* The lanes' pixels (SIMD_LANES of a block's HBAO_BLOCK_PIXELS, see
@@ -836,6 +825,8 @@ static void SIMD_NAME(lanes_ao)(const hbao_horizon_job *job, int x0, int x1, int
         /* The slices of a group of directions are set up first, one after
          * the other: their chains of square roots and divisions overlap,
          * where a search loop between them would keep each waiting. */
+        const VF n_cross_v[2] = {V_SUB(V_MUL(b.n[1], b.v[2]), V_MUL(b.n[2], b.v[1])),
+                                 V_SUB(V_MUL(b.n[2], b.v[0]), V_MUL(b.n[0], b.v[2]))};
         const float *direction_cos = job->direction_cos[cell];
         const float *direction_sin = job->direction_sin[cell];
         for (int first = 0; first < s->directions; first += SIMD_DIRECTION_GROUP) {
@@ -844,7 +835,7 @@ static void SIMD_NAME(lanes_ao)(const hbao_horizon_job *job, int x0, int x1, int
             SIMD_NAME(slice) slices[SIMD_DIRECTION_GROUP];
             for (int k = 0; k < count; k++) {
                 const VF dc = V_SET(direction_cos[first + k]), ds = V_SET(direction_sin[first + k]);
-                SIMD_NAME(slice_setup)(b.v, b.n, dc, ds, &slices[k]);
+                SIMD_NAME(slice_setup)(b.v, b.n, n_cross_v, b.n_dot_v, dc, ds, &slices[k]);
             }
             for (int k = 0; k < count; k++) {
                 const float dc = direction_cos[first + k], ds = direction_sin[first + k];
