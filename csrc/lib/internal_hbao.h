@@ -285,8 +285,9 @@ void hbao_horizon_span_avx512(const hbao_horizon_job *job, int x0, int x1, int j
 
 /* blur.c, upsample.c: the stages after the horizon search (internal_finish.h). */
 
-/* exp(-x) for x >= 0, to 3e-5 relative error (a degree-6 Taylor polynomial of 2^-f), without libm: the blur
- * and the upsample evaluate it for every tap. */
+/* exp(-x) for x >= 0, to 3.2e-6 relative error (a degree-4 polynomial of
+ * 2^-f, fitted for the least largest relative error on [0, 1)), without
+ * libm: the blur and the upsample evaluate it for every tap. */
 static inline float hbao_exp_negative(float x) {
     /* Branch-free (selects are integer masks) so that loops calling it
      * vectorize for any vector width. Beyond 87 the result is below FLT_MIN:
@@ -302,13 +303,11 @@ static inline float hbao_exp_negative(float x) {
     const float y = in.f * 1.44269504088896341f;
     const int n = (int)y;
     const float f = y - (float)n;
-    /* 2^-f on [0, 1): degree-6 Taylor polynomial of exp(-f ln 2). */
-    float p = -1.530163e-4f;
-    p = p * f + 1.3333558e-3f;
-    p = p * f - 9.6181291e-3f;
-    p = p * f + 5.5504109e-2f;
-    p = p * f - 2.4022651e-1f;
-    p = p * f + 6.9314718e-1f;
+    /* 2^-f on [0, 1) */
+    float p = -6.83187228e-3f;
+    p = p * f + 5.32235354e-2f;
+    p = p * f - 2.39456713e-1f;
+    p = p * f + 6.93063557e-1f;
     p = 1.0f - p * f;
     scale.u = (uint32_t)(127 - n) << 23; /* 2^-n, 0 <= n <= 125 */
     out.f = p * scale.f;

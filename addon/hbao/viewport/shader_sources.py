@@ -86,7 +86,7 @@ AO_FRAGMENT = CAMERA + horizon_sources.HORIZON_SEARCH
 # after it, nearest first on the negative side, as csrc/lib/blur.c does; down
 # a column the order is mirrored (textures are bottom-up), which only changes
 # rounding. The library evaluates exp(-x) with its own polynomial
-# (hbao_exp_negative, 3e-5 relative error); the GPU's exp differs from it by
+# (hbao_exp_negative, 3.2e-6 relative error); the GPU's exp differs from it by
 # that much in a tap's weight, far below tests/test_viewport.py's tolerances.
 BLUR_FRAGMENT = COMMON + """
 /* FLT_MAX: sharpness / z overflows for tiny depths, and a tap at the same
