@@ -30,7 +30,7 @@
  * few enough that the 2r rows a band recomputes stay a small share. A band
  * is at least MIN_BAND_ROWS high, so that on small images or many threads it
  * does not spend most of its time remaking its neighbours' rows. */
-#define BANDS_PER_THREAD 8
+#define BANDS_PER_THREAD 4
 #define MIN_BAND_ROWS 16
 
 /* The blur over the grid, row bands in parallel. */
