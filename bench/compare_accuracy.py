@@ -2,8 +2,9 @@
 """Accuracy of two builds of libhbao side by side, on the quick benchmark's
 cached scenes: RMSE against the ray-traced reference for the benchmark's
 settings grids (directions x steps x full/half x blur; integration x falloff
-x angle bias), per scene, and how much the second build moves it. For a change to the horizon search or the blur that
-is meant to keep the accuracy (issue 11: within 2 %).
+x angle bias), per scene, and how much the second build moves it. For a
+change to the horizon search or the blur that is meant to keep the accuracy
+(issue 11: within 2 %).
 
     /usr/bin/python3 bench/compare_accuracy.py BEFORE.so AFTER.so
 
