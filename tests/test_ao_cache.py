@@ -50,3 +50,20 @@ def test_nan_matches_nan_and_keep_only_forgets():
     cache.keep_only({"node": (inputs(plain), plain)})
     cache.keep_only({})
     assert cache.get("node", inputs(plain)) is None
+
+
+def test_passes_are_compared_bit_for_bit():
+    depth = np.linspace(1.0, 2.0, 3 * 5000, dtype=np.float32).reshape(3, 5000)
+    depth[2, 4999] = 0.0
+    cache = AOCache()
+    cache.keep_only({"node": (inputs(depth), np.ones_like(depth))})
+    # Past the first probe stride too: a change only the full comparison sees.
+    late = depth.copy()
+    late[2, 4998] = np.nextafter(late[2, 4998], np.float32(0))
+    assert cache.get("node", inputs(late)) is None
+    # -0.0 equals 0.0 as a number but not as bits: a recomputation, never a wrong AO.
+    signed = depth.copy()
+    signed[2, 4999] = -0.0
+    assert cache.get("node", inputs(signed)) is None
+    assert cache.get("node", inputs(depth.astype(np.float64))) is None
+    assert cache.get("node", inputs(depth.copy())) is not None
