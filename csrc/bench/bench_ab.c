@@ -10,15 +10,19 @@
  *
  *   bench_ab BEFORE/libhbao.so AFTER/libhbao.so [--rounds R] [--calls N]
  *            [--threads T] [--half] [--radius R] [--directions D] [--steps S]
- *            [--blur B] */
+ *            [--blur B] [--implementation NAME] [--back-faces]
+ *
+ * --back-faces: with a back-face layer every surface 0.3 deep, as
+ * bench_speed's back-face row (hbao_compute_layers; without it the same
+ * function with no layer, which is hbao_compute). */
 #define _GNU_SOURCE /* RTLD_DEEPBIND */
 #include <dlfcn.h>
 
 #include "bench_common.h"
 
 typedef hbao_result (*compute_function)(const hbao_params *, const hbao_camera *, int32_t, int32_t,
-                                        const hbao_channel *, const hbao_channel *, float *,
-                                        int64_t);
+                                        const hbao_channel *, const hbao_channel *,
+                                        const hbao_channel *, float *, int64_t);
 
 typedef struct build {
     const char *path;
@@ -36,10 +40,10 @@ static int load(build *b, int width, int height) {
         fprintf(stderr, "bench_ab: %s\n", dlerror());
         return 0;
     }
-    b->compute = (compute_function)(uintptr_t)dlsym(library, "hbao_compute");
+    b->compute = (compute_function)(uintptr_t)dlsym(library, "hbao_compute_layers");
     b->ao = malloc(sizeof(float) * (size_t)width * (size_t)height);
     if (b->compute == NULL || b->ao == NULL) {
-        fprintf(stderr, "bench_ab: %s has no hbao_compute\n", b->path);
+        fprintf(stderr, "bench_ab: %s has no hbao_compute_layers\n", b->path);
         return 0;
     }
     return 1;
@@ -49,12 +53,13 @@ static void usage(const char *program) {
     fprintf(stderr,
             "usage: %s BEFORE_LIBRARY AFTER_LIBRARY [--rounds R] [--calls N] [--threads T] "
             "[--half] [--radius R] [--directions D] [--steps S] [--blur B]\n"
-            "  [--implementation scalar|avx2|avx512] (default: the best this CPU has)\n",
+            "  [--implementation scalar|avx2|avx512] (default: the best this CPU has) "
+            "[--back-faces]\n",
             program);
 }
 
 int main(int argc, char **argv) {
-    int rounds = 3, calls = 15, threads = 1, half = 0;
+    int rounds = 3, calls = 15, threads = 1, half = 0, back_faces = 0;
     hbao_params params = HBAO_PARAMS_DEFAULT_INITIALIZER;
     float radius = 0.5f;
     if (argc < 3) {
@@ -78,6 +83,8 @@ int main(int argc, char **argv) {
             params.blur_size = atoi(argv[++a]);
         else if (!strcmp(argv[a], "--half"))
             half = 1;
+        else if (!strcmp(argv[a], "--back-faces"))
+            back_faces = 1;
         else if (!strcmp(argv[a], "--implementation") && a + 1 < argc)
             params.implementation = bench_implementation(argv[++a]);
         else {
@@ -102,13 +109,17 @@ int main(int argc, char **argv) {
     params.half_resolution = half;
     const hbao_channel depth = {frame.depth, 1, width};
     const hbao_channel normal = {frame.normal, 3, 3 * (int64_t)width};
+    float *back = malloc(sizeof(float) * (size_t)width * height);
+    if (back == NULL) return 1;
+    for (size_t k = 0; k < (size_t)width * height; k++) back[k] = frame.depth[k] + 0.3f;
+    const hbao_channel back_depth = {back, 1, width};
     double *times = malloc(sizeof(double) * (size_t)calls);
     if (times == NULL) return 1;
     const char *unit = threads == 1 ? "CPU ms" : "wall ms";
-    printf("1920x1080, %d x %d, blur %d%s, radius %g, %d thread(s); per round and build: "
+    printf("1920x1080, %d x %d, blur %d%s%s, radius %g, %d thread(s); per round and build: "
            "fastest and lower-quartile %s of %d calls\n",
            params.directions, params.steps, params.blur_size, half ? ", half resolution" : "",
-           radius, threads, unit, calls);
+           back_faces ? ", back faces" : "", radius, threads, unit, calls);
     print_load("before");
     for (int round = 0; round < rounds; round++) {
         for (int k = 0; k < 2; k++) {
@@ -116,8 +127,9 @@ int main(int argc, char **argv) {
             for (int call = 0; call < calls; call++) {
                 const clockid_t clock = threads == 1 ? CLOCK_PROCESS_CPUTIME_ID : CLOCK_MONOTONIC;
                 const double start = clock_seconds(clock);
-                const hbao_result result = b->compute(&params, &frame.view.camera, width, height,
-                                                      &depth, &normal, b->ao, width);
+                const hbao_result result =
+                    b->compute(&params, &frame.view.camera, width, height, &depth, &normal,
+                               back_faces ? &back_depth : NULL, b->ao, width);
                 times[call] = 1e3 * (clock_seconds(clock) - start);
                 if (result != HBAO_SUCCESS) {
                     fprintf(stderr, "bench_ab: %s failed (%d)\n", b->path, (int)result);
