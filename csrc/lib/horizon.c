@@ -371,9 +371,32 @@ static inline int enter_the_ball(const march *m, size_t at, float delta[3], floa
 
 /* march_sample with the back layer: a sample beyond the radius whose
  * occluder enters it is a sample at the entry point (enter_the_ball). */
+/* Whether a sample of the two-layer search lies wholly on or below the
+ * tangent plane (hbao_height_plane's heights), so that it can mark no
+ * sector: its front, its back point and, beyond the radius, the point
+ * where its occluder enters the ball all lie on its view ray between its
+ * depth and max(back depth, depth + min_thickness), where the height is
+ * linear in depth; where the back is unknown the occluder reaches any
+ * depth behind, so the height must not rise with depth. Not where V lies
+ * below the plane (a sample below it can then count, as in the one-layer
+ * search). The SIMD kernels leave the same samples out, lane by lane. */
+static inline int layer_sample_below(const march *m, size_t at, int ox, int sj) {
+    const hbao_grid *g = m->grid;
+    if (m->n_dot_v < 0.0f) return 0;
+    const float across = hbao_height_across(&m->height, (float)ox, hbao_grid_y(g, sj));
+    if (!(hbao_height_at(g, &m->height, across, g->depth[at]) <= 0.0f)) return 0;
+    if (g->back[at] < INFINITY)
+        return hbao_height_at(g, &m->height, across, hbao_back_depth(g, at, m->min_thickness)) <=
+               0.0f;
+    return g->orthographic ? m->height.depth >= 0.0f : across <= 0.0f;
+}
+
 static inline int march_layer_sample(const march *m, int step, float delta[3], float *dist2,
                                      size_t *at) {
     const int status = march_sample(m, step, delta, dist2, at, NULL);
+    if (status != SAMPLE_OK && status != SAMPLE_FAR) return status;
+    const int si = (int)(*at % (size_t)m->grid->width), sj = (int)(*at / (size_t)m->grid->width);
+    if (layer_sample_below(m, *at, si - m->i, sj)) return SAMPLE_SKIP;
     if (status != SAMPLE_FAR) return status;
     return enter_the_ball(m, *at, delta, dist2) ? SAMPLE_OK : SAMPLE_SKIP;
 }

@@ -604,6 +604,26 @@ static inline VF SIMD_NAME(back_point)(const SIMD_NAME(block) * b, const SIMD_NA
     return SIMD_NAME(dot3)(delta[0], delta[1], delta[2], delta[0], delta[1], delta[2]);
 }
 
+/* horizon.c's layer_sample_below, lane by lane */
+static inline VM SIMD_NAME(layer_below)(const SIMD_NAME(block) * b, const SIMD_NAME(fetch) * f) {
+    const int orthographic = b->grid->orthographic;
+    const VF across = V_ADD(V_ADD(b->height_across, V_MUL(V_SET(f->ox), b->height_per_pixel)),
+                            V_MUL(V_SET(f->row), b->height_per_row));
+    const VF front =
+        V_SUB(orthographic ? V_SUB(across, V_MUL(f->zs, b->height_depth)) : V_MUL(f->zs, across),
+              b->height_offset);
+    const VF thinnest = V_ADD(f->zs, b->min_thickness);
+    const VF zb = V_SELECT(V_GT(f->zb, thinnest), thinnest, f->zb); /* hbao_back_depth */
+    const VF back =
+        V_SUB(orthographic ? V_SUB(across, V_MUL(zb, b->height_depth)) : V_MUL(zb, across),
+              b->height_offset);
+    const VM known = V_LT(f->zb, V_SET(INFINITY));
+    const VM falling =
+        orthographic ? V_GE(b->height_depth, V_SET(0.0f)) : V_LE(across, V_SET(0.0f));
+    const VM rest = M_OR(M_AND(known, V_LE(back, V_SET(0.0f))), M_ANDNOT(known, falling));
+    return M_ANDNOT(b->view_below, M_AND(V_LE(front, V_SET(0.0f)), rest));
+}
+
 /* Whether any lane of `ok` can mark a sector: as above_tangent, with the
  * back point too (a sample whose front and known back both lie on or below
  * the tangent plane has both fractions at 1, an empty interval). */
@@ -664,8 +684,10 @@ static VF SIMD_NAME(direction_occlusion_cosine_layers)(const hbao_settings *s,
     SIMD_NAME(fetch) fetches[HBAO_MAX_STEPS];
     const int fetched = SIMD_NAME(fetch_steps)(b, s->steps, dc, ds, lanes, fetches);
     for (int step = 0; step < fetched; step++) {
+        const VM live = M_ANDNOT(SIMD_NAME(layer_below)(b, &fetches[step]), lanes);
+        if (!M_ANY(M_AND(live, fetches[step].candidate))) continue;
         VF delta[3], dist2;
-        const VM ok = SIMD_NAME(sample_layers)(b, &fetches[step], lanes, delta, &dist2);
+        const VM ok = SIMD_NAME(sample_layers)(b, &fetches[step], live, delta, &dist2);
         if (!M_ANY(ok)) continue;
         VF delta_back[3];
         VM known;
@@ -703,8 +725,10 @@ static VF SIMD_NAME(direction_occlusion_hbao_layers)(const hbao_settings *s,
     const int fetched = SIMD_NAME(fetch_steps)(b, s->steps, dc, ds, active, fetches);
     VM alive = active; /* lanes that have not stopped past the normal */
     for (int step = 0; step < fetched && M_ANY(alive); step++) {
+        const VM live = M_ANDNOT(SIMD_NAME(layer_below)(b, &fetches[step]), alive);
+        if (!M_ANY(M_AND(live, fetches[step].candidate))) continue;
         VF delta[3], dist2;
-        VM ok = SIMD_NAME(sample_layers)(b, &fetches[step], alive, delta, &dist2);
+        VM ok = SIMD_NAME(sample_layers)(b, &fetches[step], live, delta, &dist2);
         if (!M_ANY(ok)) continue;
         VF delta_back[3];
         VM known;

@@ -181,10 +181,20 @@ static inline void hbao_height_plane_setup(const hbao_grid *grid, const float n[
                     HBAO_HEIGHT_ROUNDING * rounding;
 }
 
+/* The plane's across term at a sample's pixel, and the height there at
+ * depth z: along the sample's view ray the height is linear in z. */
+static inline float hbao_height_across(const hbao_height_plane *plane, float ox, float row) {
+    return plane->across + ox * plane->per_pixel + row * plane->per_row;
+}
+
+static inline float hbao_height_at(const hbao_grid *grid, const hbao_height_plane *plane,
+                                   float across, float z) {
+    return (grid->orthographic ? across - z * plane->depth : z * across) - plane->offset;
+}
+
 static inline float hbao_sample_height(const hbao_grid *grid, const hbao_height_plane *plane,
                                        float zs, float ox, float row) {
-    const float across = plane->across + ox * plane->per_pixel + row * plane->per_row;
-    return (grid->orthographic ? across - zs * plane->depth : zs * across) - plane->offset;
+    return hbao_height_at(grid, plane, hbao_height_across(plane, ox, row), zs);
 }
 
 /* parallel.c: run job(context, row) for every row in [0, rows), on up to
