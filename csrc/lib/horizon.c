@@ -369,8 +369,6 @@ static inline int enter_the_ball(const march *m, size_t at, float delta[3], floa
     return *dist2 > 0.0f;
 }
 
-/* march_sample with the back layer: a sample beyond the radius whose
- * occluder enters it is a sample at the entry point (enter_the_ball). */
 /* Whether a sample of the two-layer search lies wholly on or below the
  * tangent plane (hbao_height_plane's heights), so that it can mark no
  * sector: its front, its back point and, beyond the radius, the point
@@ -391,6 +389,9 @@ static inline int layer_sample_below(const march *m, size_t at, int ox, int sj) 
     return g->orthographic ? m->height.depth >= 0.0f : across <= 0.0f;
 }
 
+/* march_sample with the back layer: a sample wholly below the tangent
+ * plane is skipped (layer_sample_below), and a sample beyond the radius
+ * whose occluder enters it is a sample at the entry point (enter_the_ball). */
 static inline int march_layer_sample(const march *m, int step, float delta[3], float *dist2,
                                      size_t *at) {
     const int status = march_sample(m, step, delta, dist2, at, NULL);

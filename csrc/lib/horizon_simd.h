@@ -253,6 +253,25 @@ static inline VF SIMD_NAME(sample_column)(const SIMD_NAME(block) * b, const SIMD
     return V_MUL(V_ADD(V_ADD(b->lane_float, V_SET(f->ox)), V_SET(g->x_offset)), V_SET(g->x_step));
 }
 
+/* horizon.c's hbao_height_across and hbao_height_at, lane by lane: the
+ * height plane at a fetched step's pixels, and the height there at depth z */
+static inline VF SIMD_NAME(height_across)(const SIMD_NAME(block) * b, const SIMD_NAME(fetch) * f) {
+    return V_ADD(V_ADD(b->height_across, V_MUL(V_SET(f->ox), b->height_per_pixel)),
+                 V_MUL(V_SET(f->row), b->height_per_row));
+}
+
+static inline VF SIMD_NAME(height_at)(const SIMD_NAME(block) * b, VF across, VF z) {
+    return V_SUB(b->grid->orthographic ? V_SUB(across, V_MUL(z, b->height_depth))
+                                       : V_MUL(z, across),
+                 b->height_offset);
+}
+
+/* hbao_back_depth: the back made at least min_thickness thick */
+static inline VF SIMD_NAME(back_depth)(const SIMD_NAME(block) * b, const SIMD_NAME(fetch) * f) {
+    const VF thinnest = V_ADD(f->zs, b->min_thickness);
+    return V_SELECT(V_GT(f->zb, thinnest), thinnest, f->zb);
+}
+
 /* The lanes among `live` whose fetched sample has a usable depth. */
 static inline VM SIMD_NAME(sample_valid)(const SIMD_NAME(block) * b, const SIMD_NAME(fetch) * f,
                                          VM live) {
@@ -365,11 +384,7 @@ static inline VM SIMD_NAME(above_tangent)(const SIMD_NAME(block) * b, VM ok, VF 
 static inline VM SIMD_NAME(sample_rising)(const SIMD_NAME(block) * b, const SIMD_NAME(fetch) * f,
                                           VM live, VF delta[3], VF *dist2, VF *height) {
     /* hbao_sample_height */
-    const VF across = V_ADD(V_ADD(b->height_across, V_MUL(V_SET(f->ox), b->height_per_pixel)),
-                            V_MUL(V_SET(f->row), b->height_per_row));
-    *height = V_SUB(b->grid->orthographic ? V_SUB(across, V_MUL(f->zs, b->height_depth))
-                                          : V_MUL(f->zs, across),
-                    b->height_offset);
+    *height = SIMD_NAME(height_at)(b, SIMD_NAME(height_across)(b, f), f->zs);
     const VM tangent = M_OR(V_GT(*height, V_SET(0.0f)), b->view_below);
     const VM none = M_NONE(); /* delta and dist2 are left unset */
     if (!M_ANY(tangent)) return none;
@@ -593,8 +608,7 @@ static inline VF SIMD_NAME(mark_sectors)(VI *marked, VM ok, VF a, VF b, VF weigh
 static inline VF SIMD_NAME(back_point)(const SIMD_NAME(block) * b, const SIMD_NAME(fetch) * f,
                                        VF delta[3], VM *known) {
     const hbao_grid *g = b->grid;
-    const VF thinnest = V_ADD(f->zs, b->min_thickness);
-    const VF zb = V_SELECT(V_GT(f->zb, thinnest), thinnest, f->zb);
+    const VF zb = SIMD_NAME(back_depth)(b, f);
     *known = V_LT(f->zb, V_SET(INFINITY));
     const VF column = SIMD_NAME(sample_column)(b, f);
     const VF row = V_SET(f->row);
@@ -606,20 +620,12 @@ static inline VF SIMD_NAME(back_point)(const SIMD_NAME(block) * b, const SIMD_NA
 
 /* horizon.c's layer_sample_below, lane by lane */
 static inline VM SIMD_NAME(layer_below)(const SIMD_NAME(block) * b, const SIMD_NAME(fetch) * f) {
-    const int orthographic = b->grid->orthographic;
-    const VF across = V_ADD(V_ADD(b->height_across, V_MUL(V_SET(f->ox), b->height_per_pixel)),
-                            V_MUL(V_SET(f->row), b->height_per_row));
-    const VF front =
-        V_SUB(orthographic ? V_SUB(across, V_MUL(f->zs, b->height_depth)) : V_MUL(f->zs, across),
-              b->height_offset);
-    const VF thinnest = V_ADD(f->zs, b->min_thickness);
-    const VF zb = V_SELECT(V_GT(f->zb, thinnest), thinnest, f->zb); /* hbao_back_depth */
-    const VF back =
-        V_SUB(orthographic ? V_SUB(across, V_MUL(zb, b->height_depth)) : V_MUL(zb, across),
-              b->height_offset);
+    const VF across = SIMD_NAME(height_across)(b, f);
+    const VF front = SIMD_NAME(height_at)(b, across, f->zs);
+    const VF back = SIMD_NAME(height_at)(b, across, SIMD_NAME(back_depth)(b, f));
     const VM known = V_LT(f->zb, V_SET(INFINITY));
     const VM falling =
-        orthographic ? V_GE(b->height_depth, V_SET(0.0f)) : V_LE(across, V_SET(0.0f));
+        b->grid->orthographic ? V_GE(b->height_depth, V_SET(0.0f)) : V_LE(across, V_SET(0.0f));
     const VM rest = M_OR(M_AND(known, V_LE(back, V_SET(0.0f))), M_ANDNOT(known, falling));
     return M_ANDNOT(b->view_below, M_AND(V_LE(front, V_SET(0.0f)), rest));
 }
