@@ -50,10 +50,15 @@ typedef struct finish_job {
     atomic_int out_of_memory;
 } finish_job;
 
-/* One ring slot: a row blurred along itself, and its guide normals. */
-typedef struct ring_row {
-    float *ao, *nx, *ny, *nz;
-} ring_row;
+/* A row's guide normals, a row of each component (hbao_grid_normal_row). */
+typedef struct normal_row {
+    const float *nx, *ny, *nz;
+} normal_row;
+
+static HBAO_ALWAYS_INLINE normal_row normals_of_row(const hbao_grid *grid, int j) {
+    return (normal_row){hbao_grid_normal_row(grid, j, 0), hbao_grid_normal_row(grid, j, 1),
+                        hbao_grid_normal_row(grid, j, 2)};
+}
 
 /* The taps of one pass for one row of centres, the centre itself left out
  * (it weighs 1): tap t of pixel i reads z[t][i + offset[t]] (and likewise ao
@@ -180,44 +185,33 @@ static HBAO_ALWAYS_INLINE void blur_pass(const tap_set *taps, const centre_row *
     for (; i < width; i++) target[i] = blur_pixel(taps, c, sharpness, width, i);
 }
 
-/* Scratch of one band: the ring and the finished row, width floats each. */
+/* Scratch of one band: the finished row and the ring of rows blurred
+ * along themselves, width floats each. */
 typedef struct band_memory {
     float *block;
     float *finished;
-    ring_row ring[2 * MAX_BLUR_RADIUS + 1];
+    float *ring[2 * MAX_BLUR_RADIUS + 1];
 } band_memory;
 
 static int band_memory_make(band_memory *m, int width, int slots) {
     const size_t row = (size_t)width;
-    m->block = malloc((1 + 4 * (size_t)slots) * row * sizeof(float));
+    m->block = malloc((1 + (size_t)slots) * row * sizeof(float));
     if (m->block == NULL) return 0;
     m->finished = m->block;
-    for (int s = 0; s < slots; s++) {
-        float *base = m->finished + row + 4 * (size_t)s * row;
-        m->ring[s] = (ring_row){base, base + row, base + 2 * row, base + 3 * row};
-    }
+    for (int s = 0; s < slots; s++) m->ring[s] = m->finished + (1 + (size_t)s) * row;
     return 1;
 }
 
-/* Row j into its ring slot: its guide normals, and its raw AO blurred
- * along the row. */
+/* Row j's raw AO blurred along the row, into its ring slot. */
 static HBAO_ALWAYS_INLINE void make_row(const finish_job *job, band_memory *m, int j) {
     const int width = job->width, radius = job->radius;
-    const ring_row *slot = &m->ring[j % (2 * radius + 1)];
+    float *slot = m->ring[j % (2 * radius + 1)];
     const float *raw = job->grid_ao + (size_t)j * width;
-    if (radius > 0) {
-        const float *n = job->grid->normal + 3 * (size_t)j * width;
-        float *restrict nx = slot->nx, *restrict ny = slot->ny, *restrict nz = slot->nz;
-        for (int i = 0; i < width; i++) {
-            nx[i] = n[3 * i];
-            ny[i] = n[3 * i + 1];
-            nz[i] = n[3 * i + 2];
-        }
-    }
     if (radius == 0) {
-        memcpy(slot->ao, raw, (size_t)width * sizeof(float));
+        memcpy(slot, raw, (size_t)width * sizeof(float));
         return;
     }
+    const normal_row n = normals_of_row(job->grid, j);
     const float *z = job->depth + (size_t)j * width;
     tap_set taps;
     taps.count = 0;
@@ -226,15 +220,15 @@ static HBAO_ALWAYS_INLINE void make_row(const finish_job *job, band_memory *m, i
         if (k == 0) continue;
         taps.z[taps.count] = z;
         taps.ao[taps.count] = raw;
-        taps.nx[taps.count] = slot->nx;
-        taps.ny[taps.count] = slot->ny;
-        taps.nz[taps.count] = slot->nz;
+        taps.nx[taps.count] = n.nx;
+        taps.ny[taps.count] = n.ny;
+        taps.nz[taps.count] = n.nz;
         taps.offset[taps.count] = k;
         taps.spatial[taps.count] = job->spatial[k < 0 ? -k : k];
         taps.count++;
     }
-    const centre_row centre = {z, raw, slot->nx, slot->ny, slot->nz};
-    blur_pass(&taps, &centre, job->sharpness, width, radius, slot->ao);
+    const centre_row centre = {z, raw, n.nx, n.ny, n.nz};
+    blur_pass(&taps, &centre, job->sharpness, width, radius, slot);
 }
 
 /* A finished row of AO (1 on background, where zc <= 0) to the output:
@@ -257,25 +251,25 @@ static HBAO_ALWAYS_INLINE void write_output(const float *zc, const float *ao, in
 static HBAO_ALWAYS_INLINE void finish_row(const finish_job *job, band_memory *m, int j) {
     const int width = job->width, radius = job->radius, slots = 2 * radius + 1;
     const float *zc = job->depth + (size_t)j * width;
-    const ring_row *centre = &m->ring[j % slots];
-    const float *blurred = centre->ao;
+    const float *blurred = m->ring[j % slots];
     if (radius > 0) {
         tap_set taps;
         taps.count = 0;
         taps.along_row = 0;
         for (int k = -radius; k <= radius; k++) {
             if (k == 0 || j + k < 0 || j + k >= job->height) continue;
-            const ring_row *tap = &m->ring[(j + k) % slots];
+            const normal_row n = normals_of_row(job->grid, j + k);
             taps.z[taps.count] = job->depth + (size_t)(j + k) * width;
-            taps.ao[taps.count] = tap->ao;
-            taps.nx[taps.count] = tap->nx;
-            taps.ny[taps.count] = tap->ny;
-            taps.nz[taps.count] = tap->nz;
+            taps.ao[taps.count] = m->ring[(j + k) % slots];
+            taps.nx[taps.count] = n.nx;
+            taps.ny[taps.count] = n.ny;
+            taps.nz[taps.count] = n.nz;
             taps.offset[taps.count] = 0;
             taps.spatial[taps.count] = job->spatial[k < 0 ? -k : k];
             taps.count++;
         }
-        const centre_row c = {zc, centre->ao, centre->nx, centre->ny, centre->nz};
+        const normal_row n = normals_of_row(job->grid, j);
+        const centre_row c = {zc, blurred, n.nx, n.ny, n.nz};
         blur_pass(&taps, &c, job->sharpness, width, radius, m->finished);
         blurred = m->finished;
     }

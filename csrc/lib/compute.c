@@ -187,7 +187,7 @@ hbao_result hbao_compute_layers(const hbao_params *params, const hbao_camera *ca
     float *half_back = back_depth != NULL && s.half_resolution
                            ? hbao_scratch_take(grid_pixels * sizeof(float))
                            : NULL;
-    grid.normal = hbao_scratch_take(grid_pixels * 3 * sizeof(float));
+    grid.normal = hbao_scratch_take((grid_pixels * 3 + HBAO_NORMAL_PADDING) * sizeof(float));
     grid.back = NULL;
     if (full_depth == NULL || grid_ao == NULL || grid.normal == NULL ||
         (s.half_resolution && half_depth == NULL) || (back_depth != NULL && full_back == NULL) ||

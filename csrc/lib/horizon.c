@@ -501,7 +501,8 @@ float hbao_horizon_pixel(const horizon_job *job, int i, int j, float step_px) {
         const float inv = 1.0f / sqrtf(m.p[0] * m.p[0] + m.p[1] * m.p[1] + m.p[2] * m.p[2]);
         for (int c = 0; c < 3; c++) v[c] = -m.p[c] * inv;
     }
-    const float *n = g->normal + 3 * ((size_t)j * g->width + i);
+    float n[3];
+    hbao_grid_normal_at(g, i, j, n);
     m.n_dot_v = n[0] * v[0] + n[1] * v[1] + n[2] * v[2];
     m.height_tolerance = g->depth_precision * hbao_rounding_along_normal(g, n, m.p);
     hbao_height_plane_setup(g, n, m.p, hbao_grid_x(g, i), m.height_tolerance, &m.height);

@@ -55,6 +55,22 @@
 #define I_SRLI _mm256_srli_epi32
 #define I_SRAI _mm256_srai_epi32
 #define I_ZERO_UNLESS(m, v) _mm256_castps_si256(_mm256_and_ps((m), _mm256_castsi256_ps(v)))
+/* m ? p[k] : fill[k]; lanes outside m are not read */
+#define V_LOAD_LANES(m, p, fill)                                                                   \
+    _mm256_blendv_ps((fill), _mm256_maskload_ps((p), _mm256_castps_si256(m)), (m))
+
+/* p[0], p[4], ..., p[28]: four loads and three shuffles */
+static inline __m256 load_every_fourth_avx2(const float *p) {
+    /* per 128-bit half: v0[0], v0[0], v1[0], v1[0] (then the same of [4]) */
+    const __m256 v01 =
+        _mm256_shuffle_ps(_mm256_loadu_ps(p), _mm256_loadu_ps(p + 8), _MM_SHUFFLE(0, 0, 0, 0));
+    const __m256 v23 = _mm256_shuffle_ps(_mm256_loadu_ps(p + 16), _mm256_loadu_ps(p + 24),
+                                         _MM_SHUFFLE(0, 0, 0, 0));
+    /* p[0], p[8], p[16], p[24], p[4], p[12], p[20], p[28] */
+    const __m256 mixed = _mm256_shuffle_ps(v01, v23, _MM_SHUFFLE(2, 0, 2, 0));
+    return _mm256_permutevar8x32_ps(mixed, _mm256_setr_epi32(0, 4, 1, 5, 2, 6, 3, 7));
+}
+#define V_LOAD_EVERY_FOURTH load_every_fourth_avx2
 
 #include "horizon_simd.h"
 

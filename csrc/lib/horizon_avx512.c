@@ -58,6 +58,20 @@
 #define I_SRLI _mm512_srli_epi32
 #define I_SRAI _mm512_srai_epi32
 #define I_ZERO_UNLESS(m, v) _mm512_maskz_mov_epi32((m), (v))
+/* m ? p[k] : fill[k]; lanes outside m are not read */
+#define V_LOAD_LANES(m, p, fill) _mm512_mask_loadu_ps((fill), (m), (p))
+
+/* p[0], p[4], ..., p[60]: four loads and three shuffles */
+static inline __m512 load_every_fourth_avx512(const float *p) {
+    const __m512i every_fourth =
+        _mm512_setr_epi32(0, 4, 8, 12, 16, 20, 24, 28, 0, 4, 8, 12, 16, 20, 24, 28);
+    const __m512 low = _mm512_permutex2var_ps(_mm512_loadu_ps(p), every_fourth,
+                                              _mm512_loadu_ps(p + 16)); /* p[0..28] twice */
+    const __m512 high = _mm512_permutex2var_ps(_mm512_loadu_ps(p + 32), every_fourth,
+                                               _mm512_loadu_ps(p + 48)); /* p[32..60] twice */
+    return _mm512_shuffle_f32x4(low, high, _MM_SHUFFLE(1, 0, 1, 0));
+}
+#define V_LOAD_EVERY_FOURTH load_every_fourth_avx512
 
 #include "horizon_simd.h"
 

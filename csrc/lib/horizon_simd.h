@@ -188,16 +188,19 @@ static int SIMD_NAME(fetch_at_side)(const SIMD_NAME(block) * b, int ox, int oy, 
     const int new_phase = moved & 3;                        /* moved mod 4, two's complement */
     const int first = b->first_x + (moved - new_phase) / 4; /* exact */
     const size_t row_start = ((size_t)new_phase * g->height + sj) * phase_width;
-    const float *row = b->job->phase_depth + row_start;
-    float lanes[SIMD_LANES];
-    for (int k = 0; k < SIMD_LANES; k++)
-        lanes[k] = first + k >= 0 && first + k < phase_width ? row[first + k] : 0.0f;
-    f->zs = V_ZERO_UNLESS(candidate, V_LOADU(lanes));
+    /* the lanes whose index lies in the row (exact small integers) */
+    const VF index = I_TO_F(I_ADD(I_LANES, I_SET(first)));
+    const VM in_row = M_AND(V_GE(index, V_SET(0.0f)), V_LT(index, V_SET((float)phase_width)));
+    /* the address of index `first`, formed without pointer arithmetic past
+     * the row: lanes outside in_row are not read */
+    const uintptr_t first_address =
+        (uintptr_t)(b->job->phase_depth + row_start) + (uintptr_t)(intptr_t)first * sizeof(float);
+    f->zs =
+        V_ZERO_UNLESS(candidate, V_LOAD_LANES(in_row, (const float *)first_address, V_SET(0.0f)));
     if (b->job->phase_back != NULL) {
-        const float *back = b->job->phase_back + row_start;
-        for (int k = 0; k < SIMD_LANES; k++)
-            lanes[k] = first + k >= 0 && first + k < phase_width ? back[first + k] : INFINITY;
-        f->zb = V_LOADU(lanes);
+        const uintptr_t back_address = (uintptr_t)(b->job->phase_back + row_start) +
+                                       (uintptr_t)(intptr_t)first * sizeof(float);
+        f->zb = V_LOAD_LANES(in_row, (const float *)back_address, V_SET(INFINITY));
     }
     f->row = hbao_grid_y(g, sj);
     f->ox = (float)ox;
@@ -817,13 +820,10 @@ static void SIMD_NAME(lanes_ao)(const hbao_horizon_job *job, int x0, int x1, int
                       V_SQRT(SIMD_NAME(dot3)(b.p[0], b.p[1], b.p[2], b.p[0], b.p[1], b.p[2])));
             for (int c = 0; c < 3; c++) b.v[c] = V_MUL(V_NEG(b.p[c]), inv);
         }
-        float normal_lanes[3][SIMD_LANES];
-        for (int k = 0; k < SIMD_LANES; k++) {
-            const int i = first_i + 4 * k;
-            const float *normal = g->normal + 3 * ((size_t)j * g->width + (i < x1 ? i : x0));
-            for (int c = 0; c < 3; c++) normal_lanes[c][k] = normal[c];
-        }
-        for (int c = 0; c < 3; c++) b.n[c] = V_LOADU(normal_lanes[c]);
+        /* lanes past x1 read the next component's or row's normals, or the
+         * padding: they are background (not active) */
+        for (int c = 0; c < 3; c++)
+            b.n[c] = V_LOAD_EVERY_FOURTH(hbao_grid_normal_row(g, j, c) + first_i);
         b.n_dot_v = SIMD_NAME(dot3)(b.n[0], b.n[1], b.n[2], b.v[0], b.v[1], b.v[2]);
         b.view_below = V_LT(b.n_dot_v, V_SET(0.0f));
         /* hbao_rounding_along_normal */

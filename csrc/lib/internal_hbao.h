@@ -60,7 +60,14 @@ typedef struct hbao_grid {
     /* width * height: the back faces' depth (hbao_compute_layers), INFINITY
      * where unknown; NULL without the layer */
     const float *back;
-    float *normal; /* width * height * 3, camera space, facing the viewer */
+    /* Camera space, facing the viewer. Each row is three rows of width
+     * floats, its normals' x, y and z (hbao_grid_normal_row), and
+     * HBAO_NORMAL_PADDING zeros follow the last: so the blur reads each
+     * component as a row, and a SIMD kernel loads the lanes of a column
+     * phase with whole vectors (horizon_simd.h) without reading past the
+     * end. The three rows of a row lie together, so that writing them is
+     * one stream through memory, not three. */
+    float *normal;
     /* View-plane coordinates (per unit depth if perspective) of column i and
      * row j: (i + x_offset) * x_step and (j + y_offset) * y_step. Computed,
      * not tabulated, so that SIMD code needs no gather for them. */
@@ -73,6 +80,15 @@ typedef struct hbao_grid {
      * hbao_compute_normals(), docs/algorithm.md "Depth precision"). */
     float depth_precision;
 } hbao_grid;
+
+/* Component c of row j's normals (row height: the padding) */
+static inline float *hbao_grid_normal_row(const hbao_grid *grid, int j, int c) {
+    return grid->normal + (3 * (size_t)j + (size_t)c) * (size_t)grid->width;
+}
+
+static inline void hbao_grid_normal_at(const hbao_grid *grid, int i, int j, float n[3]) {
+    for (int c = 0; c < 3; c++) n[c] = hbao_grid_normal_row(grid, j, c)[i];
+}
 
 /* ulp(z) / z <= 2^-10 for half floats (10 mantissa bits), 2^-23 for floats. */
 #define HBAO_HALF_DEPTH_PRECISION 9.765625e-4f
@@ -247,6 +263,10 @@ typedef struct hbao_horizon_job {
  * load from phase_depth (docs/algorithm.md, "Per-pixel sampling"). */
 #define HBAO_BLOCK_PIXELS 16
 #define HBAO_BLOCK_SPAN (4 * HBAO_BLOCK_PIXELS) /* columns a block spans */
+/* Floats after grid->normal's planes: more than a block spans, so that a
+ * kernel may load a block's normals as whole vectors from its first pixel
+ * on, even in the last row of the last plane. */
+#define HBAO_NORMAL_PADDING (2 * HBAO_BLOCK_SPAN)
 
 /* The step length in pixels, (R_block - 1) / steps, of the block of phase a
  * that starts at column x0 of row j (pixels before x1 only); negative

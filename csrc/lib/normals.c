@@ -4,6 +4,7 @@
  * (Bavoil & Sainz: face normals avoid the false occlusion that interpolated
  * normals give). Every normal is turned to face the viewer. */
 #include <math.h>
+#include <string.h>
 #include <stdatomic.h>
 #include <stdint.h>
 
@@ -164,9 +165,9 @@ static int reconstruct_normal(const hbao_grid *grid, int i, int j, const float c
     return normalize3(n);
 }
 
-/* A pixel without a usable given normal: the face normal from depth, or V. */
-static void fallback_normal(const normal_job *job, int i, int j, float n[3]) {
-    const hbao_grid *grid = job->grid;
+/* The normal of a pixel without a usable given normal: the face normal
+ * from depth, or V. */
+static void face_normal(const hbao_grid *grid, int i, int j, float n[3]) {
     const float z = grid->depth[(size_t)j * grid->width + i];
     if (z <= 0.0f) {
         n[0] = 0.0f;
@@ -185,6 +186,14 @@ static void fallback_normal(const normal_job *job, int i, int j, float n[3]) {
     }
 }
 
+/* ... into grid->normal */
+static void fallback_normal(const normal_job *job, int i, int j) {
+    hbao_grid *grid = job->grid;
+    float n[3];
+    face_normal(grid, i, j, n);
+    for (int c = 0; c < 3; c++) hbao_grid_normal_row(grid, j, c)[i] = n[c];
+}
+
 /* The given normals of CHUNK pixels at a time, in lanes: the same float
  * operations, in the same order, as view_vector and transform_given_normal
  * (no FMA contraction: internal_finish.h), so every compiled copy gives the
@@ -200,7 +209,8 @@ static HBAO_ALWAYS_INLINE void given_normals_row(const normal_job *job, int j) {
     const int orthographic = grid->orthographic;
     const float *source_row = given->data + (int64_t)(j * job->scale) * given->row_stride;
     const int64_t pixel_step = (int64_t)job->scale * given->pixel_stride;
-    float *normal_row_out = grid->normal + 3 * (size_t)j * grid->width;
+    float *out[3];
+    for (int c = 0; c < 3; c++) out[c] = hbao_grid_normal_row(grid, j, c);
     const float *depth_row = grid->depth + (size_t)j * grid->width;
     for (int i0 = 0; i0 < grid->width; i0 += CHUNK) {
         const int count = grid->width - i0 < CHUNK ? grid->width - i0 : CHUNK;
@@ -240,16 +250,23 @@ static HBAO_ALWAYS_INLINE void given_normals_row(const normal_job *job, int j) {
             ny[k] = flip ? -u1 : u1;
             nz[k] = flip ? -u2 : u2;
         }
-        float *out = normal_row_out + 3 * (size_t)i0;
-        for (int k = 0; k < count; k++) {
-            if (usable[k]) {
-                out[3 * k] = nx[k];
-                out[3 * k + 1] = ny[k];
-                out[3 * k + 2] = nz[k];
-            } else {
-                fallback_normal(job, i0 + k, j, out + 3 * k);
-            }
+        /* a whole chunk in copies of a constant size, which compile to
+         * vector moves (a copy of `count` floats became `rep movs`) */
+        const size_t bytes = (size_t)count * sizeof(float);
+        if (count == CHUNK) {
+            memcpy(out[0] + i0, nx, sizeof nx);
+            memcpy(out[1] + i0, ny, sizeof ny);
+            memcpy(out[2] + i0, nz, sizeof nz);
+        } else {
+            memcpy(out[0] + i0, nx, bytes);
+            memcpy(out[1] + i0, ny, bytes);
+            memcpy(out[2] + i0, nz, bytes);
         }
+        int any_unusable = 0;
+        for (int k = 0; k < count; k++) any_unusable |= !usable[k];
+        if (any_unusable)
+            for (int k = 0; k < count; k++)
+                if (!usable[k]) fallback_normal(job, i0 + k, j);
     }
 }
 
@@ -283,8 +300,7 @@ static void normal_row(void *context, int j) {
         given_normals_row_portable(job, j);
         return;
     }
-    for (int i = 0; i < job->grid->width; i++)
-        fallback_normal(job, i, j, job->grid->normal + 3 * ((size_t)j * job->grid->width + i));
+    for (int i = 0; i < job->grid->width; i++) fallback_normal(job, i, j);
 }
 
 /* Whether a depth is exactly a half float: a normal one, in [2^-14, 65504]
@@ -342,4 +358,6 @@ void hbao_compute_normals(const hbao_settings *settings, const hbao_camera *came
     normal_job job = {camera, grid, normal, scale,
                       hbao_finish_implementation(settings->implementation)};
     hbao_parallel_rows(settings->threads, grid->height, normal_row, &job);
+    float *padding = hbao_grid_normal_row(grid, grid->height, 0); /* past the last row */
+    for (int k = 0; k < HBAO_NORMAL_PADDING; k++) padding[k] = 0.0f;
 }
