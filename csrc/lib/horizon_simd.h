@@ -497,6 +497,15 @@ static inline VF SIMD_NAME(horizon_visibility)(VM past_normal, VF cos_past_max, 
                                             SIMD_NAME(acos)(elevation_max), gamma, sl);
 }
 
+/* The visibility at the bias elevation, below which no horizon lies: every
+ * direction's start (the bias's sine and arc cosine from hbao_settings). */
+static inline VF SIMD_NAME(visibility_start)(const hbao_settings *s, VF gamma,
+                                             const SIMD_NAME(slice) * sl) {
+    return SIMD_NAME(horizon_visibility_of)(M_NONE(), sl->cos_gamma, V_SET(s->sin_bias),
+                                            V_SET(s->bias_elevation_sine),
+                                            V_SET(s->bias_elevation_acos), gamma, sl);
+}
+
 static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SIMD_NAME(block) * b,
                                                 VM active, float dc, float ds,
                                                 const SIMD_NAME(slice) * sl, VF *open_part) {
@@ -513,10 +522,7 @@ static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SI
     VF elevation_max = V_SET(s->sin_bias);
     VM past_normal = M_NONE(); /* no lane */
     VF cos_past_max = sl->cos_gamma;
-    const VF visibility_start = SIMD_NAME(horizon_visibility_of)(
-        past_normal, cos_past_max, elevation_max, V_SET(s->bias_elevation_sine),
-        V_SET(s->bias_elevation_acos), gamma, sl);
-    VF visibility_at_max = visibility_start;
+    VF visibility_at_max = quadratic ? SIMD_NAME(visibility_start)(s, gamma, sl) : V_SET(0.0f);
     VF occlusion = V_SET(0.0f);
     int any_raised = 0;
     SIMD_NAME(steps) t;
@@ -564,12 +570,12 @@ static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SI
         }
     }
     /* Where no lane's horizon rose or passed the normal, the end is the
-     * start: visibility_start - visibility_start, without recomputing it. */
-    if (!quadratic)
-        occlusion = V_SUB(visibility_start,
-                          any_raised ? SIMD_NAME(horizon_visibility)(past_normal, cos_past_max,
-                                                                     elevation_max, gamma, sl)
-                                     : visibility_start);
+     * start, and start - start is 0 on every lane that counts (a finite
+     * start; the others are left out by the caller): neither is computed. */
+    if (!quadratic && any_raised)
+        occlusion = V_SUB(
+            SIMD_NAME(visibility_start)(s, gamma, sl),
+            SIMD_NAME(horizon_visibility)(past_normal, cos_past_max, elevation_max, gamma, sl));
     return occlusion;
 }
 
