@@ -362,6 +362,43 @@ def test_keep_input_output_is_valid_for_the_reference_openexr(hbao_tool, tmp_pat
     assert "BlenderMultiChannel" in header
 
 
+@pytest.mark.parametrize("compression", ["zip", "piz", "zips", "rle", "none"])
+def test_output_file_does_not_depend_on_the_thread_count(hbao_tool, tmp_path, compression):
+    """Chunks are compressed by --threads threads and written in file order:
+    every thread count gives the same bytes (the fixture's 48 rows make 3 ZIP
+    chunks, 2 PIZ ones and 48 ZIPS ones)."""
+    files = {}
+    for threads in (1, 2, 3):
+        output = tmp_path / f"ao_{threads}.exr"
+        compute_ao(hbao_tool, "cycles_half_piz", output, "--keep-input", "--compression",
+                   compression, "--threads", str(threads))
+        files[threads] = output.read_bytes()
+    assert files[2] == files[1]
+    assert files[3] == files[1]
+    assert info(hbao_tool, tmp_path / "ao_3.exr")["compression"] == compression
+
+
+@pytest.mark.parametrize("threads", [1, 3])
+def test_a_write_failure_midway_is_an_error_with_any_thread_count(hbao_tool, tmp_path, threads):
+    """A file size limit that the header fits in but the chunks do not: the
+    write fails part of the way through (with several threads, while other
+    chunks wait for their turn); a clean error, no output, no temporary file."""
+    def limit_file_size():
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # EFBIG instead of a kill
+        resource.setrlimit(resource.RLIMIT_FSIZE, (20000, 20000))
+
+    output = tmp_path / "ao.exr"
+    completed = subprocess.run(
+        [str(hbao_tool), str(fixture_path("cycles_float_none")), "-o", str(output),
+         "--camera", str(camera_path("cycles_float_none")), "--keep-input",
+         "--compression", "zip", "--threads", str(threads)],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, timeout=TOOL_TIMEOUT_S,
+        preexec_fn=limit_file_size)
+    assert_clean_error(completed, EXIT_RUNTIME, "cannot encode a chunk", "File too large")
+    assert not output.exists()
+    assert leftover_temporary_files(tmp_path) == []
+
+
 def test_layer_selection(hbao_tool, tmp_path):
     layers = info(hbao_tool, fixture_path("two_layers"))["layers"]
     assert layers == ["Back", "Front"]

@@ -230,7 +230,8 @@ static int write_outputs(const cli_options *options, const exr_input *input,
                                 options->compression,
                                 options->keep_input ? input->context : NULL,
                                 NULL,
-                                NULL};
+                                NULL,
+                                input->threads}; /* as many as the AO and the read */
     char settings[RUN_SETTINGS_MAX];
     if (run_settings_text(options, settings)) {
         layout.stamp_name = RUN_SETTINGS_ATTRIBUTE;

@@ -2,6 +2,8 @@
 #include "exr_writer.h"
 
 #include <errno.h>
+#include <pthread.h>
+#include <stdbool.h>
 #include <string.h>
 #include <unistd.h>
 
@@ -92,13 +94,185 @@ static exr_result_t fix_copied_chunk_count(exr_context_t context, int part,
     return exr_set_chunk_count(context, part, (int32_t)((height + lines - 1) / lines));
 }
 
+/* The chunks of the part, encoded (packed and compressed) by up to
+ * layout->threads threads and written in file order. A thread claims the
+ * next chunk, encodes it, waits in the pipeline's yield_until_ready_fn until
+ * every chunk before it is written, and writes it: chunks are claimed in
+ * order, so the next one to write is always held by a thread that is not
+ * waiting, whichever threads started. The file is the same for any number
+ * of threads; the first chunk that fails, from the top, gives the message. */
+typedef struct chunk_writing {
+    exr_context_t context;
+    int part;
+    const char *name;
+    const pixel_rect *window;
+    const exr_output_channel *channels;
+    int count;
+    int32_t lines_per_chunk;
+    int64_t chunks;
+    pthread_mutex_t lock;
+    pthread_cond_t written; /* next_to_write moved, or a chunk failed */
+    int64_t next_to_claim, next_to_write;
+    int64_t failed_chunk; /* the first chunk that failed; chunks if none */
+    int status;           /* and its message */
+    tool_error error;
+} chunk_writing;
+
+/* One thread's pipeline; first, so that yield_until_ready_fn finds the rest */
+typedef struct chunk_encoder {
+    exr_encode_pipeline_t pipeline;
+    int ready;
+    chunk_writing *writing;
+    int64_t chunk;
+    int cancelled; /* the chunk stopped because one before it failed */
+} chunk_encoder;
+
+/* Returns once every chunk before this one is written; an error (which
+ * stops this chunk, the file being incomplete anyway) if one failed. */
+static exr_result_t wait_for_turn(exr_encode_pipeline_t *pipeline) {
+    chunk_encoder *encoder = (chunk_encoder *)pipeline;
+    chunk_writing *writing = encoder->writing;
+    pthread_mutex_lock(&writing->lock);
+    while (writing->next_to_write != encoder->chunk && writing->failed_chunk > encoder->chunk)
+        pthread_cond_wait(&writing->written, &writing->lock);
+    encoder->cancelled = writing->next_to_write != encoder->chunk;
+    pthread_mutex_unlock(&writing->lock);
+    return encoder->cancelled ? EXR_ERR_INCORRECT_CHUNK : EXR_ERR_SUCCESS;
+}
+
+#define CHUNK_CHECK(call, what)                                                                    \
+    do {                                                                                           \
+        exr_result_t check_result_ = (call);                                                       \
+        if (check_result_ != EXR_ERR_SUCCESS)                                                      \
+            return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot write %s: %s: %s (%s)",             \
+                             writing->name, what, exr_error_text(check_result_),                   \
+                             exr_get_error_code_as_string(check_result_));                         \
+    } while (0)
+
+/* Encodes and writes chunk `encoder->chunk` with the encoder's pipeline. */
+static int write_chunk(chunk_writing *writing, chunk_encoder *encoder, int ordered,
+                       tool_error *error) {
+    const int64_t y = writing->window->min_y + encoder->chunk * writing->lines_per_chunk;
+    exr_chunk_info_t chunk;
+    CHUNK_CHECK(exr_write_scanline_chunk_info(writing->context, writing->part, (int)y, &chunk),
+                "cannot start a chunk");
+    exr_encode_pipeline_t *pipeline = &encoder->pipeline;
+    if (!encoder->ready) {
+        CHUNK_CHECK(exr_encoding_initialize(writing->context, writing->part, &chunk, pipeline),
+                    "cannot start encoding");
+        encoder->ready = 1;
+    } else {
+        CHUNK_CHECK(exr_encoding_update(writing->context, writing->part, &chunk, pipeline),
+                    "cannot encode a chunk");
+    }
+    const int64_t first_row = chunk.start_y - writing->window->min_y;
+    for (int c = 0; c < pipeline->channel_count; ++c) {
+        exr_coding_channel_info_t *channel = &pipeline->channels[c];
+        const exr_output_channel *source =
+            find_channel(writing->channels, writing->count, channel->channel_name);
+        if (source == NULL)
+            return tool_fail(error, TOOL_EXIT_RUNTIME, "internal: no data for channel %s",
+                             channel->channel_name);
+        channel->encode_from_ptr = source->data + first_row * source->row_stride;
+        channel->user_pixel_stride = source->pixel_stride;
+        channel->user_line_stride = (int32_t)source->row_stride;
+        channel->user_data_type = (uint16_t)source->type;
+        channel->user_bytes_per_element = (int16_t)exr_pixel_type_size(source->type);
+    }
+    CHUNK_CHECK(exr_encoding_choose_default_routines(writing->context, writing->part, pipeline),
+                "cannot encode this channel layout");
+    if (ordered) pipeline->yield_until_ready_fn = wait_for_turn;
+    CHUNK_CHECK(exr_encoding_run(writing->context, writing->part, pipeline),
+                "cannot encode a chunk");
+    return TOOL_EXIT_SUCCESS;
+}
+
+static int finish_encoder(chunk_writing *writing, chunk_encoder *encoder, tool_error *error) {
+    if (!encoder->ready) return TOOL_EXIT_SUCCESS;
+    encoder->ready = 0;
+    CHUNK_CHECK(exr_encoding_destroy(writing->context, &encoder->pipeline),
+                "cannot finish encoding");
+    return TOOL_EXIT_SUCCESS;
+}
+
+static void *write_chunks(void *argument) {
+    chunk_writing *writing = argument;
+    exr_clear_last_error(); /* this thread's copy of OpenEXRCore's detail */
+    chunk_encoder encoder = {EXR_ENCODE_PIPELINE_INITIALIZER, 0, writing, 0, 0};
+    tool_error error;
+    for (;;) {
+        pthread_mutex_lock(&writing->lock);
+        encoder.chunk = writing->next_to_claim++;
+        const int stop = encoder.chunk >= writing->failed_chunk; /* chunks if none failed */
+        pthread_mutex_unlock(&writing->lock);
+        if (stop) break;
+        encoder.cancelled = 0;
+        const int status = write_chunk(writing, &encoder, 1, &error);
+        pthread_mutex_lock(&writing->lock);
+        if (status == TOOL_EXIT_SUCCESS) {
+            writing->next_to_write = encoder.chunk + 1;
+        } else if (!encoder.cancelled && encoder.chunk < writing->failed_chunk) {
+            writing->failed_chunk = encoder.chunk;
+            writing->status = status;
+            writing->error = error;
+        }
+        pthread_cond_broadcast(&writing->written);
+        pthread_mutex_unlock(&writing->lock);
+    }
+    finish_encoder(writing, &encoder, &error);
+    return NULL;
+}
+
+/* The part's data, chunk by chunk, with up to `threads` threads. */
+static int write_data(chunk_writing *writing, int threads, tool_error *error) {
+    if (threads > EXR_MAX_WRITE_THREADS) threads = EXR_MAX_WRITE_THREADS;
+    if (threads > writing->chunks) threads = (int)writing->chunks;
+    exr_compression_t compression = EXR_COMPRESSION_NONE;
+    exr_get_compression(writing->context, writing->part, &compression);
+    if (threads <= 1 || compression == EXR_COMPRESSION_NONE) {
+        /* one pipeline, OpenEXRCore's own order check */
+        chunk_encoder encoder = {EXR_ENCODE_PIPELINE_INITIALIZER, 0, writing, 0, 0};
+        int status = TOOL_EXIT_SUCCESS;
+        for (; encoder.chunk < writing->chunks && status == TOOL_EXIT_SUCCESS; ++encoder.chunk)
+            status = write_chunk(writing, &encoder, 0, error);
+        tool_error finish_error;
+        const int finished = finish_encoder(writing, &encoder, &finish_error);
+        if (status == TOOL_EXIT_SUCCESS && finished != TOOL_EXIT_SUCCESS) {
+            *error = finish_error;
+            status = finished;
+        }
+        return status;
+    }
+    writing->next_to_claim = writing->next_to_write = 0;
+    writing->failed_chunk = writing->chunks;
+    writing->status = TOOL_EXIT_SUCCESS;
+    if (pthread_mutex_init(&writing->lock, NULL) != 0)
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot write %s: no lock", writing->name);
+    if (pthread_cond_init(&writing->written, NULL) != 0) {
+        pthread_mutex_destroy(&writing->lock);
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot write %s: no lock", writing->name);
+    }
+    pthread_t workers[EXR_MAX_WRITE_THREADS];
+    bool started[EXR_MAX_WRITE_THREADS] = {false};
+    for (int t = 1; t < threads; ++t)
+        started[t] = pthread_create(&workers[t], NULL, write_chunks, writing) == 0;
+    write_chunks(writing); /* the calling thread takes part; enough alone */
+    for (int t = 1; t < threads; ++t)
+        if (started[t]) pthread_join(workers[t], NULL);
+    pthread_cond_destroy(&writing->written);
+    pthread_mutex_destroy(&writing->lock);
+    if (writing->failed_chunk < writing->chunks) {
+        *error = writing->error;
+        return writing->status;
+    }
+    return TOOL_EXIT_SUCCESS;
+}
+
 int exr_write_image(int fd, const char *name, const exr_output_layout *layout,
                     const exr_output_channel *channels, int count, tool_error *error) {
     int status = TOOL_EXIT_SUCCESS;
     int descriptor = fd;
     exr_context_t context = NULL;
-    exr_encode_pipeline_t encoder = EXR_ENCODE_PIPELINE_INITIALIZER;
-    int encoder_ready = 0;
     exr_clear_last_error();
 
     exr_context_initializer_t initializer = exr_quiet_initializer();
@@ -143,45 +317,23 @@ int exr_write_image(int fd, const char *name, const exr_output_layout *layout,
                            lines_per_chunk_for(layout->compression));
         goto fail;
     }
-    const pixel_rect *window = &layout->data_window;
-    for (int64_t y = window->min_y; y <= window->max_y; y += lines_per_chunk) {
-        exr_chunk_info_t chunk;
-        CHECK_EXR(exr_write_scanline_chunk_info(context, part, (int)y, &chunk),
-                  "cannot start a chunk");
-        if (!encoder_ready) {
-            CHECK_EXR(exr_encoding_initialize(context, part, &chunk, &encoder),
-                      "cannot start encoding");
-            encoder_ready = 1;
-        } else {
-            CHECK_EXR(exr_encoding_update(context, part, &chunk, &encoder),
-                      "cannot encode a chunk");
-        }
-        const int64_t first_row = chunk.start_y - window->min_y;
-        for (int c = 0; c < encoder.channel_count; ++c) {
-            exr_coding_channel_info_t *channel = &encoder.channels[c];
-            const exr_output_channel *source = find_channel(channels, count, channel->channel_name);
-            if (source == NULL) {
-                status = tool_fail(error, TOOL_EXIT_RUNTIME, "internal: no data for channel %s",
-                                   channel->channel_name);
-                goto fail;
-            }
-            channel->encode_from_ptr = source->data + first_row * source->row_stride;
-            channel->user_pixel_stride = source->pixel_stride;
-            channel->user_line_stride = (int32_t)source->row_stride;
-            channel->user_data_type = (uint16_t)source->type;
-            channel->user_bytes_per_element = (int16_t)exr_pixel_type_size(source->type);
-        }
-        CHECK_EXR(exr_encoding_choose_default_routines(context, part, &encoder),
-                  "cannot encode this channel layout");
-        CHECK_EXR(exr_encoding_run(context, part, &encoder), "cannot encode a chunk");
-    }
-    CHECK_EXR(exr_encoding_destroy(context, &encoder), "cannot finish encoding");
-    encoder_ready = 0;
+    chunk_writing writing;
+    writing.context = context;
+    writing.part = part;
+    writing.name = name;
+    writing.window = &layout->data_window;
+    writing.channels = channels;
+    writing.count = count;
+    writing.lines_per_chunk = lines_per_chunk;
+    writing.chunks =
+        ((int64_t)layout->data_window.max_y - layout->data_window.min_y + lines_per_chunk) /
+        lines_per_chunk;
+    status = write_data(&writing, layout->threads, error);
+    if (status != TOOL_EXIT_SUCCESS) goto fail;
     CHECK_EXR(exr_finish(&context), "cannot finish the file");
     return TOOL_EXIT_SUCCESS;
 
 fail:
-    if (encoder_ready) exr_encoding_destroy(context, &encoder);
     if (context != NULL) exr_finish(&context);
     return status;
 }

@@ -23,7 +23,13 @@ typedef struct exr_output_layout {
      *  the copied ones, so an input's attribute of the same name is replaced). */
     const char *stamp_name;
     const char *stamp_text;
+    /** Threads that encode (compress) the chunks, at most
+     *  EXR_MAX_WRITE_THREADS; 0 or 1: the calling thread alone. The file does
+     *  not depend on it. */
+    int threads;
 } exr_output_layout;
+
+#define EXR_MAX_WRITE_THREADS 16
 
 /** One channel to write: `data` holds pixels of type `type` (the type it is
  *  stored as in the file); strides in bytes. */
