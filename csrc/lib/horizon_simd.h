@@ -935,10 +935,20 @@ static float SIMD_NAME(block_step)(const hbao_horizon_job *job, int x0, int j, i
 }
 
 static void SIMD_NAME(span)(const hbao_horizon_job *job, int x0, int x1, int j) {
+    float *out = job->ao + (size_t)j * job->grid->width;
+    float step[4];
+    int unsampled = 0;
     for (int a = 0; a < 4; a++) {
-        const float step_px = SIMD_NAME(block_step)(job, x0, j, a);
+        step[a] = SIMD_NAME(block_step)(job, x0, j, a);
+        unsampled += step[a] < 0.0f;
+    }
+    if (unsampled == 4) { /* the whole span, in one contiguous run */
+        for (int i = x0; i < x1; i++) out[i] = 1.0f;
+        return;
+    }
+    for (int a = 0; a < 4; a++) {
+        const float step_px = step[a];
         if (step_px < 0.0f) { /* no lane active: lanes_ao's result, without its set-up */
-            float *out = job->ao + (size_t)j * job->grid->width;
             for (int i = x0 + a; i < x1; i += 4) out[i] = 1.0f;
             continue;
         }
