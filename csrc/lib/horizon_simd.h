@@ -172,6 +172,13 @@ static inline void SIMD_NAME(plan_steps)(const SIMD_NAME(block) * b, float dc, f
     }
 }
 
+/* The address of row[first], which may lie before the row (first < 0):
+ * formed as an integer, not by pointer arithmetic outside the array; only
+ * the lanes inside the row are read from it (V_LOAD_LANES). */
+static inline const float *SIMD_NAME(lane_address)(const float *row, int first) {
+    return (const float *)((uintptr_t)row + (uintptr_t)(intptr_t)first * sizeof(float));
+}
+
 /* A step that is not plain: lanes whose column leaves the image stop (in
  * *alive), and only the lanes inside read. Returns 0 where every lane's
  * sample row has left the image: the direction's search ends there. */
@@ -191,16 +198,11 @@ static int SIMD_NAME(fetch_at_side)(const SIMD_NAME(block) * b, int ox, int oy, 
     /* the lanes whose index lies in the row (exact small integers) */
     const VF index = I_TO_F(I_ADD(I_LANES, I_SET(first)));
     const VM in_row = M_AND(V_GE(index, V_SET(0.0f)), V_LT(index, V_SET((float)phase_width)));
-    /* the address of index `first`, formed without pointer arithmetic past
-     * the row: lanes outside in_row are not read */
-    const uintptr_t first_address =
-        (uintptr_t)(b->job->phase_depth + row_start) + (uintptr_t)(intptr_t)first * sizeof(float);
-    f->zs =
-        V_ZERO_UNLESS(candidate, V_LOAD_LANES(in_row, (const float *)first_address, V_SET(0.0f)));
+    const float *depths = SIMD_NAME(lane_address)(b->job->phase_depth + row_start, first);
+    f->zs = V_ZERO_UNLESS(candidate, V_LOAD_LANES(in_row, depths, V_SET(0.0f)));
     if (b->job->phase_back != NULL) {
-        const uintptr_t back_address = (uintptr_t)(b->job->phase_back + row_start) +
-                                       (uintptr_t)(intptr_t)first * sizeof(float);
-        f->zb = V_LOAD_LANES(in_row, (const float *)back_address, V_SET(INFINITY));
+        const float *backs = SIMD_NAME(lane_address)(b->job->phase_back + row_start, first);
+        f->zb = V_LOAD_LANES(in_row, backs, V_SET(INFINITY));
     }
     f->row = hbao_grid_y(g, sj);
     f->ox = (float)ox;

@@ -81,7 +81,7 @@ typedef struct hbao_grid {
     float depth_precision;
 } hbao_grid;
 
-/* Component c of row j's normals (row height: the padding) */
+/* Component c (x, y, z) of row j's normals; row `height` is the padding */
 static inline float *hbao_grid_normal_row(const hbao_grid *grid, int j, int c) {
     return grid->normal + (3 * (size_t)j + (size_t)c) * (size_t)grid->width;
 }
@@ -263,9 +263,9 @@ typedef struct hbao_horizon_job {
  * load from phase_depth (docs/algorithm.md, "Per-pixel sampling"). */
 #define HBAO_BLOCK_PIXELS 16
 #define HBAO_BLOCK_SPAN (4 * HBAO_BLOCK_PIXELS) /* columns a block spans */
-/* Floats after grid->normal's planes: more than a block spans, so that a
+/* Floats after grid->normal's last row: more than a block spans, so that a
  * kernel may load a block's normals as whole vectors from its first pixel
- * on, even in the last row of the last plane. */
+ * on, even in the z row of the grid's last row. */
 #define HBAO_NORMAL_PADDING (2 * HBAO_BLOCK_SPAN)
 
 /* The step length in pixels, (R_block - 1) / steps, of the block of phase a
