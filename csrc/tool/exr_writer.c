@@ -30,13 +30,19 @@ static int64_t write_to_descriptor(exr_const_context_t context, void *user_data,
     return (int64_t)done;
 }
 
+/* The message of a failed OpenEXRCore call while writing `name`: one
+ * wording for the header's calls (CHECK_EXR) and the chunks' (CHUNK_CHECK). */
+static int write_failure(tool_error *error, const char *name, const char *what,
+                         exr_result_t result) {
+    return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot write %s: %s: %s (%s)", name, what,
+                     exr_error_text(result), exr_get_error_code_as_string(result));
+}
+
 #define CHECK_EXR(call, what)                                                                      \
     do {                                                                                           \
         exr_result_t check_result_ = (call);                                                       \
         if (check_result_ != EXR_ERR_SUCCESS) {                                                    \
-            status = tool_fail(error, TOOL_EXIT_RUNTIME, "cannot write %s: %s: %s (%s)", name,     \
-                               what, exr_error_text(check_result_),                                \
-                               exr_get_error_code_as_string(check_result_));                       \
+            status = write_failure(error, name, what, check_result_);                              \
             goto fail;                                                                             \
         }                                                                                          \
     } while (0)
@@ -144,9 +150,7 @@ static exr_result_t wait_for_turn(exr_encode_pipeline_t *pipeline) {
     do {                                                                                           \
         exr_result_t check_result_ = (call);                                                       \
         if (check_result_ != EXR_ERR_SUCCESS)                                                      \
-            return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot write %s: %s: %s (%s)",             \
-                             writing->name, what, exr_error_text(check_result_),                   \
-                             exr_get_error_code_as_string(check_result_));                         \
+            return write_failure(error, writing->name, what, check_result_);                       \
     } while (0)
 
 /* Encodes and writes chunk `encoder->chunk` with the encoder's pipeline. */
