@@ -511,11 +511,13 @@ static inline VF SIMD_NAME(visibility_start)(const hbao_settings *s, VF gamma,
 static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SIMD_NAME(block) * b,
                                                 VM active, float dc, float ds,
                                                 const SIMD_NAME(slice) * sl, VF *open_part) {
+    /* The steps are planned first and the open part is left to the end:
+     * the search does not wait on them (bench_ab, 1080p, four file copies
+     * of each build: 0.97 on 1 thread, 0.98 on 2, against gamma and the
+     * open part first). */
+    SIMD_NAME(steps) t;
+    SIMD_NAME(plan_steps)(b, dc, ds, s->steps, &t);
     const VF gamma = V_SUB(V_SET(0.5f * HBAO_PI), SIMD_NAME(acos)(sl->sin_gamma));
-    *open_part =
-        V_MUL(V_SET(0.25f),
-              V_ADD(V_MUL(V_SET(2.0f), sl->cos_gamma),
-                    V_MUL(V_ADD(V_MUL(V_SET(2.0f), gamma), V_SET(HBAO_PI)), sl->sin_gamma)));
     const VF inv_np = sl->inv_np;
     const VM check_past_normal = V_GT(sl->sin_gamma, V_SET(0.0f));
     const int any_check = M_ANY(M_AND(check_past_normal, active));
@@ -527,8 +529,6 @@ static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SI
     VF visibility_at_max = quadratic ? SIMD_NAME(visibility_start)(s, gamma, sl) : V_SET(0.0f);
     VF occlusion = V_SET(0.0f);
     int any_raised = 0;
-    SIMD_NAME(steps) t;
-    SIMD_NAME(plan_steps)(b, dc, ds, s->steps, &t);
     VM inside = active;
     for (int step = 0; step < t.count; step++) {
         SIMD_NAME(fetch) f;
@@ -574,6 +574,10 @@ static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SI
     /* Where no lane's horizon rose or passed the normal, the end is the
      * start, and start - start is 0 on every lane that counts (a finite
      * start; the others are left out by the caller): neither is computed. */
+    *open_part =
+        V_MUL(V_SET(0.25f),
+              V_ADD(V_MUL(V_SET(2.0f), sl->cos_gamma),
+                    V_MUL(V_ADD(V_MUL(V_SET(2.0f), gamma), V_SET(HBAO_PI)), sl->sin_gamma)));
     if (!quadratic && any_raised)
         occlusion = V_SUB(
             SIMD_NAME(visibility_start)(s, gamma, sl),
