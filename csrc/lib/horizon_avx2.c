@@ -8,7 +8,6 @@
 #include <immintrin.h>
 
 #define SIMD_LANES 8
-#define SIMD_NAME(name) name##_avx2
 #define VF __m256
 #define VI __m256i
 #define VM __m256 /* lanes of all ones or all zeros */
@@ -72,6 +71,13 @@ static inline __m256 load_every_fourth_avx2(const float *p) {
 }
 #define V_LOAD_EVERY_FOURTH load_every_fourth_avx2
 
+#define SIMD_ORTHOGRAPHIC 0
+#define SIMD_NAME(name) name##_avx2
+#include "horizon_simd.h"
+#undef SIMD_ORTHOGRAPHIC
+#undef SIMD_NAME
+#define SIMD_ORTHOGRAPHIC 1
+#define SIMD_NAME(name) name##_avx2_orthographic
 #include "horizon_simd.h"
 
 int hbao_horizon_avx2_available(void) {
@@ -80,7 +86,10 @@ int hbao_horizon_avx2_available(void) {
 }
 
 void hbao_horizon_span_avx2(const hbao_horizon_job *job, int x0, int x1, int j) {
-    span_avx2(job, x0, x1, j);
+    if (job->grid->orthographic)
+        span_avx2_orthographic(job, x0, x1, j);
+    else
+        span_avx2(job, x0, x1, j);
 }
 
 #else /* not built for x86-64: never chosen */

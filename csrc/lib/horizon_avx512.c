@@ -8,7 +8,6 @@
 #include <immintrin.h>
 
 #define SIMD_LANES 16
-#define SIMD_NAME(name) name##_avx512
 #define VF __m512
 #define VI __m512i
 #define VM __mmask16
@@ -73,6 +72,13 @@ static inline __m512 load_every_fourth_avx512(const float *p) {
 }
 #define V_LOAD_EVERY_FOURTH load_every_fourth_avx512
 
+#define SIMD_ORTHOGRAPHIC 0
+#define SIMD_NAME(name) name##_avx512
+#include "horizon_simd.h"
+#undef SIMD_ORTHOGRAPHIC
+#undef SIMD_NAME
+#define SIMD_ORTHOGRAPHIC 1
+#define SIMD_NAME(name) name##_avx512_orthographic
 #include "horizon_simd.h"
 
 int hbao_horizon_avx512_available(void) {
@@ -81,7 +87,10 @@ int hbao_horizon_avx512_available(void) {
 }
 
 void hbao_horizon_span_avx512(const hbao_horizon_job *job, int x0, int x1, int j) {
-    span_avx512(job, x0, x1, j);
+    if (job->grid->orthographic)
+        span_avx512_orthographic(job, x0, x1, j);
+    else
+        span_avx512(job, x0, x1, j);
 }
 
 #else /* not built for x86-64: never chosen */
