@@ -115,8 +115,12 @@ typedef struct SIMD_NAME(steps) {
     int count; /* the steps before the first that lies a whole image away */
     int ox[SIMD_STEP_ROOM], oy[SIMD_STEP_ROOM], index[SIMD_STEP_ROOM];
     float row[SIMD_STEP_ROOM], ox_float[SIMD_STEP_ROOM];
-    /* whether step k is plain: bit k % SIMD_LANES of word k / SIMD_LANES */
-    unsigned plain[SIMD_STEP_ROOM / SIMD_LANES];
+    /* Steps 0 .. plain_end - 1 are plain (the steps move away from the
+     * pixel, so plain steps come first; a later one would take the side
+     * path, which is right for any step). One comparison per step instead
+     * of a bit test: bench_ab, 1080p, four file copies of each build,
+     * 0.973 on 1 thread, 0.979 on 2. */
+    int plain_end;
 } SIMD_NAME(steps);
 
 static inline VI SIMD_NAME(floor_to_int)(VF x) {
@@ -133,6 +137,7 @@ static inline void SIMD_NAME(plan_steps)(const SIMD_NAME(block) * b, float dc, f
     const hbao_grid *g = b->grid;
     const int phase_width = b->job->phase_width;
     t->count = steps;
+    t->plain_end = 0;
     for (int first = 0; first < steps; first += SIMD_LANES) {
         const VF step = I_TO_F(I_ADD(I_SET(first), I_LANES));
         const VF along =
@@ -164,9 +169,12 @@ static inline void SIMD_NAME(plan_steps)(const SIMD_NAME(block) * b, float dc, f
                                          I_ADD(I_SET(b->first_x), I_SRAI(moved, 2))));
         V_STOREU(t->row + first, V_MUL(V_ADD(sj_float, V_SET(g->y_offset)), V_SET(g->y_step)));
         V_STOREU(t->ox_float + first, ox_float);
-        t->plain[first / SIMD_LANES] = b->job->int_indices ? (unsigned)M_BITS(plain) : 0u;
         const int count = steps - first < SIMD_LANES ? steps - first : SIMD_LANES;
         const unsigned wanted = (count == 32 ? 0u : 1u << count) - 1u;
+        if (t->plain_end == first && b->job->int_indices) {
+            const unsigned run = ~(unsigned)M_BITS(plain) & wanted;
+            t->plain_end = first + (run == 0 ? count : __builtin_ctz(run));
+        }
         const unsigned outside = ~(unsigned)M_BITS(inside) & wanted;
         if (outside != 0) {
             t->count = first + __builtin_ctz(outside);
@@ -184,7 +192,9 @@ static inline const float *SIMD_NAME(lane_address)(const float *row, int first) 
 
 /* A step that is not plain: lanes whose column leaves the image stop (in
  * *alive), and only the lanes inside read. Returns 0 where every lane's
- * sample row has left the image: the direction's search ends there. */
+ * sample row, or every lane's column, has left the image: the direction's
+ * search ends there (no step can bring a lane back: the steps move away
+ * from the pixel). */
 static int SIMD_NAME(fetch_at_side)(const SIMD_NAME(block) * b, int ox, int oy, VM *alive,
                                     SIMD_NAME(fetch) * f) {
     const hbao_grid *g = b->grid;
@@ -193,6 +203,7 @@ static int SIMD_NAME(fetch_at_side)(const SIMD_NAME(block) * b, int ox, int oy, 
     if (sj < 0 || sj >= g->height) return 0;
     const VF si = I_TO_F(I_ADD(b->lane_i, I_SET(ox))); /* exact: |si| < 2^24 */
     *alive = M_AND(*alive, M_AND(V_GE(si, V_SET(0.0f)), V_LT(si, V_SET((float)g->width))));
+    if (!M_ANY(*alive)) return 0;
     const VM candidate = (ox == 0 && oy == 0) ? M_NONE() : *alive;
     const int moved = b->phase + ox;
     const int new_phase = moved & 3;                        /* moved mod 4, two's complement */
@@ -222,10 +233,9 @@ static int SIMD_NAME(fetch_at_side)(const SIMD_NAME(block) * b, int ox, int oy, 
  * changes no result, and the step count adapts to the projected radius. */
 static inline int SIMD_NAME(fetch_step)(const SIMD_NAME(block) * b, const SIMD_NAME(steps) * t,
                                         int step, VM *alive, SIMD_NAME(fetch) * f) {
-    if (!M_ANY(*alive)) return -1;
     const int ox = t->ox[step], oy = t->oy[step];
     if (step > 0 && ox == t->ox[step - 1] && oy == t->oy[step - 1]) return 0;
-    if ((t->plain[step / SIMD_LANES] >> (step % SIMD_LANES)) & 1u) {
+    if (step < t->plain_end) {
         const VM candidate = (ox | oy) == 0 ? M_NONE() : *alive;
         const int index = t->index[step];
         f->zs = V_ZERO_UNLESS(candidate, V_LOADU(b->job->phase_depth + index));
