@@ -124,10 +124,9 @@ typedef struct SIMD_NAME(steps) {
 } SIMD_NAME(steps);
 
 static inline VI SIMD_NAME(floor_to_int)(VF x) {
-    /* hbao_floor_in_range's truncation and correction, exact in range */
-    const VI truncated = V_CVTT(x);
-    const VF whole = I_TO_F(truncated);
-    return V_CVTT(V_SUB(whole, V_SELECT(V_GT(whole, x), V_SET(0.0f), V_SET(1.0f))));
+    /* hbao_floor_in_range's result in range (its truncation and correction
+     * is the floor there) */
+    return V_CVTT(V_FLOOR(x));
 }
 
 /* hbao_step_offset for SIMD_LANES steps at once, each lane one step, with
