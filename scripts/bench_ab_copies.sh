@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-2.0-or-later
+# Two builds of libhbao compared the way session 10 kept or dropped its
+# changes: on this machine two file copies of the same library time a steady
+# 3-5 % apart (where the pages land in memory), so one bench_ab run of one
+# copy of each build is worth +-5 %. This makes COPIES copies of each
+# library, runs bench_ab once per pair (every other run in the reverse
+# order), and prints each run's after / before ratio (fastest call) and
+# their mean. Extra arguments go to bench_ab (--threads, --half, ...).
+#   scripts/bench_ab_copies.sh BEFORE.so AFTER.so [bench_ab options]
+# Environment: COPIES (default 4), ROUNDS (bench_ab --rounds, default 3).
+set -euo pipefail
+REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+if [ $# -lt 2 ] || [ ! -f "$1" ] || [ ! -f "$2" ]; then
+    echo "usage: $0 BEFORE.so AFTER.so [bench_ab options]" >&2
+    exit 2
+fi
+before=$1
+after=$2
+shift 2
+copies=${COPIES:-4}
+rounds=${ROUNDS:-3}
+bench="$REPO/build/bench_ab"
+if [ ! -x "$bench" ]; then
+    "$REPO/scripts/setup.sh"
+    cmake -S "$REPO" -B "$REPO/build" -DCMAKE_BUILD_TYPE=Release -DHBAO_BUILD_BENCHMARKS=ON >/dev/null
+    cmake --build "$REPO/build" -j2 --target bench_ab >/dev/null
+fi
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+ratio_of() { # bench_ab's output -> its fastest-call after / before ratio
+    sed -n 's/.*after \/ before \([0-9.]*\) .*/\1/p' | tail -n 1
+}
+
+ratios=()
+for i in $(seq 1 "$copies"); do
+    cp "$before" "$work/before_$i.so"
+    cp "$after" "$work/after_$i.so"
+    if [ $((i % 2)) = 1 ]; then
+        r=$("$bench" "$work/before_$i.so" "$work/after_$i.so" --rounds "$rounds" "$@" | ratio_of)
+    else # reversed: the ratio is before / after, inverted
+        r=$("$bench" "$work/after_$i.so" "$work/before_$i.so" --rounds "$rounds" "$@" | ratio_of)
+        r=$(awk -v r="$r" 'BEGIN { printf "%.3f", 1 / r }')
+    fi
+    if [ -z "$r" ]; then
+        echo "bench_ab gave no ratio (run it alone to see why)" >&2
+        exit 1
+    fi
+    ratios+=("$r")
+done
+printf 'after / before [%s]: %s -> mean %s\n' "$*" "${ratios[*]}" \
+    "$(printf '%s\n' "${ratios[@]}" | awk '{ s += $1 } END { printf "%.3f", s / NR }')"
