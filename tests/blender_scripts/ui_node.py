@@ -87,8 +87,13 @@ def menu_report(window, area):
     texts = []
     with override(window, area):
         context = bpy.context
-        fake = type("FakeMenu", (), {"layout": Recorder(texts),
-                                     "bl_idname": getattr(menu, "bl_idname", menu.__name__)})()
+        attributes = {"layout": Recorder(texts),
+                      "bl_idname": getattr(menu, "bl_idname", menu.__name__)}
+        # Blender 3.x's Add menus are node categories: their own draw
+        # function reads the menu's category.
+        if hasattr(menu, "category"):
+            attributes["category"] = menu.category
+        fake = type("FakeMenu", (), attributes)()
         menu.draw(fake, context)
         import nodeitems_utils
         labels = [item.label for item in nodeitems_utils.node_items_iter(context)
