@@ -33,8 +33,9 @@ compositor.composite(hbao.outputs["Image"])
 hbao.inputs["Directions"].default_value = 8.0
 value = compositor.value(7.0)
 value.name = "Steps Value"
-# Beside the node, not over it: the UI test's screenshots show the node.
-value.location = (hbao.location.x - 250, hbao.location.y - 300)
+# Beside the node and below the Render Layers node, over neither: the UI
+# test's screenshots show the node.
+value.location = (hbao.location.x - 220, hbao.location.y - 470)
 compositor.link(value.outputs[0], hbao.inputs["Steps"])
 blur = hbao.inputs["Blur Size"]
 for frame, size in ((1, 3.0), (11, 9.0)):
