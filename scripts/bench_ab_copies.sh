@@ -20,6 +20,12 @@ after=$2
 shift 2
 copies=${COPIES:-4}
 rounds=${ROUNDS:-3}
+for setting in "COPIES=$copies" "ROUNDS=$rounds"; do
+    if ! [[ ${setting#*=} =~ ^[1-9][0-9]?$ ]]; then
+        echo "$0: $setting: give a whole number from 1 to 99" >&2
+        exit 2
+    fi
+done
 bench="$REPO/build/bench_ab"
 if [ ! -x "$bench" ]; then
     "$REPO/scripts/setup.sh"
@@ -29,8 +35,16 @@ fi
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
-ratio_of() { # bench_ab's output -> its fastest-call after / before ratio
-    sed -n 's/.*after \/ before \([0-9.]*\) .*/\1/p' | tail -n 1
+# One bench_ab run; prints its fastest-call after / before ratio, or stops
+# the script with bench_ab's own message when it fails.
+ratio_of_run() {
+    local output
+    if ! output=$("$bench" "$1" "$2" --rounds "$rounds" "${@:3}" 2>&1); then
+        echo "$output" >&2
+        echo "$0: bench_ab failed (above)" >&2
+        exit 1
+    fi
+    sed -n 's/.*after \/ before \([0-9.]*\) .*/\1/p' <<<"$output" | tail -n 1
 }
 
 ratios=()
@@ -38,13 +52,13 @@ for i in $(seq 1 "$copies"); do
     cp "$before" "$work/before_$i.so"
     cp "$after" "$work/after_$i.so"
     if [ $((i % 2)) = 1 ]; then
-        r=$("$bench" "$work/before_$i.so" "$work/after_$i.so" --rounds "$rounds" "$@" | ratio_of)
+        r=$(ratio_of_run "$work/before_$i.so" "$work/after_$i.so" "$@")
     else # reversed: the ratio is before / after, inverted
-        r=$("$bench" "$work/after_$i.so" "$work/before_$i.so" --rounds "$rounds" "$@" | ratio_of)
-        r=$(awk -v r="$r" 'BEGIN { printf "%.3f", 1 / r }')
+        r=$(ratio_of_run "$work/after_$i.so" "$work/before_$i.so" "$@")
+        [ -n "$r" ] && r=$(awk -v r="$r" 'BEGIN { printf "%.3f", 1 / r }')
     fi
     if [ -z "$r" ]; then
-        echo "bench_ab gave no ratio (run it alone to see why)" >&2
+        echo "$0: bench_ab printed no ratio (run it alone to see why)" >&2
         exit 1
     fi
     ratios+=("$r")
