@@ -567,13 +567,14 @@ float hbao_block_step(const horizon_job *job, int x0, int x1, int j, int a) {
 /* Pixels are visited tile by tile: a pixel's samples spread over the whole
  * projected radius, and the pixel below it samples nearly the same cache
  * lines, which are still cached when only a tile's height lies between them
- * (not a whole image). A tile is one block span wide and TILE_ROWS high;
- * tiles are taken along the image's rows. Measured with csrc/bench/bench_ab.c,
- * 1080p, means over four file copies of each build: 16 rows against 64, one
+ * (not a whole image). A tile is one block span wide (TILE_COLUMNS) and
+ * TILE_ROWS high; tiles are taken along the image's rows. Measured with
+ * csrc/bench/bench_ab.c, 1080p, means over four file copies of each
+ * build: 16 rows against 64, one
  * thread 0.91 (half resolution 0.95, 8 x 6 + blur 15 0.93, AVX2 0.95); two
  * threads 1.00 and 1.04 in two runs, within the noise. Walking each thread
  * down a strip of its own did not help two threads either. */
-#define TILE_SIZE HBAO_BLOCK_SPAN
+#define TILE_COLUMNS HBAO_BLOCK_SPAN
 #define TILE_ROWS 16
 
 typedef struct tiled_job {
@@ -586,9 +587,9 @@ static void horizon_tile(void *context, int tile) {
     const tiled_job *tiled = context;
     const horizon_job *job = tiled->job;
     const int width = job->grid->width, height = job->grid->height;
-    const int x0 = (tile % tiled->tiles_across) * TILE_SIZE;
+    const int x0 = (tile % tiled->tiles_across) * TILE_COLUMNS;
     const int y0 = (tile / tiled->tiles_across) * TILE_ROWS;
-    const int x1 = x0 + TILE_SIZE < width ? x0 + TILE_SIZE : width;
+    const int x1 = x0 + TILE_COLUMNS < width ? x0 + TILE_COLUMNS : width;
     const int y1 = y0 + TILE_ROWS < height ? y0 + TILE_ROWS : height;
     for (int j = y0; j < y1; j++) {
         if (tiled->simd != NULL) {
@@ -667,7 +668,7 @@ void hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *grid,
     }
     tiled_job tiled;
     tiled.job = &job;
-    tiled.tiles_across = (grid->width + TILE_SIZE - 1) / TILE_SIZE;
+    tiled.tiles_across = (grid->width + TILE_COLUMNS - 1) / TILE_COLUMNS;
     tiled.simd = choose_kernel(settings->implementation);
     float *phase_depth = NULL, *phase_back = NULL;
     job.phase_depth = NULL;

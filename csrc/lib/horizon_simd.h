@@ -12,8 +12,8 @@
  * with 0, NaN -> 0); comparisons V_GT V_GE V_LT V_LE -> VM; masks M_AND M_OR
  * M_ANDNOT(a, b) = ~a & b, M_ANY, M_NONE() (no lane); V_SELECT(m, a, b) = m ? b : a;
  * V_ZERO_UNLESS(m, v); I_SET I_ADD I_MULLO I_LANES (0, 1, ...) I_TO_F; V_CVTT
- * (truncating float -> int32); I_STOREU; M_BITS(m) (lane k -> bit k);
- * for the back layer's sector masks: V_MIN V_CEIL V_FLOOR, I_SUB I_AND I_OR
+ * (truncating float -> int32); V_FLOOR; I_STOREU; M_BITS(m) (lane k -> bit k);
+ * for the back layer's sector masks: V_MIN V_CEIL, I_SUB I_AND I_OR
  * I_ANDNOT(a, b) = ~a & b, I_SLLV (per-lane shift, 0 from 32 on) I_SRLI,
  * I_ZERO_UNLESS(m, v); I_SRAI (arithmetic shift) for the steps' indices;
  * SIMD_NAME(x) gives the instance's function names. SIMD_ORTHOGRAPHIC (0 or
@@ -953,7 +953,7 @@ static float SIMD_NAME(block_step)(const hbao_horizon_job *job, int x0, int j, i
  * blocks load them as their first step, and these rows were written by the
  * normals stage long before. bench_ab, 1080p, four file copies of each
  * build: AVX2 0.964 on 2 threads, 0.971 on 1, half 0.973; AVX-512 1.00
- * (its lanes ask for them half as often). */
+ * (why it gains nothing there is not known). */
 static inline void SIMD_NAME(prefetch_normals)(const hbao_grid *g, int x0, int j) {
     if (j >= g->height) return;
     for (int c = 0; c < 3; c++) {
