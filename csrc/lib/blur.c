@@ -41,7 +41,6 @@ typedef struct finish_job {
     int width, height;     /* the grid's */
     int radius;            /* taps on each side; 0 = no blur */
     int band_rows;
-    int implementation; /* resolved: which compiled copy runs */
     float sharpness;
     float strength;
     float spatial[MAX_BLUR_RADIUS + 1]; /* Gaussian weight by tap distance */
@@ -113,77 +112,10 @@ static HBAO_ALWAYS_INLINE float blur_pixel(const tap_set *taps, const centre_row
     return zc > 0.0f ? sum / weight_sum : 1.0f;
 }
 
-/* 16 pixels at once in GCC vector types: each function that inlines this
- * is compiled for its instruction set (one AVX-512 register, two AVX2 or
- * four SSE2 ones per vector), and every operation is blur_pixel's, lane by
- * lane, so all copies give the same floats. */
-#define LANES 16
-/* GCC and clang warn that passing these vectors by value differs between
- * instruction sets; the helpers are always inlined, so no call passes one. */
-#pragma GCC diagnostic ignored "-Wpsabi"
-typedef float vfloat __attribute__((vector_size(4 * LANES)));
-typedef int32_t vint __attribute__((vector_size(4 * LANES)));
-
-static HBAO_ALWAYS_INLINE vfloat load_lanes(const float *p) {
-    vfloat v;
-    memcpy(&v, p, sizeof v);
-    return v;
-}
-
-/* mask ? a : b, mask lanes all ones or zero */
-static HBAO_ALWAYS_INLINE vfloat select_lanes(vint mask, vfloat a, vfloat b) {
-    return (vfloat)((mask & (vint)a) | (~mask & (vint)b));
-}
-
-/* hbao_exp_negative, lane by lane: a loop of LANES iterations that the
- * compiler vectorizes, so that the polynomial is written once. */
-static HBAO_ALWAYS_INLINE vfloat exp_negative_lanes(vfloat x) {
-    float in[LANES], out[LANES];
-    memcpy(in, &x, sizeof in);
-    for (int l = 0; l < LANES; l++) out[l] = hbao_exp_negative(in[l]);
-    vfloat result;
-    memcpy(&result, out, sizeof result);
-    return result;
-}
-
-static HBAO_ALWAYS_INLINE void blur_lanes(const tap_set *taps, const centre_row *c, float sharpness,
-                                          int i, float *target) {
-    const vfloat zero = {0.0f}, one = zero + 1.0f;
-    const vfloat zc = load_lanes(c->z + i);
-    const vint geometry = zc > 0.0f;
-    const vfloat scaled = select_lanes(geometry, sharpness / zc, zero);
-    const vfloat factor = select_lanes(scaled < FLT_MAX, scaled, zero + FLT_MAX);
-    const vfloat cx = load_lanes(c->nx + i), cy = load_lanes(c->ny + i), cz = load_lanes(c->nz + i);
-    vfloat sum = load_lanes(c->ao + i), weight_sum = one;
-    for (int t = 0; t < taps->count; t++) {
-        const int at = i + taps->offset[t];
-        const vfloat z = load_lanes(taps->z[t] + at);
-        const vfloat difference = (z - zc) * factor;
-        const vfloat facing = load_lanes(taps->nx[t] + at) * cx +
-                              load_lanes(taps->ny[t] + at) * cy + load_lanes(taps->nz[t] + at) * cz;
-        const vfloat bend = 1.0f - facing;
-        const vfloat exponent = difference * difference +
-                                HBAO_BLUR_NORMAL_SHARPNESS * (vfloat)((vint)bend & (bend > 0.0f));
-        const vfloat valid = (vfloat)((vint)one & (z > 0.0f));
-        const vfloat weight = taps->spatial[t] * exp_negative_lanes(exponent) * valid;
-        sum += weight * load_lanes(taps->ao[t] + at);
-        weight_sum += weight;
-    }
-    const vfloat blurred = select_lanes(geometry, sum / weight_sum, one);
-    memcpy(target + i, &blurred, sizeof blurred);
-}
-
-/* One pass over a row of centres: the vector loop where every tap lies
- * inside the row, blur_pixel at the ends. */
-static HBAO_ALWAYS_INLINE void blur_pass(const tap_set *taps, const centre_row *c, float sharpness,
-                                         int width, int radius, float *target) {
-    const int first = taps->along_row ? radius : 0;
-    const int last = taps->along_row ? width - radius : width; /* vector lanes in [first, last) */
-    int i = 0;
-    for (; i < first && i < width; i++) target[i] = blur_pixel(taps, c, sharpness, width, i);
-    for (; i + LANES <= last; i += LANES) blur_lanes(taps, c, sharpness, i, target);
-    for (; i < width; i++) target[i] = blur_pixel(taps, c, sharpness, width, i);
-}
+/* One pass over a row of centres into target: blur_pixel for every pixel
+ * (blur_lanes.h writes each instruction set's copy). */
+typedef void (*blur_pass_fn)(const tap_set *taps, const centre_row *c, float sharpness, int width,
+                             int radius, float *target);
 
 /* Scratch of one band: the finished row and the ring of rows blurred
  * along themselves, width floats each. */
@@ -203,7 +135,8 @@ static int band_memory_make(band_memory *m, int width, int slots) {
 }
 
 /* Row j's raw AO blurred along the row, into its ring slot. */
-static HBAO_ALWAYS_INLINE void make_row(const finish_job *job, band_memory *m, int j) {
+static HBAO_ALWAYS_INLINE void make_row(const finish_job *job, blur_pass_fn pass, band_memory *m,
+                                        int j) {
     const int width = job->width, radius = job->radius;
     float *slot = m->ring[j % (2 * radius + 1)];
     const float *raw = job->grid_ao + (size_t)j * width;
@@ -228,7 +161,7 @@ static HBAO_ALWAYS_INLINE void make_row(const finish_job *job, band_memory *m, i
         taps.count++;
     }
     const centre_row centre = {z, raw, n.nx, n.ny, n.nz};
-    blur_pass(&taps, &centre, job->sharpness, width, radius, slot);
+    pass(&taps, &centre, job->sharpness, width, radius, slot);
 }
 
 /* A finished row of AO (1 on background, where zc <= 0) to the output:
@@ -248,7 +181,8 @@ static HBAO_ALWAYS_INLINE void write_output(const float *zc, const float *ao, in
 
 /* Finished row j: rows j - r .. j + r of the ring blurred down the column,
  * then strength and the clamp to [0, 1]. */
-static HBAO_ALWAYS_INLINE void finish_row(const finish_job *job, band_memory *m, int j) {
+static HBAO_ALWAYS_INLINE void finish_row(const finish_job *job, blur_pass_fn pass, band_memory *m,
+                                          int j) {
     const int width = job->width, radius = job->radius, slots = 2 * radius + 1;
     const float *zc = job->depth + (size_t)j * width;
     const float *blurred = m->ring[j % slots];
@@ -270,14 +204,15 @@ static HBAO_ALWAYS_INLINE void finish_row(const finish_job *job, band_memory *m,
         }
         const normal_row n = normals_of_row(job->grid, j);
         const centre_row c = {zc, blurred, n.nx, n.ny, n.nz};
-        blur_pass(&taps, &c, job->sharpness, width, radius, m->finished);
+        pass(&taps, &c, job->sharpness, width, radius, m->finished);
         blurred = m->finished;
     }
     write_output(zc, blurred, width, job->strength, job->out + (int64_t)j * job->out_row_stride);
 }
 
-/* One band of output rows, each row made once it is needed. */
-static HBAO_ALWAYS_INLINE void finish_band(void *context, int band) {
+/* One band of output rows, each row made once it is needed, with the
+ * instruction set's pass. */
+static HBAO_ALWAYS_INLINE void finish_band(void *context, int band, blur_pass_fn pass) {
     finish_job *job = context;
     const int radius = job->radius, height = job->height;
     const int first = band * job->band_rows;
@@ -290,24 +225,33 @@ static HBAO_ALWAYS_INLINE void finish_band(void *context, int band) {
     int next = first - radius > 0 ? first - radius : 0; /* the next row to make */
     for (int j = first; j < last; j++) {
         const int needed = j + radius < height ? j + radius : height - 1;
-        for (; next <= needed; next++) make_row(job, &m, next);
-        finish_row(job, &m, j);
+        for (; next <= needed; next++) make_row(job, pass, &m, next);
+        finish_row(job, pass, &m, j);
     }
     free(m.block);
 }
 
-static void finish_band_portable(void *context, int band) {
-    finish_band(context, band);
-}
+/* The passes, BLUR_LANES pixels at a time, and their row jobs (blur_lanes.h),
+ * one copy per instruction set at its registers' width: GCC splits a vector
+ * wider than the registers piece by piece, partly through memory, and with
+ * 16 lanes the AVX2 copy of the 15-pixel blur took 2.6 times as long as
+ * with 8. The baseline copy keeps 16 lanes (four SSE2 registers), which its
+ * loop runs faster than 8. */
+#define BLUR_LANES 16
+#define BLUR_NAME(name) name##_portable
+#define BLUR_TARGET
+#include "blur_lanes.h"
 
 #ifdef HBAO_FINISH_X86
-HBAO_TARGET_AVX2 static void finish_band_avx2(void *context, int band) {
-    finish_band(context, band);
-}
+#define BLUR_LANES 8
+#define BLUR_NAME(name) name##_avx2
+#define BLUR_TARGET HBAO_TARGET_AVX2
+#include "blur_lanes.h"
 
-HBAO_TARGET_AVX512 static void finish_band_avx512(void *context, int band) {
-    finish_band(context, band);
-}
+#define BLUR_LANES 16
+#define BLUR_NAME(name) name##_avx512
+#define BLUR_TARGET HBAO_TARGET_AVX512
+#include "blur_lanes.h"
 #endif
 
 /* The blur of grid_ao over the grid, with `strength`, into out. */
@@ -321,7 +265,7 @@ static hbao_result blur_grid(const hbao_settings *settings, const hbao_grid *gri
     job.width = grid->width;
     job.height = grid->height;
     job.radius = settings->grid_blur_radius;
-    job.implementation = hbao_finish_implementation(settings->implementation);
+    const int implementation = hbao_finish_implementation(settings->implementation);
     job.sharpness = settings->blur_sharpness;
     job.strength = strength;
     job.out = out;
@@ -340,8 +284,8 @@ static hbao_result blur_grid(const hbao_settings *settings, const hbao_grid *gri
 
     hbao_row_job run = finish_band_portable;
 #ifdef HBAO_FINISH_X86
-    if (job.implementation == HBAO_IMPLEMENTATION_AVX512) run = finish_band_avx512;
-    if (job.implementation == HBAO_IMPLEMENTATION_AVX2) run = finish_band_avx2;
+    if (implementation == HBAO_IMPLEMENTATION_AVX512) run = finish_band_avx512;
+    if (implementation == HBAO_IMPLEMENTATION_AVX2) run = finish_band_avx2;
 #endif
     hbao_parallel_rows(settings->threads, bands, run, &job);
     return atomic_load(&job.out_of_memory) ? HBAO_ERROR_OUT_OF_MEMORY : HBAO_SUCCESS;
