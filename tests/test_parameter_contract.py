@@ -170,6 +170,32 @@ def test_the_blur_formulas_match_the_library():
     assert "sigma =" not in shader_sources.BLUR_FRAGMENT
 
 
+def _falloff_form(body, scale_pattern):
+    """(1 / scale, 2^squarings) of a (1 - x * scale)^(2^n) written as squarings."""
+    scale = float(re.search(scale_pattern, body).group(1))
+    squarings = len(re.findall(r"(\w+(?:\.f)?) \*=? \1\b", body))
+    return 1.0 / scale, 2 ** squarings
+
+
+def test_the_blur_falloff_matches_the_library():
+    # hbao_blur_falloff (csrc/lib/internal_finish.h) and the GLSL's blur_falloff
+    # are (1 - x / R)^R, by squarings: the same R in both, and the power is R. The
+    # viewport's image comparison cannot tell this from exp(-x) (a mutation back
+    # to exp passes its tolerances), so the form is held here.
+    header = (REPO / "csrc" / "lib" / "internal_finish.h").read_text()
+    c_body = re.search(r"float hbao_blur_falloff\(float x\) \{(.*?)\n\}", header, re.S)
+    glsl_body = re.search(r"float blur_falloff\(float x\)\s*\{(.*?)\n\}",
+                          shader_sources.BLUR_FRAGMENT, re.S)
+    assert c_body and glsl_body, "the blur's falloff function not found"
+    c_reach, c_power = _falloff_form(c_body.group(1), r"= 1\.0f - x \* ([\d.]+)f;")
+    glsl_reach, glsl_power = _falloff_form(glsl_body.group(1), r"1\.0 - x \* ([\d.]+)\)")
+    assert c_reach == glsl_reach == c_power == glsl_power == 16.0
+    assert "blur_falloff(difference * difference + NORMAL_SHARPNESS * bend)" in \
+        shader_sources.BLUR_FRAGMENT
+    library_pattern(r"spatial\[t\] \* hbao_blur_falloff\(exponent\)",
+                    "the blur's weight through hbao_blur_falloff")
+
+
 def test_the_glsl_constants_match_the_library():
     defines = shader_sources.AO_DEFINES
     for enum_name in ("hbao_falloff", "hbao_integration"):

@@ -18,7 +18,7 @@ ARTIFACTS = REPO / "out" / "test-artifacts"
 
 # The GLSL follows csrc/lib/ operation for operation in float32; what differs is
 # the GPU's sin/cos/atan/acos/exp (the library uses its own polynomial acos, and
-# hbao_exp_negative, 3.2e-6 relative, in the blur) and rounding order. On llvmpipe
+# hbao_exp_negative, 3.2e-6 relative, in the upsample) and rounding order. On llvmpipe
 # that gives mean |difference| <= 5e-6 and 99th percentile <= 4e-5 (measured,
 # every case). The tolerances leave room for GPUs with coarser transcendentals
 # (NVIDIA's sin/cos: ~1e-6 absolute, more after range reduction) and for the

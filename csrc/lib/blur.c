@@ -80,7 +80,7 @@ typedef struct centre_row {
 } centre_row;
 
 /* One pixel: the centre with weight 1, then the taps in order; the weight
- * of a tap is spatial * exp(-(factor * (z - zc))^2 - NS * max(0, 1 - n.c)),
+ * of a tap is spatial * falloff((factor * (z - zc))^2 + NS * max(0, 1 - n.c)),
  * 0 on background, with factor = min(sharpness / zc, FLT_MAX): sharpness / zc
  * overflows for tiny depths (below ~1e-37, denormals), and an infinite
  * factor would turn a tap at the same depth into 0 * inf = NaN; capped, a
@@ -105,7 +105,7 @@ static HBAO_ALWAYS_INLINE float blur_pixel(const tap_set *taps, const centre_row
         const float exponent =
             difference * difference + HBAO_BLUR_NORMAL_SHARPNESS * (bend > 0.0f ? bend : 0.0f);
         const float valid = (float)(z > 0.0f);
-        const float weight = taps->spatial[t] * hbao_exp_negative(exponent) * valid;
+        const float weight = taps->spatial[t] * hbao_blur_falloff(exponent) * valid;
         sum += weight * taps->ao[t][at];
         weight_sum += weight;
     }

@@ -27,12 +27,17 @@ static HBAO_ALWAYS_INLINE VF BLUR_NAME(select)(VI mask, VF a, VF b) {
     return (VF)((mask & (VI)a) | (~mask & (VI)b));
 }
 
-/* hbao_exp_negative, lane by lane: a loop of BLUR_LANES iterations that
- * the compiler vectorizes, so that the polynomial is written once. */
-static HBAO_ALWAYS_INLINE VF BLUR_NAME(exp_negative)(VF x) {
+/* m ? x : 0, m lanes all ones or zero */
+static HBAO_ALWAYS_INLINE VF BLUR_NAME(zero_unless)(VI m, VF x) {
+    return (VF)(m & (VI)x);
+}
+
+/* hbao_blur_falloff, lane by lane: a loop of BLUR_LANES iterations that the
+ * compiler vectorizes, so that the function is written once. */
+static HBAO_ALWAYS_INLINE VF BLUR_NAME(falloff)(VF x) {
     float in[BLUR_LANES], out[BLUR_LANES];
     memcpy(in, &x, sizeof in);
-    for (int l = 0; l < BLUR_LANES; l++) out[l] = hbao_exp_negative(in[l]);
+    for (int l = 0; l < BLUR_LANES; l++) out[l] = hbao_blur_falloff(in[l]);
     VF result;
     memcpy(&result, out, sizeof result);
     return result;
@@ -60,8 +65,9 @@ static HBAO_ALWAYS_INLINE void BLUR_NAME(lanes)(const tap_set *taps, const centr
         const VF bend = 1.0f - facing;
         const VF exponent =
             difference * difference + HBAO_BLUR_NORMAL_SHARPNESS * (VF)((VI)bend & (bend > 0.0f));
-        const VF valid = (VF)((VI)one & (z > 0.0f));
-        const VF weight = taps->spatial[t] * BLUR_NAME(exp_negative)(exponent) * valid;
+        /* blur_pixel's "* valid": the product is finite, so times 1 is itself */
+        const VF weight =
+            BLUR_NAME(zero_unless)(z > 0.0f, taps->spatial[t] * BLUR_NAME(falloff)(exponent));
         sum += weight * BLUR_NAME(load)(taps->ao[t] + at);
         weight_sum += weight;
     }

@@ -85,14 +85,23 @@ AO_FRAGMENT = CAMERA + horizon_sources.HORIZON_SEARCH
 # blur_sigma, the library's rule. The centre weighs 1 and the taps are summed
 # after it, nearest first on the negative side, as csrc/lib/blur.c does; down
 # a column the order is mirrored (textures are bottom-up), which only changes
-# rounding. The library evaluates exp(-x) with its own polynomial
-# (hbao_exp_negative, 3.2e-6 relative error); the GPU's exp differs from it by
-# that much in a tap's weight, far below tests/test_viewport.py's tolerances.
+# rounding. The weight's falloff is the library's hbao_blur_falloff
+# (csrc/lib/internal_finish.h), (1 - x / 16)^16, by the same four squarings.
 BLUR_FRAGMENT = COMMON + """
 /* FLT_MAX: sharpness / z overflows for tiny depths, and a tap at the same
  * depth would weigh 0 * inf = NaN; capped, it weighs what any tap at the
  * same depth does (csrc/lib/blur.c). */
 #define LARGEST_FLOAT 3.402823466e38
+
+/* hbao_blur_falloff: (1 - x / 16)^16, 0 from 16 on */
+float blur_falloff(float x)
+{
+    float power = max(0.0, 1.0 - x * 0.0625);
+    power *= power;
+    power *= power;
+    power *= power;
+    return power * power;
+}
 
 void main()
 {
@@ -118,7 +127,7 @@ void main()
         float difference = (zq - zc) * factor;
         float bend = max(0.0, 1.0 - dot(texelFetch(normal_texture, q, 0).xyz, nc));
         float spatial = exp(-float(x * x) / (2.0 * sigma * sigma));
-        float w = spatial * exp(-(difference * difference + NORMAL_SHARPNESS * bend));
+        float w = spatial * blur_falloff(difference * difference + NORMAL_SHARPNESS * bend);
         sum += w * texelFetch(ao_texture, q, 0).r;
         weight_sum += w;
     }
