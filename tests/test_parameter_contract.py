@@ -170,30 +170,42 @@ def test_the_blur_formulas_match_the_library():
     assert "sigma =" not in shader_sources.BLUR_FRAGMENT
 
 
-def _falloff_form(body, scale_pattern):
-    """(1 / scale, 2^squarings) of a (1 - x * scale)^(2^n) written as squarings."""
-    scale = float(re.search(scale_pattern, body).group(1))
-    squarings = len(re.findall(r"(\w+(?:\.f)?) \*=? \1\b", body))
-    return 1.0 / scale, 2 ** squarings
+def _squarings(body):
+    """How many times `body` squares: `p * p` and `p *= p`."""
+    return len(re.findall(r"(\w+(?:\.f)?) \*=? \1\b", body))
 
 
 def test_the_blur_falloff_matches_the_library():
-    # hbao_blur_falloff (csrc/lib/internal_finish.h) and the GLSL's blur_falloff
-    # are (1 - x / R)^R, by squarings: the same R in both, and the power is R. The
-    # viewport's image comparison cannot tell this from exp(-x) (a mutation back
-    # to exp passes its tolerances), so the form is held here.
+    # The blur's weight (csrc/lib/internal_finish.h) is (1 - e / R)^R with
+    # R = HBAO_BLUR_FALLOFF_REACH, formed as max(0, base)^16 (hbao_blur_power,
+    # by squarings) of base = (1 - NS / R + min(n.c', NS / R)) - (d / sqrt R)^2.
+    # The viewport's image comparison cannot tell such a weight from exp(-e)
+    # (a mutation back to exp passed its tolerances), so the form is held here:
+    # the power is R in C and GLSL, the depth weight is 1 / sqrt(R), and both
+    # form the base the same way (test_viewport.py compares the constants).
     header = (REPO / "csrc" / "lib" / "internal_finish.h").read_text()
-    c_body = re.search(r"float hbao_blur_falloff\(float x\) \{(.*?)\n\}", header, re.S)
-    glsl_body = re.search(r"float blur_falloff\(float x\)\s*\{(.*?)\n\}",
-                          shader_sources.BLUR_FRAGMENT, re.S)
-    assert c_body and glsl_body, "the blur's falloff function not found"
-    c_reach, c_power = _falloff_form(c_body.group(1), r"= 1\.0f - x \* ([\d.]+)f;")
-    glsl_reach, glsl_power = _falloff_form(glsl_body.group(1), r"1\.0 - x \* ([\d.]+)\)")
-    assert c_reach == glsl_reach == c_power == glsl_power == 16.0
-    assert "blur_falloff(difference * difference + NORMAL_SHARPNESS * bend)" in \
-        shader_sources.BLUR_FRAGMENT
-    library_pattern(r"spatial\[t\] \* hbao_blur_falloff\(exponent\)",
-                    "the blur's weight through hbao_blur_falloff")
+    reach = float(re.search(r"#define HBAO_BLUR_FALLOFF_REACH ([\d.]+)f", header).group(1))
+    depth_weight = float(re.search(r"#define HBAO_BLUR_DEPTH_WEIGHT ([\d.]+)f", header).group(1))
+    assert depth_weight ** 2 * reach == 1.0
+    assert "#define HBAO_BLUR_NORMAL_WEIGHT (HBAO_BLUR_NORMAL_SHARPNESS / " \
+        "HBAO_BLUR_FALLOFF_REACH)" in header
+    c_power = re.search(r"float hbao_blur_power\(float base\) \{(.*?)\n\}", header, re.S)
+    glsl = shader_sources.BLUR_FRAGMENT
+    glsl_power = re.search(r"float blur_power\(float base\)\s*\{(.*?)\n\}", glsl, re.S)
+    assert c_power and glsl_power, "the blur's power function not found"
+    assert 2 ** _squarings(c_power.group(1)) == 2 ** _squarings(glsl_power.group(1)) == reach
+    assert "#define NORMAL_WEIGHT (NORMAL_SHARPNESS / FALLOFF_REACH)" in glsl
+    for c_form, glsl_form in [
+            ("(scaled < FLT_MAX ? scaled : FLT_MAX) * HBAO_BLUR_DEPTH_WEIGHT",
+             "min(sharpness / zc, LARGEST_FLOAT) * DEPTH_WEIGHT"),
+            ("c->nx[i] * HBAO_BLUR_NORMAL_WEIGHT", ".xyz * NORMAL_WEIGHT"),
+            ("facing < HBAO_BLUR_NORMAL_WEIGHT ? facing : HBAO_BLUR_NORMAL_WEIGHT",
+             "min(dot(texelFetch(normal_texture, q, 0).xyz, nc), NORMAL_WEIGHT)"),
+            ("(1.0f - HBAO_BLUR_NORMAL_WEIGHT + capped) - difference * difference",
+             "(1.0 - NORMAL_WEIGHT + facing) - difference * difference"),
+            ("taps->spatial[t] * hbao_blur_power(base)", "spatial * blur_power(base)")]:
+        assert c_form in LIBRARY_SOURCES["blur.c"], c_form
+        assert glsl_form in glsl, glsl_form
 
 
 def test_the_glsl_constants_match_the_library():

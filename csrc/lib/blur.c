@@ -22,6 +22,9 @@
 #include <string.h>
 
 #include "internal_finish.h"
+#ifdef HBAO_FINISH_X86
+#include <immintrin.h>
+#endif
 
 #define MAX_BLUR_RADIUS ((HBAO_MAX_BLUR_SIZE - 1) / 2)
 
@@ -80,42 +83,40 @@ typedef struct centre_row {
 } centre_row;
 
 /* One pixel: the centre with weight 1, then the taps in order; the weight
- * of a tap is spatial * falloff((factor * (z - zc))^2 + NS * max(0, 1 - n.c)),
- * 0 on background, with factor = min(sharpness / zc, FLT_MAX): sharpness / zc
- * overflows for tiny depths (below ~1e-37, denormals), and an infinite
- * factor would turn a tap at the same depth into 0 * inf = NaN; capped, a
- * tap whose scaled difference overflows weighs 0. A 0/1 factor rather than a
- * branch marks background; the weight is finite, so the product is exact.
- * The vector loop below performs exactly these operations lane by lane.
- * Background centres give 1. */
+ * of a tap is spatial * F, 0 on background, with F of the depth difference
+ * (factor * (z - zc)) and the normals as internal_finish.h forms it and
+ * factor = min(sharpness / zc, FLT_MAX): sharpness / zc overflows for tiny
+ * depths (below ~1e-37, denormals), and an infinite factor would turn a
+ * tap at the same depth into 0 * inf = NaN; capped, a tap whose scaled
+ * difference overflows weighs 0. min(n.c, 1) also keeps what a normal
+ * that is not unit (infinite where a denormal depth's view vector
+ * overflowed) may do: at most the weight of a tap on the same plane. A 0/1
+ * factor rather than a branch marks background; the weight is finite, so
+ * the product is exact. The vector loop (blur_lanes.h) performs exactly
+ * these operations lane by lane. Background centres give 1. */
 static HBAO_ALWAYS_INLINE float blur_pixel(const tap_set *taps, const centre_row *c,
                                            float sharpness, int width, int i) {
     const float zc = c->z[i];
     const float scaled = zc > 0.0f ? sharpness / zc : 0.0f;
-    const float factor = scaled < FLT_MAX ? scaled : FLT_MAX;
+    const float factor = (scaled < FLT_MAX ? scaled : FLT_MAX) * HBAO_BLUR_DEPTH_WEIGHT;
+    const float cx = c->nx[i] * HBAO_BLUR_NORMAL_WEIGHT, cy = c->ny[i] * HBAO_BLUR_NORMAL_WEIGHT,
+                cz = c->nz[i] * HBAO_BLUR_NORMAL_WEIGHT;
     float sum = c->ao[i], weight_sum = 1.0f;
     for (int t = 0; t < taps->count; t++) {
         const int at = i + taps->offset[t];
         if (taps->along_row && (at < 0 || at >= width)) continue;
         const float z = taps->z[t][at];
         const float difference = (z - zc) * factor;
-        const float facing =
-            taps->nx[t][at] * c->nx[i] + taps->ny[t][at] * c->ny[i] + taps->nz[t][at] * c->nz[i];
-        const float bend = 1.0f - facing;
-        const float exponent =
-            difference * difference + HBAO_BLUR_NORMAL_SHARPNESS * (bend > 0.0f ? bend : 0.0f);
+        const float facing = taps->nx[t][at] * cx + taps->ny[t][at] * cy + taps->nz[t][at] * cz;
+        const float capped = facing < HBAO_BLUR_NORMAL_WEIGHT ? facing : HBAO_BLUR_NORMAL_WEIGHT;
+        const float base = (1.0f - HBAO_BLUR_NORMAL_WEIGHT + capped) - difference * difference;
         const float valid = (float)(z > 0.0f);
-        const float weight = taps->spatial[t] * hbao_blur_falloff(exponent) * valid;
+        const float weight = taps->spatial[t] * hbao_blur_power(base) * valid;
         sum += weight * taps->ao[t][at];
         weight_sum += weight;
     }
     return zc > 0.0f ? sum / weight_sum : 1.0f;
 }
-
-/* One pass over a row of centres into target: blur_pixel for every pixel
- * (blur_lanes.h writes each instruction set's copy). */
-typedef void (*blur_pass_fn)(const tap_set *taps, const centre_row *c, float sharpness, int width,
-                             int radius, float *target);
 
 /* Scratch of one band: the finished row and the ring of rows blurred
  * along themselves, width floats each. */
@@ -134,34 +135,51 @@ static int band_memory_make(band_memory *m, int width, int slots) {
     return 1;
 }
 
-/* Row j's raw AO blurred along the row, into its ring slot. */
-static HBAO_ALWAYS_INLINE void make_row(const finish_job *job, blur_pass_fn pass, band_memory *m,
-                                        int j) {
+/* The taps and centres of row j's pass along the row (radius > 0): row j's
+ * raw AO, to be blurred into its ring slot. */
+static HBAO_ALWAYS_INLINE void row_pass(const finish_job *job, int j, tap_set *taps,
+                                        centre_row *c) {
     const int width = job->width, radius = job->radius;
-    float *slot = m->ring[j % (2 * radius + 1)];
     const float *raw = job->grid_ao + (size_t)j * width;
-    if (radius == 0) {
-        memcpy(slot, raw, (size_t)width * sizeof(float));
-        return;
-    }
     const normal_row n = normals_of_row(job->grid, j);
     const float *z = job->depth + (size_t)j * width;
-    tap_set taps;
-    taps.count = 0;
-    taps.along_row = 1;
+    taps->count = 0;
+    taps->along_row = 1;
     for (int k = -radius; k <= radius; k++) {
         if (k == 0) continue;
-        taps.z[taps.count] = z;
-        taps.ao[taps.count] = raw;
-        taps.nx[taps.count] = n.nx;
-        taps.ny[taps.count] = n.ny;
-        taps.nz[taps.count] = n.nz;
-        taps.offset[taps.count] = k;
-        taps.spatial[taps.count] = job->spatial[k < 0 ? -k : k];
-        taps.count++;
+        taps->z[taps->count] = z;
+        taps->ao[taps->count] = raw;
+        taps->nx[taps->count] = n.nx;
+        taps->ny[taps->count] = n.ny;
+        taps->nz[taps->count] = n.nz;
+        taps->offset[taps->count] = k;
+        taps->spatial[taps->count] = job->spatial[k < 0 ? -k : k];
+        taps->count++;
     }
-    const centre_row centre = {z, raw, n.nx, n.ny, n.nz};
-    pass(&taps, &centre, job->sharpness, width, radius, slot);
+    *c = (centre_row){z, raw, n.nx, n.ny, n.nz};
+}
+
+/* The taps and centres of row j's pass down the column (radius > 0): rows
+ * j - r .. j + r of the ring. */
+static HBAO_ALWAYS_INLINE void column_pass(const finish_job *job, const band_memory *m, int j,
+                                           tap_set *taps, centre_row *c) {
+    const int width = job->width, radius = job->radius, slots = 2 * radius + 1;
+    taps->count = 0;
+    taps->along_row = 0;
+    for (int k = -radius; k <= radius; k++) {
+        if (k == 0 || j + k < 0 || j + k >= job->height) continue;
+        const normal_row n = normals_of_row(job->grid, j + k);
+        taps->z[taps->count] = job->depth + (size_t)(j + k) * width;
+        taps->ao[taps->count] = m->ring[(j + k) % slots];
+        taps->nx[taps->count] = n.nx;
+        taps->ny[taps->count] = n.ny;
+        taps->nz[taps->count] = n.nz;
+        taps->offset[taps->count] = 0;
+        taps->spatial[taps->count] = job->spatial[k < 0 ? -k : k];
+        taps->count++;
+    }
+    const normal_row n = normals_of_row(job->grid, j);
+    *c = (centre_row){job->depth + (size_t)j * width, m->ring[j % slots], n.nx, n.ny, n.nz};
 }
 
 /* A finished row of AO (1 on background, where zc <= 0) to the output:
@@ -179,64 +197,16 @@ static HBAO_ALWAYS_INLINE void write_output(const float *zc, const float *ao, in
     }
 }
 
-/* Finished row j: rows j - r .. j + r of the ring blurred down the column,
- * then strength and the clamp to [0, 1]. */
-static HBAO_ALWAYS_INLINE void finish_row(const finish_job *job, blur_pass_fn pass, band_memory *m,
-                                          int j) {
-    const int width = job->width, radius = job->radius, slots = 2 * radius + 1;
-    const float *zc = job->depth + (size_t)j * width;
-    const float *blurred = m->ring[j % slots];
-    if (radius > 0) {
-        tap_set taps;
-        taps.count = 0;
-        taps.along_row = 0;
-        for (int k = -radius; k <= radius; k++) {
-            if (k == 0 || j + k < 0 || j + k >= job->height) continue;
-            const normal_row n = normals_of_row(job->grid, j + k);
-            taps.z[taps.count] = job->depth + (size_t)(j + k) * width;
-            taps.ao[taps.count] = m->ring[(j + k) % slots];
-            taps.nx[taps.count] = n.nx;
-            taps.ny[taps.count] = n.ny;
-            taps.nz[taps.count] = n.nz;
-            taps.offset[taps.count] = 0;
-            taps.spatial[taps.count] = job->spatial[k < 0 ? -k : k];
-            taps.count++;
-        }
-        const normal_row n = normals_of_row(job->grid, j);
-        const centre_row c = {zc, blurred, n.nx, n.ny, n.nz};
-        pass(&taps, &c, job->sharpness, width, radius, m->finished);
-        blurred = m->finished;
-    }
-    write_output(zc, blurred, width, job->strength, job->out + (int64_t)j * job->out_row_stride);
-}
-
-/* One band of output rows, each row made once it is needed, with the
- * instruction set's pass. */
-static HBAO_ALWAYS_INLINE void finish_band(void *context, int band, blur_pass_fn pass) {
-    finish_job *job = context;
-    const int radius = job->radius, height = job->height;
-    const int first = band * job->band_rows;
-    const int last = first + job->band_rows < height ? first + job->band_rows : height;
-    band_memory m;
-    if (!band_memory_make(&m, job->width, 2 * radius + 1)) {
-        atomic_store(&job->out_of_memory, 1);
-        return;
-    }
-    int next = first - radius > 0 ? first - radius : 0; /* the next row to make */
-    for (int j = first; j < last; j++) {
-        const int needed = j + radius < height ? j + radius : height - 1;
-        for (; next <= needed; next++) make_row(job, pass, &m, next);
-        finish_row(job, pass, &m, j);
-    }
-    free(m.block);
-}
-
-/* The passes, BLUR_LANES pixels at a time, and their row jobs (blur_lanes.h),
+/* The passes, BLUR_LANES pixels at a time, and the band jobs that run them
+ * (blur_lanes.h),
  * one copy per instruction set at its registers' width: GCC splits a vector
  * wider than the registers piece by piece, partly through memory, and with
  * 16 lanes the AVX2 copy of the 15-pixel blur took 2.6 times as long as
  * with 8. The baseline copy keeps 16 lanes (four SSE2 registers), which its
- * loop runs faster than 8. */
+ * loop runs faster than 8. The x86 copies take their minimum and maximum
+ * from the instruction set (BLUR_MIN, BLUR_MAX: a < b ? a : b and
+ * a > b ? a : b, NaN giving b, as the scalar code's selects), one
+ * instruction where GCC's vector selects take two. */
 #define BLUR_LANES 16
 #define BLUR_NAME(name) name##_portable
 #define BLUR_TARGET
@@ -244,11 +214,15 @@ static HBAO_ALWAYS_INLINE void finish_band(void *context, int band, blur_pass_fn
 
 #ifdef HBAO_FINISH_X86
 #define BLUR_LANES 8
+#define BLUR_MIN _mm256_min_ps
+#define BLUR_MAX _mm256_max_ps
 #define BLUR_NAME(name) name##_avx2
 #define BLUR_TARGET HBAO_TARGET_AVX2
 #include "blur_lanes.h"
 
 #define BLUR_LANES 16
+#define BLUR_MIN _mm512_min_ps
+#define BLUR_MAX _mm512_max_ps
 #define BLUR_NAME(name) name##_avx512
 #define BLUR_TARGET HBAO_TARGET_AVX512
 #include "blur_lanes.h"

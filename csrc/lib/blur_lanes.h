@@ -1,10 +1,12 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
 /* A pass of the blur over a row of centres, BLUR_LANES pixels at a time in
- * GCC vector types, and the row job that runs it: written once for every
+ * GCC vector types, and the band job that runs it: written once for every
  * instruction set, blur.c includes this header once per copy, after
  * defining BLUR_LANES (the lanes of a vector), BLUR_NAME(x) (the copy's
- * names) and BLUR_TARGET (its instruction set's function attribute, or
- * nothing). Every operation is blur_pixel's (blur.c), lane by lane and
+ * names), BLUR_TARGET (its instruction set's function attribute, or
+ * nothing) and, optionally, BLUR_MIN and BLUR_MAX (the instruction set's
+ * minimum and maximum of two vectors of BLUR_LANES floats: a < b ? a : b
+ * and a > b ? a : b, b where either is NaN). Every operation is blur_pixel's (blur.c), lane by lane and
  * never contracted into an FMA, so every copy gives the same floats as the
  * scalar reference (test_blur.c compares them). */
 
@@ -16,44 +18,58 @@ typedef int32_t BLUR_NAME(vint) __attribute__((vector_size(4 * BLUR_LANES)));
 #define VF BLUR_NAME(vfloat)
 #define VI BLUR_NAME(vint)
 
-static HBAO_ALWAYS_INLINE VF BLUR_NAME(load)(const float *p) {
+BLUR_TARGET static HBAO_ALWAYS_INLINE VF BLUR_NAME(load)(const float *p) {
     VF v;
     memcpy(&v, p, sizeof v);
     return v;
 }
 
 /* mask ? a : b, mask lanes all ones or zero */
-static HBAO_ALWAYS_INLINE VF BLUR_NAME(select)(VI mask, VF a, VF b) {
+BLUR_TARGET static HBAO_ALWAYS_INLINE VF BLUR_NAME(select)(VI mask, VF a, VF b) {
     return (VF)((mask & (VI)a) | (~mask & (VI)b));
 }
 
 /* m ? x : 0, m lanes all ones or zero */
-static HBAO_ALWAYS_INLINE VF BLUR_NAME(zero_unless)(VI m, VF x) {
+BLUR_TARGET static HBAO_ALWAYS_INLINE VF BLUR_NAME(zero_unless)(VI m, VF x) {
     return (VF)(m & (VI)x);
 }
 
-/* hbao_blur_falloff, lane by lane: a loop of BLUR_LANES iterations that the
- * compiler vectorizes, so that the function is written once. */
-static HBAO_ALWAYS_INLINE VF BLUR_NAME(falloff)(VF x) {
-    float in[BLUR_LANES], out[BLUR_LANES];
-    memcpy(in, &x, sizeof in);
-    for (int l = 0; l < BLUR_LANES; l++) out[l] = hbao_blur_falloff(in[l]);
-    VF result;
-    memcpy(&result, out, sizeof result);
-    return result;
+/* min(a, b) as blur_pixel's a < b ? a : b, lane by lane */
+BLUR_TARGET static HBAO_ALWAYS_INLINE VF BLUR_NAME(min)(VF a, VF b) {
+#ifdef BLUR_MIN
+    return (VF)BLUR_MIN(a, b);
+#else
+    return BLUR_NAME(select)(a < b, a, b);
+#endif
+}
+
+/* hbao_blur_power, lane by lane */
+BLUR_TARGET static HBAO_ALWAYS_INLINE VF BLUR_NAME(power)(VF base) {
+#ifdef BLUR_MAX
+    const VF zero = {0.0f};
+    VF power = (VF)BLUR_MAX(base, zero);
+#else
+    VF power = BLUR_NAME(zero_unless)(base > 0.0f, base);
+#endif
+    power *= power; /* ^2 */
+    power *= power; /* ^4 */
+    power *= power; /* ^8 */
+    return power * power;
 }
 
 /* blur_pixel for pixels i .. i + BLUR_LANES - 1, all of whose taps lie
  * inside the row. */
-static HBAO_ALWAYS_INLINE void BLUR_NAME(lanes)(const tap_set *taps, const centre_row *c,
-                                                float sharpness, int i, float *target) {
+BLUR_TARGET static HBAO_ALWAYS_INLINE void
+BLUR_NAME(lanes)(const tap_set *taps, const centre_row *c, float sharpness, int i, float *target) {
     const VF zero = {0.0f}, one = zero + 1.0f;
     const VF zc = BLUR_NAME(load)(c->z + i);
     const VI geometry = zc > 0.0f;
     const VF scaled = BLUR_NAME(select)(geometry, sharpness / zc, zero);
-    const VF factor = BLUR_NAME(select)(scaled < FLT_MAX, scaled, zero + FLT_MAX);
-    const VF cx = BLUR_NAME(load)(c->nx + i), cy = BLUR_NAME(load)(c->ny + i),
-             cz = BLUR_NAME(load)(c->nz + i);
+    const VF factor =
+        BLUR_NAME(select)(scaled < FLT_MAX, scaled, zero + FLT_MAX) * HBAO_BLUR_DEPTH_WEIGHT;
+    const VF cx = BLUR_NAME(load)(c->nx + i) * HBAO_BLUR_NORMAL_WEIGHT,
+             cy = BLUR_NAME(load)(c->ny + i) * HBAO_BLUR_NORMAL_WEIGHT,
+             cz = BLUR_NAME(load)(c->nz + i) * HBAO_BLUR_NORMAL_WEIGHT;
     VF sum = BLUR_NAME(load)(c->ao + i), weight_sum = one;
     for (int t = 0; t < taps->count; t++) {
         const int at = i + taps->offset[t];
@@ -62,12 +78,11 @@ static HBAO_ALWAYS_INLINE void BLUR_NAME(lanes)(const tap_set *taps, const centr
         const VF facing = BLUR_NAME(load)(taps->nx[t] + at) * cx +
                           BLUR_NAME(load)(taps->ny[t] + at) * cy +
                           BLUR_NAME(load)(taps->nz[t] + at) * cz;
-        const VF bend = 1.0f - facing;
-        const VF exponent =
-            difference * difference + HBAO_BLUR_NORMAL_SHARPNESS * (VF)((VI)bend & (bend > 0.0f));
+        const VF capped = BLUR_NAME(min)(facing, zero + HBAO_BLUR_NORMAL_WEIGHT);
+        const VF base = (1.0f - HBAO_BLUR_NORMAL_WEIGHT + capped) - difference * difference;
         /* blur_pixel's "* valid": the product is finite, so times 1 is itself */
         const VF weight =
-            BLUR_NAME(zero_unless)(z > 0.0f, taps->spatial[t] * BLUR_NAME(falloff)(exponent));
+            BLUR_NAME(zero_unless)(z > 0.0f, taps->spatial[t] * BLUR_NAME(power)(base));
         sum += weight * BLUR_NAME(load)(taps->ao[t] + at);
         weight_sum += weight;
     }
@@ -75,11 +90,12 @@ static HBAO_ALWAYS_INLINE void BLUR_NAME(lanes)(const tap_set *taps, const centr
     memcpy(target + i, &blurred, sizeof blurred);
 }
 
-/* The copy's blur_pass_fn (blur.c): the vector loop where every tap lies
- * inside the row, blur_pixel at the ends. */
-static HBAO_ALWAYS_INLINE void BLUR_NAME(blur_pass)(const tap_set *taps, const centre_row *c,
-                                                    float sharpness, int width, int radius,
-                                                    float *target) {
+/* One pass over a row of centres into target: the vector loop where every
+ * tap lies inside the row, blur_pixel (blur.c) at the ends. */
+BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(blur_pass)(const tap_set *taps,
+                                                                const centre_row *c,
+                                                                float sharpness, int width,
+                                                                int radius, float *target) {
     const int first = taps->along_row ? radius : 0;
     const int last = taps->along_row ? width - radius : width; /* vector lanes in [first, last) */
     int i = 0;
@@ -88,9 +104,44 @@ static HBAO_ALWAYS_INLINE void BLUR_NAME(blur_pass)(const tap_set *taps, const c
     for (; i < width; i++) target[i] = blur_pixel(taps, c, sharpness, width, i);
 }
 
-/* The copy's row job: blur.c's finish_band with this copy's pass inlined. */
+/* The copy's job for one band of output rows: each row is made (blurred
+ * along itself into the ring) once a column pass needs it, then the band's
+ * rows are blurred down their columns and written out. */
 BLUR_TARGET static void BLUR_NAME(finish_band)(void *context, int band) {
-    finish_band(context, band, BLUR_NAME(blur_pass));
+    finish_job *job = context;
+    const int width = job->width, radius = job->radius, height = job->height;
+    const int slots = 2 * radius + 1;
+    const int first = band * job->band_rows;
+    const int last = first + job->band_rows < height ? first + job->band_rows : height;
+    band_memory m;
+    if (!band_memory_make(&m, width, slots)) {
+        atomic_store(&job->out_of_memory, 1);
+        return;
+    }
+    tap_set taps;
+    centre_row c;
+    int next = first - radius > 0 ? first - radius : 0; /* the next row to make */
+    for (int j = first; j < last; j++) {
+        const int needed = j + radius < height ? j + radius : height - 1;
+        for (; next <= needed; next++) {
+            float *slot = m.ring[next % slots];
+            if (radius == 0) {
+                memcpy(slot, job->grid_ao + (size_t)next * width, (size_t)width * sizeof(float));
+                continue;
+            }
+            row_pass(job, next, &taps, &c);
+            BLUR_NAME(blur_pass)(&taps, &c, job->sharpness, width, radius, slot);
+        }
+        const float *blurred = m.ring[j % slots];
+        if (radius > 0) {
+            column_pass(job, &m, j, &taps, &c);
+            BLUR_NAME(blur_pass)(&taps, &c, job->sharpness, width, radius, m.finished);
+            blurred = m.finished;
+        }
+        write_output(job->depth + (size_t)j * width, blurred, width, job->strength,
+                     job->out + (int64_t)j * job->out_row_stride);
+    }
+    free(m.block);
 }
 
 #undef VF
@@ -98,3 +149,5 @@ BLUR_TARGET static void BLUR_NAME(finish_band)(void *context, int band) {
 #undef BLUR_LANES
 #undef BLUR_NAME
 #undef BLUR_TARGET
+#undef BLUR_MIN
+#undef BLUR_MAX

@@ -16,7 +16,7 @@
 
 /* How strongly the blur stops where the normal turns, in units of
  * 1 - cos(angle between the two normals) (docs/algorithm.md, "After
- * sampling"): a tap on a face at 90 degrees weighs falloff(8) ~ 1.5e-5, at
+ * sampling"): a tap on a face at 90 degrees weighs F(8) ~ 1.5e-5, at
  * 45 degrees 0.08, at 20 degrees 0.61, at 5 degrees 0.97. A crease is cut
  * off at 8 as at 16 (the fin test measures the same errors), while the
  * facets of a low-polygon curved surface (10-25 degrees apart) keep most of
@@ -24,27 +24,37 @@
  * them. */
 #define HBAO_BLUR_NORMAL_SHARPNESS 8.0f
 
-/* The blur's weight for an exponent x >= 0 (its depth and normal terms):
- * (1 - x / 16)^16, 0 from x = 16 on and for NaN. It follows exp(-x) where
- * the weights matter (x = 0.5: 0.602 for 0.607, x = 1: 0.356 for 0.368,
- * x = 2: 0.118 for 0.135) and falls faster beyond, to exactly 0 where
- * exp(-x) is below 1e-7. Four multiplications instead of exp's polynomial
- * and scale, which were a third of a tap: the blur's stages take 0.80 of
- * the time with the 15-pixel blur, and the quick benchmark's error moves by
- * less than 0.2 % (docs/speed.md). Branch-free (the select is an integer
- * mask) so that loops calling it vectorize. The viewport's GLSL
- * (blur_falloff, addon/hbao/viewport/shader_sources.py) is the same. */
-static inline float hbao_blur_falloff(float x) {
+/* The blur's range weight (docs/algorithm.md, "After sampling"): with
+ * d = f_c (z - z_c) and the bend NS (1 - min(n.c, 1)) (NS =
+ * HBAO_BLUR_NORMAL_SHARPNESS), the weight of the exponent e = d^2 + bend is
+ * F(e) = (1 - e / R)^R, 0 from e = R on, with R = HBAO_BLUR_FALLOFF_REACH.
+ * F follows exp(-e) where the weights matter (e = 0.5: 0.602 for 0.607,
+ * e = 1: 0.356 for 0.368, e = 2: 0.118 for 0.135) and falls faster beyond,
+ * to exactly 0 where exp(-e) is below 1e-7. Its base 1 - e / R is formed as
+ *   (1 - NS / R + min(n.(NS / R c), NS / R)) - (d / sqrt(R))^2,
+ * the centre's normal and depth factor scaled once per pixel
+ * (HBAO_BLUR_NORMAL_WEIGHT, HBAO_BLUR_DEPTH_WEIGHT; both scalings are by
+ * powers of 2, so exact): 22 vector operations a tap, where exp(-e) with
+ * the old exponent took 38 (docs/speed.md). The GLSL preview
+ * (addon/hbao/viewport/shader_sources.py, blur_power) computes the same. */
+#define HBAO_BLUR_FALLOFF_REACH 16.0f
+#define HBAO_BLUR_NORMAL_WEIGHT (HBAO_BLUR_NORMAL_SHARPNESS / HBAO_BLUR_FALLOFF_REACH)
+#define HBAO_BLUR_DEPTH_WEIGHT 0.25f /* 1 / sqrt(HBAO_BLUR_FALLOFF_REACH) */
+
+/* F's power: max(0, base)^R by four squarings (R = 16), 0 for NaN.
+ * Branch-free (the select is an integer mask) so that loops calling it
+ * vectorize. */
+static inline float hbao_blur_power(float base) {
     union {
         float f;
         uint32_t u;
-    } base;
-    base.f = 1.0f - x * 0.0625f;
-    base.u &= 0u - (uint32_t)(base.f > 0.0f); /* x >= 16 or NaN: 0 */
-    float power = base.f * base.f;            /* ^2 */
-    power *= power;                           /* ^4 */
-    power *= power;                           /* ^8 */
-    return power * power;                     /* ^16 */
+    } clamped;
+    clamped.f = base;
+    clamped.u &= 0u - (uint32_t)(base > 0.0f); /* max(0, base); NaN: 0 */
+    float power = clamped.f * clamped.f;       /* ^2 */
+    power *= power;                            /* ^4 */
+    power *= power;                            /* ^8 */
+    return power * power;                      /* ^16 */
 }
 
 /* The loops of these stages are plain C written to auto-vectorize (the

@@ -85,18 +85,21 @@ AO_FRAGMENT = CAMERA + horizon_sources.HORIZON_SEARCH
 # blur_sigma, the library's rule. The centre weighs 1 and the taps are summed
 # after it, nearest first on the negative side, as csrc/lib/blur.c does; down
 # a column the order is mirrored (textures are bottom-up), which only changes
-# rounding. The weight's falloff is the library's hbao_blur_falloff
-# (csrc/lib/internal_finish.h), (1 - x / 16)^16, by the same four squarings.
+# rounding. The weight is the library's (csrc/lib/internal_finish.h,
+# hbao_blur_power): max(0, base)^16 by the same four squarings, of the same
+# base, with the centre's factor and normal scaled once per pixel.
 BLUR_FRAGMENT = COMMON + """
 /* FLT_MAX: sharpness / z overflows for tiny depths, and a tap at the same
  * depth would weigh 0 * inf = NaN; capped, it weighs what any tap at the
  * same depth does (csrc/lib/blur.c). */
 #define LARGEST_FLOAT 3.402823466e38
+/* HBAO_BLUR_NORMAL_WEIGHT: NORMAL_SHARPNESS / FALLOFF_REACH */
+#define NORMAL_WEIGHT (NORMAL_SHARPNESS / FALLOFF_REACH)
 
-/* hbao_blur_falloff: (1 - x / 16)^16, 0 from 16 on */
-float blur_falloff(float x)
+/* hbao_blur_power: max(0, base)^16 */
+float blur_power(float base)
 {
-    float power = max(0.0, 1.0 - x * 0.0625);
+    float power = max(base, 0.0);
     power *= power;
     power *= power;
     power *= power;
@@ -111,8 +114,8 @@ void main()
         frag_output = vec4(1.0, 0.0, 0.0, 1.0);
         return;
     }
-    float factor = min(sharpness / zc, LARGEST_FLOAT);
-    vec3 nc = texelFetch(normal_texture, p, 0).xyz;
+    float factor = min(sharpness / zc, LARGEST_FLOAT) * DEPTH_WEIGHT;
+    vec3 nc = texelFetch(normal_texture, p, 0).xyz * NORMAL_WEIGHT;
     float sum = texelFetch(ao_texture, p, 0).r;
     float weight_sum = 1.0;
     for (int x = -kernel_radius; x <= kernel_radius; x++) {
@@ -125,9 +128,10 @@ void main()
             continue;
         }
         float difference = (zq - zc) * factor;
-        float bend = max(0.0, 1.0 - dot(texelFetch(normal_texture, q, 0).xyz, nc));
+        float facing = min(dot(texelFetch(normal_texture, q, 0).xyz, nc), NORMAL_WEIGHT);
+        float base = (1.0 - NORMAL_WEIGHT + facing) - difference * difference;
         float spatial = exp(-float(x * x) / (2.0 * sigma * sigma));
-        float w = spatial * blur_falloff(difference * difference + NORMAL_SHARPNESS * bend);
+        float w = spatial * blur_power(base);
         sum += w * texelFetch(ao_texture, q, 0).r;
         weight_sum += w;
     }
@@ -252,7 +256,10 @@ UPSAMPLE_DEFINES = {
 }
 
 BLUR_DEFINES = {
-    # csrc/lib/internal_finish.h, HBAO_BLUR_NORMAL_SHARPNESS
-    # (tests/test_viewport.py compares the two).
+    # csrc/lib/internal_finish.h, HBAO_BLUR_NORMAL_SHARPNESS,
+    # HBAO_BLUR_FALLOFF_REACH and HBAO_BLUR_DEPTH_WEIGHT
+    # (tests/test_viewport.py compares them).
     "NORMAL_SHARPNESS": 8.0,
+    "FALLOFF_REACH": 16.0,
+    "DEPTH_WEIGHT": 0.25,
 }
