@@ -65,8 +65,8 @@ static HBAO_ALWAYS_INLINE normal_row normals_of_row(const hbao_grid *grid, int j
 /* The taps of one pass for one row of centres, the centre itself left out
  * (it weighs 1): tap t of pixel i reads z[t][i + offset[t]] (and likewise ao
  * and the normal); along a row every tap reads the centre row shifted by
- * its offset k, down a column every tap reads its own row unshifted. Taps
- * outside the image are left out. */
+ * its offset k (its pointers are the centre's), down a column every tap
+ * reads its own row unshifted. Taps outside the image are left out. */
 typedef struct tap_set {
     int count;
     int along_row; /* 1: offsets shift along the row, so edge pixels lose taps */
