@@ -63,17 +63,19 @@ static HBAO_ALWAYS_INLINE normal_row normals_of_row(const hbao_grid *grid, int j
 }
 
 /* The taps of one pass for one row of centres, the centre itself left out
- * (it weighs 1): tap t of pixel i reads z[t][i + offset[t]] (and likewise ao
- * and the normal); along a row every tap reads the centre row shifted by
- * its offset k (its pointers are the centre's), down a column every tap
- * reads its own row unshifted. Taps outside the image are left out. */
+ * (it weighs 1), as steps from the centre's rows (centre_row): tap t of
+ * pixel i reads the depth at c->z[i + depth_step[t]], the normal at
+ * c->nx, ny, nz[i + normal_step[t]] and the AO at ao[t][i + k] along a row,
+ * ao[t][i] down a column. Along a row every step is the tap's offset k
+ * (the same rows, shifted) and ao[t] is the centre's row; down a column the
+ * steps are k rows of depth and k rows of normals (which lie three
+ * components apart) and ao[t] is row j + k of the ring. Taps outside the
+ * image are left out. */
 typedef struct tap_set {
     int count;
-    int along_row; /* 1: offsets shift along the row, so edge pixels lose taps */
-    const float *z[2 * MAX_BLUR_RADIUS + 1], *ao[2 * MAX_BLUR_RADIUS + 1];
-    const float *nx[2 * MAX_BLUR_RADIUS + 1], *ny[2 * MAX_BLUR_RADIUS + 1],
-        *nz[2 * MAX_BLUR_RADIUS + 1];
-    int offset[2 * MAX_BLUR_RADIUS + 1];
+    int along_row; /* 1: steps shift along the row, so edge pixels lose taps */
+    int depth_step[2 * MAX_BLUR_RADIUS + 1], normal_step[2 * MAX_BLUR_RADIUS + 1];
+    const float *ao[2 * MAX_BLUR_RADIUS + 1];
     float spatial[2 * MAX_BLUR_RADIUS + 1];
 } tap_set;
 
@@ -103,16 +105,16 @@ static HBAO_ALWAYS_INLINE float blur_pixel(const tap_set *taps, const centre_row
                 cz = c->nz[i] * HBAO_BLUR_NORMAL_WEIGHT;
     float sum = c->ao[i], weight_sum = 1.0f;
     for (int t = 0; t < taps->count; t++) {
-        const int at = i + taps->offset[t];
+        const int at = i + taps->depth_step[t], normal_at = i + taps->normal_step[t];
         if (taps->along_row && (at < 0 || at >= width)) continue;
-        const float z = taps->z[t][at];
+        const float z = c->z[at];
         const float difference = (z - zc) * factor;
-        const float facing = taps->nx[t][at] * cx + taps->ny[t][at] * cy + taps->nz[t][at] * cz;
+        const float facing = c->nx[normal_at] * cx + c->ny[normal_at] * cy + c->nz[normal_at] * cz;
         const float capped = facing < HBAO_BLUR_NORMAL_WEIGHT ? facing : HBAO_BLUR_NORMAL_WEIGHT;
         const float base = (1.0f - HBAO_BLUR_NORMAL_WEIGHT + capped) - difference * difference;
         const float valid = (float)(z > 0.0f);
         const float weight = taps->spatial[t] * hbao_blur_power(base) * valid;
-        sum += weight * taps->ao[t][at];
+        sum += weight * taps->ao[t][taps->along_row ? at : i];
         weight_sum += weight;
     }
     return zc > 0.0f ? sum / weight_sum : 1.0f;
@@ -147,12 +149,9 @@ static HBAO_ALWAYS_INLINE void row_pass(const finish_job *job, int j, tap_set *t
     taps->along_row = 1;
     for (int k = -radius; k <= radius; k++) {
         if (k == 0) continue;
-        taps->z[taps->count] = z;
+        taps->depth_step[taps->count] = k;
+        taps->normal_step[taps->count] = k;
         taps->ao[taps->count] = raw;
-        taps->nx[taps->count] = n.nx;
-        taps->ny[taps->count] = n.ny;
-        taps->nz[taps->count] = n.nz;
-        taps->offset[taps->count] = k;
         taps->spatial[taps->count] = job->spatial[k < 0 ? -k : k];
         taps->count++;
     }
@@ -166,19 +165,15 @@ static HBAO_ALWAYS_INLINE void column_pass(const finish_job *job, const band_mem
     const int width = job->width, radius = job->radius, slots = 2 * radius + 1;
     taps->count = 0;
     taps->along_row = 0;
+    const normal_row n = normals_of_row(job->grid, j);
     for (int k = -radius; k <= radius; k++) {
         if (k == 0 || j + k < 0 || j + k >= job->height) continue;
-        const normal_row n = normals_of_row(job->grid, j + k);
-        taps->z[taps->count] = job->depth + (size_t)(j + k) * width;
+        taps->depth_step[taps->count] = k * width;
+        taps->normal_step[taps->count] = (int)(normals_of_row(job->grid, j + k).nx - n.nx);
         taps->ao[taps->count] = m->ring[(j + k) % slots];
-        taps->nx[taps->count] = n.nx;
-        taps->ny[taps->count] = n.ny;
-        taps->nz[taps->count] = n.nz;
-        taps->offset[taps->count] = 0;
         taps->spatial[taps->count] = job->spatial[k < 0 ? -k : k];
         taps->count++;
     }
-    const normal_row n = normals_of_row(job->grid, j);
     *c = (centre_row){job->depth + (size_t)j * width, m->ring[j % slots], n.nx, n.ny, n.nz};
 }
 

@@ -58,11 +58,9 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE VF BLUR_NAME(power)(VF base) {
 }
 
 /* blur_pixel for pixels i .. i + BLUR_LANES - 1, all of whose taps lie
- * inside the row. along_row is taps->along_row as a constant, so that the
- * pass along a row reads the centre's rows (every tap's, shifted) with no
- * pointer to load per tap: AVX-512, 0.960 of the stages' time with the
- * 15-pixel blur and 0.965 of 8 x 6 + blur 15's frame on 2 threads; AVX2
- * unchanged. */
+ * inside the row. along_row is taps->along_row as a constant, so that
+ * each pass loads only the steps it has: along a row one per tap, down a
+ * column two and the AO's row. */
 BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(lanes)(const tap_set *taps,
                                                             const centre_row *c, float sharpness,
                                                             int i, float *target, int along_row) {
@@ -77,18 +75,19 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(lanes)(const tap_set *taps,
              cz = BLUR_NAME(load)(c->nz + i) * HBAO_BLUR_NORMAL_WEIGHT;
     VF sum = BLUR_NAME(load)(c->ao + i), weight_sum = one;
     for (int t = 0; t < taps->count; t++) {
-        const int at = i + taps->offset[t];
-        const VF z = BLUR_NAME(load)((along_row ? c->z : taps->z[t]) + at);
+        const int at = i + taps->depth_step[t];
+        const int normal_at = along_row ? at : i + taps->normal_step[t];
+        const VF z = BLUR_NAME(load)(c->z + at);
         const VF difference = (z - zc) * factor;
-        const VF facing = BLUR_NAME(load)((along_row ? c->nx : taps->nx[t]) + at) * cx +
-                          BLUR_NAME(load)((along_row ? c->ny : taps->ny[t]) + at) * cy +
-                          BLUR_NAME(load)((along_row ? c->nz : taps->nz[t]) + at) * cz;
+        const VF facing = BLUR_NAME(load)(c->nx + normal_at) * cx +
+                          BLUR_NAME(load)(c->ny + normal_at) * cy +
+                          BLUR_NAME(load)(c->nz + normal_at) * cz;
         const VF capped = BLUR_NAME(min)(facing, zero + HBAO_BLUR_NORMAL_WEIGHT);
         const VF base = (1.0f - HBAO_BLUR_NORMAL_WEIGHT + capped) - difference * difference;
         /* blur_pixel's "* valid": the product is finite, so times 1 is itself */
         const VF weight =
             BLUR_NAME(zero_unless)(z > 0.0f, taps->spatial[t] * BLUR_NAME(power)(base));
-        sum += weight * BLUR_NAME(load)((along_row ? c->ao : taps->ao[t]) + at);
+        sum += weight * BLUR_NAME(load)(along_row ? c->ao + at : taps->ao[t] + i);
         weight_sum += weight;
     }
     const VF blurred = BLUR_NAME(select)(geometry, sum / weight_sum, one);
