@@ -6,9 +6,10 @@
  * names), BLUR_TARGET (its instruction set's function attribute, or
  * nothing) and, optionally, BLUR_MIN and BLUR_MAX (the instruction set's
  * minimum and maximum of two vectors of BLUR_LANES floats: a < b ? a : b
- * and a > b ? a : b, b where either is NaN). Every operation is blur_pixel's (blur.c), lane by lane and
- * never contracted into an FMA, so every copy gives the same floats as the
- * scalar reference (test_blur.c compares them). */
+ * and a > b ? a : b, b where either is NaN). Every operation is
+ * blur_pixel's (blur.c), lane by lane and never contracted into an FMA, so
+ * every copy gives the same floats as the scalar reference (test_blur.c
+ * compares them). */
 
 /* GCC and clang warn that passing these vectors by value differs between
  * instruction sets; the helpers are always inlined, so no call passes one. */
