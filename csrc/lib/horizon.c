@@ -5,6 +5,7 @@
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "internal_hbao.h"
 
@@ -613,13 +614,41 @@ typedef struct deinterleave_job {
     float *phase_back; /* NULL without the back layer */
 } deinterleave_job;
 
+#if defined(__clang__) || (defined(__GNUC__) && __GNUC__ >= 12)
+#define HBAO_SHUFFLE_VECTOR 1
+typedef float four_floats __attribute__((vector_size(16)));
+#endif
+
+/* Row j of the grid into its four column phases: phase a gets columns
+ * 4 x + a, beyond where x runs past the row. */
 static void deinterleave(const hbao_grid *g, const float *row, int j, int phase_width, float beyond,
                          float *phases) {
-    for (int a = 0; a < 4; a++) {
-        float *out = phases + ((size_t)a * g->height + j) * phase_width;
-        for (int x = 0; x < phase_width; x++) {
+    float *out[4];
+    for (int a = 0; a < 4; a++) out[a] = phases + ((size_t)a * g->height + j) * phase_width;
+    int x = 0;
+#ifdef HBAO_SHUFFLE_VECTOR
+    /* 16 columns at a time, a 4 x 4 transpose in vector registers (SSE2's
+     * baseline), where the element loop below takes a load and a store per
+     * float: the stages around the search (bench_ab_copies.sh, 1080p,
+     * radius 1e-4, blur 0) 0.971 on 1 thread, 0.967 on 2. */
+    for (; 4 * (x + 4) <= g->width; x += 4) {
+        four_floats r[4], o[4];
+        memcpy(r, row + 4 * x, sizeof r);
+        const four_floats low01 = __builtin_shufflevector(r[0], r[1], 0, 4, 1, 5);
+        const four_floats high01 = __builtin_shufflevector(r[0], r[1], 2, 6, 3, 7);
+        const four_floats low23 = __builtin_shufflevector(r[2], r[3], 0, 4, 1, 5);
+        const four_floats high23 = __builtin_shufflevector(r[2], r[3], 2, 6, 3, 7);
+        o[0] = __builtin_shufflevector(low01, low23, 0, 1, 4, 5);
+        o[1] = __builtin_shufflevector(low01, low23, 2, 3, 6, 7);
+        o[2] = __builtin_shufflevector(high01, high23, 0, 1, 4, 5);
+        o[3] = __builtin_shufflevector(high01, high23, 2, 3, 6, 7);
+        for (int a = 0; a < 4; a++) memcpy(out[a] + x, &o[a], sizeof o[a]);
+    }
+#endif
+    for (; x < phase_width; x++) {
+        for (int a = 0; a < 4; a++) {
             const int i = 4 * x + a;
-            out[x] = i < g->width ? row[i] : beyond;
+            out[a][x] = i < g->width ? row[i] : beyond;
         }
     }
 }
