@@ -54,8 +54,9 @@ typedef struct depth_job {
 /* Dense depth with background (not finite, <= 0, >= background_depth) as 0.
  * z > 0 && z < background_depth fails for NaN, -inf and +inf (+inf < +inf
  * is false where the background depth is infinite) as for background, so no
- * isfinite() is needed, and a dense source row (the add-on's) is a loop the
- * compiler vectorizes. */
+ * isfinite() is needed. The stage is bound by memory: the dense row's loop
+ * vectorized (this file at -O3 -fno-trapping-math) timed the same,
+ * bench_ab_copies.sh 0.998 on 1 and 2 threads. */
 static void convert_depth_row(void *context, int j) {
     const depth_job *job = context;
     const float *row = job->source->data + (int64_t)j * job->source->row_stride;
