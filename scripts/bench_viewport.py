@@ -38,10 +38,20 @@ def main():
     blender = shutil.which(args.blender)
     if blender is None:
         sys.exit(f"blender not found ({args.blender}); pass --blender PATH")
+    build = REPO / "build"
+    if not (build / "libhbao.so").is_file() or not (build / "libhbao_exr.so").is_file():
+        subprocess.run(["cmake", "-S", str(REPO), "-B", str(build), "-DCMAKE_BUILD_TYPE=Release"],
+                       check=True, stdout=subprocess.DEVNULL)
+        subprocess.run(["cmake", "--build", str(build), "-j2", "--target", "hbao", "hbao_exr"],
+                       check=True, stdout=subprocess.DEVNULL)
     with tempfile.TemporaryDirectory() as user_scripts:
         (Path(user_scripts) / "addons").mkdir()
         (Path(user_scripts) / "addons" / "hbao").symlink_to(REPO / "addon" / "hbao")
+        # The source add-on has no lib/ folder: it loads this checkout's build
+        # (as scripts/demo.sh does), unless the environment names a library.
         env = dict(os.environ, BLENDER_USER_SCRIPTS=user_scripts, PYTHONUNBUFFERED="1")
+        env.setdefault("HBAO_LIBRARY", str(build / "libhbao.so"))
+        env.setdefault("HBAO_EXR_LIBRARY", str(build / "libhbao_exr.so"))
         command = [blender, "--factory-startup", "-noaudio", "--addons", "hbao",
                    "--python-exit-code", "1", "--python", str(INNER), "--",
                    "--repeats", str(args.repeats)]
