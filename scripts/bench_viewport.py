@@ -7,7 +7,9 @@
 
 Starts Blender with a window (under xvfb-run unless --no-xvfb: on a machine
 with a display and a real GPU, pass --no-xvfb so that Blender uses that GPU)
-and this checkout's add-on, and runs scripts/bench_viewport_blender.py, which
+and this checkout's add-on with the libraries of its build (brought up to
+date first, in HBAO_BUILD_DIR or build/, unless HBAO_LIBRARY and
+HBAO_EXR_LIBRARY name libraries), and runs scripts/bench_viewport_blender.py, which
 prints the renderer and a table of median milliseconds per frame: the scene
 drawn by Blender, the depth read-back + upload alone, the whole preview with
 the default blur and without blur. --backend-check only prints the renderer
@@ -38,20 +40,23 @@ def main():
     blender = shutil.which(args.blender)
     if blender is None:
         sys.exit(f"blender not found ({args.blender}); pass --blender PATH")
-    build = REPO / "build"
-    if not (build / "libhbao.so").is_file() or not (build / "libhbao_exr.so").is_file():
-        subprocess.run(["cmake", "-S", str(REPO), "-B", str(build), "-DCMAKE_BUILD_TYPE=Release"],
-                       check=True, stdout=subprocess.DEVNULL)
+    # The source add-on has no lib/ folder: it loads this checkout's build,
+    # brought up to date here (as scripts/demo.sh does), unless the
+    # environment names both libraries.
+    build = Path(os.environ.get("HBAO_BUILD_DIR", REPO / "build"))
+    libraries = {"HBAO_LIBRARY": build / "libhbao.so", "HBAO_EXR_LIBRARY": build / "libhbao_exr.so"}
+    if not all(name in os.environ for name in libraries):
+        if not (build / "CMakeCache.txt").is_file():
+            subprocess.run(["cmake", "-S", str(REPO), "-B", str(build),
+                            "-DCMAKE_BUILD_TYPE=Release"], check=True, stdout=subprocess.DEVNULL)
         subprocess.run(["cmake", "--build", str(build), "-j2", "--target", "hbao", "hbao_exr"],
                        check=True, stdout=subprocess.DEVNULL)
     with tempfile.TemporaryDirectory() as user_scripts:
         (Path(user_scripts) / "addons").mkdir()
         (Path(user_scripts) / "addons" / "hbao").symlink_to(REPO / "addon" / "hbao")
-        # The source add-on has no lib/ folder: it loads this checkout's build
-        # (as scripts/demo.sh does), unless the environment names a library.
         env = dict(os.environ, BLENDER_USER_SCRIPTS=user_scripts, PYTHONUNBUFFERED="1")
-        env.setdefault("HBAO_LIBRARY", str(build / "libhbao.so"))
-        env.setdefault("HBAO_EXR_LIBRARY", str(build / "libhbao_exr.so"))
+        for name, path in libraries.items():
+            env.setdefault(name, str(path))
         command = [blender, "--factory-startup", "-noaudio", "--addons", "hbao",
                    "--python-exit-code", "1", "--python", str(INNER), "--",
                    "--repeats", str(args.repeats)]

@@ -94,8 +94,9 @@ typedef struct centre_row {
  * that is not unit (infinite where a denormal depth's view vector
  * overflowed) may do: at most the weight of a tap on the same plane. A 0/1
  * factor rather than a branch marks background; the weight is finite, so
- * the product is exact. The vector loop (blur_lanes.h) performs exactly
- * these operations lane by lane. Background centres give 1. */
+ * the product is exact. The vector loop (blur_lanes.h) gives the same
+ * floats lane by lane (its mask and its min and max instructions are
+ * exactly these selects and this product). Background centres give 1. */
 static HBAO_ALWAYS_INLINE float blur_pixel(const tap_set *taps, const centre_row *c,
                                            float sharpness, int width, int i) {
     const float zc = c->z[i];
@@ -193,8 +194,8 @@ static HBAO_ALWAYS_INLINE void write_output(const float *zc, const float *ao, in
 }
 
 /* The passes, BLUR_LANES pixels at a time, and the band jobs that run them
- * (blur_lanes.h),
- * one copy per instruction set at its registers' width: GCC splits a vector
+ * (blur_lanes.h), one copy per instruction set at its registers' width:
+ * GCC splits a vector
  * wider than the registers piece by piece, partly through memory, and with
  * 16 lanes the AVX2 copy of the 15-pixel blur took 2.6 times as long as
  * with 8. The baseline copy keeps 16 lanes (four SSE2 registers), which its
@@ -234,7 +235,6 @@ static hbao_result blur_grid(const hbao_settings *settings, const hbao_grid *gri
     job.width = grid->width;
     job.height = grid->height;
     job.radius = settings->grid_blur_radius;
-    const int implementation = hbao_finish_implementation(settings->implementation);
     job.sharpness = settings->blur_sharpness;
     job.strength = strength;
     job.out = out;
@@ -253,6 +253,7 @@ static hbao_result blur_grid(const hbao_settings *settings, const hbao_grid *gri
 
     hbao_row_job run = finish_band_portable;
 #ifdef HBAO_FINISH_X86
+    const int implementation = hbao_finish_implementation(settings->implementation);
     if (implementation == HBAO_IMPLEMENTATION_AVX512) run = finish_band_avx512;
     if (implementation == HBAO_IMPLEMENTATION_AVX2) run = finish_band_avx2;
 #endif

@@ -317,7 +317,8 @@ void hbao_horizon_span_avx512(const hbao_horizon_job *job, int x0, int x1, int j
 
 /* exp(-x) for x >= 0, to 3.2e-6 relative error (a degree-4 polynomial of
  * 2^-f, fitted for the least largest relative error on [0, 1)), without
- * libm: the blur and the upsample evaluate it for every tap. */
+ * libm: the upsample evaluates it for every candidate. (The blur's weight
+ * is hbao_blur_power, internal_finish.h.) */
 static inline float hbao_exp_negative(float x) {
     /* Branch-free (selects are integer masks) so that loops calling it
      * vectorize for any vector width. Beyond 87 the result is below FLT_MIN:

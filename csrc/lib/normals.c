@@ -329,7 +329,8 @@ typedef struct precision_job {
 static void precision_row(void *context, int j) {
     precision_job *job = context;
     /* One depth that is no half float decides: float depth (Cycles') is
-     * told from its first row, and the other rows stop at once. */
+     * told from its first row (detect_depth_precision reads it first), and
+     * rows still to come stop at once. */
     if (atomic_load_explicit(&job->not_half, memory_order_relaxed)) return;
     const float *row = job->grid->depth + (size_t)j * job->grid->width;
     for (int i = 0; i < job->grid->width; i++) {
@@ -350,7 +351,8 @@ static float detect_depth_precision(const hbao_settings *settings, const hbao_gr
     job.grid = grid;
     atomic_init(&job.not_half, 0);
     /* The first row alone first: it decides almost every float image, and
-     * then no thread is started for the others (0.1 ms on 2 threads). */
+     * then no thread is started for the others (the scan took 0.08-0.1 ms
+     * of a 2-thread frame). */
     precision_row(&job, 0);
     /* the rows' threads have all finished when this returns */
     if (!atomic_load(&job.not_half))

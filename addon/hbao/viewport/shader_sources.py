@@ -83,7 +83,7 @@ AO_FRAGMENT = CAMERA + horizon_sources.HORIZON_SEARCH
 # sampling", 2); `blur_step` is (1, 0) for rows, (0, 1) for columns;
 # `kernel_radius` and `sigma` come from parameters.blur_kernel_radius and
 # blur_sigma, the library's rule. The centre weighs 1 and the taps are summed
-# after it, nearest first on the negative side, as csrc/lib/blur.c does; down
+# after it, from -r up to r, as csrc/lib/blur.c does; down
 # a column the order is mirrored (textures are bottom-up), which only changes
 # rounding. The weight is the library's (csrc/lib/internal_finish.h,
 # hbao_blur_power): max(0, base)^16 by the same four squarings, of the same
