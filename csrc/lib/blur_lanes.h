@@ -9,9 +9,8 @@
  * and a > b ? a : b, b where either is NaN). Every operation is
  * blur_pixel's (blur.c), lane by lane and never contracted into an FMA, so
  * every copy gives the same floats as the scalar reference. test_blur.c
- * compares the copies with each other; as the AVX2 copy has 8 lanes and
- * the others 16, some pixels go through blur_pixel in one copy and through
- * the vector loop in another. */
+ * compares the copies with each other, and each copy's blur_pixel with its
+ * vector loop (blur_pixel_and_the_vector_loop_agree). */
 
 /* GCC and clang warn that passing these vectors by value differs between
  * instruction sets; the helpers are always inlined, so no call passes one. */

@@ -176,6 +176,72 @@ TEST_CASE(identical_output_for_any_band_height) {
     }
 }
 
+/* A row's pixels go through blur_pixel (blur.c) near its ends and through
+ * the vector loop (blur_lanes.h) elsewhere, which must give the same bits.
+ * The same picture is computed twice: alone, and with PAD background columns
+ * on each side. With the sensor fitted vertically a pixel's ray depends on
+ * its column's distance from the image's centre only, and PAD keeps the
+ * search's 4 x 4 pattern and blocks in step, so the picture's pixels get the
+ * same raw AO in both; a tap on background weighs 0 as a tap outside the
+ * image adds nothing. The ends of the picture (blur_pixel alone) lie inside
+ * the padded image's vector loop, and its column pass's last partial vector
+ * too, for every copy whatever its lanes. */
+TEST_CASE(blur_pixel_and_the_vector_loop_agree) {
+    enum { PAD = 64, w = 75, h = 40, wide = w + 2 * PAD };
+    static float depth[w * h], normal[3 * w * h], ao[w * h];
+    static float padded_depth[wide * h], padded_normal[3 * wide * h], padded_ao[wide * h];
+    for (int j = 0; j < h; j++) {
+        for (int i = 0; i < w; i++) {
+            const int k = j * w + i;
+            /* steps, slopes and a few background holes */
+            depth[k] = (i * 7 + j * 3) % 53 == 0
+                           ? 0.0f
+                           : 2.0f + 0.01f * (float)j + 0.3f * (float)((i / 9) % 3);
+            normal[3 * k] = (float)((i / 9) % 3) - 1.0f;
+            normal[3 * k + 1] = 0.2f;
+            normal[3 * k + 2] = 1.0f;
+        }
+    }
+    memset(padded_depth, 0, sizeof padded_depth);
+    memset(padded_normal, 0, sizeof padded_normal);
+    for (int j = 0; j < h; j++) {
+        memcpy(padded_depth + (size_t)j * wide + PAD, depth + (size_t)j * w, w * sizeof(float));
+        memcpy(padded_normal + 3 * ((size_t)j * wide + PAD), normal + 3 * (size_t)j * w,
+               3 * w * sizeof(float));
+    }
+    hbao_camera camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
+    camera.sensor_fit = HBAO_SENSOR_FIT_VERTICAL;
+    const hbao_channel d = {depth, 1, w}, n = {normal, 3, 3 * (int64_t)w};
+    const hbao_channel pd = {padded_depth, 1, wide}, pn = {padded_normal, 3, 3 * (int64_t)wide};
+    const int sizes[] = {5, 15, 33};
+    for (int size = 0; size < 3; size++) {
+        for (int implementation = HBAO_IMPLEMENTATION_SCALAR;
+             implementation <= HBAO_IMPLEMENTATION_AVX512; implementation++) {
+            hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+            p.radius = 0.3f;
+            p.blur_size = sizes[size];
+            p.threads = 1;
+            p.implementation = implementation;
+            CHECK_RESULT(hbao_compute(&p, &camera, w, h, &d, &n, ao, w), HBAO_SUCCESS);
+            CHECK_RESULT(hbao_compute(&p, &camera, wide, h, &pd, &pn, padded_ao, wide),
+                         HBAO_SUCCESS);
+            int differ = 0, occluded = 0;
+            for (int j = 0; j < h; j++) {
+                for (int i = 0; i < w; i++) {
+                    const float alone = ao[j * w + i], padded = padded_ao[j * wide + PAD + i];
+                    differ += memcmp(&alone, &padded, sizeof alone) != 0;
+                    occluded += alone < 0.99f;
+                }
+            }
+            if (differ)
+                printf("  blur %d, implementation %d: %d pixels differ\n", p.blur_size,
+                       implementation, differ);
+            CHECK(differ == 0);
+            CHECK(occluded > w * h / 10); /* something to blur */
+        }
+    }
+}
+
 /* --- a thin fin: the normal weight ----------------------------------------- */
 
 /* A floor (z = 0) with a long thin wall standing on it: front face x = -0.05
@@ -296,4 +362,5 @@ TEST_CASE(blur_keeps_a_thin_fin) {
 TEST_MAIN(TEST_ENTRY(flat_plane_at_extreme_depths_is_unoccluded),
           TEST_ENTRY(planes_at_denormal_and_huge_depth_side_by_side),
           TEST_ENTRY(random_depths_over_the_float_range_stay_in_range),
-          TEST_ENTRY(identical_output_for_any_band_height), TEST_ENTRY(blur_keeps_a_thin_fin))
+          TEST_ENTRY(identical_output_for_any_band_height),
+          TEST_ENTRY(blur_pixel_and_the_vector_loop_agree), TEST_ENTRY(blur_keeps_a_thin_fin))
