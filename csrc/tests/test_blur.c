@@ -128,6 +128,24 @@ TEST_CASE(random_depths_over_the_float_range_stay_in_range) {
 
 /* --- bands ---------------------------------------------------------------- */
 
+/* A sloped floor with steps (depth edges, creases) and holes where
+ * (7 i + 3 j) % hole_period == 0 whose depth is hole_depth (background):
+ * w x h depths and world-space normals, interleaved. */
+static void stepped_floor(int w, int h, int hole_period, float hole_depth, float *depth,
+                          float *normal) {
+    for (int j = 0; j < h; j++) {
+        for (int i = 0; i < w; i++) {
+            const int k = j * w + i;
+            depth[k] = (i * 7 + j * 3) % hole_period == 0
+                           ? hole_depth
+                           : 2.0f + 0.01f * (float)j + 0.3f * (float)((i / 9) % 3);
+            normal[3 * k] = (float)((i / 9) % 3) - 1.0f;
+            normal[3 * k + 1] = 0.2f;
+            normal[3 * k + 2] = 1.0f;
+        }
+    }
+}
+
 /* The blur runs per band of rows whose height follows the thread count
  * (blur.c), each band remaking the r rows above and below it. A tall image
  * makes 1, 2 and 5 threads cut it into bands of 38, 19 and 16 rows; blur
@@ -136,18 +154,7 @@ TEST_CASE(random_depths_over_the_float_range_stay_in_range) {
 TEST_CASE(identical_output_for_any_band_height) {
     enum { w = 75, h = 300 };
     static float depth[w * h], normal[3 * w * h], one[w * h], many[w * h];
-    for (int j = 0; j < h; j++) {
-        for (int i = 0; i < w; i++) {
-            const int k = j * w + i;
-            /* a sloped floor with steps and holes: depth edges, creases, background */
-            depth[k] = (i * 7 + j * 3) % 101 == 0
-                           ? 1e10f
-                           : 2.0f + 0.01f * (float)j + 0.3f * (float)((i / 9) % 3);
-            normal[3 * k] = (float)((i / 9) % 3) - 1.0f;
-            normal[3 * k + 1] = 0.2f;
-            normal[3 * k + 2] = 1.0f;
-        }
-    }
+    stepped_floor(w, h, 101, 1e10f, depth, normal);
     hbao_camera camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
     hbao_channel d = {depth, 1, w};
     hbao_channel n = {normal, 3, 3 * (int64_t)w};
@@ -190,18 +197,7 @@ TEST_CASE(blur_pixel_and_the_vector_loop_agree) {
     enum { PAD = 64, w = 75, h = 40, wide = w + 2 * PAD };
     static float depth[w * h], normal[3 * w * h], ao[w * h];
     static float padded_depth[wide * h], padded_normal[3 * wide * h], padded_ao[wide * h];
-    for (int j = 0; j < h; j++) {
-        for (int i = 0; i < w; i++) {
-            const int k = j * w + i;
-            /* steps, slopes and a few background holes */
-            depth[k] = (i * 7 + j * 3) % 53 == 0
-                           ? 0.0f
-                           : 2.0f + 0.01f * (float)j + 0.3f * (float)((i / 9) % 3);
-            normal[3 * k] = (float)((i / 9) % 3) - 1.0f;
-            normal[3 * k + 1] = 0.2f;
-            normal[3 * k + 2] = 1.0f;
-        }
-    }
+    stepped_floor(w, h, 53, 0.0f, depth, normal);
     memset(padded_depth, 0, sizeof padded_depth);
     memset(padded_normal, 0, sizeof padded_normal);
     for (int j = 0; j < h; j++) {
