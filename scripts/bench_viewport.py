@@ -46,11 +46,16 @@ def main():
     build = Path(os.environ.get("HBAO_BUILD_DIR", REPO / "build"))
     libraries = {"HBAO_LIBRARY": build / "libhbao.so", "HBAO_EXR_LIBRARY": build / "libhbao_exr.so"}
     if not all(name in os.environ for name in libraries):
+        steps = [["cmake", "--build", str(build), "-j2", "--target", "hbao", "hbao_exr"]]
         if not (build / "CMakeCache.txt").is_file():
-            subprocess.run(["cmake", "-S", str(REPO), "-B", str(build),
-                            "-DCMAKE_BUILD_TYPE=Release"], check=True, stdout=subprocess.DEVNULL)
-        subprocess.run(["cmake", "--build", str(build), "-j2", "--target", "hbao", "hbao_exr"],
-                       check=True, stdout=subprocess.DEVNULL)
+            steps.insert(0, ["cmake", "-S", str(REPO), "-B", str(build),
+                             "-DCMAKE_BUILD_TYPE=Release"])
+        for step in steps:
+            if shutil.which(step[0]) is None:
+                sys.exit("cmake not found: run scripts/setup.sh, or set HBAO_LIBRARY and "
+                         "HBAO_EXR_LIBRARY to built libraries")
+            if subprocess.run(step, stdout=subprocess.DEVNULL).returncode != 0:
+                sys.exit(f"building the libraries failed: {' '.join(step)}")
     with tempfile.TemporaryDirectory() as user_scripts:
         (Path(user_scripts) / "addons").mkdir()
         (Path(user_scripts) / "addons" / "hbao").symlink_to(REPO / "addon" / "hbao")
