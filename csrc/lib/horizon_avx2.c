@@ -71,6 +71,7 @@ static inline __m256 load_every_fourth_avx2(const float *p) {
 }
 #define V_LOAD_EVERY_FOURTH load_every_fourth_avx2
 
+#define SIMD_PREFETCH_STEPS 1
 #define SIMD_ORTHOGRAPHIC 0
 #define SIMD_NAME(name) name##_avx2
 #include "horizon_simd.h"

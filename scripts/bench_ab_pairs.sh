@@ -1,0 +1,62 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-2.0-or-later
+# Two builds of libhbao compared on a machine whose speed drifts by tens of
+# per cent over minutes (a shared VM, where the neighbours' memory traffic
+# moves a memory-bound loop): bench_ab with one call of each build per
+# round (--calls 1), so that the two calls of a round see the same machine,
+# in both orders (the second call of a round runs a few per cent slower).
+# Prints the median over the rounds of each round's after / before ratio,
+# for each order, and their geometric mean (the order's bias cancelled).
+#   scripts/bench_ab_pairs.sh BEFORE.so AFTER.so [bench_ab options]
+# Environment: ROUNDS (per order, default 30). scripts/bench_ab_copies.sh
+# is the steadier choice where the machine's speed holds still.
+set -euo pipefail
+REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+if [ $# -lt 2 ] || [ ! -f "$1" ] || [ ! -f "$2" ]; then
+    echo "usage: $0 BEFORE.so AFTER.so [bench_ab options]" >&2
+    exit 2
+fi
+before=$1
+after=$2
+shift 2
+rounds=${ROUNDS:-30}
+if ! [[ $rounds =~ ^[1-9][0-9]{0,2}$ ]]; then
+    echo "$0: ROUNDS=$rounds: give a whole number from 1 to 999" >&2
+    exit 2
+fi
+bench="$REPO/build/bench_ab"
+if [ ! -x "$bench" ]; then
+    "$REPO/scripts/setup.sh"
+    cmake -S "$REPO" -B "$REPO/build" -DCMAKE_BUILD_TYPE=Release -DHBAO_BUILD_BENCHMARKS=ON >/dev/null
+    cmake --build "$REPO/build" -j2 --target bench_ab >/dev/null
+fi
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+"$bench" "$before" "$after" --rounds "$rounds" --calls 1 "$@" >"$work/forward" 2>&1 ||
+    { cat "$work/forward" >&2; exit 1; }
+"$bench" "$after" "$before" --rounds "$rounds" --calls 1 "$@" >"$work/reverse" 2>&1 ||
+    { cat "$work/reverse" >&2; exit 1; }
+python3 - "$work/forward" "$work/reverse" "$*" <<'PY'
+import math
+import statistics
+import sys
+
+
+def ratios(path):
+    """Each round's second-named / first-named fastest call."""
+    first, second = [], []
+    for line in open(path, encoding="utf-8"):
+        fields = line.split()
+        if len(fields) >= 4 and fields[0] == "round":
+            (first if fields[2] == "before" else second).append(float(fields[3]))
+    if not first or len(first) != len(second):
+        sys.exit(f"bench_ab_pairs.sh: no rounds in {path}")
+    return [b / a for a, b in zip(first, second)]
+
+
+forward = statistics.median(ratios(sys.argv[1]))
+reverse = 1.0 / statistics.median(ratios(sys.argv[2]))
+options = f" [{sys.argv[3]}]" if sys.argv[3] else ""
+print(f"after / before{options}: {forward:.3f} (after second), {reverse:.3f} (after first)"
+      f" -> {math.sqrt(forward * reverse):.3f}")
+PY
