@@ -64,26 +64,37 @@ def test_undo_during_f12_leaves_the_hook_intact(run_in_blender, tmp_path,
 def test_escape_while_the_add_on_computes_cancels_the_render(
         run_in_blender, tmp_path, no_leftovers):  # noqa: F811
     """Escape (a real key press) while the add-on's engine computes the first
-    of two slow HBAO nodes (about 1.7 s each). Observed in 3.4: Blender does
-    not pass the Escape on to the helper scene's engine (its
-    RenderEngine.test_break() stays False, so the engine's checks between
-    nodes never fire): both AO passes finish, then the render is cancelled,
-    or, when Blender reads the key only after compositing, completes (2 of
-    about 15 runs on this machine; the outcome is printed). The artist waits
-    for the AO already started, at most one frame's AO time; Blender stays
-    responsive, a second F12 completes with AO, no hbao-passes-* file is
-    left, the PNG output stays PNG."""
+    of two slow HBAO nodes (about 1.7 s each). Two outcomes are observed in
+    3.4, as Blender's timing falls:
+    - Blender does not pass the Escape on to the helper scene's engine (its
+      RenderEngine.test_break() stays False, so the engine's checks between
+      nodes never fire): both AO passes finish, then the render is
+      cancelled, or, when Blender reads the key only after compositing,
+      completes (2 of about 15 runs on the Zen 5 of sessions 6-11);
+    - test_break() turns True while the first node computes (on the slower
+      Zen 3 of session 12): the engine stops before the second node ("AO
+      left out") and the render is cancelled.
+    The outcome is printed. The artist waits for the AO already started, at
+    most one node's AO time; Blender stays responsive, a second F12
+    completes with AO, no hbao-passes-* file is left, the PNG output stays
+    PNG."""
     if shutil.which("xdotool") is None:
         pytest.fail("xdotool missing: run scripts/setup.sh")
     out = tmp_path / "cancel_in_hbao"
     completed = run_in_blender(SCRIPTS / "fault_f12_cancel.py", out, "escape_in_hbao", ui=True)
     log = completed.stdout
     assert "KEY Escape sent to" in log, log[-3000:]
-    assert "HBAO: 2 AO pass(es) 800x480" in log, log[-3000:]
     first = [line for line in log.splitlines() if line.endswith(" first render")]
-    assert first and first[0] in ("CANCELLED first render", "COMPLETED first render"), \
-        log[-3000:]
-    print(first[0])
+    stopped_between_nodes = "HBAO: render cancelled: AO left out" in log
+    if stopped_between_nodes:
+        # the first node's AO was dropped with the render, not composited
+        assert first and first[0] == "CANCELLED first render", log[-3000:]
+        assert "HBAO: 2 AO pass(es) 800x480" not in log, log[-3000:]
+    else:
+        assert "HBAO: 2 AO pass(es) 800x480" in log, log[-3000:]
+        assert first and first[0] in ("CANCELLED first render", "COMPLETED first render"), \
+            log[-3000:]
+    print(first[0], "(stopped between the nodes)" if stopped_between_nodes else "")
     assert "F12: RENDERED" in log, log[-3000:]
     assert _settings(log, "AFTER") == _settings(log, "BEFORE")
     assert node_outputs(out, 1)["ao"].min() < 0.9
