@@ -185,16 +185,25 @@ static inline void SIMD_NAME(plan_steps)(const SIMD_NAME(block) * b, float dc, f
 }
 
 /* The plain steps' depths, asked of the memory as soon as the steps are
- * planned, before the search reaches them. Where SIMD_PREFETCH_STEPS is 1:
- * the AVX2 copy, measured on a Zen 3 (AMD EPYC, 512 KiB of L2 per core,
- * where a timer profile put half of the search's time on the depth load) by
- * bench_ab with paired calls in both orders (scripts/bench_ab_pairs.sh),
- * 1080p defaults: 0.908 on 1 thread, 0.852 on 2. The AVX-512 copy has not
- * been measured with it on AVX-512 hardware, so it stays without. */
+ * planned, before the search reaches them: the cache lines of a step's first
+ * and last lane (a load of SIMD_LANES floats crosses a line's end unless it
+ * starts within its first 64 - 4 SIMD_LANES bytes). Where
+ * SIMD_PREFETCH_STEPS is 1: the AVX2 copy, measured on a Zen 3 (AMD EPYC,
+ * 512 KiB of L2 per core, where a timer profile put half of the search's
+ * time on the depth load) by bench_ab with paired calls in both orders
+ * (scripts/bench_ab_pairs.sh), 1080p defaults: the first lane's line 0.884
+ * and 0.908 on 1 thread, 0.924 and 0.926 on 2; the last lane's as well, on
+ * top of that, 0.848-0.939 on 1 thread (three runs), 0.948-0.979 on 2. The
+ * AVX-512 copy has not been measured with it on AVX-512 hardware, so it
+ * stays without. */
 static inline void SIMD_NAME(prefetch_steps)(const SIMD_NAME(block) * b,
                                              const SIMD_NAME(steps) * t) {
 #if SIMD_PREFETCH_STEPS
-    for (int k = 0; k < t->plain_end; k++) __builtin_prefetch(b->job->phase_depth + t->index[k]);
+    for (int k = 0; k < t->plain_end; k++) {
+        const float *depths = b->job->phase_depth + t->index[k];
+        __builtin_prefetch(depths);
+        __builtin_prefetch(depths + SIMD_LANES - 1);
+    }
 #else
     (void)b;
     (void)t;
