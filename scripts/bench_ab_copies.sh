@@ -11,12 +11,9 @@
 # Environment: COPIES (default 4), ROUNDS (bench_ab --rounds, default 3).
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-if [ $# -lt 2 ] || [ ! -f "$1" ] || [ ! -f "$2" ]; then
-    echo "usage: $0 BEFORE.so AFTER.so [bench_ab options]" >&2
-    exit 2
-fi
-before=$1
-after=$2
+# shellcheck source=bench_ab_setup.sh
+. "$REPO/scripts/bench_ab_setup.sh"
+bench_ab_arguments "$0" "$@"
 shift 2
 copies=${COPIES:-4}
 rounds=${ROUNDS:-3}
@@ -26,12 +23,7 @@ for setting in "COPIES=$copies" "ROUNDS=$rounds"; do
         exit 2
     fi
 done
-bench="$REPO/build/bench_ab"
-if [ ! -x "$bench" ]; then
-    "$REPO/scripts/setup.sh"
-    cmake -S "$REPO" -B "$REPO/build" -DCMAKE_BUILD_TYPE=Release -DHBAO_BUILD_BENCHMARKS=ON >/dev/null
-    cmake --build "$REPO/build" -j2 --target bench_ab >/dev/null
-fi
+bench_ab_program
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 

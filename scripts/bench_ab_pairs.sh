@@ -12,24 +12,16 @@
 # is the steadier choice where the machine's speed holds still.
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-if [ $# -lt 2 ] || [ ! -f "$1" ] || [ ! -f "$2" ]; then
-    echo "usage: $0 BEFORE.so AFTER.so [bench_ab options]" >&2
-    exit 2
-fi
-before=$1
-after=$2
+# shellcheck source=bench_ab_setup.sh
+. "$REPO/scripts/bench_ab_setup.sh"
+bench_ab_arguments "$0" "$@"
 shift 2
 rounds=${ROUNDS:-30}
 if ! [[ $rounds =~ ^[1-9][0-9]{0,2}$ ]]; then
     echo "$0: ROUNDS=$rounds: give a whole number from 1 to 999" >&2
     exit 2
 fi
-bench="$REPO/build/bench_ab"
-if [ ! -x "$bench" ]; then
-    "$REPO/scripts/setup.sh"
-    cmake -S "$REPO" -B "$REPO/build" -DCMAKE_BUILD_TYPE=Release -DHBAO_BUILD_BENCHMARKS=ON >/dev/null
-    cmake --build "$REPO/build" -j2 --target bench_ab >/dev/null
-fi
+bench_ab_program
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 "$bench" "$before" "$after" --rounds "$rounds" --calls 1 "$@" >"$work/forward" 2>&1 ||
