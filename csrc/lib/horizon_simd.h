@@ -187,7 +187,7 @@ static inline void SIMD_NAME(plan_steps)(const SIMD_NAME(block) * b, float dc, f
 /* The plain steps' depths, asked of the memory as soon as the steps are
  * planned, before the search reaches them: the cache lines of a step's first
  * and last lane (a load of SIMD_LANES floats crosses a line's end unless it
- * starts within its first 64 - 4 SIMD_LANES bytes). Where
+ * starts at most 64 - 4 SIMD_LANES bytes into the line). Where
  * SIMD_PREFETCH_STEPS is 1: the AVX2 copy, measured on a Zen 3 (AMD EPYC,
  * 512 KiB of L2 per core, where a timer profile put half of the search's
  * time on the depth load) by bench_ab with paired calls in both orders
