@@ -72,11 +72,16 @@ static inline void SIMD_NAME(slice_setup)(const VF v[3], const VF n[3], const VF
     sl->sin_gamma = V_SELECT(sl->usable, V_SET(0.0f), V_MUL(n_dot_e, sl->inv_np));
 }
 
-/* The lanes' pixels (SIMD_LANES of a block's HBAO_BLOCK_PIXELS, see
- * internal_hbao.h) and what does not change between directions. */
+/* The vectors that a block's HBAO_BLOCK_PIXELS pixels fill (internal_hbao.h):
+ * 2 with AVX2, 1 with AVX-512. A block's parts share its steps' plan. */
+#define SIMD_BLOCK_PARTS (HBAO_BLOCK_PIXELS / SIMD_LANES)
+
+/* The lanes' pixels (part `part` of a block, its SIMD_LANES pixels from
+ * pixel part * SIMD_LANES on) and what does not change between directions. */
 typedef struct SIMD_NAME(block) {
     const hbao_horizon_job *job;
     const hbao_grid *grid;
+    int part;
     VI lane_i;     /* the lanes' columns: first_i + 4 k */
     VF lane_float; /* and as floats (exact) */
     int first_i;   /* lane 0's column */
@@ -85,6 +90,7 @@ typedef struct SIMD_NAME(block) {
     int j;
     float jitter, step_px, inv_ycor; /* shared by the block */
     VF p[3], v[3], n[3];
+    VF n_cross_v[2]; /* the x and y of n x V, for slice_setup */
     VF radius2, inv_radius2;
     VF height_tolerance, n_dot_v, near_limit; /* as in horizon.c's march */
     VM view_below;                            /* n_dot_v < 0: V below the tangent plane */
@@ -107,22 +113,31 @@ typedef struct SIMD_NAME(fetch) {
     VM candidate; /* inside the image, on another pixel */
 } SIMD_NAME(fetch);
 
-/* A direction's steps, worked out SIMD_LANES steps at a time: each step's
- * pixel offset from lane 0 (ox, oy), and for a step whose lanes all lie
- * inside the image (a `plain` step, the common case) what its fetch needs:
- * the index of its depths in phase_depth, its grid row and ox as a float.
- * Arrays hold whole vectors: HBAO_MAX_STEPS + SIMD_LANES entries. */
+/* A direction's steps for a whole block, worked out SIMD_LANES steps at a
+ * time: each step's pixel offset from a lane to its sample (ox, oy), and
+ * for a step whose lanes all lie inside the image (a `plain` step, the
+ * common case) what its fetch needs: the index of part 0's depths in
+ * phase_depth (part k's lie k SIMD_LANES further), its grid row and ox as
+ * a float. Arrays hold whole vectors: HBAO_MAX_STEPS + SIMD_LANES entries.
+ * The parts differ only in their columns, so they share one plan (AVX2
+ * planned each direction twice, and planning was 8.5 % of the frame) and
+ * its prefetch, which now asks for both parts' depths before the first
+ * part's search. scripts/bench_ab_pairs.sh, 1080p, Zen 3, on 2 threads:
+ * defaults 0.941 and 0.890, 8 x 6 + blur 15 0.897, half resolution 0.946,
+ * back faces 0.902; on 1: 0.847, 0.898 and 0.905, 0.955, 0.908. Planning
+ * the next direction during a search (on top of this): 2 threads 0.99,
+ * 0.977, 1.049 (half), 1 thread 0.95, 0.86, 1.046: not kept. */
 #define SIMD_STEP_ROOM (HBAO_MAX_STEPS + SIMD_LANES)
 typedef struct SIMD_NAME(steps) {
     int count; /* the steps before the first that lies a whole image away */
     int ox[SIMD_STEP_ROOM], oy[SIMD_STEP_ROOM], index[SIMD_STEP_ROOM];
     float row[SIMD_STEP_ROOM], ox_float[SIMD_STEP_ROOM];
-    /* Steps 0 .. plain_end - 1 are plain (the steps move away from the
-     * pixel, so plain steps come first; a later one would take the side
-     * path, which is right for any step). One comparison per step instead
-     * of a bit test: bench_ab, 1080p, four file copies of each build,
-     * 0.973 on 1 thread, 0.979 on 2. */
-    int plain_end;
+    /* Steps 0 .. plain_end[part] - 1 are plain for the part (the steps
+     * move away from the pixel, so plain steps come first; a later one
+     * would take the side path, which is right for any step). One
+     * comparison per step instead of a bit test: bench_ab, 1080p, four
+     * file copies of each build, 0.973 on 1 thread, 0.979 on 2. */
+    int plain_end[SIMD_BLOCK_PARTS];
 } SIMD_NAME(steps);
 
 static inline VI SIMD_NAME(floor_to_int)(VF x) {
@@ -132,13 +147,14 @@ static inline VI SIMD_NAME(floor_to_int)(VF x) {
 }
 
 /* hbao_step_offset for SIMD_LANES steps at once, each lane one step, with
- * the same float operations, and the plain steps' fetch data. */
+ * the same float operations, and the plain steps' fetch data, for the block
+ * whose part 0 is b. */
 static inline void SIMD_NAME(plan_steps)(const SIMD_NAME(block) * b, float dc, float ds, int steps,
                                          SIMD_NAME(steps) * t) {
     const hbao_grid *g = b->grid;
     const int phase_width = b->job->phase_width;
     t->count = steps;
-    t->plain_end = 0;
+    for (int part = 0; part < SIMD_BLOCK_PARTS; part++) t->plain_end[part] = 0;
     for (int first = 0; first < steps; first += SIMD_LANES) {
         const VF step = I_TO_F(I_ADD(I_SET(first), I_LANES));
         const VF along =
@@ -151,17 +167,11 @@ static inline void SIMD_NAME(plan_steps)(const SIMD_NAME(block) * b, float dc, f
         const VI ox = SIMD_NAME(floor_to_int)(x), oy = SIMD_NAME(floor_to_int)(y);
         I_STOREU(t->ox + first, ox);
         I_STOREU(t->oy + first, oy);
-        /* plain: the sample row inside, and lane 0's and the last lane's
-         * columns (exact small integers as floats) */
         const VI sj = I_ADD(I_SET(b->j), oy);
         const VF sj_float = I_TO_F(sj);
         const VF ox_float = I_TO_F(ox);
-        const VF column0 = V_ADD(V_SET((float)b->first_i), ox_float);
-        const VM plain =
-            M_AND(M_AND(V_GE(sj_float, V_SET(0.0f)), V_LT(sj_float, V_SET((float)g->height))),
-                  M_AND(V_GE(column0, V_SET(0.0f)),
-                        V_LT(V_ADD(column0, V_SET((float)(4 * (SIMD_LANES - 1)))),
-                             V_SET((float)g->width))));
+        const VM row_inside =
+            M_AND(V_GE(sj_float, V_SET(0.0f)), V_LT(sj_float, V_SET((float)g->height)));
         /* lane k samples column first_i + 4 k + ox: phase (phase + ox) mod
          * 4, index first_x + k + floor((phase + ox) / 4) of that phase's row */
         const VI moved = I_ADD(I_SET(b->phase), ox);
@@ -172,9 +182,17 @@ static inline void SIMD_NAME(plan_steps)(const SIMD_NAME(block) * b, float dc, f
         V_STOREU(t->ox_float + first, ox_float);
         const int count = steps - first < SIMD_LANES ? steps - first : SIMD_LANES;
         const unsigned wanted = (count == 32 ? 0u : 1u << count) - 1u;
-        if (t->plain_end == first && b->job->int_indices) {
+        for (int part = 0; part < SIMD_BLOCK_PARTS; part++) {
+            if (t->plain_end[part] != first || !b->job->int_indices) continue;
+            /* plain: the sample row inside, and the part's lane 0's and
+             * last lane's columns (exact small integers as floats) */
+            const VF column0 = V_ADD(V_SET((float)(b->first_i + 4 * SIMD_LANES * part)), ox_float);
+            const VM plain =
+                M_AND(row_inside, M_AND(V_GE(column0, V_SET(0.0f)),
+                                        V_LT(V_ADD(column0, V_SET((float)(4 * (SIMD_LANES - 1)))),
+                                             V_SET((float)g->width))));
             const unsigned run = ~(unsigned)M_BITS(plain) & wanted;
-            t->plain_end = first + (run == 0 ? count : __builtin_ctz(run));
+            t->plain_end[part] = first + (run == 0 ? count : __builtin_ctz(run));
         }
         const unsigned outside = ~(unsigned)M_BITS(inside) & wanted;
         if (outside != 0) {
@@ -187,7 +205,10 @@ static inline void SIMD_NAME(plan_steps)(const SIMD_NAME(block) * b, float dc, f
 /* The plain steps' depths, asked of the memory as soon as the steps are
  * planned, before the search reaches them: the cache lines of a step's first
  * and last lane (a load of SIMD_LANES floats crosses a line's end unless it
- * starts at most 64 - 4 SIMD_LANES bytes into the line). Where
+ * starts at most 64 - 4 SIMD_LANES bytes into the line), over the whole
+ * block (its HBAO_BLOCK_PIXELS floats lie in at most two lines), for the
+ * steps that are plain for every part (at the image's sides a step may be
+ * plain for one part only: it is not prefetched). Where
  * SIMD_PREFETCH_STEPS is 1: the AVX2 copy, measured on a Zen 3 (AMD EPYC,
  * 512 KiB of L2 per core, where a timer profile put half of the search's
  * time on the depth load) by bench_ab with paired calls in both orders
@@ -196,13 +217,22 @@ static inline void SIMD_NAME(plan_steps)(const SIMD_NAME(block) * b, float dc, f
  * top of that, 0.848-0.939 on 1 thread (three runs), 0.948-0.979 on 2. The
  * AVX-512 copy has not been measured with it on AVX-512 hardware, so it
  * stays without. */
+#ifndef SIMD_PREFETCH
+/* prefetcht0 as a statement the compiler keeps: GCC 12 deleted every
+ * __builtin_prefetch of prefetch_steps when its loop took the least of the
+ * parts' plain_end (the copies are x86 only) */
+#define SIMD_PREFETCH(p) __asm__ volatile("prefetcht0 %0" : : "m"(*(const char *)(p)))
+#endif
 static inline void SIMD_NAME(prefetch_steps)(const SIMD_NAME(block) * b,
                                              const SIMD_NAME(steps) * t) {
 #if SIMD_PREFETCH_STEPS
-    for (int k = 0; k < t->plain_end; k++) {
-        const float *depths = b->job->phase_depth + t->index[k];
-        __builtin_prefetch(depths);
-        __builtin_prefetch(depths + SIMD_LANES - 1);
+    const float *depths = b->job->phase_depth;
+    int every = t->plain_end[0];
+    for (int part = 1; part < SIMD_BLOCK_PARTS; part++)
+        every = t->plain_end[part] < every ? t->plain_end[part] : every;
+    for (int k = 0; k < every; k++) {
+        SIMD_PREFETCH(depths + t->index[k]);
+        SIMD_PREFETCH(depths + t->index[k] + HBAO_BLOCK_PIXELS - 1);
     }
 #else
     (void)b;
@@ -262,9 +292,9 @@ static inline int SIMD_NAME(fetch_step)(const SIMD_NAME(block) * b, const SIMD_N
                                         int step, VM *alive, SIMD_NAME(fetch) * f) {
     const int ox = t->ox[step], oy = t->oy[step];
     if (step > 0 && ox == t->ox[step - 1] && oy == t->oy[step - 1]) return 0;
-    if (step < t->plain_end) {
+    if (step < t->plain_end[b->part]) {
         const VM candidate = (ox | oy) == 0 ? M_NONE() : *alive;
-        const int index = t->index[step];
+        const int index = t->index[step] + b->part * SIMD_LANES;
         f->zs = V_ZERO_UNLESS(candidate, V_LOADU(b->job->phase_depth + index));
         if (b->job->phase_back != NULL) f->zb = V_LOADU(b->job->phase_back + index);
         f->row = t->row[step];
@@ -275,16 +305,15 @@ static inline int SIMD_NAME(fetch_step)(const SIMD_NAME(block) * b, const SIMD_N
     return SIMD_NAME(fetch_at_side)(b, ox, oy, alive, f) ? 1 : -1;
 }
 
-/* Fills fetches[0..n) and returns n: the steps before every lane has left
- * the image, less the steps that repeat the previous step's pixel. */
-static inline int SIMD_NAME(fetch_steps)(const SIMD_NAME(block) * b, int steps, float dc, float ds,
+/* Fills fetches[0..n) with plan t's steps and returns n: the steps before
+ * every lane has left the image, less the steps that repeat the previous
+ * step's pixel. */
+static inline int SIMD_NAME(fetch_steps)(const SIMD_NAME(block) * b, const SIMD_NAME(steps) * t,
                                          VM active, SIMD_NAME(fetch) * fetches) {
-    SIMD_NAME(steps) t;
-    SIMD_NAME(plan_steps)(b, dc, ds, steps, &t);
     VM alive = active;
     int fetched = 0;
-    for (int step = 0; step < t.count; step++) {
-        const int got = SIMD_NAME(fetch_step)(b, &t, step, &alive, &fetches[fetched]);
+    for (int step = 0; step < t->count; step++) {
+        const int got = SIMD_NAME(fetch_step)(b, t, step, &alive, &fetches[fetched]);
         if (got < 0) break;
         fetched += got;
     }
@@ -445,7 +474,7 @@ static inline VF SIMD_NAME(cos_to_view)(const SIMD_NAME(block) * b, const VF del
 }
 
 static VF SIMD_NAME(direction_occlusion_hbao)(const hbao_settings *s, const SIMD_NAME(block) * b,
-                                              VM active, float dc, float ds,
+                                              VM active, const SIMD_NAME(steps) * t,
                                               const SIMD_NAME(slice) * sl) {
     const int quadratic = s->falloff == HBAO_FALLOFF_QUADRATIC;
     const VF half_occluded = V_SET(0.5f * (1.0f - s->sin_bias));
@@ -453,14 +482,11 @@ static VF SIMD_NAME(direction_occlusion_hbao)(const hbao_settings *s, const SIMD
     const int any_check = M_ANY(M_AND(check_past_normal, active));
     VF sin_max = V_SET(s->sin_bias);
     VF occlusion = V_SET(0.0f);
-    SIMD_NAME(steps) t;
-    SIMD_NAME(plan_steps)(b, dc, ds, s->steps, &t);
-    SIMD_NAME(prefetch_steps)(b, &t);
     VM inside = active;
     VM alive = active; /* lanes that have not stopped past the normal */
-    for (int step = 0; step < t.count && M_ANY(alive); step++) {
+    for (int step = 0; step < t->count && M_ANY(alive); step++) {
         SIMD_NAME(fetch) f;
-        const int got = SIMD_NAME(fetch_step)(b, &t, step, &inside, &f);
+        const int got = SIMD_NAME(fetch_step)(b, t, step, &inside, &f);
         if (got < 0) break;
         if (got == 0) continue;
         VF delta[3], dist2;
@@ -546,16 +572,13 @@ static inline VF SIMD_NAME(visibility_start)(const hbao_settings *s, VF gamma,
                                             V_SET(s->bias_elevation_acos), gamma, sl);
 }
 
+/* t: the direction's steps, planned (by the caller) before anything else:
+ * the search does not wait on them; the open part is left to the end
+ * (bench_ab, 1080p, four file copies of each build: 0.97 on 1 thread,
+ * 0.98 on 2, against gamma and the open part first). */
 static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SIMD_NAME(block) * b,
-                                                VM active, float dc, float ds,
+                                                VM active, const SIMD_NAME(steps) * t,
                                                 const SIMD_NAME(slice) * sl, VF *open_part) {
-    /* The steps are planned first and the open part is left to the end:
-     * the search does not wait on them (bench_ab, 1080p, four file copies
-     * of each build: 0.97 on 1 thread, 0.98 on 2, against gamma and the
-     * open part first). */
-    SIMD_NAME(steps) t;
-    SIMD_NAME(plan_steps)(b, dc, ds, s->steps, &t);
-    SIMD_NAME(prefetch_steps)(b, &t);
     const VF gamma = V_SUB(V_SET(0.5f * HBAO_PI), SIMD_NAME(acos)(sl->sin_gamma));
     const VF inv_np = sl->inv_np;
     const VM check_past_normal = V_GT(sl->sin_gamma, V_SET(0.0f));
@@ -569,9 +592,9 @@ static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SI
     VF occlusion = V_SET(0.0f);
     int any_raised = 0;
     VM inside = active;
-    for (int step = 0; step < t.count; step++) {
+    for (int step = 0; step < t->count; step++) {
         SIMD_NAME(fetch) f;
-        const int got = SIMD_NAME(fetch_step)(b, &t, step, &inside, &f);
+        const int got = SIMD_NAME(fetch_step)(b, t, step, &inside, &f);
         if (got < 0) break;
         if (got == 0) continue;
         VF delta[3], dist2;
@@ -722,7 +745,7 @@ static inline VF SIMD_NAME(sector_fraction_cosine)(const SIMD_NAME(block) * b,
 
 static VF SIMD_NAME(direction_occlusion_cosine_layers)(const hbao_settings *s,
                                                        const SIMD_NAME(block) * b, VM active,
-                                                       float dc, float ds,
+                                                       const SIMD_NAME(steps) * t,
                                                        const SIMD_NAME(slice) * sl, VF *open_part) {
     const VF gamma = V_SUB(V_SET(0.5f * HBAO_PI), SIMD_NAME(acos)(sl->sin_gamma));
     *open_part =
@@ -741,7 +764,7 @@ static VF SIMD_NAME(direction_occlusion_cosine_layers)(const hbao_settings *s,
     VI marked = I_SET(0);
     VF occlusion = V_SET(0.0f); /* in sectors */
     SIMD_NAME(fetch) fetches[HBAO_MAX_STEPS];
-    const int fetched = SIMD_NAME(fetch_steps)(b, s->steps, dc, ds, lanes, fetches);
+    const int fetched = SIMD_NAME(fetch_steps)(b, t, lanes, fetches);
     for (int step = 0; step < fetched; step++) {
         const VM live = M_ANDNOT(SIMD_NAME(layer_below)(b, &fetches[step]), lanes);
         if (!M_ANY(M_AND(live, fetches[step].candidate))) continue;
@@ -769,7 +792,7 @@ static VF SIMD_NAME(direction_occlusion_cosine_layers)(const hbao_settings *s,
 
 static VF SIMD_NAME(direction_occlusion_hbao_layers)(const hbao_settings *s,
                                                      const SIMD_NAME(block) * b, VM active,
-                                                     float dc, float ds,
+                                                     const SIMD_NAME(steps) * t,
                                                      const SIMD_NAME(slice) * sl) {
     const int quadratic = s->falloff == HBAO_FALLOFF_QUADRATIC;
     const float range = 1.0f - s->sin_bias;
@@ -781,7 +804,7 @@ static VF SIMD_NAME(direction_occlusion_hbao_layers)(const hbao_settings *s,
     VF occlusion = V_SET(0.0f); /* in sectors */
     VF past = V_SET(0.0f);
     SIMD_NAME(fetch) fetches[HBAO_MAX_STEPS];
-    const int fetched = SIMD_NAME(fetch_steps)(b, s->steps, dc, ds, active, fetches);
+    const int fetched = SIMD_NAME(fetch_steps)(b, t, active, fetches);
     VM alive = active; /* lanes that have not stopped past the normal */
     for (int step = 0; step < fetched && M_ANY(alive); step++) {
         const VM live = M_ANDNOT(SIMD_NAME(layer_below)(b, &fetches[step]), alive);
@@ -819,145 +842,185 @@ static VF SIMD_NAME(direction_occlusion_hbao_layers)(const hbao_settings *s,
     return V_SELECT(V_GT(occlusion, past), past, occlusion);
 }
 
-/* Directions whose slices lanes_ao sets up together: 8 keep the stack
- * frame small (2.5 KiB of slices with AVX-512). */
+/* Directions whose slices block_ao sets up together: 8 keep the stack
+ * frame small (2.5 KiB of slices with AVX-512, and with AVX2's two parts). */
 #define SIMD_DIRECTION_GROUP 8
 
-/* Lanes first_lane .. first_lane + SIMD_LANES - 1 of the block of phase a
- * at x0 in row j, with the block's step step_px. */
-static void SIMD_NAME(lanes_ao)(const hbao_horizon_job *job, int x0, int x1, int j, int a,
-                                int first_lane, float step_px) {
+/* Sets up *b, part `part` of the block of phase a at x0 in row j, with the
+ * block's step step_px, and returns its active lanes. What the steps' plan
+ * reads is set in every part; the rest only where a lane is active. */
+static VM SIMD_NAME(block_setup)(const hbao_horizon_job *job, int x0, int j, int a, int part,
+                                 float step_px, SIMD_NAME(block) * b) {
     const hbao_settings *s = job->settings;
     const hbao_grid *g = job->grid;
-    SIMD_NAME(block) b;
-    b.job = job;
-    b.grid = g;
-    b.j = j;
-    const int first_i = x0 + a + 4 * first_lane;
-    b.first_i = first_i;
-    b.phase = a;
-    b.first_x = first_i / 4;
+    b->job = job;
+    b->grid = g;
+    b->part = part;
+    b->j = j;
+    const int first_i = x0 + a + 4 * SIMD_LANES * part;
+    b->first_i = first_i;
+    b->phase = a;
+    b->first_x = first_i / 4;
+    b->jitter = job->jitter[a + 4 * (j & 3)];
+    b->step_px = step_px;
+    b->inv_ycor = 1.0f / g->ycor;
     /* phase_depth rows are padded to whole blocks with zeros: background */
     const VF z =
-        V_LOADU(job->phase_depth + ((size_t)a * g->height + j) * job->phase_width + b.first_x);
-    b.lane_i = I_ADD(I_SET(first_i), I_MULLO(I_LANES, I_SET(4)));
-    b.lane_float = I_TO_F(b.lane_i);
-    const VF column = V_MUL(V_ADD(b.lane_float, V_SET(g->x_offset)), V_SET(g->x_step));
+        V_LOADU(job->phase_depth + ((size_t)a * g->height + j) * job->phase_width + b->first_x);
+    b->lane_i = I_ADD(I_SET(first_i), I_MULLO(I_LANES, I_SET(4)));
+    b->lane_float = I_TO_F(b->lane_i);
+    const VF column = V_MUL(V_ADD(b->lane_float, V_SET(g->x_offset)), V_SET(g->x_step));
     const VF row = V_SET(hbao_grid_y(g, j));
-    b.p[0] = SIMD_ORTHOGRAPHIC ? column : V_MUL(column, z);
-    b.p[1] = SIMD_ORTHOGRAPHIC ? row : V_MUL(row, z);
-    b.p[2] = V_NEG(z);
+    b->p[0] = SIMD_ORTHOGRAPHIC ? column : V_MUL(column, z);
+    b->p[1] = SIMD_ORTHOGRAPHIC ? row : V_MUL(row, z);
+    b->p[2] = V_NEG(z);
     const VF radius_px = SIMD_ORTHOGRAPHIC
                              ? V_SET(s->radius / g->pixel_size)
                              : V_DIV(V_SET(s->radius), V_MUL(V_SET(g->pixel_size), z));
     const VM active = M_AND(V_GT(z, V_SET(0.0f)), V_GE(radius_px, V_SET(1.0f)));
-    float result[SIMD_LANES];
-    if (!M_ANY(active)) {
-        V_STOREU(result, V_SET(1.0f));
+    if (!M_ANY(active)) return active;
+    b->radius2 = V_SET(s->radius * s->radius);
+    b->inv_radius2 = V_SET(1.0f / (s->radius * s->radius));
+    if (SIMD_ORTHOGRAPHIC) {
+        b->v[0] = V_SET(0.0f);
+        b->v[1] = V_SET(0.0f);
+        b->v[2] = V_SET(1.0f);
     } else {
-        const int cell = a + 4 * (j & 3);
-        b.jitter = job->jitter[cell];
-        b.step_px = step_px;
-        b.inv_ycor = 1.0f / g->ycor;
-        b.radius2 = V_SET(s->radius * s->radius);
-        b.inv_radius2 = V_SET(1.0f / (s->radius * s->radius));
-        if (SIMD_ORTHOGRAPHIC) {
-            b.v[0] = V_SET(0.0f);
-            b.v[1] = V_SET(0.0f);
-            b.v[2] = V_SET(1.0f);
-        } else {
-            const VF inv =
-                V_DIV(V_SET(1.0f),
-                      V_SQRT(SIMD_NAME(dot3)(b.p[0], b.p[1], b.p[2], b.p[0], b.p[1], b.p[2])));
-            for (int c = 0; c < 3; c++) b.v[c] = V_MUL(V_NEG(b.p[c]), inv);
-        }
-        /* lanes past x1 read the next component's or row's normals, or the
-         * padding: they are background (not active) */
-        for (int c = 0; c < 3; c++)
-            b.n[c] = V_LOAD_EVERY_FOURTH(hbao_grid_normal_row(g, j, c) + first_i);
-        b.n_dot_v = SIMD_NAME(dot3)(b.n[0], b.n[1], b.n[2], b.v[0], b.v[1], b.v[2]);
-        b.view_below = V_LT(b.n_dot_v, V_SET(0.0f));
-        /* hbao_rounding_along_normal */
-        const VF along = SIMD_ORTHOGRAPHIC
-                             ? V_MUL(b.n[2], b.p[2])
-                             : SIMD_NAME(dot3)(b.n[0], b.n[1], b.n[2], b.p[0], b.p[1], b.p[2]);
-        b.height_tolerance = V_MUL(V_SET(g->depth_precision),
-                                   V_SELECT(V_LT(along, V_SET(0.0f)), along, V_NEG(along)));
-        /* hbao_height_plane_setup */
-        b.height_across =
-            SIMD_ORTHOGRAPHIC ? V_MUL(column, b.n[0]) : V_SUB(V_MUL(column, b.n[0]), b.n[2]);
-        b.height_per_pixel = V_MUL(V_SET(g->x_step), b.n[0]);
-        b.height_per_row = b.n[1];
-        b.height_depth = b.n[2];
-        {
-            const VF pn0 = V_MUL(b.p[0], b.n[0]), pn1 = V_MUL(b.p[1], b.n[1]);
-            const VF pn2 = V_MUL(b.p[2], b.n[2]);
-            const VF rounding = V_ADD(V_ADD(V_ABS(pn0), V_ABS(pn1)), V_ABS(pn2));
-            b.height_offset = V_ADD(V_ADD(V_ADD(V_ADD(pn0, pn1), pn2), b.height_tolerance),
-                                    V_MUL(V_SET(HBAO_HEIGHT_ROUNDING), rounding));
-        }
-        /* hbao_near_limit */
-        b.near_limit = s->thickness > 0.0f ? V_SUB(z, V_SET(s->thickness)) : V_SET(0.0f);
-        b.min_thickness = V_SET(HBAO_MIN_BACK_THICKNESS * s->radius);
+        const VF inv =
+            V_DIV(V_SET(1.0f),
+                  V_SQRT(SIMD_NAME(dot3)(b->p[0], b->p[1], b->p[2], b->p[0], b->p[1], b->p[2])));
+        for (int c = 0; c < 3; c++) b->v[c] = V_MUL(V_NEG(b->p[c]), inv);
+    }
+    /* lanes past the image's width read the next component's or row's
+     * normals, or the padding: they are background (not active) */
+    for (int c = 0; c < 3; c++)
+        b->n[c] = V_LOAD_EVERY_FOURTH(hbao_grid_normal_row(g, j, c) + first_i);
+    b->n_dot_v = SIMD_NAME(dot3)(b->n[0], b->n[1], b->n[2], b->v[0], b->v[1], b->v[2]);
+    b->view_below = V_LT(b->n_dot_v, V_SET(0.0f));
+    b->n_cross_v[0] = V_SUB(V_MUL(b->n[1], b->v[2]), V_MUL(b->n[2], b->v[1]));
+    b->n_cross_v[1] = V_SUB(V_MUL(b->n[2], b->v[0]), V_MUL(b->n[0], b->v[2]));
+    /* hbao_rounding_along_normal */
+    const VF along = SIMD_ORTHOGRAPHIC
+                         ? V_MUL(b->n[2], b->p[2])
+                         : SIMD_NAME(dot3)(b->n[0], b->n[1], b->n[2], b->p[0], b->p[1], b->p[2]);
+    b->height_tolerance =
+        V_MUL(V_SET(g->depth_precision), V_SELECT(V_LT(along, V_SET(0.0f)), along, V_NEG(along)));
+    /* hbao_height_plane_setup */
+    b->height_across =
+        SIMD_ORTHOGRAPHIC ? V_MUL(column, b->n[0]) : V_SUB(V_MUL(column, b->n[0]), b->n[2]);
+    b->height_per_pixel = V_MUL(V_SET(g->x_step), b->n[0]);
+    b->height_per_row = b->n[1];
+    b->height_depth = b->n[2];
+    {
+        const VF pn0 = V_MUL(b->p[0], b->n[0]), pn1 = V_MUL(b->p[1], b->n[1]);
+        const VF pn2 = V_MUL(b->p[2], b->n[2]);
+        const VF rounding = V_ADD(V_ADD(V_ABS(pn0), V_ABS(pn1)), V_ABS(pn2));
+        b->height_offset = V_ADD(V_ADD(V_ADD(V_ADD(pn0, pn1), pn2), b->height_tolerance),
+                                 V_MUL(V_SET(HBAO_HEIGHT_ROUNDING), rounding));
+    }
+    /* hbao_near_limit */
+    b->near_limit = s->thickness > 0.0f ? V_SUB(z, V_SET(s->thickness)) : V_SET(0.0f);
+    b->min_thickness = V_SET(HBAO_MIN_BACK_THICKNESS * s->radius);
+    return active;
+}
 
-        const int cosine = s->integration == HBAO_INTEGRATION_COSINE;
-        const int layers = job->phase_back != NULL;
-        VF occlusion_sum = V_SET(0.0f), visible_sum = V_SET(0.0f), open_sum = V_SET(0.0f);
-        /* The slices of a group of directions are set up first, one after
-         * the other: their chains of square roots and divisions overlap,
-         * where a search loop between them would keep each waiting. */
-        const VF n_cross_v[2] = {V_SUB(V_MUL(b.n[1], b.v[2]), V_MUL(b.n[2], b.v[1])),
-                                 V_SUB(V_MUL(b.n[2], b.v[0]), V_MUL(b.n[0], b.v[2]))};
-        const float *direction_cos = job->direction_cos[cell];
-        const float *direction_sin = job->direction_sin[cell];
-        for (int first = 0; first < s->directions; first += SIMD_DIRECTION_GROUP) {
-            const int count = s->directions - first < SIMD_DIRECTION_GROUP ? s->directions - first
-                                                                           : SIMD_DIRECTION_GROUP;
-            SIMD_NAME(slice) slices[SIMD_DIRECTION_GROUP];
+/* The AO of the block of phase a at x0 in row j (its pixels before x1),
+ * with the block's step step_px: each direction's steps are planned once,
+ * then each part with an active lane searches them. */
+static void SIMD_NAME(block_ao)(const hbao_horizon_job *job, int x0, int x1, int j, int a,
+                                float step_px) {
+    const hbao_settings *s = job->settings;
+    SIMD_NAME(block) b[SIMD_BLOCK_PARTS];
+    VM active[SIMD_BLOCK_PARTS];
+    unsigned live = 0; /* bit k: part k has an active lane */
+    for (int part = 0; part < SIMD_BLOCK_PARTS; part++) {
+        active[part] = SIMD_NAME(block_setup)(job, x0, j, a, part, step_px, &b[part]);
+        if (M_ANY(active[part])) live |= 1u << part;
+    }
+    const int cosine = s->integration == HBAO_INTEGRATION_COSINE;
+    const int layers = job->phase_back != NULL;
+    VF occlusion_sum[SIMD_BLOCK_PARTS], visible_sum[SIMD_BLOCK_PARTS], open_sum[SIMD_BLOCK_PARTS];
+    for (int part = 0; part < SIMD_BLOCK_PARTS; part++)
+        occlusion_sum[part] = visible_sum[part] = open_sum[part] = V_SET(0.0f);
+    const int cell = a + 4 * (j & 3);
+    const float *direction_cos = job->direction_cos[cell];
+    const float *direction_sin = job->direction_sin[cell];
+    /* The slices of a group of directions are set up first, one after the
+     * other: their chains of square roots and divisions overlap, where a
+     * search loop between them would keep each waiting. */
+    for (int first = 0; live != 0 && first < s->directions; first += SIMD_DIRECTION_GROUP) {
+        const int count = s->directions - first < SIMD_DIRECTION_GROUP ? s->directions - first
+                                                                       : SIMD_DIRECTION_GROUP;
+        SIMD_NAME(slice) slices[SIMD_BLOCK_PARTS][SIMD_DIRECTION_GROUP];
+        for (int part = 0; part < SIMD_BLOCK_PARTS; part++) {
+            if (!(live >> part & 1u)) continue;
+            const SIMD_NAME(block) *bp = &b[part];
             for (int k = 0; k < count; k++) {
                 const VF dc = V_SET(direction_cos[first + k]), ds = V_SET(direction_sin[first + k]);
-                SIMD_NAME(slice_setup)(b.v, b.n, n_cross_v, b.n_dot_v, dc, ds, &slices[k]);
+                SIMD_NAME(slice_setup)
+                (bp->v, bp->n, bp->n_cross_v, bp->n_dot_v, dc, ds, &slices[part][k]);
             }
-            for (int k = 0; k < count; k++) {
-                const float dc = direction_cos[first + k], ds = direction_sin[first + k];
-                const SIMD_NAME(slice) *sl = &slices[k];
+        }
+        for (int k = 0; k < count; k++) {
+            VM lanes[SIMD_BLOCK_PARTS];
+            unsigned searched = 0; /* bit k: part k searches this direction */
+            for (int part = 0; part < SIMD_BLOCK_PARTS; part++) {
+                if (!(live >> part & 1u)) continue;
+                lanes[part] = cosine ? M_AND(active[part], slices[part][k].usable) : active[part];
+                if (M_ANY(lanes[part])) searched |= 1u << part;
+            }
+            if (searched == 0) continue;
+            SIMD_NAME(steps) t;
+            SIMD_NAME(plan_steps)
+            (&b[0], direction_cos[first + k], direction_sin[first + k], s->steps, &t);
+            SIMD_NAME(prefetch_steps)(&b[0], &t);
+            for (int part = 0; part < SIMD_BLOCK_PARTS; part++) {
+                if (!(searched >> part & 1u)) continue;
+                const SIMD_NAME(block) *bp = &b[part];
+                const SIMD_NAME(slice) *sl = &slices[part][k];
                 if (cosine) {
-                    const VM lanes = M_AND(active, sl->usable);
-                    if (!M_ANY(lanes)) continue;
                     VF open;
                     const VF occlusion = layers ? SIMD_NAME(direction_occlusion_cosine_layers)(
-                                                      s, &b, lanes, dc, ds, sl, &open)
+                                                      s, bp, lanes[part], &t, sl, &open)
                                                 : SIMD_NAME(direction_occlusion_cosine)(
-                                                      s, &b, lanes, dc, ds, sl, &open);
-                    visible_sum =
-                        V_SELECT(lanes, visible_sum,
-                                 V_ADD(visible_sum, V_MUL(sl->np_length, V_SUB(open, occlusion))));
-                    open_sum =
-                        V_SELECT(lanes, open_sum, V_ADD(open_sum, V_MUL(sl->np_length, open)));
+                                                      s, bp, lanes[part], &t, sl, &open);
+                    visible_sum[part] = V_SELECT(
+                        lanes[part], visible_sum[part],
+                        V_ADD(visible_sum[part], V_MUL(sl->np_length, V_SUB(open, occlusion))));
+                    open_sum[part] = V_SELECT(lanes[part], open_sum[part],
+                                              V_ADD(open_sum[part], V_MUL(sl->np_length, open)));
                 } else {
-                    occlusion_sum = V_ADD(
-                        occlusion_sum,
-                        layers
-                            ? SIMD_NAME(direction_occlusion_hbao_layers)(s, &b, active, dc, ds, sl)
-                            : SIMD_NAME(direction_occlusion_hbao)(s, &b, active, dc, ds, sl));
+                    occlusion_sum[part] = V_ADD(
+                        occlusion_sum[part],
+                        layers ? SIMD_NAME(direction_occlusion_hbao_layers)(s, bp, active[part], &t,
+                                                                            sl)
+                               : SIMD_NAME(direction_occlusion_hbao)(s, bp, active[part], &t, sl));
                 }
             }
         }
-        VF ao;
-        if (cosine)
-            ao = V_SELECT(V_GT(open_sum, V_SET(1e-12f)), V_SET(1.0f), V_DIV(visible_sum, open_sum));
-        else
-            ao = V_SUB(V_SET(1.0f),
-                       V_DIV(occlusion_sum, V_SET((float)s->directions * (1.0f - s->sin_bias))));
-        ao = V_ZERO_UNLESS(V_GT(ao, V_SET(0.0f)), ao); /* !(ao > 0) -> 0, NaN included */
-        ao = V_SELECT(V_LT(ao, V_SET(1.0f)), V_SET(1.0f), ao);
-        ao = V_SELECT(active, V_SET(1.0f), ao);
-        V_STOREU(result, ao);
     }
-    float *out = job->ao + (size_t)j * g->width;
-    for (int k = 0; k < SIMD_LANES; k++) {
-        const int i = first_i + 4 * k;
-        if (i < x1) out[i] = result[k];
+    float *out = job->ao + (size_t)j * job->grid->width;
+    for (int part = 0; part < SIMD_BLOCK_PARTS; part++) {
+        float result[SIMD_LANES];
+        if (!(live >> part & 1u)) {
+            V_STOREU(result, V_SET(1.0f));
+        } else {
+            VF ao;
+            if (cosine)
+                ao = V_SELECT(V_GT(open_sum[part], V_SET(1e-12f)), V_SET(1.0f),
+                              V_DIV(visible_sum[part], open_sum[part]));
+            else
+                ao = V_SUB(V_SET(1.0f), V_DIV(occlusion_sum[part],
+                                              V_SET((float)s->directions * (1.0f - s->sin_bias))));
+            ao = V_ZERO_UNLESS(V_GT(ao, V_SET(0.0f)), ao); /* !(ao > 0) -> 0, NaN included */
+            ao = V_SELECT(V_LT(ao, V_SET(1.0f)), V_SET(1.0f), ao);
+            ao = V_SELECT(active[part], V_SET(1.0f), ao);
+            V_STOREU(result, ao);
+        }
+        for (int k = 0; k < SIMD_LANES; k++) {
+            const int i = b[part].first_i + 4 * k;
+            if (i < x1) out[i] = result[k];
+        }
     }
 }
 
@@ -1008,11 +1071,10 @@ static void SIMD_NAME(span)(const hbao_horizon_job *job, int x0, int x1, int j) 
     }
     for (int a = 0; a < 4; a++) {
         const float step_px = step[a];
-        if (step_px < 0.0f) { /* no lane active: lanes_ao's result, without its set-up */
+        if (step_px < 0.0f) { /* no lane active: block_ao's result, without its set-up */
             for (int i = x0 + a; i < x1; i += 4) out[i] = 1.0f;
             continue;
         }
-        for (int first_lane = 0; first_lane < HBAO_BLOCK_PIXELS; first_lane += SIMD_LANES)
-            SIMD_NAME(lanes_ao)(job, x0, x1, j, a, first_lane, step_px);
+        SIMD_NAME(block_ao)(job, x0, x1, j, a, step_px);
     }
 }
