@@ -5,8 +5,10 @@
 # moves a memory-bound loop): bench_ab with one call of each build per
 # round (--calls 1), so that the two calls of a round see the same machine,
 # in both orders (the second call of a round runs a few per cent slower).
-# Prints the median over the rounds of each round's after / before ratio,
-# for each order, and their geometric mean (the order's bias cancelled).
+# Prints the settings bench_ab ran with (the thread count included: bench_ab
+# runs on 1 thread unless --threads says otherwise), then the median over
+# the rounds of each round's after / before ratio, for each order, and their
+# geometric mean (the order's bias cancelled).
 #   scripts/bench_ab_pairs.sh BEFORE.so AFTER.so [bench_ab options]
 # Environment: ROUNDS (per order, default 30). scripts/bench_ab_copies.sh
 # is the steadier choice where the machine's speed holds still.
@@ -34,6 +36,13 @@ import statistics
 import sys
 
 
+def settings(path):
+    """bench_ab's first line up to its ';': size, directions x steps, blur,
+    radius and threads."""
+    with open(path, encoding="utf-8") as lines:
+        return next(lines, "").split(";")[0].strip()
+
+
 def ratios(path):
     """Each round's second-named / first-named fastest call."""
     first, second = [], []
@@ -46,6 +55,7 @@ def ratios(path):
     return [b / a for a, b in zip(first, second)]
 
 
+print(f"bench_ab: {settings(sys.argv[1])}")
 forward = statistics.median(ratios(sys.argv[1]))
 reverse = 1.0 / statistics.median(ratios(sys.argv[2]))
 options = f" [{sys.argv[3]}]" if sys.argv[3] else ""
