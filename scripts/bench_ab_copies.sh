@@ -17,12 +17,8 @@ bench_ab_arguments "$0" "$@"
 shift 2
 copies=${COPIES:-4}
 rounds=${ROUNDS:-3}
-for setting in "COPIES=$copies" "ROUNDS=$rounds"; do
-    if ! [[ ${setting#*=} =~ ^[1-9][0-9]?$ ]]; then
-        echo "$0: $setting: give a whole number from 1 to 99" >&2
-        exit 2
-    fi
-done
+bench_ab_count "$0" COPIES "$copies" 2
+bench_ab_count "$0" ROUNDS "$rounds" 2
 bench_ab_program
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT

@@ -19,10 +19,7 @@ REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bench_ab_arguments "$0" "$@"
 shift 2
 rounds=${ROUNDS:-30}
-if ! [[ $rounds =~ ^[1-9][0-9]{0,2}$ ]]; then
-    echo "$0: ROUNDS=$rounds: give a whole number from 1 to 999" >&2
-    exit 2
-fi
+bench_ab_count "$0" ROUNDS "$rounds" 3
 bench_ab_program
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT

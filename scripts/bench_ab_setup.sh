@@ -14,6 +14,17 @@ bench_ab_arguments() {
     after=$2
 }
 
+# bench_ab_count SCRIPT NAME VALUE DIGITS: exits 2 with a message unless
+# VALUE (the environment variable NAME's) is a whole number from 1 with at
+# most DIGITS digits.
+bench_ab_count() {
+    local script=$1 name=$2 value=$3 digits=$4
+    if ! [[ $value =~ ^[1-9][0-9]{0,$((digits - 1))}$ ]]; then
+        echo "$script: $name=$value: give a whole number from 1 to $((10 ** digits - 1))" >&2
+        exit 2
+    fi
+}
+
 # bench_ab_program: sets bench to build/bench_ab, set up and built first
 # where it is missing.
 bench_ab_program() {
