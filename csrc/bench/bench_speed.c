@@ -70,6 +70,18 @@ static int time_call(const hbao_params *p, const bench_scene *b, float *ao, timi
     return 1;
 }
 
+/* The median of a row's rounds and its fastest and slowest round (sorts
+ * values[0 .. count)): on a shared machine the spread says how far one
+ * run's median can move. */
+typedef struct round_spread {
+    double median, low, high;
+} round_spread;
+
+static round_spread spread_of(double *values, int count) {
+    const double median = median_of(values, count);
+    return (round_spread){median, values[0], values[count - 1]};
+}
+
 static int parse_implementations(const char *list, int wanted[COLUMN_COUNT]) {
     for (int c = 0; c < COLUMN_COUNT; c++) wanted[c] = 0;
     char copy[256];
@@ -148,9 +160,8 @@ int main(int argc, char **argv) {
         "on "
         "1 thread. A round times every column once (and the last one without blur). Cells: median "
         "wall-clock ms (median process CPU ms, all threads together). Speed-up and blur share "
-        "((time - time without blur) / time, on the last column; wall (CPU; the blur's own CPU "
-        "ms)) "
-        "are medians of the per-round values.\n",
+        "((time - time without blur) / time, on the last column: wall, with the least and the "
+        "greatest round's; CPU; the blur's own CPU ms) are medians of the per-round values.\n",
         HBAO_DEFAULT_DIRECTIONS, HBAO_DEFAULT_STEPS, HBAO_DEFAULT_BLUR_SIZE, kernel_names[best]);
     print_load("before");
     printf("\n| settings | size |");
@@ -232,12 +243,13 @@ int main(int argc, char **argv) {
                 scratch[k] = times[c * runs + k].wall;
                 scratch[runs + k] = times[c * runs + k].cpu;
             }
-            measured[r][c] = median_of(scratch, runs); /* sorts scratch[0 .. runs) */
+            const round_spread wall = spread_of(scratch, runs);
+            measured[r][c] = wall.median;
             if (c == last_column) {
-                round_fastest[r] = scratch[0];
-                round_slowest[r] = scratch[runs - 1];
+                round_fastest[r] = wall.low;
+                round_slowest[r] = wall.high;
             }
-            printf(" %.1f (%.1f) |", 1e3 * measured[r][c], 1e3 * median_of(scratch + runs, runs));
+            printf(" %.1f (%.1f) |", 1e3 * wall.median, 1e3 * median_of(scratch + runs, runs));
         }
         speedup[r] = 0.0;
         if (scalar_column >= 0 && scalar_column != last_column) {
@@ -250,20 +262,20 @@ int main(int argc, char **argv) {
             printf(" - |");
         }
         /* The blur's share, wall and CPU, and its own CPU time, per round. */
-        double share_wall, share_cpu, blur_cpu;
         for (int k = 0; k < runs; k++) {
             const timing with = times[last_column * runs + k],
                          without = times[UNBLURRED * runs + k];
             scratch[k] = (with.wall - without.wall) / with.wall;
             scratch[runs + k] = (with.cpu - without.cpu) / with.cpu;
         }
-        share_wall = median_of(scratch, runs);
-        share_cpu = median_of(scratch + runs, runs);
+        const round_spread share_wall = spread_of(scratch, runs);
+        const double share_cpu = median_of(scratch + runs, runs);
         for (int k = 0; k < runs; k++)
             scratch[k] = times[last_column * runs + k].cpu - times[UNBLURRED * runs + k].cpu;
-        blur_cpu = median_of(scratch, runs);
-        printf(" %.0f %% (%.0f %%; %.1f ms) |\n", 100.0 * share_wall, 100.0 * share_cpu,
-               1e3 * blur_cpu);
+        const double blur_cpu = median_of(scratch, runs);
+        printf(" %.0f %% (rounds %.0f to %.0f %%; CPU %.0f %%; %.1f ms) |\n",
+               100.0 * share_wall.median, 100.0 * share_wall.low, 100.0 * share_wall.high,
+               100.0 * share_cpu, 1e3 * blur_cpu);
         fflush(stdout);
         free(ao);
         free(reference);
@@ -325,48 +337,65 @@ int main(int argc, char **argv) {
     }
 
     /* What a frame does not need is skipped: the same frame with and
-     * without the thing that lets the library skip work. */
+     * without the thing that lets the library skip work. A round times
+     * every case once, so that a change of load during the run affects
+     * them alike, and each case's saving is the median of its per-round
+     * ratio to the reference case of the same round. */
     {
         bench_scene b;
         bench_scene_make(&b, 1920, 1080);
         const size_t pixels = (size_t)1920 * 1080;
+        enum { CASES = 4 };
         float *ao = malloc(pixels * sizeof(float)), *sky = malloc(pixels * sizeof(float));
-        double *wall = malloc((size_t)runs * sizeof(double));
-        if (ao == NULL || sky == NULL || wall == NULL) return 1;
+        double *wall = malloc((size_t)CASES * runs * sizeof(double));
+        double *ratio = malloc((size_t)runs * sizeof(double));
+        if (ao == NULL || sky == NULL || wall == NULL || ratio == NULL) return 1;
         memcpy(sky, b.depth, pixels * sizeof(float));
         for (size_t k = 0; k < pixels / 2; k++) sky[k] = 1e10f; /* the upper half: background */
         float *const full_depth = b.depth;
-        printf("\n## Skips, 1920x1080, defaults, %s, median wall ms\n\n",
-               all_columns[last_column].name);
-        printf("| what is skipped | frame | ms |\n|---|---|---|\n");
+        printf("\n## Skips, 1920x1080, defaults, %s, wall ms\n\n", all_columns[last_column].name);
+        printf("A round times every case once. Time: the median round, with the fastest and the "
+               "slowest; time / reference: the median of the rounds' ratios.\n\n");
+        printf("| what is skipped | frame | median ms | rounds: fastest - slowest | "
+               "time / reference |\n|---|---|---|---|---|\n");
         const struct {
             const char *what, *frame;
             float radius;
             int sky;
-        } cases[] = {
+        } cases[CASES] = {
             {"nothing (reference)", "every pixel geometry, radius 0.5", 0.5f, 0},
             {"background pixels and blocks", "upper half background, radius 0.5", 0.5f, 1},
             {"steps that land on the same pixel", "radius 0.02 (about 10 pixels)", 0.02f, 0},
             {"the horizon search (radius under a pixel)", "radius 1e-4", 1e-4f, 0},
         };
-        for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
-            hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
-            p.radius = cases[c].radius;
-            p.implementation = all_columns[last_column].implementation;
-            p.threads = all_columns[last_column].threads;
-            b.depth = cases[c].sky ? sky : full_depth;
-            for (int round = -1; round < runs; round++) {
+        for (int round = -1; round < runs; round++) {
+            for (int c = 0; c < CASES; c++) {
+                hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+                p.radius = cases[c].radius;
+                p.implementation = all_columns[last_column].implementation;
+                p.threads = all_columns[last_column].threads;
+                b.depth = cases[c].sky ? sky : full_depth;
                 timing t;
                 if (!time_call(&p, &b, ao, &t)) return 1;
-                if (round >= 0) wall[round] = t.wall;
+                if (round >= 0) wall[c * runs + round] = t.wall;
             }
-            printf("| %s | %s | %.1f |\n", cases[c].what, cases[c].frame,
-                   1e3 * median_of(wall, runs));
+        }
+        /* every ratio first: spread_of sorts a case's rounds out of their order */
+        double relative[CASES];
+        for (int c = 0; c < CASES; c++) {
+            for (int k = 0; k < runs; k++) ratio[k] = wall[c * runs + k] / wall[k];
+            relative[c] = median_of(ratio, runs);
+        }
+        for (int c = 0; c < CASES; c++) {
+            const round_spread ms = spread_of(wall + c * runs, runs);
+            printf("| %s | %s | %.1f | %.1f - %.1f | %.2f |\n", cases[c].what, cases[c].frame,
+                   1e3 * ms.median, 1e3 * ms.low, 1e3 * ms.high, relative[c]);
         }
         b.depth = full_depth;
         free(ao);
         free(sky);
         free(wall);
+        free(ratio);
         free(b.depth);
         free(b.normal);
     }
@@ -379,7 +408,8 @@ int main(int argc, char **argv) {
         const size_t pixels = (size_t)1920 * 1080;
         float *ao = malloc(pixels * sizeof(float)), *back = malloc(pixels * sizeof(float));
         double *wall = malloc(2 * (size_t)runs * sizeof(double));
-        if (ao == NULL || back == NULL || wall == NULL) return 1;
+        double *ratio = malloc((size_t)runs * sizeof(double));
+        if (ao == NULL || back == NULL || wall == NULL || ratio == NULL) return 1;
         for (size_t k = 0; k < pixels; k++) back[k] = b.depth[k] + 0.3f;
         hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
         p.radius = radius;
@@ -396,15 +426,24 @@ int main(int argc, char **argv) {
                     wall[layered * runs + round] = clock_seconds(CLOCK_MONOTONIC) - start;
             }
         }
-        const double without = median_of(wall, runs), with = median_of(wall + runs, runs);
-        printf("\n## Back-face layer, 1920x1080, defaults, %s, median wall ms\n\n",
+        /* the rounds' ratios first: spread_of sorts the rounds out of their order */
+        for (int r = 0; r < runs; r++) ratio[r] = wall[runs + r] / wall[r];
+        const round_spread relative = spread_of(ratio, runs);
+        const round_spread without = spread_of(wall, runs), with = spread_of(wall + runs, runs);
+        printf("\n## Back-face layer, 1920x1080, defaults, %s, wall ms\n\n",
                all_columns[last_column].name);
+        printf("A round times the frame without and with the layer. Times: the median round "
+               "(fastest - slowest); ratio: the median of the rounds' ratios (least - "
+               "greatest).\n\n");
         printf("| without the layer | with a layer (every surface 0.3 deep) | ratio |\n");
-        printf("|---|---|---|\n| %.1f | %.1f | %.2fx |\n", 1e3 * without, 1e3 * with,
-               with / without);
+        printf("|---|---|---|\n| %.1f (%.1f - %.1f) | %.1f (%.1f - %.1f) | %.2fx (%.2f - "
+               "%.2f) |\n",
+               1e3 * without.median, 1e3 * without.low, 1e3 * without.high, 1e3 * with.median,
+               1e3 * with.low, 1e3 * with.high, relative.median, relative.low, relative.high);
         free(ao);
         free(back);
         free(wall);
+        free(ratio);
         free(b.depth);
         free(b.normal);
     }
