@@ -1,0 +1,80 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: GPL-2.0-or-later
+# The CLI on a sequence, as a render farm task runs it (issue 11): FRAMES
+# frames (default 250), each a symbolic link to one 1920x1080 render of the
+# demo scene (Debian's Blender, Cycles, 1 sample, 32-bit ZIP multilayer EXR
+# with Combined, Depth and Normal; rendered once and kept in
+# .cache/bench/sequence), computed by
+#   hbao 'render_####.exr' -o 'ao_####.exr' --camera render.camera.json \
+#        --frames 1-FRAMES -j JOBS
+# twice in a new temporary folder: the first run computes every frame, the
+# second finds every output up to date and skips it. Prints each run's wall
+# time and frames per second. Exits 1 when a run fails, when an output is
+# missing after the first run, or when the second run rewrites any output.
+#   scripts/bench_cli_sequence.sh [--frames N] [--jobs J]
+set -euo pipefail
+REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+FRAMES=250
+JOBS=2
+usage() { echo "usage: $0 [--frames N] [--jobs J]   (N in [1, 9999], J in [1, 32])" >&2; exit 2; }
+while [ $# -gt 0 ]; do
+    case "$1" in
+        --frames) [ $# -ge 2 ] || usage; FRAMES="$2"; shift 2 ;;
+        --jobs) [ $# -ge 2 ] || usage; JOBS="$2"; shift 2 ;;
+        *) usage ;;
+    esac
+done
+case "$FRAMES" in ''|*[!0-9]*) usage ;; esac
+case "$JOBS" in ''|*[!0-9]*) usage ;; esac
+[ "$FRAMES" -ge 1 ] && [ "$FRAMES" -le 9999 ] && [ "$JOBS" -ge 1 ] && [ "$JOBS" -le 32 ] || usage
+
+"$REPO/scripts/setup.sh"
+cmake -S "$REPO" -B "$REPO/build" -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build "$REPO/build" -j2 --target hbao_tool >/dev/null
+HBAO="$REPO/build/hbao"
+
+# The render, made once (a few seconds of Cycles at 1 sample).
+CACHE="$REPO/.cache/bench/sequence"
+RENDER="$CACHE/demo_1920x1080"
+if [ ! -f "$RENDER.exr" ] || [ ! -f "$RENDER.camera.json" ]; then
+    mkdir -p "$CACHE"
+    blender -b --factory-startup -noaudio --python-exit-code 1 \
+        --python "$REPO/scripts/render_passes.py" -- --scene demo --out "$RENDER" \
+        --width 1920 --height 1080 --samples 1 --codec ZIP --force >/dev/null
+fi
+
+WORK="$(mktemp -d)"
+trap 'rm -rf "$WORK"' EXIT
+for ((frame = 1; frame <= FRAMES; frame++)); do
+    ln -s "$RENDER.exr" "$WORK/$(printf 'render_%04d.exr' "$frame")"
+done
+
+run() {  # prints the run's wall seconds
+    local start end
+    start=$(date +%s.%N)
+    (cd "$WORK" && "$HBAO" 'render_####.exr' -o 'ao_####.exr' --camera "$RENDER.camera.json" \
+        --frames "1-$FRAMES" -j "$JOBS" 2>"$WORK/log.txt")
+    end=$(date +%s.%N)
+    echo "$start $end" | awk '{printf "%.3f", $2 - $1}'
+}
+
+echo "hbao on $FRAMES frames of $(basename "$RENDER").exr ($(du -Lh "$RENDER.exr" | cut -f1)" \
+     "each), -j $JOBS, $(nproc) cores"
+first=$(run) || { echo "first run failed:" >&2; tail -n 20 "$WORK/log.txt" >&2; exit 1; }
+computed=$(ls "$WORK" | grep -c '^ao_[0-9]*\.exr$' || true)
+if [ "$computed" -ne "$FRAMES" ]; then
+    echo "first run wrote $computed of $FRAMES outputs" >&2
+    exit 1
+fi
+before=$(cd "$WORK" && stat -c '%n %Y.%y' ao_*.exr | md5sum)
+second=$(run) || { echo "second run failed:" >&2; tail -n 20 "$WORK/log.txt" >&2; exit 1; }
+after=$(cd "$WORK" && stat -c '%n %Y.%y' ao_*.exr | md5sum)
+skipped=$(grep -c 'is up to date, skipped' "$WORK/log.txt" || true)
+if [ "$before" != "$after" ] || [ "$skipped" -ne "$FRAMES" ]; then
+    echo "second run rewrote outputs (skipped $skipped of $FRAMES)" >&2
+    exit 1
+fi
+awk -v n="$FRAMES" -v a="$first" -v b="$second" 'BEGIN {
+    printf "first run (every frame computed): %.1f s, %.2f frames/s, %.0f ms a frame\n", a, n / a, 1000 * a / n
+    printf "second run (every output up to date, skipped): %.3f s\n", b
+}'
