@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
 /* Two builds of libhbao timed against each other in the same run: "before"
- * and "after" a change, on bench_speed's 1080p scene at the defaults (or
- * --half, --radius). On a shared machine the time of one build moves by
+ * and "after" a change, on bench_speed's scene at 1920x1080 (--size WxH
+ * for another) at the defaults (or --half, --radius). On a shared machine the time of one build moves by
  * 10 % between minutes, so the builds alternate: a round makes --calls calls
  * with each, and prints each build's fastest call and lower quartile (the
  * steadiest figures under load: CPU ms on 1 thread, wall ms on more). Also
@@ -10,7 +10,7 @@
  *
  *   bench_ab BEFORE/libhbao.so AFTER/libhbao.so [--rounds R] [--calls N]
  *            [--threads T] [--half] [--radius R] [--directions D] [--steps S]
- *            [--blur B] [--implementation NAME] [--back-faces]
+ *            [--blur B] [--size WxH] [--implementation NAME] [--back-faces]
  *
  * --back-faces: with a back-face layer every surface 0.3 deep, as
  * bench_speed's back-face row (hbao_compute_layers; without it the same
@@ -52,7 +52,7 @@ static int load(build *b, int width, int height) {
 static void usage(const char *program) {
     fprintf(stderr,
             "usage: %s BEFORE_LIBRARY AFTER_LIBRARY [--rounds R] [--calls N] [--threads T] "
-            "[--half] [--radius R] [--directions D] [--steps S] [--blur B]\n"
+            "[--half] [--radius R] [--directions D] [--steps S] [--blur B] [--size WxH]\n"
             "  [--implementation scalar|avx2|avx512] (default: the best this CPU has) "
             "[--back-faces]\n",
             program);
@@ -60,6 +60,7 @@ static void usage(const char *program) {
 
 int main(int argc, char **argv) {
     int rounds = 3, calls = 15, threads = 1, half = 0, back_faces = 0;
+    int width = 1920, height = 1080;
     hbao_params params = HBAO_PARAMS_DEFAULT_INITIALIZER;
     float radius = 0.5f;
     if (argc < 3) {
@@ -85,7 +86,10 @@ int main(int argc, char **argv) {
             half = 1;
         else if (!strcmp(argv[a], "--back-faces"))
             back_faces = 1;
-        else if (!strcmp(argv[a], "--implementation") && a + 1 < argc)
+        else if (!strcmp(argv[a], "--size") && a + 1 < argc) {
+            char end = '\0';
+            if (sscanf(argv[++a], "%dx%d%c", &width, &height, &end) != 2) width = 0;
+        } else if (!strcmp(argv[a], "--implementation") && a + 1 < argc)
             params.implementation = bench_implementation(argv[++a]);
         else {
             usage(argv[0]);
@@ -93,12 +97,13 @@ int main(int argc, char **argv) {
         }
     }
     if (rounds < 1 || rounds > 100 || calls < 1 || calls > 1000 || threads < 1 || threads > 64 ||
-        !(radius > 0.0f) || params.implementation < 0) {
+        !(radius > 0.0f) || params.implementation < 0 || width < 16 || width > 8192 ||
+        height < 16 || height > 8192) {
         fprintf(stderr, "bench_ab: --rounds 1-100, --calls 1-1000, --threads 1-64, radius > 0, "
-                        "--implementation scalar, avx2 or avx512\n");
+                        "--implementation scalar, avx2 or avx512, --size WxH with W and H in "
+                        "16-8192\n");
         return 2;
     }
-    const int width = 1920, height = 1080;
     build builds[2] = {{argv[1], NULL, NULL, 0.0, 0.0}, {argv[2], NULL, NULL, 0.0, 0.0}};
     for (int k = 0; k < 2; k++)
         if (!load(&builds[k], width, height)) return 1;
@@ -116,10 +121,11 @@ int main(int argc, char **argv) {
     double *times = malloc(sizeof(double) * (size_t)calls);
     if (times == NULL) return 1;
     const char *unit = threads == 1 ? "CPU ms" : "wall ms";
-    printf("1920x1080, %d x %d, blur %d%s%s, radius %g, %d thread(s); per round and build: "
+    printf("%dx%d, %d x %d, blur %d%s%s, radius %g, %d thread(s); per round and build: "
            "fastest and lower-quartile %s of %d calls\n",
-           params.directions, params.steps, params.blur_size, half ? ", half resolution" : "",
-           back_faces ? ", back faces" : "", radius, threads, unit, calls);
+           width, height, params.directions, params.steps, params.blur_size,
+           half ? ", half resolution" : "", back_faces ? ", back faces" : "", radius, threads, unit,
+           calls);
     print_load("before");
     for (int round = 0; round < rounds; round++) {
         for (int k = 0; k < 2; k++) {

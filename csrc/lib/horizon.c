@@ -569,18 +569,25 @@ float hbao_block_step(const horizon_job *job, int x0, int x1, int j, int a) {
  * projected radius, and the pixel below it samples nearly the same cache
  * lines, which are still cached when only a tile's height lies between them
  * (not a whole image). A tile is one block span wide (TILE_COLUMNS) and
- * TILE_ROWS high; tiles are taken along the image's rows. Measured with
- * csrc/bench/bench_ab.c, 1080p, means over four file copies of each
- * build: 16 rows against 64, one
- * thread 0.91 (half resolution 0.95, 8 x 6 + blur 15 0.93, AVX2 0.95); two
- * threads 1.00 and 1.04 in two runs, within the noise. Walking each thread
- * down a strip of its own did not help two threads either. */
+ * TILE_ROWS high. Tiles are taken down the image's columns of tiles, each
+ * column from top to bottom: the cache lines that a tile's samples reach
+ * span the radius around it, and the tile below shares all but TILE_ROWS
+ * rows of them, where the tile beside it shares all but TILE_COLUMNS
+ * columns (and along a row the lines left behind were evicted from a 512
+ * KiB L2 before the next band of tiles came back to them). On the Zen 3
+ * machine, scripts/bench_ab_pairs.sh, against tiles taken along the rows:
+ * 1080p 0.928 on 1 thread, 0.96-1.01 on 2 (8 x 6 + blur 15 0.935, back
+ * faces 0.942, half resolution 1.006); 3840x2160 0.922 on 1, 0.866 on 2.
+ * Tiles 8 or 32 rows high instead of 16: 0.999-1.010. Earlier, along the
+ * rows, 16 rows against 64 on the Zen 5 (bench_ab, four file copies of each
+ * build): one thread 0.91 (half resolution 0.95, 8 x 6 + blur 15 0.93,
+ * AVX2 0.95); two threads 1.00 and 1.04. */
 #define TILE_COLUMNS HBAO_BLOCK_SPAN
 #define TILE_ROWS 16
 
 typedef struct tiled_job {
     const horizon_job *job;
-    int tiles_across;
+    int tiles_across, tiles_down;
     hbao_horizon_span simd; /* NULL: the scalar reference */
 } tiled_job;
 
@@ -588,8 +595,8 @@ static void horizon_tile(void *context, int tile) {
     const tiled_job *tiled = context;
     const horizon_job *job = tiled->job;
     const int width = job->grid->width, height = job->grid->height;
-    const int x0 = (tile % tiled->tiles_across) * TILE_COLUMNS;
-    const int y0 = (tile / tiled->tiles_across) * TILE_ROWS;
+    const int x0 = (tile / tiled->tiles_down) * TILE_COLUMNS;
+    const int y0 = (tile % tiled->tiles_down) * TILE_ROWS;
     const int x1 = x0 + TILE_COLUMNS < width ? x0 + TILE_COLUMNS : width;
     const int y1 = y0 + TILE_ROWS < height ? y0 + TILE_ROWS : height;
     for (int j = y0; j < y1; j++) {
@@ -698,6 +705,7 @@ void hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *grid,
     tiled_job tiled;
     tiled.job = &job;
     tiled.tiles_across = (grid->width + TILE_COLUMNS - 1) / TILE_COLUMNS;
+    tiled.tiles_down = (grid->height + TILE_ROWS - 1) / TILE_ROWS;
     tiled.simd = choose_kernel(settings->implementation);
     float *phase_depth = NULL, *phase_back = NULL;
     job.phase_depth = NULL;
@@ -725,8 +733,8 @@ void hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *grid,
         job.phase_depth = phase_depth;
         job.phase_back = phase_back;
     }
-    const int tiles_down = (grid->height + TILE_ROWS - 1) / TILE_ROWS;
-    hbao_parallel_rows(settings->threads, tiled.tiles_across * tiles_down, horizon_tile, &tiled);
+    hbao_parallel_rows(settings->threads, tiled.tiles_across * tiled.tiles_down, horizon_tile,
+                       &tiled);
     hbao_scratch_give(phase_depth);
     hbao_scratch_give(phase_back);
 }
