@@ -568,21 +568,23 @@ float hbao_block_step(const horizon_job *job, int x0, int x1, int j, int a) {
 /* Pixels are visited tile by tile: a pixel's samples spread over the whole
  * projected radius, and the pixel below it samples nearly the same cache
  * lines, which are still cached when only a tile's height lies between them
- * (not a whole image). A tile is one block span wide (TILE_COLUMNS) and
- * TILE_ROWS high. Tiles are taken down the image's columns of tiles, each
- * column from top to bottom: the cache lines that a tile's samples reach
- * span the radius around it, and the tile below shares all but TILE_ROWS
- * rows of them, where the tile beside it shares all but TILE_COLUMNS
- * columns (and along a row the lines left behind were evicted from a 512
- * KiB L2 before the next band of tiles came back to them). On the Zen 3
- * machine, scripts/bench_ab_pairs.sh, against tiles taken along the rows:
- * 1080p 0.928 on 1 thread, 0.96-1.01 on 2 (8 x 6 + blur 15 0.935, back
- * faces 0.942, half resolution 1.006); 3840x2160 0.922 on 1, 0.866 on 2.
- * Tiles 8 or 32 rows high instead of 16: 0.999-1.010. Earlier, along the
- * rows, 16 rows against 64 on the Zen 5 (bench_ab, four file copies of each
- * build): one thread 0.91 (half resolution 0.95, 8 x 6 + blur 15 0.93,
- * AVX2 0.95); two threads 1.00 and 1.04. */
-#define TILE_COLUMNS HBAO_BLOCK_SPAN
+ * (not a whole image). A tile is four block spans wide (TILE_COLUMNS, 256
+ * columns; its rows are searched span by span) and TILE_ROWS high, and the
+ * tiles are taken down the image's columns of tiles, each from top to
+ * bottom. The cache lines a tile's samples reach span the radius around
+ * it; the tile below shares all but TILE_ROWS rows of them. Taken along the
+ * image's rows instead (as before), the lines left behind were evicted from
+ * a 512 KiB L2 before the next band of tiles came back to them; and a
+ * wider tile brings fewer new lines per pixel, as long as the lines around
+ * it stay cached. scripts/bench_ab_pairs.sh on the Zen 3 machine, against
+ * one-span tiles along the rows: 1080p defaults 0.879, 0.934 and 0.989 on 2
+ * threads (60, 60 and 30 rounds), 0.889 on 1; 8 x 6 + blur 15 0.991; back
+ * faces 0.737; 3840x2160 0.756. One-span tiles down the columns took
+ * 0.928 on 1 thread, 0.96-1.01 on 2; two, four and eight spans against
+ * one: four best on 2 threads (0.93-0.98), eight on 1 (0.915); 4, 16 or 32
+ * rows: no change. Each thread walking a half of the image's columns of
+ * its own: 1.07 (the two threads' samples shared the L3's lines). */
+#define TILE_COLUMNS (4 * HBAO_BLOCK_SPAN)
 #define TILE_ROWS 16
 
 typedef struct tiled_job {
@@ -600,14 +602,17 @@ static void horizon_tile(void *context, int tile) {
     const int x1 = x0 + TILE_COLUMNS < width ? x0 + TILE_COLUMNS : width;
     const int y1 = y0 + TILE_ROWS < height ? y0 + TILE_ROWS : height;
     for (int j = y0; j < y1; j++) {
-        if (tiled->simd != NULL) {
-            tiled->simd(job, x0, x1, j);
-        } else {
-            float *out = job->ao + (size_t)j * width;
-            for (int a = 0; a < 4; a++) {
-                const float step_px = hbao_block_step(job, x0, x1, j, a);
-                for (int i = x0 + a; i < x1; i += 4)
-                    out[i] = hbao_horizon_pixel(job, i, j, step_px);
+        for (int s0 = x0; s0 < x1; s0 += HBAO_BLOCK_SPAN) {
+            const int s1 = s0 + HBAO_BLOCK_SPAN < x1 ? s0 + HBAO_BLOCK_SPAN : x1;
+            if (tiled->simd != NULL) {
+                tiled->simd(job, s0, s1, j);
+            } else {
+                float *out = job->ao + (size_t)j * width;
+                for (int a = 0; a < 4; a++) {
+                    const float step_px = hbao_block_step(job, s0, s1, j, a);
+                    for (int i = s0 + a; i < s1; i += 4)
+                        out[i] = hbao_horizon_pixel(job, i, j, step_px);
+                }
             }
         }
     }
