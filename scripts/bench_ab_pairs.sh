@@ -8,7 +8,8 @@
 # Prints the settings bench_ab ran with (the thread count included: bench_ab
 # runs on 1 thread unless --threads says otherwise), then the median over
 # the rounds of each round's after / before ratio, for each order, and their
-# geometric mean (the order's bias cancelled).
+# geometric mean (the order's bias cancelled), and the quartiles of each
+# order's per-round ratios.
 #   scripts/bench_ab_pairs.sh BEFORE.so AFTER.so [bench_ab options]
 # Environment: ROUNDS (per order, default 30). scripts/bench_ab_copies.sh
 # is the steadier choice where the machine's speed holds still.
@@ -52,10 +53,22 @@ def ratios(path):
     return [b / a for a, b in zip(first, second)]
 
 
+def quartiles(values):
+    """The lower and upper quartile, as text."""
+    low, _, high = statistics.quantiles(values, n=4)
+    return f"{low:.3f}-{high:.3f}"
+
+
 print(f"bench_ab: {settings(sys.argv[1])}")
-forward = statistics.median(ratios(sys.argv[1]))
-reverse = 1.0 / statistics.median(ratios(sys.argv[2]))
+forward_rounds = ratios(sys.argv[1])
+reverse_rounds = [1.0 / ratio for ratio in ratios(sys.argv[2])]
+forward = statistics.median(forward_rounds)
+reverse = statistics.median(reverse_rounds)
 options = f" [{sys.argv[3]}]" if sys.argv[3] else ""
 print(f"after / before{options}: {forward:.3f} (after second), {reverse:.3f} (after first)"
       f" -> {math.sqrt(forward * reverse):.3f}")
+# Where the quartiles of the rounds' ratios are far apart, or the two
+# orders' medians disagree, the machine drifted: run again with more ROUNDS.
+print(f"rounds' quartiles: {quartiles(forward_rounds)} (after second), "
+      f"{quartiles(reverse_rounds)} (after first)")
 PY
