@@ -11,9 +11,10 @@
 # second finds every output up to date and skips it. Prints each run's wall
 # time and frames per second. Exits 1 when a run fails, when an output is
 # missing after the first run, or when the second run rewrites any output.
-#   scripts/bench_cli_sequence.sh [--frames N] [--jobs J]
+#   scripts/bench_cli_sequence.sh [--frames N] [--jobs J]   (BLENDER=/path/to/blender renders)
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+BLENDER="${BLENDER:-blender}"
 FRAMES=250
 JOBS=2
 usage() { echo "usage: $0 [--frames N] [--jobs J]   (N in [1, 9999], J in [1, 32])" >&2; exit 2; }
@@ -26,6 +27,9 @@ while [ $# -gt 0 ]; do
 done
 case "$FRAMES" in ''|*[!0-9]*) usage ;; esac
 case "$JOBS" in ''|*[!0-9]*) usage ;; esac
+[ ${#FRAMES} -le 4 ] && [ ${#JOBS} -le 2 ] || usage
+FRAMES=$((10#$FRAMES))  # decimal, also with leading zeros
+JOBS=$((10#$JOBS))
 [ "$FRAMES" -ge 1 ] && [ "$FRAMES" -le 9999 ] && [ "$JOBS" -ge 1 ] && [ "$JOBS" -le 32 ] || usage
 
 "$REPO/scripts/setup.sh"
@@ -38,7 +42,7 @@ CACHE="$REPO/.cache/bench/sequence"
 RENDER="$CACHE/demo_1920x1080"
 if [ ! -f "$RENDER.exr" ] || [ ! -f "$RENDER.camera.json" ]; then
     mkdir -p "$CACHE"
-    blender -b --factory-startup -noaudio --python-exit-code 1 \
+    "$BLENDER" -b --factory-startup -noaudio --python-exit-code 1 \
         --python "$REPO/scripts/render_passes.py" -- --scene demo --out "$RENDER" \
         --width 1920 --height 1080 --samples 1 --codec ZIP --force >/dev/null
 fi
@@ -49,13 +53,14 @@ for ((frame = 1; frame <= FRAMES; frame++)); do
     ln -s "$RENDER.exr" "$WORK/$(printf 'render_%04d.exr' "$frame")"
 done
 
-run() {  # prints the run's wall seconds
-    local start end
+run() {  # prints the run's wall seconds; returns hbao's exit status
+    local start end status=0
     start=$(date +%s.%N)
     (cd "$WORK" && "$HBAO" 'render_####.exr' -o 'ao_####.exr' --camera "$RENDER.camera.json" \
-        --frames "1-$FRAMES" -j "$JOBS" 2>"$WORK/log.txt")
+        --frames "1-$FRAMES" -j "$JOBS" 2>"$WORK/log.txt") || status=$?
     end=$(date +%s.%N)
     echo "$start $end" | awk '{printf "%.3f", $2 - $1}'
+    return "$status"
 }
 
 echo "hbao on $FRAMES frames of $(basename "$RENDER").exr ($(du -Lh "$RENDER.exr" | cut -f1)" \
