@@ -220,7 +220,8 @@ static inline void SIMD_NAME(plan_steps)(const SIMD_NAME(block) * b, float dc, f
 #ifndef SIMD_PREFETCH
 /* prefetcht0 as a statement the compiler keeps: GCC 12 deleted every
  * __builtin_prefetch of prefetch_steps when its loop took the least of the
- * parts' plain_end (the copies are x86 only) */
+ * parts' plain_end (the copies are x86 only). Every prefetch of this file
+ * (prefetch_normals too) goes through it. */
 #define SIMD_PREFETCH(p) __asm__ volatile("prefetcht0 %0" : : "m"(*(const char *)(p)))
 #endif
 static inline void SIMD_NAME(prefetch_steps)(const SIMD_NAME(block) * b,
@@ -1052,7 +1053,7 @@ static inline void SIMD_NAME(prefetch_normals)(const hbao_grid *g, int x0, int j
     for (int c = 0; c < 3; c++) {
         const char *row = (const char *)(hbao_grid_normal_row(g, j, c) + x0);
         for (int at = 0; at < HBAO_BLOCK_SPAN * (int)sizeof(float); at += 64)
-            __builtin_prefetch(row + at);
+            SIMD_PREFETCH(row + at);
     }
 }
 
