@@ -54,7 +54,9 @@ def ratios(path):
 
 
 def quartiles(values):
-    """The lower and upper quartile, as text."""
+    """The lower and upper quartile, as text (ROUNDS=1 has none)."""
+    if len(values) < 2:
+        return "none (one round)"
     low, _, high = statistics.quantiles(values, n=4)
     return f"{low:.3f}-{high:.3f}"
 
