@@ -72,16 +72,15 @@ static inline void SIMD_NAME(slice_setup)(const VF v[3], const VF n[3], const VF
     sl->sin_gamma = V_SELECT(sl->usable, V_SET(0.0f), V_MUL(n_dot_e, sl->inv_np));
 }
 
-/* The vectors that a block's HBAO_BLOCK_PIXELS pixels fill (internal_hbao.h):
- * 2 with AVX2, 1 with AVX-512. A block's parts share its steps' plan. */
-#define SIMD_BLOCK_PARTS (HBAO_BLOCK_PIXELS / SIMD_LANES)
+/* A vector holds a whole block: its HBAO_BLOCK_PIXELS pixels (internal_hbao.h)
+ * are the lanes (AVX-512's registers; AVX2's in pairs, horizon_avx2.c). */
+_Static_assert(SIMD_LANES == HBAO_BLOCK_PIXELS, "a vector is a block");
 
-/* The lanes' pixels (part `part` of a block, its SIMD_LANES pixels from
- * pixel part * SIMD_LANES on) and what does not change between directions. */
+/* The lanes' pixels (a block's) and what does not change between
+ * directions. */
 typedef struct SIMD_NAME(block) {
     const hbao_horizon_job *job;
     const hbao_grid *grid;
-    int part;
     VI lane_i;     /* the lanes' columns: first_i + 4 k */
     VF lane_float; /* and as floats (exact) */
     int first_i;   /* lane 0's column */
@@ -116,28 +115,22 @@ typedef struct SIMD_NAME(fetch) {
 /* A direction's steps for a whole block, worked out SIMD_LANES steps at a
  * time: each step's pixel offset from a lane to its sample (ox, oy), and
  * for a step whose lanes all lie inside the image (a `plain` step, the
- * common case) what its fetch needs: the index of part 0's depths in
- * phase_depth (part k's lie k SIMD_LANES further), its grid row and ox as
- * a float. Arrays hold whole vectors: HBAO_MAX_STEPS + SIMD_LANES entries.
- * The parts differ only in their columns, so they share one plan (AVX2
- * planned each direction twice, and planning was 8.5 % of the frame) and
- * its prefetch, which now asks for both parts' depths before the first
- * part's search. scripts/bench_ab_pairs.sh, 1080p, Zen 3, on 2 threads:
- * defaults 0.941 and 0.890, 8 x 6 + blur 15 0.897, half resolution 0.946,
- * back faces 0.902; on 1: 0.847, 0.898 and 0.905, 0.955, 0.908. Planning
- * the next direction during a search (on top of this): 2 threads 0.99,
+ * common case) what its fetch needs: the index of the lanes' depths in
+ * phase_depth, its grid row and ox as a float. Arrays hold whole vectors:
+ * HBAO_MAX_STEPS + SIMD_LANES entries. Planning the next direction during
+ * a search (AVX2, when it searched a block in two halves): 2 threads 0.99,
  * 0.977, 1.049 (half), 1 thread 0.95, 0.86, 1.046: not kept. */
 #define SIMD_STEP_ROOM (HBAO_MAX_STEPS + SIMD_LANES)
 typedef struct SIMD_NAME(steps) {
     int count; /* the steps before the first that lies a whole image away */
     int ox[SIMD_STEP_ROOM], oy[SIMD_STEP_ROOM], index[SIMD_STEP_ROOM];
     float row[SIMD_STEP_ROOM], ox_float[SIMD_STEP_ROOM];
-    /* Steps 0 .. plain_end[part] - 1 are plain for the part (the steps
-     * move away from the pixel, so plain steps come first; a later one
-     * would take the side path, which is right for any step). One
-     * comparison per step instead of a bit test: bench_ab, 1080p, four
-     * file copies of each build, 0.973 on 1 thread, 0.979 on 2. */
-    int plain_end[SIMD_BLOCK_PARTS];
+    /* Steps 0 .. plain_end - 1 are plain (the steps move away from the
+     * pixel, so plain steps come first; a later one would take the side
+     * path, which is right for any step). One comparison per step instead
+     * of a bit test: bench_ab, 1080p, four file copies of each build, 0.973
+     * on 1 thread, 0.979 on 2. */
+    int plain_end;
 } SIMD_NAME(steps);
 
 static inline VI SIMD_NAME(floor_to_int)(VF x) {
@@ -147,14 +140,13 @@ static inline VI SIMD_NAME(floor_to_int)(VF x) {
 }
 
 /* hbao_step_offset for SIMD_LANES steps at once, each lane one step, with
- * the same float operations, and the plain steps' fetch data, for the block
- * whose part 0 is b. */
+ * the same float operations, and the plain steps' fetch data, for block b. */
 static inline void SIMD_NAME(plan_steps)(const SIMD_NAME(block) * b, float dc, float ds, int steps,
                                          SIMD_NAME(steps) * t) {
     const hbao_grid *g = b->grid;
     const int phase_width = b->job->phase_width;
     t->count = steps;
-    for (int part = 0; part < SIMD_BLOCK_PARTS; part++) t->plain_end[part] = 0;
+    t->plain_end = 0;
     for (int first = 0; first < steps; first += SIMD_LANES) {
         const VF step = I_TO_F(I_ADD(I_SET(first), I_LANES));
         const VF along =
@@ -182,17 +174,16 @@ static inline void SIMD_NAME(plan_steps)(const SIMD_NAME(block) * b, float dc, f
         V_STOREU(t->ox_float + first, ox_float);
         const int count = steps - first < SIMD_LANES ? steps - first : SIMD_LANES;
         const unsigned wanted = (count == 32 ? 0u : 1u << count) - 1u;
-        for (int part = 0; part < SIMD_BLOCK_PARTS; part++) {
-            if (t->plain_end[part] != first || !b->job->int_indices) continue;
-            /* plain: the sample row inside, and the part's lane 0's and
-             * last lane's columns (exact small integers as floats) */
-            const VF column0 = V_ADD(V_SET((float)(b->first_i + 4 * SIMD_LANES * part)), ox_float);
+        if (t->plain_end == first && b->job->int_indices) {
+            /* plain: the sample row inside, and lane 0's and the last
+             * lane's columns (exact small integers as floats) */
+            const VF column0 = V_ADD(V_SET((float)b->first_i), ox_float);
             const VM plain =
                 M_AND(row_inside, M_AND(V_GE(column0, V_SET(0.0f)),
                                         V_LT(V_ADD(column0, V_SET((float)(4 * (SIMD_LANES - 1)))),
                                              V_SET((float)g->width))));
             const unsigned run = ~(unsigned)M_BITS(plain) & wanted;
-            t->plain_end[part] = first + (run == 0 ? count : __builtin_ctz(run));
+            t->plain_end = first + (run == 0 ? count : __builtin_ctz(run));
         }
         const unsigned outside = ~(unsigned)M_BITS(inside) & wanted;
         if (outside != 0) {
@@ -204,23 +195,21 @@ static inline void SIMD_NAME(plan_steps)(const SIMD_NAME(block) * b, float dc, f
 
 /* The plain steps' depths, asked of the memory as soon as the steps are
  * planned, before the search reaches them: the cache lines of a step's first
- * and last lane (a load of SIMD_LANES floats crosses a line's end unless it
- * starts at most 64 - 4 SIMD_LANES bytes into the line), over the whole
- * block (its HBAO_BLOCK_PIXELS floats lie in at most two lines), for the
- * steps that are plain for every part (at the image's sides a step may be
- * plain for one part only: it is not prefetched). Where
+ * and last lane (the block's HBAO_BLOCK_PIXELS floats, 64 bytes, lie in two
+ * lines unless they start one), for the plain steps. Where
  * SIMD_PREFETCH_STEPS is 1: the AVX2 copy, measured on a Zen 3 (AMD EPYC,
  * 512 KiB of L2 per core, where a timer profile put half of the search's
  * time on the depth load) by bench_ab with paired calls in both orders
  * (scripts/bench_ab_pairs.sh), 1080p defaults: the first lane's line 0.884
  * and 0.908 on 1 thread, 0.924 and 0.926 on 2; the last lane's as well, on
- * top of that, 0.848-0.939 on 1 thread (three runs), 0.948-0.979 on 2. The
+ * top of that, 0.848-0.939 on 1 thread (three runs), 0.948-0.979 on 2 (then
+ * with a block searched in two halves of 8 lanes, sharing one plan). The
  * AVX-512 copy has not been measured with it on AVX-512 hardware, so it
  * stays without. */
 #ifndef SIMD_PREFETCH
 /* prefetcht0 as a statement the compiler keeps: GCC 12 deleted every
- * __builtin_prefetch of prefetch_steps when its loop took the least of the
- * parts' plain_end (the copies are x86 only). Every prefetch of this file
+ * __builtin_prefetch of prefetch_steps when its loop took the least of two
+ * halves' plain_end (the copies are x86 only). Every prefetch of this file
  * (prefetch_normals too) goes through it. */
 #define SIMD_PREFETCH(p) __asm__ volatile("prefetcht0 %0" : : "m"(*(const char *)(p)))
 #endif
@@ -228,10 +217,7 @@ static inline void SIMD_NAME(prefetch_steps)(const SIMD_NAME(block) * b,
                                              const SIMD_NAME(steps) * t) {
 #if SIMD_PREFETCH_STEPS
     const float *depths = b->job->phase_depth;
-    int every = t->plain_end[0];
-    for (int part = 1; part < SIMD_BLOCK_PARTS; part++)
-        every = t->plain_end[part] < every ? t->plain_end[part] : every;
-    for (int k = 0; k < every; k++) {
+    for (int k = 0; k < t->plain_end; k++) {
         SIMD_PREFETCH(depths + t->index[k]);
         SIMD_PREFETCH(depths + t->index[k] + HBAO_BLOCK_PIXELS - 1);
     }
@@ -293,9 +279,9 @@ static inline int SIMD_NAME(fetch_step)(const SIMD_NAME(block) * b, const SIMD_N
                                         int step, VM *alive, SIMD_NAME(fetch) * f) {
     const int ox = t->ox[step], oy = t->oy[step];
     if (step > 0 && ox == t->ox[step - 1] && oy == t->oy[step - 1]) return 0;
-    if (step < t->plain_end[b->part]) {
+    if (step < t->plain_end) {
         const VM candidate = (ox | oy) == 0 ? M_NONE() : *alive;
-        const int index = t->index[step] + b->part * SIMD_LANES;
+        const int index = t->index[step];
         f->zs = V_ZERO_UNLESS(candidate, V_LOADU(b->job->phase_depth + index));
         if (b->job->phase_back != NULL) f->zb = V_LOADU(b->job->phase_back + index);
         f->row = t->row[step];
@@ -844,21 +830,20 @@ static VF SIMD_NAME(direction_occlusion_hbao_layers)(const hbao_settings *s,
 }
 
 /* Directions whose slices block_ao sets up together: 8 keep the stack
- * frame small (2.5 KiB of slices with AVX-512, and with AVX2's two parts). */
+ * frame small (2.5 KiB of slices). */
 #define SIMD_DIRECTION_GROUP 8
 
-/* Sets up *b, part `part` of the block of phase a at x0 in row j, with the
- * block's step step_px, and returns its active lanes. What the steps' plan
- * reads is set in every part; the rest only where a lane is active. */
-static VM SIMD_NAME(block_setup)(const hbao_horizon_job *job, int x0, int j, int a, int part,
-                                 float step_px, SIMD_NAME(block) * b) {
+/* Sets up *b, the block of phase a at x0 in row j, with the block's step
+ * step_px, and returns its active lanes. What the steps' plan reads is set
+ * first; the rest only where a lane is active. */
+static VM SIMD_NAME(block_setup)(const hbao_horizon_job *job, int x0, int j, int a, float step_px,
+                                 SIMD_NAME(block) * b) {
     const hbao_settings *s = job->settings;
     const hbao_grid *g = job->grid;
     b->job = job;
     b->grid = g;
-    b->part = part;
     b->j = j;
-    const int first_i = x0 + a + 4 * SIMD_LANES * part;
+    const int first_i = x0 + a;
     b->first_i = first_i;
     b->phase = a;
     b->first_x = first_i / 4;
@@ -926,102 +911,76 @@ static VM SIMD_NAME(block_setup)(const hbao_horizon_job *job, int x0, int j, int
 }
 
 /* The AO of the block of phase a at x0 in row j (its pixels before x1),
- * with the block's step step_px: each direction's steps are planned once,
- * then each part with an active lane searches them. */
+ * with the block's step step_px: each direction's steps are planned, then
+ * searched. */
 static void SIMD_NAME(block_ao)(const hbao_horizon_job *job, int x0, int x1, int j, int a,
                                 float step_px) {
     const hbao_settings *s = job->settings;
-    SIMD_NAME(block) b[SIMD_BLOCK_PARTS];
-    VM active[SIMD_BLOCK_PARTS];
-    unsigned live = 0; /* bit k: part k has an active lane */
-    for (int part = 0; part < SIMD_BLOCK_PARTS; part++) {
-        active[part] = SIMD_NAME(block_setup)(job, x0, j, a, part, step_px, &b[part]);
-        if (M_ANY(active[part])) live |= 1u << part;
-    }
+    SIMD_NAME(block) b;
+    const VM active = SIMD_NAME(block_setup)(job, x0, j, a, step_px, &b);
+    const int live = M_ANY(active);
     const int cosine = s->integration == HBAO_INTEGRATION_COSINE;
     const int layers = job->phase_back != NULL;
-    VF occlusion_sum[SIMD_BLOCK_PARTS], visible_sum[SIMD_BLOCK_PARTS], open_sum[SIMD_BLOCK_PARTS];
-    for (int part = 0; part < SIMD_BLOCK_PARTS; part++)
-        occlusion_sum[part] = visible_sum[part] = open_sum[part] = V_SET(0.0f);
+    VF occlusion_sum = V_SET(0.0f), visible_sum = V_SET(0.0f), open_sum = V_SET(0.0f);
     const int cell = a + 4 * (j & 3);
     const float *direction_cos = job->direction_cos[cell];
     const float *direction_sin = job->direction_sin[cell];
     /* The slices of a group of directions are set up first, one after the
      * other: their chains of square roots and divisions overlap, where a
      * search loop between them would keep each waiting. */
-    for (int first = 0; live != 0 && first < s->directions; first += SIMD_DIRECTION_GROUP) {
+    for (int first = 0; live && first < s->directions; first += SIMD_DIRECTION_GROUP) {
         const int count = s->directions - first < SIMD_DIRECTION_GROUP ? s->directions - first
                                                                        : SIMD_DIRECTION_GROUP;
-        SIMD_NAME(slice) slices[SIMD_BLOCK_PARTS][SIMD_DIRECTION_GROUP];
-        for (int part = 0; part < SIMD_BLOCK_PARTS; part++) {
-            if (!(live >> part & 1u)) continue;
-            const SIMD_NAME(block) *bp = &b[part];
-            for (int k = 0; k < count; k++) {
-                const VF dc = V_SET(direction_cos[first + k]), ds = V_SET(direction_sin[first + k]);
-                SIMD_NAME(slice_setup)
-                (bp->v, bp->n, bp->n_cross_v, bp->n_dot_v, dc, ds, &slices[part][k]);
-            }
+        SIMD_NAME(slice) slices[SIMD_DIRECTION_GROUP];
+        for (int k = 0; k < count; k++) {
+            const VF dc = V_SET(direction_cos[first + k]), ds = V_SET(direction_sin[first + k]);
+            SIMD_NAME(slice_setup)(b.v, b.n, b.n_cross_v, b.n_dot_v, dc, ds, &slices[k]);
         }
         for (int k = 0; k < count; k++) {
-            VM lanes[SIMD_BLOCK_PARTS];
-            unsigned searched = 0; /* bit k: part k searches this direction */
-            for (int part = 0; part < SIMD_BLOCK_PARTS; part++) {
-                if (!(live >> part & 1u)) continue;
-                lanes[part] = cosine ? M_AND(active[part], slices[part][k].usable) : active[part];
-                if (M_ANY(lanes[part])) searched |= 1u << part;
-            }
-            if (searched == 0) continue;
+            const SIMD_NAME(slice) *sl = &slices[k];
+            const VM lanes = cosine ? M_AND(active, sl->usable) : active;
+            if (!M_ANY(lanes)) continue;
             SIMD_NAME(steps) t;
             SIMD_NAME(plan_steps)
-            (&b[0], direction_cos[first + k], direction_sin[first + k], s->steps, &t);
-            SIMD_NAME(prefetch_steps)(&b[0], &t);
-            for (int part = 0; part < SIMD_BLOCK_PARTS; part++) {
-                if (!(searched >> part & 1u)) continue;
-                const SIMD_NAME(block) *bp = &b[part];
-                const SIMD_NAME(slice) *sl = &slices[part][k];
-                if (cosine) {
-                    VF open;
-                    const VF occlusion = layers ? SIMD_NAME(direction_occlusion_cosine_layers)(
-                                                      s, bp, lanes[part], &t, sl, &open)
-                                                : SIMD_NAME(direction_occlusion_cosine)(
-                                                      s, bp, lanes[part], &t, sl, &open);
-                    visible_sum[part] = V_SELECT(
-                        lanes[part], visible_sum[part],
-                        V_ADD(visible_sum[part], V_MUL(sl->np_length, V_SUB(open, occlusion))));
-                    open_sum[part] = V_SELECT(lanes[part], open_sum[part],
-                                              V_ADD(open_sum[part], V_MUL(sl->np_length, open)));
-                } else {
-                    occlusion_sum[part] = V_ADD(
-                        occlusion_sum[part],
-                        layers ? SIMD_NAME(direction_occlusion_hbao_layers)(s, bp, active[part], &t,
-                                                                            sl)
-                               : SIMD_NAME(direction_occlusion_hbao)(s, bp, active[part], &t, sl));
-                }
+            (&b, direction_cos[first + k], direction_sin[first + k], s->steps, &t);
+            SIMD_NAME(prefetch_steps)(&b, &t);
+            if (cosine) {
+                VF open;
+                const VF occlusion =
+                    layers
+                        ? SIMD_NAME(direction_occlusion_cosine_layers)(s, &b, lanes, &t, sl, &open)
+                        : SIMD_NAME(direction_occlusion_cosine)(s, &b, lanes, &t, sl, &open);
+                visible_sum =
+                    V_SELECT(lanes, visible_sum,
+                             V_ADD(visible_sum, V_MUL(sl->np_length, V_SUB(open, occlusion))));
+                open_sum = V_SELECT(lanes, open_sum, V_ADD(open_sum, V_MUL(sl->np_length, open)));
+            } else {
+                occlusion_sum =
+                    V_ADD(occlusion_sum,
+                          layers ? SIMD_NAME(direction_occlusion_hbao_layers)(s, &b, active, &t, sl)
+                                 : SIMD_NAME(direction_occlusion_hbao)(s, &b, active, &t, sl));
             }
         }
     }
+    float result[SIMD_LANES];
+    if (!live) {
+        V_STOREU(result, V_SET(1.0f));
+    } else {
+        VF ao;
+        if (cosine)
+            ao = V_SELECT(V_GT(open_sum, V_SET(1e-12f)), V_SET(1.0f), V_DIV(visible_sum, open_sum));
+        else
+            ao = V_SUB(V_SET(1.0f),
+                       V_DIV(occlusion_sum, V_SET((float)s->directions * (1.0f - s->sin_bias))));
+        ao = V_ZERO_UNLESS(V_GT(ao, V_SET(0.0f)), ao); /* !(ao > 0) -> 0, NaN included */
+        ao = V_SELECT(V_LT(ao, V_SET(1.0f)), V_SET(1.0f), ao);
+        ao = V_SELECT(active, V_SET(1.0f), ao);
+        V_STOREU(result, ao);
+    }
     float *out = job->ao + (size_t)j * job->grid->width;
-    for (int part = 0; part < SIMD_BLOCK_PARTS; part++) {
-        float result[SIMD_LANES];
-        if (!(live >> part & 1u)) {
-            V_STOREU(result, V_SET(1.0f));
-        } else {
-            VF ao;
-            if (cosine)
-                ao = V_SELECT(V_GT(open_sum[part], V_SET(1e-12f)), V_SET(1.0f),
-                              V_DIV(visible_sum[part], open_sum[part]));
-            else
-                ao = V_SUB(V_SET(1.0f), V_DIV(occlusion_sum[part],
-                                              V_SET((float)s->directions * (1.0f - s->sin_bias))));
-            ao = V_ZERO_UNLESS(V_GT(ao, V_SET(0.0f)), ao); /* !(ao > 0) -> 0, NaN included */
-            ao = V_SELECT(V_LT(ao, V_SET(1.0f)), V_SET(1.0f), ao);
-            ao = V_SELECT(active[part], V_SET(1.0f), ao);
-            V_STOREU(result, ao);
-        }
-        for (int k = 0; k < SIMD_LANES; k++) {
-            const int i = b[part].first_i + 4 * k;
-            if (i < x1) out[i] = result[k];
-        }
+    for (int k = 0; k < SIMD_LANES; k++) {
+        const int i = b.first_i + 4 * k;
+        if (i < x1) out[i] = result[k];
     }
 }
 
