@@ -2,9 +2,7 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 # The CLI on a sequence, as a render farm task runs it (issue 11): FRAMES
 # frames (default 250), each a symbolic link to one 1920x1080 render of the
-# demo scene (Debian's Blender, Cycles, 1 sample, 32-bit ZIP multilayer EXR
-# with Combined, Depth and Normal; rendered once and kept in
-# .cache/bench/sequence), computed by
+# demo scene (scripts/bench_cli_render.sh), computed by
 #   hbao 'render_####.exr' -o 'ao_####.exr' --camera render.camera.json \
 #        --frames 1-FRAMES -j JOBS
 # twice in a new temporary folder: the first run computes every frame, the
@@ -14,7 +12,6 @@
 #   scripts/bench_cli_sequence.sh [--frames N] [--jobs J]   (BLENDER=/path/to/blender renders)
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-BLENDER="${BLENDER:-blender}"
 FRAMES=250
 JOBS=2
 usage() { echo "usage: $0 [--frames N] [--jobs J]   (N in [1, 9999], J in [1, 32])" >&2; exit 2; }
@@ -32,20 +29,8 @@ FRAMES=$((10#$FRAMES))  # decimal, also with leading zeros
 JOBS=$((10#$JOBS))
 [ "$FRAMES" -ge 1 ] && [ "$FRAMES" -le 9999 ] && [ "$JOBS" -ge 1 ] && [ "$JOBS" -le 32 ] || usage
 
-"$REPO/scripts/setup.sh"
-cmake -S "$REPO" -B "$REPO/build" -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build "$REPO/build" -j2 --target hbao_tool >/dev/null
+RENDER="$("$REPO/scripts/bench_cli_render.sh")"
 HBAO="$REPO/build/hbao"
-
-# The render, made once (a few seconds of Cycles at 1 sample).
-CACHE="$REPO/.cache/bench/sequence"
-RENDER="$CACHE/demo_1920x1080"
-if [ ! -f "$RENDER.exr" ] || [ ! -f "$RENDER.camera.json" ]; then
-    mkdir -p "$CACHE"
-    "$BLENDER" -b --factory-startup -noaudio --python-exit-code 1 \
-        --python "$REPO/scripts/render_passes.py" -- --scene demo --out "$RENDER" \
-        --width 1920 --height 1080 --samples 1 --codec ZIP --force >/dev/null
-fi
 
 WORK="$(mktemp -d)"
 trap 'rm -rf "$WORK"' EXIT
