@@ -12,6 +12,7 @@ blender. The summary at the end counts the results per Blender."""
 import collections
 import os
 import shutil
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -183,10 +184,21 @@ def run_in_blender(blender, blender_user_scripts):
 
 
 def run_command(command, user_scripts, env=None, check=True, timeout=BLENDER_TIMEOUT_S):
-    """Run a Blender command line with this checkout's add-on and libraries."""
-    completed = subprocess.run(
-        command, env=blender_environment(user_scripts, env),
-        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=timeout)
+    """Run a Blender command line with this checkout's add-on and libraries.
+    It runs in a session of its own: past the timeout the whole process
+    group is killed (xvfb-run, its Xvfb and Blender; killing xvfb-run alone
+    left Blender and Xvfb running), and the test fails with the output so far."""
+    process = subprocess.Popen(
+        command, env=blender_environment(user_scripts, env), start_new_session=True,
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        stdout, _ = process.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(process.pid, signal.SIGKILL)
+        stdout, _ = process.communicate()
+        pytest.fail(f"Blender did not end within {timeout} s (killed):\n"
+                    f"{' '.join(command)}\n{stdout[-6000:]}")
+    completed = subprocess.CompletedProcess(command, process.returncode, stdout)
     if check and completed.returncode != 0:
         pytest.fail(f"Blender exited with {completed.returncode}:\n"
                     f"{' '.join(command)}\n{completed.stdout[-6000:]}")

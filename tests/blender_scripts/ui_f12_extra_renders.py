@@ -37,13 +37,11 @@ def tick():
     elif state["phase"] == "render":
         if job.finished():
             print("F12: DONE", flush=True)
-            bpy.ops.wm.quit_blender()
+            f12_job.quit_blender()
             return None
         if now - state["since"] > RENDER_TIMEOUT_S:
-            print("F12: TIMEOUT", flush=True)
-            bpy.ops.wm.quit_blender()
-            return None
+            f12_job.give_up("F12: TIMEOUT")
     return 0.2
 
 
-bpy.app.timers.register(tick, first_interval=0.5)
+f12_job.guarded_timer(tick, 0.5)

@@ -44,9 +44,7 @@ def tick():
         job.start()
     elif state["phase"] == "render":
         if now - state["since"] > RENDER_TIMEOUT_S:
-            print("F12: TIMEOUT", flush=True)
-            bpy.ops.wm.quit_blender()
-            return None
+            f12_job.give_up("F12: TIMEOUT")
         if job.finished():
             state.update(phase="status", since=now)
     elif state["phase"] == "status":
@@ -57,10 +55,10 @@ def tick():
         state["step"] += 1
         if state["step"] == len(STEPS):
             print("F12: DONE", flush=True)
-            bpy.ops.wm.quit_blender()
+            f12_job.quit_blender()
             return None
         state["phase"] = "start"
     return 0.1
 
 
-bpy.app.timers.register(tick, first_interval=1.0)
+f12_job.guarded_timer(tick, 1.0)

@@ -53,17 +53,15 @@ def tick():
         job.start()
     elif state["phase"] == "render":
         if now - state["since"] > RENDER_TIMEOUT_S:
-            print("INFO: TIMEOUT", flush=True)
-            bpy.ops.wm.quit_blender()
-            return None
+            f12_job.give_up("INFO: TIMEOUT")
         if job.finished():
             state.update(phase="settle", since=now)
     elif state["phase"] == "settle" and now - state["since"] > SETTLE_S:
         print(f"INFO {json.dumps(info_reports())}", flush=True)
         print("INFO: DONE", flush=True)
-        bpy.ops.wm.quit_blender()
+        f12_job.quit_blender()
         return None
     return 0.1
 
 
-bpy.app.timers.register(tick, first_interval=1.0)
+f12_job.guarded_timer(tick, 1.0)

@@ -79,9 +79,7 @@ def tick():
         render("rendered")
     elif phase == "rendering":
         if now - state["since"] > RENDER_TIMEOUT_S:
-            print("RECOMPOSITE: TIMEOUT", flush=True)
-            bpy.ops.wm.quit_blender()
-            return None
+            f12_job.give_up("RECOMPOSITE: TIMEOUT")
         if job.finished():
             state.update(phase=state["after"], since=now)
     elif phase == "rendered" and now - state["since"] > SETTLE_S:
@@ -100,9 +98,9 @@ def tick():
         print_image("normal_unlinked")
         print(f"HINT {json.dumps(node.hint)}", flush=True)
         print("RECOMPOSITE: DONE", flush=True)
-        bpy.ops.wm.quit_blender()
+        f12_job.quit_blender()
         return None
     return 0.1
 
 
-bpy.app.timers.register(tick, first_interval=1.0)
+f12_job.guarded_timer(tick, 1.0)
