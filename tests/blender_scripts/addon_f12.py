@@ -15,6 +15,8 @@ out_dir = sys.argv[sys.argv.index("--") + 1]
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(REPO, "scripts"))
 import blender_scenes  # noqa: E402
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import timer_guard  # noqa: E402
 
 # Wait for the render at most this long (Cycles at 96x64 takes a second).
 RENDER_TIMEOUT_S = 240.0
@@ -51,8 +53,7 @@ def wait_and_quit():
         state["started"] = time.monotonic()
     if not state["done"]:
         if time.monotonic() - state["started"] > RENDER_TIMEOUT_S:
-            print("F12: TIMEOUT")
-            bpy.ops.wm.quit_blender()
+            timer_guard.give_up("F12: TIMEOUT")
         return 0.25
     settings = scene.render.image_settings
     settings.file_format = "OPEN_EXR_MULTILAYER"
@@ -61,9 +62,9 @@ def wait_and_quit():
     bpy.data.images["Render Result"].save_render(os.path.join(out_dir, "frame_0001.exr"),
                                                  scene=scene)
     print("F12: RENDERED")
-    bpy.ops.wm.quit_blender()
+    timer_guard.quit_blender()
     return None
 
 
-bpy.app.timers.register(start_render, first_interval=1.0)
-bpy.app.timers.register(wait_and_quit, first_interval=1.5)
+timer_guard.guarded_timer(start_render, 1.0)
+timer_guard.guarded_timer(wait_and_quit, 1.5)

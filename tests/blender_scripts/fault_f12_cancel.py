@@ -24,7 +24,7 @@ REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 sys.path.insert(0, os.path.join(REPO, "scripts"))
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import blender_scenes  # noqa: E402
-import f12_job  # noqa: E402
+import timer_guard  # noqa: E402
 
 RENDER_TIMEOUT_S = 240.0
 # Escape: samples enough for minutes of Cycles, only Escape ends the first
@@ -105,8 +105,8 @@ def press_key():
 def step():
     elapsed = time.monotonic() - state["started"]
     if elapsed > RENDER_TIMEOUT_S:
-        f12_job.give_up(f"F12: TIMEOUT {state} (render job running: "
-                        f"{bpy.app.is_job_running('RENDER')})")
+        timer_guard.give_up(f"F12: TIMEOUT {state} (render job running: "
+                            f"{bpy.app.is_job_running('RENDER')})")
     if state["phase"] == "first":
         bpy.ops.render.render("INVOKE_DEFAULT")
         state["phase"], state["first_at"] = "escape", time.monotonic()
@@ -132,9 +132,9 @@ def step():
             and not bpy.app.is_job_running("RENDER"):
         print("SETTINGS AFTER", settings(), flush=True)
         print("F12: RENDERED", state["events"], flush=True)
-        f12_job.quit_blender()
+        timer_guard.quit_blender()
         return None
     return 0.25
 
 
-f12_job.guarded_timer(step, 1.0)
+timer_guard.guarded_timer(step, 1.0)

@@ -7,11 +7,15 @@ later>' and writes a screenshot of the window with the popup that says why.
 
   blender --addons hbao --python ui_engine_guard.py -- SHOT_DIR
 """
+import os
 import sys
 import time
 from pathlib import Path
 
 import bpy
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import timer_guard  # noqa: E402
 
 SHOTS = Path(sys.argv[sys.argv.index("--") + 1])
 # The message bus runs on the next event loop turns: far less than this.
@@ -45,10 +49,10 @@ def tick():
         state["try"] += 1
         if state["try"] == len(TRIES):
             print("GUARD: DONE", flush=True)
-            bpy.ops.wm.quit_blender()
+            timer_guard.quit_blender()
             return None
         state.update(phase="set_own", since=now)
     return 0.1
 
 
-bpy.app.timers.register(tick, first_interval=1.0)
+timer_guard.guarded_timer(tick, 1.0)

@@ -16,6 +16,7 @@ import bpy
 out_dir = sys.argv[sys.argv.index("--") + 1]
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import f12_job  # noqa: E402
+import timer_guard  # noqa: E402
 
 RENDER_TIMEOUT_S = 120.0
 # The add-on syncs from a timer after a setting changes: far less than this.
@@ -37,11 +38,11 @@ def tick():
     elif state["phase"] == "render":
         if job.finished():
             print("F12: DONE", flush=True)
-            f12_job.quit_blender()
+            timer_guard.quit_blender()
             return None
         if now - state["since"] > RENDER_TIMEOUT_S:
-            f12_job.give_up("F12: TIMEOUT")
+            timer_guard.give_up("F12: TIMEOUT")
     return 0.2
 
 
-f12_job.guarded_timer(tick, 0.5)
+timer_guard.guarded_timer(tick, 0.5)

@@ -18,6 +18,7 @@ import bpy
 out_dir = sys.argv[sys.argv.index("--") + 1]
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import f12_job  # noqa: E402
+import timer_guard  # noqa: E402
 
 RENDER_TIMEOUT_S = 240.0
 # The node shows the outcome shortly after the job ends (the add-on polls).
@@ -44,7 +45,7 @@ def tick():
         job.start()
     elif state["phase"] == "render":
         if now - state["since"] > RENDER_TIMEOUT_S:
-            f12_job.give_up("F12: TIMEOUT")
+            timer_guard.give_up("F12: TIMEOUT")
         if job.finished():
             state.update(phase="status", since=now)
     elif state["phase"] == "status":
@@ -55,10 +56,10 @@ def tick():
         state["step"] += 1
         if state["step"] == len(STEPS):
             print("F12: DONE", flush=True)
-            f12_job.quit_blender()
+            timer_guard.quit_blender()
             return None
         state["phase"] = "start"
     return 0.1
 
 
-f12_job.guarded_timer(tick, 1.0)
+timer_guard.guarded_timer(tick, 1.0)

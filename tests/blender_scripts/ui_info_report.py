@@ -18,6 +18,7 @@ import bpy
 out_dir, shot_dir = sys.argv[sys.argv.index("--") + 1:][:2]
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import f12_job  # noqa: E402
+import timer_guard  # noqa: E402
 
 RENDER_TIMEOUT_S = 240.0
 SETTLE_S = 1.0
@@ -53,15 +54,15 @@ def tick():
         job.start()
     elif state["phase"] == "render":
         if now - state["since"] > RENDER_TIMEOUT_S:
-            f12_job.give_up("INFO: TIMEOUT")
+            timer_guard.give_up("INFO: TIMEOUT")
         if job.finished():
             state.update(phase="settle", since=now)
     elif state["phase"] == "settle" and now - state["since"] > SETTLE_S:
         print(f"INFO {json.dumps(info_reports())}", flush=True)
         print("INFO: DONE", flush=True)
-        f12_job.quit_blender()
+        timer_guard.quit_blender()
         return None
     return 0.1
 
 
-f12_job.guarded_timer(tick, 1.0)
+timer_guard.guarded_timer(tick, 1.0)

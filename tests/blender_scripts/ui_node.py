@@ -15,11 +15,15 @@ ui_old_file.py saved: what an artist meets on the HBAO node.
   blender --addons hbao --python ui_node.py OLD.blend -- OUT.json SHOT_DIR
 """
 import json
+import os
 import sys
 import time
 from pathlib import Path
 
 import bpy
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import timer_guard  # noqa: E402
 
 args = sys.argv[sys.argv.index("--") + 1:]
 OUT, SHOTS = Path(args[0]), Path(args[1])
@@ -156,7 +160,7 @@ def run_renders():
     state["started"] = None
     if state["index"] == len(RENDERS):
         tree.links.remove(hbao.inputs["Normal"].links[0])
-        bpy.app.timers.register(changed_after_render, first_interval=SETTLE_S)
+        timer_guard.guarded_timer(changed_after_render, SETTLE_S)
         return None
     return 0.25
 
@@ -176,7 +180,7 @@ def changed_after_render():
 def finish():
     OUT.write_text(json.dumps(report, indent=2))
     print(json.dumps(report, indent=2))
-    bpy.ops.wm.quit_blender()
+    timer_guard.quit_blender()
     return None
 
 
@@ -189,11 +193,11 @@ def start():
         report.update(menu_report(window, area))
         bpy.app.handlers.render_complete.append(on_done)
         bpy.app.handlers.render_cancel.append(on_done)
-        bpy.app.timers.register(run_renders, first_interval=0.5)
+        timer_guard.guarded_timer(run_renders, 0.5)
     except Exception as error:
         report["error"] = f"{type(error).__name__}: {error}"
         finish()
     return None
 
 
-bpy.app.timers.register(start, first_interval=0.5)
+timer_guard.guarded_timer(start, 0.5)

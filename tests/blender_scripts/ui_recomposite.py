@@ -28,6 +28,7 @@ import bpy
 out_dir = sys.argv[sys.argv.index("--") + 1]
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import f12_job  # noqa: E402
+import timer_guard  # noqa: E402
 
 sys.path.insert(0, os.path.join(f12_job.REPO, "addon"))
 from hbao import exr_passes  # noqa: E402  (needs the path above)
@@ -79,7 +80,7 @@ def tick():
         render("rendered")
     elif phase == "rendering":
         if now - state["since"] > RENDER_TIMEOUT_S:
-            f12_job.give_up("RECOMPOSITE: TIMEOUT")
+            timer_guard.give_up("RECOMPOSITE: TIMEOUT")
         if job.finished():
             state.update(phase=state["after"], since=now)
     elif phase == "rendered" and now - state["since"] > SETTLE_S:
@@ -98,9 +99,9 @@ def tick():
         print_image("normal_unlinked")
         print(f"HINT {json.dumps(node.hint)}", flush=True)
         print("RECOMPOSITE: DONE", flush=True)
-        f12_job.quit_blender()
+        timer_guard.quit_blender()
         return None
     return 0.1
 
 
-f12_job.guarded_timer(tick, 1.0)
+timer_guard.guarded_timer(tick, 1.0)

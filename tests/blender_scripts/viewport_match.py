@@ -18,9 +18,11 @@ import numpy as np
 REPO = Path(__file__).resolve().parents[2]
 if str(REPO / "addon") not in sys.path:
     sys.path.insert(0, str(REPO / "addon"))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from hbao import native  # noqa: E402
 from hbao.viewport import pipeline, projection  # noqa: E402
+import timer_guard  # noqa: E402
 
 if bpy.app.background and hasattr(gpu, "init"):
     gpu.init()  # 5.2+: an offscreen GPU context without a window
@@ -227,4 +229,4 @@ finally:
     # --python-exit-code makes an exception exit Blender with an error code.
     # (Headless, the script's end ends Blender.)
     if not bpy.app.background:
-        bpy.ops.wm.quit_blender()
+        timer_guard.quit_blender()

@@ -16,8 +16,10 @@ import numpy as np
 
 REPO = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPO / "scripts"))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import blender_scenes  # noqa: E402
+import timer_guard  # noqa: E402
 
 # The preview of a 3D view is switched by its operator, as the panel does.
 TOGGLE = "hbao.viewport_preview_toggle"
@@ -117,8 +119,8 @@ def step():
     try:
         run()
     finally:
-        bpy.ops.wm.quit_blender()
+        timer_guard.quit_blender()
 
 
 # The window exists only once the event loop runs: start from a timer.
-bpy.app.timers.register(step, first_interval=0.5)
+timer_guard.guarded_timer(step, 0.5)

@@ -1,0 +1,49 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""How the scripts that drive a real Blender window from timers end it: a
+timer whose step raises, a script's own timeout and a quit that does not
+happen all end Blender at once with a message, so that the test fails
+within seconds with that message instead of waiting for its own timeout
+on a Blender left idle.
+
+  sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+  import timer_guard
+"""
+import os
+import traceback
+
+import bpy
+
+
+def give_up(message):
+    """Ends Blender at once with exit status 3, after printing message: a
+    script's timeout. bpy.ops.wm.quit_blender() only schedules the quit,
+    which a render still running can hold up; the test then waited for its
+    own timeout and left the process behind."""
+    print(message, flush=True)
+    os._exit(3)
+
+
+def guarded_timer(step, first_interval):
+    """bpy.app.timers.register(step), except that an exception in step ends
+    Blender (exit status 1, the traceback printed) instead of unregistering
+    the timer silently and leaving Blender idle until the test's timeout."""
+    def guarded():
+        try:
+            return step()
+        except Exception:
+            print("SCRIPT ERROR in the timer:", traceback.format_exc(), sep="\n", flush=True)
+            os._exit(1)
+    bpy.app.timers.register(guarded, first_interval=first_interval)
+
+
+QUIT_GRACE_S = 30.0
+
+
+def quit_blender():
+    """bpy.ops.wm.quit_blender(), and give_up() if Blender still runs
+    QUIT_GRACE_S later: the quit is only scheduled, and a test once waited
+    for its 600 s timeout on a Blender left idle (a fresh-clone CI run,
+    session 15; not reproduced in 27 runs)."""
+    bpy.ops.wm.quit_blender()
+    bpy.app.timers.register(lambda: give_up("QUIT: Blender did not end"),
+                            first_interval=QUIT_GRACE_S)
