@@ -582,8 +582,9 @@ float hbao_block_step(const horizon_job *job, int x0, int x1, int j, int a) {
  * 0.965 (60 rounds) and 0.991; back faces 0.737; 3840x2160 0.756. One-span
  * tiles down the columns took 0.928 on 1 thread, 0.96-1.01 on 2; two, four
  * and eight spans against one: four best on 2 threads (0.93-0.98), eight on
- * 1 (0.915); 4, 16 or 32 rows: no change. Each thread walking a half of the image's columns of
- * its own: 1.07 (the two threads' samples shared the L3's lines). */
+ * 1 (0.915); 4, 16 or 32 rows: no change. Each thread walking a half of
+ * the image's columns of its own: 1.07 (the two threads' samples shared the
+ * L3's lines). */
 #define TILE_COLUMNS (4 * HBAO_BLOCK_SPAN)
 #define TILE_ROWS 16
 

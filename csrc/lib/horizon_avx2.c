@@ -52,21 +52,33 @@ PAIR_I2(pair_iand, _mm256_and_si256)
 PAIR_I2(pair_ior, _mm256_or_si256)
 PAIR_I2(pair_iandnot, _mm256_andnot_si256)
 PAIR_I2(pair_isllv, _mm256_sllv_epi32)
-static inline pair_f pair_gt(pair_f a, pair_f b) {
-    return (pair_f){_mm256_cmp_ps(a.lo, b.lo, _CMP_GT_OQ), _mm256_cmp_ps(a.hi, b.hi, _CMP_GT_OQ)};
-}
-static inline pair_f pair_ge(pair_f a, pair_f b) {
-    return (pair_f){_mm256_cmp_ps(a.lo, b.lo, _CMP_GE_OQ), _mm256_cmp_ps(a.hi, b.hi, _CMP_GE_OQ)};
-}
-static inline pair_f pair_lt(pair_f a, pair_f b) {
-    return (pair_f){_mm256_cmp_ps(a.lo, b.lo, _CMP_LT_OQ), _mm256_cmp_ps(a.hi, b.hi, _CMP_LT_OQ)};
-}
-static inline pair_f pair_le(pair_f a, pair_f b) {
-    return (pair_f){_mm256_cmp_ps(a.lo, b.lo, _CMP_LE_OQ), _mm256_cmp_ps(a.hi, b.hi, _CMP_LE_OQ)};
-}
-static inline pair_f pair_sqrt(pair_f a) {
-    return (pair_f){_mm256_sqrt_ps(a.lo), _mm256_sqrt_ps(a.hi)};
-}
+/* one-argument operations: out_type name(in_type), on both halves; HALF_*:
+ * an operation on one register, a half */
+#define PAIR_1(name, out_type, in_type, op)                                                        \
+    static inline out_type name(in_type a) {                                                       \
+        return (out_type){op(a.lo), op(a.hi)};                                                     \
+    }
+#define HALF_CMP_GT(a, b) _mm256_cmp_ps((a), (b), _CMP_GT_OQ)
+#define HALF_CMP_GE(a, b) _mm256_cmp_ps((a), (b), _CMP_GE_OQ)
+#define HALF_CMP_LT(a, b) _mm256_cmp_ps((a), (b), _CMP_LT_OQ)
+#define HALF_CMP_LE(a, b) _mm256_cmp_ps((a), (b), _CMP_LE_OQ)
+PAIR_F2(pair_gt, HALF_CMP_GT)
+PAIR_F2(pair_ge, HALF_CMP_GE)
+PAIR_F2(pair_lt, HALF_CMP_LT)
+PAIR_F2(pair_le, HALF_CMP_LE)
+#define HALF_NEG(a) _mm256_xor_ps((a), _mm256_set1_ps(-0.0f))
+#define HALF_ABS(a) _mm256_andnot_ps(_mm256_set1_ps(-0.0f), (a))
+#define HALF_MAX0(a) _mm256_max_ps((a), _mm256_setzero_ps()) /* NaN -> 0, like fmaxf(0, a) */
+#define HALF_FLOOR(a) _mm256_round_ps((a), _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC)
+#define HALF_CEIL(a) _mm256_round_ps((a), _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC)
+PAIR_1(pair_sqrt, pair_f, pair_f, _mm256_sqrt_ps)
+PAIR_1(pair_neg, pair_f, pair_f, HALF_NEG)
+PAIR_1(pair_abs, pair_f, pair_f, HALF_ABS)
+PAIR_1(pair_max0, pair_f, pair_f, HALF_MAX0)
+PAIR_1(pair_floor, pair_f, pair_f, HALF_FLOOR)
+PAIR_1(pair_ceil, pair_f, pair_f, HALF_CEIL)
+PAIR_1(pair_itof, pair_f, pair_i, _mm256_cvtepi32_ps)
+PAIR_1(pair_cvtt, pair_i, pair_f, _mm256_cvttps_epi32)
 static inline pair_f pair_set(float x) {
     const __m256 v = _mm256_set1_ps(x);
     return (pair_f){v, v};
@@ -86,18 +98,6 @@ static inline void pair_istoreu(int *p, pair_i a) {
     _mm256_storeu_si256((__m256i *)p, a.lo);
     _mm256_storeu_si256((__m256i *)(p + 8), a.hi);
 }
-static inline pair_f pair_neg(pair_f a) {
-    const __m256 sign = _mm256_set1_ps(-0.0f);
-    return (pair_f){_mm256_xor_ps(a.lo, sign), _mm256_xor_ps(a.hi, sign)};
-}
-static inline pair_f pair_abs(pair_f a) {
-    const __m256 sign = _mm256_set1_ps(-0.0f);
-    return (pair_f){_mm256_andnot_ps(sign, a.lo), _mm256_andnot_ps(sign, a.hi)};
-}
-static inline pair_f pair_max0(pair_f a) { /* NaN -> 0, like fmaxf(0, a) */
-    return (pair_f){_mm256_max_ps(a.lo, _mm256_setzero_ps()),
-                    _mm256_max_ps(a.hi, _mm256_setzero_ps())};
-}
 static inline int pair_bits(pair_f m) {
     return _mm256_movemask_ps(m.lo) | _mm256_movemask_ps(m.hi) << 8;
 }
@@ -110,20 +110,6 @@ static inline pair_f pair_select(pair_f m, pair_f a, pair_f b) {
 static inline pair_i pair_lanes(void) {
     return (pair_i){_mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7),
                     _mm256_setr_epi32(8, 9, 10, 11, 12, 13, 14, 15)};
-}
-static inline pair_f pair_itof(pair_i a) {
-    return (pair_f){_mm256_cvtepi32_ps(a.lo), _mm256_cvtepi32_ps(a.hi)};
-}
-static inline pair_i pair_cvtt(pair_f a) {
-    return (pair_i){_mm256_cvttps_epi32(a.lo), _mm256_cvttps_epi32(a.hi)};
-}
-static inline pair_f pair_floor(pair_f a) {
-    return (pair_f){_mm256_round_ps(a.lo, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC),
-                    _mm256_round_ps(a.hi, _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC)};
-}
-static inline pair_f pair_ceil(pair_f a) {
-    return (pair_f){_mm256_round_ps(a.lo, _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC),
-                    _mm256_round_ps(a.hi, _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC)};
 }
 #define PAIR_SHIFT(name, op)                                                                       \
     static inline pair_i name(pair_i a, const int n) {                                             \
