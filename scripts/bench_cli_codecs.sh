@@ -45,9 +45,11 @@ wall = {codec: [] for codec in codecs}
 for _ in range(runs):
     for codec in codecs:
         before, start = os.times(), time.perf_counter()
-        subprocess.run([hbao, os.path.join(work, f"in_{codec}.exr"), "-o",
-                        os.path.join(work, "out.exr"), "--camera", camera, "--threads", "1"],
-                       check=True, capture_output=True)
+        run = subprocess.run([hbao, os.path.join(work, f"in_{codec}.exr"), "-o",
+                              os.path.join(work, "out.exr"), "--camera", camera,
+                              "--threads", "1"], capture_output=True, text=True)
+        if run.returncode != 0:
+            sys.exit(f"hbao failed on the {codec} render (exit {run.returncode}):\n{run.stderr}")
         after = os.times()
         wall[codec].append(time.perf_counter() - start)
         cpu[codec].append(after.children_user + after.children_system

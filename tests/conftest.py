@@ -194,7 +194,10 @@ def run_command(command, user_scripts, env=None, check=True, timeout=BLENDER_TIM
     try:
         stdout, _ = process.communicate(timeout=timeout)
     except subprocess.TimeoutExpired:
-        os.killpg(process.pid, signal.SIGKILL)
+        try:
+            os.killpg(process.pid, signal.SIGKILL)
+        except ProcessLookupError:  # the whole group ended meanwhile
+            pass
         stdout, _ = process.communicate()
         pytest.fail(f"Blender did not end within {timeout} s (killed):\n"
                     f"{' '.join(command)}\n{stdout[-6000:]}")
