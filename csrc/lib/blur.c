@@ -193,23 +193,28 @@ static HBAO_ALWAYS_INLINE void write_output(const float *zc, const float *ao, in
     }
 }
 
-/* The passes, BLUR_LANES pixels at a time, and the band jobs that run them
- * (blur_lanes.h), one copy per instruction set at its registers' width:
- * GCC splits a vector
- * wider than the registers piece by piece, partly through memory, and with
- * 16 lanes the AVX2 copy of the 15-pixel blur took 2.6 times as long as
- * with 8. The baseline copy keeps 16 lanes (four SSE2 registers), which its
- * loop runs faster than 8. The x86 copies take their minimum and maximum
- * from the instruction set (BLUR_MIN, BLUR_MAX: a < b ? a : b and
- * a > b ? a : b, NaN giving b, as the scalar code's selects), one
- * instruction where GCC's vector selects take two. */
+/* The passes, BLUR_GROUPS vectors of BLUR_LANES pixels at a time, and the
+ * band jobs that run them (blur_lanes.h), one copy per instruction set at
+ * its registers' width: GCC splits a vector wider than the registers piece
+ * by piece, partly through memory, and with 16 lanes the AVX2 copy of the
+ * 15-pixel blur took 2.6 times as long as with 8. Two AVX2 vectors side by
+ * side instead (BLUR_GROUPS 2, each in registers of its own) took 0.91 of
+ * one's time (scripts/bench_blur_ab.sh), three no less than two. The
+ * baseline copy keeps 16 lanes (four SSE2 registers), which its loop runs
+ * faster than 8, and one group (two were slower). The AVX-512 copy keeps
+ * one group until a machine with AVX-512 measures two. The x86 copies take
+ * their minimum and maximum from the instruction set (BLUR_MIN, BLUR_MAX:
+ * a < b ? a : b and a > b ? a : b, NaN giving b, as the scalar code's
+ * selects), one instruction where GCC's vector selects take two. */
 #define BLUR_LANES 16
+#define BLUR_GROUPS 1
 #define BLUR_NAME(name) name##_portable
 #define BLUR_TARGET
 #include "blur_lanes.h"
 
 #ifdef HBAO_FINISH_X86
 #define BLUR_LANES 8
+#define BLUR_GROUPS 2
 #define BLUR_MIN _mm256_min_ps
 #define BLUR_MAX _mm256_max_ps
 #define BLUR_NAME(name) name##_avx2
@@ -217,6 +222,7 @@ static HBAO_ALWAYS_INLINE void write_output(const float *zc, const float *ao, in
 #include "blur_lanes.h"
 
 #define BLUR_LANES 16
+#define BLUR_GROUPS 1
 #define BLUR_MIN _mm512_min_ps
 #define BLUR_MAX _mm512_max_ps
 #define BLUR_NAME(name) name##_avx512

@@ -2,7 +2,8 @@
 /* A pass of the blur over a row of centres, BLUR_LANES pixels at a time in
  * GCC vector types, and the band job that runs it: written once for every
  * instruction set, blur.c includes this header once per copy, after
- * defining BLUR_LANES (the lanes of a vector), BLUR_NAME(x) (the copy's
+ * defining BLUR_LANES (the lanes of a vector), BLUR_GROUPS (how many
+ * vectors a step of the loop takes side by side), BLUR_NAME(x) (the copy's
  * names), BLUR_TARGET (its instruction set's function attribute, or
  * nothing) and, optionally, BLUR_MIN and BLUR_MAX (the instruction set's
  * minimum and maximum of two vectors of BLUR_LANES floats: a < b ? a : b
@@ -59,41 +60,57 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE VF BLUR_NAME(power)(VF base) {
     return power * power;
 }
 
-/* blur_pixel for pixels i .. i + BLUR_LANES - 1, all of whose taps lie
- * inside the row. along_row is taps->along_row as a constant, so that
- * each pass loads only the steps it has: along a row one per tap, down a
- * column two and the AO's row. */
+/* blur_pixel for pixels i .. i + groups * BLUR_LANES - 1, all of whose
+ * taps lie inside the row, as `groups` vectors side by side. along_row is
+ * taps->along_row as a constant, so that each pass loads only the steps it
+ * has: along a row one per tap, down a column two and the AO's row. A tap's
+ * weight is a chain of some fifteen dependent operations (four of them the
+ * power's squarings); with one vector the processor cannot hold enough taps
+ * in flight to keep its multipliers busy; two vectors whose chains
+ * interleave keep more of them in flight (blur.c says where it pays). The
+ * groups are independent, so the result is the same for any count. */
 BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(lanes)(const tap_set *taps,
                                                             const centre_row *c, float sharpness,
-                                                            int i, float *target, int along_row) {
+                                                            int i, float *target, int along_row,
+                                                            int groups) {
     const VF zero = {0.0f}, one = zero + 1.0f;
-    const VF zc = BLUR_NAME(load)(c->z + i);
-    const VI geometry = zc > 0.0f;
-    const VF scaled = BLUR_NAME(select)(geometry, sharpness / zc, zero);
-    const VF factor =
-        BLUR_NAME(select)(scaled < FLT_MAX, scaled, zero + FLT_MAX) * HBAO_BLUR_DEPTH_WEIGHT;
-    const VF cx = BLUR_NAME(load)(c->nx + i) * HBAO_BLUR_NORMAL_WEIGHT,
-             cy = BLUR_NAME(load)(c->ny + i) * HBAO_BLUR_NORMAL_WEIGHT,
-             cz = BLUR_NAME(load)(c->nz + i) * HBAO_BLUR_NORMAL_WEIGHT;
-    VF sum = BLUR_NAME(load)(c->ao + i), weight_sum = one;
-    for (int t = 0; t < taps->count; t++) {
-        const int at = i + taps->depth_step[t];
-        const int normal_at = along_row ? at : i + taps->normal_step[t];
-        const VF z = BLUR_NAME(load)(c->z + at);
-        const VF difference = (z - zc) * factor;
-        const VF facing = BLUR_NAME(load)(c->nx + normal_at) * cx +
-                          BLUR_NAME(load)(c->ny + normal_at) * cy +
-                          BLUR_NAME(load)(c->nz + normal_at) * cz;
-        const VF capped = BLUR_NAME(min)(facing, zero + HBAO_BLUR_NORMAL_WEIGHT);
-        const VF base = (1.0f - HBAO_BLUR_NORMAL_WEIGHT + capped) - difference * difference;
-        /* blur_pixel's "* valid": the product is finite, so times 1 is itself */
-        const VF weight =
-            BLUR_NAME(zero_unless)(z > 0.0f, taps->spatial[t] * BLUR_NAME(power)(base));
-        sum += weight * BLUR_NAME(load)(along_row ? c->ao + at : taps->ao[t] + i);
-        weight_sum += weight;
+    VF zc[BLUR_GROUPS], factor[BLUR_GROUPS], cx[BLUR_GROUPS], cy[BLUR_GROUPS], cz[BLUR_GROUPS];
+    VF sum[BLUR_GROUPS], weight_sum[BLUR_GROUPS];
+    for (int g = 0; g < groups; g++) {
+        const int at = i + g * BLUR_LANES;
+        zc[g] = BLUR_NAME(load)(c->z + at);
+        const VF scaled = BLUR_NAME(select)(zc[g] > 0.0f, sharpness / zc[g], zero);
+        factor[g] =
+            BLUR_NAME(select)(scaled < FLT_MAX, scaled, zero + FLT_MAX) * HBAO_BLUR_DEPTH_WEIGHT;
+        cx[g] = BLUR_NAME(load)(c->nx + at) * HBAO_BLUR_NORMAL_WEIGHT;
+        cy[g] = BLUR_NAME(load)(c->ny + at) * HBAO_BLUR_NORMAL_WEIGHT;
+        cz[g] = BLUR_NAME(load)(c->nz + at) * HBAO_BLUR_NORMAL_WEIGHT;
+        sum[g] = BLUR_NAME(load)(c->ao + at);
+        weight_sum[g] = one;
     }
-    const VF blurred = BLUR_NAME(select)(geometry, sum / weight_sum, one);
-    memcpy(target + i, &blurred, sizeof blurred);
+    for (int t = 0; t < taps->count; t++) {
+        for (int g = 0; g < groups; g++) {
+            const int centre = i + g * BLUR_LANES;
+            const int at = centre + taps->depth_step[t];
+            const int normal_at = along_row ? at : centre + taps->normal_step[t];
+            const VF z = BLUR_NAME(load)(c->z + at);
+            const VF difference = (z - zc[g]) * factor[g];
+            const VF facing = BLUR_NAME(load)(c->nx + normal_at) * cx[g] +
+                              BLUR_NAME(load)(c->ny + normal_at) * cy[g] +
+                              BLUR_NAME(load)(c->nz + normal_at) * cz[g];
+            const VF capped = BLUR_NAME(min)(facing, zero + HBAO_BLUR_NORMAL_WEIGHT);
+            const VF base = (1.0f - HBAO_BLUR_NORMAL_WEIGHT + capped) - difference * difference;
+            /* blur_pixel's "* valid": the product is finite, so times 1 is itself */
+            const VF weight =
+                BLUR_NAME(zero_unless)(z > 0.0f, taps->spatial[t] * BLUR_NAME(power)(base));
+            sum[g] += weight * BLUR_NAME(load)(along_row ? c->ao + at : taps->ao[t] + centre);
+            weight_sum[g] += weight;
+        }
+    }
+    for (int g = 0; g < groups; g++) {
+        const VF blurred = BLUR_NAME(select)(zc[g] > 0.0f, sum[g] / weight_sum[g], one);
+        memcpy(target + i + g * BLUR_LANES, &blurred, sizeof blurred);
+    }
 }
 
 /* One pass over a row of centres into target: the vector loop where every
@@ -106,12 +123,18 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(blur_pass)(const tap_set *t
     const int last = taps->along_row ? width - radius : width; /* vector lanes in [first, last) */
     int i = 0;
     for (; i < first && i < width; i++) target[i] = blur_pixel(taps, c, sharpness, width, i);
-    if (taps->along_row)
+    const int group = BLUR_GROUPS * BLUR_LANES;
+    if (taps->along_row) {
+        for (; i + group <= last; i += group)
+            BLUR_NAME(lanes)(taps, c, sharpness, i, target, 1, BLUR_GROUPS);
         for (; i + BLUR_LANES <= last; i += BLUR_LANES)
-            BLUR_NAME(lanes)(taps, c, sharpness, i, target, 1);
-    else
+            BLUR_NAME(lanes)(taps, c, sharpness, i, target, 1, 1);
+    } else {
+        for (; i + group <= last; i += group)
+            BLUR_NAME(lanes)(taps, c, sharpness, i, target, 0, BLUR_GROUPS);
         for (; i + BLUR_LANES <= last; i += BLUR_LANES)
-            BLUR_NAME(lanes)(taps, c, sharpness, i, target, 0);
+            BLUR_NAME(lanes)(taps, c, sharpness, i, target, 0, 1);
+    }
     for (; i < width; i++) target[i] = blur_pixel(taps, c, sharpness, width, i);
 }
 
@@ -158,6 +181,7 @@ BLUR_TARGET static void BLUR_NAME(finish_band)(void *context, int band) {
 #undef VF
 #undef VI
 #undef BLUR_LANES
+#undef BLUR_GROUPS
 #undef BLUR_NAME
 #undef BLUR_TARGET
 #undef BLUR_MIN
