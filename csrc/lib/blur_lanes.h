@@ -3,7 +3,10 @@
  * GCC vector types, and the band job that runs it: written once for every
  * instruction set, blur.c includes this header once per copy, after
  * defining BLUR_LANES (the lanes of a vector), BLUR_GROUPS (how many
- * vectors a step of the loop takes side by side), BLUR_NAME(x) (the copy's
+ * vectors a step of the loop takes side by side), BLUR_SKIPS_CHECK (1: a
+ * row whose background taps weigh 0 by themselves skips the test for them,
+ * blur.c's background_needs_check; 0: every row tests, as the scalar
+ * reference, which the tests hold the others to), BLUR_NAME(x) (the copy's
  * names), BLUR_TARGET (its instruction set's function attribute, or
  * nothing) and, optionally, BLUR_MIN and BLUR_MAX (the instruction set's
  * minimum and maximum of two vectors of BLUR_LANES floats: a < b ? a : b
@@ -63,7 +66,10 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE VF BLUR_NAME(power)(VF base) {
 /* blur_pixel for pixels i .. i + groups * BLUR_LANES - 1, all of whose
  * taps lie inside the row, as `groups` vectors side by side. along_row is
  * taps->along_row as a constant, so that each pass loads only the steps it
- * has: along a row one per tap, down a column two and the AO's row. A tap's
+ * has: along a row one per tap, down a column two and the AO's row; check
+ * is c->checks_background as a constant, so that a row whose background
+ * taps weigh 0 by themselves (background_needs_check, blur.c) skips the
+ * test. A tap's
  * weight is a chain of some fifteen dependent operations (four of them the
  * power's squarings); with one vector the processor cannot hold enough taps
  * in flight to keep its multipliers busy; two vectors whose chains
@@ -72,7 +78,7 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE VF BLUR_NAME(power)(VF base) {
 BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(lanes)(const tap_set *taps,
                                                             const centre_row *c, float sharpness,
                                                             int i, float *target, int along_row,
-                                                            int groups) {
+                                                            int check, int groups) {
     const VF zero = {0.0f}, one = zero + 1.0f;
     VF zc[BLUR_GROUPS], factor[BLUR_GROUPS], cx[BLUR_GROUPS], cy[BLUR_GROUPS], cz[BLUR_GROUPS];
     VF sum[BLUR_GROUPS], weight_sum[BLUR_GROUPS];
@@ -101,8 +107,8 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(lanes)(const tap_set *taps,
             const VF capped = BLUR_NAME(min)(facing, zero + HBAO_BLUR_NORMAL_WEIGHT);
             const VF base = (1.0f - HBAO_BLUR_NORMAL_WEIGHT + capped) - difference * difference;
             /* blur_pixel's "* valid": the product is finite, so times 1 is itself */
-            const VF weight =
-                BLUR_NAME(zero_unless)(z > 0.0f, taps->spatial[t] * BLUR_NAME(power)(base));
+            const VF unchecked = taps->spatial[t] * BLUR_NAME(power)(base);
+            const VF weight = check ? BLUR_NAME(zero_unless)(z > 0.0f, unchecked) : unchecked;
             sum[g] += weight * BLUR_NAME(load)(along_row ? c->ao + at : taps->ao[t] + centre);
             weight_sum[g] += weight;
         }
@@ -111,6 +117,20 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(lanes)(const tap_set *taps,
         const VF blurred = BLUR_NAME(select)(zc[g] > 0.0f, sum[g] / weight_sum[g], one);
         memcpy(target + i + g * BLUR_LANES, &blurred, sizeof blurred);
     }
+}
+
+/* The vector loop of a pass over pixels i .. last - 1, as far as whole
+ * vectors go: groups of vectors, then single ones. Returns the first pixel
+ * left. along_row and check are constants (BLUR_NAME(lanes)). */
+BLUR_TARGET static HBAO_ALWAYS_INLINE int BLUR_NAME(vectors)(const tap_set *taps,
+                                                             const centre_row *c, float sharpness,
+                                                             int i, int last, float *target,
+                                                             int along_row, int check) {
+    for (; i + BLUR_GROUPS * BLUR_LANES <= last; i += BLUR_GROUPS * BLUR_LANES)
+        BLUR_NAME(lanes)(taps, c, sharpness, i, target, along_row, check, BLUR_GROUPS);
+    for (; i + BLUR_LANES <= last; i += BLUR_LANES)
+        BLUR_NAME(lanes)(taps, c, sharpness, i, target, along_row, check, 1);
+    return i;
 }
 
 /* One pass over a row of centres into target: the vector loop where every
@@ -123,18 +143,13 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(blur_pass)(const tap_set *t
     const int last = taps->along_row ? width - radius : width; /* vector lanes in [first, last) */
     int i = 0;
     for (; i < first && i < width; i++) target[i] = blur_pixel(taps, c, sharpness, width, i);
-    const int group = BLUR_GROUPS * BLUR_LANES;
-    if (taps->along_row) {
-        for (; i + group <= last; i += group)
-            BLUR_NAME(lanes)(taps, c, sharpness, i, target, 1, BLUR_GROUPS);
-        for (; i + BLUR_LANES <= last; i += BLUR_LANES)
-            BLUR_NAME(lanes)(taps, c, sharpness, i, target, 1, 1);
-    } else {
-        for (; i + group <= last; i += group)
-            BLUR_NAME(lanes)(taps, c, sharpness, i, target, 0, BLUR_GROUPS);
-        for (; i + BLUR_LANES <= last; i += BLUR_LANES)
-            BLUR_NAME(lanes)(taps, c, sharpness, i, target, 0, 1);
-    }
+    const int check = c->checks_background || !BLUR_SKIPS_CHECK;
+    if (taps->along_row)
+        i = check ? BLUR_NAME(vectors)(taps, c, sharpness, i, last, target, 1, 1)
+                  : BLUR_NAME(vectors)(taps, c, sharpness, i, last, target, 1, 0);
+    else
+        i = check ? BLUR_NAME(vectors)(taps, c, sharpness, i, last, target, 0, 1)
+                  : BLUR_NAME(vectors)(taps, c, sharpness, i, last, target, 0, 0);
     for (; i < width; i++) target[i] = blur_pixel(taps, c, sharpness, width, i);
 }
 
@@ -182,6 +197,7 @@ BLUR_TARGET static void BLUR_NAME(finish_band)(void *context, int band) {
 #undef VI
 #undef BLUR_LANES
 #undef BLUR_GROUPS
+#undef BLUR_SKIPS_CHECK
 #undef BLUR_NAME
 #undef BLUR_TARGET
 #undef BLUR_MIN

@@ -733,7 +733,10 @@ TEST_CASE(simd_paths_match_scalar_reference_bit_for_bit) {
      * which skips some samples in every kernel alike. Bit 5: 40 steps over a
      * radius of 10 to 20 pixels, so consecutive steps snap to the same pixel
      * (the SIMD kernels fetch such a pixel once). Bit 6 (variants 64 to 95,
-     * bit 5 clear): a back-face layer, known on two pixels in three. */
+     * bit 5 clear): a back-face layer, known on two pixels in three. Bit 1
+     * also lowers the blur's sharpness to 2, where a tap on background does
+     * not weigh 0 by its depth difference alone (blur.c,
+     * background_needs_check) and the vector loop must test it. */
     float *back = malloc(bytes);
     for (int k = 0; k < view.width * view.height; k++)
         back[k] = k % 3 == 0 ? 0.0f : depth[k] + 0.05f + 0.1f * (float)(k % 5);
@@ -743,6 +746,7 @@ TEST_CASE(simd_paths_match_scalar_reference_bit_for_bit) {
         p.thickness = (variant & 16) ? 0.2f : 0.0f;
         p.integration = variant & 1;
         p.falloff = (variant >> 1) & 1;
+        p.blur_sharpness = variant & 2 ? 2.0f : HBAO_DEFAULT_BLUR_SHARPNESS;
         p.half_resolution = (variant >> 2) & 1;
         p.angle_bias_degrees = (variant & 8) ? 0.0f : 20.0f;
         p.directions = 7;

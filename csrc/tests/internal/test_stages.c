@@ -1,0 +1,97 @@
+/* SPDX-License-Identifier: GPL-2.0-or-later */
+/* The library's stages tested from inside, on inputs that hbao_compute()
+ * cannot be made to produce: the blur (hbao_finish) on a raw AO of the
+ * test's choosing. Built from the library's sources (CMakeLists.txt). */
+#include <stdint.h>
+
+#include "internal_finish.h"
+#include "test_harness.h"
+
+static uint32_t next_random(uint32_t *state) {
+    *state = *state * 1664525u + 1013904223u;
+    return *state >> 8; /* 24 bits */
+}
+
+/* A w x h grid whose rows mix background (0) with ordinary depths, depths
+ * so small that the blur's depth factor is capped (1e-40, 1e-38) and large
+ * ones, each row in its own proportions; random unit normals; two pixels in
+ * three take their left neighbour's depth and normal (so that taps weigh
+ * something); a random raw AO. */
+static void make_grid(hbao_grid *grid, int w, int h, float *depth, float *normal, float *raw) {
+    static const float extremes[] = {1e-40f, 1e-38f, 1e-30f, 1e30f, 3e38f};
+    memset(grid, 0, sizeof *grid);
+    grid->width = w;
+    grid->height = h;
+    grid->depth = depth;
+    grid->normal = normal;
+    uint32_t state = 2024u;
+    for (int j = 0; j < h; j++) {
+        const int kind = j % 4; /* 0: ordinary; 1: extremes too; 2: no background; 3: sparse */
+        for (int i = 0; i < w; i++) {
+            const uint32_t r = next_random(&state);
+            float z =
+                i > 0 && r % 3 != 0 ? depth[j * w + i - 1] : 1.0f + (float)(r % 1000) / 250.0f;
+            if (kind == 1 && r % 5 == 0) z = extremes[(r >> 4) % 5];
+            if (kind != 2 && r % (kind == 3 ? 2 : 6) == 1) z = 0.0f;
+            depth[j * w + i] = z;
+            raw[j * w + i] = (float)next_random(&state) / 16777216.0f;
+            float n[3] = {0.0f, 0.0f, 0.0f};
+            if (i > 0 && r % 3 != 0) {
+                hbao_grid_normal_at(grid, i - 1, j, n);
+            } else {
+                float length = 0.0f;
+                for (int c = 0; c < 3; c++) {
+                    n[c] = (float)next_random(&state) / 8388608.0f - 1.0f;
+                    length += n[c] * n[c];
+                }
+                length = sqrtf(length) > 0.0f ? sqrtf(length) : 1.0f;
+                for (int c = 0; c < 3; c++) n[c] /= length;
+            }
+            for (int c = 0; c < 3; c++) hbao_grid_normal_row(grid, j, c)[i] = n[c];
+        }
+    }
+}
+
+/* Every copy of the blur gives the scalar reference's floats, at every
+ * sharpness: around SELF_MASKING_SHARPNESS (blur.c), above which a row's
+ * vector loop leaves out the test for background taps, and on rows whose
+ * tiny depths need the test at any sharpness (background_needs_check). */
+TEST_CASE(blur_copies_agree_on_background_at_every_sharpness) {
+    enum { w = 97, h = 41 };
+    static float depth[w * h], normal[3 * w * (h + 1) + 3 * HBAO_NORMAL_PADDING], raw[w * h];
+    static float reference[w * h], out[w * h];
+    hbao_grid grid;
+    make_grid(&grid, w, h, depth, normal, raw);
+    static const float sharpness[] = {0.0f, 2.0f, 4.0f, 4.001f, 4.01f, 32.0f, 1000.0f};
+    static const int radii[] = {1, 7, 12};
+    for (size_t s = 0; s < sizeof sharpness / sizeof sharpness[0]; s++) {
+        for (size_t r = 0; r < sizeof radii / sizeof radii[0]; r++) {
+            hbao_settings settings;
+            memset(&settings, 0, sizeof settings);
+            settings.blur_radius = settings.grid_blur_radius = radii[r];
+            settings.blur_sharpness = sharpness[s];
+            settings.strength = 1.0f;
+            settings.threads = 1;
+            settings.implementation = HBAO_IMPLEMENTATION_SCALAR;
+            CHECK_RESULT(hbao_finish(&settings, &grid, raw, depth, w, h, reference, w),
+                         HBAO_SUCCESS);
+            int blurred = 0;
+            for (int k = 0; k < w * h; k++) blurred += depth[k] > 0.0f && reference[k] != raw[k];
+            CHECK(blurred > w * h / 3);
+            for (int implementation = HBAO_IMPLEMENTATION_AVX2;
+                 implementation <= HBAO_IMPLEMENTATION_AVX512; implementation++) {
+                settings.implementation = implementation;
+                settings.threads = implementation == HBAO_IMPLEMENTATION_AVX2 ? 1 : 2;
+                CHECK_RESULT(hbao_finish(&settings, &grid, raw, depth, w, h, out, w), HBAO_SUCCESS);
+                int differ = 0;
+                for (int k = 0; k < w * h; k++) differ += memcmp(&out[k], &reference[k], 4) != 0;
+                if (differ)
+                    printf("  sharpness %g, radius %d, implementation %d: %d pixels differ\n",
+                           (double)sharpness[s], radii[r], implementation, differ);
+                CHECK(differ == 0);
+            }
+        }
+    }
+}
+
+TEST_MAIN(TEST_ENTRY(blur_copies_agree_on_background_at_every_sharpness))
