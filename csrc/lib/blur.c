@@ -137,7 +137,7 @@ static HBAO_ALWAYS_INLINE float blur_pixel(const tap_set *taps, const centre_row
  * (1 - NW) + min(n.c, NW) is at most 1 (NW = 0.5; NaN gives NW): the base
  * is <= 0, its power +0, and the weight spatial * +0 = +0, the same float
  * that the test gives. A centre on background gives 1 whatever its taps
- * weigh. bench_blur's 15-pixel blur took 0.93 of the time without the
+ * weigh. bench_blur's 15-pixel blur took 0.96 of the time without the
  * test (docs/speed.md). */
 #define SELF_MASKING_SHARPNESS 4.001f
 
@@ -228,7 +228,7 @@ static HBAO_ALWAYS_INLINE void write_output(const float *zc, const float *ao, in
  * its registers' width: GCC splits a vector wider than the registers piece
  * by piece, partly through memory, and with 16 lanes the AVX2 copy of the
  * 15-pixel blur took 2.6 times as long as with 8. Two AVX2 vectors side by
- * side instead (BLUR_GROUPS 2, each in registers of its own) took 0.91 of
+ * side instead (BLUR_GROUPS 2, each in registers of its own) took 0.87 of
  * one's time (scripts/bench_blur_ab.sh), three no less than two. The
  * baseline copy keeps 16 lanes (four SSE2 registers), which its loop runs
  * faster than 8, and one group (two were slower). The AVX-512 copy keeps

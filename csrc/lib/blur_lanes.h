@@ -66,15 +66,15 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE VF BLUR_NAME(power)(VF base) {
 /* blur_pixel for pixels i .. i + groups * BLUR_LANES - 1, all of whose
  * taps lie inside the row, as `groups` vectors side by side. along_row is
  * taps->along_row as a constant, so that each pass loads only the steps it
- * has: along a row one per tap, down a column two and the AO's row; check
- * is c->checks_background as a constant, so that a row whose background
- * taps weigh 0 by themselves (background_needs_check, blur.c) skips the
- * test. A tap's
- * weight is a chain of some fifteen dependent operations (four of them the
- * power's squarings); with one vector the processor cannot hold enough taps
- * in flight to keep its multipliers busy; two vectors whose chains
- * interleave keep more of them in flight (blur.c says where it pays). The
- * groups are independent, so the result is the same for any count. */
+ * has: along a row one per tap, down a column two and the AO's row. check
+ * is c->checks_background (or 1) as a constant, so that a row whose
+ * background taps weigh 0 by themselves (background_needs_check, blur.c)
+ * skips the test. A tap's weight is a chain of some fifteen dependent
+ * operations (four of them the power's squarings); with one vector the
+ * processor cannot hold enough taps in flight to keep its multipliers
+ * busy, and two vectors whose chains interleave keep more of them in
+ * flight (blur.c says where it pays). The groups are independent, so the
+ * result is the same for any count. */
 BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(lanes)(const tap_set *taps,
                                                             const centre_row *c, float sharpness,
                                                             int i, float *target, int along_row,
