@@ -28,10 +28,13 @@ trap 'rm -rf "$work"' EXIT
     { cat "$work/forward" >&2; exit 1; }
 "$bench" "$after" "$before" --rounds "$rounds" --calls 1 "$@" >"$work/reverse" 2>&1 ||
     { cat "$work/reverse" >&2; exit 1; }
-python3 - "$work/forward" "$work/reverse" "$*" <<'PY'
+python3 - "$work/forward" "$work/reverse" "$*" "$REPO/scripts" <<'PY'
 import math
 import statistics
 import sys
+
+sys.path.insert(0, sys.argv[4])
+from bench_stats import quartiles  # noqa: E402  (scripts/bench_stats.py)
 
 
 def settings(path):
@@ -51,14 +54,6 @@ def ratios(path):
     if not first or len(first) != len(second):
         sys.exit(f"bench_ab_pairs.sh: no rounds in {path}")
     return [b / a for a, b in zip(first, second)]
-
-
-def quartiles(values):
-    """The lower and upper quartile, as text (ROUNDS=1 has none)."""
-    if len(values) < 2:
-        return "none (one round)"
-    low, _, high = statistics.quantiles(values, n=4)
-    return f"{low:.3f}-{high:.3f}"
 
 
 print(f"bench_ab: {settings(sys.argv[1])}")

@@ -6,8 +6,8 @@
 # them alternating from round to round (the second run of a round is a few
 # per cent slower on a shared VM), and takes each run's fastest call.
 # Prints the median of the rounds' after / before ratios with their
-# quartiles, each build's median, and whether the two builds' outputs have
-# the same checksum.
+# quartiles, each build's median, and whether the two builds' outputs are
+# bit-identical (the same hash of their bits).
 #   scripts/bench_blur_ab.sh BEFORE/bench_blur AFTER/bench_blur [bench_blur options]
 # Environment: ROUNDS (default 20). bench_blur's --calls defaults to 5 here.
 set -euo pipefail
@@ -38,31 +38,33 @@ for ((round = 0; round < rounds; round++)); do
         run "$after" "$work/after" "$@"
     fi
 done
-python3 - "$work/before" "$work/after" <<'PY'
+python3 - "$work/before" "$work/after" "$REPO/scripts" <<'PY'
 import re
 import statistics
 import sys
 
+sys.path.insert(0, sys.argv[3])
+from bench_stats import quartiles  # noqa: E402  (scripts/bench_stats.py)
+
 
 def runs(path):
-    """Each run's fastest CPU ms and checksum, and the settings line."""
+    """Each run's fastest CPU ms and output hash, and the settings line."""
     with open(path, encoding="utf-8") as lines:
         text = lines.read().splitlines()
     fastest = [float(re.search(r"fastest ([\d.]+)", line).group(1)) for line in text]
-    checksums = {re.search(r"checksum (\S+)", line).group(1) for line in text}
+    checksums = {re.search(r"output hash (\S+)", line).group(1) for line in text}
     return fastest, checksums, text[0].split(":")[0]
 
 
 before, before_sums, settings = runs(sys.argv[1])
 after, after_sums, _ = runs(sys.argv[2])
-ratios = sorted(a / b for a, b in zip(after, before))
-quarter = len(ratios) // 4
+ratios = [a / b for a, b in zip(after, before)]
 print(settings)
 print(f"fastest CPU ms, median of {len(ratios)} rounds: before "
       f"{statistics.median(before):.2f}, after {statistics.median(after):.2f}")
 print(f"after / before: {statistics.median(ratios):.3f} (rounds' quartiles "
-      f"{ratios[quarter]:.3f}-{ratios[-1 - quarter]:.3f})")
+      f"{quartiles(ratios)})")
 same = before_sums == after_sums and len(before_sums) == 1
-print("outputs: " + ("the same checksum" if same else
-                     f"checksums differ: {sorted(before_sums)} / {sorted(after_sums)}"))
+print("outputs: " + ("bit-identical (the same hash)" if same else
+                     f"differ: hashes {sorted(before_sums)} / {sorted(after_sums)}"))
 PY

@@ -10,7 +10,7 @@
  *   bench_blur [--calls N] [--blur B] [--sharpness S] [--size WxH]
  *              [--threads T] [--implementation scalar|avx2|avx512]
  * Prints one line: the fastest and the median CPU ms of N calls, and a
- * checksum of the output (the same for every build that blurs alike). */
+ * hash of the output's bits (the same for every build that blurs alike). */
 #include <stdint.h>
 
 #include "bench_common.h"
@@ -23,35 +23,55 @@ static void usage(const char *program) {
             program);
 }
 
+/* A whole number in [low, high] from the whole of text, or low - 1. */
+static long whole_number(const char *text, long low, long high) {
+    char *end;
+    const long value = strtol(text, &end, 10);
+    return end != text && *end == '\0' && value >= low && value <= high ? value : low - 1;
+}
+
 int main(int argc, char **argv) {
-    int calls = 10, blur = 15, width = 1920, height = 1080, threads = 1;
+    long calls = 10, blur = 15, width = 1920, height = 1080, threads = 1;
     int implementation = HBAO_IMPLEMENTATION_AUTO;
     float sharpness = HBAO_DEFAULT_BLUR_SHARPNESS;
-    for (int a = 1; a < argc; a++) {
-        if (!strcmp(argv[a], "--calls") && a + 1 < argc)
-            calls = atoi(argv[++a]);
-        else if (!strcmp(argv[a], "--blur") && a + 1 < argc)
-            blur = atoi(argv[++a]);
-        else if (!strcmp(argv[a], "--sharpness") && a + 1 < argc)
-            sharpness = (float)atof(argv[++a]);
-        else if (!strcmp(argv[a], "--threads") && a + 1 < argc)
-            threads = atoi(argv[++a]);
-        else if (!strcmp(argv[a], "--size") && a + 1 < argc) {
-            if (sscanf(argv[++a], "%dx%d", &width, &height) != 2) width = 0;
-        } else if (!strcmp(argv[a], "--implementation") && a + 1 < argc) {
-            implementation = bench_implementation(argv[++a]);
+    int bad = 0;
+    for (int a = 1; a < argc && !bad; a += 2) {
+        const char *value = a + 1 < argc ? argv[a + 1] : NULL;
+        if (value == NULL) {
+            bad = 1;
+        } else if (!strcmp(argv[a], "--calls")) {
+            bad = (calls = whole_number(value, 1, 1000)) < 1;
+        } else if (!strcmp(argv[a], "--blur")) {
+            blur = whole_number(value, 1, HBAO_MAX_BLUR_SIZE);
+            bad = blur < 1 || blur % 2 == 0;
+        } else if (!strcmp(argv[a], "--sharpness")) {
+            char *end;
+            sharpness = strtof(value, &end);
+            bad = end == value || *end != '\0' ||
+                  !(sharpness >= 0.0f && sharpness <= HBAO_MAX_BLUR_SHARPNESS);
+        } else if (!strcmp(argv[a], "--threads")) {
+            bad = (threads = whole_number(value, 1, 64)) < 1;
+        } else if (!strcmp(argv[a], "--size")) {
+            char text[32], *by = NULL;
+            if (strlen(value) < sizeof text) {
+                strcpy(text, value);
+                by = strchr(text, 'x');
+            }
+            if (by != NULL) *by = '\0';
+            bad = by == NULL || (width = whole_number(text, 16, 16384)) < 16 ||
+                  (height = whole_number(by + 1, 16, 16384)) < 16;
+        } else if (!strcmp(argv[a], "--implementation")) {
+            bad = (implementation = bench_implementation(value)) < 0;
         } else {
-            usage(argv[0]);
-            return 2;
+            bad = 1;
         }
     }
-    if (calls < 1 || calls > 1000 || blur < 1 || blur > HBAO_MAX_BLUR_SIZE || blur % 2 == 0 ||
-        !(sharpness >= 0.0f && sharpness <= HBAO_MAX_BLUR_SHARPNESS) || width < 16 || height < 16 ||
-        width > 16384 || height > 16384 || threads < 1 || threads > 64 || implementation < 0) {
+    if (bad) {
         usage(argv[0]);
         fprintf(stderr,
                 "bench_blur: --calls 1-1000, --blur an odd size 1-%d, --sharpness 0-%g, "
-                "--size 16-16384 each way, --threads 1-64\n",
+                "--size WxH with each 16-16384, --threads 1-64, --implementation "
+                "scalar|avx2|avx512\n",
                 HBAO_MAX_BLUR_SIZE, (double)HBAO_MAX_BLUR_SHARPNESS);
         return 2;
     }
@@ -100,17 +120,20 @@ int main(int argc, char **argv) {
         }
         times[call] = 1e3 * (clock_seconds(CLOCK_PROCESS_CPUTIME_ID) - start);
     }
-    double checksum = 0.0;
-    for (size_t k = 0; k < pixels; k++) checksum += out[k];
+    /* FNV-1a over the output's bits: two builds that blur alike print the
+     * same hash, and one bit of difference changes it */
+    uint64_t hash = 14695981039346656037u;
+    const unsigned char *bytes = (const unsigned char *)out;
+    for (size_t k = 0; k < pixels * sizeof(float); k++) hash = (hash ^ bytes[k]) * 1099511628211u;
     double fastest = times[0];
     for (int call = 1; call < calls; call++)
         fastest = times[call] < fastest ? times[call] : fastest;
     static const char *const names[] = {"auto", "scalar", "AVX2", "AVX-512"};
-    printf("bench_blur %dx%d, blur %d, sharpness %g, %d thread(s), %s: fastest %.2f, median "
-           "%.2f CPU ms over %d calls; checksum %.6f\n",
+    printf("bench_blur %ldx%ld, blur %ld, sharpness %g, %ld thread(s), %s: fastest %.2f, median "
+           "%.2f CPU ms over %ld calls; output hash %016llx\n",
            width, height, blur, (double)sharpness, threads,
-           names[hbao_finish_implementation(implementation)], fastest, median_of(times, calls),
-           calls, checksum);
+           names[hbao_finish_implementation(implementation)], fastest, median_of(times, (int)calls),
+           calls, (unsigned long long)hash);
     free(times);
     free(out);
     hbao_scratch_give(raw);

@@ -99,7 +99,9 @@ typedef struct centre_row {
  * factor rather than a branch marks background; the weight is finite, so
  * the product is exact. The vector loop (blur_lanes.h) gives the same
  * floats lane by lane (its mask and its min and max instructions are
- * exactly these selects and this product). Background centres give 1. */
+ * exactly these selects and this product; where it leaves the mask out,
+ * background_needs_check says why that changes nothing). Background
+ * centres give 1. */
 static HBAO_ALWAYS_INLINE float blur_pixel(const tap_set *taps, const centre_row *c,
                                            float sharpness, int width, int i) {
     const float zc = c->z[i];
@@ -137,8 +139,11 @@ static HBAO_ALWAYS_INLINE float blur_pixel(const tap_set *taps, const centre_row
  * (1 - NW) + min(n.c, NW) is at most 1 (NW = 0.5; NaN gives NW): the base
  * is <= 0, its power +0, and the weight spatial * +0 = +0, the same float
  * that the test gives. A centre on background gives 1 whatever its taps
- * weigh. bench_blur's 15-pixel blur took 0.96 of the time without the
- * test (docs/speed.md). */
+ * weigh. Both bounds are needed: below the lower one the factor is capped
+ * (d tends to 0), and above the upper one f is denormal, 0 where the host
+ * flushes denormals to zero (as Blender's threads may): test_stages checks
+ * both. bench_blur's 15-pixel blur took 0.96 of the time without the test
+ * (docs/speed.md). */
 #define SELF_MASKING_SHARPNESS 4.001f
 
 static int background_needs_check(const float *z, int width, float sharpness) {

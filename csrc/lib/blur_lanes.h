@@ -11,8 +11,9 @@
  * nothing) and, optionally, BLUR_MIN and BLUR_MAX (the instruction set's
  * minimum and maximum of two vectors of BLUR_LANES floats: a < b ? a : b
  * and a > b ? a : b, b where either is NaN). Every operation is
- * blur_pixel's (blur.c), lane by lane and never contracted into an FMA, so
- * every copy gives the same floats as the scalar reference. test_blur.c
+ * blur_pixel's (blur.c), lane by lane and never contracted into an FMA
+ * (the background test, where it is skipped, changes no float), so every
+ * copy gives the same floats as the scalar reference. test_blur.c
  * compares the copies with each other, and each copy's blur_pixel with its
  * vector loop (blur_pixel_and_the_vector_loop_agree). */
 

@@ -6,19 +6,24 @@
 
 #include "internal_finish.h"
 #include "test_harness.h"
+#ifdef HBAO_FINISH_X86
+#include <immintrin.h>
+#endif
 
 static uint32_t next_random(uint32_t *state) {
     *state = *state * 1664525u + 1013904223u;
     return *state >> 8; /* 24 bits */
 }
 
-/* A w x h grid whose rows mix background (0) with ordinary depths, depths
- * so small that the blur's depth factor is capped (1e-40, 1e-38) and large
- * ones, each row in its own proportions; random unit normals; two pixels in
- * three take their left neighbour's depth and normal (so that taps weigh
+/* A w x h grid whose rows mix background (0) with ordinary depths and, on
+ * rows of their own, depths so small that the blur's depth factor is
+ * capped (1e-40, and 1e-38 above sharpness 3.4) or so large that it is
+ * tiny (1e30, 3e38: denormal where denormals are flushed), each kind of
+ * row in its own proportions; random unit normals; two pixels in three
+ * take their left neighbour's depth and normal (so that taps weigh
  * something); a random raw AO. */
 static void make_grid(hbao_grid *grid, int w, int h, float *depth, float *normal, float *raw) {
-    static const float extremes[] = {1e-40f, 1e-38f, 1e-30f, 1e30f, 3e38f};
+    static const float small[] = {1e-40f, 1e-38f, 1e-30f}, large[] = {1e30f, 3e38f};
     memset(grid, 0, sizeof *grid);
     grid->width = w;
     grid->height = h;
@@ -26,12 +31,15 @@ static void make_grid(hbao_grid *grid, int w, int h, float *depth, float *normal
     grid->normal = normal;
     uint32_t state = 2024u;
     for (int j = 0; j < h; j++) {
-        const int kind = j % 4; /* 0: ordinary; 1: extremes too; 2: no background; 3: sparse */
+        /* 0: ordinary; 1: small depths too; 2: no background; 3: sparse;
+         * 4: large depths too */
+        const int kind = j % 5;
         for (int i = 0; i < w; i++) {
             const uint32_t r = next_random(&state);
             float z =
                 i > 0 && r % 3 != 0 ? depth[j * w + i - 1] : 1.0f + (float)(r % 1000) / 250.0f;
-            if (kind == 1 && r % 5 == 0) z = extremes[(r >> 4) % 5];
+            if (kind == 1 && r % 5 == 0) z = small[(r >> 4) % 3];
+            if (kind == 4 && r % 5 == 0) z = large[(r >> 4) % 2];
             if (kind != 2 && r % (kind == 3 ? 2 : 6) == 1) z = 0.0f;
             depth[j * w + i] = z;
             raw[j * w + i] = (float)next_random(&state) / 16777216.0f;
@@ -52,16 +60,13 @@ static void make_grid(hbao_grid *grid, int w, int h, float *depth, float *normal
     }
 }
 
-/* Every copy of the blur gives the scalar reference's floats, at every
- * sharpness: around SELF_MASKING_SHARPNESS (blur.c), above which a row's
- * vector loop leaves out the test for background taps, and on rows whose
- * tiny depths need the test at any sharpness (background_needs_check). */
-TEST_CASE(blur_copies_agree_on_background_at_every_sharpness) {
+/* The comparison of blur_copies_agree_on_background_at_every_sharpness,
+ * in the floating-point mode it is called in (flush: its name, printed). */
+static void compare_copies(const hbao_grid *g, const float *depth, const float *raw,
+                           const char *flush) {
     enum { w = 97, h = 41 };
-    static float depth[w * h], normal[3 * w * (h + 1) + 3 * HBAO_NORMAL_PADDING], raw[w * h];
     static float reference[w * h], out[w * h];
-    hbao_grid grid;
-    make_grid(&grid, w, h, depth, normal, raw);
+    hbao_grid grid = *g;
     static const float sharpness[] = {0.0f, 2.0f, 4.0f, 4.001f, 4.01f, 32.0f, 1000.0f};
     static const int radii[] = {1, 7, 12};
     for (size_t s = 0; s < sizeof sharpness / sizeof sharpness[0]; s++) {
@@ -86,12 +91,38 @@ TEST_CASE(blur_copies_agree_on_background_at_every_sharpness) {
                 int differ = 0;
                 for (int k = 0; k < w * h; k++) differ += memcmp(&out[k], &reference[k], 4) != 0;
                 if (differ)
-                    printf("  sharpness %g, radius %d, implementation %d: %d pixels differ\n",
-                           (double)sharpness[s], radii[r], implementation, differ);
+                    printf("  %s, sharpness %g, radius %d, implementation %d: %d pixels differ\n",
+                           flush, (double)sharpness[s], radii[r], implementation, differ);
                 CHECK(differ == 0);
             }
         }
     }
+}
+
+/* Every copy of the blur gives the scalar reference's floats, at every
+ * sharpness: around SELF_MASKING_SHARPNESS (blur.c), above which a row's
+ * vector loop leaves out the test for background taps, and on rows whose
+ * small or large depths need the test at any sharpness
+ * (background_needs_check); also with denormals flushed to zero, as a
+ * host application's threads may run (Blender's do), where the large
+ * depths' factor becomes 0. */
+TEST_CASE(blur_copies_agree_on_background_at_every_sharpness) {
+    enum { w = 97, h = 41 };
+    static float depth[w * h], normal[3 * w * h + HBAO_NORMAL_PADDING], raw[w * h];
+    hbao_grid grid;
+    make_grid(&grid, w, h, depth, normal, raw);
+    if (hbao_best_implementation() < HBAO_IMPLEMENTATION_AVX512)
+        printf("  no AVX-512 on this CPU: its copy falls back to AVX2's\n");
+#ifdef HBAO_FINISH_X86
+    const unsigned int mxcsr = _mm_getcsr();
+    for (int flush = 0; flush < 2; flush++) {
+        _mm_setcsr(flush ? mxcsr | 0x8040u : mxcsr); /* FTZ | DAZ */
+        compare_copies(&grid, depth, raw, flush ? "denormals flushed" : "IEEE denormals");
+    }
+    _mm_setcsr(mxcsr);
+#else
+    compare_copies(&grid, depth, raw, "IEEE denormals");
+#endif
 }
 
 TEST_MAIN(TEST_ENTRY(blur_copies_agree_on_background_at_every_sharpness))
