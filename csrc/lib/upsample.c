@@ -33,58 +33,78 @@ static HBAO_ALWAYS_INLINE float finish_pixel(float z, float sum, float weight_su
     return hbao_clamp_ao(z > 0.0f ? blended : 1.0f);
 }
 
+/* The half grid's two rows that a full-resolution row's candidates come
+ * from (the same row twice where there is no row below), and their
+ * bilinear weights. */
+typedef struct half_rows {
+    const float *z_top, *z_bottom, *ao_top, *ao_bottom;
+    float top_weight, bottom_weight;
+} half_rows;
+
+/* Even pixel 2k: on half column k. */
+static HBAO_ALWAYS_INLINE float even_pixel(const half_rows *h, int two_rows, float z, int k) {
+    float sum = 0.0f, weight_sum = 0.0f, nearest_ao = 1.0f, nearest_difference = INFINITY;
+    add_candidate(h->top_weight, h->z_top[k], h->ao_top[k], z, &sum, &weight_sum, &nearest_ao,
+                  &nearest_difference);
+    if (two_rows)
+        add_candidate(h->bottom_weight, h->z_bottom[k], h->ao_bottom[k], z, &sum, &weight_sum,
+                      &nearest_ao, &nearest_difference);
+    return finish_pixel(z, sum, weight_sum, nearest_ao);
+}
+
+/* Odd pixel 2k + 1: between half columns k and right (k + 1, or k itself
+ * with right_weight 0 where there is no column to the right). */
+static HBAO_ALWAYS_INLINE float odd_pixel(const half_rows *h, int two_rows, float z, int k,
+                                          int right, float right_weight) {
+    const float left_weight = 1.0f - right_weight;
+    float sum = 0.0f, weight_sum = 0.0f, nearest_ao = 1.0f, nearest_difference = INFINITY;
+    add_candidate(left_weight * h->top_weight, h->z_top[k], h->ao_top[k], z, &sum, &weight_sum,
+                  &nearest_ao, &nearest_difference);
+    add_candidate(right_weight * h->top_weight, h->z_top[right], h->ao_top[right], z, &sum,
+                  &weight_sum, &nearest_ao, &nearest_difference);
+    if (two_rows) {
+        add_candidate(left_weight * h->bottom_weight, h->z_bottom[k], h->ao_bottom[k], z, &sum,
+                      &weight_sum, &nearest_ao, &nearest_difference);
+        add_candidate(right_weight * h->bottom_weight, h->z_bottom[right], h->ao_bottom[right], z,
+                      &sum, &weight_sum, &nearest_ao, &nearest_difference);
+    }
+    return finish_pixel(z, sum, weight_sum, nearest_ao);
+}
+
 /* One full-resolution row; candidates in the order (left, top), (right,
- * top), (left, bottom), (right, bottom). Even pixels sit on a half-grid
- * column and odd ones between two, so each gets its own loop over the half
- * columns k: every access to the half grid is then contiguous and both loops
- * vectorize. A candidate with bilinear weight 0 adds nothing, so even pixels
- * skip the right-hand column (and rows without a row below, see
- * upsample_row, skip the bottom candidates). */
+ * top), (left, bottom), (right, bottom). Pixel 2k sits on half column k and
+ * pixel 2k + 1 between columns k and k + 1: one loop over k makes both, so
+ * that the row's depths are read and its AO written as whole vectors (with
+ * a loop per parity, the stride-2 stores took one instruction a pixel). A
+ * candidate with bilinear weight 0 adds nothing, so even pixels skip the
+ * right-hand column (and rows without a row below, see upsample_row, skip
+ * the bottom candidates). */
 static HBAO_ALWAYS_INLINE void upsample_rows(const hbao_grid *half, const float *half_ao,
                                              const float *full_depth, int width, int j,
                                              int two_rows, float *restrict out) {
     const int half_width = half->width;
     const int r0 = j / 2;
     const int r1 = two_rows ? r0 + 1 : r0;
-    const float top_weight = two_rows ? 0.5f : 1.0f, bottom_weight = 1.0f - top_weight;
-    const float *z_top = half->depth + (size_t)r0 * half_width;
-    const float *z_bottom = half->depth + (size_t)r1 * half_width;
-    const float *ao_top = half_ao + (size_t)r0 * half_width;
-    const float *ao_bottom = half_ao + (size_t)r1 * half_width;
+    half_rows h;
+    h.top_weight = two_rows ? 0.5f : 1.0f;
+    h.bottom_weight = 1.0f - h.top_weight;
+    h.z_top = half->depth + (size_t)r0 * half_width;
+    h.z_bottom = half->depth + (size_t)r1 * half_width;
+    h.ao_top = half_ao + (size_t)r0 * half_width;
+    h.ao_bottom = half_ao + (size_t)r1 * half_width;
     const float *z_row = full_depth + (size_t)j * width;
-
     const int even_count = (width + 1) / 2; /* pixels 2k */
-    for (int k = 0; k < even_count; k++) {
-        const float z = z_row[2 * k];
-        float sum = 0.0f, weight_sum = 0.0f, nearest_ao = 1.0f, nearest_difference = INFINITY;
-        add_candidate(top_weight, z_top[k], ao_top[k], z, &sum, &weight_sum, &nearest_ao,
-                      &nearest_difference);
-        if (two_rows)
-            add_candidate(bottom_weight, z_bottom[k], ao_bottom[k], z, &sum, &weight_sum,
-                          &nearest_ao, &nearest_difference);
-        out[2 * k] = finish_pixel(z, sum, weight_sum, nearest_ao);
+    const int odd_count = width / 2;        /* pixels 2k + 1 */
+    /* odd pixels with a half column to their right; the last one may have
+     * none (width even, half_width = width / 2) */
+    const int pairs = odd_count < half_width - 1 ? odd_count : half_width - 1;
+    for (int k = 0; k < pairs; k++) {
+        out[2 * k] = even_pixel(&h, two_rows, z_row[2 * k], k);
+        out[2 * k + 1] = odd_pixel(&h, two_rows, z_row[2 * k + 1], k, k + 1, 0.5f);
     }
-    /* Odd pixels 2k + 1 lie between half columns k and k + 1; the last one
-     * may have no right neighbour (width even, half_width = width / 2). */
-    const int odd_count = width / 2;
-    const int odd_inner = odd_count < half_width - 1 ? odd_count : half_width - 1;
-    for (int k = 0; k < odd_count; k++) {
-        const int right = k < odd_inner ? k + 1 : k;
-        const float right_weight = k < odd_inner ? 0.5f : 0.0f, left_weight = 1.0f - right_weight;
-        const float z = z_row[2 * k + 1];
-        float sum = 0.0f, weight_sum = 0.0f, nearest_ao = 1.0f, nearest_difference = INFINITY;
-        add_candidate(left_weight * top_weight, z_top[k], ao_top[k], z, &sum, &weight_sum,
-                      &nearest_ao, &nearest_difference);
-        add_candidate(right_weight * top_weight, z_top[right], ao_top[right], z, &sum, &weight_sum,
-                      &nearest_ao, &nearest_difference);
-        if (two_rows) {
-            add_candidate(left_weight * bottom_weight, z_bottom[k], ao_bottom[k], z, &sum,
-                          &weight_sum, &nearest_ao, &nearest_difference);
-            add_candidate(right_weight * bottom_weight, z_bottom[right], ao_bottom[right], z, &sum,
-                          &weight_sum, &nearest_ao, &nearest_difference);
-        }
-        out[2 * k + 1] = finish_pixel(z, sum, weight_sum, nearest_ao);
-    }
+    for (int k = pairs; k < even_count; k++) out[2 * k] = even_pixel(&h, two_rows, z_row[2 * k], k);
+    for (int k = pairs; k < odd_count; k++)
+        out[2 * k + 1] = odd_pixel(&h, two_rows, z_row[2 * k + 1], k, k, 0.0f);
 }
 
 /* Rows that lie on a half-grid row (and the last odd row, which has no row

@@ -125,4 +125,52 @@ TEST_CASE(blur_copies_agree_on_background_at_every_sharpness) {
 #endif
 }
 
-TEST_MAIN(TEST_ENTRY(blur_copies_agree_on_background_at_every_sharpness))
+/* The half-resolution upsample (hbao_upsample_row) on a flat depth, where
+ * only the bilinear weights count: a full-resolution pixel on a half-grid
+ * column (and row) takes that sample's AO, one between two the mean of
+ * both, and the last column (row) of an even width (height), which has no
+ * half column (row) beyond it, its left (upper) one's. A ramp of AO makes
+ * every weight show: each copy, for odd and even sizes. */
+TEST_CASE(upsample_weights_are_bilinear_on_a_flat_depth) {
+    enum { max_width = 18, max_height = 12 };
+    static const int sizes[][2] = {{17, 11}, {18, 12}, {18, 11}, {17, 12}};
+    static float full_depth[max_width * max_height], half_depth[max_width * max_height];
+    static float half_ao[max_width * max_height], row[max_width];
+    for (size_t size = 0; size < sizeof sizes / sizeof sizes[0]; size++) {
+        const int width = sizes[size][0], height = sizes[size][1];
+        hbao_grid half;
+        memset(&half, 0, sizeof half);
+        half.width = (width + 1) / 2;
+        half.height = (height + 1) / 2;
+        half.depth = half_depth;
+        for (int k = 0; k < width * height; k++) full_depth[k] = 2.0f;
+        for (int r = 0; r < half.height; r++) {
+            for (int k = 0; k < half.width; k++) {
+                half_depth[r * half.width + k] = 2.0f;
+                half_ao[r * half.width + k] = 0.1f + 0.05f * (float)k + 0.03f * (float)r;
+            }
+        }
+        for (int implementation = HBAO_IMPLEMENTATION_SCALAR;
+             implementation <= HBAO_IMPLEMENTATION_AVX512; implementation++) {
+            const int copy = hbao_finish_implementation(implementation);
+            int wrong = 0;
+            for (int j = 0; j < height; j++) {
+                hbao_upsample_row(copy, &half, half_ao, full_depth, width, j, row);
+                /* the half-grid position, the last column and row held */
+                const double y = j / 2 + 1 < half.height ? 0.5 * j : (double)(j / 2);
+                for (int i = 0; i < width; i++) {
+                    const double x = i / 2 + 1 < half.width ? 0.5 * i : (double)(i / 2);
+                    const double expected = 0.1 + 0.05 * x + 0.03 * y;
+                    wrong += !(fabs(row[i] - expected) <= 1e-6);
+                }
+            }
+            if (wrong)
+                printf("  %dx%d, implementation %d: %d pixels off\n", width, height, implementation,
+                       wrong);
+            CHECK(wrong == 0);
+        }
+    }
+}
+
+TEST_MAIN(TEST_ENTRY(blur_copies_agree_on_background_at_every_sharpness),
+          TEST_ENTRY(upsample_weights_are_bilinear_on_a_flat_depth))
