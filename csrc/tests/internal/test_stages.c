@@ -104,7 +104,7 @@ static void compare_copies(const hbao_grid *g, const float *depth, const float *
  * vector loop leaves out the test for background taps, and on rows whose
  * small or large depths need the test at any sharpness
  * (background_needs_check); also with denormals flushed to zero, as a
- * host application's threads may run (Blender's do), where the large
+ * host application's threads may run (Blender's may), where the large
  * depths' factor becomes 0. */
 TEST_CASE(blur_copies_agree_on_background_at_every_sharpness) {
     enum { w = 97, h = 41 };
