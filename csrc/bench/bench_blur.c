@@ -128,12 +128,11 @@ int main(int argc, char **argv) {
     double fastest = times[0];
     for (int call = 1; call < calls; call++)
         fastest = times[call] < fastest ? times[call] : fastest;
-    static const char *const names[] = {"auto", "scalar", "AVX2", "AVX-512"};
     printf("bench_blur %ldx%ld, blur %ld, sharpness %g, %ld thread(s), %s: fastest %.2f, median "
            "%.2f CPU ms over %ld calls; output hash %016llx\n",
            width, height, blur, (double)sharpness, threads,
-           names[hbao_finish_implementation(implementation)], fastest, median_of(times, (int)calls),
-           calls, (unsigned long long)hash);
+           bench_implementation_label(hbao_finish_implementation(implementation)), fastest,
+           median_of(times, (int)calls), calls, (unsigned long long)hash);
     free(times);
     free(out);
     hbao_scratch_give(raw);

@@ -25,6 +25,13 @@ static inline int bench_implementation(const char *name) {
     return -1;
 }
 
+/* The name an hbao_implementation is printed by (AUTO, SCALAR, AVX2,
+ * AVX512) */
+static inline const char *bench_implementation_label(int implementation) {
+    static const char *const labels[] = {"auto", "scalar", "AVX2", "AVX-512"};
+    return implementation >= 0 && implementation < 4 ? labels[implementation] : "?";
+}
+
 static inline double clock_seconds(clockid_t clock) {
     struct timespec t;
     clock_gettime(clock, &t);

@@ -149,7 +149,6 @@ int main(int argc, char **argv) {
     };
     const int row_count = (int)(sizeof rows / sizeof rows[0]) - (with_4k ? 0 : 1);
 
-    static const char *const kernel_names[] = {"auto", "scalar", "AVX2", "AVX-512"};
     printf("# hbao_compute speed: radius %g (scene ~3-7 units deep), median of %d rounds after a "
            "warm-up round, ms per frame\n\n",
            radius, runs);
@@ -162,7 +161,8 @@ int main(int argc, char **argv) {
         "wall-clock ms (median process CPU ms, all threads together). Speed-up and blur share "
         "((time - time without blur) / time, on the last column: wall, with the least and the "
         "greatest round's; CPU; the blur's own CPU ms) are medians of the per-round values.\n",
-        HBAO_DEFAULT_DIRECTIONS, HBAO_DEFAULT_STEPS, HBAO_DEFAULT_BLUR_SIZE, kernel_names[best]);
+        HBAO_DEFAULT_DIRECTIONS, HBAO_DEFAULT_STEPS, HBAO_DEFAULT_BLUR_SIZE,
+        bench_implementation_label(best));
     print_load("before");
     printf("\n| settings | size |");
     int last_column = -1, scalar_column = -1;
@@ -297,7 +297,7 @@ int main(int argc, char **argv) {
         double *cpu = malloc((size_t)runs * sizeof(double));
         if (ao == NULL || cpu == NULL) return 1;
         printf("\n## Stages around the horizon search, 1920x1080, %s, 1 thread, median CPU ms\n\n",
-               kernel_names[best]);
+               bench_implementation_label(best));
         printf(
             "Radius 1e-4 (under a pixel everywhere, so no horizon is searched): depth conversion, "
             "normals, [upsample], blur, output. Median CPU ms (fastest call's).\n\n");

@@ -79,12 +79,9 @@ typedef struct tap_set {
     float spatial[2 * MAX_BLUR_RADIUS + 1];
 } tap_set;
 
-/* The centre row of a pass: its depth, AO and guide normals, and whether
- * the vector loop must test its taps for background
- * (background_needs_check). */
+/* The centre row of a pass: its depth, AO and guide normals. */
 typedef struct centre_row {
     const float *z, *ao, *nx, *ny, *nz;
-    int checks_background;
 } centre_row;
 
 /* One pixel: the centre with weight 1, then the taps in order; the weight
@@ -189,7 +186,7 @@ static HBAO_ALWAYS_INLINE void row_pass(const finish_job *job, int j, tap_set *t
         taps->spatial[taps->count] = job->spatial[k < 0 ? -k : k];
         taps->count++;
     }
-    *c = (centre_row){z, raw, n.nx, n.ny, n.nz, background_needs_check(z, width, job->sharpness)};
+    *c = (centre_row){z, raw, n.nx, n.ny, n.nz};
 }
 
 /* The taps and centres of row j's pass down the column (radius > 0): rows
@@ -208,9 +205,7 @@ static HBAO_ALWAYS_INLINE void column_pass(const finish_job *job, const band_mem
         taps->spatial[taps->count] = job->spatial[k < 0 ? -k : k];
         taps->count++;
     }
-    const float *z = job->depth + (size_t)j * width;
-    *c = (centre_row){
-        z, m->ring[j % slots], n.nx, n.ny, n.nz, background_needs_check(z, width, job->sharpness)};
+    *c = (centre_row){job->depth + (size_t)j * width, m->ring[j % slots], n.nx, n.ny, n.nz};
 }
 
 /* A finished row of AO (1 on background, where zc <= 0) to the output:

@@ -68,9 +68,9 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE VF BLUR_NAME(power)(VF base) {
  * taps lie inside the row, as `groups` vectors side by side. along_row is
  * taps->along_row as a constant, so that each pass loads only the steps it
  * has: along a row one per tap, down a column two and the AO's row. check
- * is c->checks_background (or 1) as a constant, so that a row whose
- * background taps weigh 0 by themselves (background_needs_check, blur.c)
- * skips the test. A tap's weight is a chain of some fifteen dependent
+ * is a constant too (blur_pass decides it), so that a row whose background
+ * taps weigh 0 by themselves (background_needs_check, blur.c) skips the
+ * test. A tap's weight is a chain of some fifteen dependent
  * operations (four of them the power's squarings); with one vector the
  * processor cannot hold enough taps in flight to keep its multipliers
  * busy, and two vectors whose chains interleave keep more of them in
@@ -144,7 +144,8 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(blur_pass)(const tap_set *t
     const int last = taps->along_row ? width - radius : width; /* vector lanes in [first, last) */
     int i = 0;
     for (; i < first && i < width; i++) target[i] = blur_pixel(taps, c, sharpness, width, i);
-    const int check = c->checks_background || !BLUR_SKIPS_CHECK;
+    /* a constant 1 where the copy never skips: no scan of the row then */
+    const int check = !BLUR_SKIPS_CHECK || background_needs_check(c->z, width, sharpness);
     if (taps->along_row)
         i = check ? BLUR_NAME(vectors)(taps, c, sharpness, i, last, target, 1, 1)
                   : BLUR_NAME(vectors)(taps, c, sharpness, i, last, target, 1, 0);
