@@ -38,7 +38,7 @@ for ((round = 0; round < rounds; round++)); do
         run "$after" "$work/after" "$@"
     fi
 done
-python3 - "$work/before" "$work/after" "$REPO/scripts" <<'PY'
+python3 - "$work/before" "$work/after" "$REPO/scripts" "$before" "$after" "$rounds" <<'PY'
 import re
 import statistics
 import sys
@@ -46,11 +46,17 @@ import sys
 sys.path.insert(0, sys.argv[3])
 from bench_stats import quartiles  # noqa: E402  (scripts/bench_stats.py)
 
+rounds = int(sys.argv[6])
+
 
 def runs(path):
     """Each run's fastest CPU ms and output hash, and the settings line."""
     with open(path, encoding="utf-8") as lines:
-        text = lines.read().splitlines()
+        text = [line for line in lines.read().splitlines() if line.startswith("bench_blur ")]
+    if len(text) != rounds or not all("fastest " in line and "output hash " in line
+                                      for line in text):
+        sys.exit(f"bench_blur_ab.sh: {sys.argv[4 + (path == sys.argv[2])]} did not print "
+                 "bench_blur's result line: is it build/bench_blur?")
     fastest = [float(re.search(r"fastest ([\d.]+)", line).group(1)) for line in text]
     checksums = {re.search(r"output hash (\S+)", line).group(1) for line in text}
     return fastest, checksums, text[0].split(":")[0]
