@@ -287,6 +287,42 @@ def test_new_node_settings_reach_the_ao_without_a_render(run_in_blender, tmp_pat
     assert np.abs(ao - expected).max() <= EXACT
 
 
+def test_timer_waits_while_blender_refuses_writes(run_in_blender, tmp_path, native):
+    """While another thread runs a read-only callback (a draw, Cycles'
+    render), Blender refuses every write and operator from Python; a CI run
+    once met that in the node timer's tick after an F12 render, which then
+    raised. The step here runs in a node class's poll, where Blender refuses
+    them for real. There the tick shows no message and raises nothing, and
+    the next tick shows it; a refresh does not render and is not taken for
+    a failure (which is not tried again until the settings change): the
+    next tick renders the new radius (its render clears the status), and
+    the AO is the library's."""
+    spec = {"frames": [1], "nodes": [{"name": "Hinted", "radius": 0.6, "blur_size": 0}],
+            "after_render": [
+                {"label": "refused tick", "post_message": "posted", "poll": True,
+                 "refused": True},
+                {"label": "next tick", "poll": True},
+                {"label": "refused refresh", "socket": ["Radius", 1.1], "refresh": True,
+                 "refused": True},
+                {"label": "next refresh", "refresh": True},
+                {"label": "rendered again", "render": 1}]}
+    out, log = render(run_in_blender, tmp_path, spec)
+    said = {}
+    for line in log.splitlines():
+        if line.startswith("HINT "):
+            step = json.loads(line[len("HINT "):])
+            said[step["label"]] = (step["status"], bool(step["hint"]))
+    assert said == {"refused tick": ("", False), "next tick": ("posted", False),
+                    "refused refresh": ("posted", True), "next refresh": ("", False),
+                    "rendered again": ("", False)}, log[-3000:]
+    refreshed = [line.split()[1] for line in log.splitlines() if line.startswith("REFRESHED ")]
+    assert refreshed == ["False", "True"], log[-3000:]
+    assert "Traceback" not in log and "could not bring the AO" not in log, log[-3000:]
+    ao = node_outputs(out, 1, "Hinted")["ao"]
+    expected = library_ao(native, out, 1, node_params(radius=1.1, blur_size=0))
+    assert np.abs(ao - expected).max() <= EXACT
+
+
 def test_two_nodes_two_view_layers_and_muted_node(run_in_blender, tmp_path, native):
     spec = {"scene": "two_layers", "nodes": [
         {"name": "Small", "layer": "Front", "radius": 0.2},

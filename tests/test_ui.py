@@ -142,13 +142,20 @@ def test_picking_the_internal_engine_keeps_the_artists_engine(run_blender):
 def test_f12_problem_reaches_the_info_editor(run_blender, tmp_path):
     """After an F12 render whose HBAO node has Depth unlinked, the Info
     editor lists the add-on's warning with what it means (read as Ctrl+C in
-    the Info editor copies it; out/test-artifacts/ui_info_report.png)."""
+    the Info editor copies it; out/test-artifacts/ui_info_report.png). A
+    report that a tick of the add-on's timer could not show, because
+    Blender refused operators then, is shown by a later tick."""
     ARTIFACTS.mkdir(parents=True, exist_ok=True)
     completed = run_blender(SCRIPTS / "ui_info_report.py", tmp_path / "f12", ARTIFACTS, ui=True)
     assert "INFO: DONE" in completed.stdout, completed.stdout[-3000:]
+    assert "INFO: PENDING AFTER A REFUSED TICK True" in completed.stdout, \
+        completed.stdout[-3000:]
+    # The test scripts' quit, refused at first, too (timer_guard.py).
+    assert "QUIT: Blender refused it for now" in completed.stdout, completed.stdout[-3000:]
     line = next(text for text in completed.stdout.splitlines() if text.startswith("INFO \""))
     reports = json.loads(line[len("INFO "):])
     assert 'HBAO node "HBAO0": Depth is not linked; AO off' in reports, reports
+    assert "posted before a tick where Blender refused operators" in reports, reports
 
 
 def test_f12_with_guard_band_and_back_faces(run_blender, tmp_path):

@@ -199,16 +199,26 @@ def show_messages(node, messages):
 
 def apply_node_messages():
     """Show what the hook last said about each node (main thread only: the
-    render thread only posts it, report.post_node_messages)."""
+    render thread only posts it, report.post_node_messages). What Blender
+    refuses to write for the moment waits for the next call (the timer's
+    next tick); a node that cannot be written at all (a linked tree) keeps
+    its line, and the console has the messages."""
     if not report.in_main_thread():
         return
     changed = False
     for scene_name, statuses in report.take_node_messages():
         scene = bpy.data.scenes.get(scene_name)
         for node in hbao_nodes(compat.compositor_tree(scene) if scene else None):
-            if node.name in statuses:
+            if node.name not in statuses:
+                continue
+            try:
                 show_messages(node, statuses[node.name])
-                changed = True
+            except (AttributeError, RuntimeError) as error:
+                if compat.writes_refused(error):
+                    report.return_node_messages(scene_name, statuses)
+                    break
+                continue
+            changed = True
     if changed:
         _redraw_node_editors()
 

@@ -21,7 +21,8 @@ import time
 
 import bpy
 
-from . import ao_cache, compat, helper_scene, layer_passes, node, render_record
+from . import (ao_cache, compat, composite_trigger, helper_scene, layer_passes, node,
+               render_record)
 from . import camera as camera_model
 from .planning import plan_node
 from .report import log
@@ -193,13 +194,20 @@ def _refresh(main, helper, due, in_background):
     if not _install(computation):
         return False
     record = render_record.last_render(main.name)
-    if not _render_helper(main, helper, due.record[0], computation.seconds):
+    try:
+        rendered = _render_helper(main, helper, due.record[0], computation.seconds)
+    except RuntimeError as error:
+        if not compat.writes_refused(error):
+            raise
+        _computing[main.name] = computation  # the next tick renders with its AO
+        return False
+    if not rendered:
         # The engine recorded the new settings before it failed: the node
         # says again that its AO is not up to date.
         render_record.put_back(main.name, record)
         raise RuntimeError("the helper scene's render did not compute the AO (see the Info "
                            "editor)")
-    _composite_again(main)
+    composite_trigger.composite_again(main)
     return True
 
 
@@ -216,6 +224,7 @@ def refresh_changed(in_background=False):
         return False
     if not bpy.context.window_manager.windows and not in_background:
         return False
+    composite_trigger.retry_refused()
     rendered, helpers_rendered = False, set()
     for main in list(bpy.data.scenes):
         helper = helper_scene.helper_scene_of(main)
@@ -242,25 +251,13 @@ def refresh_changed(in_background=False):
     return rendered
 
 
-def _composite_again(main):
-    """A value written to a socket of `main`'s tree (the same value):
-    Blender composites the tree again (in the editors that show it), now
-    with the new AO. Neither the tree's update_tag() nor a write to a node
-    property does."""
-    for hbao_node in node.hbao_nodes(compat.compositor_tree(main)):
-        for socket in hbao_node.inputs:
-            if socket.enabled and isinstance(getattr(socket, "default_value", None),
-                                             (int, float)):
-                socket.default_value = socket.default_value
-                return
-
-
 @bpy.app.handlers.persistent
 def _on_load_pre(*_args):
     # What the last renders kept belongs to the file being closed: scenes
     # of the next file may have the same names.
     _computing.clear()
     _failed.clear()
+    composite_trigger.forget()
     ao_cache.last_render.clear()
     render_record.forget()
 
@@ -281,3 +278,4 @@ def unregister():
         node.hint_refreshers.remove(refresh_changed)
     _computing.clear()
     _failed.clear()
+    composite_trigger.forget()

@@ -85,3 +85,9 @@ def take_node_messages():
         if statuses is not None:
             taken.append((scene_name, statuses))
     return taken
+
+
+def return_node_messages(scene_name, statuses):
+    """Give back what take_node_messages gave for `scene_name` and could not
+    be shown yet, unless a render posted newer messages meanwhile."""
+    _pending_node_messages.setdefault(scene_name, statuses)

@@ -40,6 +40,9 @@ REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 sys.path.insert(0, os.path.join(REPO, "scripts"))
 import blender_scenes  # noqa: E402
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from writes_refused import while_writes_refused  # noqa: E402
+
 os.makedirs(out_dir, exist_ok=True)
 resolution = tuple(spec.get("resolution", (96, 64)))
 samples = spec.get("samples", 4)
@@ -194,18 +197,31 @@ for frame in spec.get("frames", [1]):
         layer = back.view_layers[0].name
         channels, _timings = handover.read_passes(back, {layer: False})
         np.save(os.path.join(out_dir, f"back_{frame:04d}.npy"), channels[("depth", layer)])
+
+
 # After the renders: change the first node step by step and print what its
-# "changed since the last render" line says after each step.
+# "changed since the last render" line says after each step. A step with
+# "refused" runs its "refresh" and "poll" where Blender refuses writes.
 hinted = next(n for n in tree.nodes if n.bl_idname == "CompositorNodeHBAO")
 for step in spec.get("after_render", []):
-    from hbao import recomposite, render_record
+    from hbao import node as node_module
+    from hbao import recomposite, render_record, report
+
+    def timer_action(action, refused=step.get("refused", False)):
+        return while_writes_refused(action) if refused else action()
     for key, value in step.items():
         if key == "socket":
             hinted.inputs[value[0]].default_value = value[1]
         elif key == "frame":
             scene.frame_set(value)
         elif key == "refresh":  # what the add-on's timer does in a window
-            print("REFRESHED", recomposite.refresh_changed(in_background=True), flush=True)
+            print("REFRESHED", timer_action(
+                lambda: recomposite.refresh_changed(in_background=True)), flush=True)
+        elif key == "post_message":  # as the render thread posts them
+            report.post_node_messages(scene.name, [hinted.name],
+                                      [report.NodeMessage(hinted.name, value, value)])
+        elif key == "poll":  # a tick of the add-on's node timer
+            timer_action(node_module._poll_node_messages)
         elif key == "resolution_percentage":
             scene.render.resolution_percentage = value
             import hbao
@@ -222,9 +238,9 @@ for step in spec.get("after_render", []):
         elif key == "render":  # the frame rendered again, as frame_<n>_again
             scene.render.filepath = os.path.join(out_dir, f"frame_{value:04d}_again")
             bpy.ops.render.render(write_still=True)
-        elif key != "label":
+        elif key not in ("label", "refused"):
             setattr(hinted, key, value)
-    print("HINT", json.dumps({"label": step["label"],
+    print("HINT", json.dumps({"label": step["label"], "status": hinted.status,
                               "hint": render_record.changed_since_render(hinted)}))
 for node in tree.nodes:  # what each node's status line says after the renders
     if node.bl_idname == "CompositorNodeHBAO":

@@ -23,14 +23,32 @@ def give_up(message):
     os._exit(3)
 
 
+# How soon a step or a quit that Blender refused is tried again.
+REFUSED_RETRY_S = 0.25
+
+
+def _refused(error):
+    """Whether Blender refused a write or an operator for the moment: while
+    another thread runs a read-only callback (a draw, Cycles' render), it
+    refuses them in every thread, the timers' too (a CI run, session 16:
+    the quit after an F12 render)."""
+    from hbao import compat
+    return compat.writes_refused(error)
+
+
 def guarded_timer(step, first_interval):
     """bpy.app.timers.register(step), except that an exception in step ends
     Blender (exit status 1, the traceback printed) instead of unregistering
-    the timer silently and leaving Blender idle until the test's timeout."""
+    the timer silently and leaving Blender idle until the test's timeout.
+    A step that Blender refused a write or an operator runs again
+    REFUSED_RETRY_S later (steps change their state after their writes)."""
     def guarded():
         try:
             return step()
-        except Exception:
+        except Exception as error:
+            if _refused(error):
+                print("STEP: Blender refused it for now:", error, flush=True)
+                return REFUSED_RETRY_S
             print("SCRIPT ERROR in the timer:", traceback.format_exc(), sep="\n", flush=True)
             os._exit(1)
     bpy.app.timers.register(guarded, first_interval=first_interval)
@@ -40,10 +58,27 @@ QUIT_GRACE_S = 30.0
 
 
 def quit_blender():
-    """bpy.ops.wm.quit_blender(), and give_up() if Blender still runs
-    QUIT_GRACE_S later: the quit is only scheduled, and a test once waited
-    for its 600 s timeout on a Blender left idle (a fresh-clone CI run,
-    session 15; not reproduced in 27 runs)."""
-    bpy.ops.wm.quit_blender()
+    """bpy.ops.wm.quit_blender(), again while Blender refuses it, and
+    give_up() if Blender still runs QUIT_GRACE_S later: the quit is only
+    scheduled, and a test once waited for its 600 s timeout on a Blender
+    left idle (a fresh-clone CI run, session 15; not reproduced in 27
+    runs)."""
     bpy.app.timers.register(lambda: give_up("QUIT: Blender did not end"),
                             first_interval=QUIT_GRACE_S)
+    if _quit_refused():
+        bpy.app.timers.register(_quit_again, first_interval=REFUSED_RETRY_S)
+
+
+def _quit_refused():
+    try:
+        bpy.ops.wm.quit_blender()
+    except RuntimeError as error:
+        if not _refused(error):
+            raise
+        print("QUIT: Blender refused it for now:", error, flush=True)
+        return True
+    return False
+
+
+def _quit_again():
+    return REFUSED_RETRY_S if _quit_refused() else None

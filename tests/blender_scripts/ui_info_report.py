@@ -4,7 +4,9 @@ render (the render job's thread) of a tree whose HBAO node has Depth
 unlinked; once it has ended, one area of the window becomes the Info editor,
 its reports are copied (info.select_all + info.report_copy, what Ctrl+C does
 there) and read from the clipboard, and printed as 'INFO <json text>'; a
-screenshot of the window shows the Info editor.
+screenshot of the window shows the Info editor. A report posted as the
+render ends meets a tick of the add-on's timer where Blender refuses
+operators (writes_refused.py) first.
 
   blender --addons hbao --python ui_info_report.py -- <out dir> <shot dir>
 """
@@ -19,9 +21,13 @@ out_dir, shot_dir = sys.argv[sys.argv.index("--") + 1:][:2]
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import f12_job  # noqa: E402
 import timer_guard  # noqa: E402
+from writes_refused import while_writes_refused  # noqa: E402
+
+from hbao import render_reports, report  # noqa: E402
 
 RENDER_TIMEOUT_S = 240.0
 SETTLE_S = 1.0
+REFUSED_REPORT = "posted before a tick where Blender refused operators"
 
 scene, node = f12_job.corner_scene_with_node(out_dir)
 node.id_data.links.remove(node.inputs["Depth"].links[0])
@@ -56,11 +62,17 @@ def tick():
         if now - state["since"] > RENDER_TIMEOUT_S:
             timer_guard.give_up("INFO: TIMEOUT")
         if job.finished():
+            # A tick of the add-on's reports timer where Blender refuses
+            # operators (another thread drawing or rendering): the report
+            # waits for a later tick instead of being dropped.
+            report.post_render_report(REFUSED_REPORT)
+            while_writes_refused(render_reports._poll)
+            print("INFO: PENDING AFTER A REFUSED TICK", report.has_render_reports(), flush=True)
             state.update(phase="settle", since=now)
     elif state["phase"] == "settle" and now - state["since"] > SETTLE_S:
         print(f"INFO {json.dumps(info_reports())}", flush=True)
         print("INFO: DONE", flush=True)
-        timer_guard.quit_blender()
+        while_writes_refused(timer_guard.quit_blender)  # quits once Blender lets it
         return None
     return 0.1
 
