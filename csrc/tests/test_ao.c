@@ -905,7 +905,9 @@ TEST_CASE(back_face_layer_lets_light_pass_behind_a_thin_plate) {
     float *unknown = malloc((size_t)pixels * sizeof(float));
     for (int k = 0; k < pixels; k++) {
         back[k] = depth[k] < 4.9f ? depth[k] + (float)(0.25 * PLATE_GAP) : 0.0f;
-        unknown[k] = k % 3 == 0 ? 0.0f : (k % 3 == 1 ? NAN : depth[k] * 0.5f);
+        /* background, not finite, in front of the surface, on it */
+        const float not_behind[4] = {0.0f, NAN, depth[k] * 0.5f, depth[k]};
+        unknown[k] = not_behind[k % 4];
     }
     /* the gap between plate and wall (PLATE_GAP) is wider than the thinnest
      * occluder the layer assumes, HBAO_MIN_BACK_THICKNESS radii */
@@ -973,6 +975,100 @@ TEST_CASE(back_face_layer_lets_light_pass_behind_a_thin_plate) {
     free(normal);
 }
 
+TEST_CASE(half_resolution_reads_the_even_pixels_of_even_rows) {
+    /* The half grid's pixel (i, j) is full-resolution pixel (2i, 2j)
+     * (hbao_grid_set_projection): its depth, given normal and back face
+     * come from there, and nowhere else. So an image that agrees with the
+     * plate before the wall on those pixels, with other depths, normals and
+     * backs elsewhere, has the same AO there, bit for bit: at even pixels
+     * of even rows the upsample takes the half grid's AO alone. */
+    scene_view view;
+    float *depth, *normal;
+    render_plate_before_wall(&view, &depth, &normal);
+    const int pixels = view.width * view.height;
+    float *back = malloc((size_t)pixels * sizeof(float));
+    float *other_depth = malloc((size_t)pixels * sizeof(float));
+    float *other_normal = malloc((size_t)pixels * 3 * sizeof(float));
+    float *other_back = malloc((size_t)pixels * sizeof(float));
+    uint32_t state = 7u;
+    for (int j = 0; j < view.height; j++) {
+        for (int i = 0; i < view.width; i++) {
+            const int k = j * view.width + i;
+            back[k] = depth[k] < 4.9f ? depth[k] + (float)(0.25 * PLATE_GAP) : 0.0f;
+            const int kept = i % 2 == 0 && j % 2 == 0;
+            state = state * 1664525u + 1013904223u;
+            const float z = 1.0f + (float)((state >> 8) % 800) / 100.0f;
+            other_depth[k] = kept ? depth[k] : z;
+            other_back[k] = kept ? back[k] : z + 0.01f; /* a thin back: known */
+            for (int c = 0; c < 3; c++)
+                other_normal[3 * k + c] = kept ? normal[3 * k + c] : (c == 0 ? 1.0f : 0.0f);
+        }
+    }
+    for (int layered = 0; layered <= 1; layered++) {
+        hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+        p.radius = 0.4f;
+        p.half_resolution = 1;
+        float *expected = run_layers(&p, &view, depth, normal, layered ? back : NULL);
+        float *ao = run_layers(&p, &view, other_depth, other_normal, layered ? other_back : NULL);
+        int differ = 0, occluded = 0;
+        for (int j = 0; j < view.height; j += 2) {
+            for (int i = 0; i < view.width; i += 2) {
+                const int k = j * view.width + i;
+                differ += memcmp(&ao[k], &expected[k], sizeof(float)) != 0;
+                occluded += expected[k] < 0.9f;
+            }
+        }
+        printf("  %s: %d of the even pixels occluded, %d differ\n",
+               layered ? "with the back layer" : "one layer", occluded, differ);
+        CHECK(occluded > 100);
+        CHECK(differ == 0);
+        free(expected);
+        free(ao);
+    }
+    free(back);
+    free(other_depth);
+    free(other_normal);
+    free(other_back);
+    free(depth);
+    free(normal);
+}
+
+TEST_CASE(depth_at_the_background_depth_is_background) {
+    /* hbao_params.background_depth: depths at or beyond it are background.
+     * A plane at 5 beside depths of exactly 6 with background_depth 6: the
+     * 6s give what background (0) gives, not a far wall that the plane's
+     * edge occludes. */
+    const double eye[3] = {0.0, -5.0, 0.0}, target[3] = {0, 0, 0};
+    scene_view view = make_view(64, 48, eye, target);
+    const int pixels = view.width * view.height;
+    float *at_limit = malloc((size_t)pixels * sizeof(float));
+    float *zero = malloc((size_t)pixels * sizeof(float));
+    for (int k = 0; k < pixels; k++) {
+        const int near = k % view.width < view.width / 2;
+        at_limit[k] = near ? 5.0f : 6.0f;
+        zero[k] = near ? 5.0f : 0.0f;
+    }
+    hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+    p.radius = 2.0f; /* reaches from the far depths to the plane */
+    p.background_depth = 6.0f;
+    float *limit_ao = run(&p, &view, at_limit, NULL);
+    float *zero_ao = run(&p, &view, zero, NULL);
+    CHECK(memcmp(limit_ao, zero_ao, (size_t)pixels * sizeof(float)) == 0);
+    /* and the test can see a far wall: just before the limit, the edge
+     * occludes it */
+    for (int k = 0; k < pixels; k++) at_limit[k] = at_limit[k] == 6.0f ? 5.99f : 5.0f;
+    float *wall_ao = run(&p, &view, at_limit, NULL);
+    float darkest = 1.0f;
+    for (int k = 0; k < pixels; k++) darkest = fminf(darkest, wall_ao[k]);
+    printf("  darkest AO with a wall at 5.99: %.3f\n", (double)darkest);
+    CHECK(darkest < 0.9f);
+    free(at_limit);
+    free(zero);
+    free(limit_ao);
+    free(zero_ao);
+    free(wall_ao);
+}
+
 TEST_MAIN(TEST_ENTRY(plane_facing_camera_is_unoccluded), TEST_ENTRY(tilted_plane_is_unoccluded),
           TEST_ENTRY(corner_matches_analytic_cosine), TEST_ENTRY(corner_matches_analytic_hbao),
           TEST_ENTRY(corner_value_at_the_crease_is_one_half),
@@ -987,4 +1083,6 @@ TEST_MAIN(TEST_ENTRY(plane_facing_camera_is_unoccluded), TEST_ENTRY(tilted_plane
           TEST_ENTRY(tiny_projected_radius_gives_one),
           TEST_ENTRY(simd_paths_match_scalar_reference_bit_for_bit),
           TEST_ENTRY(thin_occluders_do_not_darken_what_is_behind_them),
-          TEST_ENTRY(back_face_layer_lets_light_pass_behind_a_thin_plate))
+          TEST_ENTRY(back_face_layer_lets_light_pass_behind_a_thin_plate),
+          TEST_ENTRY(half_resolution_reads_the_even_pixels_of_even_rows),
+          TEST_ENTRY(depth_at_the_background_depth_is_background))

@@ -1,7 +1,9 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
 /* The library's stages tested from inside, on inputs that hbao_compute()
- * cannot be made to produce: the blur (hbao_finish) on a raw AO of the
- * test's choosing. Built from the library's sources (CMakeLists.txt). */
+ * cannot be made to produce (the blur, hbao_finish, on a raw AO of the
+ * test's choosing) or against answers that its AO would hide (the
+ * upsample's weights, the normals). Built from the library's sources
+ * (CMakeLists.txt). */
 #include <stdint.h>
 
 #include "internal_finish.h"
@@ -172,5 +174,132 @@ TEST_CASE(upsample_weights_are_bilinear_on_a_flat_depth) {
     }
 }
 
+/* The normals hbao_compute_normals makes for a w x h image of `depth`
+ * through the default camera (into `normal`: 3 w h floats and the
+ * padding), from `given` (world space, 3 floats a pixel) or, NULL, from
+ * the depth; with copy `implementation` on `threads` threads. */
+static void make_normals(hbao_grid *grid, int w, int h, float *depth, float *normal,
+                         const float *given, int implementation, int threads) {
+    memset(grid, 0, sizeof *grid);
+    grid->width = w;
+    grid->height = h;
+    grid->depth = depth;
+    grid->normal = normal;
+    const hbao_camera camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
+    hbao_grid_set_projection(grid, &camera, w, h, 1);
+    hbao_settings settings;
+    memset(&settings, 0, sizeof settings);
+    settings.threads = threads;
+    settings.implementation = implementation;
+    const hbao_channel channel = {given, 3, 3 * (int64_t)w};
+    hbao_compute_normals(&settings, &camera, grid, given ? &channel : NULL, 1);
+}
+
+/* Pixels whose normal is not within 1e-6 of (x, y, z), among those for
+ * which `select` (indexed by pixel) is nonzero or, NULL, every pixel
+ * with a depth. */
+static int normals_off(const hbao_grid *grid, const int *select, float x, float y, float z) {
+    int off = 0;
+    for (int j = 0; j < grid->height; j++) {
+        for (int i = 0; i < grid->width; i++) {
+            const int k = j * grid->width + i;
+            if (select ? !select[k] : !(grid->depth[k] > 0.0f)) continue;
+            float n[3];
+            hbao_grid_normal_at(grid, i, j, n);
+            off +=
+                !(fabsf(n[0] - x) <= 1e-6f && fabsf(n[1] - y) <= 1e-6f && fabsf(n[2] - z) <= 1e-6f);
+        }
+    }
+    return off;
+}
+
+/* Normals from depth take, along each axis, the neighbour whose depth
+ * changes least, so that a step does not bend them: on planes facing the
+ * camera, at 5.1 and 8.3 (or, as half floats, 5 and 8, fitted along runs)
+ * with steps along rows and columns and a column of background, every
+ * normal faces the camera exactly. */
+TEST_CASE(face_normals_keep_to_their_side_of_a_step) {
+    enum { w = 40, h = 30 };
+    static float depth[w * h], normal[3 * w * h + HBAO_NORMAL_PADDING];
+    static const float near_far[2][2] = {{5.1f, 8.3f}, {5.0f, 8.0f}};
+    for (int kind = 0; kind < 2; kind++) {
+        for (int k = 0; k < w * h; k++) {
+            const int i = k % w, j = k / w;
+            depth[k] = near_far[kind][(i >= 17) != (j >= 12)];
+            if (i == 30) depth[k] = 0.0f;
+        }
+        hbao_grid grid;
+        make_normals(&grid, w, h, depth, normal, NULL, HBAO_IMPLEMENTATION_SCALAR, 2);
+        CHECK_NEAR(grid.depth_precision,
+                   kind ? HBAO_HALF_DEPTH_PRECISION : HBAO_FLOAT_DEPTH_PRECISION, 0.0);
+        const int off = normals_off(&grid, NULL, 0.0f, 0.0f, 1.0f);
+        if (off) printf("  %s depths: %d normals off\n", kind ? "half" : "float", off);
+        CHECK(off == 0);
+    }
+}
+
+/* The depth's format is told from every row, in any thread: half floats
+ * (of a normal or a subnormal half's size) on every row but one depth
+ * elsewhere make it float. */
+TEST_CASE(depth_precision_is_told_from_every_row) {
+    enum { w = 50, h = 40 };
+    static float depth[w * h], normal[3 * w * h + HBAO_NORMAL_PADDING];
+    /* 3 x 2^-24: a subnormal half float; 1e-7: none */
+    static const struct {
+        float odd_one;
+        float precision;
+    } cases[] = {{0.0f, HBAO_HALF_DEPTH_PRECISION},
+                 {3.0f * 5.9604645e-8f, HBAO_HALF_DEPTH_PRECISION},
+                 {1.1f, HBAO_FLOAT_DEPTH_PRECISION},
+                 {1e-7f, HBAO_FLOAT_DEPTH_PRECISION}};
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
+        for (int threads = 1; threads <= 2; threads++) {
+            for (int k = 0; k < w * h; k++) depth[k] = 1.0f + 0.25f * (float)(k % 7);
+            depth[(h - 3) * w + 11] = cases[c].odd_one;
+            hbao_grid grid;
+            make_normals(&grid, w, h, depth, normal, NULL, HBAO_IMPLEMENTATION_SCALAR, threads);
+            if (grid.depth_precision != cases[c].precision)
+                printf("  depth %g on row %d, %d threads: precision %g\n", (double)cases[c].odd_one,
+                       h - 3, threads, (double)grid.depth_precision);
+            CHECK(grid.depth_precision == cases[c].precision);
+        }
+    }
+}
+
+/* A given normal is used, turned into the camera, normalized and made to
+ * face the viewer, where it is at least HBAO_MIN_NORMAL_LENGTH long and
+ * finite; shorter ones (Blender's Normal pass is 0 where nothing was
+ * rendered, and filtering shortens it at edges), 0 and NaN give the face
+ * normal from depth. On a plane facing the camera: (0.6, 0, 0.8) where
+ * given as that, as twice that or as its opposite (a back face), else
+ * (0, 0, 1); in every copy. */
+TEST_CASE(given_normals_too_short_give_the_face_normal) {
+    enum { w = 37, h = 9, kinds = 6, usable_kinds = 3 };
+    static float depth[w * h], normal[3 * w * h + HBAO_NORMAL_PADDING], given[3 * w * h];
+    static int usable[w * h], unusable[w * h];
+    static const float kind_normal[kinds][3] = {{0.6f, 0.0f, 0.8f},   {1.2f, 0.0f, 1.6f},
+                                                {-0.6f, 0.0f, -0.8f}, {0.03f, 0.0f, 0.04f},
+                                                {0.0f, 0.0f, 0.0f},   {NAN, 0.0f, 1.0f}};
+    for (int k = 0; k < w * h; k++) {
+        depth[k] = 5.1f;
+        const int kind = (k * 7 / 3) % kinds;
+        for (int c = 0; c < 3; c++) given[3 * k + c] = kind_normal[kind][c];
+        usable[k] = kind < usable_kinds;
+        unusable[k] = !usable[k];
+    }
+    for (int implementation = HBAO_IMPLEMENTATION_SCALAR;
+         implementation <= HBAO_IMPLEMENTATION_AVX512; implementation++) {
+        hbao_grid grid;
+        make_normals(&grid, w, h, depth, normal, given, implementation, 1);
+        const int off = normals_off(&grid, usable, 0.6f, 0.0f, 0.8f) +
+                        normals_off(&grid, unusable, 0.0f, 0.0f, 1.0f);
+        if (off) printf("  implementation %d: %d normals off\n", implementation, off);
+        CHECK(off == 0);
+    }
+}
+
 TEST_MAIN(TEST_ENTRY(blur_copies_agree_on_background_at_every_sharpness),
-          TEST_ENTRY(upsample_weights_are_bilinear_on_a_flat_depth))
+          TEST_ENTRY(upsample_weights_are_bilinear_on_a_flat_depth),
+          TEST_ENTRY(face_normals_keep_to_their_side_of_a_step),
+          TEST_ENTRY(depth_precision_is_told_from_every_row),
+          TEST_ENTRY(given_normals_too_short_give_the_face_normal))
