@@ -296,27 +296,51 @@ def test_timer_waits_while_blender_refuses_writes(run_in_blender, tmp_path, nati
     the next tick shows it; a refresh does not render and is not taken for
     a failure (which is not tried again until the settings change): the
     next tick renders the new radius (its render clears the status), and
-    the AO is the library's."""
+    the AO is the library's. The sync timer that rebuilds a deleted hook
+    runs again until it has, and a sync refused after it made the helper
+    scene leaves none behind."""
     spec = {"frames": [1], "nodes": [{"name": "Hinted", "radius": 0.6, "blur_size": 0}],
             "after_render": [
+                {"label": "refused probe", "writes_allowed": True, "refused": True},
+                {"label": "probe", "writes_allowed": True},
                 {"label": "refused tick", "post_message": "posted", "poll": True,
                  "refused": True},
                 {"label": "next tick", "poll": True},
                 {"label": "refused refresh", "socket": ["Radius", 1.1], "refresh": True,
                  "refused": True},
                 {"label": "next refresh", "refresh": True},
-                {"label": "rendered again", "render": 1}]}
+                {"label": "rendered again", "render": 1},
+                {"label": "refused sync tick", "delete_helper": True, "sync_tick": True,
+                 "refused": True},
+                {"label": "next sync tick", "sync_tick": True},
+                {"label": "refused midway", "delete_helper": True, "sync_all": True,
+                 "refused": True},
+                {"label": "sync", "sync_all": True}]}
     out, log = render(run_in_blender, tmp_path, spec)
     said = {}
     for line in log.splitlines():
         if line.startswith("HINT "):
             step = json.loads(line[len("HINT "):])
             said[step["label"]] = (step["status"], bool(step["hint"]))
-    assert said == {"refused tick": ("", False), "next tick": ("posted", False),
+    assert said == {"refused probe": ("", False), "probe": ("", False),
+                    "refused tick": ("", False), "next tick": ("posted", False),
                     "refused refresh": ("posted", True), "next refresh": ("", False),
-                    "rendered again": ("", False)}, log[-3000:]
+                    "rendered again": ("", False), "refused sync tick": ("", False),
+                    "next sync tick": ("", False), "refused midway": ("", False),
+                    "sync": ("", False)}, log[-3000:]
+    # The sync timer (after an edit in a window) asks first (writes.py) and
+    # runs again until the hook is rebuilt; a sync refused midway, after it
+    # made the helper scene, removes it again and says so.
+    helper = [".HBAO passes Scene"]
+    syncs = [json.loads(line[len("SYNC "):]) for line in log.splitlines()
+             if line.startswith("SYNC ")]
+    assert [(sync["returned"], sync["helpers"]) for sync in syncs] == [
+        (0.25, []), (None, helper), (True, []), (False, helper)], log[-3000:]
+    assert "could not update the HBAO hook" not in log, log[-3000:]
     refreshed = [line.split()[1] for line in log.splitlines() if line.startswith("REFRESHED ")]
     assert refreshed == ["False", "True"], log[-3000:]
+    probes = [line.split()[2] for line in log.splitlines() if line.startswith("WRITES ALLOWED ")]
+    assert probes == ["False", "True"], log[-3000:]
     assert "Traceback" not in log and "could not bring the AO" not in log, log[-3000:]
     ao = node_outputs(out, 1, "Hinted")["ao"]
     expected = library_ao(native, out, 1, node_params(radius=1.1, blur_size=0))

@@ -8,7 +8,7 @@ viewport.projection/shader_sources work in plain Python (tests, benchmarks).
 
     bpy-free   parameters, library_loading, native, exr_passes, camera,
                viewport.projection, viewport.shader_sources
-    Blender    compat (every version difference), preferences, node,
+    Blender    compat (every version difference), writes, preferences, node,
                helper_lookup, helper_scene, socket_values, planning, handover, engine,
                engine_guard, render_reports, handlers,
                viewport.*
@@ -53,8 +53,8 @@ def register():
         if not compat.version_is_new_enough():
             return  # the message says why; a traceback would not
     from . import (engine, engine_guard, handlers, node, node_setup, recomposite,
-                   render_record, render_reports)
-    for module in (node, node_setup, render_record, recomposite, engine, engine_guard,
+                   render_record, render_reports, writes)
+    for module in (writes, node, node_setup, render_record, recomposite, engine, engine_guard,
                    render_reports, handlers):
         module.register()
         _registered.append(module)

@@ -267,18 +267,3 @@ def new_file_output_input(node, name, socket):
     else:
         node.file_slots.new(name)
     return node.inputs[name]
-
-
-# While another thread runs a Python callback that may only read (a panel's
-# or node's draw or poll, Cycles' render), Blender refuses every write to
-# data and every operator call from Python, in any thread. Each refusal's
-# text, as 3.4 to 5.x word it ("can't" became "cannot" in 5.0).
-_WRITE_REFUSALS = ((AttributeError, "Writing to ID classes in this context is not allowed"),
-                   (RuntimeError, "modify blend data in this state"))
-
-
-def writes_refused(error):
-    """Whether `error` is Blender refusing a write or an operator for the
-    moment (a retry on a later timer tick succeeds), rather than data that
-    is read-only for good (a linked tree) or a bug."""
-    return any(isinstance(error, kind) and text in str(error) for kind, text in _WRITE_REFUSALS)

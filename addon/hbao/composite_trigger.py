@@ -1,10 +1,10 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """Making Blender composite a scene's tree again after a refresh rendered
 its helper (recomposite.py), now or, where Blender refuses the write for
-the moment (compat.writes_refused), on the timer's next tick."""
+the moment (writes.writes_refused), on the timer's next tick."""
 import bpy
 
-from . import compat, node
+from . import compat, node, writes
 
 # Main scene names whose compositing Blender refused to start.
 _refused = set()
@@ -23,7 +23,7 @@ def composite_again(main):
                 try:
                     socket.default_value = socket.default_value
                 except AttributeError as error:
-                    if not compat.writes_refused(error):
+                    if not writes.writes_refused(error):
                         raise
                     _refused.add(main.name)
                 return

@@ -9,16 +9,19 @@ copy plain settings only. `blender -b ... -f N` runs them in the main thread,
 the only chance such a render has to build the hook."""
 import bpy
 
-from . import compat, helper_lookup, helper_scene, node
+from . import compat, helper_lookup, helper_scene, node, writes
 from .report import in_main_thread, log
 
 _sync_scheduled = False
+# How soon a sync that Blender refused (writes.py) runs again.
+_REFUSED_RETRY_S = 0.25
 
 
 def _timer_sync():
     global _sync_scheduled
+    if not writes.writes_allowed() or helper_scene.sync_all():
+        return _REFUSED_RETRY_S  # still scheduled
     _sync_scheduled = False
-    helper_scene.sync_all()
     return None  # run once
 
 

@@ -16,7 +16,7 @@ pointed at each scene's helper in turn would flip with every sync. The render
 handlers record the scene being rendered, which the engine reads."""
 import bpy
 
-from . import compat, extra_renders
+from . import compat, extra_renders, writes
 from .data_edits import set_if_different
 from .helper_lookup import (ENGINE_IDNAME, HELPER_SCENE_PREFIX, MAIN_SCENE_KEY, MAIN_TREE_KEY,
                             MANAGED_NODE_KEY, helper_scene_of, is_helper, main_scene_of,
@@ -96,9 +96,13 @@ def _find_or_make_helper_scene(scene):
                 and not scenes_pointing_at(candidate)):
             return candidate, True
     helper = bpy.data.scenes.new(HELPER_SCENE_PREFIX + scene.name)
-    helper[MAIN_SCENE_KEY] = scene.name
-    # before the managed node asks it for its passes
-    helper.render.engine = ENGINE_IDNAME
+    try:
+        helper[MAIN_SCENE_KEY] = scene.name
+        # before the managed node asks it for its passes
+        helper.render.engine = ENGINE_IDNAME
+    except Exception:  # refused (writes.py): no helper left that nothing finds
+        bpy.data.scenes.remove(helper)
+        raise
     log(f"created helper scene {helper.name!r} for {scene.name!r}")
     return helper, True
 
@@ -258,21 +262,31 @@ def sync(scene):
 
 
 def sync_all():
-    """sync() every scene with HBAO nodes or a hook; drop helpers nobody uses."""
+    """sync() every scene with HBAO nodes or a hook; drop helpers nobody uses.
+    Returns whether Blender refused a write for the moment
+    (writes.writes_refused): a later call finishes the job."""
+    refused = False
     for scene in list(bpy.data.scenes):
-        if extra_renders.is_extra(scene):
-            if not any(extra_renders.scene_of(helper, kind) == scene
-                       for helper in bpy.data.scenes if is_helper(helper)
-                       for kind in extra_renders.KINDS):
-                bpy.data.scenes.remove(scene)
-            continue
-        if is_helper(scene):
-            if not scenes_served_by(scene):
-                bpy.data.scenes.remove(scene)
-            continue
+        try:
+            _sync_or_drop(scene)
+        except Exception as error:  # never break the user's session
+            if writes.writes_refused(error):
+                refused = True
+            else:
+                log(f"could not update the HBAO hook of {scene.name!r}: {error}")
+    return refused
+
+
+def _sync_or_drop(scene):
+    if extra_renders.is_extra(scene):
+        if not any(extra_renders.scene_of(helper, kind) == scene
+                   for helper in bpy.data.scenes if is_helper(helper)
+                   for kind in extra_renders.KINDS):
+            bpy.data.scenes.remove(scene)
+    elif is_helper(scene):
+        if not scenes_served_by(scene):
+            bpy.data.scenes.remove(scene)
+    else:
         tree = compat.compositor_tree(scene)
         if hbao_nodes(tree) or managed_node(tree) is not None:
-            try:
-                sync(scene)
-            except Exception as error:  # never break the user's session
-                log(f"could not update the HBAO hook of {scene.name!r}: {error}")
+            sync(scene)

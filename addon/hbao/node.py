@@ -10,7 +10,7 @@ nothing of the hook: it announces that nodes came or went through
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 
-from . import compat, guard_geometry, parameters, report
+from . import compat, guard_geometry, parameters, report, writes
 from .node_group import (AO_OUTPUT, AO_PASS_INPUT, DEPTH_INPUT, GROUP_TREE_NAME,  # noqa: F401
                          IMAGE_INPUT, IMAGE_OUTPUT, NORMAL_INPUT, VALUE_INPUTS, group_tree,
                          upgrade_group_tree)
@@ -214,7 +214,7 @@ def apply_node_messages():
             try:
                 show_messages(node, statuses[node.name])
             except (AttributeError, RuntimeError) as error:
-                if compat.writes_refused(error):
+                if writes.writes_refused(error):
                     report.return_node_messages(scene_name, statuses)
                     break
                 continue
@@ -233,13 +233,14 @@ def _redraw_node_editors():
 # During an F12 render every render handler runs in the job's thread, where
 # nodes may not be written and no timer may be started; this timer, running
 # while the add-on is enabled, shows what the render thread posted once no
-# render job runs, and keeps the hint lines current. It costs a dictionary
-# check and, per HBAO node of a rendered scene, a comparison per tick.
+# render job runs, and keeps the hint lines current. It costs an operator
+# call (writes.writes_allowed: a tick where Blender refuses writes does
+# nothing) and, per HBAO node of a rendered scene, a comparison per tick.
 _POLL_S = 0.25
 
 
 def _poll_node_messages():
-    if not bpy.app.is_job_running("RENDER"):
+    if not bpy.app.is_job_running("RENDER") and writes.writes_allowed():
         if report.has_node_messages():
             apply_node_messages()
         if any([refresh() for refresh in hint_refreshers]):

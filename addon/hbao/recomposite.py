@@ -22,7 +22,7 @@ import time
 import bpy
 
 from . import (ao_cache, compat, composite_trigger, helper_scene, layer_passes, node,
-               render_record)
+               render_record, writes)
 from . import camera as camera_model
 from .planning import plan_node
 from .report import log
@@ -197,7 +197,7 @@ def _refresh(main, helper, due, in_background):
     try:
         rendered = _render_helper(main, helper, due.record[0], computation.seconds)
     except RuntimeError as error:
-        if not compat.writes_refused(error):
+        if not writes.writes_refused(error):
             raise
         _computing[main.name] = computation  # the next tick renders with its AO
         return False

@@ -8,7 +8,7 @@ operator run from Python stay with the caller), so the operator is modal:
 it reports on its first timer event."""
 import bpy
 
-from . import compat, report
+from . import report, writes
 
 _POLL_S = 0.25
 
@@ -40,7 +40,7 @@ def _poll():
             with bpy.context.temp_override(window=windows[0], screen=windows[0].screen):
                 bpy.ops.hbao.render_report("INVOKE_DEFAULT")
         except (RuntimeError, IndexError, AttributeError) as error:
-            if compat.writes_refused(error):
+            if writes.writes_refused(error):
                 return _POLL_S  # they wait for the next tick
             # never break the artist's session; the console has the messages
             report.log(f"could not show the render's reports in the Info editor: {error}")

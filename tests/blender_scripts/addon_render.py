@@ -201,7 +201,8 @@ for frame in spec.get("frames", [1]):
 
 # After the renders: change the first node step by step and print what its
 # "changed since the last render" line says after each step. A step with
-# "refused" runs its "refresh" and "poll" where Blender refuses writes.
+# "refused" runs its "refresh", "poll", "sync_tick", "sync_all" and
+# "writes_allowed" where Blender refuses writes.
 hinted = next(n for n in tree.nodes if n.bl_idname == "CompositorNodeHBAO")
 for step in spec.get("after_render", []):
     from hbao import node as node_module
@@ -222,6 +223,18 @@ for step in spec.get("after_render", []):
                                       [report.NodeMessage(hinted.name, value, value)])
         elif key == "poll":  # a tick of the add-on's node timer
             timer_action(node_module._poll_node_messages)
+        elif key == "writes_allowed":
+            from hbao import writes
+            print("WRITES ALLOWED", timer_action(writes.writes_allowed), flush=True)
+        elif key == "delete_helper":
+            for helper in helper_scenes():
+                bpy.data.scenes.remove(helper)
+        elif key in ("sync_tick", "sync_all"):  # the sync timer; the sync it runs
+            from hbao import handlers, helper_scene
+            job = handlers._timer_sync if key == "sync_tick" else helper_scene.sync_all
+            print("SYNC", json.dumps({"label": step["label"], "returned": timer_action(job),
+                                      "helpers": sorted(s.name for s in helper_scenes())}),
+                  flush=True)
         elif key == "resolution_percentage":
             scene.render.resolution_percentage = value
             import hbao

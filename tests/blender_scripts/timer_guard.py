@@ -32,8 +32,8 @@ def _refused(error):
     another thread runs a read-only callback (a draw, Cycles' render), it
     refuses them in every thread, the timers' too (a CI run, session 16:
     the quit after an F12 render)."""
-    from hbao import compat
-    return compat.writes_refused(error)
+    from hbao import writes
+    return writes.writes_refused(error)
 
 
 def guarded_timer(step, first_interval):
