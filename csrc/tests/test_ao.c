@@ -644,25 +644,29 @@ TEST_CASE(blur_keeps_depth_edges) {
 }
 
 TEST_CASE(strength_is_a_power) {
+    /* at full and at half resolution, whose output the upsample writes */
     scene_view view;
     float *depth, *normal;
     render_standard_view(corner_scene(), 64, 48, &view, &depth, &normal);
-    hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
-    float *base = run(&p, &view, depth, normal);
-    p.strength = 2.0f;
-    float *squared = run(&p, &view, depth, normal);
-    p.strength = 0.0f;
-    float *none = run(&p, &view, depth, normal);
-    double darkest = 1.0;
-    for (int k = 0; k < view.width * view.height; k++) {
-        CHECK_NEAR(squared[k], base[k] * base[k], 1e-5);
-        CHECK_NEAR(none[k], 1.0f, 0.0);
-        darkest = fmin(darkest, base[k]);
+    for (int half = 0; half <= 1; half++) {
+        hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+        p.half_resolution = half;
+        float *base = run(&p, &view, depth, normal);
+        p.strength = 2.0f;
+        float *squared = run(&p, &view, depth, normal);
+        p.strength = 0.0f;
+        float *none = run(&p, &view, depth, normal);
+        double darkest = 1.0;
+        for (int k = 0; k < view.width * view.height; k++) {
+            CHECK_NEAR(squared[k], base[k] * base[k], 1e-5);
+            CHECK_NEAR(none[k], 1.0f, 0.0);
+            darkest = fmin(darkest, base[k]);
+        }
+        CHECK(darkest < 0.8); /* the corner is occluded at all */
+        free(base);
+        free(squared);
+        free(none);
     }
-    CHECK(darkest < 0.8); /* the corner is occluded at all */
-    free(base);
-    free(squared);
-    free(none);
     free(depth);
     free(normal);
 }

@@ -175,24 +175,26 @@ TEST_CASE(upsample_weights_are_bilinear_on_a_flat_depth) {
 }
 
 /* The normals hbao_compute_normals makes for a w x h image of `depth`
- * through the default camera (into `normal`: 3 w h floats and the
- * padding), from `given` (world space, 3 floats a pixel) or, NULL, from
+ * through `camera` (NULL: the default one; into `normal`: 3 w h floats and
+ * the padding), from `given` (world space, 3 floats a pixel) or, NULL, from
  * the depth; with copy `implementation` on `threads` threads. */
 static void make_normals(hbao_grid *grid, int w, int h, float *depth, float *normal,
-                         const float *given, int implementation, int threads) {
+                         const float *given, const hbao_camera *camera, int implementation,
+                         int threads) {
     memset(grid, 0, sizeof *grid);
     grid->width = w;
     grid->height = h;
     grid->depth = depth;
     grid->normal = normal;
-    const hbao_camera camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
-    hbao_grid_set_projection(grid, &camera, w, h, 1);
+    const hbao_camera default_camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
+    if (camera == NULL) camera = &default_camera;
+    hbao_grid_set_projection(grid, camera, w, h, 1);
     hbao_settings settings;
     memset(&settings, 0, sizeof settings);
     settings.threads = threads;
     settings.implementation = implementation;
     const hbao_channel channel = {given, 3, 3 * (int64_t)w};
-    hbao_compute_normals(&settings, &camera, grid, given ? &channel : NULL, 1);
+    hbao_compute_normals(&settings, camera, grid, given ? &channel : NULL, 1);
 }
 
 /* Pixels whose normal is not within 1e-6 of (x, y, z), among those for
@@ -229,7 +231,7 @@ TEST_CASE(face_normals_keep_to_their_side_of_a_step) {
             if (i == 30) depth[k] = 0.0f;
         }
         hbao_grid grid;
-        make_normals(&grid, w, h, depth, normal, NULL, HBAO_IMPLEMENTATION_SCALAR, 2);
+        make_normals(&grid, w, h, depth, normal, NULL, NULL, HBAO_IMPLEMENTATION_SCALAR, 2);
         CHECK_NEAR(grid.depth_precision,
                    kind ? HBAO_HALF_DEPTH_PRECISION : HBAO_FLOAT_DEPTH_PRECISION, 0.0);
         const int off = normals_off(&grid, NULL, 0.0f, 0.0f, 1.0f);
@@ -257,7 +259,8 @@ TEST_CASE(depth_precision_is_told_from_every_row) {
             for (int k = 0; k < w * h; k++) depth[k] = 1.0f + 0.25f * (float)(k % 7);
             depth[(h - 3) * w + 11] = cases[c].odd_one;
             hbao_grid grid;
-            make_normals(&grid, w, h, depth, normal, NULL, HBAO_IMPLEMENTATION_SCALAR, threads);
+            make_normals(&grid, w, h, depth, normal, NULL, NULL, HBAO_IMPLEMENTATION_SCALAR,
+                         threads);
             if (grid.depth_precision != cases[c].precision)
                 printf("  depth %g on row %d, %d threads: precision %g\n", (double)cases[c].odd_one,
                        h - 3, threads, (double)grid.depth_precision);
@@ -270,16 +273,22 @@ TEST_CASE(depth_precision_is_told_from_every_row) {
  * face the viewer, where it is at least HBAO_MIN_NORMAL_LENGTH long and
  * finite; shorter ones (Blender's Normal pass is 0 where nothing was
  * rendered, and filtering shortens it at edges), 0 and NaN give the face
- * normal from depth. On a plane facing the camera: (0.6, 0, 0.8) where
- * given as that, as twice that or as its opposite (a back face), else
- * (0, 0, 1); in every copy. */
+ * normal from depth. A camera turned a quarter about its view axis (world
+ * y is camera x) sees a plane facing it: (0.6, 0, 0.8) in the camera where
+ * the world normal is (0, 0.6, 0.8), twice that or its opposite (a back
+ * face), else (0, 0, 1); rows longer than the 64-pixel chunks that
+ * given_normals_row works in; every copy. */
 TEST_CASE(given_normals_too_short_give_the_face_normal) {
-    enum { w = 37, h = 9, kinds = 6, usable_kinds = 3 };
+    enum { w = 150, h = 5, kinds = 6, usable_kinds = 3 };
     static float depth[w * h], normal[3 * w * h + HBAO_NORMAL_PADDING], given[3 * w * h];
     static int usable[w * h], unusable[w * h];
-    static const float kind_normal[kinds][3] = {{0.6f, 0.0f, 0.8f},   {1.2f, 0.0f, 1.6f},
-                                                {-0.6f, 0.0f, -0.8f}, {0.03f, 0.0f, 0.04f},
-                                                {0.0f, 0.0f, 0.0f},   {NAN, 0.0f, 1.0f}};
+    /* 0.0594, 0.0792: 0.099 long, just short of HBAO_MIN_NORMAL_LENGTH */
+    static const float kind_normal[kinds][3] = {{0.0f, 0.6f, 0.8f},   {0.0f, 1.2f, 1.6f},
+                                                {0.0f, -0.6f, -0.8f}, {0.0f, 0.0594f, 0.0792f},
+                                                {0.0f, 0.0f, 0.0f},   {0.0f, NAN, 1.0f}};
+    hbao_camera camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
+    static const float quarter_turn[16] = {0, 1, 0, 0, -1, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    memcpy(camera.world_to_camera, quarter_turn, sizeof quarter_turn);
     for (int k = 0; k < w * h; k++) {
         depth[k] = 5.1f;
         const int kind = (k * 7 / 3) % kinds;
@@ -290,7 +299,7 @@ TEST_CASE(given_normals_too_short_give_the_face_normal) {
     for (int implementation = HBAO_IMPLEMENTATION_SCALAR;
          implementation <= HBAO_IMPLEMENTATION_AVX512; implementation++) {
         hbao_grid grid;
-        make_normals(&grid, w, h, depth, normal, given, implementation, 1);
+        make_normals(&grid, w, h, depth, normal, given, &camera, implementation, 1);
         const int off = normals_off(&grid, usable, 0.6f, 0.0f, 0.8f) +
                         normals_off(&grid, unusable, 0.0f, 0.0f, 1.0f);
         if (off) printf("  implementation %d: %d normals off\n", implementation, off);
