@@ -29,9 +29,9 @@ def _widened_output(scene, job, scratch):
     """render_jobs.configure_output, then the frame widened by the guard band."""
     _frame_output(scene, job, scratch)
     if job.get("back_faces"):
-        from hbao import extra_renders
+        from hbao import back_material
         layer = scene.view_layers[0]
-        layer.material_override = extra_renders.back_material()
+        layer.material_override = back_material.get_or_make()
         layer.pass_alpha_threshold = 0.5
         scene.cycles.transparent_max_bounces = 64
     band = job["overscan"]

@@ -293,7 +293,9 @@ def test_timer_waits_while_blender_refuses_writes(run_in_blender, tmp_path, nati
     once met that in the node timer's tick after an F12 render, which then
     raised. The step here runs in a node class's poll, where Blender refuses
     them for real. There the tick shows no message and raises nothing, and
-    the next tick shows it; a refresh does not render and is not taken for
+    the next tick shows it (the tick asks first, writes.py; the messages
+    are kept when a write is refused all the same); a compositing refused
+    waits for the next tick; a refresh does not render and is not taken for
     a failure (which is not tried again until the settings change): the
     next tick renders the new radius (its render clears the status), and
     the AO is the library's. The sync timer that rebuilds a deleted hook
@@ -310,6 +312,11 @@ def test_timer_waits_while_blender_refuses_writes(run_in_blender, tmp_path, nati
                  "refused": True},
                 {"label": "next refresh", "refresh": True},
                 {"label": "rendered again", "render": 1},
+                {"label": "refused apply", "post_message": "again", "apply": True,
+                 "refused": True},
+                {"label": "applied", "apply": True},
+                {"label": "refused composite", "composite_again": True, "refused": True},
+                {"label": "composited", "refresh": True},
                 {"label": "refused sync tick", "delete_helper": True, "sync_tick": True,
                  "refused": True},
                 {"label": "next sync tick", "sync_tick": True},
@@ -317,17 +324,20 @@ def test_timer_waits_while_blender_refuses_writes(run_in_blender, tmp_path, nati
                  "refused": True},
                 {"label": "sync", "sync_all": True}]}
     out, log = render(run_in_blender, tmp_path, spec)
-    said = {}
+    said, waiting = {}, {}
     for line in log.splitlines():
         if line.startswith("HINT "):
             step = json.loads(line[len("HINT "):])
             said[step["label"]] = (step["status"], bool(step["hint"]))
+            waiting[step["label"]] = step["composite_waiting"]
     assert said == {"refused probe": ("", False), "probe": ("", False),
+                    "refused apply": ("", False), "applied": ("again", False),
+                    "refused composite": ("again", False), "composited": ("again", False),
                     "refused tick": ("", False), "next tick": ("posted", False),
                     "refused refresh": ("posted", True), "next refresh": ("", False),
-                    "rendered again": ("", False), "refused sync tick": ("", False),
-                    "next sync tick": ("", False), "refused midway": ("", False),
-                    "sync": ("", False)}, log[-3000:]
+                    "rendered again": ("", False), "refused sync tick": ("again", False),
+                    "next sync tick": ("again", False), "refused midway": ("again", False),
+                    "sync": ("again", False)}, log[-3000:]
     # The sync timer (after an edit in a window) asks first (writes.py) and
     # runs again until the hook is rebuilt; a sync refused midway, after it
     # made the helper scene, removes it again and says so.
@@ -335,10 +345,13 @@ def test_timer_waits_while_blender_refuses_writes(run_in_blender, tmp_path, nati
     syncs = [json.loads(line[len("SYNC "):]) for line in log.splitlines()
              if line.startswith("SYNC ")]
     assert [(sync["returned"], sync["helpers"]) for sync in syncs] == [
-        (0.25, []), (None, helper), (True, []), (False, helper)], log[-3000:]
+        ("again", []), (None, helper), (True, []), (False, helper)], log[-3000:]
     assert "could not update the HBAO hook" not in log, log[-3000:]
+    # A compositing refused waits for the timer's next tick (a refresh).
+    assert {label: names for label, names in waiting.items() if names} == {
+        "refused composite": ["Scene"]}, log[-3000:]
     refreshed = [line.split()[1] for line in log.splitlines() if line.startswith("REFRESHED ")]
-    assert refreshed == ["False", "True"], log[-3000:]
+    assert refreshed == ["False", "True", "False"], log[-3000:]
     probes = [line.split()[2] for line in log.splitlines() if line.startswith("WRITES ALLOWED ")]
     assert probes == ["False", "True"], log[-3000:]
     assert "Traceback" not in log and "could not bring the AO" not in log, log[-3000:]

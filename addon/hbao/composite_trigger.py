@@ -5,6 +5,7 @@ the moment (writes.writes_refused), on the timer's next tick."""
 import bpy
 
 from . import compat, node, writes
+from .report import log
 
 # Main scene names whose compositing Blender refused to start.
 _refused = set()
@@ -30,12 +31,17 @@ def composite_again(main):
 
 
 def retry_refused():
-    """composite_again each scene whose compositing was refused."""
+    """composite_again each scene whose compositing was refused; an error
+    that is not a refusal ends the retries of that scene (logged)."""
     for name in list(_refused):
-        if name in bpy.data.scenes:
-            composite_again(bpy.data.scenes[name])
-        else:
+        if name not in bpy.data.scenes:
             _refused.discard(name)
+            continue
+        try:
+            composite_again(bpy.data.scenes[name])
+        except Exception as error:
+            _refused.discard(name)
+            log(f"could not composite {name!r} again with its new AO: {error}")
 
 
 def forget():

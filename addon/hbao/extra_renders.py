@@ -15,7 +15,7 @@ before the helper's: when the helper's engine runs, their Render Results
 hold this frame's passes (docs/blender-integration.md)."""
 import bpy
 
-from . import compat, guard_geometry
+from . import back_material, compat, guard_geometry, writes
 from .data_edits import set_if_different
 from .report import log
 
@@ -43,7 +43,6 @@ EXTRA_KEY = "hbao_guard_for"
 SCALE_KEY = "hbao_guard_scale"
 CAMERA_SETTINGS = ("type", "lens", "sensor_width", "sensor_height", "sensor_fit", "shift_x",
                    "shift_y", "ortho_scale", "clip_start", "clip_end")
-BACK_MATERIAL = ".HBAO back faces only"
 
 
 def is_extra(scene):
@@ -98,36 +97,17 @@ def _guard_camera(main, guard):
     if camera is None or camera == main.camera:
         data = bpy.data.cameras.new(GUARD.prefix + main.name)
         camera = bpy.data.objects.new(GUARD.prefix + main.name, data)
-        camera.constraints.new("COPY_TRANSFORMS")
-        guard.camera = camera
+
+        def remove():
+            bpy.data.objects.remove(camera)
+            bpy.data.cameras.remove(data)
+        with writes.whole_or_removed(remove):
+            camera.constraints.new("COPY_TRANSFORMS")
+            guard.camera = camera
     constraint = camera.constraints[0] if camera.constraints else None
     if constraint is not None and constraint.target != main.camera:
         constraint.target = main.camera
     return camera
-
-
-# --- the back faces' material -------------------------------------------------
-
-def back_material():
-    """Transparent where a ray meets a front face, opaque at a back face."""
-    material = bpy.data.materials.get(BACK_MATERIAL)
-    if material is not None:
-        return material
-    material = bpy.data.materials.new(BACK_MATERIAL)
-    material.use_nodes = True
-    nodes = material.node_tree.nodes
-    nodes.clear()
-    geometry = nodes.new("ShaderNodeNewGeometry")
-    mix = nodes.new("ShaderNodeMixShader")
-    transparent = nodes.new("ShaderNodeBsdfTransparent")
-    opaque = nodes.new("ShaderNodeBsdfDiffuse")
-    output = nodes.new("ShaderNodeOutputMaterial")
-    links = material.node_tree.links
-    links.new(geometry.outputs["Backfacing"], mix.inputs[0])
-    links.new(transparent.outputs[0], mix.inputs[1])
-    links.new(opaque.outputs[0], mix.inputs[2])
-    links.new(mix.outputs[0], output.inputs["Surface"])
-    return material
 
 
 # --- shared -------------------------------------------------------------------
@@ -153,7 +133,7 @@ def _configure_render(scene, kind):
     set_if_different(view_layer, "use_pass_normal", kind.wants_normal)
     if kind is BACK:
         if view_layer.material_override is None:
-            view_layer.material_override = back_material()
+            view_layer.material_override = back_material.get_or_make()
         set_if_different(view_layer, "pass_alpha_threshold", 0.5)
     if not compat.HAS_COMPOSITING_NODE_GROUP and scene.use_nodes:
         scene.use_nodes = False
@@ -208,9 +188,8 @@ def remove(helper, tree, kind):
         bpy.data.objects.remove(camera)
         if data is not None and data.users == 0:
             bpy.data.cameras.remove(data)
-    material = bpy.data.materials.get(BACK_MATERIAL) if kind is BACK else None
-    if material is not None and material.users == 0:
-        bpy.data.materials.remove(material)
+    if kind is BACK:
+        back_material.remove_if_unused()
     log(f"removed the {kind.name} render of {helper.name!r}")
 
 
@@ -224,8 +203,9 @@ def _sync_kind(main, tree, nodes, helper, view_layer, kind):
     scene = scene_of(helper, kind)
     if scene is None:
         scene = bpy.data.scenes.new(kind.prefix + main.name)
-        scene[EXTRA_KEY] = helper.name
-        helper[kind.helper_key] = scene
+        with writes.whole_or_removed(lambda: bpy.data.scenes.remove(scene)):
+            scene[EXTRA_KEY] = helper.name
+            helper[kind.helper_key] = scene
         log(f"created the {kind.name} render {scene.name!r} for {main.name!r}")
     _configure_render(scene, kind)
     if kind is GUARD:
@@ -248,12 +228,13 @@ def _sync_kind(main, tree, nodes, helper, view_layer, kind):
     node = node_of(tree, kind)
     if node is None:
         node = tree.nodes.new("CompositorNodeRLayers")
-        node[kind.node_key] = True
-        node.name = kind.node_name
-        node.label = f"{kind.node_name} (managed by the HBAO add-on)"
-        node.hide = True
-        node.location = (nodes[0].location.x,
-                         nodes[0].location.y - 520 - 40 * KINDS.index(kind))
+        with writes.whole_or_removed(lambda: tree.nodes.remove(node)):
+            node[kind.node_key] = True
+            node.name = kind.node_name
+            node.label = f"{kind.node_name} (managed by the HBAO add-on)"
+            node.hide = True
+            node.location = (nodes[0].location.x,
+                             nodes[0].location.y - 520 - 40 * KINDS.index(kind))
     if node.scene != scene:
         node.scene = scene
     for output in node.outputs:

@@ -25,6 +25,14 @@ def _timer_sync():
     return None  # run once
 
 
+def _sync_all_or_later():
+    """sync_all() from a handler; what Blender refused waits for the timer."""
+    if helper_scene.sync_all():
+        log("Blender refused to update the HBAO hook just now; it is updated later "
+            "(or at the render)")
+        schedule_sync()
+
+
 def schedule_sync():
     """Sync soon, from the main loop (node callbacks must not edit the tree)."""
     global _sync_scheduled
@@ -35,14 +43,16 @@ def schedule_sync():
 
 @bpy.app.handlers.persistent
 def _on_load_post(*_args):
-    helper_scene.sync_all()
+    global _sync_scheduled
+    _sync_scheduled = False  # opening a file removed the timer, if it waited
+    _sync_all_or_later()
 
 
 @bpy.app.handlers.persistent
 def _on_save_pre(*_args):
     # Background scripts get no timer: the hook is built at the latest here, so
     # that `blender -b file.blend -f N` finds it in the file.
-    helper_scene.sync_all()
+    _sync_all_or_later()
 
 
 @bpy.app.handlers.persistent
@@ -98,6 +108,10 @@ def register():
 
 
 def unregister():
+    global _sync_scheduled
+    if bpy.app.timers.is_registered(_timer_sync):
+        bpy.app.timers.unregister(_timer_sync)
+    _sync_scheduled = False
     if schedule_sync in node.changed_callbacks:
         node.changed_callbacks.remove(schedule_sync)
     for handlers, function in _HANDLERS:

@@ -96,13 +96,10 @@ def _find_or_make_helper_scene(scene):
                 and not scenes_pointing_at(candidate)):
             return candidate, True
     helper = bpy.data.scenes.new(HELPER_SCENE_PREFIX + scene.name)
-    try:
+    with writes.whole_or_removed(lambda: bpy.data.scenes.remove(helper)):
         helper[MAIN_SCENE_KEY] = scene.name
         # before the managed node asks it for its passes
         helper.render.engine = ENGINE_IDNAME
-    except Exception:  # refused (writes.py): no helper left that nothing finds
-        bpy.data.scenes.remove(helper)
-        raise
     log(f"created helper scene {helper.name!r} for {scene.name!r}")
     return helper, True
 
@@ -181,13 +178,15 @@ def _ensure_managed_node(tree, nodes, helper):
     rlayers = managed_node(tree)
     if rlayers is None:
         rlayers = tree.nodes.new("CompositorNodeRLayers")
-        rlayers[MANAGED_NODE_KEY] = True
-        rlayers.name = MANAGED_NODE_NAME
-        rlayers.label = "HBAO passes (managed by the HBAO add-on)"
-        # Below the first HBAO node, clear of the artist's Render Layers node
-        # on its left.
-        rlayers.location = (nodes[0].location.x, nodes[0].location.y - HBAO_NODE_CLEARANCE)
-        rlayers.hide = True
+        with writes.whole_or_removed(lambda: tree.nodes.remove(rlayers)):
+            rlayers[MANAGED_NODE_KEY] = True
+            rlayers.name = MANAGED_NODE_NAME
+            rlayers.label = "HBAO passes (managed by the HBAO add-on)"
+            # Below the first HBAO node, clear of the artist's Render Layers
+            # node on its left.
+            rlayers.location = (nodes[0].location.x,
+                                nodes[0].location.y - HBAO_NODE_CLEARANCE)
+            rlayers.hide = True
     if rlayers.scene != helper:
         rlayers.scene = helper
     # Missing (new node) or unavailable (file loaded before the engine was
@@ -265,16 +264,14 @@ def sync_all():
     """sync() every scene with HBAO nodes or a hook; drop helpers nobody uses.
     Returns whether Blender refused a write for the moment
     (writes.writes_refused): a later call finishes the job."""
-    refused = False
     for scene in list(bpy.data.scenes):
         try:
             _sync_or_drop(scene)
         except Exception as error:  # never break the user's session
             if writes.writes_refused(error):
-                refused = True
-            else:
-                log(f"could not update the HBAO hook of {scene.name!r}: {error}")
-    return refused
+                return True  # the rest waits too
+            log(f"could not update the HBAO hook of {scene.name!r}: {error}")
+    return False
 
 
 def _sync_or_drop(scene):

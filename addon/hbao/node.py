@@ -233,15 +233,15 @@ def _redraw_node_editors():
 # During an F12 render every render handler runs in the job's thread, where
 # nodes may not be written and no timer may be started; this timer, running
 # while the add-on is enabled, shows what the render thread posted once no
-# render job runs, and keeps the hint lines current. It costs an operator
-# call (writes.writes_allowed: a tick where Blender refuses writes does
-# nothing) and, per HBAO node of a rendered scene, a comparison per tick.
+# render job runs (asking writes.writes_allowed first), and keeps the hint
+# lines current. It costs a dictionary check and, per HBAO node of a
+# rendered scene, a comparison per tick.
 _POLL_S = 0.25
 
 
 def _poll_node_messages():
-    if not bpy.app.is_job_running("RENDER") and writes.writes_allowed():
-        if report.has_node_messages():
+    if not bpy.app.is_job_running("RENDER"):
+        if report.has_node_messages() and writes.writes_allowed():
             apply_node_messages()
         if any([refresh() for refresh in hint_refreshers]):
             _redraw_node_editors()

@@ -8,8 +8,12 @@ the whole process, so the add-on's timers meet it by chance
 (docs/blender-integration.md). Creating data-blocks and nodes
 (`bpy.data.scenes.new`, `nodes.new`) is not refused, so a job that creates
 and then writes would leave half-made data behind: it asks writes_allowed()
-first, and a refusal met midway (the flag changed since) leaves its work for
-a later call."""
+first (an operator call, which also brings the view layer up to date: only
+when there is work), every creation is made whole or removed
+(whole_or_removed), and a refusal met midway (the flag changed since)
+leaves the rest of the job for a later call."""
+import contextlib
+
 import bpy
 
 # Each refusal's text, as 3.4 to 5.x word it ("can't" became "cannot" in 5.0).
@@ -45,7 +49,22 @@ def writes_allowed():
         bpy.ops.hbao.writes_probe()
     except RuntimeError as error:  # the poll's failure, or the refusal
         return not writes_refused(error)
+    except AttributeError:  # the add-on being disabled: the probe is gone
+        return True
     return True
+
+
+@contextlib.contextmanager
+def whole_or_removed(remove):
+    """Around the writes that make a data-block or node just created whole
+    and findable (its key first): if one fails (refused, see above),
+    remove() takes the half-made thing away again and the error goes on,
+    so that no later sync meets data it does not know."""
+    try:
+        yield
+    except BaseException:
+        remove()
+        raise
 
 
 def register():

@@ -201,8 +201,8 @@ for frame in spec.get("frames", [1]):
 
 # After the renders: change the first node step by step and print what its
 # "changed since the last render" line says after each step. A step with
-# "refused" runs its "refresh", "poll", "sync_tick", "sync_all" and
-# "writes_allowed" where Blender refuses writes.
+# "refused" runs its "refresh", "poll", "apply", "composite_again",
+# "sync_tick", "sync_all" and "writes_allowed" where Blender refuses writes.
 hinted = next(n for n in tree.nodes if n.bl_idname == "CompositorNodeHBAO")
 for step in spec.get("after_render", []):
     from hbao import node as node_module
@@ -223,6 +223,11 @@ for step in spec.get("after_render", []):
                                       [report.NodeMessage(hinted.name, value, value)])
         elif key == "poll":  # a tick of the add-on's node timer
             timer_action(node_module._poll_node_messages)
+        elif key == "apply":  # what the node timer's tick calls once allowed
+            timer_action(node_module.apply_node_messages)
+        elif key == "composite_again":  # a refresh's last step
+            from hbao import composite_trigger
+            timer_action(lambda: composite_trigger.composite_again(scene))
         elif key == "writes_allowed":
             from hbao import writes
             print("WRITES ALLOWED", timer_action(writes.writes_allowed), flush=True)
@@ -232,7 +237,10 @@ for step in spec.get("after_render", []):
         elif key in ("sync_tick", "sync_all"):  # the sync timer; the sync it runs
             from hbao import handlers, helper_scene
             job = handlers._timer_sync if key == "sync_tick" else helper_scene.sync_all
-            print("SYNC", json.dumps({"label": step["label"], "returned": timer_action(job),
+            returned = timer_action(job)
+            if key == "sync_tick" and returned == handlers._REFUSED_RETRY_S:
+                returned = "again"
+            print("SYNC", json.dumps({"label": step["label"], "returned": returned,
                                       "helpers": sorted(s.name for s in helper_scenes())}),
                   flush=True)
         elif key == "resolution_percentage":
@@ -253,8 +261,11 @@ for step in spec.get("after_render", []):
             bpy.ops.render.render(write_still=True)
         elif key not in ("label", "refused"):
             setattr(hinted, key, value)
+    from hbao import composite_trigger
     print("HINT", json.dumps({"label": step["label"], "status": hinted.status,
-                              "hint": render_record.changed_since_render(hinted)}))
+                              "hint": render_record.changed_since_render(hinted),
+                              # scenes whose compositing waits for a tick
+                              "composite_waiting": sorted(composite_trigger._refused)}))
 for node in tree.nodes:  # what each node's status line says after the renders
     if node.bl_idname == "CompositorNodeHBAO":
         print("STATUS", json.dumps({"node": node.name, "status": node.status}))

@@ -15,6 +15,7 @@ import bpy
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(REPO, "scripts"))
 import blender_scenes  # noqa: E402  (needs the path above)
+from hbao import writes  # noqa: E402  (the scripts run with the add-on enabled)
 
 
 def corner_scene_with_node(out_dir):
@@ -27,7 +28,7 @@ def corner_scene_with_node(out_dir):
 
 class F12Job:
     def __init__(self):
-        self.ended = False
+        self.ended, self.started = False, False
         bpy.app.handlers.render_complete.append(self._end)
         bpy.app.handlers.render_cancel.append(self._end)
 
@@ -35,10 +36,25 @@ class F12Job:
         self.ended = True
 
     def start(self):
-        self.ended = False
-        bpy.ops.render.render("INVOKE_DEFAULT")
+        """Start the render; where Blender refuses the operator for the
+        moment (hbao.writes), finished() asks again."""
+        self.ended, self.started = False, False
+        self._try_start()
+
+    def _try_start(self):
+        try:
+            bpy.ops.render.render("INVOKE_DEFAULT")
+        except RuntimeError as error:
+            if not writes.writes_refused(error):
+                raise
+            print("F12: Blender refused the render for now:", error, flush=True)
+            return
+        self.started = True
 
     def finished(self):
         """Whether the job started last has ended (its handlers ran and no
         render job runs any more)."""
+        if not self.started:
+            self._try_start()
+            return False
         return self.ended and not bpy.app.is_job_running("RENDER")

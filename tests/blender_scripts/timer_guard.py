@@ -12,6 +12,7 @@ import os
 import traceback
 
 import bpy
+from hbao import writes  # the scripts run with the add-on enabled
 
 
 def give_up(message):
@@ -23,8 +24,10 @@ def give_up(message):
     os._exit(3)
 
 
-# How soon a step or a quit that Blender refused is tried again.
+# How soon a step or a quit that Blender refused is tried again, and how
+# often in a row before the script gives up (40 s).
 REFUSED_RETRY_S = 0.25
+REFUSED_RETRIES = 160
 
 
 def _refused(error):
@@ -32,7 +35,6 @@ def _refused(error):
     another thread runs a read-only callback (a draw, Cycles' render), it
     refuses them in every thread, the timers' too (a CI run, session 16:
     the quit after an F12 render)."""
-    from hbao import writes
     return writes.writes_refused(error)
 
 
@@ -41,12 +43,19 @@ def guarded_timer(step, first_interval):
     Blender (exit status 1, the traceback printed) instead of unregistering
     the timer silently and leaving Blender idle until the test's timeout.
     A step that Blender refused a write or an operator runs again
-    REFUSED_RETRY_S later (steps change their state after their writes)."""
+    REFUSED_RETRY_S later, up to REFUSED_RETRIES times in a row: a step
+    changes its state only after its writes and operators, or makes them
+    once (f12_job.F12Job asks for its render again itself)."""
+    refusals = [0]
+
     def guarded():
         try:
-            return step()
+            interval = step()
+            refusals[0] = 0
+            return interval
         except Exception as error:
-            if _refused(error):
+            if _refused(error) and refusals[0] < REFUSED_RETRIES:
+                refusals[0] += 1
                 print("STEP: Blender refused it for now:", error, flush=True)
                 return REFUSED_RETRY_S
             print("SCRIPT ERROR in the timer:", traceback.format_exc(), sep="\n", flush=True)

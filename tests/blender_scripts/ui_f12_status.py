@@ -39,7 +39,9 @@ job = f12_job.F12Job()
 def tick():
     now = time.monotonic()
     if state["phase"] == "start":
-        STEPS[state["step"]]()
+        if state.get("changed") != state["step"]:  # once, should the step run again
+            STEPS[state["step"]]()
+            state["changed"] = state["step"]
         state.update(phase="render", since=now)
         print(f"F12: render {state['step']}", flush=True)
         job.start()

@@ -139,9 +139,13 @@ def run_renders():
     area = state.get("area")
     if state["started"] is None:
         name, change = RENDERS[state["index"]]
-        change()
-        state.update(started=time.monotonic(), done=False, ended=None)
+        if state.get("changed") != state["index"]:  # once, should the step run again
+            change()
+            state["changed"] = state["index"]
+        state["done"] = False
+        # refused (timer_guard runs the step again), the state stays as it was
         print("UI: render", name, bpy.ops.render.render("INVOKE_DEFAULT"), flush=True)
+        state.update(started=time.monotonic(), ended=None)
         return 0.25
     if not state["done"] or bpy.app.is_job_running("RENDER"):
         if time.monotonic() - state["started"] > RENDER_TIMEOUT_S:
