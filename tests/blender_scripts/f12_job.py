@@ -15,7 +15,8 @@ import bpy
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(REPO, "scripts"))
 import blender_scenes  # noqa: E402  (needs the path above)
-from hbao import writes  # noqa: E402  (the scripts run with the add-on enabled)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import timer_guard  # noqa: E402
 
 
 def corner_scene_with_node(out_dir):
@@ -42,14 +43,8 @@ class F12Job:
         self._try_start()
 
     def _try_start(self):
-        try:
-            bpy.ops.render.render("INVOKE_DEFAULT")
-        except RuntimeError as error:
-            if not writes.writes_refused(error):
-                raise
-            print("F12: Blender refused the render for now:", error, flush=True)
-            return
-        self.started = True
+        self.started = not timer_guard.refused_for_now(
+            lambda: bpy.ops.render.render("INVOKE_DEFAULT"), "F12")
 
     def finished(self):
         """Whether the job started last has ended (its handlers ran and no

@@ -30,12 +30,19 @@ REFUSED_RETRY_S = 0.25
 REFUSED_RETRIES = 160
 
 
-def _refused(error):
-    """Whether Blender refused a write or an operator for the moment: while
-    another thread runs a read-only callback (a draw, Cycles' render), it
-    refuses them in every thread, the timers' too (a CI run, session 16:
-    the quit after an F12 render)."""
-    return writes.writes_refused(error)
+def refused_for_now(operation, label):
+    """Calls operation() (an operator); True, after saying so, when Blender
+    refused it for the moment: while another thread runs a read-only
+    callback (a draw, Cycles' render) it refuses operators in every thread,
+    the timers' too (a CI run, session 16: the quit after an F12 render)."""
+    try:
+        operation()
+    except RuntimeError as error:
+        if not writes.writes_refused(error):
+            raise
+        print(f"{label}: Blender refused it for now:", error, flush=True)
+        return True
+    return False
 
 
 def guarded_timer(step, first_interval):
@@ -54,7 +61,7 @@ def guarded_timer(step, first_interval):
             refusals[0] = 0
             return interval
         except Exception as error:
-            if _refused(error) and refusals[0] < REFUSED_RETRIES:
+            if writes.writes_refused(error) and refusals[0] < REFUSED_RETRIES:
                 refusals[0] += 1
                 print("STEP: Blender refused it for now:", error, flush=True)
                 return REFUSED_RETRY_S
@@ -74,20 +81,9 @@ def quit_blender():
     runs)."""
     bpy.app.timers.register(lambda: give_up("QUIT: Blender did not end"),
                             first_interval=QUIT_GRACE_S)
-    if _quit_refused():
+    if refused_for_now(bpy.ops.wm.quit_blender, "QUIT"):
         bpy.app.timers.register(_quit_again, first_interval=REFUSED_RETRY_S)
 
 
-def _quit_refused():
-    try:
-        bpy.ops.wm.quit_blender()
-    except RuntimeError as error:
-        if not _refused(error):
-            raise
-        print("QUIT: Blender refused it for now:", error, flush=True)
-        return True
-    return False
-
-
 def _quit_again():
-    return REFUSED_RETRY_S if _quit_refused() else None
+    return REFUSED_RETRY_S if refused_for_now(bpy.ops.wm.quit_blender, "QUIT") else None
