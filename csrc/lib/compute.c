@@ -8,7 +8,7 @@
 
 /* The limits are hbao_params_resolve()'s (params.c); this only derives the
  * pipeline's settings from the resolved values. */
-static hbao_result make_settings(const hbao_params *params, hbao_settings *s) {
+hbao_result hbao_settings_make(const hbao_params *params, hbao_settings *s) {
     hbao_params p;
     const hbao_result resolved = hbao_params_resolve(params, &p, NULL);
     if (resolved != HBAO_SUCCESS) return resolved;
@@ -163,7 +163,7 @@ hbao_result hbao_compute_layers(const hbao_params *params, const hbao_camera *ca
         !stride_fits(1, ao_row_stride, width, height, 1))
         return HBAO_ERROR_INVALID_STRIDE;
     hbao_settings s;
-    hbao_result result = make_settings(params, &s);
+    hbao_result result = hbao_settings_make(params, &s);
     if (result != HBAO_SUCCESS) return result;
     result = hbao_validate_camera(camera);
     if (result != HBAO_SUCCESS) return result;

@@ -225,6 +225,10 @@ void *hbao_scratch_take(size_t bytes);
 void hbao_scratch_give(void *memory);
 int hbao_available_cores(void);
 
+/* compute.c: the pipeline's settings from params (resolved within their
+ * limits, hbao_params_resolve), or the error that hbao_compute returns. */
+hbao_result hbao_settings_make(const hbao_params *params, hbao_settings *s);
+
 /* normals.c: grid->normal from the given normals (world space, sampled at
  * full-resolution pixel (scale*i, scale*j)) or reconstructed from depth. */
 void hbao_compute_normals(const hbao_settings *settings, const hbao_camera *camera, hbao_grid *grid,

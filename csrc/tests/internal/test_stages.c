@@ -127,6 +127,162 @@ TEST_CASE(blur_copies_agree_on_background_at_every_sharpness) {
 #endif
 }
 
+/* The blur's range weight F (docs/algorithm.md, "After sampling"), in
+ * double, from the numbers the page gives: the exponent e = d^2 +
+ * 8 (1 - min(n.c, 1)) with d = (sharpness / z_c)(z - z_c), and F(e) =
+ * (1 - e / 16)^16 below 16, 0 from 16 on. */
+static double documented_range_weight(double sharpness, double zc, double z, const float *nc,
+                                      const float *n) {
+    const double d = sharpness / zc * (z - zc);
+    double facing = (double)n[0] * nc[0] + (double)n[1] * nc[1] + (double)n[2] * nc[2];
+    if (facing > 1.0) facing = 1.0;
+    const double e = d * d + 8.0 * (1.0 - facing);
+    return e < 16.0 ? pow(1.0 - e / 16.0, 16.0) : 0.0;
+}
+
+/* One pass of the documented blur over the grid, in double: along the rows
+ * (step 1) or down the columns (step w), taps k = -r..r inside the image,
+ * each weighing exp(-k^2 / (2 sigma^2)) F [z > 0] with sigma = (r + 1) / 2,
+ * the centre 1; background centres give 1. */
+static void documented_blur_pass(const hbao_grid *grid, int radius, double sharpness, int along_row,
+                                 const double *in, double *out) {
+    const int w = grid->width, h = grid->height;
+    const double sigma = 0.5 * (radius + 1);
+    for (int j = 0; j < h; j++) {
+        for (int i = 0; i < w; i++) {
+            const double zc = grid->depth[j * w + i];
+            if (!(zc > 0.0)) {
+                out[j * w + i] = 1.0;
+                continue;
+            }
+            float nc[3], n[3];
+            hbao_grid_normal_at(grid, i, j, nc);
+            double sum = in[j * w + i], weight_sum = 1.0;
+            for (int k = -radius; k <= radius; k++) {
+                const int x = along_row ? i + k : i, y = along_row ? j : j + k;
+                if (k == 0 || x < 0 || x >= w || y < 0 || y >= h) continue;
+                const double z = grid->depth[y * w + x];
+                if (!(z > 0.0)) continue;
+                hbao_grid_normal_at(grid, x, y, n);
+                const double weight = exp(-(double)(k * k) / (2.0 * sigma * sigma)) *
+                                      documented_range_weight(sharpness, zc, z, nc, n);
+                sum += weight * in[y * w + x];
+                weight_sum += weight;
+            }
+            out[j * w + i] = sum / weight_sum;
+        }
+    }
+}
+
+/* The blur gives what docs/algorithm.md writes, to float rounding: rows,
+ * then columns, on a grid whose depths (2 to 2.1, a step to 3, a column of
+ * background) and normals (up to ~35 degrees apart) give each tap a weight
+ * between 0 and 1, at the default sharpness and a high one, radii 2 (blur
+ * 5) and 7 (blur 15); every copy, on 1 and 2 threads. The tolerance, 2e-5,
+ * is float rounding over 31 taps of AO in [0, 1] (the copies' floats
+ * differ from double by ~1e-6); a tap left out or added, a normal
+ * sharpness of 7 for 8 or a sigma off by half a pixel moves pixels by
+ * more than 1e-3. */
+TEST_CASE(blur_follows_its_formula) {
+    enum { w = 61, h = 37 };
+    static float depth[w * h], normal[3 * w * h + HBAO_NORMAL_PADDING], raw[w * h], out[w * h];
+    static double in[w * h], rows[w * h], expected[w * h];
+    hbao_grid grid;
+    memset(&grid, 0, sizeof grid);
+    grid.width = w;
+    grid.height = h;
+    grid.depth = depth;
+    grid.normal = normal;
+    uint32_t state = 77u;
+    for (int j = 0; j < h; j++) {
+        for (int i = 0; i < w; i++) {
+            const int k = j * w + i;
+            depth[k] = 2.0f + (float)(next_random(&state) % 100) / 1000.0f;
+            if (i > 40 && j > 20) depth[k] = 3.0f;
+            if (i == 13) depth[k] = 0.0f;
+            /* a normal tilted up to 0.35 rad from the view axis, as a face
+             * seen from the camera */
+            const float a = (float)(next_random(&state) % 1000) / 1000.0f * 6.2831853f;
+            const float t = (float)(next_random(&state) % 1000) / 1000.0f * 0.35f;
+            const float n[3] = {sinf(t) * cosf(a), sinf(t) * sinf(a), cosf(t)};
+            for (int c = 0; c < 3; c++) hbao_grid_normal_row(&grid, j, c)[i] = n[c];
+            raw[k] = (float)(next_random(&state) % 1000) / 1000.0f;
+            in[k] = raw[k];
+        }
+    }
+    static const float sharpness[] = {32.0f, 200.0f};
+    static const int radii[] = {2, 7};
+    for (size_t s = 0; s < sizeof sharpness / sizeof sharpness[0]; s++) {
+        for (size_t r = 0; r < sizeof radii / sizeof radii[0]; r++) {
+            documented_blur_pass(&grid, radii[r], sharpness[s], 1, in, rows);
+            documented_blur_pass(&grid, radii[r], sharpness[s], 0, rows, expected);
+            int changed = 0;
+            for (int k = 0; k < w * h; k++) changed += fabs(expected[k] - in[k]) > 0.05;
+            CHECK(changed > w * h / 2); /* the taps weigh something */
+            for (int implementation = HBAO_IMPLEMENTATION_SCALAR;
+                 implementation <= HBAO_IMPLEMENTATION_AVX512; implementation++) {
+                for (int threads = 1; threads <= 2; threads++) {
+                    hbao_settings settings;
+                    memset(&settings, 0, sizeof settings);
+                    settings.blur_radius = settings.grid_blur_radius = radii[r];
+                    settings.blur_sharpness = sharpness[s];
+                    settings.strength = 1.0f;
+                    settings.threads = threads;
+                    settings.implementation = implementation;
+                    CHECK_RESULT(hbao_finish(&settings, &grid, raw, depth, w, h, out, w),
+                                 HBAO_SUCCESS);
+                    int off = 0;
+                    double worst = 0.0;
+                    for (int k = 0; k < w * h; k++) {
+                        const double error = fabs(out[k] - expected[k]);
+                        off += !(error <= 2e-5);
+                        worst = error > worst ? error : worst;
+                    }
+                    if (off)
+                        printf("  sharpness %g, radius %d, implementation %d, %d threads: %d "
+                               "pixels off, worst %.3g\n",
+                               (double)sharpness[s], radii[r], implementation, threads, off, worst);
+                    CHECK(off == 0);
+                }
+            }
+        }
+    }
+}
+
+/* A blur of size b reaches r = (b - 1) / 2 pixels each side (none below
+ * 2); at half resolution its taps on the half grid, 2 full pixels apart,
+ * reach as far: the fewest whose reach is at least r (docs/algorithm.md,
+ * r_grid = (r + 1) / 2), for every size up to the limit. */
+TEST_CASE(half_resolution_blur_reaches_as_far) {
+    for (int size = 0; size <= HBAO_MAX_BLUR_SIZE; size++) {
+        hbao_params params = HBAO_PARAMS_DEFAULT_INITIALIZER;
+        params.blur_size = size;
+        hbao_settings full, half;
+        CHECK_RESULT(hbao_settings_make(&params, &full), HBAO_SUCCESS);
+        params.half_resolution = 1;
+        CHECK_RESULT(hbao_settings_make(&params, &half), HBAO_SUCCESS);
+        const int reach = size >= 2 ? (size - 1) / 2 : 0;
+        const int taps = half.grid_blur_radius;
+        const int ok = full.grid_blur_radius == reach && 2 * taps >= reach &&
+                       (taps == 0 || 2 * (taps - 1) < reach);
+        if (!ok)
+            printf("  blur %d: %d taps at full resolution, %d on the half grid\n", size,
+                   full.grid_blur_radius, taps);
+        CHECK(ok);
+    }
+}
+
+/* The half grid of a width x height image: ceil(width / 2) x
+ * ceil(height / 2) pixels, with depths `depth` (no normals). */
+static hbao_grid half_grid_of(int width, int height, float *depth) {
+    hbao_grid half;
+    memset(&half, 0, sizeof half);
+    half.width = (width + 1) / 2;
+    half.height = (height + 1) / 2;
+    half.depth = depth;
+    return half;
+}
+
 /* The half-resolution upsample (hbao_upsample_row) on a flat depth, where
  * only the bilinear weights count: a full-resolution pixel on a half-grid
  * column (and row) takes that sample's AO, one between two the mean of
@@ -140,11 +296,7 @@ TEST_CASE(upsample_weights_are_bilinear_on_a_flat_depth) {
     static float half_ao[max_width * max_height], row[max_width];
     for (size_t size = 0; size < sizeof sizes / sizeof sizes[0]; size++) {
         const int width = sizes[size][0], height = sizes[size][1];
-        hbao_grid half;
-        memset(&half, 0, sizeof half);
-        half.width = (width + 1) / 2;
-        half.height = (height + 1) / 2;
-        half.depth = half_depth;
+        const hbao_grid half = half_grid_of(width, height, half_depth);
         for (int k = 0; k < width * height; k++) full_depth[k] = 2.0f;
         for (int r = 0; r < half.height; r++) {
             for (int k = 0; k < half.width; k++) {
@@ -171,6 +323,115 @@ TEST_CASE(upsample_weights_are_bilinear_on_a_flat_depth) {
                        wrong);
             CHECK(wrong == 0);
         }
+    }
+}
+
+/* The documented upsample (docs/algorithm.md, "After sampling") of full
+ * pixel (i, j) at depth z, in double: the half-grid samples at
+ * floor(i/2) + {0, i odd} x floor(j/2) + {0, j odd} with their bilinear
+ * weights (all on the left or upper one where there is no column or row
+ * beyond) times exp(-(16 |z_s - z| / z)^2), background samples and those
+ * of bilinear weight 0 left out; where the weights sum to at most 1e-6, the
+ * AO of the sample nearest in depth (the first of equals, in the order
+ * left top, right top, left bottom, right bottom), 1 if none. Sets *sum to
+ * the weights' sum. */
+static double documented_upsample(const hbao_grid *half, const float *half_ao, int i, int j,
+                                  double z, double *sum) {
+    *sum = 0.0;
+    if (!(z > 0.0)) return 1.0;
+    const int x0 = i / 2, y0 = j / 2;
+    const int has_right = (i & 1) && x0 + 1 < half->width,
+              has_below = (j & 1) && y0 + 1 < half->height;
+    double weighted = 0.0, nearest_ao = 1.0, nearest = INFINITY;
+    for (int c = 0; c < 4; c++) {
+        const int dx = c & 1, dy = c >> 1;
+        const double bx = has_right ? 0.5 : (dx ? 0.0 : 1.0);
+        const double by = has_below ? 0.5 : (dy ? 0.0 : 1.0);
+        const int at = (y0 + (dy && has_below)) * half->width + x0 + (dx && has_right);
+        const double zs = half->depth[at];
+        if (!(bx * by > 0.0) || !(zs > 0.0)) continue;
+        const double difference = fabs(zs - z) / z;
+        const double weight = bx * by * exp(-(16.0 * difference) * (16.0 * difference));
+        weighted += weight * half_ao[at];
+        *sum += weight;
+        if (difference < nearest) {
+            nearest = difference;
+            nearest_ao = half_ao[at];
+        }
+    }
+    const double ao = *sum > 1e-6 ? weighted / *sum : nearest_ao;
+    return ao < 0.0 ? 0.0 : (ao > 1.0 ? 1.0 : ao);
+}
+
+/* The upsample weighs depth as docs/algorithm.md writes, to 1e-5 (float
+ * rounding and hbao_exp_negative's 3.2e-6): full depths 0.7 to 1.3 times
+ * their half-grid sample's, in front and behind, and some background on
+ * both grids, so that pixels blend their samples, fall back to the one
+ * nearest in depth (where a sample in front is farther in relative depth
+ * than one behind; the first of samples tied in depth), or are 1; odd and
+ * even sizes, every copy. Pixels whose
+ * weights sum to within 1 % of the fallback's 1e-6 are not compared (float
+ * and double may take different sides). A sharpness of 15 for 16, a
+ * signed depth difference or a fallback at 1e-5 or 1e-7 moves pixels by
+ * more than 0.05. */
+TEST_CASE(upsample_weighs_depth_as_documented) {
+    enum { max_width = 34, max_height = 22 };
+    static const int sizes[][2] = {{33, 21}, {34, 22}};
+    static float full_depth[max_width * max_height], half_depth[max_width * max_height];
+    static float half_ao[max_width * max_height], row[max_width];
+    uint32_t state = 5u;
+    for (size_t size = 0; size < sizeof sizes / sizeof sizes[0]; size++) {
+        const int width = sizes[size][0], height = sizes[size][1];
+        const hbao_grid half = half_grid_of(width, height, half_depth);
+        /* the upper half's depths by column only: samples above each other
+         * tie in depth */
+        const int tied_rows = half.height / 2;
+        for (int k = 0; k < half.width * half.height; k++) {
+            const int pattern = k / half.width < tied_rows ? k % half.width : k;
+            half_depth[k] =
+                next_random(&state) % 12 == 0 ? 0.0f : 1.0f + 0.02f * (float)(pattern % 5);
+            half_ao[k] = (float)(next_random(&state) % 1000) / 1000.0f;
+        }
+        for (int j = 0; j < height; j++) {
+            for (int i = 0; i < width; i++) {
+                const int k = j / 2 * half.width + i / 2;
+                const int pattern = j / 2 < tied_rows ? i / 2 : k;
+                const float base = 1.0f + 0.02f * (float)(pattern % 5);
+                const float u = (float)(next_random(&state) % 1000) / 1000.0f * 0.6f - 0.3f;
+                full_depth[j * width + i] =
+                    next_random(&state) % 15 == 0 ? 0.0f : base * (1.0f + u);
+            }
+        }
+        int blended = 0, fallen_back = 0, near_threshold = 0;
+        for (int implementation = HBAO_IMPLEMENTATION_SCALAR;
+             implementation <= HBAO_IMPLEMENTATION_AVX512; implementation++) {
+            const int copy = hbao_finish_implementation(implementation);
+            int off = 0;
+            for (int j = 0; j < height; j++) {
+                hbao_upsample_row(copy, &half, half_ao, full_depth, width, j, row);
+                for (int i = 0; i < width; i++) {
+                    double sum;
+                    const double expected =
+                        documented_upsample(&half, half_ao, i, j, full_depth[j * width + i], &sum);
+                    if (fabs(sum - 1e-6) < 1e-8) {
+                        near_threshold += implementation == HBAO_IMPLEMENTATION_SCALAR;
+                        continue;
+                    }
+                    if (implementation == HBAO_IMPLEMENTATION_SCALAR && sum > 0.0) {
+                        blended += sum > 1e-6 && sum < 1e-3;
+                        fallen_back += sum <= 1e-6;
+                    }
+                    off += !(fabs(row[i] - expected) <= 1e-5);
+                }
+            }
+            if (off)
+                printf("  %dx%d, implementation %d: %d pixels off\n", width, height, implementation,
+                       off);
+            CHECK(off == 0);
+        }
+        printf("  %dx%d: %d pixels blend weights below 1e-3, %d fall back, %d not compared\n",
+               width, height, blended, fallen_back, near_threshold);
+        CHECK(blended >= 10 && fallen_back >= 10 && near_threshold <= width * height / 100);
     }
 }
 
@@ -308,7 +569,9 @@ TEST_CASE(given_normals_too_short_give_the_face_normal) {
 }
 
 TEST_MAIN(TEST_ENTRY(blur_copies_agree_on_background_at_every_sharpness),
+          TEST_ENTRY(blur_follows_its_formula), TEST_ENTRY(half_resolution_blur_reaches_as_far),
           TEST_ENTRY(upsample_weights_are_bilinear_on_a_flat_depth),
+          TEST_ENTRY(upsample_weighs_depth_as_documented),
           TEST_ENTRY(face_normals_keep_to_their_side_of_a_step),
           TEST_ENTRY(depth_precision_is_told_from_every_row),
           TEST_ENTRY(given_normals_too_short_give_the_face_normal))
