@@ -568,10 +568,72 @@ TEST_CASE(given_normals_too_short_give_the_face_normal) {
     }
 }
 
+/* A given normal is turned to face the viewer along the pixel's own ray:
+ * from the eye through the pixel in a perspective view (here shifted, so
+ * that rays lean up to ~40 degrees), along the view axis in an
+ * orthographic one. Normals 1.1 degrees either side of edge-on to the ray
+ * (a tangent of the ray plus or minus 0.02 times the ray's direction
+ * towards the eye) keep their side or flip; a view vector leant by 0.1
+ * would decide many of them the other way. Every copy; rays from the
+ * documented pixel mapping (hbao_camera_view). */
+TEST_CASE(given_normals_face_the_viewer_along_its_ray) {
+    enum { w = 150, h = 7 };
+    static float depth[w * h], normal[3 * w * h + HBAO_NORMAL_PADDING], given[3 * w * h];
+    static float expected[3 * w * h];
+    for (int projection = 0; projection < 2; projection++) {
+        hbao_camera camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
+        camera.projection = projection ? HBAO_PROJECTION_ORTHOGRAPHIC : HBAO_PROJECTION_PERSPECTIVE;
+        camera.shift_x = 0.4f;
+        camera.shift_y = -0.3f;
+        hbao_view view;
+        CHECK_RESULT(hbao_camera_view(&camera, w, h, &view), HBAO_SUCCESS);
+        for (int k = 0; k < w * h; k++) {
+            const int i = k % w, j = k / w, kind = k % 4;
+            depth[k] = 4.0f + 0.01f * (float)(k % 13);
+            const double x = view.origin_x + (i + 0.5) * view.pixel_size_x;
+            const double y = view.origin_y + (h - 1 - j + 0.5) * view.pixel_size_y;
+            /* towards the eye: -P / |P|, P = z (x, y, -1); or the view axis */
+            double v[3] = {projection ? 0.0 : -x, projection ? 0.0 : -y, 1.0};
+            const double v_length = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+            for (int c = 0; c < 3; c++) v[c] /= v_length;
+            /* a tangent: v x (0, 1, 0) or v x (1, 0, 0) */
+            const double t[3] = {kind < 2 ? -v[2] : 0.0, kind < 2 ? 0.0 : v[2],
+                                 kind < 2 ? v[0] : -v[1]};
+            const double sign = kind % 2 ? -1.0 : 1.0;
+            double n[3], length = 0.0;
+            for (int c = 0; c < 3; c++) {
+                n[c] = t[c] + sign * 0.02 * v[c];
+                length += n[c] * n[c];
+            }
+            length = sqrt(length);
+            for (int c = 0; c < 3; c++) {
+                given[3 * k + c] = (float)n[c];
+                expected[3 * k + c] = (float)(sign * n[c] / length);
+            }
+        }
+        for (int implementation = HBAO_IMPLEMENTATION_SCALAR;
+             implementation <= HBAO_IMPLEMENTATION_AVX512; implementation++) {
+            hbao_grid grid;
+            make_normals(&grid, w, h, depth, normal, given, &camera, implementation, 2);
+            int off = 0;
+            for (int k = 0; k < w * h; k++) {
+                float n[3];
+                hbao_grid_normal_at(&grid, k % w, k / w, n);
+                for (int c = 0; c < 3; c++) off += !(fabsf(n[c] - expected[3 * k + c]) <= 1e-5f);
+            }
+            if (off)
+                printf("  %s, implementation %d: %d components off\n",
+                       projection ? "orthographic" : "perspective", implementation, off);
+            CHECK(off == 0);
+        }
+    }
+}
+
 TEST_MAIN(TEST_ENTRY(blur_copies_agree_on_background_at_every_sharpness),
           TEST_ENTRY(blur_follows_its_formula), TEST_ENTRY(half_resolution_blur_reaches_as_far),
           TEST_ENTRY(upsample_weights_are_bilinear_on_a_flat_depth),
           TEST_ENTRY(upsample_weighs_depth_as_documented),
           TEST_ENTRY(face_normals_keep_to_their_side_of_a_step),
           TEST_ENTRY(depth_precision_is_told_from_every_row),
-          TEST_ENTRY(given_normals_too_short_give_the_face_normal))
+          TEST_ENTRY(given_normals_too_short_give_the_face_normal),
+          TEST_ENTRY(given_normals_face_the_viewer_along_its_ray))
