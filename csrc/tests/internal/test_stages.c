@@ -2,8 +2,9 @@
 /* The library's stages tested from inside, on inputs that hbao_compute()
  * cannot be made to produce (the blur, hbao_finish, on a raw AO of the
  * test's choosing) or against answers that its AO would hide (the
- * upsample's weights, the normals). Built from the library's sources
- * (CMakeLists.txt). */
+ * upsample's weights, the blur's and the upsample's formulas, the normals,
+ * the settings hbao_compute derives). Linked with the library's own objects
+ * (CMakeLists.txt, hbao_add_internal_executable). */
 #include <stdint.h>
 
 #include "internal_finish.h"
