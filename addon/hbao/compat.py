@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """The few Blender API differences between 3.x, 4.x and 5.x, in one place."""
 import os
+import sys
 
 import bpy
 
@@ -25,6 +26,14 @@ VALUE_NODE_IDNAMES = ("CompositorNodeValue", "ShaderNodeValue")
 # Image settings that saving a Render Result reads, in the order they must be
 # restored: 5.0's media_type decides which file formats are valid, so it
 # comes before file_format, and the format before its options.
+# 3.4 frees a node type that Python unregisters while an evaluated copy of a
+# tree (the view layer's depsgraph keeps one after any evaluation, a render
+# too) still holds nodes of that type: freeing the copy later reads the
+# freed type. Blender disables every add-on before it frees its data as it
+# quits, so each quit after a render with an HBAO node read freed memory
+# (a crash under MALLOC_PERTURB_ or --debug-memory). 4.5 and 5.x are
+# unaffected; the versions between are untested and treated as 3.4.
+NODE_TYPE_FREED_UNDER_EVALUATED_COPIES = VERSION < (4, 5, 0)
 SAVED_IMAGE_SETTINGS = ("media_type", "file_format", "color_mode", "color_depth", "exr_codec",
                         "use_exr_interleave", "use_preview", "use_zbuffer", "views_format")
 
@@ -47,6 +56,18 @@ def version_message():
                 f"{_version_text(VERSION)}. Trying anyway: if renders show no AO, check the "
                 f"console for HBAO messages.")
     return None
+
+
+def blender_is_quitting():
+    """Whether the caller runs inside Blender's disabling of every add-on
+    as it quits (addon_utils.disable_all, which nothing else calls)."""
+    frame = sys._getframe(1)
+    while frame is not None:
+        if (frame.f_code.co_name == "disable_all"
+                and frame.f_globals.get("__name__") == "addon_utils"):
+            return True
+        frame = frame.f_back
+    return False
 
 
 def saved_image_settings(settings):

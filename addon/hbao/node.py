@@ -295,4 +295,6 @@ def unregister():
         while function in handlers:
             handlers.remove(function)
     bpy.utils.unregister_class(HBAO_OT_node_status)
-    bpy.utils.unregister_class(CompositorNodeHBAO)
+    # Quitting, the type may stay: it dies with Blender (compat says why).
+    if not (compat.NODE_TYPE_FREED_UNDER_EVALUATED_COPIES and compat.blender_is_quitting()):
+        bpy.utils.unregister_class(CompositorNodeHBAO)
