@@ -24,6 +24,7 @@ except ImportError:
 from hbao import camera as camera_model  # noqa: E402
 from hbao import compat  # noqa: E402
 
+import file_output  # noqa: E402  (beside this file: the File Output node's versions)
 import scene_parts  # noqa: E402  (beside this file: the parts every scene is built from)
 
 # Debian's Blender has no OpenImageDenoise; renders with denoising on fail.
@@ -258,12 +259,12 @@ class Compositor:
         the Blender version names them (find them in the folder). EXRs are
         32-bit float, uncompressed."""
         node = self.node("CompositorNodeOutputFile", location)
-        compat.set_file_output_path(node, folder, prefix)
+        file_output.set_path(node, folder, prefix)
         compat.set_image_format(node.format, file_format)
         if file_format.startswith("OPEN_EXR"):
             node.format.color_depth = "32"
             node.format.exr_codec = "NONE"
-        compat.clear_file_output_inputs(node)
+        file_output.clear_inputs(node)
         return FileOutput(self, node)
 
 
@@ -292,7 +293,7 @@ class FileOutput:
 
     def add(self, name, socket):
         """A new input called `name`, fed by `socket`."""
-        target = compat.new_file_output_input(self.node, name, socket)
+        target = file_output.new_input(self.node, name, socket)
         self.compositor.link(socket, target)
         return target
 

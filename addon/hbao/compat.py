@@ -1,6 +1,5 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """The few Blender API differences between 3.x, 4.x and 5.x, in one place."""
-import os
 import sys
 
 import bpy
@@ -258,33 +257,3 @@ def set_image_format(image_format, file_format):
         image_format.media_type = ("MULTI_LAYER_IMAGE" if file_format == "OPEN_EXR_MULTILAYER"
                                    else "IMAGE")
     image_format.file_format = file_format
-
-
-def set_file_output_path(node, folder, prefix):
-    """Where a File Output node writes: FOLDER/PREFIX<frame, 4 digits>.<ext>.
-    Before 5.0 the frame is appended to a path without '#'; 5.0 needs the '#'."""
-    if "#" not in prefix:
-        prefix += "####"
-    if hasattr(node, "directory"):  # 5.0
-        node.directory = folder
-        node.file_name = prefix
-    else:
-        node.base_path = os.path.join(folder, prefix)
-
-
-def clear_file_output_inputs(node):
-    items = node.file_output_items if hasattr(node, "file_output_items") else node.file_slots
-    items.clear()
-
-
-_FILE_OUTPUT_SOCKET_TYPES = {"VALUE": "FLOAT", "RGBA": "RGBA", "VECTOR": "VECTOR"}
-
-
-def new_file_output_input(node, name, socket):
-    """A new input of a File Output node, typed like `socket` (5.0 types its
-    items), named `name`; returns the input socket."""
-    if hasattr(node, "file_output_items"):
-        node.file_output_items.new(_FILE_OUTPUT_SOCKET_TYPES.get(socket.type, "RGBA"), name)
-    else:
-        node.file_slots.new(name)
-    return node.inputs[name]
