@@ -2,7 +2,8 @@
 /* Correctness of hbao_compute() on analytic scenes: flat and tilted planes,
  * the 90-degree corner against its analytic value, scale invariance,
  * convergence towards a brute-force reference, threads, half resolution,
- * blur, strength and background handling. */
+ * blur, strength and background handling, and cones whose closed forms pin
+ * the thickness, the angle bias and the back layer's minimum thickness. */
 #include <stdint.h>
 #include <string.h>
 
@@ -979,6 +980,349 @@ TEST_CASE(back_face_layer_lets_light_pass_behind_a_thin_plate) {
     free(normal);
 }
 
+/* --- known answers on cones ---------------------------------------------- */
+
+/* An orthographic camera looks down -z at a point P at depth CONE_DEPTH,
+ * whose given normal is n (world_to_camera is the identity: camera space
+ * is the world); V = (0, 0, 1). A point at D from P is seen from P at the
+ * elevation asin(dot(n, D) / |D|) above P's tangent plane. On a cone with
+ * its apex at P around the axis n, every point is seen at the same
+ * elevation alpha, in every direction: a step that lands on it, snapped to
+ * whichever pixel centre, finds sin_s = sin(alpha). So P's AO on such a
+ * surface has a closed form that the snapping of the steps does not
+ * change. With n = V every direction's slice holds the normal: gamma = 0
+ * and |np| = 1 (docs/algorithm.md, "The slice of a direction"), so
+ * T(h) = (1 - cos 2h) / 4 = sin^2(h) / 2, the open half slice is
+ * T(pi/2) = 1/2, and the number of directions does not matter either; the
+ * cone is then h = r tan(alpha), for a point at distance r from P's view
+ * ray and h in front of P (depth CONE_DEPTH - h).
+ * What is left is float rounding: of the depths (~5e-7 at depth 5), and the
+ * height tolerance and rounding margin of "Depth precision" (~3e-6 units),
+ * which lower the elevation's sine of a step 1 pixel (0.05 units) away by
+ * ~1e-4 and of the farther ones, which set the horizon, by less (measured
+ * at most 1.5e-5 in the AO). */
+#define CONE_PIXEL 0.05 /* scene units per pixel of the grid searched */
+#define CONE_DEPTH 5.0
+
+/* The grid is 2 m + 4 pixels square, m a margin of two pixels more than
+ * the radius (so that no step leaves the image), and P's grid pixel is
+ * (m + a, m + b) for these (a, b): four cells of the 4x4 pattern at full
+ * and at half resolution alike, so four rotations of the directions and
+ * jitters of the steps. */
+static const int cone_apex_offsets[4][2] = {{0, 0}, {1, 3}, {2, 1}, {3, 2}};
+
+/* The cone of elevation alpha around the normal n = (sin tilt, 0,
+ * cos tilt), raised by lift along the view ray, for inner <= r <= outer
+ * (r, lift in scene units); elsewhere background, P itself excepted (a
+ * floor around P would lie on its tangent plane, where it occludes
+ * nothing, so it is left out to keep the tests fast). */
+typedef struct cone {
+    double alpha, tilt, lift, inner, outer;
+    double shell; /* > 0: back faces this far behind the front (the layer) */
+} cone;
+
+/* h of the cone at (dx, dy) from P: dot(n, D) = sin(alpha) |D| for
+ * D = (dx, dy, h), a quadratic in h whose larger root is the cone's half in
+ * front of the tangent plane (its other root, the half behind it). With
+ * tilt 0, h = r tan(alpha). */
+static double cone_height(const cone *c, double dx, double dy) {
+    const double nx = sin(c->tilt), nz = cos(c->tilt), s = sin(c->alpha);
+    const double a = nz * nz - s * s, b = nx * nz * dx;
+    const double q = nx * nx * dx * dx - s * s * (dx * dx + dy * dy);
+    return (-b + sqrt(b * b - a * q)) / a;
+}
+
+typedef struct cone_image {
+    scene_view view;
+    float *depth, *normal, *back;
+    int apex; /* P's index in the image */
+    int cell; /* P's cell of the 4x4 pattern on the grid */
+} cone_image;
+
+/* The cone around P at the grid pixel of apex offset `at`, for a search
+ * of radius radius_px grid pixels, at full resolution or at half: then the
+ * image is twice as wide, its pixels half as large, and the half grid,
+ * whose pixel (i, j) is the image's (2i, 2j), is the same grid. P is an
+ * even pixel of an even row, where (without the blur) the upsample gives
+ * the half grid's AO alone. */
+static cone_image render_cone(const cone *c, int radius_px, int at, int half) {
+    const int scale = half ? 2 : 1, margin = radius_px + 2, grid = 2 * margin + 4;
+    const int ai = margin + cone_apex_offsets[at][0], aj = margin + cone_apex_offsets[at][1];
+    const double pixel = CONE_PIXEL / scale;
+    cone_image im;
+    memset(&im.view, 0, sizeof im.view);
+    im.view.width = im.view.height = grid * scale;
+    hbao_camera_default(&im.view.camera);
+    im.view.camera.projection = HBAO_PROJECTION_ORTHOGRAPHIC;
+    im.view.camera.ortho_scale = (float)(grid * CONE_PIXEL);
+    im.cell = (ai & 3) + 4 * (aj & 3);
+    const size_t pixels = (size_t)im.view.width * im.view.height;
+    im.depth = malloc(pixels * sizeof(float));
+    im.normal = malloc(3 * pixels * sizeof(float));
+    im.back = malloc(pixels * sizeof(float));
+    const int pi = scale * ai, pj = scale * aj;
+    im.apex = pj * im.view.width + pi;
+    for (int j = 0; j < im.view.height; j++) {
+        for (int i = 0; i < im.view.width; i++) {
+            const int k = j * im.view.width + i;
+            const double dx = pixel * (i - pi), dy = pixel * (pj - j); /* rows grow down */
+            const double r = sqrt(dx * dx + dy * dy);
+            const int on_cone = k != im.apex && r >= c->inner && r <= c->outer;
+            const double front = CONE_DEPTH - c->lift - cone_height(c, dx, dy);
+            im.depth[k] = k == im.apex ? (float)CONE_DEPTH : on_cone ? (float)front : 1e10f;
+            im.back[k] = on_cone && c->shell > 0.0 ? (float)(front + c->shell) : 0.0f;
+            im.normal[3 * k] = (float)sin(c->tilt);
+            im.normal[3 * k + 1] = 0.0f;
+            im.normal[3 * k + 2] = (float)cos(c->tilt);
+        }
+    }
+    return im;
+}
+
+static void free_cone(cone_image *im) {
+    free(im->depth);
+    free(im->normal);
+    free(im->back);
+}
+
+/* P's AO, with the back layer or without it. */
+static float cone_ao(const hbao_params *p, const cone_image *im, int layer) {
+    float *ao = run_layers(p, &im->view, im->depth, im->normal, layer ? im->back : NULL);
+    const float at_apex = ao[im->apex];
+    free(ao);
+    return at_apex;
+}
+
+/* P's AO on a cone of elevation alpha around n = V, by the closed forms
+ * of docs/algorithm.md with angle bias b < alpha and falloff NONE. HBAO:
+ * every direction starts at sin(b) and rises to sin(alpha),
+ * occ = sin(alpha) - sin(b), normalised by 1 - sin(b) (this one holds for
+ * a tilted n too: it sees only the elevation's sine). Cosine: the horizon
+ * falls from h_open - b = pi/2 - b to acos(sin alpha) = pi/2 - alpha,
+ * occluding T(pi/2 - b) - T(pi/2 - alpha) = (cos^2 b - cos^2 alpha) / 2 of
+ * T(h_open) = 1/2. With b >= alpha no step rises above the start: AO = 1. */
+static double cone_closed_form(int integration, double alpha, double bias) {
+    if (bias >= alpha) return 1.0;
+    if (integration == HBAO_INTEGRATION_HBAO)
+        return 1.0 - (sin(alpha) - sin(bias)) / (1.0 - sin(bias));
+    return 1.0 - (cos(bias) * cos(bias) - cos(alpha) * cos(alpha));
+}
+
+/* P's cosine AO on the cone of elevation alpha around n = (sin tilt, 0,
+ * cos tilt): every sample still has sin_s = sin(alpha), but a slice now
+ * holds only the normal projected into it, so the AO is the sum of
+ * docs/algorithm.md, "Integration COSINE", over the directions the library
+ * takes at P's pattern cell ("Per-pixel sampling"). With V = (0, 0, 1) and
+ * dir3 = (cos theta, sin theta, 0): dot(n, m) = dot(dir3, n x V), |np| =
+ * sqrt(1 - dot(n, m)^2), gamma = atan2(dot(n, dir3), dot(n, V)), the
+ * horizon at gamma + acos(sin(alpha) / |np|), the start at
+ * gamma + acos(sin(b)) = h_open - b. At tilt 0 it is cone_closed_form's. */
+static double cone_cosine_sum(double alpha, double tilt, double bias, int directions, int cell) {
+    static const int pattern[16] = {0, 8, 2, 10, 12, 4, 14, 6, 3, 11, 1, 9, 15, 7, 13, 5};
+    const double n[3] = {sin(tilt), 0.0, cos(tilt)};
+    const double rotation = (pattern[cell] + 0.5) / 16.0;
+    double visible = 0.0, open = 0.0;
+    for (int d = 0; d < directions; d++) {
+        const double theta = 2.0 * PI * (d + rotation) / directions;
+        const double dc = cos(theta), ds = sin(theta);
+        const double n_dot_m = dc * n[1] - ds * n[0];
+        const double np = sqrt(1.0 - n_dot_m * n_dot_m);
+        const double gamma = atan2(dc * n[0] + ds * n[1], n[2]);
+#define HALF_SLICE(x) (0.25 * (-cos(2 * (x)-gamma) + cos(gamma) + 2 * (x)*sin(gamma)))
+        const double h_open = gamma + PI / 2, h_start = gamma + acos(sin(bias));
+        const double h = fmax(0.0, gamma + acos(fmin(1.0, sin(alpha) / np)));
+        const double occlusion = h < h_start ? HALF_SLICE(h_start) - HALF_SLICE(h) : 0.0;
+        visible += np * (HALF_SLICE(h_open) - occlusion);
+        open += np * HALF_SLICE(h_open);
+#undef HALF_SLICE
+    }
+    return visible / open;
+}
+
+TEST_CASE(thickness_skips_exactly_the_occluders_wholly_in_front) {
+    /* P seen through the lower opening of a funnel: the cone of elevation
+     * alpha = 30 degrees with apex P (n = V), cut off below r = 32 grid
+     * pixels (and a pixel beyond r = R cos(alpha), where it leaves the
+     * radius R = 44 px). Its nearest points lie h_in = 32 px tan(alpha) in
+     * front of P. With thickness t a sample is skipped when its depth is
+     * below P's minus t, i.e. when h > t (docs/algorithm.md, "Thickness"):
+     * - t = h_in / 1.05: every point of the funnel lies more than t in
+     *   front of P, every sample is skipped: AO = 1.
+     * - t = 1.1 h_in: the samples up to r = 1.1 x 32 = 35.2 px are kept
+     *   (within the radius: 35.2 / cos(alpha) < 44). Steps lie 43/44 =
+     *   0.98 px apart along a direction and snapping moves a step at most
+     *   0.71 px, so every direction keeps at least one sample (the 1.8 px
+     *   from 32.7 to 34.5 px hold a step), seen at alpha: the cone's closed
+     *   form.
+     * A thickness 10 % too large keeps the funnel's first 1.5 px at
+     * t = h_in / 1.05 (their samples occlude); 10 % too small skips every
+     * sample at t = 1.1 h_in (AO 1). Tolerance 2e-4: the float rounding
+     * above, with room to spare; a direction's sample kept or lost moves
+     * the AO by 0.03 or more. */
+    const int radius_px = 44;
+    const double alpha = 30.0 * PI / 180.0, radius = radius_px * CONE_PIXEL;
+    const double inner = 32 * CONE_PIXEL;
+    const cone funnel = {alpha, 0.0, 0.0, inner, radius * cos(alpha) + CONE_PIXEL, 0.0};
+    const double h_in = inner * tan(alpha);
+    const double thickness[2] = {h_in / 1.05, 1.1 * h_in};
+    double worst = 0.0;
+    for (int half = 0; half <= 1; half++) {
+        for (int at = 0; at < 4; at++) {
+            cone_image im = render_cone(&funnel, radius_px, at, half);
+            for (int integration = 0; integration <= 1; integration++) {
+                for (int implementation = HBAO_IMPLEMENTATION_SCALAR;
+                     implementation <= hbao_best_implementation(); implementation++) {
+                    for (int c = 0; c < 2; c++) {
+                        hbao_params p = exact_params(integration);
+                        p.radius = (float)radius;
+                        p.directions = 8;
+                        p.steps = 44;
+                        p.half_resolution = half;
+                        p.implementation = implementation;
+                        p.thickness = (float)thickness[c];
+                        const double expected =
+                            c == 0 ? 1.0 : cone_closed_form(integration, alpha, 0.0);
+                        const float ao = cone_ao(&p, &im, 0);
+                        if (fabs(ao - expected) > 2e-4)
+                            printf("  %s%s, apex %d, kernel %d, thickness %.3f h_in: AO %.5f, "
+                                   "expected %.5f\n",
+                                   integration ? "cosine" : "hbao", half ? ", half" : "", at,
+                                   implementation, thickness[c] / h_in, (double)ao, expected);
+                        CHECK_NEAR(ao, expected, 2e-4);
+                        worst = fmax(worst, fabs(ao - expected));
+                    }
+                }
+            }
+            free_cone(&im);
+        }
+    }
+    printf("  funnel: largest |AO - closed form| %.2g\n", worst);
+}
+
+TEST_CASE(angle_bias_matches_the_closed_form_on_a_cone) {
+    /* P at the apex of a cone of elevation alpha = 50 degrees (a funnel
+     * with its tip at P, out to where it leaves the radius of 16 px) under
+     * angle biases from 0 to beyond alpha: every direction starts its
+     * horizon at the bias, and every sample has sin_s = sin(alpha). Around
+     * n = V the AO is cone_closed_form's, 1 - (sin alpha - sin b) /
+     * (1 - sin b) (HBAO) and 1 - (cos^2 b - cos^2 alpha) (cosine), and 1
+     * from b = alpha on. Around a normal tilted 25 degrees from V, HBAO's
+     * is the same and the cosine's is cone_cosine_sum's, where each slice
+     * has its own gamma (-25 to 25 degrees) and |np| (no sample lies past
+     * the normal there: sin(alpha) = 0.77 < dot(n, V) = 0.91). 7
+     * directions, an odd number: no direction has its opposite, whose
+     * gamma is the negative of its own, so a change to the start's terms
+     * odd in gamma does not cancel in the sum. A bias 10 % off moves the
+     * AO by 0.01 to 0.18 at 15 to 45 degrees; tolerance 2e-4, the float
+     * rounding above with room to spare. */
+    const int radius_px = 16;
+    const double alpha = 50.0 * PI / 180.0, radius = radius_px * CONE_PIXEL;
+    const float biases[] = {0.0f, 15.0f, 30.0f, 45.0f, 55.0f};
+    const int directions = 7;
+    double worst = 0.0;
+    for (int tilted = 0; tilted <= 1; tilted++) {
+        /* out to a pixel beyond the radius: the cone's lines lie at most
+         * 90 degrees - alpha + tilt from V, so r <= R cos(alpha - tilt) */
+        const double tilt = tilted ? 25.0 * PI / 180.0 : 0.0;
+        const cone funnel = {alpha, tilt, 0.0, 0.0, radius * cos(alpha - tilt) + CONE_PIXEL, 0.0};
+        for (int half = 0; half <= 1; half++) {
+            for (int at = 0; at < 4; at++) {
+                cone_image im = render_cone(&funnel, radius_px, at, half);
+                for (int integration = 0; integration <= 1; integration++) {
+                    for (int b = 0; b < 5; b++) {
+                        const double bias = biases[b] * PI / 180.0;
+                        double expected = cone_closed_form(integration, alpha, bias);
+                        if (integration == HBAO_INTEGRATION_COSINE) {
+                            const double sum =
+                                cone_cosine_sum(alpha, tilt, bias, directions, im.cell);
+                            if (!tilted) CHECK_NEAR(sum, expected, 1e-12);
+                            expected = sum;
+                        }
+                        for (int implementation = HBAO_IMPLEMENTATION_SCALAR;
+                             implementation <= hbao_best_implementation(); implementation++) {
+                            hbao_params p = exact_params(integration);
+                            p.radius = (float)radius;
+                            p.directions = directions;
+                            p.steps = 16;
+                            p.half_resolution = half;
+                            p.implementation = implementation;
+                            p.angle_bias_degrees = biases[b];
+                            const float ao = cone_ao(&p, &im, 0);
+                            if (fabs(ao - expected) > 2e-4)
+                                printf("  %s%s%s, apex %d, kernel %d, bias %.0f: AO %.5f, "
+                                       "expected %.5f\n",
+                                       integration ? "cosine" : "hbao", tilted ? ", tilted" : "",
+                                       half ? ", half" : "", at, implementation, (double)biases[b],
+                                       (double)ao, expected);
+                            CHECK_NEAR(ao, expected, 2e-4);
+                            worst = fmax(worst, fabs(ao - expected));
+                        }
+                    }
+                }
+                free_cone(&im);
+            }
+        }
+    }
+    printf("  cone: largest |AO - closed form| %.2g\n", worst);
+}
+
+TEST_CASE(back_layer_takes_occluders_half_the_radius_thick) {
+    /* A lampshade over P: the cone of elevation alpha = 32 degrees with
+     * apex P (n = V) raised by half the radius R = 40 px (h = 0.5 R +
+     * r tan(alpha), out to r = 0.4 R, all within the radius), a thin shell
+     * whose back faces the layer gives 0.05 R behind its front. The back
+     * depth used is at least the front's plus HBAO_MIN_BACK_THICKNESS = 0.5
+     * radii (docs/algorithm.md, "Two depth layers"), so every sample's back
+     * point lies 0.5 R behind its front: on the cone h = r tan(alpha)
+     * through P, seen at exactly alpha. The fronts lie higher; the first
+     * step of every direction (within 2.4 px of P: steps 39/64 = 0.61 px
+     * apart, snapping <= 0.71 px) at over 83 degrees (h / r >= 20 / 2.4),
+     * where the fraction f of the direction's range (from the top) is under
+     * 1/64 (cosine cos^2(83 deg) = 0.015, HBAO 1 - sin(83 deg) = 0.007):
+     * before sector 0's centre. A sample marks the sectors whose centres
+     * lie between its front's f and its back's, f(alpha); so each
+     * direction's samples mark those from 0 to the last whose centre
+     * (k + 0.5) / 32 lies at or before f(alpha): n = floor(32 f(alpha) - 0.5) + 1 of 32, and with
+     * bias 0, AO = 1 - n / 32, where f(alpha) = T(pi/2 - alpha) / T(pi/2) =
+     * cos^2(alpha) (cosine: 32 f - 0.5 = 22.51, n = 23) or 1 - sin(alpha)
+     * (HBAO: 14.54, n = 15). Both lie far from a sector's centre, so float
+     * rounding (above) moves no sector: tolerance 1e-5 (the AO itself in
+     * float).
+     * At 0.4 R the back points rise above the cone (to at least 41 degrees
+     * within the 0.4 R: at least four sectors fewer, AO +0.125); at 0.6 R
+     * those within 0.1 R / tan(alpha) = 6.4 px of P fall below the tangent
+     * plane and every sector is marked (AO 0). */
+    const int radius_px = 40;
+    const double alpha = 32.0 * PI / 180.0, radius = radius_px * CONE_PIXEL;
+    const cone lampshade = {alpha, 0.0, 0.5 * radius, 0.0, 0.4 * radius, 0.05 * radius};
+    for (int half = 0; half <= 1; half++) {
+        for (int at = 0; at < 4; at++) {
+            cone_image im = render_cone(&lampshade, radius_px, at, half);
+            for (int integration = 0; integration <= 1; integration++) {
+                const double f = integration == HBAO_INTEGRATION_COSINE ? cos(alpha) * cos(alpha)
+                                                                        : 1.0 - sin(alpha);
+                const double expected = 1.0 - (floor(32.0 * f - 0.5) + 1.0) / 32.0;
+                for (int implementation = HBAO_IMPLEMENTATION_SCALAR;
+                     implementation <= hbao_best_implementation(); implementation++) {
+                    hbao_params p = exact_params(integration);
+                    p.radius = (float)radius;
+                    p.directions = 8;
+                    p.steps = 64;
+                    p.half_resolution = half;
+                    p.implementation = implementation;
+                    const float ao = cone_ao(&p, &im, 1);
+                    if (fabs(ao - expected) > 1e-5)
+                        printf("  %s%s, apex %d, kernel %d: AO %.5f, expected %.5f\n",
+                               integration ? "cosine" : "hbao", half ? ", half" : "", at,
+                               implementation, (double)ao, expected);
+                    CHECK_NEAR(ao, expected, 1e-5);
+                }
+            }
+            free_cone(&im);
+        }
+    }
+}
+
 TEST_CASE(half_resolution_reads_the_even_pixels_of_even_rows) {
     /* The half grid's pixel (i, j) is full-resolution pixel (2i, 2j)
      * (hbao_grid_set_projection): its depth, given normal and back face
@@ -1088,5 +1432,8 @@ TEST_MAIN(TEST_ENTRY(plane_facing_camera_is_unoccluded), TEST_ENTRY(tilted_plane
           TEST_ENTRY(simd_paths_match_scalar_reference_bit_for_bit),
           TEST_ENTRY(thin_occluders_do_not_darken_what_is_behind_them),
           TEST_ENTRY(back_face_layer_lets_light_pass_behind_a_thin_plate),
+          TEST_ENTRY(thickness_skips_exactly_the_occluders_wholly_in_front),
+          TEST_ENTRY(angle_bias_matches_the_closed_form_on_a_cone),
+          TEST_ENTRY(back_layer_takes_occluders_half_the_radius_thick),
           TEST_ENTRY(half_resolution_reads_the_even_pixels_of_even_rows),
           TEST_ENTRY(depth_at_the_background_depth_is_background))
