@@ -13,9 +13,7 @@ hbao_result hbao_settings_make(const hbao_params *params, hbao_settings *s) {
     const hbao_result resolved = hbao_params_resolve(params, &p, NULL);
     if (resolved != HBAO_SUCCESS) return resolved;
     s->radius = p.radius;
-    s->bias_rad = p.angle_bias_degrees * (HBAO_PI / 180.0f);
-    s->sin_bias = sinf(s->bias_rad);
-    s->cos_bias = cosf(s->bias_rad);
+    s->sin_bias = sinf(p.angle_bias_degrees * (HBAO_PI / 180.0f));
     s->bias_elevation_sine = hbao_sine_from_cosine(s->sin_bias);
     s->bias_elevation_acos = hbao_acos(s->sin_bias);
     s->directions = p.directions;

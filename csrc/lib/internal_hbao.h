@@ -28,9 +28,7 @@
 /* Parameters after clamping to the documented limits. */
 typedef struct hbao_settings {
     float radius;
-    float bias_rad; /* angle bias */
-    float sin_bias;
-    float cos_bias;
+    float sin_bias; /* of the angle bias */
     /* the bias elevation's (sin_bias as an elevation) sine and arc cosine,
      * as horizon_from_elevation computes them: where every horizon starts */
     float bias_elevation_sine, bias_elevation_acos;
