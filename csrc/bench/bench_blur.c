@@ -15,6 +15,7 @@
 
 #include "bench_common.h"
 #include "internal_finish.h"
+#include "test_random.h"
 
 static void usage(const char *program) {
     fprintf(stderr,
@@ -100,8 +101,7 @@ int main(int argc, char **argv) {
         for (int i = 0; i < width; i++) {
             const size_t k = (size_t)j * width + i;
             for (int c = 0; c < 3; c++) hbao_grid_normal_row(&grid, j, c)[i] = b.normal[3 * k + c];
-            state = state * 1664525u + 1013904223u;
-            raw[k] = (float)(state >> 8) / 16777216.0f;
+            raw[k] = (float)(test_random(&state) >> 8) / 16777216.0f;
         }
     }
 

@@ -10,6 +10,7 @@
 #include "hbao.h"
 #include "scene.h"
 #include "test_harness.h"
+#include "test_random.h"
 
 #define PI 3.14159265358979323846
 
@@ -1344,8 +1345,7 @@ TEST_CASE(half_resolution_reads_the_even_pixels_of_even_rows) {
             const int k = j * view.width + i;
             back[k] = depth[k] < 4.9f ? depth[k] + (float)(0.25 * PLATE_GAP) : 0.0f;
             const int kept = i % 2 == 0 && j % 2 == 0;
-            state = state * 1664525u + 1013904223u;
-            const float z = 1.0f + (float)((state >> 8) % 800) / 100.0f;
+            const float z = 1.0f + (float)((test_random(&state) >> 8) % 800) / 100.0f;
             other_depth[k] = kept ? depth[k] : z;
             other_back[k] = kept ? back[k] : z + 0.01f; /* a thin back: known */
             for (int c = 0; c < 3; c++)

@@ -9,6 +9,7 @@
 #include "hbao.h"
 #include "scene.h"
 #include "test_harness.h"
+#include "test_random.h"
 
 /* --- helpers ------------------------------------------------------------- */
 
@@ -94,7 +95,7 @@ TEST_CASE(random_depths_over_the_float_range_stay_in_range) {
     uint32_t state = 12345u;
     for (int trial = 0; trial < 16; trial++) {
         for (int k = 0; k < w * h; k++) {
-            state = state * 1664525u + 1013904223u;
+            test_random(&state);
             /* exponent bits 0..254: every finite magnitude from denormals up */
             union {
                 uint32_t u;

@@ -9,13 +9,14 @@
 
 #include "internal_finish.h"
 #include "test_harness.h"
+#include "test_random.h"
 #ifdef HBAO_FINISH_X86
 #include <immintrin.h>
 #endif
 
+/* 24 random bits (test_random.h) */
 static uint32_t next_random(uint32_t *state) {
-    *state = *state * 1664525u + 1013904223u;
-    return *state >> 8; /* 24 bits */
+    return test_random(state) >> 8;
 }
 
 /* A w x h grid whose rows mix background (0) with ordinary depths and, on
