@@ -155,16 +155,20 @@ def pytest_terminal_summary(terminalreporter):
 
 def _runner(blender, user_scripts):
     def run(script, *args, blend=None, ui=False, addon=True, env=None, check=True,
-            timeout=BLENDER_TIMEOUT_S):
+            timeout=BLENDER_TIMEOUT_S, debug_memory=False):
         command = blender.command(script, args, blend=blend, ui=ui,
                                   addons=("hbao",) if addon else ())
+        if debug_memory and blender.kind == "app":  # bpy has no such option
+            # Blender's allocator fills freed memory: reading it then crashes.
+            command.insert(command.index(blender.executable) + 1, "--debug-memory")
         return run_command(command, user_scripts, env, check, timeout)
     return run
 
 
 @pytest.fixture(scope="session")
 def run_blender(blender_user_scripts):
-    """run_blender(script, *args, blend=None, ui=False, addon=True, env=None)
+    """run_blender(script, *args, blend=None, ui=False, addon=True, env=None,
+    debug_memory=False)
 
     Runs `script` (a path) in Debian's Blender, factory settings, this
     checkout's add-on enabled unless addon=False. Headless, or with ui=True in

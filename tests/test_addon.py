@@ -8,7 +8,7 @@ import subprocess
 import numpy as np
 import pytest
 
-from conftest import BLENDER, DEBIAN_BLENDER, REPO, blender_environment, run_command
+from conftest import BLENDER, REPO, blender_environment, run_command
 
 SCRIPTS = REPO / "tests" / "blender_scripts"
 APPEND_SCRIPT = REPO / "tests" / "blender_scripts" / "addon_append.py"
@@ -659,7 +659,7 @@ def test_add_filter_menu_of_each_blender_lists_hbao(run_in_blender):
     assert menu["entries"] == [["node.add_node", "HBAO", "CompositorNodeHBAO"]], menu
 
 
-def test_quitting_after_a_render_reads_no_freed_memory(blender_user_scripts, tmp_path):
+def test_quitting_after_a_render_reads_no_freed_memory(run_blender, tmp_path):
     """Blender disables every add-on as it quits, before it frees its data:
     3.4 then freed the HBAO node type under the view layer's evaluated copy
     of the tree, whose freeing read the freed type
@@ -669,14 +669,31 @@ def test_quitting_after_a_render_reads_no_freed_memory(blender_user_scripts, tmp
     with nothing left unfreed (3.4 also leaked the File Output inputs that
     the test scripts removed: scripts/file_output.py). The bpy builds have
     no such option (and no such bug)."""
-    if DEBIAN_BLENDER is None:
-        pytest.fail("blender not found: run scripts/setup.sh")
     spec = {"nodes": [{"radius": 0.7, "blur_size": 0}]}
-    command = DEBIAN_BLENDER.command(RENDER_SCRIPT, (json.dumps(spec), tmp_path / "render"))
-    command.insert(1, "--debug-memory")
-    completed = run_command(command, blender_user_scripts)
+    completed = run_blender(RENDER_SCRIPT, json.dumps(spec), tmp_path / "render",
+                            debug_memory=True)
     assert "RENDERED" in completed.stdout, completed.stdout[-3000:]
     assert "Not freed memory blocks" not in completed.stdout, completed.stdout[-3000:]
+
+
+def test_disabled_and_enabled_again_still_renders_ao(run_in_blender, blender, tmp_path):
+    """The add-on disabled by hand (with an HBAO node in the file) and enabled
+    again, then disabled by Blender loading factory settings and enabled
+    again, renders AO each time. Versions that would read a freed node type
+    (compat.NODE_TYPE_FREED_UNDER_EVALUATED_COPIES: 3.4) keep it registered
+    while a node uses it, and enabling the add-on again reuses it. Debian's
+    Blender runs with --debug-memory: any read of a freed type crashes it."""
+    completed = run_in_blender(SCRIPTS / "addon_reenable.py", tmp_path, debug_memory=True)
+    assert "REENABLE OK" in completed.stdout, completed.stdout[-3000:]
+    stages = {entry["stage"]: entry for entry in (
+        json.loads(line[len("STAGE "):]) for line in completed.stdout.splitlines()
+        if line.startswith("STAGE "))}
+    assert stages["disabled"]["registered"] == (blender.version_tuple < (4, 5)), stages
+    for stage in ("enabled", "enabled_again", "after_factory_settings"):
+        assert stages[stage]["registered"], stages
+        ao = node_outputs(tmp_path / stage, 1)["ao"]
+        # the corner scene's contact shadows: computed AO, not the fallback 1
+        assert ao.min() < 0.7 and ao.max() <= 1.0, (stage, ao.min())
 
 
 def test_hook_lifecycle(run_in_blender, tmp_path):

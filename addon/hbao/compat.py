@@ -22,17 +22,19 @@ TREES_SHARED_BETWEEN_SCENES = HAS_COMPOSITING_NODE_GROUP
 # The Value node's idname: the compositor's own until 4.x, the shared
 # ShaderNodeValue in 5.x files and menus (old files may still hold either).
 VALUE_NODE_IDNAMES = ("CompositorNodeValue", "ShaderNodeValue")
-# Image settings that saving a Render Result reads, in the order they must be
-# restored: 5.0's media_type decides which file formats are valid, so it
-# comes before file_format, and the format before its options.
 # 3.4 frees a node type that Python unregisters while an evaluated copy of a
 # tree (the view layer's depsgraph keeps one after any evaluation, a render
 # too) still holds nodes of that type: freeing the copy later reads the
 # freed type. Blender disables every add-on before it frees its data as it
-# quits, so each quit after a render with an HBAO node read freed memory
-# (a crash under MALLOC_PERTURB_ or --debug-memory). 4.5 and 5.x are
-# unaffected; the versions between are untested and treated as 3.4.
+# quits or loads factory settings, so each quit after a render with an HBAO
+# node read freed memory (a crash under --debug-memory). On these versions
+# the node type stays registered while Blender may still read it
+# (keep_node_type_registered). 4.5 and 5.x are unaffected; the versions
+# between are untested and treated as 3.4.
 NODE_TYPE_FREED_UNDER_EVALUATED_COPIES = VERSION < (4, 5, 0)
+# Image settings that saving a Render Result reads, in the order they must be
+# restored: 5.0's media_type decides which file formats are valid, so it
+# comes before file_format, and the format before its options.
 SAVED_IMAGE_SETTINGS = ("media_type", "file_format", "color_mode", "color_depth", "exr_codec",
                         "use_exr_interleave", "use_preview", "use_zbuffer", "views_format")
 
@@ -57,9 +59,10 @@ def version_message():
     return None
 
 
-def blender_is_quitting():
-    """Whether the caller runs inside Blender's disabling of every add-on
-    as it quits (addon_utils.disable_all, which nothing else calls)."""
+def every_addon_being_disabled():
+    """Whether the caller runs inside addon_utils.disable_all: Blender
+    disables every add-on so before it frees its data, as it quits and as it
+    loads factory settings or another app template."""
     frame = sys._getframe(1)
     while frame is not None:
         if (frame.f_code.co_name == "disable_all"
@@ -67,6 +70,23 @@ def blender_is_quitting():
             return True
         frame = frame.f_back
     return False
+
+
+def keep_node_type_registered(idname):
+    """Whether a disabled add-on must leave its node type `idname`
+    registered, so that Blender never reads it freed: on the versions that
+    would (NODE_TYPE_FREED_UNDER_EVALUATED_COPIES), while Blender is about to
+    free its data or while a tree still holds such a node. The type then
+    lives until Blender quits, and enabling the add-on again reuses it."""
+    if not NODE_TYPE_FREED_UNDER_EVALUATED_COPIES:
+        return False
+    if every_addon_being_disabled():
+        return True
+    if not isinstance(bpy.data, bpy.types.BlendData):
+        return False  # no file yet (add-on start-up)
+    trees = list(bpy.data.node_groups) + [compositor_tree(scene) for scene in bpy.data.scenes]
+    return any(node.bl_idname == idname for tree in trees if tree is not None
+               for node in tree.nodes)
 
 
 def saved_image_settings(settings):

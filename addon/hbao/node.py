@@ -273,7 +273,8 @@ def _draw_add_menu(menu, context):
 
 
 def register():
-    bpy.utils.register_class(CompositorNodeHBAO)
+    if "bl_rna" not in CompositorNodeHBAO.__dict__:  # kept (compat.keep_node_type_registered)
+        bpy.utils.register_class(CompositorNodeHBAO)
     bpy.utils.register_class(HBAO_OT_node_status)
     for name, function in _HANDLERS:
         getattr(bpy.app.handlers, name).append(function)
@@ -295,6 +296,5 @@ def unregister():
         while function in handlers:
             handlers.remove(function)
     bpy.utils.unregister_class(HBAO_OT_node_status)
-    # Quitting, the type may stay: it dies with Blender (compat says why).
-    if not (compat.NODE_TYPE_FREED_UNDER_EVALUATED_COPIES and compat.blender_is_quitting()):
+    if not compat.keep_node_type_registered(NODE_IDNAME):
         bpy.utils.unregister_class(CompositorNodeHBAO)
