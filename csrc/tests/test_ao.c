@@ -1094,6 +1094,35 @@ static float cone_ao(const hbao_params *p, const cone_image *im, int layer) {
     return at_apex;
 }
 
+/* The parameters of every cone test: exact_params' with the search's
+ * radius, directions and steps, at full or half resolution, on one kernel. */
+static hbao_params cone_params(int integration, double radius, int directions, int steps, int half,
+                               int implementation) {
+    hbao_params p = exact_params(integration);
+    p.radius = (float)radius;
+    p.directions = directions;
+    p.steps = steps;
+    p.half_resolution = half;
+    p.implementation = implementation;
+    return p;
+}
+
+/* Checks P's AO on `im` (layer: with the back layer) against `expected`
+ * to `tolerance`; where it is off, prints the case (`what`, the apex
+ * offset `at` and p's integration, resolution and kernel) and both values.
+ * Returns |AO - expected|. */
+static double check_cone_ao(const hbao_params *p, const cone_image *im, int layer, double expected,
+                            double tolerance, const char *what, int at) {
+    const float ao = cone_ao(p, im, layer);
+    if (fabs(ao - expected) > tolerance)
+        printf("  %s%s%s, apex %d, kernel %d: AO %.5f, expected %.5f\n",
+               p->integration == HBAO_INTEGRATION_COSINE ? "cosine" : "hbao",
+               p->half_resolution ? ", half" : "", what, at, p->implementation, (double)ao,
+               expected);
+    CHECK_NEAR(ao, expected, tolerance);
+    return fabs(ao - expected);
+}
+
 /* P's AO on a cone of elevation alpha around n = V, by the closed forms
  * of docs/algorithm.md with angle bias b < alpha and falloff NONE. HBAO:
  * every direction starts at sin(b) and rises to sin(alpha),
@@ -1174,23 +1203,14 @@ TEST_CASE(thickness_skips_exactly_the_occluders_wholly_in_front) {
                 for (int implementation = HBAO_IMPLEMENTATION_SCALAR;
                      implementation <= hbao_best_implementation(); implementation++) {
                     for (int c = 0; c < 2; c++) {
-                        hbao_params p = exact_params(integration);
-                        p.radius = (float)radius;
-                        p.directions = 8;
-                        p.steps = 44;
-                        p.half_resolution = half;
-                        p.implementation = implementation;
+                        hbao_params p =
+                            cone_params(integration, radius, 8, 44, half, implementation);
                         p.thickness = (float)thickness[c];
                         const double expected =
                             c == 0 ? 1.0 : cone_closed_form(integration, alpha, 0.0);
-                        const float ao = cone_ao(&p, &im, 0);
-                        if (fabs(ao - expected) > 2e-4)
-                            printf("  %s%s, apex %d, kernel %d, thickness %.3f h_in: AO %.5f, "
-                                   "expected %.5f\n",
-                                   integration ? "cosine" : "hbao", half ? ", half" : "", at,
-                                   implementation, thickness[c] / h_in, (double)ao, expected);
-                        CHECK_NEAR(ao, expected, 2e-4);
-                        worst = fmax(worst, fabs(ao - expected));
+                        char what[64];
+                        snprintf(what, sizeof what, ", thickness %.3f h_in", thickness[c] / h_in);
+                        worst = fmax(worst, check_cone_ao(&p, &im, 0, expected, 2e-4, what, at));
                     }
                 }
             }
@@ -1241,22 +1261,14 @@ TEST_CASE(angle_bias_matches_the_closed_form_on_a_cone) {
                         }
                         for (int implementation = HBAO_IMPLEMENTATION_SCALAR;
                              implementation <= hbao_best_implementation(); implementation++) {
-                            hbao_params p = exact_params(integration);
-                            p.radius = (float)radius;
-                            p.directions = directions;
-                            p.steps = 16;
-                            p.half_resolution = half;
-                            p.implementation = implementation;
+                            hbao_params p = cone_params(integration, radius, directions, 16, half,
+                                                        implementation);
                             p.angle_bias_degrees = biases[b];
-                            const float ao = cone_ao(&p, &im, 0);
-                            if (fabs(ao - expected) > 2e-4)
-                                printf("  %s%s%s, apex %d, kernel %d, bias %.0f: AO %.5f, "
-                                       "expected %.5f\n",
-                                       integration ? "cosine" : "hbao", tilted ? ", tilted" : "",
-                                       half ? ", half" : "", at, implementation, (double)biases[b],
-                                       (double)ao, expected);
-                            CHECK_NEAR(ao, expected, 2e-4);
-                            worst = fmax(worst, fabs(ao - expected));
+                            char what[64];
+                            snprintf(what, sizeof what, "%s, bias %.0f", tilted ? ", tilted" : "",
+                                     (double)biases[b]);
+                            worst =
+                                fmax(worst, check_cone_ao(&p, &im, 0, expected, 2e-4, what, at));
                         }
                     }
                 }
@@ -1305,18 +1317,9 @@ TEST_CASE(back_layer_takes_occluders_half_the_radius_thick) {
                 const double expected = 1.0 - (floor(32.0 * f - 0.5) + 1.0) / 32.0;
                 for (int implementation = HBAO_IMPLEMENTATION_SCALAR;
                      implementation <= hbao_best_implementation(); implementation++) {
-                    hbao_params p = exact_params(integration);
-                    p.radius = (float)radius;
-                    p.directions = 8;
-                    p.steps = 64;
-                    p.half_resolution = half;
-                    p.implementation = implementation;
-                    const float ao = cone_ao(&p, &im, 1);
-                    if (fabs(ao - expected) > 1e-5)
-                        printf("  %s%s, apex %d, kernel %d: AO %.5f, expected %.5f\n",
-                               integration ? "cosine" : "hbao", half ? ", half" : "", at,
-                               implementation, (double)ao, expected);
-                    CHECK_NEAR(ao, expected, 1e-5);
+                    const hbao_params p =
+                        cone_params(integration, radius, 8, 64, half, implementation);
+                    check_cone_ao(&p, &im, 1, expected, 1e-5, "", at);
                 }
             }
             free_cone(&im);
