@@ -1184,20 +1184,28 @@ def test_back_layer_lets_light_pass_behind_a_thin_occluder(hbao_tool, tmp_path, 
         assert completed.returncode != 0 and fragment in completed.stderr, completed.stderr
 
 
-@pytest.mark.parametrize("names", [("B", "G", "R", "Z"), ("G", "R", "Z")])
-def test_half_depth_beside_half_colour_channels(hbao_tool, tmp_path, names):
-    """A half-float Z among three or four half channels of which only Z is
-    read: OpenEXRCore 3.1's fast half-to-float unpackers for 3 and 4 channels
-    wrote the skipped channels through a NULL pointer (the tool crashed; found
-    by fuzz_exr_compute). The AO must equal that of the same depths stored
-    alone as float."""
+@pytest.mark.parametrize("names, half", [
+    (("B", "G", "R", "Z"), ("B", "G", "R", "Z")),
+    (("G", "R", "Z"), ("G", "R", "Z")),
+    # Z float beside half and float channels
+    (("B", "G", "R", "Z"), ("B", "G", "R")),
+    (("A", "B", "G", "R", "Z"), ("B", "R")),
+])
+def test_depth_beside_colour_channels_not_read(hbao_tool, tmp_path, names, half):
+    """Z among three or four other channels, only Z read. Half Z among half
+    channels: OpenEXRCore 3.1's fast half-to-float unpackers for 3 and 4
+    channels wrote the skipped channels through a NULL pointer (the tool
+    crashed; found by fuzz_exr_compute). Float Z beside half and float
+    channels: the channels not read share one scratch destination, each in
+    its own type. The AO must equal that of the same depths stored alone as
+    float."""
     from hbao import exr_passes
     width, height = 40, 24
     depth = _wavy_depth(width, height).astype(np.float16).astype(np.float32)
     channels = {name: np.full((height, width), 0.5, np.float32) for name in names}
     channels["Z"] = depth
     mixed = tmp_path / "mixed.exr"
-    mixed.write_bytes(scanline_exr(channels, width, height, half=names))
+    mixed.write_bytes(scanline_exr(channels, width, height, half=half))
     alone = tmp_path / "alone.exr"
     alone.write_bytes(scanline_exr({"Z": depth}, width, height))
     ao = {}

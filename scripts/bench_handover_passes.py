@@ -1,0 +1,82 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The add-on's pass hand-over against the passes a render has: the same
+1920x1080 interior render (Cycles, 1 sample, the HBAO node at the library's
+defaults) with only Combined, Depth and Normal, then with a compositing
+artist's usual passes as well (bench/addon_timing.py, PRODUCTION_PASSES).
+The hand-over saves the whole Render Result (handover.py), so it grows with
+them. Prints, for each, the AO and the hand-over (save, read, write) of the
+renders that computed the AO, as the add-on's console lines give them.
+
+  python3 scripts/bench_handover_passes.py [--blender bpy-5] [--repeats 4]
+
+Needs the build (build/libhbao.so, build/libhbao_exr.so) and the Blender
+named (scripts/blenders.py; default: the newest bpy)."""
+import argparse
+import json
+import os
+import re
+import statistics
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import blenders
+
+REPO = Path(__file__).resolve().parent.parent
+LINE = re.compile(r"AO (\d+) ms, pass hand-over (\d+) ms \(save (\d+), read (\d+), write (\d+)\)")
+FIELDS = ("ao", "handover", "save", "read", "write")
+
+
+def run(blender, passes, repeats, user_scripts):
+    spec = {"scene": "interior", "width": 1920, "height": 1080, "samples": 1,
+            "repeats": repeats, "threads": 2, "passes": passes,
+            "node": {"directions": 4, "steps": 16, "blur_size": 5}}
+    env = dict(os.environ, HBAO_LIBRARY=str(REPO / "build/libhbao.so"),
+               HBAO_EXR_LIBRARY=str(REPO / "build/libhbao_exr.so"),
+               BLENDER_USER_SCRIPTS=str(user_scripts), PYTHONUNBUFFERED="1")
+    command = blender.command(REPO / "bench" / "addon_timing.py", [json.dumps(spec)])
+    completed = subprocess.run(command, env=env, capture_output=True, text=True)
+    if completed.returncode != 0:
+        sys.stderr.write(completed.stdout[-3000:] + completed.stderr[-3000:])
+        raise SystemExit(f"bench_handover_passes: {blender.name} failed ({passes})")
+    # The renders that computed the AO: the first of each timed_renders()
+    # group is a warm-up; "reused" and "re-composited" lines did not compute.
+    rows = [tuple(int(v) for v in match.groups())
+            for line in completed.stdout.splitlines()
+            if "reused" not in line and (match := LINE.search(line))]
+    return rows[1:]
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--blender", default="bpy-5",
+                        help="a name or prefix from scripts/blenders.py (default bpy-5)")
+    parser.add_argument("--repeats", type=int, default=4)
+    args = parser.parse_args()
+    found = [b for b in blenders.all_blenders() if b.name.startswith(args.blender)]
+    if not found:
+        raise SystemExit(f"bench_handover_passes: no Blender named {args.blender}* here")
+    blender = found[-1]
+    with tempfile.TemporaryDirectory(prefix="hbao-handover-") as folder:
+        user_scripts = Path(folder)
+        (user_scripts / "addons").mkdir()
+        (user_scripts / "addons" / "hbao").symlink_to(REPO / "addon" / "hbao")
+        print(f"bench_handover_passes: {blender.name}, interior 1920x1080, 1 Cycles sample, "
+              f"defaults; ms per render that computed the AO (median, least-greatest)")
+        print("| passes | AO | hand-over | save | read | write | hand-over / AO |")
+        print("|---|---|---|---|---|---|---|")
+        for passes in ("plain", "production"):
+            rows = run(blender, passes, args.repeats, user_scripts)
+            cells = []
+            for index in range(len(FIELDS)):
+                values = [row[index] for row in rows]
+                cells.append(f"{statistics.median(values):.0f} ({min(values)}-{max(values)})")
+            ratios = [row[1] / row[0] for row in rows]
+            name = "Combined, Depth, Normal" if passes == "plain" else "production (81 channels)"
+            print(f"| {name} | " + " | ".join(cells) +
+                  f" | {statistics.median(ratios):.2f} ({min(ratios):.2f}-{max(ratios):.2f}) |")
+
+
+if __name__ == "__main__":
+    main()
