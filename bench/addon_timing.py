@@ -8,7 +8,7 @@ and without an HBAO compositor node. Run by run_benchmark.py:
 Spec: scene, width, height, samples, repeats, node (the HBAO node's settings:
 radius, directions, steps, blur_size, falloff, integration, half_resolution,
 guard_band, back_faces); optional: passes, "production" to enable
-PRODUCTION_PASSES as well (the Render Result the hand-over saves grows with
+blender_scenes.PRODUCTION_PASSES as well (the Render Result the hand-over saves grows with
 them), threads.
 Prints one line `bench-addon: {json}` with the render times in seconds
 (without the node; with it, the AO computed each time; with it, the same
@@ -33,18 +33,6 @@ import scene_library  # noqa: E402
 SOCKETS = {"radius": "Radius", "directions": "Directions", "steps": "Steps",
            "blur_size": "Blur Size", "angle_bias_degrees": "Angle Bias"}
 PROPERTIES = ("falloff", "integration", "half_resolution", "guard_band", "back_faces")
-# A compositing artist's usual Cycles passes (the light passes, emission,
-# environment, mist, position where Blender has it, Cryptomatte's object,
-# material and asset passes at its default depth): 81 channels in bpy 5.3,
-# with Combined, Depth and Normal, against those 8.
-PRODUCTION_PASSES = ("use_pass_mist", "use_pass_position", "use_pass_emit",
-                     "use_pass_environment", "use_pass_diffuse_direct",
-                     "use_pass_diffuse_indirect", "use_pass_diffuse_color",
-                     "use_pass_glossy_direct", "use_pass_glossy_indirect",
-                     "use_pass_glossy_color", "use_pass_transmission_direct",
-                     "use_pass_transmission_indirect", "use_pass_transmission_color",
-                     "use_pass_cryptomatte_object", "use_pass_cryptomatte_material",
-                     "use_pass_cryptomatte_asset")
 
 
 def configure(scene, spec):
@@ -62,9 +50,7 @@ def configure(scene, spec):
     layer.use_pass_z = True
     layer.use_pass_normal = True
     if spec.get("passes") == "production":
-        for name in PRODUCTION_PASSES:
-            if hasattr(layer, name):  # use_pass_position: 4.x on
-                setattr(layer, name, True)
+        blender_scenes.enable_production_passes(layer)
 
 
 def build_tree(scene, node_settings):

@@ -2,7 +2,7 @@
 """The add-on's pass hand-over against the passes a render has: the same
 1920x1080 interior render (Cycles, 1 sample, the HBAO node at the library's
 defaults) with only Combined, Depth and Normal, then with a compositing
-artist's usual passes as well (bench/addon_timing.py, PRODUCTION_PASSES).
+artist's usual passes as well (blender_scenes.PRODUCTION_PASSES).
 The hand-over saves the whole Render Result (handover.py), so it grows with
 them. Prints, for each, the AO and the hand-over (save, read, write) of the
 renders that computed the AO, as the add-on's console lines give them.

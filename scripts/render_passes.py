@@ -4,7 +4,7 @@
     blender -b --factory-startup --python scripts/render_passes.py -- \\
         --scene demo --out out/demo --width 640 --height 360 \\
         [--engine CYCLES|BLENDER_EEVEE] [--samples N] [--half] [--codec ZIP] \\
-        [--ortho] [--ao-distance D] [--no-depth] [--png] [--force]
+        [--ortho] [--ao-distance D] [--no-depth] [--production-passes] [--png] [--force]
 
 Writes OUT.exr (every pass of the Render Result: Depth, Normal, AO when asked,
 Combined) and OUT.camera.json (the camera as the `hbao` CLI reads it). An
@@ -83,6 +83,9 @@ def parse_arguments(argv):
     parser.add_argument("--ao-distance", type=positive_float, default=None,
                         help="also write an AO pass with rays this long (metres)")
     parser.add_argument("--no-depth", action="store_true", help="leave the Depth pass out")
+    parser.add_argument("--production-passes", action="store_true",
+                        help="a compositing artist's usual passes as well (light passes, "
+                        "mist, Cryptomatte, ...)")
     parser.add_argument("--png", action="store_true",
                         help="also write OUT.png, the Combined pass as the viewer sees it")
     parser.add_argument("--force", action="store_true", help="overwrite existing outputs")
@@ -124,6 +127,8 @@ def build_scene(arguments):
     for view_layer in scene.view_layers:
         blender_scenes.enable_passes(view_layer, depth=not arguments.no_depth, normal=True,
                                      ao=arguments.ao_distance is not None)
+        if arguments.production_passes:
+            blender_scenes.enable_production_passes(view_layer)
     if arguments.ao_distance is not None:
         blender_scenes.configure_ao_reference(scene, arguments.ao_distance)
     settings = scene.render.image_settings

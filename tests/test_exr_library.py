@@ -25,10 +25,15 @@ RESULT_CODES = (0, 1, 2, 3, 4, 5)
 MESSAGE_SIZE = 1024  # HBAO_EXR_MESSAGE_SIZE
 # Fixture renders: tiny and few samples; the pixel values do not matter, only
 # that Blender wrote them. One file as the render hook writes it (32-bit,
-# uncompressed), one as artists often save (half float, ZIP), two layers.
+# uncompressed), one with many passes, one as artists often save (half float,
+# ZIP), two layers (last: tests take it as blender_exrs[-1]).
 RENDERS = {
     "hook_like": ["--scene", "corner", "--width", "48", "--height", "32", "--samples", "1",
                   "--codec", "NONE"],
+    # As the hook writes a render with an artist's usual passes: a few
+    # channels of many are read (exr_stream.h).
+    "production_passes": ["--scene", "corner", "--width", "48", "--height", "32",
+                          "--samples", "1", "--codec", "NONE", "--production-passes"],
     "half_zip_two_layers": ["--scene", "two_layers", "--width", "40", "--height", "24",
                             "--samples", "1", "--codec", "ZIP", "--half"],
 }
@@ -407,6 +412,71 @@ def test_reads_in_parallel_threads_agree(blender_exrs):
     for result in results:
         assert all(np.array_equal(result[name], reference[name], equal_nan=True)
                    for name in names)
+
+
+def _depth_and_normal(path, threads):
+    layer = next(name for name in exr.channel_names(path) if name.endswith(".Depth.Z"))[:-8]
+    return exr.read_channel_groups(path, {
+        "depth": [f"{layer}.Depth.Z"],
+        "normal": [f"{layer}.Normal.{axis}" for axis in "XYZ"]}, threads)
+
+
+def test_a_few_channels_of_many_are_what_reading_every_channel_gives(blender_exrs):
+    """The hand-over's read of a render with an artist's passes: Depth and the
+    interleaved Normal are at most a quarter of the uncompressed file's bytes,
+    so OpenEXRCore reads only their lines and the stream skips the rest
+    (exr_reader.c, part_reads_direct). They must be exactly what a read of
+    every channel gives, on 1 and 3 threads."""
+    path = next(path for path in blender_exrs if path.stem == "production_passes")
+    names = exr.channel_names(path)
+    assert len(names) >= 4 * 4 * 3, names  # Depth and Normal well under a quarter
+    layer = next(name for name in names if name.endswith(".Depth.Z"))[:-8]
+    every = exr.read_channels(path, names, threads=1)
+    for threads in (1, 3):
+        got = _depth_and_normal(path, threads)
+        assert np.array_equal(got["depth"], every[f"{layer}.Depth.Z"]), threads
+        for index, axis in enumerate("XYZ"):
+            assert np.array_equal(got["normal"][:, :, index], every[f"{layer}.Normal.{axis}"])
+    assert got["depth"].min() < got["depth"].max()
+
+
+def test_a_few_channels_among_half_and_float_ones(tmp_path):
+    """Uncompressed, one part: float Z and N.X/Y/Z among 24 float and 8 half
+    channels that are not read (the stream skips their lines), and half ones
+    read as float (OpenEXRCore converts: every line is read). Each value
+    must be the one written; a chunk whose size is not its lines' is an
+    error, never other pixels."""
+    from test_cli import scanline_exr
+    width, height = 37, 21
+    generator = np.random.default_rng(19)
+    channels = {name: generator.uniform(-4, 4, (height, width)).astype(np.float32)
+                for name in [f"F{k:02d}" for k in range(24)] + [f"h{k}" for k in range(8)] +
+                ["N.X", "N.Y", "N.Z", "Z"]}
+    half = [f"h{k}" for k in range(8)]
+    for name in half:
+        channels[name] = channels[name].astype(np.float16).astype(np.float32)
+    path = tmp_path / "wide.exr"
+    data = scanline_exr(channels, width, height, half=half)
+    path.write_bytes(data)
+    groups = {"depth": ["Z"], "normal": ["N.X", "N.Y", "N.Z"], "halves": ["h2", "h5"]}
+    for threads in (1, 2):
+        got = exr.read_channel_groups(path, {key: groups[key] for key in ("depth", "normal")},
+                                      threads)
+        assert np.array_equal(got["depth"], channels["Z"])
+        for index, name in enumerate(groups["normal"]):
+            assert np.array_equal(got["normal"][:, :, index], channels[name])
+        got = exr.read_channel_groups(path, {"halves": groups["halves"]}, threads)
+        for index, name in enumerate(groups["halves"]):
+            assert np.array_equal(got["halves"][:, :, index], channels[name])
+    # Row 7's chunk says it holds 4 bytes fewer than its lines.
+    table = _offset_table_start(data, height)
+    chunk = int.from_bytes(data[table + 8 * 7:table + 8 * 8], "little")
+    size = int.from_bytes(data[chunk + 4:chunk + 8], "little")
+    corrupt = tmp_path / "corrupt.exr"
+    corrupt.write_bytes(data[:chunk + 4] + (size - 4).to_bytes(4, "little") + data[chunk + 8:])
+    with pytest.raises(exr.EXRFormatError, match="corrupt chunk at scanline 7") as raised:
+        exr.read_channel_groups(corrupt, {key: groups[key] for key in ("depth", "normal")}, 1)
+    assert raised.value.code == ERROR_FORMAT
 
 
 def test_binding_says_what_to_do_when_the_library_is_missing(tmp_path, monkeypatch):

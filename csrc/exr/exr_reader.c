@@ -10,6 +10,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "exr_stream.h"
 #include "hbao.h"
 
 /* OpenEXRCore reports details (which attribute is bad, which chunk is
@@ -275,10 +276,12 @@ static int check_chunks(exr_input *input, tool_error *error) {
 
 int exr_input_open(exr_input *input, const char *path, tool_error *error) {
     memset(input, 0, sizeof *input);
+    input->stream.fd = -1;
     input->path = path;
     input->threads = 1;
     exr_clear_last_error();
     exr_context_initializer_t initializer = exr_quiet_initializer();
+    exr_stream_open(&input->stream, path, &initializer);
     int status = TOOL_EXIT_SUCCESS;
     exr_result_t opened = exr_start_read(&input->context, path, &initializer);
     if (opened != EXR_ERR_SUCCESS) {
@@ -378,32 +381,72 @@ static const exr_channel_request *find_request(const exr_channel_request *reques
     return NULL;
 }
 
+/* Whether `part` is read directly (exr_stream.h): uncompressed, every
+ * request for one of its channels in that channel's own type (so that
+ * OpenEXRCore converts nothing and reads each channel's line straight into
+ * its destination), and the requested channels at most a quarter of the
+ * part's bytes. Reading a line channel by channel costs a system call each:
+ * on the Zen 3 VM of docs/speed.md (session 19), 4 float channels of 8 read
+ * this way took twice as long as whole chunks, 4 of 81 a third as long.
+ * Requests whose pixel stride is not the type's size, `*staged` of them, go
+ * to a staging buffer first. */
+static bool part_reads_direct(exr_input *input, int part, const exr_channel_request *requests,
+                              int count, int *staged) {
+    exr_compression_t compression = EXR_COMPRESSION_LAST_TYPE;
+    const exr_attr_chlist_t *list = NULL;
+    *staged = 0;
+    if (exr_get_compression(input->context, part, &compression) != EXR_ERR_SUCCESS ||
+        compression != EXR_COMPRESSION_NONE ||
+        exr_get_channels(input->context, part, &list) != EXR_ERR_SUCCESS || list == NULL)
+        return false;
+    int64_t requested_bytes = 0, part_bytes = 0;
+    for (int c = 0; c < list->num_channels; ++c) {
+        const int size = exr_pixel_type_size(list->entries[c].pixel_type);
+        part_bytes += size;
+        const exr_channel_request *request =
+            find_request(requests, count, list->entries[c].name.str);
+        if (request == NULL) continue;
+        if (request->type != list->entries[c].pixel_type) return false;
+        requested_bytes += size;
+        *staged += request->pixel_stride != size;
+    }
+    return requested_bytes * 4 <= part_bytes;
+}
+
 /* Decode the requests that name channels of `part`, for the chunks that
  * start at rows first_y .. last_y of the file (a band; every chunk of the
  * part when the band is the whole data window); the other requests are left
  * to the other parts (a name is in one part only).
  *
- * The part's channels that nobody asked for are decoded too, into one scratch
- * chunk that is thrown away: OpenEXRCore 3.1 is told to skip a channel by a
- * NULL destination, but its fast unpackers for 3 and 4 half channels converted
- * to float write through the NULL (an RGB + Z half file whose Z alone is read
- * crashed). Every channel with a real destination keeps the library on paths
- * that need no such care; the cost is a copy of channels that are decompressed
- * anyway. */
+ * The part's channels that nobody asked for get a destination too, one
+ * scratch chunk that is thrown away: OpenEXRCore 3.1 is told to skip a channel
+ * by a NULL destination, but its fast unpackers for 3 and 4 half channels
+ * converted to float write through the NULL (an RGB + Z half file whose Z
+ * alone is read crashed). Every channel with a real destination keeps the
+ * library on paths that need no such care. Where the part is compressed,
+ * this costs a copy of channels that are decompressed anyway. Where it is
+ * not (the add-on's scratch file, every pass of a render), OpenEXRCore reads
+ * each channel's line into its destination, and the stream skips the reads
+ * into the scratch chunk (exr_stream.h): only the requested channels' bytes
+ * leave the file. */
 static int read_band(exr_input *input, int part, const exr_channel_request *requests, int count,
                      int64_t first_y, int64_t last_y, atomic_bool *stop, tool_error *error) {
     int status = TOOL_EXIT_SUCCESS;
     exr_decode_pipeline_t decoder = EXR_DECODE_PIPELINE_INITIALIZER;
     bool decoder_ready = false;
-    uint8_t *scratch = NULL;
+    uint8_t *scratch = NULL, *staging = NULL;
 
     int32_t lines_per_chunk = 0;
     status = part_lines_per_chunk(input, part, &lines_per_chunk, error);
     if (status != TOOL_EXIT_SUCCESS) goto fail;
     /* 4 bytes: the widest pixel type (float, uint). */
     const int64_t scratch_line = (int64_t)input->width * 4;
-    scratch = malloc((size_t)(scratch_line * lines_per_chunk));
-    if (scratch == NULL) {
+    const size_t scratch_size = (size_t)(scratch_line * lines_per_chunk);
+    int staged_count = 0;
+    const bool direct = part_reads_direct(input, part, requests, count, &staged_count);
+    scratch = malloc(scratch_size);
+    if (staged_count > 0) staging = malloc(scratch_size * (size_t)staged_count);
+    if (scratch == NULL || (staged_count > 0 && staging == NULL)) {
         status = tool_fail(error, TOOL_EXIT_RUNTIME, "out of memory");
         goto fail;
     }
@@ -414,6 +457,15 @@ static int read_band(exr_input *input, int part, const exr_channel_request *requ
         exr_chunk_info_t chunk;
         status = read_chunk_info(input, part, lines_per_chunk, y, input->file_size, &chunk, error);
         if (status != TOOL_EXIT_SUCCESS) goto fail;
+        /* A direct read takes the channels' lines one after the other from
+         * the chunk's start: they must be all the chunk holds. */
+        if (direct && chunk.packed_size != chunk.unpacked_size) {
+            status = tool_fail(error, TOOL_EXIT_RUNTIME,
+                               "%s: corrupt chunk at scanline %lld (%llu bytes for %llu)",
+                               input->path, (long long)y, (unsigned long long)chunk.packed_size,
+                               (unsigned long long)chunk.unpacked_size);
+            goto fail;
+        }
         if (!decoder_ready) {
             CHECK_EXR(exr_decoding_initialize(input->context, part, &chunk, &decoder),
                       "cannot start decoding");
@@ -423,6 +475,7 @@ static int read_band(exr_input *input, int part, const exr_channel_request *requ
                       "cannot decode a chunk");
         }
         const int64_t first_row = chunk.start_y - window->min_y;
+        int staged = 0;
         for (int c = 0; c < decoder.channel_count; ++c) {
             exr_coding_channel_info_t *channel = &decoder.channels[c];
             const exr_channel_request *request =
@@ -430,20 +483,30 @@ static int read_band(exr_input *input, int part, const exr_channel_request *requ
             if (request == NULL) {
                 channel->decode_to_ptr = scratch;
                 channel->user_pixel_stride = channel->bytes_per_element;
-                channel->user_line_stride = (int32_t)(channel->bytes_per_element * input->width);
+                /* direct: every line of the chunk on the first (skipped) */
+                channel->user_line_stride =
+                    direct ? 0 : (int32_t)(channel->bytes_per_element * input->width);
                 channel->user_data_type = channel->data_type;
                 channel->user_bytes_per_element = channel->bytes_per_element;
+                continue;
+            }
+            channel->user_data_type = (uint16_t)request->type;
+            channel->user_bytes_per_element = (int16_t)exr_pixel_type_size(request->type);
+            if (direct && request->pixel_stride != channel->user_bytes_per_element) {
+                channel->decode_to_ptr = staging + scratch_size * (size_t)staged++;
+                channel->user_pixel_stride = channel->user_bytes_per_element;
+                channel->user_line_stride = (int32_t)scratch_line;
                 continue;
             }
             channel->decode_to_ptr = request->data + first_row * request->row_stride;
             channel->user_pixel_stride = request->pixel_stride;
             channel->user_line_stride = (int32_t)request->row_stride;
-            channel->user_data_type = (uint16_t)request->type;
-            channel->user_bytes_per_element = (int16_t)exr_pixel_type_size(request->type);
         }
         CHECK_EXR(exr_decoding_choose_default_routines(input->context, part, &decoder),
                   "cannot decode this channel layout");
+        if (direct) exr_stream_discard_into(scratch, scratch_size);
         exr_result_t decoded = exr_decoding_run(input->context, part, &decoder);
+        exr_stream_discard_into(NULL, 0);
         if (decoded == EXR_ERR_FEATURE_NOT_IMPLEMENTED) {
             /* OpenEXRCore 3.1 cannot decompress DWAA/DWAB. */
             exr_compression_t compression = input->compression;
@@ -455,12 +518,29 @@ static int read_band(exr_input *input, int part, const exr_channel_request *requ
             goto fail;
         }
         CHECK_EXR(decoded, "cannot decode a chunk (file truncated or corrupt?)");
+        /* the staged lines to their requests, in the decoder's order */
+        staged = 0;
+        for (int c = 0; c < decoder.channel_count && staged < staged_count; ++c) {
+            const exr_coding_channel_info_t *channel = &decoder.channels[c];
+            if (channel->decode_to_ptr != staging + scratch_size * (size_t)staged) continue;
+            const exr_channel_request *request =
+                find_request(requests, count, channel->channel_name);
+            const size_t size = (size_t)channel->user_bytes_per_element;
+            for (int32_t line = 0; line < chunk.height; ++line) {
+                const uint8_t *from = channel->decode_to_ptr + (size_t)line * (size_t)scratch_line;
+                uint8_t *to = request->data + (first_row + line) * request->row_stride;
+                for (int32_t x = 0; x < input->width; ++x)
+                    memcpy(to + (int64_t)x * request->pixel_stride, from + (size_t)x * size, size);
+            }
+            ++staged;
+        }
     }
 
 fail:
     if (status != TOOL_EXIT_SUCCESS) atomic_store(stop, true);
     if (decoder_ready) exr_decoding_destroy(input->context, &decoder);
     free(scratch);
+    free(staging);
     return status;
 }
 
@@ -567,6 +647,7 @@ int exr_input_read(exr_input *input, const exr_channel_request *requests, int co
 void exr_input_close(exr_input *input) {
     if (input->context != NULL) exr_finish(&input->context);
     input->context = NULL;
+    exr_stream_close(&input->stream);
     input->channels = NULL;
     free((void *)input->channel_union.entries);
     input->channel_union.entries = NULL;

@@ -13,11 +13,13 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "exr_stream.h"
 #include "pixel_rect.h"
 #include "tool_error.h"
 
 typedef struct exr_input {
     exr_context_t context;
+    exr_stream stream; /**< the file the context reads */
     const char *path;
     pixel_rect data_window;
     pixel_rect display_window;
