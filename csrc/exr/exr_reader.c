@@ -255,10 +255,22 @@ static int check_chunks(exr_input *input, tool_error *error) {
         int32_t lines_per_chunk = 0;
         status = part_lines_per_chunk(input, part, &lines_per_chunk, error);
         if (status != TOOL_EXIT_SUCCESS) return status;
+        exr_compression_t compression = EXR_COMPRESSION_LAST_TYPE;
+        CHECK_EXR(exr_get_compression(input->context, part, &compression), "no compression");
         for (int64_t y = window->min_y; y <= window->max_y; y += lines_per_chunk) {
             exr_chunk_info_t chunk;
             status = read_chunk_info(input, part, lines_per_chunk, y, (int64_t)file_status.st_size,
                                      &chunk, error);
+            /* Uncompressed, a chunk holds its lines and nothing else: one that
+             * says it is shorter would be read past its end, or (read whole)
+             * leave part of the decoder's buffer unwritten. OpenEXRCore 3.4.15
+             * and later refuse it in exr_read_scanline_chunk_info already. */
+            if (status == TOOL_EXIT_SUCCESS && compression == EXR_COMPRESSION_NONE &&
+                chunk.packed_size != chunk.unpacked_size)
+                return tool_fail(error, TOOL_EXIT_RUNTIME,
+                                 "%s: corrupt chunk at scanline %lld (%llu bytes for %llu)",
+                                 input->path, (long long)y, (unsigned long long)chunk.packed_size,
+                                 (unsigned long long)chunk.unpacked_size);
             if (status != TOOL_EXIT_SUCCESS) {
                 char detail[TOOL_ERROR_MESSAGE_SIZE];
                 snprintf(detail, sizeof detail, "%s", error->message);
@@ -271,12 +283,12 @@ static int check_chunks(exr_input *input, tool_error *error) {
         }
     }
     input->file_size = (int64_t)file_status.st_size;
+fail:
     return status;
 }
 
 int exr_input_open(exr_input *input, const char *path, tool_error *error) {
-    memset(input, 0, sizeof *input);
-    input->stream.fd = -1;
+    memset(input, 0, sizeof *input); /* input->stream: not open */
     input->path = path;
     input->threads = 1;
     exr_clear_last_error();
@@ -400,6 +412,7 @@ static bool part_reads_direct(exr_input *input, int part, const exr_channel_requ
         exr_get_channels(input->context, part, &list) != EXR_ERR_SUCCESS || list == NULL)
         return false;
     int64_t requested_bytes = 0, part_bytes = 0;
+    int staged_requests = 0;
     for (int c = 0; c < list->num_channels; ++c) {
         const int size = exr_pixel_type_size(list->entries[c].pixel_type);
         part_bytes += size;
@@ -408,9 +421,11 @@ static bool part_reads_direct(exr_input *input, int part, const exr_channel_requ
         if (request == NULL) continue;
         if (request->type != list->entries[c].pixel_type) return false;
         requested_bytes += size;
-        *staged += request->pixel_stride != size;
+        staged_requests += request->pixel_stride != size;
     }
-    return requested_bytes * 4 <= part_bytes;
+    if (requested_bytes * 4 > part_bytes) return false;
+    *staged = staged_requests;
+    return true;
 }
 
 /* Decode the requests that name channels of `part`, for the chunks that
@@ -457,15 +472,6 @@ static int read_band(exr_input *input, int part, const exr_channel_request *requ
         exr_chunk_info_t chunk;
         status = read_chunk_info(input, part, lines_per_chunk, y, input->file_size, &chunk, error);
         if (status != TOOL_EXIT_SUCCESS) goto fail;
-        /* A direct read takes the channels' lines one after the other from
-         * the chunk's start: they must be all the chunk holds. */
-        if (direct && chunk.packed_size != chunk.unpacked_size) {
-            status = tool_fail(error, TOOL_EXIT_RUNTIME,
-                               "%s: corrupt chunk at scanline %lld (%llu bytes for %llu)",
-                               input->path, (long long)y, (unsigned long long)chunk.packed_size,
-                               (unsigned long long)chunk.unpacked_size);
-            goto fail;
-        }
         if (!decoder_ready) {
             CHECK_EXR(exr_decoding_initialize(input->context, part, &chunk, &decoder),
                       "cannot start decoding");

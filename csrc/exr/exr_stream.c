@@ -68,7 +68,8 @@ static int64_t stream_read(exr_const_context_t context, void *user_data, void *b
 
 void exr_stream_open(exr_stream *stream, const char *path, exr_context_initializer_t *initializer) {
     stream->fd = open(path, O_RDONLY | O_CLOEXEC);
-    if (stream->fd < 0) return;
+    stream->open = stream->fd >= 0;
+    if (!stream->open) return;
     struct stat status;
     if (fstat(stream->fd, &status) != 0 || !S_ISREG(status.st_mode)) {
         /* a folder, a pipe: OpenEXRCore's own open says what it is */
@@ -81,6 +82,7 @@ void exr_stream_open(exr_stream *stream, const char *path, exr_context_initializ
 }
 
 void exr_stream_close(exr_stream *stream) {
-    if (stream->fd >= 0) close(stream->fd);
+    if (stream->open) close(stream->fd);
+    stream->open = false;
     stream->fd = -1;
 }

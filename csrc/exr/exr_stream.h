@@ -17,10 +17,12 @@
 #define HBAO_EXR_STREAM_H
 
 #include <openexr.h>
+#include <stdbool.h>
 #include <stddef.h>
 
 typedef struct exr_stream {
-    int fd; /**< -1: not open; OpenEXRCore then opens the path itself */
+    bool open; /**< false (as zeroed): OpenEXRCore opens the path itself */
+    int fd;
 } exr_stream;
 
 /** Opens `path` for reading and hooks it into *initializer. Where the file
