@@ -4,8 +4,9 @@
 defaults) with only Combined, Depth and Normal, then with a compositing
 artist's usual passes as well (blender_scenes.PRODUCTION_PASSES).
 The hand-over saves the whole Render Result (handover.py), so it grows with
-them. Prints, for each, the AO and the hand-over (save, read, write) of the
-renders that computed the AO, as the add-on's console lines give them.
+them. Prints, for each, the helper scene's whole render (the engine's part
+of the frame), the AO and the hand-over (save, read, write) of the renders
+that computed the AO, as the add-on's console lines give them.
 
   python3 scripts/bench_handover_passes.py [--blender bpy-5] [--repeats 4]
 
@@ -24,8 +25,9 @@ from pathlib import Path
 import blenders
 
 REPO = Path(__file__).resolve().parent.parent
-LINE = re.compile(r"AO (\d+) ms, pass hand-over (\d+) ms \(save (\d+), read (\d+), write (\d+)\)")
-FIELDS = ("ao", "handover", "save", "read", "write")
+LINE = re.compile(r"in (\d+) ms: AO (\d+) ms, pass hand-over (\d+) ms "
+                  r"\(save (\d+), read (\d+), write (\d+)\)")
+FIELDS = ("total", "ao", "handover", "save", "read", "write")
 
 
 def run(blender, passes, repeats, user_scripts):
@@ -64,15 +66,16 @@ def main():
         (user_scripts / "addons" / "hbao").symlink_to(REPO / "addon" / "hbao")
         print(f"bench_handover_passes: {blender.name}, interior 1920x1080, 1 Cycles sample, "
               f"defaults; ms per render that computed the AO (median, least-greatest)")
-        print("| passes | AO | hand-over | save | read | write | hand-over / AO |")
-        print("|---|---|---|---|---|---|---|")
+        print("| passes | the helper's render | AO | hand-over | save | read | write | "
+              "hand-over / AO |")
+        print("|---|---|---|---|---|---|---|---|")
         for passes in ("plain", "production"):
             rows = run(blender, passes, args.repeats, user_scripts)
             cells = []
             for index in range(len(FIELDS)):
                 values = [row[index] for row in rows]
                 cells.append(f"{statistics.median(values):.0f} ({min(values)}-{max(values)})")
-            ratios = [row[1] / row[0] for row in rows]
+            ratios = [row[2] / row[1] for row in rows]
             name = "Combined, Depth, Normal" if passes == "plain" else "production (81 channels)"
             print(f"| {name} | " + " | ".join(cells) +
                   f" | {statistics.median(ratios):.2f} ({min(ratios):.2f}-{max(ratios):.2f}) |")

@@ -3,6 +3,7 @@
 Python engine no access to another scene's Render Result pixels, but it can
 save the Render Result as a multilayer EXR, which libhbao_exr decodes
 straight into numpy arrays."""
+import itertools
 import os
 import tempfile
 import threading
@@ -11,6 +12,7 @@ from time import perf_counter as _clock
 import bpy
 
 from . import compat, exr_passes
+from .report import log
 
 
 def _render_result_image():
@@ -24,13 +26,37 @@ def _render_result_image():
 SCRATCH_FOLDER_VARIABLE = "HBAO_TEMP_DIR"
 
 
+# Each scratch file its own number: the last one may still be being removed
+# (_remove_later) when the next is saved.
+_scratch_numbers = itertools.count()
+
+
 def _scratch_path():
     # Memory-backed where there is one: the file lives for milliseconds.
     folder = os.environ.get(SCRATCH_FOLDER_VARIABLE)
     if not folder:
         folder = "/dev/shm" if os.path.isdir("/dev/shm") and os.access("/dev/shm", os.W_OK) \
             else tempfile.gettempdir()
-    return os.path.join(folder, f"hbao-passes-{os.getpid()}-{threading.get_ident()}.exr")
+    return os.path.join(folder, f"hbao-passes-{os.getpid()}-{threading.get_ident()}-"
+                                f"{next(_scratch_numbers)}.exr")
+
+
+def _remove(path):
+    try:
+        os.remove(path)
+    except FileNotFoundError:
+        pass
+    except OSError as error:
+        log(f"could not remove the scratch file {path}: {error}")
+
+
+def _remove_later(path):
+    """Remove `path` in a thread of its own. Freeing a large file's pages is
+    the kernel's work, and long: a 1920x1080 render with 81 channels, 672
+    MB, took 115 ms on tmpfs (docs/speed.md, session 19), which the render
+    need not wait for. Not a daemon thread: Python waits for it before the
+    process ends, so no scratch file outlives Blender."""
+    threading.Thread(target=_remove, args=(path,), name="hbao-scratch-removal").start()
 
 
 def save_passes(scene, path):
@@ -75,8 +101,7 @@ def read_passes(scene, layers):
         channels = exr_passes.read_channel_groups(path, groups)
         timings["read"] = _clock() - read_start
     finally:
-        if os.path.exists(path):
-            os.remove(path)
+        _remove_later(path)
     return channels, timings
 
 

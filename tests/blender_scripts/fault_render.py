@@ -6,9 +6,11 @@ fault set up first, by a render_pre handler registered after the add-on's
   blender -b --addons hbao --python fault_render.py -- '<json spec>' <out dir> <fault>
 
 Faults:
-  unreadable_save   the scratch path (HBAO_TEMP_DIR/hbao-passes-<pid>-<thread>.exr,
-                    known here: a -b render runs in this thread) is a link to
-                    /dev/null: the save "succeeds", the file read back is empty.
+  unreadable_save   the scratch path (HBAO_TEMP_DIR/hbao-passes-<pid>-<thread>-0.exr,
+                    known here: a -b render runs in this thread, and its first
+                    hand-over saves the process's first scratch file) is a link
+                    to /dev/null: the save "succeeds", the file read back is
+                    empty.
   helper_resized    after the hook synced the helper scene, its
                     resolution_percentage is halved (meant to make its pass
                     smaller than the Render Result; Blender renders it at full
@@ -34,7 +36,7 @@ if fault == "unreadable_save":
     # The add-on's own naming (handover._scratch_path): the test checks the
     # link is gone afterwards, so a changed name fails it rather than passing.
     link = os.path.join(os.environ["HBAO_TEMP_DIR"],
-                        f"hbao-passes-{os.getpid()}-{threading.get_ident()}.exr")
+                        f"hbao-passes-{os.getpid()}-{threading.get_ident()}-0.exr")
     os.symlink("/dev/null", link)
     print("FAULT link", link, flush=True)
 elif fault == "helper_resized":
