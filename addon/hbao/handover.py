@@ -50,13 +50,33 @@ def _remove(path):
         log(f"could not remove the scratch file {path}: {error}")
 
 
+# The removals started and not yet waited for.
+_removals = []
+_removals_lock = threading.Lock()
+
+
 def _remove_later(path):
     """Remove `path` in a thread of its own. Freeing a large file's pages is
     the kernel's work, and long: a 1920x1080 render with 81 channels, 672
     MB, took 115 ms on tmpfs (docs/speed.md, session 19), which the render
     need not wait for. Not a daemon thread: Python waits for it before the
     process ends, so no scratch file outlives Blender."""
-    threading.Thread(target=_remove, args=(path,), name="hbao-scratch-removal").start()
+    thread = threading.Thread(target=_remove, args=(path,), name="hbao-scratch-removal")
+    thread.start()
+    with _removals_lock:
+        _removals.append(thread)
+
+
+def _wait_for_older_removals():
+    """Before the next save: every removal but the latest done, so that at
+    most two scratch files exist at a time, however quickly frames follow
+    each other, while a frame's second save (a guard band's, a back face
+    layer's) does not wait for its first one's removal."""
+    with _removals_lock:
+        older = _removals[:-1]
+        del _removals[:-1]
+    for thread in older:
+        thread.join()
 
 
 def save_passes(scene, path):
@@ -84,6 +104,7 @@ def read_passes(scene, layers):
     row first, of `scene`'s Render Result, for `layers` {view layer name:
     whether its normal is wanted}; and the seconds the save and the read
     took."""
+    _wait_for_older_removals()
     path = _scratch_path()
     timings = {}
     try:
