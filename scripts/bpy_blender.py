@@ -16,6 +16,8 @@ import argparse
 import os
 import runpy
 import sys
+import threading
+import time
 import traceback
 
 
@@ -80,8 +82,19 @@ def main(argv):
     return 0
 
 
+def wait_for_python_threads(timeout_s=60.0):
+    """What Python's own shutdown does first, and Blender's WM_exit with it:
+    wait for the threads that are not daemons (the add-on removes its scratch
+    files in such threads)."""
+    deadline = time.monotonic() + timeout_s
+    for thread in threading.enumerate():
+        if thread is not threading.current_thread() and not thread.daemon:
+            thread.join(max(0.0, deadline - time.monotonic()))
+
+
 if __name__ == "__main__":
     status = main(sys.argv[1:])
+    wait_for_python_threads()
     # bpy 4.5's module can deadlock in its C++ static destructors at exit
     # (its delayed file-close thread still waits on the condition variable
     # being destroyed; seen after a render whose render_pre handler changed

@@ -732,3 +732,12 @@ def test_package_and_install(tmp_path):
          "bpy.context.preferences.addons, n.library_version())"],
         env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     assert "ENABLED True 0." in check.stdout, check.stdout[-2000:]
+
+
+def test_scratch_files_are_removed_beside_the_render_two_at_most(run_in_blender, tmp_path):
+    """handover.py removes each scratch file in a thread of its own; a save
+    waits for every removal but the latest (at most two files at a time), and
+    Blender does not end before the last removal: the folder is empty after."""
+    completed = run_in_blender(SCRIPTS / "scratch_removal.py", tmp_path)
+    assert "REMOVAL OK" in completed.stdout, completed.stdout[-3000:]
+    assert list(tmp_path.iterdir()) == []

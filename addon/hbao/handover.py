@@ -60,7 +60,8 @@ def _remove_later(path):
     the kernel's work, and long: a 1920x1080 render with 81 channels, 672
     MB, took 115 ms on tmpfs (docs/speed.md, session 19), which the render
     need not wait for. Not a daemon thread: Python waits for it before the
-    process ends, so no scratch file outlives Blender."""
+    process ends, so no scratch file outlives Blender (a process that ends
+    by os._exit skips that wait: scripts/bpy_blender.py waits first)."""
     thread = threading.Thread(target=_remove, args=(path,), name="hbao-scratch-removal")
     thread.start()
     with _removals_lock:

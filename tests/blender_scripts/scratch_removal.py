@@ -1,0 +1,56 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Run in every Blender of the matrix by tests/test_addon.py: the hand-over
+removes its scratch files in threads of their own (handover._remove_later),
+and before each save waits for every removal but the latest, so that at most
+two scratch files exist at a time. Here the removals are held back until
+released, to see who waits for whom. Prints 'REMOVAL OK'; the test checks
+that <folder> is empty once Blender has ended (Python waits for the last
+removal's thread, still running when this script ends).
+
+  blender -b --addons hbao --python scratch_removal.py -- <folder>
+"""
+import os
+import sys
+import threading
+import time
+
+from hbao import handover
+
+folder = sys.argv[sys.argv.index("--") + 1]
+release = threading.Event()
+remove = handover._remove
+
+
+def held_back(path):
+    release.wait(30)
+    if path.endswith("-2.exr"):
+        time.sleep(1.0)  # still pending when the script ends
+    remove(path)
+
+
+handover._remove = held_back  # the add-on's own function, not Blender's
+paths = []
+for number in range(3):
+    path = os.path.join(folder, f"hbao-passes-test-{number}.exr")
+    with open(path, "wb") as scratch:
+        scratch.write(b"\0" * 4096)
+    handover._remove_later(path)
+    paths.append(path)
+assert all(os.path.exists(path) for path in paths)
+
+# The next save waits for the first two removals, not for the third.
+waiter = threading.Thread(target=handover._wait_for_older_removals)
+waiter.start()
+time.sleep(0.3)
+assert waiter.is_alive(), "the save did not wait for the older removals"
+release.set()
+waiter.join(30)
+assert not waiter.is_alive()
+assert not os.path.exists(paths[0]) and not os.path.exists(paths[1]), os.listdir(folder)
+
+# A save right after waits for nothing: the third removal is the latest.
+start = time.perf_counter()
+handover._wait_for_older_removals()
+assert time.perf_counter() - start < 0.5
+assert os.path.exists(paths[2]), "the latest removal should still be pending"
+print("REMOVAL OK", flush=True)
