@@ -5,8 +5,10 @@ save the Render Result as a multilayer EXR, which libhbao_exr decodes
 straight into numpy arrays."""
 import itertools
 import os
+import re
 import tempfile
 import threading
+import time
 from time import perf_counter as _clock
 
 import bpy
@@ -31,14 +33,68 @@ SCRATCH_FOLDER_VARIABLE = "HBAO_TEMP_DIR"
 _scratch_numbers = itertools.count()
 
 
-def _scratch_path():
+def _scratch_folder():
     # Memory-backed where there is one: the file lives for milliseconds.
     folder = os.environ.get(SCRATCH_FOLDER_VARIABLE)
     if not folder:
         folder = "/dev/shm" if os.path.isdir("/dev/shm") and os.access("/dev/shm", os.W_OK) \
             else tempfile.gettempdir()
-    return os.path.join(folder, f"hbao-passes-{os.getpid()}-{threading.get_ident()}-"
-                                f"{next(_scratch_numbers)}.exr")
+    return folder
+
+
+def _scratch_path():
+    return os.path.join(_scratch_folder(), f"hbao-passes-{os.getpid()}-{threading.get_ident()}-"
+                                           f"{next(_scratch_numbers)}.exr")
+
+
+SCRATCH_NAME = re.compile(r"hbao-passes-(\d+)-\d+(-\d+)?\.exr")
+
+
+def _process_ended(pid):
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return True
+    except OSError:  # another user's: alive
+        return False
+    return False
+
+
+# A scratch file lives for a second at most; one this old is left over.
+STALE_AGE_S = 600
+
+
+def remove_stale_scratch_files():
+    """Remove the scratch files of Blender processes that have ended: one
+    killed while it handed passes over, or a bpy script that ended by
+    os._exit before its removal thread was done. Only files older than
+    STALE_AGE_S: a process of another PID namespace that shares the folder
+    looks ended from here, but its files are never that old. A file of a
+    running process, or one this user may not remove, is left alone.
+    Returns the paths removed."""
+    folder = _scratch_folder()
+    removed = []
+    try:
+        names = os.listdir(folder)
+    except OSError:
+        return removed
+    now = time.time()
+    for name in names:
+        match = SCRATCH_NAME.fullmatch(name)
+        if match is None or not _process_ended(int(match.group(1))):
+            continue
+        path = os.path.join(folder, name)
+        try:
+            if now - os.stat(path).st_mtime < STALE_AGE_S:
+                continue
+            os.remove(path)
+            removed.append(path)
+        except OSError:
+            pass
+    return removed
+
+
+_stale_files_checked = False
 
 
 def _remove(path):
@@ -105,6 +161,11 @@ def read_passes(scene, layers):
     row first, of `scene`'s Render Result, for `layers` {view layer name:
     whether its normal is wanted}; and the seconds the save and the read
     took."""
+    global _stale_files_checked
+    if not _stale_files_checked:
+        _stale_files_checked = True
+        for stale in remove_stale_scratch_files():
+            log(f"removed {stale}, left by a Blender that has ended")
     _wait_for_older_removals()
     path = _scratch_path()
     timings = {}

@@ -3,13 +3,15 @@
 removes its scratch files in threads of their own (handover._remove_later),
 and before each save waits for every removal but the latest, so that at most
 two scratch files exist at a time. Here the removals are held back until
-released, to see who waits for whom. Prints 'REMOVAL OK'; the test checks
-that <folder> is empty once Blender has ended (Python waits for the last
-removal's thread, still running when this script ends).
+released, to see who waits for whom. Then: the files that Blenders which
+have ended left behind are removed, and no others. Prints 'REMOVAL OK'; the
+test checks that <folder> is empty once Blender has ended (Python waits for
+the last removal's thread, still running when this script ends).
 
   blender -b --addons hbao --python scratch_removal.py -- <folder>
 """
 import os
+import subprocess
 import sys
 import threading
 import time
@@ -53,4 +55,30 @@ start = time.perf_counter()
 handover._wait_for_older_removals()
 assert time.perf_counter() - start < 0.5
 assert os.path.exists(paths[2]), "the latest removal should still be pending"
+
+
+# Files left by Blenders that ended (killed, or os._exit before the removal
+# thread was done) go at a process's first hand-over: only files older than
+# handover.STALE_AGE_S, of processes that have ended.
+os.environ[handover.SCRATCH_FOLDER_VARIABLE] = folder
+ended = subprocess.Popen(["true"])
+ended.wait()
+old = time.time() - handover.STALE_AGE_S - 60
+names = {"stale": (f"hbao-passes-{ended.pid}-1-7.exr", old),
+         "stale, before session 19's numbers": (f"hbao-passes-{ended.pid}-1.exr", old),
+         "fresh": (f"hbao-passes-{ended.pid}-1-8.exr", None),
+         "this process's": (f"hbao-passes-{os.getpid()}-1-9.exr", old),
+         "not a scratch file": ("hbao-passes-notes.exr", old)}
+for name, mtime in names.values():
+    path = os.path.join(folder, name)
+    open(path, "wb").close()
+    if mtime is not None:
+        os.utime(path, (mtime, mtime))
+removed = sorted(os.path.basename(path) for path in handover.remove_stale_scratch_files())
+expected = sorted(names[kind][0] for kind in ("stale", "stale, before session 19's numbers"))
+assert removed == expected, (removed, expected)
+for kind in ("fresh", "this process's", "not a scratch file"):
+    path = os.path.join(folder, names[kind][0])
+    assert os.path.exists(path), kind
+    os.remove(path)
 print("REMOVAL OK", flush=True)
