@@ -55,7 +55,7 @@ def _process_ended(pid):
         os.kill(pid, 0)
     except ProcessLookupError:
         return True
-    except OSError:  # another user's: alive
+    except (OSError, OverflowError):  # another user's (alive), or no process id at all
         return False
     return False
 

@@ -68,7 +68,8 @@ names = {"stale": (f"hbao-passes-{ended.pid}-1-7.exr", old),
          "stale, before session 19's numbers": (f"hbao-passes-{ended.pid}-1.exr", old),
          "fresh": (f"hbao-passes-{ended.pid}-1-8.exr", None),
          "this process's": (f"hbao-passes-{os.getpid()}-1-9.exr", old),
-         "not a scratch file": ("hbao-passes-notes.exr", old)}
+         "not a scratch file": ("hbao-passes-notes.exr", old),
+         "no process id": (f"hbao-passes-{2 ** 80}-1-1.exr", old)}
 for name, mtime in names.values():
     path = os.path.join(folder, name)
     open(path, "wb").close()
@@ -77,7 +78,7 @@ for name, mtime in names.values():
 removed = sorted(os.path.basename(path) for path in handover.remove_stale_scratch_files())
 expected = sorted(names[kind][0] for kind in ("stale", "stale, before session 19's numbers"))
 assert removed == expected, (removed, expected)
-for kind in ("fresh", "this process's", "not a scratch file"):
+for kind in ("fresh", "this process's", "not a scratch file", "no process id"):
     path = os.path.join(folder, names[kind][0])
     assert os.path.exists(path), kind
     os.remove(path)
