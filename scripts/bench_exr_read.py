@@ -41,10 +41,13 @@ print(json.dumps(statistics.median(times)))
 
 def median_read(library, args):
     env = dict(os.environ, HBAO_EXR_LIBRARY=str(library))
-    output = subprocess.run(
+    completed = subprocess.run(
         [sys.executable, "-c", CHILD, str(REPO / "addon"), str(args.file), args.layer,
-         str(args.reads)], env=env, check=True, capture_output=True, text=True).stdout
-    return json.loads(output.strip().splitlines()[-1])
+         str(args.reads)], env=env, capture_output=True, text=True)
+    if completed.returncode != 0:
+        last = (completed.stderr.strip().splitlines() or ["(no message)"])[-1]
+        raise SystemExit(f"bench_exr_read: reading {args.file} with {library} failed: {last}")
+    return json.loads(completed.stdout.strip().splitlines()[-1])
 
 
 def main():
@@ -56,6 +59,11 @@ def main():
     parser.add_argument("--rounds", type=int, default=10)
     parser.add_argument("--reads", type=int, default=7)
     args = parser.parse_args()
+    for path in (args.before, args.after, args.file):
+        if not path.is_file():
+            parser.error(f"{path}: no such file")
+    if args.rounds < 1 or args.reads < 1:
+        parser.error("--rounds and --reads must be at least 1")
     times = {"before": [], "after": []}
     ratios = []
     for round_index in range(args.rounds):

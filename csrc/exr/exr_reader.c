@@ -450,6 +450,10 @@ static int read_band(exr_input *input, int part, const exr_channel_request *requ
     exr_decode_pipeline_t decoder = EXR_DECODE_PIPELINE_INITIALIZER;
     bool decoder_ready = false;
     uint8_t *scratch = NULL, *staging = NULL;
+    /* each decoder channel's request (NULL: none), looked up once: the
+     * decoder keeps its channels in one order for every chunk */
+    const exr_channel_request **channel_requests = NULL;
+    int *staged_channels = NULL; /* the decoder channels that go through staging */
 
     int32_t lines_per_chunk = 0;
     status = part_lines_per_chunk(input, part, &lines_per_chunk, error);
@@ -460,8 +464,11 @@ static int read_band(exr_input *input, int part, const exr_channel_request *requ
     int staged_count = 0;
     const bool direct = part_reads_direct(input, part, requests, count, &staged_count);
     scratch = malloc(scratch_size);
-    if (staged_count > 0) staging = malloc(scratch_size * (size_t)staged_count);
-    if (scratch == NULL || (staged_count > 0 && staging == NULL)) {
+    if (staged_count > 0) {
+        staging = malloc(scratch_size * (size_t)staged_count);
+        staged_channels = malloc((size_t)staged_count * sizeof *staged_channels);
+    }
+    if (scratch == NULL || (staged_count > 0 && (staging == NULL || staged_channels == NULL))) {
         status = tool_fail(error, TOOL_EXIT_RUNTIME, "out of memory");
         goto fail;
     }
@@ -476,6 +483,14 @@ static int read_band(exr_input *input, int part, const exr_channel_request *requ
             CHECK_EXR(exr_decoding_initialize(input->context, part, &chunk, &decoder),
                       "cannot start decoding");
             decoder_ready = true;
+            channel_requests = malloc((size_t)decoder.channel_count * sizeof *channel_requests);
+            if (channel_requests == NULL) {
+                status = tool_fail(error, TOOL_EXIT_RUNTIME, "out of memory");
+                goto fail;
+            }
+            for (int c = 0; c < decoder.channel_count; ++c)
+                channel_requests[c] =
+                    find_request(requests, count, decoder.channels[c].channel_name);
         } else {
             CHECK_EXR(exr_decoding_update(input->context, part, &chunk, &decoder),
                       "cannot decode a chunk");
@@ -484,8 +499,7 @@ static int read_band(exr_input *input, int part, const exr_channel_request *requ
         int staged = 0;
         for (int c = 0; c < decoder.channel_count; ++c) {
             exr_coding_channel_info_t *channel = &decoder.channels[c];
-            const exr_channel_request *request =
-                find_request(requests, count, channel->channel_name);
+            const exr_channel_request *request = channel_requests[c];
             if (request == NULL) {
                 channel->decode_to_ptr = scratch;
                 channel->user_pixel_stride = channel->bytes_per_element;
@@ -499,6 +513,7 @@ static int read_band(exr_input *input, int part, const exr_channel_request *requ
             channel->user_data_type = (uint16_t)request->type;
             channel->user_bytes_per_element = (int16_t)exr_pixel_type_size(request->type);
             if (direct && request->pixel_stride != channel->user_bytes_per_element) {
+                staged_channels[staged] = c;
                 channel->decode_to_ptr = staging + scratch_size * (size_t)staged++;
                 channel->user_pixel_stride = channel->user_bytes_per_element;
                 channel->user_line_stride = (int32_t)scratch_line;
@@ -524,13 +539,10 @@ static int read_band(exr_input *input, int part, const exr_channel_request *requ
             goto fail;
         }
         CHECK_EXR(decoded, "cannot decode a chunk (file truncated or corrupt?)");
-        /* the staged lines to their requests, in the decoder's order */
-        staged = 0;
-        for (int c = 0; c < decoder.channel_count && staged < staged_count; ++c) {
-            const exr_coding_channel_info_t *channel = &decoder.channels[c];
-            if (channel->decode_to_ptr != staging + scratch_size * (size_t)staged) continue;
-            const exr_channel_request *request =
-                find_request(requests, count, channel->channel_name);
+        /* the staged lines to their requests */
+        for (int k = 0; k < staged; ++k) {
+            const exr_coding_channel_info_t *channel = &decoder.channels[staged_channels[k]];
+            const exr_channel_request *request = channel_requests[staged_channels[k]];
             const size_t size = (size_t)channel->user_bytes_per_element;
             for (int32_t line = 0; line < chunk.height; ++line) {
                 const uint8_t *from = channel->decode_to_ptr + (size_t)line * (size_t)scratch_line;
@@ -538,7 +550,6 @@ static int read_band(exr_input *input, int part, const exr_channel_request *requ
                 for (int32_t x = 0; x < input->width; ++x)
                     memcpy(to + (int64_t)x * request->pixel_stride, from + (size_t)x * size, size);
             }
-            ++staged;
         }
     }
 
@@ -547,6 +558,8 @@ fail:
     if (decoder_ready) exr_decoding_destroy(input->context, &decoder);
     free(scratch);
     free(staging);
+    free(channel_requests);
+    free(staged_channels);
     return status;
 }
 
