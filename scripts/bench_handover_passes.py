@@ -10,8 +10,9 @@ that computed the AO, as the add-on's console lines give them.
 
   python3 scripts/bench_handover_passes.py [--blender bpy-5] [--repeats 4]
 
-Needs the build (build/libhbao.so, build/libhbao_exr.so) and the Blender
-named (scripts/blenders.py; default: the newest bpy)."""
+Needs the build (build/libhbao.so, build/libhbao_exr.so, or the libraries
+that HBAO_LIBRARY and HBAO_EXR_LIBRARY name, to time another build) and the
+Blender named (scripts/blenders.py; default: the newest bpy)."""
 import argparse
 import json
 import os
@@ -34,9 +35,9 @@ def run(blender, passes, repeats, user_scripts):
     spec = {"scene": "interior", "width": 1920, "height": 1080, "samples": 1,
             "repeats": repeats, "threads": 2, "passes": passes,
             "node": {"directions": 4, "steps": 16, "blur_size": 5}}
-    env = dict(os.environ, HBAO_LIBRARY=str(REPO / "build/libhbao.so"),
-               HBAO_EXR_LIBRARY=str(REPO / "build/libhbao_exr.so"),
-               BLENDER_USER_SCRIPTS=str(user_scripts), PYTHONUNBUFFERED="1")
+    env = dict(os.environ, BLENDER_USER_SCRIPTS=str(user_scripts), PYTHONUNBUFFERED="1")
+    env.setdefault("HBAO_LIBRARY", str(REPO / "build/libhbao.so"))
+    env.setdefault("HBAO_EXR_LIBRARY", str(REPO / "build/libhbao_exr.so"))
     command = blender.command(REPO / "bench" / "addon_timing.py", [json.dumps(spec)])
     completed = subprocess.run(command, env=env, capture_output=True, text=True)
     if completed.returncode != 0:
