@@ -31,8 +31,9 @@ RENDERS = {
     "hook_like": ["--scene", "corner", "--width", "48", "--height", "32", "--samples", "1",
                   "--codec", "NONE"],
     # As the hook writes a render with an artist's usual passes: a few
-    # channels of many are read (exr_stream.h).
-    "production_passes": ["--scene", "corner", "--width", "48", "--height", "32",
+    # channels of many are read (exr_stream.h). Wide enough that the passes
+    # between Depth and Normal are more than the stream reads along (16 KiB).
+    "production_passes": ["--scene", "corner", "--width", "240", "--height", "160",
                           "--samples", "1", "--codec", "NONE", "--production-passes"],
     "half_zip_two_layers": ["--scene", "two_layers", "--width", "40", "--height", "24",
                             "--samples", "1", "--codec", "ZIP", "--half"],
@@ -434,10 +435,10 @@ def _read_counting_bytes(read):
 
 
 def test_a_few_channels_of_many_are_what_reading_every_channel_gives(blender_exrs):
-    """The hand-over's read of a render with an artist's passes: Depth and the
-    interleaved Normal are at most a quarter of the uncompressed file's bytes,
-    so OpenEXRCore reads only their lines and the stream skips the rest
-    (exr_reader.c, part_reads_direct): the process reads under a quarter of
+    """The hand-over's read of a render with an artist's passes: the file is
+    uncompressed, so OpenEXRCore reads only the lines of Depth and the
+    interleaved Normal and the stream skips the rest (exr_reader.c,
+    part_reads_direct; exr_stream.c): the process reads under a quarter of
     the file (a read of every channel, all of it). The pixels must be exactly
     what a read of every channel gives, on 1 and 3 threads."""
     path = next(path for path in blender_exrs if path.stem == "production_passes")
@@ -459,11 +460,16 @@ def test_a_few_channels_of_many_are_what_reading_every_channel_gives(blender_exr
 def test_a_few_channels_among_half_and_float_ones(tmp_path):
     """Uncompressed, one part: float Z and N.X/Y/Z among 24 float and 8 half
     channels that are not read (the stream skips their lines: the process
-    reads under half the file), and half ones read as float (OpenEXRCore
-    converts: every line is read). Each value must be the one written; a
-    chunk whose size is not its lines' is an error, never other pixels."""
+    reads under a quarter of the file), N.X and N.Z without the N.Y between
+    them (a line short enough for the stream to read along, into its
+    discard buffer, in the same system call), and half ones read as float
+    (OpenEXRCore converts: every line is read). Each value must be the one
+    written; a chunk whose size is not its lines' is an error, never other
+    pixels."""
     from test_cli import scanline_exr
-    width, height = 37, 21
+    # 2100 floats a line: the 24 float channels before N.X are far more than
+    # the 16 KiB the stream reads along, N.Y (8.2 KiB) less.
+    width, height = 2100, 9
     generator = np.random.default_rng(19)
     channels = {name: generator.uniform(-4, 4, (height, width)).astype(np.float32)
                 for name in [f"F{k:02d}" for k in range(24)] + [f"h{k}" for k in range(8)] +
@@ -478,10 +484,15 @@ def test_a_few_channels_among_half_and_float_ones(tmp_path):
     for threads in (1, 2):
         got, read = _read_counting_bytes(lambda: exr.read_channel_groups(
             path, {key: groups[key] for key in ("depth", "normal")}, threads))
-        assert read < len(data) / 2, (read, len(data))
+        assert read < len(data) / 4, (read, len(data))
         assert np.array_equal(got["depth"], channels["Z"])
         for index, name in enumerate(groups["normal"]):
             assert np.array_equal(got["normal"][:, :, index], channels[name])
+        got = exr.read_channel_groups(path, {"x": ["N.X"], "z": ["N.Z"]}, threads)
+        assert np.array_equal(got["x"], channels["N.X"])
+        assert np.array_equal(got["z"], channels["N.Z"])
+        got = exr.read_channel_groups(path, {"xz": ["N.X", "N.Z"]}, threads)
+        assert np.array_equal(got["xz"], np.stack([channels["N.X"], channels["N.Z"]], axis=-1))
         got = exr.read_channel_groups(path, {"halves": groups["halves"]}, threads)
         for index, name in enumerate(groups["halves"]):
             assert np.array_equal(got["halves"][:, :, index], channels[name])

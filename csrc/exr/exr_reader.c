@@ -393,15 +393,12 @@ static const exr_channel_request *find_request(const exr_channel_request *reques
     return NULL;
 }
 
-/* Whether `part` is read directly (exr_stream.h): uncompressed, every
- * request for one of its channels in that channel's own type (so that
+/* Whether `part` is read directly (exr_stream.h): uncompressed, and every
+ * request for one of its channels in that channel's own type, so that
  * OpenEXRCore converts nothing and reads each channel's line straight into
- * its destination), and the requested channels at most a quarter of the
- * part's bytes. Reading a line channel by channel costs a system call each:
- * on the Zen 3 VM of docs/speed.md (session 19), 4 float channels of 8 read
- * this way took twice as long as whole chunks, 4 of 81 a third as long.
- * Requests whose pixel stride is not the type's size, `*staged` of them, go
- * to a staging buffer first. */
+ * its destination (the stream gathers a chunk's lines into one preadv per
+ * run of lines that follow each other). Requests whose pixel stride is not
+ * the type's size, `*staged` of them, go to a staging buffer first. */
 static bool part_reads_direct(exr_input *input, int part, const exr_channel_request *requests,
                               int count, int *staged) {
     exr_compression_t compression = EXR_COMPRESSION_LAST_TYPE;
@@ -411,21 +408,28 @@ static bool part_reads_direct(exr_input *input, int part, const exr_channel_requ
         compression != EXR_COMPRESSION_NONE ||
         exr_get_channels(input->context, part, &list) != EXR_ERR_SUCCESS || list == NULL)
         return false;
-    int64_t requested_bytes = 0, part_bytes = 0;
     int staged_requests = 0;
     for (int c = 0; c < list->num_channels; ++c) {
-        const int size = exr_pixel_type_size(list->entries[c].pixel_type);
-        part_bytes += size;
         const exr_channel_request *request =
             find_request(requests, count, list->entries[c].name.str);
         if (request == NULL) continue;
         if (request->type != list->entries[c].pixel_type) return false;
-        requested_bytes += size;
-        staged_requests += request->pixel_stride != size;
+        staged_requests += request->pixel_stride != exr_pixel_type_size(request->type);
     }
-    if (requested_bytes * 4 > part_bytes) return false;
     *staged = staged_requests;
     return true;
+}
+
+/* A staged line of `width` values of `size` bytes (2 or 4) to its request's
+ * pixels, `pixel_stride` bytes apart: the element size a constant in each
+ * loop, so that no value costs a call to memcpy. */
+static void scatter_line(const uint8_t *from, int size, int32_t width, uint8_t *to,
+                         int64_t pixel_stride) {
+    if (size == 4) {
+        for (int32_t x = 0; x < width; ++x) memcpy(to + x * pixel_stride, from + 4 * x, 4);
+    } else {
+        for (int32_t x = 0; x < width; ++x) memcpy(to + x * pixel_stride, from + 2 * x, 2);
+    }
 }
 
 /* Decode the requests that name channels of `part`, for the chunks that
@@ -525,9 +529,9 @@ static int read_band(exr_input *input, int part, const exr_channel_request *requ
         }
         CHECK_EXR(exr_decoding_choose_default_routines(input->context, part, &decoder),
                   "cannot decode this channel layout");
-        if (direct) exr_stream_discard_into(scratch, scratch_size);
+        if (direct) exr_stream_direct_begin(scratch, scratch_size);
         exr_result_t decoded = exr_decoding_run(input->context, part, &decoder);
-        exr_stream_discard_into(NULL, 0);
+        const char *unread = direct ? exr_stream_direct_end() : NULL;
         if (decoded == EXR_ERR_FEATURE_NOT_IMPLEMENTED) {
             /* OpenEXRCore 3.1 cannot decompress DWAA/DWAB. */
             exr_compression_t compression = input->compression;
@@ -539,17 +543,21 @@ static int read_band(exr_input *input, int part, const exr_channel_request *requ
             goto fail;
         }
         CHECK_EXR(decoded, "cannot decode a chunk (file truncated or corrupt?)");
+        if (unread != NULL) {
+            status = tool_fail(error, TOOL_EXIT_RUNTIME,
+                               "%s: cannot read the chunk at scanline %lld: %s", input->path,
+                               (long long)chunk.start_y, unread);
+            goto fail;
+        }
         /* the staged lines to their requests */
         for (int k = 0; k < staged; ++k) {
             const exr_coding_channel_info_t *channel = &decoder.channels[staged_channels[k]];
             const exr_channel_request *request = channel_requests[staged_channels[k]];
-            const size_t size = (size_t)channel->user_bytes_per_element;
-            for (int32_t line = 0; line < chunk.height; ++line) {
-                const uint8_t *from = channel->decode_to_ptr + (size_t)line * (size_t)scratch_line;
-                uint8_t *to = request->data + (first_row + line) * request->row_stride;
-                for (int32_t x = 0; x < input->width; ++x)
-                    memcpy(to + (int64_t)x * request->pixel_stride, from + (size_t)x * size, size);
-            }
+            for (int32_t line = 0; line < chunk.height; ++line)
+                scatter_line(channel->decode_to_ptr + (size_t)line * (size_t)scratch_line,
+                             channel->user_bytes_per_element, input->width,
+                             request->data + (first_row + line) * request->row_stride,
+                             request->pixel_stride);
         }
     }
 

@@ -1,26 +1,147 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
+#define _DEFAULT_SOURCE /* preadv */
 #include "exr_stream.h"
 
 #include <errno.h>
-#include <limits.h>
 #include <fcntl.h>
+#include <limits.h>
+#include <stdbool.h>
 #include <stdint.h>
 #include <string.h>
+#include <stdio.h>
 #include <sys/stat.h>
+#include <sys/uio.h>
 #include <unistd.h>
 
-static _Thread_local const char *discard_begin;
-static _Thread_local size_t discard_size;
+/* A run of skipped bytes between two gathered reads at most this long is
+ * read along with them (into the discard buffer) rather than splitting the
+ * run into two system calls: about what a call costs in copying (a float
+ * line of a 1920-pixel-wide file is 7.5 KiB). */
+#define GAP_BYTES ((uint64_t)16 * 1024)
+/* Reads gathered before they are done anyway (a chunk of 1920 x 1 lines of
+ * 81 channels asks for 81), and the most iovecs one preadv() takes. */
+#define GATHERED_READS 256
+#define RUN_IOVECS 256
 
-void exr_stream_discard_into(const void *begin, size_t size) {
-    discard_begin = begin;
-    discard_size = begin != NULL ? size : 0;
+typedef struct gathered_read {
+    char *buffer; /* NULL: a skipped read, into the discard buffer */
+    uint64_t size, offset;
+} gathered_read;
+
+/* The calling thread's direct decode (exr_stream_direct_begin). */
+typedef struct direct_decode {
+    const char *discard;
+    size_t discard_size;
+    bool gathering;
+    int fd;
+    int count;
+    gathered_read reads[GATHERED_READS];
+    char message[192];
+} direct_decode;
+
+static _Thread_local direct_decode direct;
+
+void exr_stream_direct_begin(const void *discard, size_t discard_size) {
+    direct.discard = discard;
+    direct.discard_size = discard != NULL ? discard_size : 0;
+    direct.gathering = true;
+    direct.count = 0;
+    direct.fd = -1;
+    direct.message[0] = '\0';
 }
 
 static int discarded(const void *buffer, uint64_t size) {
-    const uintptr_t at = (uintptr_t)buffer, begin = (uintptr_t)discard_begin;
-    return discard_begin != NULL && at >= begin && at - begin <= discard_size &&
-           size <= discard_size - (at - begin);
+    const uintptr_t at = (uintptr_t)buffer, begin = (uintptr_t)direct.discard;
+    return direct.discard != NULL && at >= begin && at - begin <= direct.discard_size &&
+           size <= direct.discard_size - (at - begin);
+}
+
+/* preadv of `count` iovecs, `bytes` in all, from `offset`, to the end:
+ * NULL, or why not (direct.message). */
+static const char *read_run(struct iovec *iov, int count, uint64_t offset, uint64_t bytes) {
+    uint64_t done = 0;
+    while (done < bytes) {
+        const ssize_t got = preadv(direct.fd, iov, count, (off_t)(offset + done));
+        if (got < 0 && errno == EINTR) continue;
+        if (got < 0) {
+            snprintf(direct.message, sizeof direct.message, "cannot read the file: %s",
+                     strerror(errno));
+            return direct.message;
+        }
+        if (got == 0) {
+            snprintf(direct.message, sizeof direct.message,
+                     "the file ends at byte %llu, inside its chunk (truncated while read?)",
+                     (unsigned long long)(offset + done));
+            return direct.message;
+        }
+        done += (uint64_t)got;
+        /* past the iovecs read whole, and into the one read in part */
+        size_t left = (size_t)got;
+        while (count > 0 && left >= iov->iov_len) {
+            left -= iov->iov_len;
+            iov++;
+            count--;
+        }
+        if (count > 0) {
+            iov->iov_base = (char *)iov->iov_base + left;
+            iov->iov_len -= left;
+        }
+    }
+    return NULL;
+}
+
+/* The skipped reads from reads[from] on that lie between the run's end `at`
+ * and the next gathered read, short enough to read along: how many (0:
+ * none, the run ends here). */
+static int gap_to_read_along(int from, uint64_t at) {
+    uint64_t gap = 0;
+    int k = from;
+    while (k < direct.count && direct.reads[k].buffer == NULL &&
+           direct.reads[k].offset == at + gap && gap + direct.reads[k].size <= GAP_BYTES)
+        gap += direct.reads[k++].size;
+    const bool joins =
+        k < direct.count && direct.reads[k].buffer != NULL && direct.reads[k].offset == at + gap;
+    return joins ? k - from : 0;
+}
+
+/* Does the gathered reads, a run of reads that follow each other in the
+ * file per preadv(): NULL, or why a read failed. */
+static const char *flush(void) {
+    struct iovec iov[RUN_IOVECS];
+    int k = 0;
+    while (k < direct.count) {
+        if (direct.reads[k].buffer == NULL) { /* skipped, and not between two reads */
+            k++;
+            continue;
+        }
+        const uint64_t start = direct.reads[k].offset;
+        uint64_t bytes = 0;
+        int n = 0;
+        while (k < direct.count && n < RUN_IOVECS && direct.reads[k].buffer != NULL &&
+               direct.reads[k].offset == start + bytes) {
+            iov[n++] = (struct iovec){direct.reads[k].buffer, (size_t)direct.reads[k].size};
+            bytes += direct.reads[k++].size;
+            const int gaps = gap_to_read_along(k, start + bytes);
+            if (gaps == 0 || n + gaps >= RUN_IOVECS) continue;
+            for (int g = 0; g < gaps; g++, k++) {
+                iov[n++] = (struct iovec){(void *)direct.discard, (size_t)direct.reads[k].size};
+                bytes += direct.reads[k].size;
+            }
+        }
+        const char *why = read_run(iov, n, start, bytes);
+        if (why != NULL) return why;
+    }
+    direct.count = 0;
+    return NULL;
+}
+
+const char *exr_stream_direct_end(void) {
+    const char *why = direct.message[0] != '\0' ? direct.message : flush();
+    direct.gathering = false;
+    direct.discard = NULL;
+    direct.discard_size = 0;
+    direct.count = 0;
+    return why;
 }
 
 /* The file descriptor travels as OpenEXRCore's user data, so that the
@@ -37,10 +158,12 @@ static int64_t stream_size(exr_const_context_t context, void *user_data) {
 }
 
 /* pread semantics, as OpenEXRCore asks: the bytes read (fewer at the end of
- * the file), or -1 after reporting the error. Safe from several threads. A
- * read into the thread's discard buffer answers as a whole read: only a
- * decoder's destinations are discard buffers, and the reader checks that
- * every chunk it decodes lies inside the file (read_chunk_info). */
+ * the file), or -1 after reporting the error. Safe from several threads.
+ * During a direct decode (exr_stream_direct_begin) every read answers as a
+ * whole read and is gathered: a skipped one is only noted, so that a short
+ * one between two reads can be read along; the reader checks that every
+ * chunk it decodes lies inside the file (read_chunk_info), and
+ * exr_stream_direct_end reports a read that still comes up short. */
 static int64_t stream_read(exr_const_context_t context, void *user_data, void *buffer,
                            uint64_t size, uint64_t offset, exr_stream_error_func_ptr_t error) {
     if (size > (uint64_t)INT64_MAX || offset > (uint64_t)INT64_MAX - size) {
@@ -48,7 +171,21 @@ static int64_t stream_read(exr_const_context_t context, void *user_data, void *b
               (unsigned long long)size, (unsigned long long)offset);
         return -1;
     }
-    if (discarded(buffer, size)) return (int64_t)size;
+    if (direct.gathering) {
+        const int fd = stream_fd(user_data);
+        if (direct.count == GATHERED_READS || (direct.count > 0 && fd != direct.fd)) {
+            const char *why = flush();
+            if (why != NULL) {
+                error(context, EXR_ERR_READ_IO, "%s", why);
+                return -1;
+            }
+        }
+        direct.fd = fd;
+        const bool skipped = discarded(buffer, size);
+        direct.reads[direct.count++] =
+            (gathered_read){skipped ? NULL : (char *)buffer, size, offset};
+        return (int64_t)size;
+    }
     uint64_t done = 0;
     while (done < size) {
         const size_t ask =

@@ -11,7 +11,9 @@
  * has one (read_uncompressed_direct). The reader points the channels nobody
  * asked for at its discard buffer, so only the requested channels' bytes are
  * read: the add-on's scratch file holds every pass of the render, of which
- * it reads four channels (exr_reader.c, read_band).
+ * it reads four channels (exr_reader.c, read_band). A read per channel line
+ * would cost a system call each; the stream gathers a chunk's reads and
+ * makes one preadv() of each run of lines that follow each other.
  */
 #ifndef HBAO_EXR_STREAM_H
 #define HBAO_EXR_STREAM_H
@@ -33,8 +35,25 @@ void exr_stream_open(exr_stream *stream, const char *path, exr_context_initializ
 /** Closes the file: after exr_finish() of every context that used it. */
 void exr_stream_close(exr_stream *stream);
 
-/** The calling thread's discard buffer: reads into [begin, begin + size)
- *  are skipped (their bytes are left as they were). NULL, 0: none. */
-void exr_stream_discard_into(const void *begin, size_t size);
+/** Starts the calling thread's direct decode of one chunk (OpenEXRCore's
+ *  read_uncompressed_direct, which reads each channel's line straight into
+ *  its destination and reads nothing back before exr_decoding_run returns).
+ *  Until exr_stream_direct_end():
+ *  - reads into [discard, discard + discard_size), the destination of the
+ *    channels nobody asked for, are skipped (their bytes are left as they
+ *    were);
+ *  - the other reads are gathered, not done: OpenEXRCore asks for a chunk's
+ *    lines one after the other, and lines that follow each other in the
+ *    file are read with one preadv() into their destinations, the skipped
+ *    lines between them too (into the discard buffer) where they are short.
+ *  The caller must not look at the destinations before the end. */
+void exr_stream_direct_begin(const void *discard, size_t discard_size);
+
+/** Ends the direct decode that exr_stream_direct_begin() started on this
+ *  thread: does the reads gathered since and forgets the discard buffer.
+ *  Returns NULL, or why a read failed (static text of this thread, valid
+ *  until its next read); the destinations are then incomplete. Call it
+ *  after every begin, whether exr_decoding_run succeeded or not. */
+const char *exr_stream_direct_end(void);
 
 #endif /* HBAO_EXR_STREAM_H */
