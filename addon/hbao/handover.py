@@ -117,9 +117,16 @@ def _remove_later(path):
     MB, took 115 ms on tmpfs (docs/speed.md, session 19), which the render
     need not wait for. Not a daemon thread: Python waits for it before the
     process ends, so no scratch file outlives Blender (a process that ends
-    by os._exit skips that wait: scripts/bpy_blender.py waits first)."""
+    by os._exit skips that wait: scripts/bpy_blender.py waits first). Where
+    no thread can be started (the process has run out of them), the file is
+    removed at once, and the render waits for it."""
     thread = threading.Thread(target=_remove, args=(path,), name="hbao-scratch-removal")
-    thread.start()
+    try:
+        thread.start()
+    except RuntimeError as error:
+        log(f"removing the scratch file in the render's own thread: {error}")
+        _remove(path)
+        return
     with _removals_lock:
         _removals.append(thread)
 

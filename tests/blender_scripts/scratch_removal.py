@@ -3,8 +3,9 @@
 removes its scratch files in threads of their own (handover._remove_later),
 and before each save waits for every removal but the latest, so that at most
 two scratch files exist at a time. Here the removals are held back until
-released, to see who waits for whom. Then: the files that Blenders which
-have ended left behind are removed, and no others. Prints 'REMOVAL OK'; the
+released, to see who waits for whom; where no thread can be started, the
+file is removed at once. Then: the files that Blenders which have ended
+left behind are removed, and no others. Prints 'REMOVAL OK'; the
 test checks that <folder> is empty once Blender has ended (Python waits for
 the last removal's thread, still running when this script ends).
 
@@ -55,6 +56,24 @@ start = time.perf_counter()
 handover._wait_for_older_removals()
 assert time.perf_counter() - start < 0.5
 assert os.path.exists(paths[2]), "the latest removal should still be pending"
+
+# Where no thread can be started (a process out of them), the file goes at
+# once, in the caller's thread, and the hand-over goes on.
+start_thread = threading.Thread.start
+
+
+def refuse(thread):
+    raise RuntimeError("can't start new thread")
+
+
+path = os.path.join(folder, "hbao-passes-test-3.exr")
+open(path, "wb").close()
+threading.Thread.start = refuse
+try:
+    handover._remove_later(path)
+finally:
+    threading.Thread.start = start_thread
+assert not os.path.exists(path), "the file was not removed without a thread"
 
 
 # Files left by Blenders that ended (killed, or os._exit before the removal
