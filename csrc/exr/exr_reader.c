@@ -247,8 +247,12 @@ fail:
  * checks against the file size. */
 static int check_chunks(exr_input *input, tool_error *error) {
     int status = TOOL_EXIT_SUCCESS;
+    /* the size of the file read, not of whatever the path names by now (a
+     * render written anew and renamed over it meanwhile) */
     struct stat file_status;
-    if (stat(input->path, &file_status) != 0)
+    const int statted = input->stream.open ? fstat(input->stream.fd, &file_status)
+                                           : stat(input->path, &file_status);
+    if (statted != 0)
         return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: cannot read its size", input->path);
     const pixel_rect *window = &input->data_window;
     for (int part = 0; part < input->part_count; ++part) {
