@@ -511,6 +511,82 @@ def test_a_few_channels_among_half_and_float_ones(tmp_path):
         assert raised.value.code == ERROR_FORMAT
 
 
+def test_more_channels_than_the_stream_gathers_at_once(tmp_path):
+    """300 channels, every 7th half: a chunk's direct decode asks for more
+    lines than the stream gathers before reading them (256, exr_stream.c),
+    so it reads part of the chunk in the middle of the decode. Float
+    channels read one per group, every other one, and all of them
+    interleaved in one group: each value the one written, on 1 and 2
+    threads. A file cut short after it was opened is an error that says so,
+    never other pixels."""
+    from test_cli import scanline_exr
+    width, height = 64, 5
+    generator = np.random.default_rng(23)
+    names = [f"C{k:03d}" for k in range(300)]
+    half = names[::7]
+    channels = {name: generator.uniform(-4, 4, (height, width)).astype(np.float32)
+                for name in names}
+    for name in half:
+        channels[name] = channels[name].astype(np.float16).astype(np.float32)
+    floats = [name for name in names if name not in half]
+    path = tmp_path / "many.exr"
+    data = scanline_exr(channels, width, height, half=half)
+    path.write_bytes(data)
+    for threads in (1, 2):
+        got = exr.read_channel_groups(path, {name: [name] for name in floats}, threads)
+        for name in floats:
+            assert np.array_equal(got[name], channels[name]), (threads, name)
+        every_other = floats[::2]
+        got = exr.read_channel_groups(path, {name: [name] for name in every_other}, threads)
+        for name in every_other:
+            assert np.array_equal(got[name], channels[name]), (threads, name)
+        got = exr.read_channel_groups(path, {"all": floats}, threads)
+        for index, name in enumerate(floats):
+            assert np.array_equal(got["all"][:, :, index], channels[name]), (threads, name)
+    # Cut inside the last row's chunk, within its first 256 channels' lines:
+    # the stream's reads in the middle of the decode come up short, and its
+    # message is the one given (OpenEXRCore's own says less).
+    table = _offset_table_start(data, height)
+    last = height - 1
+    chunk = int.from_bytes(data[table + 8 * last:table + 8 * last + 8], "little")
+    line_bytes = [width * (2 if name in half else 4) for name in names]
+    cut = chunk + 8 + sum(line_bytes[:200]) + 10
+    _read_after_cutting(path, floats, cut, (height, width, len(floats)))
+
+
+def _read_after_cutting(path, names, cut, shape):
+    """Open `path`, cut it to `cut` bytes, then read `names` into one array:
+    the reader must say the file ended (as the stream does, or as
+    OpenEXRCore does where it checks the chunk itself)."""
+    array = np.zeros(shape, dtype=np.float32)
+    with exr._OpenFile(path) as handle:
+        os.truncate(path, cut)
+        with pytest.raises(exr.EXRFormatError,
+                           match=r"ends at byte \d+, inside its chunk \(truncated while read"
+                                 r"|cannot read a chunk \(file truncated"):
+            handle.read([(name, array, index) for index, name in enumerate(names)])
+
+
+def test_a_file_cut_short_after_it_was_opened(tmp_path):
+    """Depth and Normal of the hand-over's kind of file, cut inside the last
+    row's N.Z after the file was opened (no later chunk's header to find
+    the file short): an error that says the file ended, not the pixels of
+    whatever the destinations held."""
+    from test_cli import scanline_exr
+    width, height = 300, 8
+    generator = np.random.default_rng(29)
+    channels = {name: generator.uniform(-4, 4, (height, width)).astype(np.float32)
+                for name in ["A", "B", "G", "R", "N.X", "N.Y", "N.Z", "Z"]}
+    path = tmp_path / "cut.exr"
+    data = scanline_exr(channels, width, height)
+    path.write_bytes(data)
+    table = _offset_table_start(data, height)
+    chunk = int.from_bytes(data[table + 8 * (height - 1):table + 8 * height], "little")
+    n_z = sorted(channels).index("N.Z")
+    _read_after_cutting(path, ["N.X", "N.Y", "N.Z", "Z"],
+                        chunk + 8 + n_z * width * 4 + 100, (height, width, 4))
+
+
 def test_binding_says_what_to_do_when_the_library_is_missing(tmp_path, monkeypatch):
     monkeypatch.setenv(exr.LIBRARY_ENVIRONMENT_VARIABLE, str(tmp_path / "libhbao_exr.so"))
     exr.unload_library()

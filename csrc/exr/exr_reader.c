@@ -533,9 +533,20 @@ static int read_band(exr_input *input, int part, const exr_channel_request *requ
         }
         CHECK_EXR(exr_decoding_choose_default_routines(input->context, part, &decoder),
                   "cannot decode this channel layout");
-        if (direct) exr_stream_direct_begin(scratch, scratch_size);
+        /* The stream skips and gathers reads only where OpenEXRCore chose
+         * its direct read, which neither decompresses nor unpacks: its other
+         * routines read their input back within exr_decoding_run. */
+        const bool read_direct =
+            direct && decoder.decompress_fn == NULL && decoder.unpack_and_convert_fn == NULL;
+        if (read_direct) exr_stream_direct_begin(scratch, scratch_size);
         exr_result_t decoded = exr_decoding_run(input->context, part, &decoder);
-        const char *unread = direct ? exr_stream_direct_end() : NULL;
+        const char *unread = read_direct ? exr_stream_direct_end() : NULL;
+        if (unread != NULL) { /* first: OpenEXRCore's own message says less */
+            status = tool_fail(error, TOOL_EXIT_RUNTIME,
+                               "%s: cannot read the chunk at scanline %lld: %s", input->path,
+                               (long long)chunk.start_y, unread);
+            goto fail;
+        }
         if (decoded == EXR_ERR_FEATURE_NOT_IMPLEMENTED) {
             /* OpenEXRCore 3.1 cannot decompress DWAA/DWAB. */
             exr_compression_t compression = input->compression;
@@ -547,12 +558,6 @@ static int read_band(exr_input *input, int part, const exr_channel_request *requ
             goto fail;
         }
         CHECK_EXR(decoded, "cannot decode a chunk (file truncated or corrupt?)");
-        if (unread != NULL) {
-            status = tool_fail(error, TOOL_EXIT_RUNTIME,
-                               "%s: cannot read the chunk at scanline %lld: %s", input->path,
-                               (long long)chunk.start_y, unread);
-            goto fail;
-        }
         /* the staged lines to their requests */
         for (int k = 0; k < staged; ++k) {
             const exr_coding_channel_info_t *channel = &decoder.channels[staged_channels[k]];

@@ -41,10 +41,19 @@ typedef struct direct_decode {
 
 static _Thread_local direct_decode direct;
 
+/* OpenEXRCore's direct read converts each line to the host's byte order as
+ * soon as it is read: a no-op on a little-endian host, where alone a read
+ * may be put off. Elsewhere the reads are done at once. */
+#if defined(__BYTE_ORDER__) && __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__
+#define MAY_GATHER true
+#else
+#define MAY_GATHER false
+#endif
+
 void exr_stream_direct_begin(const void *discard, size_t discard_size) {
     direct.discard = discard;
     direct.discard_size = discard != NULL ? discard_size : 0;
-    direct.gathering = true;
+    direct.gathering = MAY_GATHER;
     direct.count = 0;
     direct.fd = -1;
     direct.message[0] = '\0';
@@ -171,6 +180,7 @@ static int64_t stream_read(exr_const_context_t context, void *user_data, void *b
               (unsigned long long)size, (unsigned long long)offset);
         return -1;
     }
+    if (!direct.gathering && discarded(buffer, size)) return (int64_t)size;
     if (direct.gathering) {
         const int fd = stream_fd(user_data);
         if (direct.count == GATHERED_READS || (direct.count > 0 && fd != direct.fd)) {

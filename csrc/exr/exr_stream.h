@@ -40,13 +40,17 @@ void exr_stream_close(exr_stream *stream);
  *  its destination and reads nothing back before exr_decoding_run returns).
  *  Until exr_stream_direct_end():
  *  - reads into [discard, discard + discard_size), the destination of the
- *    channels nobody asked for, are skipped (their bytes are left as they
- *    were);
+ *    channels nobody asked for, are skipped (the buffer's bytes are
+ *    undefined after);
  *  - the other reads are gathered, not done: OpenEXRCore asks for a chunk's
  *    lines one after the other, and lines that follow each other in the
  *    file are read with one preadv() into their destinations, the skipped
  *    lines between them too (into the discard buffer) where they are short.
- *  The caller must not look at the destinations before the end. */
+ *    On a big-endian host, where OpenEXRCore swaps each line's bytes as
+ *    soon as it has read it, the reads are done at once instead.
+ *  Only for a decoder that neither decompresses nor unpacks (its
+ *  decompress_fn and unpack_and_convert_fn NULL). The caller must not look
+ *  at the destinations before the end. */
 void exr_stream_direct_begin(const void *discard, size_t discard_size);
 
 /** Ends the direct decode that exr_stream_direct_begin() started on this
