@@ -19,9 +19,9 @@
  * line of a 1920-pixel-wide file is 7.5 KiB). */
 #define GAP_BYTES ((uint64_t)16 * 1024)
 /* Reads gathered before they are done anyway (a chunk of 1920 x 1 lines of
- * 81 channels asks for 81), and the most iovecs one preadv() takes. */
+ * 81 channels asks for 81). A run takes an iovec per gathered read, so
+ * this is also the most one preadv() is given (Linux takes 1024). */
 #define GATHERED_READS 256
-#define RUN_IOVECS 256
 
 typedef struct gathered_read {
     char *buffer; /* NULL: a skipped read, into the discard buffer */
@@ -65,24 +65,16 @@ static int discarded(const void *buffer, uint64_t size) {
            size <= direct.discard_size - (at - begin);
 }
 
-/* preadv of `count` iovecs, `bytes` in all, from `offset`, to the end:
- * NULL, or why not (direct.message). */
-static const char *read_run(struct iovec *iov, int count, uint64_t offset, uint64_t bytes) {
+/* preadv() of `count` iovecs, `bytes` in all (at most SSIZE_MAX), from
+ * `offset`, until all are read or the file ends: the bytes read, or -1
+ * (errno says why). Both the gathered runs and the reads done at once. */
+static int64_t read_fully(int fd, struct iovec *iov, int count, uint64_t offset, uint64_t bytes) {
     uint64_t done = 0;
     while (done < bytes) {
-        const ssize_t got = preadv(direct.fd, iov, count, (off_t)(offset + done));
+        const ssize_t got = preadv(fd, iov, count, (off_t)(offset + done));
         if (got < 0 && errno == EINTR) continue;
-        if (got < 0) {
-            snprintf(direct.message, sizeof direct.message, "cannot read the file: %s",
-                     strerror(errno));
-            return direct.message;
-        }
-        if (got == 0) {
-            snprintf(direct.message, sizeof direct.message,
-                     "the file ends at byte %llu, inside its chunk (truncated while read?)",
-                     (unsigned long long)(offset + done));
-            return direct.message;
-        }
+        if (got < 0) return -1;
+        if (got == 0) break; /* end of file */
         done += (uint64_t)got;
         /* past the iovecs read whole, and into the one read in part */
         size_t left = (size_t)got;
@@ -96,7 +88,22 @@ static const char *read_run(struct iovec *iov, int count, uint64_t offset, uint6
             iov->iov_len -= left;
         }
     }
-    return NULL;
+    return (int64_t)done;
+}
+
+/* A gathered run, read whole: NULL, or why not (direct.message). */
+static const char *read_run(struct iovec *iov, int count, uint64_t offset, uint64_t bytes) {
+    const int64_t got = read_fully(direct.fd, iov, count, offset, bytes);
+    if (got < 0)
+        snprintf(direct.message, sizeof direct.message, "cannot read the file: %s",
+                 strerror(errno));
+    else if ((uint64_t)got < bytes)
+        snprintf(direct.message, sizeof direct.message,
+                 "the file ends at byte %llu, inside its chunk (truncated while read?)",
+                 (unsigned long long)(offset + (uint64_t)got));
+    else
+        return NULL;
+    return direct.message;
 }
 
 /* The skipped reads from reads[from] on that lie between the run's end `at`
@@ -116,7 +123,7 @@ static int gap_to_read_along(int from, uint64_t at) {
 /* Does the gathered reads, a run of reads that follow each other in the
  * file per preadv(): NULL, or why a read failed. */
 static const char *flush(void) {
-    struct iovec iov[RUN_IOVECS];
+    struct iovec iov[GATHERED_READS];
     int k = 0;
     while (k < direct.count) {
         if (direct.reads[k].buffer == NULL) { /* skipped, and not between two reads */
@@ -126,12 +133,11 @@ static const char *flush(void) {
         const uint64_t start = direct.reads[k].offset;
         uint64_t bytes = 0;
         int n = 0;
-        while (k < direct.count && n < RUN_IOVECS && direct.reads[k].buffer != NULL &&
+        while (k < direct.count && direct.reads[k].buffer != NULL &&
                direct.reads[k].offset == start + bytes) {
             iov[n++] = (struct iovec){direct.reads[k].buffer, (size_t)direct.reads[k].size};
             bytes += direct.reads[k++].size;
             const int gaps = gap_to_read_along(k, start + bytes);
-            if (gaps == 0 || n + gaps >= RUN_IOVECS) continue;
             for (int g = 0; g < gaps; g++, k++) {
                 iov[n++] = (struct iovec){(void *)direct.discard, (size_t)direct.reads[k].size};
                 bytes += direct.reads[k].size;
@@ -175,14 +181,13 @@ static int64_t stream_size(exr_const_context_t context, void *user_data) {
  * exr_stream_direct_end reports a read that still comes up short. */
 static int64_t stream_read(exr_const_context_t context, void *user_data, void *buffer,
                            uint64_t size, uint64_t offset, exr_stream_error_func_ptr_t error) {
-    if (size > (uint64_t)INT64_MAX || offset > (uint64_t)INT64_MAX - size) {
+    if (size > (uint64_t)SSIZE_MAX || offset > (uint64_t)INT64_MAX - size) {
         error(context, EXR_ERR_READ_IO, "read of %llu bytes at %llu is out of range",
               (unsigned long long)size, (unsigned long long)offset);
         return -1;
     }
-    if (!direct.gathering && discarded(buffer, size)) return (int64_t)size;
+    const int fd = stream_fd(user_data);
     if (direct.gathering) {
-        const int fd = stream_fd(user_data);
         if (direct.count == GATHERED_READS || (direct.count > 0 && fd != direct.fd)) {
             const char *why = flush();
             if (why != NULL) {
@@ -196,21 +201,11 @@ static int64_t stream_read(exr_const_context_t context, void *user_data, void *b
             (gathered_read){skipped ? NULL : (char *)buffer, size, offset};
         return (int64_t)size;
     }
-    uint64_t done = 0;
-    while (done < size) {
-        const size_t ask =
-            size - done > (uint64_t)SSIZE_MAX ? (size_t)SSIZE_MAX : (size_t)(size - done);
-        const ssize_t got =
-            pread(stream_fd(user_data), (char *)buffer + done, ask, (off_t)(offset + done));
-        if (got < 0 && errno == EINTR) continue;
-        if (got < 0) {
-            error(context, EXR_ERR_READ_IO, "cannot read the file: %s", strerror(errno));
-            return -1;
-        }
-        if (got == 0) break; /* end of file */
-        done += (uint64_t)got;
-    }
-    return (int64_t)done;
+    if (discarded(buffer, size)) return (int64_t)size; /* a direct decode done at once */
+    struct iovec whole = {buffer, (size_t)size};
+    const int64_t got = read_fully(fd, &whole, 1, offset, size);
+    if (got < 0) error(context, EXR_ERR_READ_IO, "cannot read the file: %s", strerror(errno));
+    return got;
 }
 
 void exr_stream_open(exr_stream *stream, const char *path, exr_context_initializer_t *initializer) {
