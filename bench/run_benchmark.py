@@ -15,7 +15,6 @@ import argparse
 import hashlib
 import json
 import os
-import re
 import shutil
 import statistics
 import subprocess
@@ -29,6 +28,7 @@ import numpy as np
 import config
 import report
 import sweep
+from hbao import timing_line  # sweep puts the add-on on sys.path
 
 REPO = Path(__file__).resolve().parent.parent
 BENCH = REPO / "bench"
@@ -36,7 +36,6 @@ BLENDER = os.environ.get("BLENDER", "blender")
 # The HBAO node's settings that the add-on timing copies from the recommendation.
 NODE_SETTINGS = ("directions", "steps", "blur_size", "angle_bias_degrees", "falloff",
                  "integration", "half_resolution")
-HANDOVER_PATTERN = re.compile(r"AO (\d+) ms, pass hand-over (\d+) ms")
 
 
 def log(message):
@@ -147,10 +146,10 @@ def addon_timing(mode, setting, env, bunny_json):
     for line in output.splitlines():
         if line.startswith("bench-addon: "):
             result = json.loads(line[len("bench-addon: "):])
-        match = HANDOVER_PATTERN.search(line)
-        if match:
-            ao_times.append(int(match.group(1)) / 1000.0)
-            handovers.append(int(match.group(2)) / 1000.0)
+        figures = timing_line.parse(line)
+        if figures is not None:
+            ao_times.append(figures["ao_ms"] / 1000.0)
+            handovers.append(figures["handover_ms"] / 1000.0)
     if result is None or not handovers:
         raise RuntimeError("the add-on timing run printed no timings:\n" + output[-3000:])
     result.update(width=spec["width"], height=spec["height"], node=spec["node"],

@@ -16,7 +16,6 @@ Blender named (scripts/blenders.py; default: the newest bpy)."""
 import argparse
 import json
 import os
-import re
 import statistics
 import subprocess
 import sys
@@ -26,9 +25,10 @@ from pathlib import Path
 import blenders
 
 REPO = Path(__file__).resolve().parent.parent
-LINE = re.compile(r"in (\d+) ms: AO (\d+) ms, pass hand-over (\d+) ms "
-                  r"\(save (\d+), read (\d+), write (\d+)\)")
-FIELDS = ("total", "ao", "handover", "save", "read", "write")
+sys.path.insert(0, str(REPO / "addon"))  # the add-on's bpy-free timing_line
+from hbao import timing_line  # noqa: E402
+
+FIELDS = ("total_ms", "ao_ms", "handover_ms", "save_ms", "read_ms", "write_ms")
 
 
 def run(blender, passes, repeats, user_scripts):
@@ -45,9 +45,9 @@ def run(blender, passes, repeats, user_scripts):
         raise SystemExit(f"bench_handover_passes: {blender.name} failed ({passes})")
     # The renders that computed the AO: the first of each timed_renders()
     # group is a warm-up; "reused" and "re-composited" lines did not compute.
-    rows = [tuple(int(v) for v in match.groups())
-            for line in completed.stdout.splitlines()
-            if "reused" not in line and (match := LINE.search(line))]
+    found = [timing_line.parse(line) for line in completed.stdout.splitlines()]
+    rows = [tuple(figures[field] for field in FIELDS) for figures in found
+            if figures is not None and not figures["reused"] and not figures["recomposited"]]
     return rows[1:]
 
 

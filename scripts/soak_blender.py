@@ -33,7 +33,9 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "addon"))
 import blenders  # noqa: E402
+from hbao import scratch_names, timing_line  # noqa: E402
 
 REPO = blenders.REPO
 BUILD = Path(os.environ.get("HBAO_BUILD_DIR", REPO / "build"))
@@ -65,11 +67,9 @@ STEADY_WINDOW = 10
 CPU_SLOWDOWN_LIMIT = 2.0
 # Generous: a frame takes well under a second; a hang must still end the run.
 SECONDS_PER_FRAME_LIMIT = 30
-SCRATCH_GLOB = "hbao-passes-{pid}-*"
 # The report names the first few other things left in the temp folder.
 SHOWN_LEFTOVERS = 3
 PROBE_LINE = re.compile(r"^HBAO-SOAK frame=(\d+) (.*)$")
-HOOK_LINE = re.compile(r"^HBAO: (\d+) AO pass\(es\) \d+x\d+ in (\d+) ms: AO (\d+) ms")
 MIB = 1024.0
 
 
@@ -156,9 +156,9 @@ def run_render(command, env, frames, log_path):
                     print(f"  frame {samples[-1]['frame']}: RSS "
                           f"{samples[-1]['rss_kib'] / MIB:.1f} MiB", flush=True)
                 continue
-            hook = HOOK_LINE.match(line)
-            if hook:
-                hook_ms.append((int(hook.group(2)), int(hook.group(3))))
+            hook = timing_line.parse(line) if line.startswith("HBAO: ") else None
+            if hook is not None:
+                hook_ms.append((hook["total_ms"], hook["ao_ms"]))
             elif line.startswith("HBAO:") and "created helper scene" not in line:
                 messages.append(line)
         try:
@@ -271,7 +271,7 @@ def leftovers(pid, temp):
         folders.append(Path(os.environ["HBAO_TEMP_DIR"]))
     for folder in folders:
         if folder.is_dir() and pid is not None:
-            scratch += [str(p) for p in folder.glob(SCRATCH_GLOB.format(pid=pid))]
+            scratch += [str(p) for p in folder.glob(scratch_names.glob_of(pid))]
     other = [str(p.relative_to(temp)) + ("/" if p.is_dir() else "")
              for p in temp.rglob("*") if str(p) not in scratch]
     return sorted(scratch), sorted(other)

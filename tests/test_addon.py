@@ -36,6 +36,7 @@ pytestmark = pytest.mark.matrix
 
 from hbao import exr_passes as exr  # noqa: E402  (conftest puts addon/ on sys.path)
 from hbao import parameters as PARAMETERS  # noqa: E402
+from hbao import timing_line  # noqa: E402
 
 
 def render(run_in_blender, tmp_path, spec, env=None, name="render"):
@@ -188,6 +189,9 @@ def test_unchanged_frame_reuses_its_ao(run_in_blender, tmp_path, native):
     assert "unchanged: reused" not in lines[0], lines
     assert "(2 of 2 unchanged: reused)" in lines[1], lines
     assert "(1 of 2 unchanged: reused)" in lines[2], lines
+    # The parser that the benchmarks and the soak use reads the real lines.
+    figures = [timing_line.parse(line) for line in lines]
+    assert [f and (f["passes"], f["reused"]) for f in figures] == [(2, 0), (2, 2), (2, 1)], lines
     passes = [frame_passes(out, frame) for frame in (1, 2, 3)]
     assert all(np.array_equal(a, b) for a, b in zip(passes[0], passes[1]))
     for frame, radius in ((1, 0.6), (2, 0.6), (3, 1.1)):
@@ -270,6 +274,12 @@ def test_new_node_settings_reach_the_ao_without_a_render(run_in_blender, tmp_pat
     assert "(1 of 1 unchanged: reused)" in lines[1], lines
     assert "(save 0, read 0, write" in lines[1], lines
     assert "(1 of 1 unchanged: reused)" in lines[2], lines
+    # The parser that the benchmarks use reads the real lines.
+    first, refreshed_line = (timing_line.parse(line) for line in lines[:2])
+    assert first and not first["recomposited"] and not first["reused"], lines
+    assert refreshed_line and refreshed_line["recomposited"], lines
+    assert (refreshed_line["reused"], refreshed_line["save_ms"], refreshed_line["read_ms"]) \
+        == (1, 0, 0), lines
     refreshed = [line.split()[1] for line in log.splitlines() if line.startswith("REFRESHED ")]
     # After the file is opened again, nothing of the render before is kept.
     assert refreshed == ["False", "True", "False", "False", "False"], log[-3000:]

@@ -11,7 +11,8 @@ import bpy
 import numpy as np
 
 from . import camera as camera_model
-from . import ao_cache, exr_passes, handover, layer_passes, native, recomposite, render_record
+from . import (ao_cache, exr_passes, handover, layer_passes, native, recomposite, render_record,
+               timing_line)
 from .helper_lookup import ENGINE_IDNAME, is_helper, pass_names_for_helper
 from .helper_scene import rendered_for_a_scene, scene_for_render
 from .planning import node_names, plan
@@ -144,25 +145,6 @@ def compute_passes(engine, depsgraph, width, height, request=None):
     return results
 
 
-def _timing_line(count, width, height, total, timings):
-    milliseconds = {name: timings.get(name, 0.0) * 1000 for name in ("save", "read", "write",
-                                                                     "ao")}
-    handover_ms = milliseconds["save"] + milliseconds["read"] + milliseconds["write"]
-    cached = f" ({timings['cached']} of {count} unchanged: reused)" if "cached" in timings else ""
-    line = (f"{count} AO pass(es) {width}x{height} in {total * 1000:.0f} ms: AO "
-            f"{milliseconds['ao']:.0f} ms{cached}, pass hand-over {handover_ms:.0f} ms "
-            f"(save {milliseconds['save']:.0f}, read {milliseconds['read']:.0f}, write "
-            f"{milliseconds['write']:.0f})")
-    if "kept" in timings:
-        line += (f", re-composited with new settings from the last render's passes (their AO "
-                 f"computed beforehand in {timings['kept'] * 1000:.0f} ms)")
-    for kind in ("guard band", "back faces"):  # extra_renders' kinds
-        if f"{kind} save" in timings:
-            seconds = timings[f"{kind} save"] + timings.get(f"{kind} read", 0.0)
-            line += f", {kind} passes {seconds * 1000:.0f} ms"
-    return line
-
-
 def _report(engine, text):
     """A warning in the render's report, and (report.py) in the Info editor."""
     engine.report({"WARNING"}, text)
@@ -229,7 +211,8 @@ def render_helper(engine, depsgraph):
     timings = dict(engine.hbao_timings)
     timings["write"] = time.perf_counter() - write_start
     if results:
-        line = _timing_line(len(results), width, height, time.perf_counter() - start, timings)
+        line = timing_line.format_line(len(results), width, height,
+                                       time.perf_counter() - start, timings)
         log(line)
         engine.update_stats("HBAO", line)
 

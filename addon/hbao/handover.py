@@ -5,7 +5,6 @@ save the Render Result as a multilayer EXR, which libhbao_exr decodes
 straight into numpy arrays."""
 import itertools
 import os
-import re
 import tempfile
 import threading
 import time
@@ -13,7 +12,7 @@ from time import perf_counter as _clock
 
 import bpy
 
-from . import compat, exr_passes
+from . import compat, exr_passes, scratch_names
 from .report import log
 
 
@@ -43,11 +42,8 @@ def _scratch_folder():
 
 
 def _scratch_path():
-    return os.path.join(_scratch_folder(), f"hbao-passes-{os.getpid()}-{threading.get_ident()}-"
-                                           f"{next(_scratch_numbers)}.exr")
-
-
-SCRATCH_NAME = re.compile(r"hbao-passes-(\d+)-\d+(-\d+)?\.exr")
+    return os.path.join(_scratch_folder(), scratch_names.name(
+        os.getpid(), threading.get_ident(), next(_scratch_numbers)))
 
 
 def _process_ended(pid):
@@ -80,8 +76,8 @@ def remove_stale_scratch_files():
         return removed
     now = time.time()
     for name in names:
-        match = SCRATCH_NAME.fullmatch(name)
-        if match is None or not _process_ended(int(match.group(1))):
+        process = scratch_names.process_of(name)
+        if process is None or not _process_ended(process):
             continue
         path = os.path.join(folder, name)
         try:

@@ -1,0 +1,24 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""addon/hbao/scratch_names.py without Blender: the add-on's stale-file
+cleanup and the soak's leftover check recognise exactly the names the
+hand-over gives its scratch files (tests/blender_scripts/scratch_removal.py
+removes real ones)."""
+import fnmatch
+
+from conftest import REPO  # noqa: F401  (puts the add-on on sys.path)
+from hbao import scratch_names
+
+
+def test_a_name_gives_back_its_process():
+    name = scratch_names.name(4242, 139872, 7)
+    assert name == "hbao-passes-4242-139872-7.exr"
+    assert scratch_names.process_of(name) == 4242
+    assert fnmatch.fnmatchcase(name, scratch_names.glob_of(4242))
+    assert not fnmatch.fnmatchcase(name, scratch_names.glob_of(424))
+
+
+def test_names_before_session_19_and_other_files():
+    assert scratch_names.process_of("hbao-passes-4242-139872.exr") == 4242
+    for other in ("hbao-passes-notes.exr", "hbao-passes-4242-1-2.exr.tmp",
+                  "hbao-passes--1-2.exr", "render-4242-1-2.exr", "hbao-passes-4242.exr"):
+        assert scratch_names.process_of(other) is None, other
