@@ -254,6 +254,7 @@ def test_new_node_settings_reach_the_ao_without_a_render(run_in_blender, tmp_pat
     size than the kept passes. A file opened again keeps nothing of the
     render before it."""
     spec = {"frames": [1], "nodes": [{"name": "Hinted", "radius": 0.6, "blur_size": 0}],
+            "user_handlers": True,
             "after_render": [
                 {"label": "radius", "socket": ["Radius", 1.1]},
                 {"label": "half size", "resolution_percentage": 50, "refresh": True},
@@ -283,6 +284,17 @@ def test_new_node_settings_reach_the_ao_without_a_render(run_in_blender, tmp_pat
     refreshed = [line.split()[1] for line in log.splitlines() if line.startswith("REFRESHED ")]
     # After the file is opened again, nothing of the render before is kept.
     assert refreshed == ["False", "True", "False", "False", "False"], log[-3000:]
+    # A pipeline's own render handlers see the artist's two renders, never
+    # the helper scene that the refreshes render alone (handler_hold.py).
+    seen = json.loads(next(line for line in log.splitlines()
+                           if line.startswith("USER HANDLERS "))[len("USER HANDLERS "):])
+    assert len(seen["render_complete"]) == 2, seen
+    for name, scenes in seen.items():
+        helper = [scene for scene in scenes if scene.startswith(".HBAO")]
+        if name.startswith("render_"):
+            assert not helper, seen
+        else:  # Blender sets every scene a render renders to its frame: at most once a render
+            assert len(helper) <= len(seen["render_complete"]), seen
     hints = printed_hints(log)
     changed = "Changed: render to update"
     assert hints == {"radius": changed, "half size": changed, "full size": changed,

@@ -21,8 +21,8 @@ import time
 
 import bpy
 
-from . import (ao_cache, compat, composite_trigger, helper_scene, layer_passes, node,
-               render_record, writes)
+from . import (ao_cache, compat, composite_trigger, handler_hold, helper_scene, layer_passes,
+               node, render_record, writes)
 from . import camera as camera_model
 from .planning import plan_node
 from .report import log
@@ -150,13 +150,14 @@ def _work(main, jobs):
 
 
 def _render_helper(main, helper, frame, ao_seconds):
-    """Whether the helper rendered every pass for `main` (Request.completed)."""
+    """Whether the helper rendered every pass for `main` (Request.completed).
+    No render or frame change handler runs for this render."""
     global _request
     request = _request = Request(main.name, helper.name, frame, ao_seconds)
     try:
         windows = bpy.context.window_manager.windows
         override = {"window": windows[0]} if windows else {}
-        with bpy.context.temp_override(scene=main, **override):
+        with bpy.context.temp_override(scene=main, **override), handler_hold.held_back():
             bpy.ops.render.render(scene=helper.name)
     finally:
         _request = None

@@ -23,9 +23,11 @@ then linked by the node's Connect Passes operator after the passes are
 disabled)}], disable_normal_pass, disable_depth_pass, output_format (the main
 output's file format, default OPEN_EXR_MULTILAYER), prepare [actions before
 rendering: sync, delete_helper, delete_extra_renders, rename_helper, pick_internal_engine,
-render_the_helper, rename_node, second_scene_shares_the_tree]. Prints OUTPUT SETTINGS {json}
-(the main output's settings after the renders), STATUS {json} (each node's
-status line) and RENDERED.
+render_the_helper, rename_node, second_scene_shares_the_tree], user_handlers (a
+pipeline's own render and frame change handlers, which print USER HANDLERS
+{json}: the scenes each list's handler saw, in order; render_stats leaves out
+repeats of the scene before). Prints OUTPUT SETTINGS {json} (the main output's settings after
+the renders), STATUS {json} (each node's status line) and RENDERED.
 """
 import json
 import os
@@ -172,6 +174,27 @@ for action in spec.get("prepare", []):
         raise ValueError(f"unknown prepare action {action!r}")
     print("PREPARED", action, flush=True)
 
+# A pipeline's own handlers (user_handlers): persistent, so that they
+# outlive a "reopen" step.
+USER_HANDLER_LISTS = ("render_init", "render_pre", "render_stats", "render_post", "render_write",
+                      "render_complete", "render_cancel", "frame_change_pre", "frame_change_post")
+seen_by_user_handlers = {name: [] for name in USER_HANDLER_LISTS}
+
+
+def user_handler(list_name):
+    @bpy.app.handlers.persistent
+    def handler(scene, *_args):
+        seen = seen_by_user_handlers[list_name]
+        if list_name != "render_stats" or not seen or seen[-1] != scene.name:
+            seen.append(scene.name)
+    return handler
+
+
+if spec.get("user_handlers"):
+    for list_name in USER_HANDLER_LISTS:
+        if hasattr(bpy.app.handlers, list_name):
+            getattr(bpy.app.handlers, list_name).append(user_handler(list_name))
+
 if spec.get("save_blend"):
     bpy.ops.wm.save_as_mainfile(filepath=spec["save_blend"])
     print("SAVED", spec["save_blend"])
@@ -274,4 +297,6 @@ print("OUTPUT SETTINGS", json.dumps({
     "file_format": settings.file_format, "color_depth": settings.color_depth,
     "exr_codec": settings.exr_codec, "media_type": getattr(settings, "media_type", None),
     "use_exr_interleave": getattr(settings, "use_exr_interleave", None)}))
+if spec.get("user_handlers"):
+    print("USER HANDLERS", json.dumps(seen_by_user_handlers))
 print("RENDERED", json.dumps({"frames": spec.get("frames", [1])}))
