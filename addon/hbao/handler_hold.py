@@ -25,12 +25,12 @@ def held_back():
     the block, and put back after it in its order (with any that the block
     added after them)."""
     held = []
-    for name in RENDER_HANDLERS:
-        handlers = getattr(bpy.app.handlers, name, None)
-        if handlers is not None:
-            held.append((handlers, list(handlers)))
-            handlers[:] = [function for function in handlers if _ours(function)]
-    try:
+    try:  # whatever fails, every list taken out of is put back
+        for name in RENDER_HANDLERS:
+            handlers = getattr(bpy.app.handlers, name, None)
+            if handlers is not None:
+                held.append((handlers, list(handlers)))
+                handlers[:] = [function for function in handlers if _ours(function)]
         yield
     finally:
         for handlers, functions in held:
