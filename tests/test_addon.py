@@ -309,6 +309,26 @@ def test_new_node_settings_reach_the_ao_without_a_render(run_in_blender, tmp_pat
     assert np.abs(ao - expected).max() <= EXACT
 
 
+def test_a_render_stops_the_refresh_worker(run_in_blender, tmp_path, native):
+    """Two nodes' radius changed after a render: the refresh's worker
+    computes their AO one after the other (recomposite.py). A render of the
+    scene that begins meanwhile makes it stop after the node it is
+    computing, rather than compete with the render for the cores; its AO
+    is dropped, and the render's AO is the library's for the new radius."""
+    spec = {"frames": [1], "nodes": [{"name": "First", "radius": 0.6, "blur_size": 0},
+                                     {"name": "Second", "radius": 0.3, "blur_size": 0}],
+            "after_render": [{"label": "render", "render_during_refresh": 0.9}]}
+    out, log = render(run_in_blender, tmp_path, spec)
+    worker = json.loads(next(line for line in log.splitlines()
+                             if line.startswith("WORKER "))[len("WORKER "):])
+    assert worker == {"jobs": 2, "computed": 1, "refreshed": False}, log[-3000:]
+    assert printed_hints(log) == {"render": None}, log[-3000:]
+    # The File Output of the render during the refresh replaced the first's.
+    expected = library_ao(native, out, 1, node_params(radius=0.9, blur_size=0))
+    for name in ("First", "Second"):
+        assert np.abs(node_outputs(out, 1, name)["ao"] - expected).max() <= EXACT, name
+
+
 def test_timer_waits_while_blender_refuses_writes(run_in_blender, tmp_path, native):
     """While another thread runs a read-only callback (a draw, Cycles'
     render), Blender refuses every write and operator from Python; a CI run

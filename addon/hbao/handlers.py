@@ -9,7 +9,7 @@ copy plain settings only. `blender -b ... -f N` runs them in the main thread,
 the only chance such a render has to build the hook."""
 import bpy
 
-from . import compat, helper_lookup, helper_scene, node, writes
+from . import compat, helper_lookup, helper_scene, node, recomposite, writes
 from .report import in_main_thread, log
 
 _sync_scheduled = False
@@ -62,6 +62,7 @@ def _on_render_pre(scene, *_args):
     tree = compat.compositor_tree(scene)
     if not node.hbao_nodes(tree):
         return
+    recomposite.cancel(scene.name)
     try:
         if in_main_thread():
             helper_scene.sync(scene)

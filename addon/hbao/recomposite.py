@@ -63,11 +63,13 @@ _failed = {}
 
 class _Computation:
     """The AO of a refresh's changed jobs, computed in a worker thread from
-    the kept passes: {cache key: (AOInputs, ao)}, or the error."""
+    the kept passes: {cache key: (AOInputs, ao)}, or the error. Once
+    `cancelled` (cancel()), the worker starts no further job."""
 
     def __init__(self, due, work):
         self.due = due
         self.results, self.error, self.seconds = {}, None, 0.0
+        self.cancelled = False
         self.thread = threading.Thread(target=self._run, args=(work,), daemon=True)
         self.thread.start()
 
@@ -75,6 +77,8 @@ class _Computation:
         start = time.perf_counter()
         try:
             for key, job, inputs, extra in work:
+                if self.cancelled:
+                    break
                 depth, normal = inputs.arrays[0], inputs.arrays[1]
                 self.results[key] = (inputs, layer_passes.compute(job, depth, normal,
                                                                   inputs.camera, extra))
@@ -89,6 +93,18 @@ class _Computation:
 # Main scene name -> its refresh's computation: one at a time per scene; a
 # change while it runs waits for it, and then starts another.
 _computing = {}
+
+
+def cancel(scene_name):
+    """A render of `scene_name` began (any thread): its refresh's worker
+    stops after the job it is computing rather than compete with the
+    render for the cores. The render brings the AO up to date, which
+    drops the refresh; should it be cancelled instead, the next tick's
+    refresh goes on from what the worker computed (the helper's engine
+    computes the rest from the kept passes)."""
+    computation = _computing.get(scene_name)
+    if computation is not None:
+        computation.cancelled = True
 
 
 def request_for(helper):

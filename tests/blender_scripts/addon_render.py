@@ -279,6 +279,40 @@ for step in spec.get("after_render", []):
             hinted = next(n for n in tree.nodes if n.bl_idname == "CompositorNodeHBAO")
         elif key == "unlink":
             tree.links.remove(hinted.inputs[value].links[0])
+        elif key == "render_during_refresh":
+            # Every node's radius set to `value`, then a render while the
+            # refresh's worker computes the first node's AO.
+            import threading
+            from hbao import helper_scene
+            for each in tree.nodes:
+                if each.bl_idname == "CompositorNodeHBAO":
+                    each.inputs["Radius"].default_value = value
+            started, release = threading.Event(), threading.Event()
+            compute = recomposite.layer_passes.compute
+
+            def first_job_held(*args, **kwargs):
+                if not started.is_set():  # the worker's first job waits for the render
+                    started.set()
+                    release.wait(60)
+                return compute(*args, **kwargs)
+            recomposite.layer_passes.compute = first_job_held
+            try:
+                # What the timer's first tick does in a window: start the worker.
+                helper = helper_scene.helper_scene_of(scene)
+                due = recomposite._needs_refresh(scene, helper)
+                assert not recomposite._refresh(scene, helper, due, False)
+                computation = recomposite._computing[scene.name]
+                started.wait(60)
+                scene.render.filepath = os.path.join(out_dir, "frame_during_refresh")
+                bpy.ops.render.render(write_still=True)
+            finally:
+                release.set()
+                recomposite.layer_passes.compute = compute
+            computation.thread.join()
+            print("WORKER", json.dumps({"jobs": len(computation.due.changed),
+                                        "computed": len(computation.results),
+                                        "refreshed": recomposite.refresh_changed(
+                                            in_background=True)}), flush=True)
         elif key == "render":  # the frame rendered again, as frame_<n>_again
             scene.render.filepath = os.path.join(out_dir, f"frame_{value:04d}_again")
             bpy.ops.render.render(write_still=True)
