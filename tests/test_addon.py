@@ -293,8 +293,8 @@ def test_new_node_settings_reach_the_ao_without_a_render(run_in_blender, tmp_pat
         helper = [scene for scene in scenes if scene.startswith(".HBAO")]
         if name.startswith("render_"):
             assert not helper, seen
-        else:  # Blender sets every scene a render renders to its frame: at most once a render
-            assert len(helper) <= len(seen["render_complete"]), seen
+        else:  # Blender sets every scene a render renders to its frame: once a render
+            assert len(helper) == len(seen["render_complete"]), seen
     hints = printed_hints(log)
     changed = "Changed: render to update"
     assert hints == {"radius": changed, "half size": changed, "full size": changed,
