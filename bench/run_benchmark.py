@@ -147,7 +147,9 @@ def addon_timing(mode, setting, env, bunny_json):
         if line.startswith("bench-addon: "):
             result = json.loads(line[len("bench-addon: "):])
         figures = timing_line.parse(line)
-        if figures is not None:
+        # The renders that computed the AO: not the unchanged frames (AO
+        # reused) nor the refreshes (which also neither save nor read).
+        if figures is not None and not figures["reused"] and not figures["recomposited"]:
             ao_times.append(figures["ao_ms"] / 1000.0)
             handovers.append(figures["handover_ms"] / 1000.0)
     if result is None or not handovers:

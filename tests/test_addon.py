@@ -279,8 +279,8 @@ def test_new_node_settings_reach_the_ao_without_a_render(run_in_blender, tmp_pat
     first, refreshed_line = (timing_line.parse(line) for line in lines[:2])
     assert first and not first["recomposited"] and not first["reused"], lines
     assert refreshed_line and refreshed_line["recomposited"], lines
-    assert (refreshed_line["reused"], refreshed_line["save_ms"], refreshed_line["read_ms"]) \
-        == (1, 0, 0), lines
+    assert (refreshed_line["reused"], refreshed_line["save_ms"],
+            refreshed_line["read_ms"]) == (1, 0, 0), lines
     refreshed = [line.split()[1] for line in log.splitlines() if line.startswith("REFRESHED ")]
     # After the file is opened again, nothing of the render before is kept.
     assert refreshed == ["False", "True", "False", "False", "False"], log[-3000:]

@@ -59,10 +59,10 @@ def _on_save_pre(*_args):
 def _on_render_pre(scene, *_args):
     if helper_lookup.is_helper(scene):
         return
+    recomposite.cancel_all()  # a render of any scene needs the cores
     tree = compat.compositor_tree(scene)
     if not node.hbao_nodes(tree):
         return
-    recomposite.cancel(scene.name)
     try:
         if in_main_thread():
             helper_scene.sync(scene)

@@ -64,7 +64,7 @@ _failed = {}
 class _Computation:
     """The AO of a refresh's changed jobs, computed in a worker thread from
     the kept passes: {cache key: (AOInputs, ao)}, or the error. Once
-    `cancelled` (cancel()), the worker starts no further job."""
+    `cancelled` (cancel_all()), the worker starts no further job."""
 
     def __init__(self, due, work):
         self.due = due
@@ -95,15 +95,14 @@ class _Computation:
 _computing = {}
 
 
-def cancel(scene_name):
-    """A render of `scene_name` began (any thread): its refresh's worker
-    stops after the job it is computing rather than compete with the
-    render for the cores. The render brings the AO up to date, which
-    drops the refresh; should it be cancelled instead, the next tick's
-    refresh goes on from what the worker computed (the helper's engine
-    computes the rest from the kept passes)."""
-    computation = _computing.get(scene_name)
-    if computation is not None:
+def cancel_all():
+    """A render began (any thread): every refresh's worker stops after the
+    job it is computing rather than compete with the render for the cores.
+    A render of the worker's own scene brings its AO up to date, which
+    drops the refresh; otherwise (another scene, or the render cancelled)
+    the next tick's refresh goes on from what the worker computed (the
+    helper's engine computes the rest from the kept passes)."""
+    for computation in list(_computing.values()):
         computation.cancelled = True
 
 
@@ -167,7 +166,8 @@ def _work(main, jobs):
 
 def _render_helper(main, helper, frame, ao_seconds):
     """Whether the helper rendered every pass for `main` (Request.completed).
-    No render or frame change handler runs for this render."""
+    No render or frame change handler but the add-on's own runs for this
+    render (handler_hold.py)."""
     global _request
     request = _request = Request(main.name, helper.name, frame, ao_seconds)
     try:

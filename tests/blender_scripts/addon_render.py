@@ -32,6 +32,7 @@ the renders), STATUS {json} (each node's status line) and RENDERED.
 import json
 import os
 import sys
+import threading
 
 import bpy
 
@@ -282,7 +283,6 @@ for step in spec.get("after_render", []):
         elif key == "render_during_refresh":
             # Every node's radius set to `value`, then a render while the
             # refresh's worker computes the first node's AO.
-            import threading
             from hbao import helper_scene
             for each in tree.nodes:
                 if each.bl_idname == "CompositorNodeHBAO":
@@ -302,7 +302,7 @@ for step in spec.get("after_render", []):
                 due = recomposite._needs_refresh(scene, helper)
                 assert not recomposite._refresh(scene, helper, due, False)
                 computation = recomposite._computing[scene.name]
-                started.wait(60)
+                assert started.wait(60), "the refresh's worker did not start"
                 scene.render.filepath = os.path.join(out_dir, "frame_during_refresh")
                 bpy.ops.render.render(write_still=True)
             finally:
