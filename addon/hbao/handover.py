@@ -107,24 +107,35 @@ _removals = []
 _removals_lock = threading.Lock()
 
 
-def _remove_later(path):
-    """Remove `path` in a thread of its own. Freeing a large file's pages is
-    the kernel's work, and long: a 1920x1080 render with 81 channels, 672
-    MB, took 115 ms on tmpfs (docs/speed.md, session 19), which the render
-    need not wait for. Not a daemon thread: Python waits for it before the
+def _in_background(removal, *args):
+    """removal(*args) in a thread of its own, counted among the removals
+    that the next save waits for. Freeing a large file's pages is the
+    kernel's work, and long: a 1920x1080 render with 81 channels, 672 MB,
+    took 115 ms on tmpfs (docs/speed.md, session 19), which the render need
+    not wait for. Not a daemon thread: Python waits for it before the
     process ends, so no scratch file outlives Blender (a process that ends
     by os._exit skips that wait: scripts/bpy_blender.py waits first). Where
-    no thread can be started (the process has run out of them), the file is
-    removed at once, and the render waits for it."""
-    thread = threading.Thread(target=_remove, args=(path,), name="hbao-scratch-removal")
+    no thread can be started (the process has run out of them), it runs at
+    once, and the render waits for it."""
+    thread = threading.Thread(target=removal, args=args, name="hbao-scratch-removal")
     try:
         thread.start()
     except RuntimeError as error:
-        log(f"removing the scratch file in the render's own thread: {error}")
-        _remove(path)
+        log(f"removing scratch files in the render's own thread: {error}")
+        removal(*args)
         return
     with _removals_lock:
         _removals.append(thread)
+
+
+def _remove_later(path):
+    """Remove `path` in the background (_in_background)."""
+    _in_background(_remove, path)
+
+
+def _remove_stale_files():
+    for stale in remove_stale_scratch_files():
+        log(f"removed {stale}, left by a Blender that has ended")
 
 
 def _wait_for_older_removals():
@@ -165,10 +176,9 @@ def read_passes(scene, layers):
     whether its normal is wanted}; and the seconds the save and the read
     took."""
     global _stale_files_checked
-    if not _stale_files_checked:
+    if not _stale_files_checked:  # a process's first hand-over, which need not wait for it
         _stale_files_checked = True
-        for stale in remove_stale_scratch_files():
-            log(f"removed {stale}, left by a Blender that has ended")
+        _in_background(_remove_stale_files)
     _wait_for_older_removals()
     path = _scratch_path()
     timings = {}

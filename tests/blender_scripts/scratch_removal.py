@@ -5,7 +5,8 @@ and before each save waits for every removal but the latest, so that at most
 two scratch files exist at a time. Here the removals are held back until
 released, to see who waits for whom; where no thread can be started, the
 file is removed at once. Then: the files that Blenders which have ended
-left behind are removed, and no others. Prints 'REMOVAL OK'; the
+left behind are removed, and no others, by a process's first hand-over,
+which does not wait for that. Prints 'REMOVAL OK'; the
 test checks that <folder> is empty once Blender has ended (Python waits for
 the last removal's thread, still running when this script ends).
 
@@ -17,6 +18,7 @@ import sys
 import threading
 import time
 
+import bpy
 from hbao import handover
 
 folder = sys.argv[sys.argv.index("--") + 1]
@@ -101,4 +103,36 @@ for kind in ("fresh", "this process's", "not a scratch file", "no process id"):
     path = os.path.join(folder, names[kind][0])
     assert os.path.exists(path), kind
     os.remove(path)
+
+# A process's first hand-over starts that removal and does not wait for it:
+# here it is held until released, and the hand-over (which fails at once:
+# nothing was rendered) comes back before.
+stale = os.path.join(folder, names["stale"][0])
+open(stale, "wb").close()
+os.utime(stale, (old, old))
+cleanup_release = threading.Event()
+remove_stale = handover.remove_stale_scratch_files
+
+
+def held_cleanup():
+    cleanup_release.wait(30)
+    return remove_stale()
+
+
+handover.remove_stale_scratch_files = held_cleanup
+handover._stale_files_checked = False
+try:
+    start = time.perf_counter()
+    try:
+        handover.read_passes(bpy.context.scene, {})
+        raise AssertionError("a hand-over with nothing rendered did not fail")
+    except RuntimeError:  # no Render Result, or one without pixels
+        pass
+    assert time.perf_counter() - start < 10, "the first hand-over waited for the stale files"
+    assert os.path.exists(stale), "the stale file went before its removal was released"
+finally:
+    cleanup_release.set()
+for thread in list(handover._removals):
+    thread.join(30)
+assert not os.path.exists(stale), "the first hand-over did not remove the stale file"
 print("REMOVAL OK", flush=True)
