@@ -208,6 +208,33 @@ def test_the_blur_falloff_matches_the_library():
         assert glsl_form in glsl, glsl_form
 
 
+def test_the_upsample_falloff_matches_the_library():
+    # The upsample weighs a candidate's depth by the blur's F of
+    # (UPSAMPLE_SHARPNESS |zs - z| / z)^2, formed as max(0, 1 - scaled^2)^16
+    # with scaled = |zs - z| UPSAMPLE_SHARPNESS / sqrt(R) / z, the factor
+    # capped at FLT_MAX; the nearest candidate is the one of least |zs - z|.
+    # Held in form, as the blur's is: the viewport's comparison would not
+    # tell F from exp(-e).
+    header = (REPO / "csrc" / "lib" / "internal_finish.h").read_text()
+    assert "#define HBAO_UPSAMPLE_DEPTH_WEIGHT (HBAO_UPSAMPLE_SHARPNESS * " \
+        "HBAO_BLUR_DEPTH_WEIGHT)" in header
+    glsl = shader_sources.UPSAMPLE_FRAGMENT
+    assert shader_sources.FALLOFF in glsl and shader_sources.FALLOFF in \
+        shader_sources.BLUR_FRAGMENT, "the blur and the upsample share blur_power"
+    assert "#define UPSAMPLE_DEPTH_WEIGHT (UPSAMPLE_SHARPNESS * DEPTH_WEIGHT)" in glsl
+    for c_form, glsl_form in [
+            ("HBAO_UPSAMPLE_DEPTH_WEIGHT / z;", "UPSAMPLE_DEPTH_WEIGHT / z"),
+            ("factor < FLT_MAX ? factor : FLT_MAX",
+             "min(UPSAMPLE_DEPTH_WEIGHT / z, LARGEST_FLOAT)"),
+            ("gap = fabsf(zs - z)", "gap = abs(zs - z)"),
+            ("scaled = gap * factor", "scaled = gap * factor"),
+            ("bilinear * hbao_blur_power(1.0f - scaled * scaled)",
+             "bilinear * blur_power(1.0 - scaled * scaled)"),
+            ("gap < *nearest_gap", "gap < nearest_gap")]:
+        assert c_form in LIBRARY_SOURCES["upsample.c"], c_form
+        assert glsl_form in glsl, glsl_form
+
+
 def test_the_glsl_constants_match_the_library():
     defines = shader_sources.AO_DEFINES
     for enum_name in ("hbao_falloff", "hbao_integration"):

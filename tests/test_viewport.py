@@ -17,8 +17,8 @@ SCRIPTS = REPO / "tests" / "blender_scripts"
 ARTIFACTS = REPO / "out" / "test-artifacts"
 
 # The GLSL follows csrc/lib/ operation for operation in float32; what differs is
-# the GPU's sin/cos/atan/acos/exp (the library uses its own polynomial acos, and
-# hbao_exp_negative, 3.2e-6 relative, in the upsample) and rounding order. On llvmpipe
+# the GPU's sin/cos/atan/acos/exp (the library uses its own polynomial acos) and
+# rounding order. On llvmpipe
 # that gives mean |difference| <= 5e-6 and 99th percentile <= 4e-5 (measured,
 # every case). The tolerances leave room for GPUs with coarser transcendentals
 # (NVIDIA's sin/cos: ~1e-6 absolute, more after range reduction) and for the
@@ -111,9 +111,9 @@ _LIBRARY_CONSTANTS = [
      "HBAO_BLOCK_PIXELS"),
     ("NORMAL_SHARPNESS", shader_sources.BLUR_DEFINES["NORMAL_SHARPNESS"], "internal_finish.h",
      "HBAO_BLUR_NORMAL_SHARPNESS"),
-    ("FALLOFF_REACH", shader_sources.BLUR_DEFINES["FALLOFF_REACH"], "internal_finish.h",
+    ("FALLOFF_REACH", shader_sources.FALLOFF_DEFINES["FALLOFF_REACH"], "internal_finish.h",
      "HBAO_BLUR_FALLOFF_REACH"),
-    ("DEPTH_WEIGHT", shader_sources.BLUR_DEFINES["DEPTH_WEIGHT"], "internal_finish.h",
+    ("DEPTH_WEIGHT", shader_sources.FALLOFF_DEFINES["DEPTH_WEIGHT"], "internal_finish.h",
      "HBAO_BLUR_DEPTH_WEIGHT"),
     ("FLOAT_DEPTH_PRECISION", shader_sources.FLOAT_DEPTH_PRECISION, "internal_hbao.h",
      "HBAO_FLOAT_DEPTH_PRECISION"),

@@ -5,10 +5,10 @@
 #ifndef HBAO_INTERNAL_FINISH_H
 #define HBAO_INTERNAL_FINISH_H
 
-/* Before internal_hbao.h, so that its inline helpers (hbao_exp_negative)
- * are not contracted into FMAs either where the AVX-512 copies inline them:
- * clang contracts by default, GCC does not in ISO C mode. Include this
- * header before internal_hbao.h. */
+/* Before internal_hbao.h, so that its inline helpers are not contracted
+ * into FMAs either where the AVX-512 copies inline them: clang contracts
+ * by default, GCC does not in ISO C mode. Include this header before
+ * internal_hbao.h. */
 #ifdef __clang__
 #pragma STDC FP_CONTRACT OFF
 #endif
@@ -40,6 +40,12 @@
 #define HBAO_BLUR_FALLOFF_REACH 16.0f
 #define HBAO_BLUR_NORMAL_WEIGHT (HBAO_BLUR_NORMAL_SHARPNESS / HBAO_BLUR_FALLOFF_REACH)
 #define HBAO_BLUR_DEPTH_WEIGHT 0.25f /* 1 / sqrt(HBAO_BLUR_FALLOFF_REACH) */
+/* The upsample weighs a candidate's depth by the same F, of
+ * (UPSAMPLE_SHARPNESS |zs - z| / z)^2: its base is 1 - scaled^2 with
+ * scaled = |zs - z| (UPSAMPLE_DEPTH_WEIGHT / z), the factor once per pixel
+ * (upsample.c; exp(-e) until session 22, which took the upsample a
+ * division and an exponential for each of a pixel's candidates). */
+#define HBAO_UPSAMPLE_DEPTH_WEIGHT (HBAO_UPSAMPLE_SHARPNESS * HBAO_BLUR_DEPTH_WEIGHT)
 
 /* F's power: max(0, base)^R by four squarings (R = 16), 0 for NaN.
  * Branch-free (the select is an integer mask) so that loops calling it

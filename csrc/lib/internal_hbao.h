@@ -317,37 +317,6 @@ void hbao_horizon_span_avx512(const hbao_horizon_job *job, int x0, int x1, int j
 
 /* blur.c, upsample.c: the stages after the horizon search (internal_finish.h). */
 
-/* exp(-x) for x >= 0, to 3.2e-6 relative error (a degree-4 polynomial of
- * 2^-f, fitted for the least largest relative error on [0, 1)), without
- * libm: the upsample evaluates it for every candidate. (The blur's weight
- * is hbao_blur_power, internal_finish.h.) */
-static inline float hbao_exp_negative(float x) {
-    /* Branch-free (selects are integer masks) so that loops calling it
-     * vectorize for any vector width. Beyond 87 the result is below FLT_MIN:
-     * 0. NaN compares false and gives 0 too. */
-    const uint32_t keep = 0u - (uint32_t)(x < 87.0f); /* all ones or zero */
-    union {
-        float f;
-        uint32_t u;
-    } in, scale, out;
-    in.f = x;
-    in.u &= keep; /* out of range: compute with 0, mask the result below */
-    /* 2^(-x * log2 e) = 2^-n * 2^-f with n integer, f in [0, 1). */
-    const float y = in.f * 1.44269504088896341f;
-    const int n = (int)y;
-    const float f = y - (float)n;
-    /* 2^-f on [0, 1) */
-    float p = -6.83187228e-3f;
-    p = p * f + 5.32235354e-2f;
-    p = p * f - 2.39456713e-1f;
-    p = p * f + 6.93063557e-1f;
-    p = 1.0f - p * f;
-    scale.u = (uint32_t)(127 - n) << 23; /* 2^-n, 0 <= n <= 125 */
-    out.f = p * scale.f;
-    out.u &= keep;
-    return out.f;
-}
-
 /* sqrt(1 - c^2), 0 where rounding takes c past 1: the sine of an angle
  * from its cosine (a horizon's, from its elevation or its angle to V). */
 static inline float hbao_sine_from_cosine(float c) {

@@ -3,24 +3,37 @@
  * by the full-resolution depth so that AO does not bleed across edges. One
  * full-resolution row at a time, written straight into the caller's output
  * (blur.c): the AO arrives already blurred on the half grid. */
+#include <float.h>
 #include <math.h>
 
 #include "internal_finish.h"
 
-/* One candidate's share: bilinear weight times depth similarity. Written
- * with selects only (no branches) so that the row loop vectorizes. */
+/* One candidate's share: bilinear weight times depth similarity, the
+ * blur's falloff F (internal_finish.h) of (UPSAMPLE_SHARPNESS |zs - z| / z)^2,
+ * its base formed from the pixel's factor (upsample_factor). The nearest
+ * candidate is the one nearest in |zs - z|, which orders the candidates of
+ * a pixel as the relative difference does. Written with selects only (no
+ * branches) so that the row loop vectorizes. */
 static HBAO_ALWAYS_INLINE void add_candidate(float bilinear, float zs, float ao, float z,
-                                             float *sum, float *weight_sum, float *nearest_ao,
-                                             float *nearest_difference) {
+                                             float factor, float *sum, float *weight_sum,
+                                             float *nearest_ao, float *nearest_gap) {
     const int usable = (bilinear > 0.0f) & (zs > 0.0f);
-    const float difference = fabsf(zs - z) / z;
-    const float scaled = HBAO_UPSAMPLE_SHARPNESS * difference;
-    const float weight = bilinear * hbao_exp_negative(scaled * scaled) * (float)usable;
+    const float gap = fabsf(zs - z);
+    const float scaled = gap * factor;
+    const float weight = bilinear * hbao_blur_power(1.0f - scaled * scaled) * (float)usable;
     *sum += weight * ao;
     *weight_sum += weight;
-    const int nearer = usable & (difference < *nearest_difference);
+    const int nearer = usable & (gap < *nearest_gap);
     *nearest_ao = nearer ? ao : *nearest_ao;
-    *nearest_difference = nearer ? difference : *nearest_difference;
+    *nearest_gap = nearer ? gap : *nearest_gap;
+}
+
+/* A pixel's factor: UPSAMPLE_SHARPNESS / sqrt(R) / z, computed once for
+ * its candidates. Capped at FLT_MAX, as the blur's is: for a tiny depth it
+ * overflows, and a candidate at the same depth would weigh 0 * inf = NaN. */
+static HBAO_ALWAYS_INLINE float upsample_factor(float z) {
+    const float factor = HBAO_UPSAMPLE_DEPTH_WEIGHT / z;
+    return factor < FLT_MAX ? factor : FLT_MAX;
 }
 
 /* One pixel's AO from its candidates' sums; with no sample at a similar
@@ -43,12 +56,13 @@ typedef struct half_rows {
 
 /* Even pixel 2k: on half column k. */
 static HBAO_ALWAYS_INLINE float even_pixel(const half_rows *h, int two_rows, float z, int k) {
-    float sum = 0.0f, weight_sum = 0.0f, nearest_ao = 1.0f, nearest_difference = INFINITY;
-    add_candidate(h->top_weight, h->z_top[k], h->ao_top[k], z, &sum, &weight_sum, &nearest_ao,
-                  &nearest_difference);
+    const float factor = upsample_factor(z);
+    float sum = 0.0f, weight_sum = 0.0f, nearest_ao = 1.0f, nearest_gap = INFINITY;
+    add_candidate(h->top_weight, h->z_top[k], h->ao_top[k], z, factor, &sum, &weight_sum,
+                  &nearest_ao, &nearest_gap);
     if (two_rows)
-        add_candidate(h->bottom_weight, h->z_bottom[k], h->ao_bottom[k], z, &sum, &weight_sum,
-                      &nearest_ao, &nearest_difference);
+        add_candidate(h->bottom_weight, h->z_bottom[k], h->ao_bottom[k], z, factor, &sum,
+                      &weight_sum, &nearest_ao, &nearest_gap);
     return finish_pixel(z, sum, weight_sum, nearest_ao);
 }
 
@@ -57,16 +71,17 @@ static HBAO_ALWAYS_INLINE float even_pixel(const half_rows *h, int two_rows, flo
 static HBAO_ALWAYS_INLINE float odd_pixel(const half_rows *h, int two_rows, float z, int k,
                                           int right, float right_weight) {
     const float left_weight = 1.0f - right_weight;
-    float sum = 0.0f, weight_sum = 0.0f, nearest_ao = 1.0f, nearest_difference = INFINITY;
-    add_candidate(left_weight * h->top_weight, h->z_top[k], h->ao_top[k], z, &sum, &weight_sum,
-                  &nearest_ao, &nearest_difference);
-    add_candidate(right_weight * h->top_weight, h->z_top[right], h->ao_top[right], z, &sum,
-                  &weight_sum, &nearest_ao, &nearest_difference);
+    const float factor = upsample_factor(z);
+    float sum = 0.0f, weight_sum = 0.0f, nearest_ao = 1.0f, nearest_gap = INFINITY;
+    add_candidate(left_weight * h->top_weight, h->z_top[k], h->ao_top[k], z, factor, &sum,
+                  &weight_sum, &nearest_ao, &nearest_gap);
+    add_candidate(right_weight * h->top_weight, h->z_top[right], h->ao_top[right], z, factor, &sum,
+                  &weight_sum, &nearest_ao, &nearest_gap);
     if (two_rows) {
-        add_candidate(left_weight * h->bottom_weight, h->z_bottom[k], h->ao_bottom[k], z, &sum,
-                      &weight_sum, &nearest_ao, &nearest_difference);
+        add_candidate(left_weight * h->bottom_weight, h->z_bottom[k], h->ao_bottom[k], z, factor,
+                      &sum, &weight_sum, &nearest_ao, &nearest_gap);
         add_candidate(right_weight * h->bottom_weight, h->z_bottom[right], h->ao_bottom[right], z,
-                      &sum, &weight_sum, &nearest_ao, &nearest_difference);
+                      factor, &sum, &weight_sum, &nearest_ao, &nearest_gap);
     }
     return finish_pixel(z, sum, weight_sum, nearest_ao);
 }

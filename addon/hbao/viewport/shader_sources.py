@@ -79,22 +79,14 @@ vec3 view_vector(vec3 position)
 NORMAL_FRAGMENT = CAMERA + horizon_sources.NORMALS
 AO_FRAGMENT = CAMERA + horizon_sources.HORIZON_SEARCH
 
-# One separable pass of the cross-bilateral blur (docs/algorithm.md, "After
-# sampling", 2); `blur_step` is (1, 0) for rows, (0, 1) for columns;
-# `kernel_radius` and `sigma` come from parameters.blur_kernel_radius and
-# blur_sigma, the library's rule. The centre weighs 1 and the taps are summed
-# after it, from -r up to r, as csrc/lib/blur.c does; down
-# a column the order is mirrored (textures are bottom-up), which only changes
-# rounding. The weight is the library's (csrc/lib/internal_finish.h,
-# hbao_blur_power): max(0, base)^16 by the same four squarings, of the same
-# base, with the centre's factor and normal scaled once per pixel.
-BLUR_FRAGMENT = COMMON + """
-/* FLT_MAX: sharpness / z overflows for tiny depths, and a tap at the same
- * depth would weigh 0 * inf = NaN; capped, it weighs what any tap at the
- * same depth does (csrc/lib/blur.c). */
+# The range weight F of the blur and the upsample (csrc/lib/internal_finish.h,
+# hbao_blur_power): max(0, base)^16 by the same four squarings; each caller
+# forms the base as the library does.
+FALLOFF = """
+/* FLT_MAX: a factor sharpness / z overflows for tiny depths, and a sample at
+ * the same depth would weigh 0 * inf = NaN; capped, it weighs what any
+ * sample at the same depth does (csrc/lib/blur.c, upsample.c). */
 #define LARGEST_FLOAT 3.402823466e38
-/* HBAO_BLUR_NORMAL_WEIGHT: NORMAL_SHARPNESS / FALLOFF_REACH */
-#define NORMAL_WEIGHT (NORMAL_SHARPNESS / FALLOFF_REACH)
 
 /* hbao_blur_power: max(0, base)^16 */
 float blur_power(float base)
@@ -105,6 +97,19 @@ float blur_power(float base)
     power *= power;
     return power * power;
 }
+"""
+
+# One separable pass of the cross-bilateral blur (docs/algorithm.md, "After
+# sampling", 2); `blur_step` is (1, 0) for rows, (0, 1) for columns;
+# `kernel_radius` and `sigma` come from parameters.blur_kernel_radius and
+# blur_sigma, the library's rule. The centre weighs 1 and the taps are summed
+# after it, from -r up to r, as csrc/lib/blur.c does; down
+# a column the order is mirrored (textures are bottom-up), which only changes
+# rounding. The weight is the library's F of the same base, with the centre's
+# factor and normal scaled once per pixel.
+BLUR_FRAGMENT = COMMON + FALLOFF + """
+/* HBAO_BLUR_NORMAL_WEIGHT: NORMAL_SHARPNESS / FALLOFF_REACH */
+#define NORMAL_WEIGHT (NORMAL_SHARPNESS / FALLOFF_REACH)
 
 void main()
 {
@@ -154,27 +159,28 @@ void main()
 # Joint bilateral upsampling of the half grid's AO to full resolution,
 # csrc/lib/upsample.c operation for operation: a pixel's candidates are the
 # half-grid pixels around it with bilinear weights (even columns and rows sit
-# on the grid), each weighed by its depth's similarity. The half grid's AO
-# arrives already blurred.
-UPSAMPLE_FRAGMENT = COMMON + """
-#define LARGEST_FLOAT 3.402823466e38
+# on the grid), each weighed by its depth's similarity, F of the same base.
+# The half grid's AO arrives already blurred.
+UPSAMPLE_FRAGMENT = COMMON + FALLOFF + """
+/* HBAO_UPSAMPLE_DEPTH_WEIGHT: UPSAMPLE_SHARPNESS / sqrt(FALLOFF_REACH) */
+#define UPSAMPLE_DEPTH_WEIGHT (UPSAMPLE_SHARPNESS * DEPTH_WEIGHT)
 
-float sum, weight_sum, nearest_ao, nearest_difference;
+float sum, weight_sum, nearest_ao, nearest_gap;
 
-void add_candidate(float bilinear, int k, int r, float z)
+void add_candidate(float bilinear, int k, int r, float z, float factor)
 {
     ivec2 texel = ivec2(k, half_size.y - 1 - r);
     float zs = texelFetch(half_depth_texture, texel, 0).r;
     float ao = texelFetch(half_ao_texture, texel, 0).r;
     bool usable = bilinear > 0.0 && !is_background(zs);
-    float difference = abs(zs - z) / z;
-    float scaled = UPSAMPLE_SHARPNESS * difference;
-    float weight = usable ? bilinear * exp(-(scaled * scaled)) : 0.0;
+    float gap = abs(zs - z);
+    float scaled = gap * factor;
+    float weight = usable ? bilinear * blur_power(1.0 - scaled * scaled) : 0.0;
     sum += weight * ao;
     weight_sum += weight;
-    if (usable && difference < nearest_difference) {
+    if (usable && gap < nearest_gap) {
         nearest_ao = ao;
-        nearest_difference = difference;
+        nearest_gap = gap;
     }
 }
 
@@ -190,22 +196,24 @@ void main()
     sum = 0.0;
     weight_sum = 0.0;
     nearest_ao = 1.0;
-    nearest_difference = LARGEST_FLOAT; /* the library's INFINITY: no finite difference is larger */
+    nearest_gap = LARGEST_FLOAT; /* the library's INFINITY: no finite gap is larger */
+    /* upsample.c's upsample_factor, once for the pixel's candidates */
+    float factor = min(UPSAMPLE_DEPTH_WEIGHT / z, LARGEST_FLOAT);
     if ((i & 1) == 0) {
-        add_candidate(top_weight, k, r0, z);
+        add_candidate(top_weight, k, r0, z, factor);
         if (two_rows) {
-            add_candidate(bottom_weight, k, r1, z);
+            add_candidate(bottom_weight, k, r1, z, factor);
         }
     } else {
         /* between half columns k and k + 1, if there is one */
         int odd_inner = min(full_size.x / 2, half_size.x - 1);
         int right = k < odd_inner ? k + 1 : k;
         float right_weight = k < odd_inner ? 0.5 : 0.0, left_weight = 1.0 - right_weight;
-        add_candidate(left_weight * top_weight, k, r0, z);
-        add_candidate(right_weight * top_weight, right, r0, z);
+        add_candidate(left_weight * top_weight, k, r0, z, factor);
+        add_candidate(right_weight * top_weight, right, r0, z, factor);
         if (two_rows) {
-            add_candidate(left_weight * bottom_weight, k, r1, z);
-            add_candidate(right_weight * bottom_weight, right, r1, z);
+            add_candidate(left_weight * bottom_weight, k, r1, z, factor);
+            add_candidate(right_weight * bottom_weight, right, r1, z, factor);
         }
     }
     float blended = weight_sum > 1e-6 ? sum / weight_sum : nearest_ao;
@@ -249,17 +257,24 @@ AO_DEFINES = {
     "BLOCK_PIXELS": 16,
 }
 
+# The range weight's (FALLOFF): csrc/lib/internal_finish.h,
+# HBAO_BLUR_FALLOFF_REACH and HBAO_BLUR_DEPTH_WEIGHT (tests/test_viewport.py
+# compares them).
+FALLOFF_DEFINES = {
+    "FALLOFF_REACH": 16.0,
+    "DEPTH_WEIGHT": 0.25,
+}
+
 UPSAMPLE_DEFINES = {
     # csrc/lib/internal_hbao.h, HBAO_UPSAMPLE_SHARPNESS
     # (tests/test_viewport.py compares the two).
     "UPSAMPLE_SHARPNESS": 16.0,
+    **FALLOFF_DEFINES,
 }
 
 BLUR_DEFINES = {
-    # csrc/lib/internal_finish.h, HBAO_BLUR_NORMAL_SHARPNESS,
-    # HBAO_BLUR_FALLOFF_REACH and HBAO_BLUR_DEPTH_WEIGHT
-    # (tests/test_viewport.py compares them).
+    # csrc/lib/internal_finish.h, HBAO_BLUR_NORMAL_SHARPNESS
+    # (tests/test_viewport.py compares the two).
     "NORMAL_SHARPNESS": 8.0,
-    "FALLOFF_REACH": 16.0,
-    "DEPTH_WEIGHT": 0.25,
+    **FALLOFF_DEFINES,
 }

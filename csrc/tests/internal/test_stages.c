@@ -332,7 +332,8 @@ TEST_CASE(upsample_weights_are_bilinear_on_a_flat_depth) {
  * pixel (i, j) at depth z, in double: the half-grid samples at
  * floor(i/2) + {0, i odd} x floor(j/2) + {0, j odd} with their bilinear
  * weights (all on the left or upper one where there is no column or row
- * beyond) times exp(-(16 |z_s - z| / z)^2), background samples and those
+ * beyond) times F((16 |z_s - z| / z)^2), F the blur's falloff (F(e) =
+ * (1 - e / 16)^16 below 16, 0 from 16 on), background samples and those
  * of bilinear weight 0 left out; where the weights sum to at most 1e-6, the
  * AO of the sample nearest in depth (the first of equals, in the order
  * left top, right top, left bottom, right bottom), 1 if none. Sets *sum to
@@ -355,7 +356,8 @@ static double documented_upsample(const hbao_grid *half, const float *half_ao, i
         const double zs = half->depth[at];
         if (!(bx * by > 0.0) || !(zs > 0.0)) continue;
         const double difference = fabs(zs - z) / z;
-        const double weight = bx * by * exp(-(16.0 * difference) * (16.0 * difference));
+        const double e = (16.0 * difference) * (16.0 * difference);
+        const double weight = bx * by * (e < 16.0 ? pow(1.0 - e / 16.0, 16.0) : 0.0);
         weighted += weight * half_ao[at];
         *sum += weight;
         if (difference < nearest) {
@@ -369,7 +371,7 @@ static double documented_upsample(const hbao_grid *half, const float *half_ao, i
 }
 
 /* The upsample weighs depth as docs/algorithm.md writes, to 1e-5 (float
- * rounding and hbao_exp_negative's 3.2e-6): full depths 0.7 to 1.3 times
+ * rounding, which F's four squarings multiply by 16): full depths 0.7 to 1.3 times
  * their half-grid sample's, in front and behind, and some background on
  * both grids, so that pixels blend their samples, fall back to the one
  * nearest in depth (where a sample in front is farther in relative depth
