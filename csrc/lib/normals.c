@@ -194,11 +194,11 @@ static void fallback_normal(const normal_job *job, int i, int j) {
     for (int c = 0; c < 3; c++) hbao_grid_normal_row(grid, j, c)[i] = n[c];
 }
 
-/* The given normals of CHUNK pixels at a time, in lanes: the same float
- * operations, in the same order, as view_vector and transform_given_normal
- * (no FMA contraction: internal_finish.h), so every compiled copy gives the
- * same normals. A pixel whose given normal is unusable, or that is
- * background, is marked for fallback_normal. */
+/* The given normals of CHUNK pixels at a time, in lanes (no FMA
+ * contraction: internal_finish.h), so every compiled copy gives the same
+ * normals: world to camera space, scaled to unit length by one reciprocal,
+ * and turned towards the camera. A pixel whose given normal is unusable, or
+ * that is background, is marked for fallback_normal. */
 #define CHUNK 64
 
 static HBAO_ALWAYS_INLINE void given_normals_row(const normal_job *job, int j) {
@@ -225,27 +225,26 @@ static HBAO_ALWAYS_INLINE void given_normals_row(const normal_job *job, int j) {
             z[k] = depth_row[i0 + k];
         }
         for (int k = 0; k < count; k++) {
-            /* view_vector */
-            const float x = ((float)(i0 + k) + grid->x_offset) * grid->x_step;
-            const float p0 = orthographic ? x : x * z[k];
-            const float p1 = orthographic ? y : y * z[k];
-            const float p2 = -z[k];
-            const float p_length = sqrtf(p0 * p0 + p1 * p1 + p2 * p2);
-            const float v0 = orthographic ? 0.0f : -p0 / p_length;
-            const float v1 = orthographic ? 0.0f : -p1 / p_length;
-            const float v2 = orthographic ? 1.0f : -p2 / p_length;
-            /* transform_given_normal */
+            /* the camera-space normal, unit length */
             const float world_length = sqrtf(wx[k] * wx[k] + wy[k] * wy[k] + wz[k] * wz[k]);
             const float n0 = m[0] * wx[k] + m[1] * wy[k] + m[2] * wz[k];
             const float n1 = m[4] * wx[k] + m[5] * wy[k] + m[6] * wz[k];
             const float n2 = m[8] * wx[k] + m[9] * wy[k] + m[10] * wz[k];
             const float length = sqrtf(n0 * n0 + n1 * n1 + n2 * n2);
-            const float u0 = n0 / length, u1 = n1 / length, u2 = n2 / length;
+            const float inverse = 1.0f / length;
+            const float u0 = n0 * inverse, u1 = n1 * inverse, u2 = n2 * inverse;
             /* isfinite(x) as x <= FLT_MAX on |x|: NaN fails, and it vectorizes */
             usable[k] = z[k] > 0.0f && fabsf(world_length) <= 3.40282347e38f &&
                         world_length >= HBAO_MIN_NORMAL_LENGTH && fabsf(length) <= 3.40282347e38f &&
                         length > 0.0f;
-            const int flip = u0 * v0 + u1 * v1 + u2 * v2 < 0.0f;
+            /* Turned towards the camera: dot(u, V) >= 0. V is the position
+             * p negated and scaled by 1 / |p| > 0 (view_vector), or +z
+             * orthographic; the scale does not change the sign, so the
+             * test needs neither |p|'s square root nor its divisions. */
+            const float x = ((float)(i0 + k) + grid->x_offset) * grid->x_step;
+            const float facing =
+                orthographic ? u2 : u2 * z[k] - (u0 * (x * z[k]) + u1 * (y * z[k]));
+            const int flip = facing < 0.0f;
             nx[k] = flip ? -u0 : u0;
             ny[k] = flip ? -u1 : u1;
             nz[k] = flip ? -u2 : u2;
