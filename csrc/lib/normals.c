@@ -237,13 +237,14 @@ static HBAO_ALWAYS_INLINE void given_normals_row(const normal_job *job, int j) {
             usable[k] = z[k] > 0.0f && fabsf(world_length) <= 3.40282347e38f &&
                         world_length >= HBAO_MIN_NORMAL_LENGTH && fabsf(length) <= 3.40282347e38f &&
                         length > 0.0f;
-            /* Turned towards the camera: dot(u, V) >= 0. V is the position
-             * p negated and scaled by 1 / |p| > 0 (view_vector), or +z
-             * orthographic; the scale does not change the sign, so the
-             * test needs neither |p|'s square root nor its divisions. */
+            /* Turned towards the camera: dot(u, V) >= 0. V is +z
+             * orthographic, and in perspective the position p = z (x, y,
+             * -1) negated and scaled by 1 / |p| (view_vector): for the
+             * usable pixels (z > 0) its sign is that of dot(u, (-x, -y,
+             * 1)), which needs neither |p| nor the depth, so that no
+             * depth in the float range overflows it. */
             const float x = ((float)(i0 + k) + grid->x_offset) * grid->x_step;
-            const float facing =
-                orthographic ? u2 : u2 * z[k] - (u0 * (x * z[k]) + u1 * (y * z[k]));
+            const float facing = orthographic ? u2 : u2 - (u0 * x + u1 * y);
             const int flip = facing < 0.0f;
             nx[k] = flip ? -u0 : u0;
             ny[k] = flip ? -u1 : u1;

@@ -641,7 +641,7 @@ TEST_CASE(blur_keeps_depth_edges) {
     float sharp[64 * 16];
     CHECK_RESULT(hbao_compute(&p, &camera, w, h, &d, NULL, sharp, w), HBAO_SUCCESS);
     /* near-plane pixels next to the edge: unchanged by the blur, because the
-     * far plane's taps are 200% deeper (weight exp(-(8*2)^2) ~ 0) */
+     * far plane's taps are 200% deeper (the range weight F is 0 there) */
     CHECK_NEAR(ao[8 * w + w / 2 - 1], sharp[8 * w + w / 2 - 1], 1e-4);
 }
 

@@ -335,8 +335,9 @@ TEST_CASE(upsample_weights_are_bilinear_on_a_flat_depth) {
  * beyond) times F((16 |z_s - z| / z)^2), F the blur's falloff (F(e) =
  * (1 - e / 16)^16 below 16, 0 from 16 on), background samples and those
  * of bilinear weight 0 left out; where the weights sum to at most 1e-6, the
- * AO of the sample nearest in depth (the first of equals, in the order
- * left top, right top, left bottom, right bottom), 1 if none. Sets *sum to
+ * AO of the sample nearest in depth, of least |z_s - z| (the first of
+ * equals, in the order left top, right top, left bottom, right bottom), 1
+ * if none. Sets *sum to
  * the weights' sum and *blend_nearest_gap to how far apart the blend and
  * the nearest sample's AO are (what the fallback's threshold decides). */
 static double documented_upsample(const hbao_grid *half, const float *half_ao, int i, int j,
@@ -355,13 +356,13 @@ static double documented_upsample(const hbao_grid *half, const float *half_ao, i
         const int at = (y0 + (dy && has_below)) * half->width + x0 + (dx && has_right);
         const double zs = half->depth[at];
         if (!(bx * by > 0.0) || !(zs > 0.0)) continue;
-        const double difference = fabs(zs - z) / z;
-        const double e = (16.0 * difference) * (16.0 * difference);
+        const double gap = fabs(zs - z);
+        const double e = (16.0 * gap / z) * (16.0 * gap / z);
         const double weight = bx * by * (e < 16.0 ? pow(1.0 - e / 16.0, 16.0) : 0.0);
         weighted += weight * half_ao[at];
         *sum += weight;
-        if (difference < nearest) {
-            nearest = difference;
+        if (gap < nearest) {
+            nearest = gap;
             nearest_ao = half_ao[at];
         }
     }
@@ -585,12 +586,19 @@ TEST_CASE(given_normals_too_short_give_the_face_normal) {
  * (a tangent of the ray plus or minus 0.02 times the ray's direction
  * towards the eye) keep their side or flip; a view vector leant by 0.1
  * would decide many of them the other way. Every copy; rays from the
- * documented pixel mapping (hbao_camera_view). */
+ * documented pixel mapping (hbao_camera_view); depths about 4 times a scale
+ * from the least denormal to near FLT_MAX (issue 13): with |P|^2 (until
+ * session 22) about half the normals took the wrong side from 1e25 and
+ * below 1e-30, with P's own coordinates at the least denormal and near
+ * FLT_MAX. */
 TEST_CASE(given_normals_face_the_viewer_along_its_ray) {
     enum { w = 150, h = 7 };
     static float depth[w * h], normal[3 * w * h + HBAO_NORMAL_PADDING], given[3 * w * h];
     static float expected[3 * w * h];
-    for (int projection = 0; projection < 2; projection++) {
+    static const float scales[] = {1.0f, 1e-45f, 1e-40f, 1e-30f, 1e25f, 8e37f};
+    for (int run = 0; run < 2 * (int)(sizeof scales / sizeof scales[0]); run++) {
+        const int projection = run & 1;
+        const float scale = scales[run / 2];
         hbao_camera camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
         camera.projection = projection ? HBAO_PROJECTION_ORTHOGRAPHIC : HBAO_PROJECTION_PERSPECTIVE;
         camera.shift_x = 0.4f;
@@ -599,7 +607,7 @@ TEST_CASE(given_normals_face_the_viewer_along_its_ray) {
         CHECK_RESULT(hbao_camera_view(&camera, w, h, &view), HBAO_SUCCESS);
         for (int k = 0; k < w * h; k++) {
             const int i = k % w, j = k / w, kind = k % 4;
-            depth[k] = 4.0f + 0.01f * (float)(k % 13);
+            depth[k] = (4.0f + 0.01f * (float)(k % 13)) * scale;
             const double x = view.origin_x + (i + 0.5) * view.pixel_size_x;
             const double y = view.origin_y + (h - 1 - j + 0.5) * view.pixel_size_y;
             /* towards the eye: -P / |P|, P = z (x, y, -1); or the view axis */
@@ -632,8 +640,9 @@ TEST_CASE(given_normals_face_the_viewer_along_its_ray) {
                 for (int c = 0; c < 3; c++) off += !(fabsf(n[c] - expected[3 * k + c]) <= 1e-5f);
             }
             if (off)
-                printf("  %s, implementation %d: %d components off\n",
-                       projection ? "orthographic" : "perspective", implementation, off);
+                printf("  %s, depth scale %g, implementation %d: %d components off\n",
+                       projection ? "orthographic" : "perspective", (double)scale, implementation,
+                       off);
             CHECK(off == 0);
         }
     }
