@@ -315,8 +315,6 @@ void hbao_horizon_span_avx2(const hbao_horizon_job *job, int x0, int x1, int j);
 int hbao_horizon_avx512_available(void);
 void hbao_horizon_span_avx512(const hbao_horizon_job *job, int x0, int x1, int j);
 
-/* blur.c, upsample.c: the stages after the horizon search (internal_finish.h). */
-
 /* sqrt(1 - c^2), 0 where rounding takes c past 1: the sine of an angle
  * from its cosine (a horizon's, from its elevation or its angle to V). */
 static inline float hbao_sine_from_cosine(float c) {
