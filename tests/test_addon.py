@@ -783,3 +783,29 @@ def test_scratch_files_are_removed_beside_the_render_two_at_most(run_in_blender,
     completed = run_in_blender(SCRIPTS / "scratch_removal.py", tmp_path)
     assert "REMOVAL OK" in completed.stdout, completed.stdout[-3000:]
     assert list(tmp_path.iterdir()) == []
+
+
+def test_scratch_file_stays_until_the_ao_is_computed(run_in_blender, tmp_path, monkeypatch):
+    """The removal of a frame's scratch file, the kernel freeing its pages,
+    waits until the frame's AO is computed (handover.removals_after), so
+    that it does not compete with the AO's threads; then it goes. Two frames,
+    two nodes each: at every AO the frame's own file is in the folder, and
+    the folder is empty after Blender ends."""
+    scratch = tmp_path / "scratch"
+    scratch.mkdir()
+    monkeypatch.setenv("HBAO_TEMP_DIR", str(scratch))
+    # The radii change from frame to frame, so that frame 2 computes its AO
+    # again instead of reusing frame 1's (ao_cache).
+    spec = {"frames": [1, 2], "nodes": [{"keyframes": [[1, 1.0], [2, 0.8]]},
+                                        {"keyframes": [[1, 0.5], [2, 0.4]]}]}
+    completed = run_in_blender(SCRIPTS / "removal_order.py", json.dumps(spec), tmp_path / "out")
+    assert "RENDERED" in completed.stdout, completed.stdout[-3000:]
+    line = next(text for text in completed.stdout.splitlines()
+                if text.startswith("SCRATCH AT AO "))
+    seen = json.loads(line[len("SCRATCH AT AO "):])
+    assert len(seen) == 4, seen
+    # This process's scratch files are numbered in the order saved
+    # (handover._scratch_path): frame 1's ends in -0.exr, frame 2's in -1.exr.
+    for at_ao, number in zip(seen, (0, 0, 1, 1)):
+        assert any(name.endswith(f"-{number}.exr") for name in at_ao), seen
+    assert list(scratch.iterdir()) == []

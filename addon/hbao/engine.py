@@ -109,7 +109,8 @@ def compute_passes(engine, depsgraph, width, height, request=None):
 
     results = {}
     # Esc: Blender asks through test_break(); the passes are left at 1 and
-    # the render ends as Blender decides (the scratch file is already gone).
+    # the render ends as Blender decides (the scratch file goes as the
+    # render_helper's removals_after block ends).
     if engine.test_break():
         log("render cancelled: no AO computed")
         _cache.clear()
@@ -188,7 +189,9 @@ def render_helper(engine, depsgraph):
     width, height = result.resolution_x, result.resolution_y
     try:
         try:
-            results = compute_passes(engine, depsgraph, width, height, request)
+            # The scratch files go once the AO is computed (handover.removals_after).
+            with handover.removals_after():
+                results = compute_passes(engine, depsgraph, width, height, request)
         except (native.HBAOLibraryError, exr_passes.EXRLibraryError) as error:
             results = {}
             _cache.clear()  # nothing kept that this render's record would not match

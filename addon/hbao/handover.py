@@ -3,6 +3,7 @@
 Python engine no access to another scene's Render Result pixels, but it can
 save the Render Result as a multilayer EXR, which libhbao_exr decodes
 straight into numpy arrays."""
+import contextlib
 import itertools
 import os
 import tempfile
@@ -112,7 +113,7 @@ def _in_background(removal, *args):
     that the next save waits for. Freeing a large file's pages is the
     kernel's work, and long: a 1920x1080 render with 81 channels, 672 MB,
     took 115 ms on tmpfs (docs/speed.md, session 19), which the render need
-    not wait for. Not a daemon thread: Python waits for it before the
+    not wait for (but see removals_after). Not a daemon thread: Python waits for it before the
     process ends, so no scratch file outlives Blender (a process that ends
     by os._exit skips that wait: scripts/bpy_blender.py waits first). Where
     no thread can be started (the process has run out of them), it runs at
@@ -128,9 +129,39 @@ def _in_background(removal, *args):
         _removals.append(thread)
 
 
+# The scratch files whose removal waits for the end of a removals_after()
+# block of this thread; None outside one.
+_deferred = threading.local()
+
+
 def _remove_later(path):
-    """Remove `path` in the background (_in_background)."""
-    _in_background(_remove, path)
+    """Remove `path` in the background (_in_background), or at the end of
+    the removals_after() block this thread is in."""
+    waiting = getattr(_deferred, "paths", None)
+    if waiting is not None:
+        waiting.append(path)
+    else:
+        _in_background(_remove, path)
+
+
+@contextlib.contextmanager
+def removals_after():
+    """Within the block, the hand-over's scratch files are removed only when
+    it ends (however it ends), each in the background as before. The
+    engine computes the AO in such a block: the removal's kernel work then
+    runs beside what Blender does after the AO, not beside the AO's
+    threads, which keep every core busy (81 channels at 1920x1080: the AO
+    218 ms with the removal beside it, 196 ms after; docs/speed.md,
+    session 23)."""
+    outer = getattr(_deferred, "paths", None)
+    _deferred.paths = [] if outer is None else outer
+    try:
+        yield
+    finally:
+        if outer is None:
+            waiting, _deferred.paths = _deferred.paths, None
+            for path in waiting:
+                _in_background(_remove, path)
 
 
 def _remove_stale_files():

@@ -4,7 +4,8 @@ removes its scratch files in threads of their own (handover._remove_later),
 and before each save waits for every removal but the latest, so that at most
 two scratch files exist at a time. Here the removals are held back until
 released, to see who waits for whom; where no thread can be started, the
-file is removed at once. Then: the files that Blenders which have ended
+file is removed at once; within a removals_after() block, a removal waits
+for the block's end. Then: the files that Blenders which have ended
 left behind are removed, and no others, by a process's first hand-over,
 which does not wait for that. Prints 'REMOVAL OK'; the
 test checks that <folder> is empty once Blender has ended (Python waits for
@@ -76,6 +77,22 @@ try:
 finally:
     threading.Thread.start = start_thread
 assert not os.path.exists(path), "the file was not removed without a thread"
+
+# In a removals_after() block (the engine's AO), a removal starts only when
+# the block ends, however it ends: here by an error.
+path = os.path.join(folder, "hbao-passes-test-4.exr")
+open(path, "wb").close()
+started = len(handover._removals)
+try:
+    with handover.removals_after():
+        handover._remove_later(path)
+        assert len(handover._removals) == started, "a removal started within the block"
+        raise KeyError("the AO failed")
+except KeyError:
+    pass
+assert len(handover._removals) == started + 1, "the block's end started no removal"
+handover._removals[-1].join(30)
+assert not os.path.exists(path), "the file was not removed after the block"
 
 
 # Files left by Blenders that ended (killed, or os._exit before the removal
