@@ -323,6 +323,76 @@ TEST_CASE(simd_kernels_match_scalar_on_half_depth_planes) {
     }
 }
 
+/* --- scale --------------------------------------------------------------- */
+
+/* Every length of a view times one power of two (depths, radius, background
+ * depth, orthographic scale) gives the same AO, bit for bit: the library's
+ * formulas are homogeneous in length, and a power of two rounds as 1 does,
+ * for depths from about 1e-16 (2^-56 here) to 1e19 (2^60; at 2^62 the
+ * search's squared distances overflow, at 2^-60 they reach the denormals
+ * and a few pixels move by an ulp: hbao.h, "Conventions"). Reconstructed
+ * normals squared a cross product of two tangents and lost the scale from
+ * 2^40 and at 2^-32 (before keep_in_range, normals.c): the floor took V for
+ * its normal and occluded itself. */
+TEST_CASE(ao_is_the_same_at_every_scale) {
+    scene s = single_plane(scene_plane_make(0, 0, 0, 0, 0, 1));
+    s.plane[s.planes] = scene_plane_make(0, 12.0, 0, 0, -1, 0);
+    scene_plane_clip(&s.plane[s.planes++], 0, 0, -1, 0);
+    const double eye[3] = {0, 0, EYE_HEIGHT}, target[3] = {0, 100.0, EYE_HEIGHT - 20.0};
+    const int exponents[] = {-56, -44, -32, -16, 16, 32, 40, 60};
+    const int implementations[] = {HBAO_IMPLEMENTATION_SCALAR, HBAO_IMPLEMENTATION_AVX2,
+                                   HBAO_IMPLEMENTATION_AVX512};
+    for (int orthographic = 0; orthographic <= 1; orthographic++) {
+        const scene_view view = make_view(203, 117, eye, target, orthographic);
+        float *depth, *normal;
+        scene_render(&s, &view, &depth, &normal);
+        const size_t pixels = (size_t)view.width * view.height;
+        float *scaled = malloc(pixels * sizeof(float));
+        float *expected = malloc(pixels * sizeof(float)), *ao = malloc(pixels * sizeof(float));
+        hbao_channel given = {normal, 3, 3 * view.width};
+        size_t differing = 0;
+        for (int variant = 0; variant < 8; variant++) {
+            hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+            p.radius = 2.0f;
+            p.background_depth = 1e9f;
+            p.half_resolution = variant & 1;
+            p.integration = (variant >> 1) & 1;
+            const hbao_channel *normals = (variant >> 2) ? &given : NULL;
+            p.thickness = (variant >> 2) ? 0.5f : 0.0f; /* a length as well */
+            p.implementation = implementations[variant % 3];
+            hbao_channel d = {depth, 1, view.width};
+            CHECK_RESULT(hbao_compute(&p, &view.camera, view.width, view.height, &d, normals,
+                                      expected, view.width),
+                         HBAO_SUCCESS);
+            float darkest = 1.0f;
+            for (size_t k = 0; k < pixels; k++) darkest = fminf(darkest, expected[k]);
+            CHECK(darkest < 0.8f); /* the wall's foot is occluded */
+            for (size_t e = 0; e < sizeof exponents / sizeof exponents[0]; e++) {
+                hbao_params q = p;
+                hbao_camera camera = view.camera;
+                q.radius = ldexpf(p.radius, exponents[e]);
+                q.background_depth = ldexpf(p.background_depth, exponents[e]);
+                q.thickness = ldexpf(p.thickness, exponents[e]);
+                camera.ortho_scale = ldexpf(camera.ortho_scale, exponents[e]);
+                for (size_t k = 0; k < pixels; k++) scaled[k] = ldexpf(depth[k], exponents[e]);
+                hbao_channel sd = {scaled, 1, view.width};
+                CHECK_RESULT(hbao_compute(&q, &camera, view.width, view.height, &sd, normals, ao,
+                                          view.width),
+                             HBAO_SUCCESS);
+                for (size_t k = 0; k < pixels; k++) differing += ao[k] != expected[k];
+            }
+        }
+        printf("  %s: pixels that differ at another scale: %zu\n",
+               orthographic ? "orthographic" : "perspective", differing);
+        CHECK(differing == 0);
+        free(scaled);
+        free(expected);
+        free(ao);
+        free(depth);
+        free(normal);
+    }
+}
+
 TEST_MAIN(TEST_ENTRY(floor_from_eye_height_float_depth),
           TEST_ENTRY(floor_from_eye_height_half_depth), TEST_ENTRY(tilted_planes_float_depth),
           TEST_ENTRY(tilted_planes_half_depth), TEST_ENTRY(orthographic_tilted_planes_float_depth),
@@ -330,4 +400,5 @@ TEST_MAIN(TEST_ENTRY(floor_from_eye_height_float_depth),
           TEST_ENTRY(one_pixel_wide_image_of_tilted_planes),
           TEST_ENTRY(one_pixel_tall_image_of_tilted_planes),
           TEST_ENTRY(wall_on_grazing_floor_still_occludes),
-          TEST_ENTRY(simd_kernels_match_scalar_on_half_depth_planes))
+          TEST_ENTRY(simd_kernels_match_scalar_on_half_depth_planes),
+          TEST_ENTRY(ao_is_the_same_at_every_scale))
