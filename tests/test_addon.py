@@ -778,7 +778,9 @@ def test_package_and_install(tmp_path):
 
 def test_scratch_files_are_removed_beside_the_render_two_at_most(run_in_blender, tmp_path):
     """handover.py removes each scratch file in a thread of its own; a save
-    waits for every removal but the latest (at most two files at a time), and
+    waits for every removal but the latest (so at most two files at a time,
+    outside the engine's removals_after block, where a frame's files go
+    together), and
     Blender does not end before the last removal: the folder is empty after."""
     completed = run_in_blender(SCRIPTS / "scratch_removal.py", tmp_path)
     assert "REMOVAL OK" in completed.stdout, completed.stdout[-3000:]

@@ -147,12 +147,12 @@ def _remove_later(path):
 @contextlib.contextmanager
 def removals_after():
     """Within the block, the hand-over's scratch files are removed only when
-    it ends (however it ends), each in the background as before. The
-    engine computes the AO in such a block: the removal's kernel work then
-    runs beside what Blender does after the AO, not beside the AO's
-    threads, which keep every core busy (81 channels at 1920x1080: the AO
-    218 ms with the removal beside it, 196 ms after; docs/speed.md,
-    session 23)."""
+    it ends (however it ends), all of them by one removal in the background.
+    The engine computes the AO in such a block: the removal's kernel work
+    then runs beside what Blender does after the AO, not beside the AO's
+    threads, which keep every core busy (docs/speed.md, session 23). A
+    block within a block of the same thread leaves its files to the outer
+    one; other threads' removals are not held back."""
     outer = getattr(_deferred, "paths", None)
     _deferred.paths = [] if outer is None else outer
     try:
@@ -160,8 +160,13 @@ def removals_after():
     finally:
         if outer is None:
             waiting, _deferred.paths = _deferred.paths, None
-            for path in waiting:
-                _in_background(_remove, path)
+            if waiting:
+                _in_background(_remove_all, waiting)
+
+
+def _remove_all(paths):
+    for path in paths:
+        _remove(path)
 
 
 def _remove_stale_files():
@@ -170,10 +175,12 @@ def _remove_stale_files():
 
 
 def _wait_for_older_removals():
-    """Before the next save: every removal but the latest done, so that at
-    most two scratch files exist at a time, however quickly frames follow
-    each other, while a frame's second save (a guard band's, a back face
-    layer's) does not wait for its first one's removal."""
+    """Before the next save: every removal but the latest done, so that
+    besides the files being saved and read, only the latest removal's may
+    still exist (a frame's, up to three with a guard band and back faces:
+    removals_after), however quickly frames follow each other; a frame's
+    second save (a guard band's, a back face layer's) does not wait for the
+    removal before it."""
     with _removals_lock:
         older = _removals[:-1]
         del _removals[:-1]

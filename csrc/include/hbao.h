@@ -27,12 +27,13 @@
  *   (Cycles writes 1e10, EEVEE's half float 65504) gets AO = 1 and never
  *   occludes anything.
  * - The output is always finite and in [0, 1].
- * - Depths are used in single precision as given. Scaling every length
- *   of a view (depths, radius, thickness, background_depth, ortho_scale)
- *   by a power of two leaves the AO bit for bit the same for depths from
- *   about 1e-16 to 1e19 scene units. Beyond 1e19 (only with a
- *   background_depth above it) squared distances overflow, and toward the
- *   denormals (below about 1e-17; below 1.2e-38 the depth weights no
+ * - Scale: depths are used in single precision as given. Scaling every
+ *   length of a view (depths, radius, thickness, background_depth,
+ *   ortho_scale) by a power of two leaves the AO bit for bit the same
+ *   while those lengths stay between about 1e-16 and 1e19 scene units
+ *   (test_planes.c, ao_is_the_same_at_every_scale). Beyond 1e19 (only with
+ *   a background_depth above it) squared distances overflow, and toward
+ *   the denormals (below about 1e-17; below 1.2e-38 the depth weights no
  *   longer tell depths apart) they lose precision: the AO there is finite
  *   and in [0, 1] but not that of the geometry.
  * - Every call returns a result code; hbao_result_message() turns it into

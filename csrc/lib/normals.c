@@ -18,14 +18,15 @@ typedef struct normal_job {
     int implementation; /* the compiled copy of given_normals_row to run */
 } normal_job;
 
-/* A vector's components scaled by one power of two where its largest lies
+/* A tangent's components scaled by one power of two where its largest lies
  * outside [2^-28, 2^28], to within [0.5, 1): a product of two such vectors'
  * components, squared, would overflow (a face normal's cross product of
  * two tangents of about 1e9 each, at depths from about 1e11) or underflow
- * (below about 1e-9). The scaling is exact, so a direction computed from
- * the scaled vector (a cross product's, a normalisation's) is the one an
- * exact product would give, and vectors inside the range, every ordinary
- * scene's, are left as they are. */
+ * (below about 1e-9). The scaling is exact unless a component is below
+ * 2^-125 of the largest, so the cross product and its normalisation give
+ * the direction that the unscaled tangents would without overflow; the
+ * tangents of every ordinary scene lie inside the range and are left as
+ * they are. */
 #define HBAO_SCALE_FREE_REACH 0x1p28f
 static void keep_in_range(float v[3]) {
     const float largest = fmaxf(fmaxf(fabsf(v[0]), fabsf(v[1])), fabsf(v[2]));
@@ -43,12 +44,11 @@ static void view_vector(const hbao_grid *grid, const float position[3], float v[
         v[2] = 1.0f;
         return;
     }
-    float p[3] = {position[0], position[1], position[2]};
-    keep_in_range(p); /* |p|^2 overflowed from depths of about 2e19 */
-    const float length = sqrtf(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
-    v[0] = -p[0] / length;
-    v[1] = -p[1] / length;
-    v[2] = -p[2] / length;
+    const float length =
+        sqrtf(position[0] * position[0] + position[1] * position[1] + position[2] * position[2]);
+    v[0] = -position[0] / length;
+    v[1] = -position[1] / length;
+    v[2] = -position[2] / length;
 }
 
 /* The neighbour difference along one axis whose depth changes least, so that

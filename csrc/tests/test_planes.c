@@ -328,7 +328,7 @@ TEST_CASE(simd_kernels_match_scalar_on_half_depth_planes) {
 /* Every length of a view times one power of two (depths, radius, background
  * depth, orthographic scale) gives the same AO, bit for bit: the library's
  * formulas are homogeneous in length, and a power of two rounds as 1 does,
- * for depths from about 1e-16 (2^-56 here) to 1e19 (2^60; at 2^62 the
+ * for depths from about 1e-16 (2^-56 here) to 1e19 (2^60; from 2^61 the
  * search's squared distances overflow, at 2^-60 they reach the denormals
  * and a few pixels move by an ulp: hbao.h, "Conventions"). Reconstructed
  * normals squared a cross product of two tangents and lost the scale from

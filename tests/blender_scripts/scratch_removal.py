@@ -94,6 +94,25 @@ assert len(handover._removals) == started + 1, "the block's end started no remov
 handover._removals[-1].join(30)
 assert not os.path.exists(path), "the file was not removed after the block"
 
+# A block within a block leaves its files to the outer one, and another
+# thread's removal is not held back by this thread's block.
+inner_path, other_path = (os.path.join(folder, f"hbao-passes-test-{n}.exr") for n in (5, 6))
+for made in (inner_path, other_path):
+    open(made, "wb").close()
+with handover.removals_after():
+    with handover.removals_after():
+        handover._remove_later(inner_path)
+    assert len(handover._removals) == started + 1, "the inner block's end started a removal"
+    other = threading.Thread(target=handover._remove_later, args=(other_path,))
+    other.start()
+    other.join(30)
+    assert len(handover._removals) == started + 2, "another thread's removal was held back"
+    handover._removals[-1].join(30)
+    assert not os.path.exists(other_path)
+    assert os.path.exists(inner_path)
+handover._removals[-1].join(30)
+assert not os.path.exists(inner_path), "the file was not removed after the outer block"
+
 
 # Files left by Blenders that ended (killed, or os._exit before the removal
 # thread was done) go at a process's first hand-over: only files older than
