@@ -113,8 +113,9 @@ def _in_background(removal, *args):
     that the next save waits for. Freeing a large file's pages is the
     kernel's work, and long: a 1920x1080 render with 81 channels, 672 MB,
     took 115 ms on tmpfs (docs/speed.md, session 19), which the render need
-    not wait for (but see removals_after). Not a daemon thread: Python waits for it before the
-    process ends, so no scratch file outlives Blender (a process that ends
+    not wait for (nor the AO share the cores with: removals_after). Not a
+    daemon thread: Python waits for it before the process ends, so no
+    scratch file outlives Blender (a process that ends
     by os._exit skips that wait: scripts/bpy_blender.py waits first). Where
     no thread can be started (the process has run out of them), it runs at
     once, and the render waits for it."""

@@ -244,10 +244,16 @@ TEST_CASE(one_pixel_tall_image_of_tilted_planes) {
  * remove the real one. The floor just in front of the wall's foot is
  * occluded by the wall above it (cosine-weighted: 0.5 at the crease, test_ao.c),
  * so the darkest floor pixel must stay well below 1. */
-TEST_CASE(wall_on_grazing_floor_still_occludes) {
+/* The floor z = 0 and a wall at y = 12 standing on it, facing the eye. */
+static scene wall_on_floor(void) {
     scene s = single_plane(scene_plane_make(0, 0, 0, 0, 0, 1));
     s.plane[s.planes] = scene_plane_make(0, 12.0, 0, 0, -1, 0); /* facing the eye */
     scene_plane_clip(&s.plane[s.planes++], 0, 0, -1, 0);        /* above the floor */
+    return s;
+}
+
+TEST_CASE(wall_on_grazing_floor_still_occludes) {
+    const scene s = wall_on_floor();
     const double eye[3] = {0, 0, EYE_HEIGHT}, target[3] = {0, 100.0, EYE_HEIGHT};
     const scene_view view = make_view(960, 540, eye, target, 0);
     float *depth, *normal;
@@ -335,9 +341,7 @@ TEST_CASE(simd_kernels_match_scalar_on_half_depth_planes) {
  * 2^40 and at 2^-32 (before keep_in_range, normals.c): the floor took V for
  * its normal and occluded itself. */
 TEST_CASE(ao_is_the_same_at_every_scale) {
-    scene s = single_plane(scene_plane_make(0, 0, 0, 0, 0, 1));
-    s.plane[s.planes] = scene_plane_make(0, 12.0, 0, 0, -1, 0);
-    scene_plane_clip(&s.plane[s.planes++], 0, 0, -1, 0);
+    const scene s = wall_on_floor();
     const double eye[3] = {0, 0, EYE_HEIGHT}, target[3] = {0, 100.0, EYE_HEIGHT - 20.0};
     const int exponents[] = {-56, -44, -32, -16, 16, 32, 40, 60};
     const int implementations[] = {HBAO_IMPLEMENTATION_SCALAR, HBAO_IMPLEMENTATION_AVX2,
