@@ -115,10 +115,10 @@ def _in_background(removal, *args):
     took 115 ms on tmpfs (docs/speed.md, session 19), which the render need
     not wait for (nor the AO share the cores with: removals_after). Not a
     daemon thread: Python waits for it before the process ends, so no
-    scratch file outlives Blender (a process that ends
-    by os._exit skips that wait: scripts/bpy_blender.py waits first). Where
-    no thread can be started (the process has run out of them), it runs at
-    once, and the render waits for it."""
+    scratch file outlives Blender (a process that ends by os._exit skips
+    that wait: scripts/bpy_blender.py waits first). Where no thread can be
+    started (the process has run out of them), it runs at once, and the
+    render waits for it."""
     thread = threading.Thread(target=removal, args=args, name="hbao-scratch-removal")
     try:
         thread.start()
