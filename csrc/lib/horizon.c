@@ -701,11 +701,19 @@ void hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *grid,
         const int i = cell & 3, j = cell >> 2;
         const double rotation = (bayer_4x4[cell] + 0.5) / 16.0;
         job.jitter[cell] = (float)((bayer_4x4[j + 4 * i] + 0.5) / 16.0);
-        for (int d = 0; d < settings->directions; d++) {
-            const double theta =
-                2.0 * 3.14159265358979323846 * (d + rotation) / settings->directions;
+        /* An even count's second half is its first half negated (the
+         * angles plus pi), exactly, so that the SIMD kernels set up a pair
+         * of opposite directions at once (horizon_simd.h, block_ao). */
+        const int directions = settings->directions;
+        const int half = directions % 2 == 0 ? directions / 2 : directions;
+        for (int d = 0; d < half; d++) {
+            const double theta = 2.0 * 3.14159265358979323846 * (d + rotation) / directions;
             job.direction_cos[cell][d] = (float)cos(theta);
             job.direction_sin[cell][d] = (float)sin(theta);
+        }
+        for (int d = half; d < directions; d++) {
+            job.direction_cos[cell][d] = -job.direction_cos[cell][d - half];
+            job.direction_sin[cell][d] = -job.direction_sin[cell][d - half];
         }
     }
     tiled_job tiled;

@@ -34,8 +34,8 @@ static inline VF SIMD_NAME(dot3)(VF a0, VF a1, VF a2, VF b0, VF b1, VF b2) {
     return V_ADD(V_ADD(V_MUL(a0, b0), V_MUL(a1, b1)), V_MUL(a2, b2));
 }
 
-/* hbao_acos, lane by lane */
-static inline VF SIMD_NAME(acos)(VF x) {
+/* hbao_acos of |x|, lane by lane (x = |x| or -|x|: the same result) */
+static inline VF SIMD_NAME(acos_of_magnitude)(VF x) {
     const VM negative = V_LT(x, V_SET(0.0f));
     const VF ax = V_SELECT(negative, x, V_NEG(x));
     VF p = V_SET(-0.0012624911f);
@@ -48,28 +48,67 @@ static inline VF SIMD_NAME(acos)(VF x) {
     p = V_ADD(V_MUL(p, ax), V_SET(1.5707963050f));
     const VF one_minus = V_SUB(V_SET(1.0f), ax);
     const VF root = V_ZERO_UNLESS(V_GT(one_minus, V_SET(0.0f)), V_SQRT(one_minus));
-    const VF r = V_MUL(root, p);
-    return V_SELECT(negative, r, V_SUB(V_SET(HBAO_PI), r));
+    return V_MUL(root, p);
+}
+
+/* hbao_acos, lane by lane, from r = acos_of_magnitude(x) */
+static inline VF SIMD_NAME(acos_from)(VF x, VF r) {
+    return V_SELECT(V_LT(x, V_SET(0.0f)), r, V_SUB(V_SET(HBAO_PI), r));
+}
+
+/* hbao_acos, lane by lane */
+static inline VF SIMD_NAME(acos)(VF x) {
+    return SIMD_NAME(acos_from)(x, SIMD_NAME(acos_of_magnitude)(x));
+}
+
+/* horizon.c's gamma (asin of sin_gamma, as pi/2 - acos), from
+ * r = acos_of_magnitude(sin_gamma) */
+static inline VF SIMD_NAME(gamma_from)(VF sin_gamma, VF r) {
+    return V_SUB(V_SET(0.5f * HBAO_PI), SIMD_NAME(acos_from)(sin_gamma, r));
 }
 
 typedef struct SIMD_NAME(slice) {
     VF np_length, inv_np, cos_gamma, sin_gamma;
+    VF gamma; /* gamma_from; set only for the cosine integration */
     VM usable;
 } SIMD_NAME(slice);
 
-/* horizon.c's slice_setup; n_cross_v: the x and y of n x V */
+/* horizon.c's slice_setup for direction (dc, ds) into *sl and, where mirror
+ * is not NULL, for the opposite direction (-dc, -ds) into *mirror. The
+ * opposite direction's products are *sl's negated, exactly, so its sums are
+ * formed here from the negated products as the reference forms them (even
+ * a zero gets the same sign); the quantities that depend on them only
+ * through a square (the square roots, the divisions, gamma's arc cosine of
+ * |sin_gamma|) are *sl's. So *mirror is the reference's slice of the
+ * opposite direction, bit for bit, for a third of the work (bench_ab,
+ * docs/speed.md). n_cross_v: the x and y of n x V; with_gamma: whether
+ * gamma is wanted (the cosine integration). */
 static inline void SIMD_NAME(slice_setup)(const VF v[3], const VF n[3], const VF n_cross_v[2],
-                                          VF n_dot_v, VF dc, VF ds, SIMD_NAME(slice) * sl) {
-    const VF dir_dot_v = V_ADD(V_MUL(dc, v[0]), V_MUL(ds, v[1]));
+                                          VF n_dot_v, VF dc, VF ds, int with_gamma,
+                                          SIMD_NAME(slice) * sl, SIMD_NAME(slice) * mirror) {
+    const VF dv0 = V_MUL(dc, v[0]), dv1 = V_MUL(ds, v[1]);
+    const VF dir_dot_v = V_ADD(dv0, dv1);
     const VF e_inv = V_DIV(V_SET(1.0f), V_SQRT(V_SUB(V_SET(1.0f), V_MUL(dir_dot_v, dir_dot_v))));
     const VF n_dot_m = V_MUL(V_ADD(V_MUL(dc, n_cross_v[0]), V_MUL(ds, n_cross_v[1])), e_inv);
     sl->np_length = V_SQRT(V_MAX0(V_SUB(V_SET(1.0f), V_MUL(n_dot_m, n_dot_m))));
     sl->usable = V_GT(sl->np_length, V_SET(1e-6f));
     sl->inv_np = V_DIV(V_SET(1.0f), sl->np_length);
     sl->cos_gamma = V_SELECT(sl->usable, V_SET(1.0f), V_MUL(n_dot_v, sl->inv_np));
-    const VF n_dot_e =
-        V_MUL(V_SUB(V_ADD(V_MUL(dc, n[0]), V_MUL(ds, n[1])), V_MUL(dir_dot_v, n_dot_v)), e_inv);
+    const VF dn0 = V_MUL(dc, n[0]), dn1 = V_MUL(ds, n[1]);
+    const VF n_dot_e = V_MUL(V_SUB(V_ADD(dn0, dn1), V_MUL(dir_dot_v, n_dot_v)), e_inv);
     sl->sin_gamma = V_SELECT(sl->usable, V_SET(0.0f), V_MUL(n_dot_e, sl->inv_np));
+    const VF acos_r = with_gamma ? SIMD_NAME(acos_of_magnitude)(sl->sin_gamma) : V_SET(0.0f);
+    if (with_gamma) sl->gamma = SIMD_NAME(gamma_from)(sl->sin_gamma, acos_r);
+    if (mirror == NULL) return;
+    mirror->np_length = sl->np_length;
+    mirror->usable = sl->usable;
+    mirror->inv_np = sl->inv_np;
+    mirror->cos_gamma = sl->cos_gamma;
+    const VF back_dot_v = V_ADD(V_NEG(dv0), V_NEG(dv1));
+    const VF back_dot_e =
+        V_MUL(V_SUB(V_ADD(V_NEG(dn0), V_NEG(dn1)), V_MUL(back_dot_v, n_dot_v)), e_inv);
+    mirror->sin_gamma = V_SELECT(sl->usable, V_SET(0.0f), V_MUL(back_dot_e, sl->inv_np));
+    if (with_gamma) mirror->gamma = SIMD_NAME(gamma_from)(mirror->sin_gamma, acos_r);
 }
 
 /* A vector holds a whole block: its HBAO_BLOCK_PIXELS pixels (internal_hbao.h)
@@ -566,7 +605,7 @@ static inline VF SIMD_NAME(visibility_start)(const hbao_settings *s, VF gamma,
 static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SIMD_NAME(block) * b,
                                                 VM active, const SIMD_NAME(steps) * t,
                                                 const SIMD_NAME(slice) * sl, VF *open_part) {
-    const VF gamma = V_SUB(V_SET(0.5f * HBAO_PI), SIMD_NAME(acos)(sl->sin_gamma));
+    const VF gamma = sl->gamma;
     const VF inv_np = sl->inv_np;
     const VM check_past_normal = V_GT(sl->sin_gamma, V_SET(0.0f));
     const int any_check = M_ANY(M_AND(check_past_normal, active));
@@ -734,7 +773,7 @@ static VF SIMD_NAME(direction_occlusion_cosine_layers)(const hbao_settings *s,
                                                        const SIMD_NAME(block) * b, VM active,
                                                        const SIMD_NAME(steps) * t,
                                                        const SIMD_NAME(slice) * sl, VF *open_part) {
-    const VF gamma = V_SUB(V_SET(0.5f * HBAO_PI), SIMD_NAME(acos)(sl->sin_gamma));
+    const VF gamma = sl->gamma;
     *open_part =
         V_MUL(V_SET(0.25f),
               V_ADD(V_MUL(V_SET(2.0f), sl->cos_gamma),
@@ -830,8 +869,12 @@ static VF SIMD_NAME(direction_occlusion_hbao_layers)(const hbao_settings *s,
 }
 
 /* Directions whose slices block_ao sets up together: 8 keep the stack
- * frame small (2.5 KiB of slices). */
+ * frame small. An even number of directions up to SIMD_PAIRED_DIRECTIONS
+ * is set up as one group, in opposite pairs (direction d + N/2 is direction
+ * d negated: horizon.c's table), each pair by one slice_setup; the 16
+ * slices take 6 KiB of stack (AVX2). */
 #define SIMD_DIRECTION_GROUP 8
+#define SIMD_PAIRED_DIRECTIONS 16
 
 /* Sets up *b, the block of phase a at x0 in row j, with the block's step
  * step_px, and returns its active lanes. What the steps' plan reads is set
@@ -928,13 +971,24 @@ static void SIMD_NAME(block_ao)(const hbao_horizon_job *job, int x0, int x1, int
     /* The slices of a group of directions are set up first, one after the
      * other: their chains of square roots and divisions overlap, where a
      * search loop between them would keep each waiting. */
-    for (int first = 0; live && first < s->directions; first += SIMD_DIRECTION_GROUP) {
-        const int count = s->directions - first < SIMD_DIRECTION_GROUP ? s->directions - first
-                                                                       : SIMD_DIRECTION_GROUP;
-        SIMD_NAME(slice) slices[SIMD_DIRECTION_GROUP];
-        for (int k = 0; k < count; k++) {
-            const VF dc = V_SET(direction_cos[first + k]), ds = V_SET(direction_sin[first + k]);
-            SIMD_NAME(slice_setup)(b.v, b.n, b.n_cross_v, b.n_dot_v, dc, ds, &slices[k]);
+    const int paired = s->directions % 2 == 0 && s->directions <= SIMD_PAIRED_DIRECTIONS;
+    const int group = paired ? SIMD_PAIRED_DIRECTIONS : SIMD_DIRECTION_GROUP;
+    for (int first = 0; live && first < s->directions; first += group) {
+        const int count = s->directions - first < group ? s->directions - first : group;
+        SIMD_NAME(slice) slices[SIMD_PAIRED_DIRECTIONS];
+        if (paired) { /* first is 0, count all the directions */
+            const int half = count / 2;
+            for (int k = 0; k < half; k++) {
+                const VF dc = V_SET(direction_cos[k]), ds = V_SET(direction_sin[k]);
+                SIMD_NAME(slice_setup)
+                (b.v, b.n, b.n_cross_v, b.n_dot_v, dc, ds, cosine, &slices[k], &slices[k + half]);
+            }
+        } else {
+            for (int k = 0; k < count; k++) {
+                const VF dc = V_SET(direction_cos[first + k]), ds = V_SET(direction_sin[first + k]);
+                SIMD_NAME(slice_setup)
+                (b.v, b.n, b.n_cross_v, b.n_dot_v, dc, ds, cosine, &slices[k], NULL);
+            }
         }
         for (int k = 0; k < count; k++) {
             const SIMD_NAME(slice) *sl = &slices[k];
