@@ -188,6 +188,7 @@ static inline pair_f load_every_fourth_pair(const float *p) {
 #define V_LOAD_EVERY_FOURTH load_every_fourth_pair
 
 #define SIMD_PREFETCH_STEPS 1
+#define SIMD_PAIRED_DIRECTIONS 16
 #define SIMD_ORTHOGRAPHIC 0
 #define SIMD_NAME(name) name##_avx2
 #include "horizon_simd.h"

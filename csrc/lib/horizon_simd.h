@@ -18,7 +18,8 @@
  * I_ZERO_UNLESS(m, v); I_SRAI (arithmetic shift) for the steps' indices;
  * SIMD_NAME(x) gives the instance's function names. SIMD_PREFETCH_STEPS (0 or
  * 1): whether a direction's depths are prefetched once its steps are planned
- * (prefetch_steps). SIMD_ORTHOGRAPHIC (0 or
+ * (prefetch_steps). SIMD_PAIRED_DIRECTIONS: up to how many directions (an
+ * even count) block_ao sets up in opposite pairs, 0 for none. SIMD_ORTHOGRAPHIC (0 or
  * 1) is the camera's projection, hbao_grid.orthographic: each file makes
  * an instance for each, so that no step tests it (bench_ab, 1080p, four
  * file copies of each build: 0.970 on 1 thread, 0.958 on 2). */
@@ -868,13 +869,21 @@ static VF SIMD_NAME(direction_occlusion_hbao_layers)(const hbao_settings *s,
     return V_SELECT(V_GT(occlusion, past), past, occlusion);
 }
 
-/* Directions whose slices block_ao sets up together: 8 keep the stack
- * frame small. An even number of directions up to SIMD_PAIRED_DIRECTIONS
+/* Directions whose slices block_ao sets up together: groups of 8, except
+ * that an even number of directions up to SIMD_PAIRED_DIRECTIONS (0: never)
  * is set up as one group, in opposite pairs (direction d + N/2 is direction
- * d negated: horizon.c's table), each pair by one slice_setup; the 16
- * slices take 6 KiB of stack (AVX2). */
+ * d negated: horizon.c's table), each pair by one slice_setup. The AVX2
+ * copy pairs up to 16 (6 KiB of slices on the stack): bench_ab, 1080p, Zen
+ * 1, defaults 0.954 on 1 thread, 0.948-0.972 on 2, 8 x 6 + blur 15 0.951
+ * (docs/speed.md, session 24). The AVX-512 copy does not: session 11
+ * measured pairs slower there (1.03-1.04), and no AVX-512 machine was at
+ * hand to measure this form. */
 #define SIMD_DIRECTION_GROUP 8
-#define SIMD_PAIRED_DIRECTIONS 16
+#if SIMD_PAIRED_DIRECTIONS > SIMD_DIRECTION_GROUP
+#define SIMD_SLICE_ROOM SIMD_PAIRED_DIRECTIONS
+#else
+#define SIMD_SLICE_ROOM SIMD_DIRECTION_GROUP
+#endif
 
 /* Sets up *b, the block of phase a at x0 in row j, with the block's step
  * step_px, and returns its active lanes. What the steps' plan reads is set
@@ -971,11 +980,12 @@ static void SIMD_NAME(block_ao)(const hbao_horizon_job *job, int x0, int x1, int
     /* The slices of a group of directions are set up first, one after the
      * other: their chains of square roots and divisions overlap, where a
      * search loop between them would keep each waiting. */
-    const int paired = s->directions % 2 == 0 && s->directions <= SIMD_PAIRED_DIRECTIONS;
+    const int paired = SIMD_PAIRED_DIRECTIONS > 0 && s->directions % 2 == 0 &&
+                       s->directions <= SIMD_PAIRED_DIRECTIONS;
     const int group = paired ? SIMD_PAIRED_DIRECTIONS : SIMD_DIRECTION_GROUP;
     for (int first = 0; live && first < s->directions; first += group) {
         const int count = s->directions - first < group ? s->directions - first : group;
-        SIMD_NAME(slice) slices[SIMD_PAIRED_DIRECTIONS];
+        SIMD_NAME(slice) slices[SIMD_SLICE_ROOM];
         if (paired) { /* first is 0, count all the directions */
             const int half = count / 2;
             for (int k = 0; k < half; k++) {

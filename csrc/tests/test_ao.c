@@ -759,7 +759,7 @@ TEST_CASE(simd_paths_match_scalar_reference_bit_for_bit) {
         p.blur_sharpness = variant & 2 ? 2.0f : HBAO_DEFAULT_BLUR_SHARPNESS;
         p.half_resolution = (variant >> 2) & 1;
         p.angle_bias_degrees = (variant & 8) ? 0.0f : 20.0f;
-        p.directions = direction_counts[(variant + variant / 4) % 4];
+        p.directions = direction_counts[(variant + variant / 8) % 4];
         p.steps = (variant & 32) ? 40 : 5;
         p.radius = (variant & 32) ? 0.3f : 0.9f;
         view.camera.projection =
