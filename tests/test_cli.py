@@ -581,6 +581,21 @@ def test_fifo_output_is_written_through(hbao_tool, tmp_path):
     assert leftover_temporary_files(tmp_path) == []
 
 
+def test_a_pipe_closed_by_its_reader_is_a_write_error(hbao_tool, tmp_path):
+    """hbao ... -o /dev/stdout | head: the write fails with EPIPE (SIGPIPE is
+    ignored), so the run ends with its message and exit 1 and removes the
+    preview's temporary file, instead of dying of the signal mid-write."""
+    read_end, write_end = os.pipe()
+    os.close(read_end)  # the reader is gone before the first byte
+    with os.fdopen(write_end, "wb") as pipe:
+        completed = subprocess.run(
+            [str(hbao_tool), fixture_path("cycles_float_zip"), "-o", "/dev/stdout",
+             "--no-normals", "--preview", tmp_path / "ao.png"],
+            stdout=pipe, stderr=subprocess.PIPE, text=True, timeout=TOOL_TIMEOUT_S)
+    assert_clean_error(completed, EXIT_RUNTIME, "cannot write /dev/stdout", "Broken pipe")
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_character_device_output_is_written_through(hbao_tool, tmp_path):
     """As root, a replaced /dev/null would break the system (issue 13, D3)."""
     before = os.lstat("/dev/null")
@@ -822,6 +837,76 @@ def test_sequence_redoes_frames_computed_with_other_flags(hbao_tool, tmp_path):
     redone = run_sequence(hbao_tool, folder, "--radius", "0.5")
     assert redone.stderr.count("is up to date, skipped") == 2
     assert "frame 1: " in redone.stderr and b"hbaoSettings" in foreign.read_bytes()
+
+
+def test_sequence_redoes_frames_computed_with_another_camera(hbao_tool, tmp_path):
+    """The camera file counts by what it holds, not by its time: adding a
+    forgotten --camera, or naming another (older) file, recomputes."""
+    name = "cycles_float_zip"
+    folder = tmp_path / "sequence"
+    folder.mkdir()
+    shutil.copyfile(fixture_path(name), folder / "render_0001.exr")
+    first = tmp_path / "first.json"
+    shutil.copyfile(camera_path(name), first)
+    camera = json.loads(first.read_text())
+    camera["lens"] *= 2
+    second = tmp_path / "second.json"
+    second.write_text(json.dumps(camera))
+    long_ago = 10**9 * 10**9  # 2001: older than every output
+    os.utime(second, ns=(long_ago, long_ago))
+
+    def run(*extra):
+        return run_ok(hbao_tool, folder / "render_####.exr", "-o", folder / "ao_####.exr",
+                      "--frames", "1", *extra)
+
+    run()  # without a camera (a warning)
+    for camera_file in (first, second):
+        assert "up to date" not in run("--camera", camera_file).stderr
+        assert "is up to date, skipped" in run("--camera", camera_file).stderr
+        single = tmp_path / "single.exr"
+        run_ok(hbao_tool, fixture_path(name), "-o", single, "--camera", camera_file)
+        assert (folder / "ao_0001.exr").read_bytes() == single.read_bytes()
+    assert "up to date" not in run().stderr
+
+
+def test_sequence_redoes_a_preview_older_than_its_exr(hbao_tool, tmp_path):
+    """A run without --preview recomputes the EXR and leaves the PNG of the
+    run before: a later run with --preview must not take that PNG as up to
+    date."""
+    folder, sources = sequence_folder(tmp_path)
+    run_sequence(hbao_tool, folder, "--radius", "0.5")
+    stale = (folder / "ao_0001.png").read_bytes()
+    run_tool(hbao_tool, folder / "render_####.exr", "-o", folder / "ao_####.exr",
+             "--frames", "1-5", "--no-normals")
+    again = run_sequence(hbao_tool, folder)
+    assert "is up to date" not in again.stderr
+    single = tmp_path / "single.png"
+    run_ok(hbao_tool, fixture_path(sources[1]), "-o", tmp_path / "single.exr", "--no-normals",
+           "--preview", single)
+    fresh = (folder / "ao_0001.png").read_bytes()
+    assert fresh == single.read_bytes() and fresh != stale
+    assert run_sequence(hbao_tool, folder).stderr.count("is up to date, skipped") == 3
+
+
+def test_sequence_refuses_an_output_that_is_another_frames_input(hbao_tool, tmp_path):
+    for frame in range(1, 11):
+        shutil.copyfile(fixture_path("cycles_float_zip"), tmp_path / f"f_{frame}.exr")
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    completed = run_tool(hbao_tool, tmp_path / "f_#.exr", "-o", tmp_path / "f_#0.exr",
+                         "--frames", "1-10", "--no-normals")
+    assert_clean_error(completed, EXIT_USAGE, "-o of frame 1", "is the input of frame 10")
+    previews = run_tool(hbao_tool, tmp_path / "f_#.exr", "-o", tmp_path / "ao_#.exr",
+                        "--preview", tmp_path / "f_1#.exr", "--frames", "1-12", "--no-normals")
+    assert_clean_error(previews, EXIT_USAGE, "--preview of frame 1 ", "is the input of frame 11")
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+    # A name that only looks like another frame's is no input of this run: a
+    # frame not listed (f_10.exr with frames 1-9), or a number the input's
+    # pattern never writes (f_01.exr: f_# writes frame 1 as f_1.exr).
+    for output in ("f_#0.exr", "f_0#.exr"):
+        run_ok(hbao_tool, tmp_path / "f_#.exr", "-o", tmp_path / output, "--frames", "1-9",
+               "--no-normals")
+    inputs = [f"f_{frame}.exr" for frame in range(1, 10)]
+    assert all((tmp_path / name).read_bytes() == before[name] for name in inputs)
 
 
 @pytest.mark.parametrize("arguments, fragment", [

@@ -77,3 +77,27 @@ bool frame_pattern_path(const char *pattern, int32_t frame, char *path, size_t s
                            (int)(run_end - run_start + 1), (int)frame, run_end + 1);
     return written >= 0 && (size_t)written < size;
 }
+
+bool frame_pattern_frame(const char *pattern, const char *path, int32_t *frame) {
+    const char *run_end = strrchr(pattern, '#');
+    if (run_end == NULL) return false;
+    const char *run_start = run_end;
+    while (run_start > pattern && run_start[-1] == '#') --run_start;
+    const size_t prefix = (size_t)(run_start - pattern), run = (size_t)(run_end - run_start + 1);
+    const size_t suffix = strlen(run_end + 1), length = strlen(path);
+    if (length < prefix + run + suffix || strncmp(path, pattern, prefix) != 0 ||
+        strcmp(path + length - suffix, run_end + 1) != 0)
+        return false;
+    const char *digits = path + prefix;
+    const size_t count = length - suffix - prefix;
+    /* frame_pattern_path pads to the run only: a longer number has no
+     * leading zero */
+    if (count > run && digits[0] == '0') return false;
+    return parse_frame(digits, count, frame);
+}
+
+bool frame_list_contains(const frame_list *list, int32_t frame) {
+    for (int r = 0; r < list->range_count; ++r)
+        if (list->ranges[r].first <= frame && frame <= list->ranges[r].last) return true;
+    return false;
+}

@@ -43,4 +43,12 @@ bool frame_pattern_has_frame(const char *pattern);
  *  result does not fit in `size` bytes. */
 bool frame_pattern_path(const char *pattern, int32_t frame, char *path, size_t size);
 
+/** The frame whose frame_pattern_path() is `path`, in *frame: true when
+ *  there is one (the path's number written as frame_pattern_path writes
+ *  it: no shorter than the run, without leading zeros beyond it). */
+bool frame_pattern_frame(const char *pattern, const char *path, int32_t *frame);
+
+/** Whether `frame` is in the list. */
+bool frame_list_contains(const frame_list *list, int32_t frame);
+
 #endif /* HBAO_TOOL_FRAME_PATTERN_H */

@@ -3,6 +3,7 @@
  * hbao: ambient occlusion for Blender's multilayer EXR renders.
  * See `hbao --help` (cli_options.c) for the command line.
  */
+#include <signal.h>
 #include <stdio.h>
 
 #include "ao_command.h"
@@ -19,6 +20,10 @@ static void print_version(void) {
 }
 
 int main(int argc, char **argv) {
+    /* A reader that closes its pipe (hbao ... -o /dev/stdout | head) makes a
+     * write fail with EPIPE, an error like any other (its message, exit 1,
+     * the temporary files removed), instead of killing the tool mid-write. */
+    signal(SIGPIPE, SIG_IGN);
     cli_options options;
     tool_error error = {{0}};
     int status = cli_parse(argc, argv, &options, &error);

@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "camera_json.h"
 #include "exr_reader.h"
 
 /* Appends to text[*used ...]; *used past RUN_SETTINGS_MAX - 1 marks a text that
@@ -25,6 +26,18 @@ static void append(char *text, size_t *used, const char *format, ...) {
     *used = written < 0 ? RUN_SETTINGS_MAX : *used + (size_t)written;
 }
 
+/* The fields a camera_settings sets and their values: "<bits>[ <values>]". */
+static void append_camera(char *text, size_t *used, const camera_settings *settings) {
+    const hbao_camera *c = &settings->camera;
+    append(text, used, "%u", (unsigned)settings->fields_set);
+    if (settings->fields_set == 0) return;
+    append(text, used, " %d %.9g %.9g %.9g %d %.9g %.9g %.9g %.9g %.9g", (int)c->projection,
+           (double)c->lens, (double)c->sensor_width, (double)c->sensor_height, (int)c->sensor_fit,
+           (double)c->shift_x, (double)c->shift_y, (double)c->ortho_scale,
+           (double)c->pixel_aspect_x, (double)c->pixel_aspect_y);
+    for (int i = 0; i < 16; ++i) append(text, used, " %.9g", (double)c->world_to_camera[i]);
+}
+
 bool run_settings_text(const cli_options *options, char text[RUN_SETTINGS_MAX]) {
     const hbao_params *p = &options->params;
     size_t used = 0;
@@ -42,15 +55,19 @@ bool run_settings_text(const cli_options *options, char text[RUN_SETTINGS_MAX]) 
            "keep input %d; no normals %d; compression %d; crop to display %d; overscan %d; ",
            (int)options->keep_input, (int)options->ignore_normals, (int)options->compression,
            (int)options->crop_to_display, (int)options->overscan);
-    const camera_settings *flags = &options->camera_flags;
-    const hbao_camera *c = &flags->camera;
-    append(text, &used, "camera flags %u", (unsigned)flags->fields_set);
-    if (flags->fields_set != 0) {
-        append(text, &used, " %d %.9g %.9g %.9g %d %.9g %.9g %.9g %.9g %.9g", (int)c->projection,
-               (double)c->lens, (double)c->sensor_width, (double)c->sensor_height,
-               (int)c->sensor_fit, (double)c->shift_x, (double)c->shift_y, (double)c->ortho_scale,
-               (double)c->pixel_aspect_x, (double)c->pixel_aspect_y);
-        for (int i = 0; i < 16; ++i) append(text, &used, " %.9g", (double)c->world_to_camera[i]);
+    append(text, &used, "camera flags ");
+    append_camera(text, &used, &options->camera_flags);
+    /* The camera file by what it holds, not by its name or time: a rerun
+     * that adds a forgotten --camera, or names another file, recomputes.
+     * (Runs without one keep the text of earlier versions.) */
+    if (options->camera_path != NULL) {
+        camera_settings file;
+        camera_settings_init(&file);
+        tool_error ignored = {{0}};
+        if (camera_json_load(options->camera_path, &file, &ignored) != TOOL_EXIT_SUCCESS)
+            return false;
+        append(text, &used, "; camera file ");
+        append_camera(text, &used, &file);
     }
     append(text, &used, "; layer %s; back layer %s; AO channel %s",
            options->layer ? options->layer : "(first)",

@@ -11,18 +11,19 @@
 
 /** The header attribute (a string) that holds the settings. */
 #define RUN_SETTINGS_ATTRIBUTE "hbaoSettings"
-/** Room for the longest text: 13 parameters, 27 camera numbers, a layer and a
- *  channel name. */
+/** Room for the longest text: 13 parameters, twice 27 camera numbers (the
+ *  flags' and the camera file's), a layer and a channel name. */
 #define RUN_SETTINGS_MAX 2048
 
 /**
- * Everything besides the input file and the camera file that decides the
- * output EXR's content: the library version, the resolved parameters (but the
- * thread count and the SIMD implementation, which change no value), the layer,
- * the AO channel's name, --keep-input, --no-normals, the compression,
- * --crop-to-display, --overscan and the camera flags. Two runs with equal text write equal files from equal inputs.
- * False when the text did not fit (a layer name of kilobytes): it is then cut
- * and must not be used to skip work.
+ * Everything besides the input file that decides the output EXR's content:
+ * the library version, the resolved parameters (but the thread count and the
+ * SIMD implementation, which change no value), the layer, the AO channel's
+ * name, --keep-input, --no-normals, the compression, --crop-to-display,
+ * --overscan, the camera flags and what the camera file (--camera) holds. Two
+ * runs with equal text write equal files from equal inputs. False when the
+ * text did not fit (a layer name of kilobytes), or the camera file cannot be
+ * read: it then must not be used to skip work.
  */
 bool run_settings_text(const cli_options *options, char text[RUN_SETTINGS_MAX]);
 

@@ -35,8 +35,10 @@ static bool newer_or_equal(const struct stat *a, const struct stat *b) {
 }
 
 /* Up to date, as make decides, and computed with the same flags: every
- * output exists and is at least as new as the input and the camera file, and
- * the EXR's header holds the settings this run would write (run_settings.h). */
+ * output exists and is at least as new as the input and the camera file, the
+ * preview at least as new as the EXR (ao_command writes it after the EXR, so
+ * a preview left from before the EXR was last computed is stale), and the
+ * EXR's header holds the settings this run would write (run_settings.h). */
 static bool up_to_date(const cli_options *frame) {
     struct stat input, output, other;
     if (stat(frame->input_path, &input) != 0 || stat(frame->output_path, &output) != 0 ||
@@ -46,7 +48,7 @@ static bool up_to_date(const cli_options *frame) {
         (stat(frame->camera_path, &other) != 0 || !newer_or_equal(&output, &other)))
         return false;
     if (frame->preview_path != NULL &&
-        (stat(frame->preview_path, &other) != 0 || !newer_or_equal(&other, &input)))
+        (stat(frame->preview_path, &other) != 0 || !newer_or_equal(&other, &output)))
         return false;
     char settings[RUN_SETTINGS_MAX];
     return run_settings_text(frame, settings) && run_settings_match(frame->output_path, settings);
@@ -129,7 +131,36 @@ static int summarize(const sequence_run *run, tool_error *error) {
                      (long long)run->count, list);
 }
 
+/* A frame's output or preview that is another frame's input would replace
+ * that frame's render before it is read (hbao 'f_#.exr' -o 'f_#0.exr'
+ * --frames 1-10: frame 1 writes f_10.exr). Each frame refuses its own input
+ * (ao_command); this refuses the others' by name, before any frame runs. */
+static int refuse_other_frames_inputs(const cli_options *options, int64_t count,
+                                      tool_error *error) {
+    const char *patterns[2] = {options->output_path, options->preview_path};
+    const char *flags[2] = {"-o", "--preview"};
+    char path[PATH_MAX];
+    for (int64_t i = 0; i < count; ++i) {
+        const int32_t frame = frame_list_at(&options->frames, i);
+        for (int k = 0; k < 2; ++k) {
+            int32_t other;
+            if (patterns[k] == NULL || !frame_pattern_path(patterns[k], frame, path, sizeof path) ||
+                !frame_pattern_frame(options->input_path, path, &other) || other == frame ||
+                !frame_list_contains(&options->frames, other))
+                continue;
+            return tool_fail(error, TOOL_EXIT_USAGE,
+                             "%s of frame %d (%s) is the input of frame %d: it would be "
+                             "replaced before it is read",
+                             flags[k], (int)frame, path, (int)other);
+        }
+    }
+    return TOOL_EXIT_SUCCESS;
+}
+
 int sequence_command(const cli_options *options, tool_error *error) {
+    const int refused =
+        refuse_other_frames_inputs(options, frame_list_count(&options->frames), error);
+    if (refused != TOOL_EXIT_SUCCESS) return refused;
     sequence_run run = {0};
     run.count = frame_list_count(&options->frames);
     run.outcomes = calloc((size_t)run.count, sizeof *run.outcomes);
