@@ -362,6 +362,58 @@ def test_keep_input_output_is_valid_for_the_reference_openexr(hbao_tool, tmp_pat
     assert "BlenderMultiChannel" in header
 
 
+def zip_chunk_size(chunk, level):
+    """The zlib size of one ZIP chunk as the OpenEXR file layout makes it: the
+    bytes split into even and odd halves, then each byte stored as its
+    difference from the one before, plus 128."""
+    raw = np.frombuffer(chunk, np.uint8)
+    split = np.concatenate([raw[0::2], raw[1::2]]).astype(np.int32)
+    split[1:] = (split[1:] - split[:-1] + 128) & 255
+    return len(zlib.compress(split.astype(np.uint8).tobytes(), level))
+
+
+def chunk_of_exactly_its_own_size():
+    """Channels for a 1 x 16 frame (one ZIP chunk: AO, Depth.Z and 40 kept
+    channels, in name order) whose zlib bytes come to exactly the chunk's
+    own size, at OpenEXR's levels 4 and 6. The depths are background, so
+    the AO is 1 everywhere; the kept channels are random bytes with a
+    quarter of them zero, which brings zlib down from storing the chunk
+    (11 bytes more) through its size."""
+    for fraction in np.linspace(0.2, 0.3, 41):
+        for seed in range(20):
+            rng = np.random.default_rng(seed)
+            exponents = rng.integers(144, 253, size=(16, 1)).astype(np.uint32) << 23
+            channels = {"Depth.Z": (exponents | rng.integers(0, 1 << 23, size=(16, 1))
+                                    .astype(np.uint32)).view(np.float32)}
+            for k in range(40):
+                raw = rng.integers(0, 256, size=(16, 4), dtype=np.uint8)
+                raw[rng.random(raw.shape) < fraction] = 0
+                values = raw.view("<f4")
+                channels[f"X{k:02d}"] = np.where(np.isfinite(values), values, 0).astype("<f4")
+            everything = dict(channels, AO=np.ones((16, 1), np.float32))
+            chunk = b"".join(everything[name][y].tobytes()
+                             for y in range(16) for name in sorted(everything))
+            if all(zip_chunk_size(chunk, level) == len(chunk) for level in (4, 6)):
+                return channels
+    pytest.fail("no chunk of its own zlib size found: has zlib changed?")
+
+
+def test_a_zip_chunk_that_does_not_shrink_is_stored(hbao_tool, tmp_path):
+    """A chunk whose zlib bytes come to exactly its own size is read back as
+    stored: OpenEXRCore (3.1.5 here; its issue 2306) kept the zlib bytes,
+    and the output came back as garbage (exr_writer.c, compress_or_store)."""
+    source = tmp_path / "in.exr"
+    source.write_bytes(scanline_exr(chunk_of_exactly_its_own_size(), 1, 16))
+    described = {}
+    for compression in ("zip", "none"):
+        output = tmp_path / f"{compression}.exr"
+        run_ok(hbao_tool, source, "-o", output, "--keep-input", "--compression", compression)
+        described[compression] = [dict(c, part=0) for c in info(hbao_tool, output)["channels"]]
+    given = [dict(c, part=0) for c in info(hbao_tool, source)["channels"]]
+    assert described["zip"] == described["none"]
+    assert [c for c in described["zip"] if c["name"] != "AO"] == given
+
+
 @pytest.mark.parametrize("compression", ["zip", "piz", "zips", "rle", "none"])
 def test_output_file_does_not_depend_on_the_thread_count(hbao_tool, tmp_path, compression):
     """Chunks are compressed by --threads threads and written in file order:

@@ -124,9 +124,11 @@ typedef struct chunk_writing {
     tool_error error;
 } chunk_writing;
 
-/* One thread's pipeline; first, so that yield_until_ready_fn finds the rest */
+/* One thread's pipeline; first, so that yield_until_ready_fn and
+ * compress_fn find the rest */
 typedef struct chunk_encoder {
     exr_encode_pipeline_t pipeline;
+    exr_result_t (*library_compress)(exr_encode_pipeline_t *pipeline);
     int ready;
     chunk_writing *writing;
     int64_t chunk;
@@ -144,6 +146,22 @@ static exr_result_t wait_for_turn(exr_encode_pipeline_t *pipeline) {
     encoder->cancelled = writing->next_to_write != encoder->chunk;
     pthread_mutex_unlock(&writing->lock);
     return encoder->cancelled ? EXR_ERR_INCORRECT_CHUNK : EXR_ERR_SUCCESS;
+}
+
+/* A chunk whose compressed size equals its packed size is read back as
+ * stored, uncompressed (the file layout's rule for a compressor that does
+ * not pay). OpenEXRCore up to 3.4.7 at least (Debian's 3.1.5 too; its issue
+ * 2306) kept its zlib bytes when they came to exactly the packed size, so
+ * ZIP and ZIPS wrote such a chunk as garbage: rare and data-dependent (2 of
+ * 48 radii on one 320x180 test scene). The packed bytes themselves are then
+ * what the chunk must hold, whichever compressor ran. */
+static exr_result_t compress_or_store(exr_encode_pipeline_t *pipeline) {
+    chunk_encoder *encoder = (chunk_encoder *)pipeline;
+    const exr_result_t result = encoder->library_compress(pipeline);
+    if (result == EXR_ERR_SUCCESS && pipeline->compressed_bytes == pipeline->packed_bytes &&
+        pipeline->compressed_buffer != pipeline->packed_buffer)
+        memcpy(pipeline->compressed_buffer, pipeline->packed_buffer, pipeline->packed_bytes);
+    return result;
 }
 
 #define CHUNK_CHECK(call, what)                                                                    \
@@ -185,6 +203,10 @@ static int write_chunk(chunk_writing *writing, chunk_encoder *encoder, int order
     }
     CHUNK_CHECK(exr_encoding_choose_default_routines(writing->context, writing->part, pipeline),
                 "cannot encode this channel layout");
+    if (pipeline->compress_fn != NULL) {
+        encoder->library_compress = pipeline->compress_fn;
+        pipeline->compress_fn = compress_or_store;
+    }
     if (ordered) pipeline->yield_until_ready_fn = wait_for_turn;
     CHUNK_CHECK(exr_encoding_run(writing->context, writing->part, pipeline),
                 "cannot encode a chunk");
@@ -202,7 +224,7 @@ static int finish_encoder(chunk_writing *writing, chunk_encoder *encoder, tool_e
 static void *write_chunks(void *argument) {
     chunk_writing *writing = argument;
     exr_clear_last_error(); /* this thread's copy of OpenEXRCore's detail */
-    chunk_encoder encoder = {EXR_ENCODE_PIPELINE_INITIALIZER, 0, writing, 0, 0};
+    chunk_encoder encoder = {EXR_ENCODE_PIPELINE_INITIALIZER, NULL, 0, writing, 0, 0};
     tool_error error;
     for (;;) {
         pthread_mutex_lock(&writing->lock);
@@ -235,7 +257,7 @@ static int write_data(chunk_writing *writing, int threads, tool_error *error) {
     exr_get_compression(writing->context, writing->part, &compression);
     if (threads <= 1 || compression == EXR_COMPRESSION_NONE) {
         /* one pipeline, OpenEXRCore's own order check */
-        chunk_encoder encoder = {EXR_ENCODE_PIPELINE_INITIALIZER, 0, writing, 0, 0};
+        chunk_encoder encoder = {EXR_ENCODE_PIPELINE_INITIALIZER, NULL, 0, writing, 0, 0};
         int status = TOOL_EXIT_SUCCESS;
         for (; encoder.chunk < writing->chunks && status == TOOL_EXIT_SUCCESS; ++encoder.chunk)
             status = write_chunk(writing, &encoder, 0, error);
