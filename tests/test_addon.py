@@ -55,8 +55,8 @@ def frame_passes(out, frame, layer="ViewLayer"):
     return depth, normal
 
 
-def node_outputs(out, frame, node="HBAO0"):
-    path = out / f"nodes_{frame:04d}.exr"
+def node_outputs(out, frame, node="HBAO0", view=""):
+    path = out / f"nodes_{frame:04d}{view}.exr"
     names = exr.channel_names(path)
     wanted = [n for n in names if n.startswith(f"{node}_") or n.startswith("Render.")
               or n.startswith("CyclesAO.")]
@@ -498,6 +498,26 @@ def test_animation_renders_every_frame_at_its_keyframed_radius(
         assert np.abs(ao[frame] - expected).max() <= EXACT
     # The radius really changed between the frames of one animation render.
     assert ao[2].mean() < ao[1].mean() - 0.02
+
+
+def test_stereo_render_renders_without_ao_and_says_so(run_in_blender, tmp_path, monkeypatch):
+    """With Stereoscopy on, the compositor reads each view's pass: the helper
+    had one view, so the AO input was 0 in both and the frame black, and the
+    hand-over's save wrote a scratch file per view that nothing removed.
+    Now the helper has the main scene's views, the engine says that stereo
+    gets no AO, and each view's image is the render."""
+    scratch = tmp_path / "scratch"
+    scratch.mkdir()
+    monkeypatch.setenv("HBAO_TEMP_DIR", str(scratch))
+    out, log = render(run_in_blender, tmp_path, {"stereo": True, "nodes": [{"radius": 1.0}]})
+    assert "stereo and multi-view renders get no AO yet" in log
+    assert "Rendering without AO" in log
+    for view in ("_L", "_R"):
+        outputs = node_outputs(out, 1, view=view)
+        assert np.all(outputs["ao"] == 1.0)
+        assert outputs["render"].max() > 0.1  # a render, not a black frame
+        assert np.abs(outputs["image"] - outputs["render"]).max() <= EXACT
+    assert list(scratch.iterdir()) == []
 
 
 def test_border_crop_render_matches_the_full_frame(run_in_blender, tmp_path):

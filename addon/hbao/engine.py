@@ -20,6 +20,8 @@ from .report import log, post_node_messages, post_render_report
 
 # The prefix of the passes this engine fills (node.pass_name's).
 PASS_PREFIX = "HBAO "
+MULTIVIEW_UNSUPPORTED = ("stereo and multi-view renders get no AO yet (turn Stereoscopy off in "
+                         "the Output properties for AO)")
 
 # The last render's passes and AO, reused for the same passes and settings,
 # and by re-compositing (recomposite.py).
@@ -101,6 +103,10 @@ def compute_passes(engine, depsgraph, width, height, request=None):
         if request is not None:
             request.completed = True
         return {}
+    if main.render.use_multiview:
+        # Each view would need its own passes and camera; the save of a
+        # multi-view Render Result writes one file per view besides.
+        raise RuntimeError(MULTIVIEW_UNSUPPORTED)
     native.load_library()
     if request:
         inputs_of, timings = _kept(main, request)

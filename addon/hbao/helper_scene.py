@@ -32,11 +32,13 @@ MANAGED_NODE_NAME = "HBAO Passes"
 # (tests/test_ui.py measures it), a status line adds about 25.
 HBAO_NODE_CLEARANCE = 660
 # Render settings copied from the main scene so that the helper's result has
-# the main Render Result's size.
+# the main Render Result's size, and its views: a stereo render's compositor
+# reads each view's pass, and a helper with one view left the AO input 0 in
+# both (a black frame).
 SYNCED_RENDER_SETTINGS = (
     "resolution_x", "resolution_y", "resolution_percentage", "pixel_aspect_x",
     "pixel_aspect_y", "use_border", "use_crop_to_border", "border_min_x", "border_max_x",
-    "border_min_y", "border_max_y", "fps", "fps_base")
+    "border_min_y", "border_max_y", "fps", "fps_base", "use_multiview", "views_format")
 
 # Helper scene name -> name of the scene whose render is using it now; the
 # helpers whose scene's render job runs (record_rendering .. record_render_end).

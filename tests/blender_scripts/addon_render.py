@@ -65,6 +65,9 @@ if spec.get("widen_camera"):  # a view `widen_camera` times as wide about its ce
         setattr(lens, name, getattr(lens, name) * spec["widen_camera"])
     lens.shift_x /= spec["widen_camera"]
     lens.shift_y /= spec["widen_camera"]
+if spec.get("stereo"):  # Stereoscopy on: a left and a right view, each written on its own
+    scene.render.use_multiview = True
+    scene.render.views_format = "STEREO_3D"
 if spec.get("border"):
     render_settings = scene.render
     (render_settings.border_min_x, render_settings.border_max_x,
