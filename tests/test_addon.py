@@ -500,6 +500,29 @@ def test_animation_renders_every_frame_at_its_keyframed_radius(
     assert ao[2].mean() < ao[1].mean() - 0.02
 
 
+def test_border_render_without_crop_gets_the_ao_of_the_full_frame(run_in_blender, tmp_path):
+    """Without "Crop to Render Region" the main Render Result is the whole
+    frame and the helper's only the border: the engine computes the whole
+    frame's AO and hands over the border's part (it rendered without AO,
+    "the Render Result is 256x128, the helper scene renders 128x64")."""
+    width, height = 256, 128
+    common = {"resolution": [width, height], "nodes": [{"radius": 0.15, "blur_size": 0}]}
+    full_out, _ = render(run_in_blender, tmp_path, common, name="full")
+    border_out, log = render(run_in_blender, tmp_path,
+                             dict(common, border=[0.25, 0.75, 0.25, 0.75], crop=False),
+                             name="border")
+    assert "Rendering without AO" not in log
+    full = node_outputs(full_out, 1)["ao"]
+    border = node_outputs(border_out, 1)["ao"]
+    assert border.shape == full.shape == (height, width)
+    # The border's pixels 64..191 and rows 32..95; away from its edge by more
+    # than the projected radius (under 9 pixels), as in the cropped test.
+    margin = 12
+    inner = (slice(32 + margin, 96 - margin), slice(64 + margin, 192 - margin))
+    assert full[inner].min() < 0.9  # there is occlusion to compare
+    assert np.abs(border[inner] - full[inner]).max() <= 1e-3
+
+
 def test_stereo_render_renders_without_ao_and_says_so(run_in_blender, tmp_path, monkeypatch):
     """With Stereoscopy on, the compositor reads each view's pass: the helper
     had one view, so the AO input was 0 in both and the frame black, and the

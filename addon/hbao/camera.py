@@ -48,6 +48,20 @@ def render_size(scene):
     return width, height
 
 
+def uncropped_border(scene, full_size, region_size):
+    """(x0, x1, y0, y1) pixels (y from the bottom) of the scene's border in
+    its full Render Result of full_size (height, width), when the scene
+    renders a border without cropping and the border's size is region_size
+    (height, width): what a helper scene's result holds then. Else None."""
+    render = scene.render
+    if not render.use_border or render.use_crop_to_border:
+        return None
+    height, width = full_size
+    border = _border_pixels(render, width, height)
+    x0, x1, y0, y1 = border
+    return border if (y1 - y0, x1 - x0) == tuple(region_size) else None
+
+
 def _border_pixels(render, width, height):
     # Blender rounds the border to whole pixels the same way (rcti from rctf).
     x0 = int(render.border_min_x * width)

@@ -130,7 +130,11 @@ def compute_passes(engine, depsgraph, width, height, request=None):
             return {}
         engine.update_stats("HBAO", f"{job.node_name}: computing AO ({index + 1}/{len(jobs)})")
         inputs, depth, normal, extra = inputs_of(job)
-        if depth.shape != (height, width):
+        # A border render without its crop: the main Render Result is the
+        # whole frame (background outside the border), the helper's only
+        # the border. The AO is the whole frame's, cut to the border.
+        border = camera_model.uncropped_border(main, depth.shape, (height, width))
+        if depth.shape != (height, width) and border is None:
             raise RuntimeError(f"the Render Result is {depth.shape[1]}x{depth.shape[0]}, the "
                                f"helper scene renders {width}x{height}")
         compute_start = time.perf_counter()
@@ -140,8 +144,11 @@ def compute_passes(engine, depsgraph, width, height, request=None):
             ao = layer_passes.compute(job, depth, normal, inputs.camera, extra)
         else:
             timings["cached"] = timings.get("cached", 0) + 1
-        results[job.pass_name] = ao
         fresh[key] = (inputs, ao)
+        if border is not None:  # bottom-up rows, as the border's y
+            x0, x1, y0, y1 = border
+            ao = np.ascontiguousarray(ao[y0:y1, x0:x1])
+        results[job.pass_name] = ao
         compute_time += time.perf_counter() - compute_start
         engine.update_progress((index + 1) / len(jobs))
     _cache.keep_only(fresh)

@@ -73,7 +73,7 @@ if spec.get("border"):
     (render_settings.border_min_x, render_settings.border_max_x,
      render_settings.border_min_y, render_settings.border_max_y) = spec["border"]
     render_settings.use_border = True
-    render_settings.use_crop_to_border = True
+    render_settings.use_crop_to_border = spec.get("crop", True)
 
 compositor = blender_scenes.Compositor(scene)
 tree = compositor.tree
