@@ -1098,6 +1098,23 @@ def test_help_and_version(hbao_tool):
     assert version.startswith("hbao 0.3.0") and "libhbao 0.3.0" in version
 
 
+def test_info_json_is_valid_utf8_whatever_the_names_hold(hbao_tool, tmp_path):
+    """JSON text is UTF-8: a channel name's bytes that are not (EXR names are
+    any bytes) come out as U+FFFD, so that a pipeline's parser reads it."""
+    depth = np.full((2, 2), 2.0, np.float32)
+    data = scanline_exr({"Depth.Z": depth, "Xq": depth, "Yq": depth, "Zq": depth}, 2, 2)
+    data = data.replace(b"Xq\0", b"X\xff\0").replace(b"Yq\0", b"Y\xc3\0")
+    data = data.replace(b"Zq\0", b"\xc3\xa9\0")  # valid: kept
+    source = tmp_path / "names.exr"
+    source.write_bytes(data)
+    completed = subprocess.run([str(hbao_tool), "--info", "--json", str(source)],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                               timeout=TOOL_TIMEOUT_S)
+    assert completed.returncode == 0, completed.stderr
+    names = [c["name"] for c in json.loads(completed.stdout.decode("utf-8"))["channels"]]
+    assert sorted(names) == sorted(["Depth.Z", "X\ufffd", "Y\ufffd", "\u00e9"])
+
+
 def test_info_lists_layers_and_types(hbao_tool):
     description = info(hbao_tool, fixture_path("eevee_half"))
     assert description["layers"] == ["ViewLayer"]

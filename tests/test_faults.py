@@ -157,7 +157,22 @@ def test_full_disk_renders_without_ao_leaves_nothing_and_restores_settings(
                       {"output_format": "PNG", "nodes": [{"radius": 1.0}]},
                       env={"HBAO_TEMP_DIR": str(full_disk)})
     assert "Rendering without AO" in log, log[-3000:]
+    # The reason names the folder and how to choose another.
+    assert f"cannot read back the passes saved in {full_disk}" in log, log[-3000:]
+    assert "is it full? HBAO_TEMP_DIR names another folder" in log
     assert list(full_disk.iterdir()) == []
+
+
+def test_scratch_folder_that_cannot_be_written_says_which_and_how(run_in_blender, tmp_path):
+    blocked = tmp_path / "a file, not a folder"
+    blocked.write_text("")
+    out, log = render(run_in_blender, tmp_path,
+                      {"output_format": "PNG", "nodes": [{"radius": 1.0}]},
+                      env={"HBAO_TEMP_DIR": str(blocked)})
+    assert "Rendering without AO" in log, log[-3000:]
+    assert f"cannot save the passes for the AO in {blocked}" in log, log[-3000:]
+    assert "HBAO_TEMP_DIR names a writable folder" in log
+    assert_no_ao_and_image_unchanged(out)
     settings = output_settings(log)
     assert settings["file_format"] == "PNG", settings
     assert_no_ao_and_image_unchanged(out)

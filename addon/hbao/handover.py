@@ -223,7 +223,12 @@ def read_passes(scene, layers):
     timings = {}
     try:
         start = _clock()
-        save_passes(scene, path)
+        try:
+            save_passes(scene, path)
+        except RuntimeError as error:  # Blender's message names neither folder nor cause
+            raise RuntimeError(
+                f"cannot save the passes for the AO in {os.path.dirname(path)} ({error}); "
+                f"{SCRATCH_FOLDER_VARIABLE} names a writable folder for them") from error
         timings["save"] = _clock() - start
         # One decode pass: each layer's depth, and its normal as one
         # interleaved (height, width, 3) image, as libhbao reads it.
@@ -233,7 +238,14 @@ def read_passes(scene, layers):
             if with_normal:
                 groups[("normal", layer)] = [f"{layer}.Normal.{axis}" for axis in "XYZ"]
         read_start = _clock()
-        channels = exr_passes.read_channel_groups(path, groups)
+        try:
+            channels = exr_passes.read_channel_groups(path, groups)
+        except (exr_passes.EXRFormatError, exr_passes.EXRFileError) as error:
+            # Blender's save does not say when the folder filled up: the
+            # file is then cut short.
+            raise RuntimeError(
+                f"cannot read back the passes saved in {os.path.dirname(path)} ({error}); is "
+                f"it full? {SCRATCH_FOLDER_VARIABLE} names another folder for them") from error
         timings["read"] = _clock() - read_start
     finally:
         _remove_later(path)

@@ -71,13 +71,62 @@ static void print_text(const exr_input *input, const channel_statistics *stats, 
     }
 }
 
+/* The length of the valid UTF-8 sequence at text (1 to 4 bytes), or 0. */
+static size_t utf8_sequence(const unsigned char *text) {
+    const unsigned char lead = text[0];
+    size_t length;
+    unsigned lowest; /* the least code point of that length: no overlong forms */
+    if (lead < 0x80) return 1;
+    if (lead >= 0xC2 && lead <= 0xDF)
+        length = 2, lowest = 0x80;
+    else if (lead >= 0xE0 && lead <= 0xEF)
+        length = 3, lowest = 0x800;
+    else if (lead >= 0xF0 && lead <= 0xF4)
+        length = 4, lowest = 0x10000;
+    else
+        return 0;
+    unsigned code = lead & (0x7F >> length);
+    for (size_t k = 1; k < length; ++k) {
+        if ((text[k] & 0xC0) != 0x80) return 0; /* also stops at the terminating 0 */
+        code = (code << 6) | (text[k] & 0x3F);
+    }
+    if (code < lowest || code > 0x10FFFF || (code >= 0xD800 && code <= 0xDFFF)) return 0;
+    return length;
+}
+
+/* A JSON string of `raw` (a path or a name from the file, any bytes): JSON
+ * text must be UTF-8, so each byte that is not part of a valid sequence
+ * becomes U+FFFD, the replacement character. NULL when out of memory. */
+static cJSON *json_string(const char *raw) {
+    const unsigned char *in = (const unsigned char *)raw;
+    char *text = malloc(3 * strlen(raw) + 1);
+    if (text == NULL) return NULL;
+    size_t used = 0;
+    while (*in != 0) {
+        const size_t length = utf8_sequence(in);
+        if (length == 0) {
+            memcpy(text + used, "\xEF\xBF\xBD", 3);
+            used += 3;
+            ++in;
+        } else {
+            memcpy(text + used, in, length);
+            used += length;
+            in += length;
+        }
+    }
+    text[used] = '\0';
+    cJSON *string = cJSON_CreateString(text);
+    free(text);
+    return string;
+}
+
 static int print_json(const exr_input *input, const channel_statistics *stats, const char **layers,
                       int layer_count, tool_error *error) {
     cJSON *root = cJSON_CreateObject();
     cJSON *layer_list = cJSON_CreateArray();
     cJSON *channel_list = cJSON_CreateArray();
     if (root == NULL || layer_list == NULL || channel_list == NULL) goto out_of_memory;
-    cJSON_AddStringToObject(root, "path", input->path);
+    cJSON_AddItemToObject(root, "path", json_string(input->path));
     cJSON_AddNumberToObject(root, "width", input->width);
     cJSON_AddNumberToObject(root, "height", input->height);
     cJSON_AddItemToObject(root, "data_window", rect_json(&input->data_window));
@@ -89,7 +138,7 @@ static int print_json(const exr_input *input, const channel_statistics *stats, c
         size_t length = strlen(layers[l]) - strlen(".Depth.Z");
         char name[BLENDER_CHANNEL_NAME_MAX];
         snprintf(name, sizeof name, "%.*s", (int)length, layers[l]);
-        cJSON_AddItemToArray(layer_list, cJSON_CreateString(name));
+        cJSON_AddItemToArray(layer_list, json_string(name));
     }
     cJSON_AddItemToObject(root, "layers", layer_list);
     layer_list = NULL;
@@ -98,7 +147,7 @@ static int print_json(const exr_input *input, const channel_statistics *stats, c
         cJSON *item = cJSON_CreateObject();
         if (item == NULL) goto out_of_memory;
         cJSON_AddItemToArray(channel_list, item);
-        cJSON_AddStringToObject(item, "name", channel->name.str);
+        cJSON_AddItemToObject(item, "name", json_string(channel->name.str));
         cJSON_AddStringToObject(item, "type", exr_pixel_type_name(channel->pixel_type));
         cJSON_AddNumberToObject(item, "part", input->channel_parts[c]);
         if (stats[c].finite_count > 0) {
