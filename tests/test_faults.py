@@ -161,6 +161,9 @@ def test_full_disk_renders_without_ao_leaves_nothing_and_restores_settings(
     assert f"cannot read back the passes saved in {full_disk}" in log, log[-3000:]
     assert "is it full? HBAO_TEMP_DIR names another folder" in log
     assert list(full_disk.iterdir()) == []
+    settings = output_settings(log)
+    assert settings["file_format"] == "PNG", settings
+    assert_no_ao_and_image_unchanged(out)
 
 
 def test_scratch_folder_that_cannot_be_written_says_which_and_how(run_in_blender, tmp_path):
@@ -172,9 +175,6 @@ def test_scratch_folder_that_cannot_be_written_says_which_and_how(run_in_blender
     assert "Rendering without AO" in log, log[-3000:]
     assert f"cannot save the passes for the AO in {blocked}" in log, log[-3000:]
     assert "HBAO_TEMP_DIR names a writable folder" in log
-    assert_no_ao_and_image_unchanged(out)
-    settings = output_settings(log)
-    assert settings["file_format"] == "PNG", settings
     assert_no_ao_and_image_unchanged(out)
 
 

@@ -202,7 +202,12 @@ def save_passes(scene, path):
         settings.color_depth = "32"
         settings.exr_codec = "NONE"
         # The Render Result of the scene given, not only its settings.
-        image.save_render(path, scene=scene)
+        try:
+            image.save_render(path, scene=scene)
+        except RuntimeError as error:  # Blender's message names neither folder nor cause
+            raise RuntimeError(
+                f"cannot save the passes for the AO in {os.path.dirname(path)} ({error}); "
+                f"{SCRATCH_FOLDER_VARIABLE} names a writable folder for them") from error
     finally:
         # The media type and format first, so that their options are valid
         # when they are set; the user's PNG output stays PNG.
@@ -223,12 +228,7 @@ def read_passes(scene, layers):
     timings = {}
     try:
         start = _clock()
-        try:
-            save_passes(scene, path)
-        except RuntimeError as error:  # Blender's message names neither folder nor cause
-            raise RuntimeError(
-                f"cannot save the passes for the AO in {os.path.dirname(path)} ({error}); "
-                f"{SCRATCH_FOLDER_VARIABLE} names a writable folder for them") from error
+        save_passes(scene, path)
         timings["save"] = _clock() - start
         # One decode pass: each layer's depth, and its normal as one
         # interleaved (height, width, 3) image, as libhbao reads it.

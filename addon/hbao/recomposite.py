@@ -120,7 +120,9 @@ def _needs_refresh(main, helper):
     pass is gone once it renders again, so a mismatch found then would
     leave the compositor without AO."""
     record = render_record.last_render(main.name)
-    if record is None or helper.render.use_border:
+    # Stereo and multi-view renders get no AO (engine.MULTIVIEW_UNSUPPORTED):
+    # nothing to refresh, and a refresh would fail.
+    if record is None or helper.render.use_border or main.render.use_multiview:
         return None
     frame, signatures, identity = record
     if identity != main.as_pointer():

@@ -31,7 +31,8 @@ static int refuse_overwriting_input(const char *output, const char *flag,
 
 /* Defaults, then the EXR header's pixel aspect, then the JSON file, then flags. */
 static int resolve_camera(const cli_options *options, const exr_input *input,
-                          camera_settings *resolved, tool_error *error) {
+                          camera_settings *resolved, camera_settings *from_file,
+                          tool_error *error) {
     camera_settings_init(resolved);
     if (input->has_pixel_aspect_ratio && input->pixel_aspect_ratio > 0.0f &&
         isfinite(input->pixel_aspect_ratio)) {
@@ -40,12 +41,11 @@ static int resolve_camera(const cli_options *options, const exr_input *input,
         resolved->camera.pixel_aspect_y = 1.0f;
         resolved->fields_set |= CAMERA_FIELD_PIXEL_ASPECT_X | CAMERA_FIELD_PIXEL_ASPECT_Y;
     }
+    camera_settings_init(from_file);
     if (options->camera_path != NULL) {
-        camera_settings from_file;
-        camera_settings_init(&from_file);
-        int status = camera_json_load(options->camera_path, &from_file, error);
+        int status = camera_json_load(options->camera_path, from_file, error);
         if (status != TOOL_EXIT_SUCCESS) return status;
-        camera_settings_apply(resolved, &from_file);
+        camera_settings_apply(resolved, from_file);
     }
     camera_settings_apply(resolved, &options->camera_flags);
     return TOOL_EXIT_SUCCESS;
@@ -212,7 +212,8 @@ static int choose_output_windows(const cli_options *options, const exr_input *in
 
 static int write_outputs(const cli_options *options, const exr_input *input,
                          exr_output_channel *channels, int channel_count, const float *ao,
-                         output_files *files, tool_error *error) {
+                         const camera_settings *camera_file, output_files *files,
+                         tool_error *error) {
     output_windows windows;
     int status = choose_output_windows(options, input, &windows, error);
     if (status != TOOL_EXIT_SUCCESS) return status;
@@ -233,7 +234,7 @@ static int write_outputs(const cli_options *options, const exr_input *input,
                                 NULL,
                                 input->threads}; /* as many as the AO and the read */
     char settings[RUN_SETTINGS_MAX];
-    if (run_settings_text(options, settings)) {
+    if (run_settings_text(options, camera_file, settings)) {
         layout.stamp_name = RUN_SETTINGS_ATTRIBUTE;
         layout.stamp_text = settings;
     }
@@ -258,7 +259,7 @@ int ao_compute_input(const cli_options *options, exr_input *input, ao_buffers *b
     if (status != TOOL_EXIT_SUCCESS) return status;
 
     camera_settings camera;
-    status = resolve_camera(options, input, &camera, error);
+    status = resolve_camera(options, input, &camera, &buffers->camera_file, error);
     if (status != TOOL_EXIT_SUCCESS) return status;
     const bool use_normals = passes.has_normal && !options->ignore_normals;
     hbao_camera cropped;
@@ -339,7 +340,8 @@ int ao_command(const cli_options *options, tool_error *error) {
         status = read_copies(&input, options->ao_channel, &buffers, outputs, &output_count, error);
         if (status != TOOL_EXIT_SUCCESS) goto done;
     }
-    status = write_outputs(options, &input, outputs, output_count, buffers.ao, &files, error);
+    status = write_outputs(options, &input, outputs, output_count, buffers.ao, &buffers.camera_file,
+                           &files, error);
 
 done:
     abort_outputs(&files);

@@ -3,6 +3,7 @@
 #ifndef HBAO_TOOL_AO_COMMAND_H
 #define HBAO_TOOL_AO_COMMAND_H
 
+#include "camera_settings.h"
 #include "cli_options.h"
 #include "exr_reader.h"
 #include "tool_error.h"
@@ -15,6 +16,7 @@ typedef struct ao_buffers {
     float *ao;        /**< width x height, rows top first */
     uint8_t **copies; /**< --keep-input: one native-type buffer per input channel */
     int copy_count;
+    camera_settings camera_file; /**< what --camera held, for the output's hbaoSettings */
 } ao_buffers;
 
 void ao_buffers_free(ao_buffers *buffers);

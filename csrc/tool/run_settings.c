@@ -38,7 +38,8 @@ static void append_camera(char *text, size_t *used, const camera_settings *setti
     for (int i = 0; i < 16; ++i) append(text, used, " %.9g", (double)c->world_to_camera[i]);
 }
 
-bool run_settings_text(const cli_options *options, char text[RUN_SETTINGS_MAX]) {
+bool run_settings_text(const cli_options *options, const camera_settings *camera_file,
+                       char text[RUN_SETTINGS_MAX]) {
     const hbao_params *p = &options->params;
     size_t used = 0;
     text[0] = '\0';
@@ -62,12 +63,15 @@ bool run_settings_text(const cli_options *options, char text[RUN_SETTINGS_MAX]) 
      * (Runs without one keep the text of earlier versions.) */
     if (options->camera_path != NULL) {
         camera_settings file;
-        camera_settings_init(&file);
-        tool_error ignored = {{0}};
-        if (camera_json_load(options->camera_path, &file, &ignored) != TOOL_EXIT_SUCCESS)
-            return false;
+        if (camera_file == NULL) {
+            camera_settings_init(&file);
+            tool_error ignored = {{0}};
+            if (camera_json_load(options->camera_path, &file, &ignored) != TOOL_EXIT_SUCCESS)
+                return false;
+            camera_file = &file;
+        }
         append(text, &used, "; camera file ");
-        append_camera(text, &used, &file);
+        append_camera(text, &used, camera_file);
     }
     append(text, &used, "; layer %s; back layer %s; AO channel %s",
            options->layer ? options->layer : "(first)",

@@ -21,11 +21,14 @@
  * SIMD implementation, which change no value), the layer, the AO channel's
  * name, --keep-input, --no-normals, the compression, --crop-to-display,
  * --overscan, the camera flags and what the camera file (--camera) holds. Two
- * runs with equal text write equal files from equal inputs. False when the
- * text did not fit (a layer name of kilobytes), or the camera file cannot be
- * read: it then must not be used to skip work.
+ * runs with equal text write equal files from equal inputs. camera_file:
+ * what the run read from --camera (so that the stamp is what the AO was
+ * computed with, and the file is read once), or NULL to read it here. False
+ * when the text did not fit (a layer name of kilobytes), or the camera file
+ * cannot be read: it then must not be used to skip work.
  */
-bool run_settings_text(const cli_options *options, char text[RUN_SETTINGS_MAX]);
+bool run_settings_text(const cli_options *options, const camera_settings *camera_file,
+                       char text[RUN_SETTINGS_MAX]);
 
 /** Whether the EXR at `path` holds RUN_SETTINGS_ATTRIBUTE equal to `text`
  *  (false when it cannot be read or has no such attribute). */

@@ -51,7 +51,8 @@ static bool up_to_date(const cli_options *frame) {
         (stat(frame->preview_path, &other) != 0 || !newer_or_equal(&other, &output)))
         return false;
     char settings[RUN_SETTINGS_MAX];
-    return run_settings_text(frame, settings) && run_settings_match(frame->output_path, settings);
+    return run_settings_text(frame, NULL, settings) &&
+           run_settings_match(frame->output_path, settings);
 }
 
 static void report(sequence_run *run, const frame_outcome *outcome, const char *output,
