@@ -500,20 +500,26 @@ def test_animation_renders_every_frame_at_its_keyframed_radius(
     assert ao[2].mean() < ao[1].mean() - 0.02
 
 
+def full_and_border_ao(run_in_blender, tmp_path, size, border, crop):
+    """The first node's AO of the corner scene rendered whole and with
+    `border` (with or without its crop), after asserting that the border
+    render computed its AO."""
+    common = {"resolution": list(size), "nodes": [{"radius": 0.15, "blur_size": 0}]}
+    full_out, _ = render(run_in_blender, tmp_path, common, name="full")
+    border_out, log = render(run_in_blender, tmp_path, dict(common, border=border, crop=crop),
+                             name="border")
+    assert "Rendering without AO" not in log
+    return node_outputs(full_out, 1)["ao"], node_outputs(border_out, 1)["ao"]
+
+
 def test_border_render_without_crop_gets_the_ao_of_the_full_frame(run_in_blender, tmp_path):
     """Without "Crop to Render Region" the main Render Result is the whole
     frame and the helper's only the border: the engine computes the whole
     frame's AO and hands over the border's part (it rendered without AO,
     "the Render Result is 256x128, the helper scene renders 128x64")."""
     width, height = 256, 128
-    common = {"resolution": [width, height], "nodes": [{"radius": 0.15, "blur_size": 0}]}
-    full_out, _ = render(run_in_blender, tmp_path, common, name="full")
-    border_out, log = render(run_in_blender, tmp_path,
-                             dict(common, border=[0.25, 0.75, 0.25, 0.75], crop=False),
-                             name="border")
-    assert "Rendering without AO" not in log
-    full = node_outputs(full_out, 1)["ao"]
-    border = node_outputs(border_out, 1)["ao"]
+    full, border = full_and_border_ao(run_in_blender, tmp_path, (width, height),
+                                      [0.25, 0.75, 0.25, 0.75], crop=False)
     assert border.shape == full.shape == (height, width)
     # The border's pixels 64..191 and rows 32..95; away from its edge by more
     # than the projected radius (under 9 pixels), as in the cropped test.
@@ -532,14 +538,8 @@ def test_border_edges_round_as_blender_rounds_them(run_in_blender, tmp_path, cro
     camera was a pixel off, which sampling noise hides here: that variant
     only shows that such a border renders with AO."""
     width, height = 100, 50
-    common = {"resolution": [width, height], "nodes": [{"radius": 0.15, "blur_size": 0}]}
-    full_out, _ = render(run_in_blender, tmp_path, common, name="full")
-    border_out, log = render(run_in_blender, tmp_path,
-                             dict(common, border=[0.01, 0.51, 0.1, 0.7], crop=crop),
-                             name="border")
-    assert "Rendering without AO" not in log
-    full = node_outputs(full_out, 1)["ao"]
-    border = node_outputs(border_out, 1)["ao"]
+    full, border = full_and_border_ao(run_in_blender, tmp_path, (width, height),
+                                      [0.01, 0.51, 0.1, 0.7], crop=crop)
     rows, columns = slice(height - 35, height - 5), slice(1, 51)  # top row first
     assert border.shape == ((30, 50) if crop else (height, width))
     inside = border if crop else border[rows, columns]
