@@ -151,31 +151,35 @@ def full_disk(tmp_path):
         subprocess.run(["umount", str(folder)], check=False)
 
 
-def test_full_disk_renders_without_ao_leaves_nothing_and_restores_settings(
-        run_in_blender, tmp_path, full_disk):
+def render_with_scratch_folder(run_in_blender, tmp_path, folder):
+    """A render whose hand-over cannot use `folder`: it renders on without
+    AO, the image unchanged and the PNG output settings restored; returns
+    the log, for the reason."""
     out, log = render(run_in_blender, tmp_path,
                       {"output_format": "PNG", "nodes": [{"radius": 1.0}]},
-                      env={"HBAO_TEMP_DIR": str(full_disk)})
+                      env={"HBAO_TEMP_DIR": str(folder)})
     assert "Rendering without AO" in log, log[-3000:]
+    settings = output_settings(log)
+    assert settings["file_format"] == "PNG", settings
+    assert_no_ao_and_image_unchanged(out)
+    return log
+
+
+def test_full_disk_renders_without_ao_leaves_nothing_and_restores_settings(
+        run_in_blender, tmp_path, full_disk):
+    log = render_with_scratch_folder(run_in_blender, tmp_path, full_disk)
     # The reason names the folder and how to choose another.
     assert f"cannot read back the passes saved in {full_disk}" in log, log[-3000:]
     assert "is it full? HBAO_TEMP_DIR names another folder" in log
     assert list(full_disk.iterdir()) == []
-    settings = output_settings(log)
-    assert settings["file_format"] == "PNG", settings
-    assert_no_ao_and_image_unchanged(out)
 
 
 def test_scratch_folder_that_cannot_be_written_says_which_and_how(run_in_blender, tmp_path):
     blocked = tmp_path / "a file, not a folder"
     blocked.write_text("")
-    out, log = render(run_in_blender, tmp_path,
-                      {"output_format": "PNG", "nodes": [{"radius": 1.0}]},
-                      env={"HBAO_TEMP_DIR": str(blocked)})
-    assert "Rendering without AO" in log, log[-3000:]
+    log = render_with_scratch_folder(run_in_blender, tmp_path, blocked)
     assert f"cannot save the passes for the AO in {blocked}" in log, log[-3000:]
     assert "HBAO_TEMP_DIR names a writable folder" in log
-    assert_no_ao_and_image_unchanged(out)
 
 
 @pytest.mark.min_blender(5, 0)
