@@ -72,8 +72,8 @@ static inline __m512 load_every_fourth_avx512(const float *p) {
 }
 #define V_LOAD_EVERY_FOURTH load_every_fourth_avx512
 
-#define SIMD_PREFETCH_STEPS 0
-#define SIMD_PAIRED_DIRECTIONS 0
+#define SIMD_PREFETCH_STEPS 1
+#define SIMD_PAIRED_DIRECTIONS 16
 #define SIMD_ORTHOGRAPHIC 0
 #define SIMD_NAME(name) name##_avx512
 #include "horizon_simd.h"

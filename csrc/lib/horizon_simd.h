@@ -244,8 +244,8 @@ static inline void SIMD_NAME(plan_steps)(const SIMD_NAME(block) * b, float dc, f
  * and 0.908 on 1 thread, 0.924 and 0.926 on 2; the last lane's as well, on
  * top of that, 0.848-0.939 on 1 thread (three runs), 0.948-0.979 on 2 (then
  * with a block searched in two halves of 8 lanes, sharing one plan). The
- * AVX-512 copy has not been measured with it on AVX-512 hardware, so it
- * stays without. */
+ * AVX-512 copy too, since session 25 measured it on an Intel Xeon with
+ * AVX-512 together with paired directions (see SIMD_PAIRED_DIRECTIONS). */
 #ifndef SIMD_PREFETCH
 /* prefetcht0 as a statement the compiler keeps: GCC 12 deleted every
  * __builtin_prefetch of prefetch_steps when its loop took the least of two
@@ -875,9 +875,13 @@ static VF SIMD_NAME(direction_occlusion_hbao_layers)(const hbao_settings *s,
  * d negated: horizon.c's table), each pair by one slice_setup. The AVX2
  * copy pairs up to 16 (6 KiB of slices on the stack): bench_ab, 1080p, Zen
  * 1, defaults 0.954 on 1 thread, 0.948-0.972 on 2, 8 x 6 + blur 15 0.951
- * (docs/speed.md, session 24). The AVX-512 copy does not: session 11
- * measured pairs slower there (1.03-1.04), and no AVX-512 machine was at
- * hand to measure this form. */
+ * (docs/speed.md, session 24). The AVX-512 copy pairs up to 16 as well
+ * (12 KiB), with SIMD_PREFETCH_STEPS 1: bench_ab, 1080p, Intel Xeon with
+ * AVX-512 (session 25), defaults 0.956-0.963 on 1 thread, 0.949-0.959 on
+ * 2, half resolution 0.986 and 0.970, 8 x 6 + blur 15 0.908 and 0.921, 4K
+ * 0.916. Either alone did less (pairs 1.008 at the defaults, the prefetch
+ * 1.044 at half resolution). Session 11 had measured an older form of
+ * pairs slower on an AMD EPYC with AVX-512 (1.03-1.04), not re-measured. */
 #define SIMD_DIRECTION_GROUP 8
 #if SIMD_PAIRED_DIRECTIONS > SIMD_DIRECTION_GROUP
 #define SIMD_SLICE_ROOM SIMD_PAIRED_DIRECTIONS
