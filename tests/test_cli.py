@@ -663,6 +663,21 @@ def test_a_pipe_closed_by_its_reader_is_a_write_error(hbao_tool, tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.parametrize("arguments", [
+    ["--help"], ["--version"], ["--info", "FIXTURE"], ["--info", "FIXTURE", "--json"]])
+def test_text_for_a_reader_that_left_ends_quietly(hbao_tool, arguments):
+    """hbao --help | head: the reader has what it wanted, so text for a person
+    (help, version, --info) ends with exit 0 and nothing on stderr, even when
+    the reader left before the first byte (EPIPE on every write)."""
+    arguments = [fixture_path("cycles_float_zip") if a == "FIXTURE" else a for a in arguments]
+    read_end, write_end = os.pipe()
+    os.close(read_end)
+    with os.fdopen(write_end, "wb") as pipe:
+        completed = subprocess.run([str(hbao_tool), *arguments], stdout=pipe,
+                                   stderr=subprocess.PIPE, text=True, timeout=TOOL_TIMEOUT_S)
+    assert (completed.returncode, completed.stderr) == (0, "")
+
+
 def test_character_device_output_is_written_through(hbao_tool, tmp_path):
     """As root, a replaced /dev/null would break the system (issue 13, D3)."""
     before = os.lstat("/dev/null")

@@ -3,6 +3,7 @@
  * hbao: ambient occlusion for Blender's multilayer EXR renders.
  * See `hbao --help` (cli_options.c) for the command line.
  */
+#include <errno.h>
 #include <signal.h>
 #include <stdio.h>
 
@@ -47,9 +48,19 @@ int main(int argc, char **argv) {
         }
     }
     if (status != TOOL_EXIT_SUCCESS) fprintf(stderr, "hbao: error: %s\n", error.message);
-    if (fflush(stdout) != 0 && status == TOOL_EXIT_SUCCESS) {
-        fprintf(stderr, "hbao: error: cannot write to standard output\n");
-        status = TOOL_EXIT_RUNTIME;
+    /* ferror: a write that failed before the last flush (output past the
+     * stream's buffer) */
+    if ((fflush(stdout) != 0 || ferror(stdout)) && status == TOOL_EXIT_SUCCESS) {
+        /* hbao --help | head: the reader took what it wanted and left. Text
+         * for a person (help, version, --info) ends there quietly, as if the
+         * reader had read it all; an AO written to standard output does not
+         * get here (ao_command reports its own write errors). */
+        const int text_mode = options.mode == TOOL_MODE_HELP || options.mode == TOOL_MODE_VERSION ||
+                              options.mode == TOOL_MODE_INFO;
+        if (!(text_mode && errno == EPIPE)) {
+            fprintf(stderr, "hbao: error: cannot write to standard output\n");
+            status = TOOL_EXIT_RUNTIME;
+        }
     }
     return status;
 }
