@@ -525,6 +525,8 @@ def test_normals_without_a_matrix_warn(hbao_tool, tmp_path):
     ('{"type": "PANO"}', '"type"'),
     ('{"lens": -1}', '"lens"'),
     ('{"world_to_camera": [[1, 0, 0, 0]]}', "world_to_camera"),
+    ('{"world_to_camera": [[0, 0, 0, 0], [0, 0, 0, 0], [0, 0, 0, 0], [0, 0, 0, 1]]}',
+     "world_to_camera\" is not a camera's matrix"),
     ('{"sensor_fit": 3}', "sensor_fit"),
 ])
 def test_bad_camera_file_is_an_error(hbao_tool, tmp_path, content, fragment):
@@ -1036,6 +1038,8 @@ def test_a_frame_pattern_without_frames_gets_a_hint(hbao_tool, tmp_path):
     (["--compression", "dwaa"], "--compression"),
     (["--world-to-camera", "1,0,0,0"], "--world-to-camera"),
     (["--world-to-camera", "1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 nan"], "--world-to-camera"),
+    (["--world-to-camera", "0 0 0 0 0 0 0 0 0 0 0 0 0 0 0 0"], "not a camera's matrix"),
+    (["--world-to-camera", "1 0 0 0 1 0 0 0 0 0 1 0 0 0 0 1"], "not a camera's matrix"),
     (["--bogus"], "unknown option --bogus"),
     (["-x"], "unknown option -x"),
     (["--half-res=1"], "takes no value"),

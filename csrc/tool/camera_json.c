@@ -101,6 +101,11 @@ static int read_matrix(const cJSON *root, camera_settings *settings, const char 
             if (status != TOOL_EXIT_SUCCESS) return status;
         }
     }
+    if (!matrix_is_usable(matrix))
+        return tool_fail(error, TOOL_EXIT_RUNTIME,
+                         "%s: \"%s\" is not a camera's matrix (its upper-left 3x3 part is "
+                         "singular or out of range)",
+                         source, key);
     memcpy(settings->camera.world_to_camera, matrix, sizeof matrix);
     settings->fields_set |= CAMERA_FIELD_WORLD_TO_CAMERA;
     return TOOL_EXIT_SUCCESS;

@@ -46,6 +46,14 @@ hbao_result camera_for_data_window(const hbao_camera *camera, const pixel_rect *
                             as_int32(height), cropped);
 }
 
+bool matrix_is_usable(const float matrix[16]) {
+    hbao_camera camera;
+    hbao_camera_default(&camera);
+    memcpy(camera.world_to_camera, matrix, sizeof camera.world_to_camera);
+    hbao_view view;
+    return hbao_camera_view(&camera, 1, 1, &view) == HBAO_SUCCESS;
+}
+
 bool matrix_is_identity(const float matrix[16]) {
     for (int i = 0; i < 16; ++i)
         if (matrix[i] != (i % 5 == 0 ? 1.0f : 0.0f)) return false;

@@ -49,6 +49,11 @@ void camera_settings_apply(camera_settings *base, const camera_settings *overrid
 hbao_result camera_for_data_window(const hbao_camera *camera, const pixel_rect *display,
                                    const pixel_rect *data, hbao_camera *cropped);
 
+/** True when the library takes `matrix` as a camera's world-to-camera
+ *  matrix (hbao_camera_view with Blender's default camera otherwise): its
+ *  rotation part must be invertible. */
+bool matrix_is_usable(const float matrix[16]);
+
 /** True when the 4x4 matrix is the identity. */
 bool matrix_is_identity(const float matrix[16]);
 

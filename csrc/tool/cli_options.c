@@ -325,6 +325,12 @@ static int apply_option(const option_spec *spec, const char *value, cli_options 
                                  "--world-to-camera: expected one argument holding 16 finite "
                                  "numbers (row-major, separated by commas or spaces), got \"%s\"",
                                  value);
+            if (!matrix_is_usable(camera->world_to_camera))
+                return tool_fail(error, TOOL_EXIT_USAGE,
+                                 "--world-to-camera: \"%s\" is not a camera's matrix (its "
+                                 "upper-left 3x3 part is singular or out of range); give "
+                                 "camera.matrix_world inverted",
+                                 value);
             flags->fields_set |= CAMERA_FIELD_WORLD_TO_CAMERA;
             break;
         case OPTION_FRAMES:
