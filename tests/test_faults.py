@@ -194,6 +194,29 @@ def test_two_scenes_sharing_one_compositing_group(run_in_blender, tmp_path, nati
     assert np.abs(ao - expected).max() <= EXACT
 
 
+@pytest.mark.parametrize("beside", [False, True], ids=["alone", "beside_a_top_level_node"])
+def test_hbao_node_inside_a_node_group_says_why_it_gives_no_ao(run_in_blender, tmp_path, native,
+                                                               no_leftovers, beside):
+    """An HBAO node that an artist put into a node group of their own passes
+    Image through with a white AO, and the render's console (and, with a
+    window, the Info editor) says why, once; the node itself says so too
+    (node_place.at_top_level, which its status line draws from). An HBAO node at
+    the top level beside it still gets its AO."""
+    nodes = [{"radius": 0.8, "blur_size": 0}] * beside + [{"radius": 1.0}]
+    grouped_name = f"HBAO{len(nodes) - 1}"
+    out, log = render(run_in_blender, tmp_path, {"prepare": ["group_last_node"], "nodes": nodes})
+    line = next(text for text in log.splitlines() if text.startswith("GROUPED "))
+    expected_places = {grouped_name: False, **({"HBAO0": True} if beside else {})}
+    assert json.loads(line[len("GROUPED "):]) == expected_places
+    said = f'HBAO: node "{grouped_name}" in node group "Artist Group": HBAO works only at the top'
+    assert log.count(said) == 1, log[-3000:]
+    assert_no_ao_and_image_unchanged(out, grouped_name)
+    if beside:
+        ao = node_outputs(out, 1)["ao"]
+        expected = library_ao(native, out, 1, node_params(radius=0.8, blur_size=0))
+        assert np.abs(ao - expected).max() <= EXACT
+
+
 FAULT_SCRIPT = REPO / "tests" / "blender_scripts" / "fault_render.py"
 
 

@@ -66,6 +66,17 @@ def test_node_status_line_after_each_f12_render(ui_report):
         assert (width, height) == (1280, 1024), (name, width, height)
 
 
+def test_node_inside_a_node_group_says_it_gives_no_ao(ui_report):
+    """Drawn inside an artist's node group (out/test-artifacts/ui_node_grouped.png),
+    the node says at once, before any render, that it computes nothing there."""
+    grouped = ui_report["grouped"]
+    assert grouped["top_level"] == [False, True], grouped
+    assert "In a node group: AO off" in grouped["texts"], grouped
+    shot = ARTIFACTS / "ui_node_grouped.png"
+    width, height = struct.unpack(">II", shot.read_bytes()[16:24])
+    assert (width, height) == (1280, 1024), (width, height)
+
+
 def test_managed_node_lies_clear_of_the_hbao_node(ui_report):
     """The add-on's Render Layers node for the AO passes goes below the HBAO
     node, with its status and hint lines showing, not over its sockets."""

@@ -9,8 +9,8 @@ copy plain settings only. `blender -b ... -f N` runs them in the main thread,
 the only chance such a render has to build the hook."""
 import bpy
 
-from . import compat, helper_lookup, helper_scene, node, recomposite, writes
-from .report import in_main_thread, log
+from . import compat, helper_lookup, helper_scene, node, node_place, recomposite, writes
+from .report import in_main_thread, log, post_render_report
 
 _sync_scheduled = False
 # How soon a sync that Blender refused (writes.py) runs again.
@@ -56,6 +56,21 @@ def _on_save_pre(*_args):
 
 
 @bpy.app.handlers.persistent
+def _on_render_init(scene, *_args):
+    """Once a render job: what the HBAO nodes inside node groups mean (the
+    hook computes only at the top level), in the console and the Info
+    editor; then as every frame."""
+    if not helper_lookup.is_helper(scene):
+        tree = compat.compositor_tree(scene)
+        for group, grouped in node_place.nodes_in_groups(tree, node.is_hbao_node):
+            message = node_place.grouped_message(group, grouped)
+            log(message)
+            if not bpy.app.background:  # `-b`: the console has it
+                post_render_report(f"HBAO {message}")
+    _on_render_pre(scene)
+
+
+@bpy.app.handlers.persistent
 def _on_render_pre(scene, *_args):
     if helper_lookup.is_helper(scene):
         return
@@ -92,7 +107,7 @@ def _on_depsgraph_update_post(scene, *_args):
 _HANDLERS = (
     (bpy.app.handlers.load_post, _on_load_post),
     (bpy.app.handlers.save_pre, _on_save_pre),
-    (bpy.app.handlers.render_init, _on_render_pre),
+    (bpy.app.handlers.render_init, _on_render_init),
     (bpy.app.handlers.render_pre, _on_render_pre),
     (bpy.app.handlers.render_complete, _on_render_end),
     (bpy.app.handlers.render_cancel, _on_render_end),

@@ -10,7 +10,7 @@ nothing of the hook: it announces that nodes came or went through
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 
-from . import compat, guard_geometry, parameters, report, writes
+from . import compat, guard_geometry, node_lines, node_place, parameters, report, writes
 from .node_group import (AO_OUTPUT, AO_PASS_INPUT, DEPTH_INPUT, GROUP_TREE_NAME,  # noqa: F401
                          IMAGE_INPUT, IMAGE_OUTPUT, NORMAL_INPUT, VALUE_INPUTS, group_tree,
                          upgrade_group_tree)
@@ -18,9 +18,6 @@ from .parameters import FALLOFF_ITEMS, INTEGRATION_ITEMS
 
 NODE_IDNAME = "CompositorNodeHBAO"
 _D = parameters.DEFAULTS
-# Status lines longer than this are cut with an ellipsis: about what the
-# node's default width shows at 100 % zoom (the full text is the tooltip).
-MAX_STATUS_CHARACTERS = 30
 # Called with no arguments when an HBAO node is added, copied or deleted
 # (the hook's handlers subscribe: node callbacks must not edit the tree).
 changed_callbacks = []
@@ -68,19 +65,6 @@ def _extra_render_changed(node, _context):
     # The hook makes or removes the extra render on its next sync.
     node.id_data.update_tag()
     _announce_change()
-
-
-def _draw_line(layout, short, details, icon):
-    """A line under the node's settings, if `short` says anything: a
-    borderless button whose tooltip (and a click: the Info editor) gives the
-    full text that the short line stands for."""
-    if not short:
-        return
-    text = short
-    if len(text) > MAX_STATUS_CHARACTERS:
-        text = text[:MAX_STATUS_CHARACTERS - 1] + "\u2026"
-    button = layout.operator(HBAO_OT_node_status.bl_idname, text=text, icon=icon, emboss=False)
-    button.details = details or short
 
 
 class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
@@ -145,7 +129,9 @@ class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
         _announce_change()
 
     def draw_buttons(self, context, layout):
-        if not self.inputs[DEPTH_INPUT].is_linked:
+        if not node_place.at_top_level(self):
+            node_lines.draw(layout, node_place.GROUPED_SHORT, node_place.GROUPED_DETAILS, "ERROR")
+        elif not self.inputs[DEPTH_INPUT].is_linked:
             # Render Layers shows no Depth output until the pass is ticked.
             button = layout.operator("hbao.connect_passes", icon="LINKED")
             button.node_name = self.name
@@ -157,8 +143,8 @@ class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
         layout.prop(self, "half_resolution")
         layout.prop(self, "guard_band")
         layout.prop(self, "back_faces")
-        _draw_line(layout, self.status, self.status_details, "ERROR")
-        _draw_line(layout, self.hint, self.hint_details, "INFO")
+        node_lines.draw(layout, self.status, self.status_details, "ERROR")
+        node_lines.draw(layout, self.hint, self.hint_details, "INFO")
 
     def draw_buttons_ext(self, context, layout):
         self.draw_buttons(context, layout)
@@ -167,24 +153,6 @@ class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
 
     def draw_label(self):
         return "HBAO"
-
-
-class HBAO_OT_node_status(bpy.types.Operator):
-    """What the render hook said about this HBAO node"""
-    bl_idname = "hbao.node_status"
-    bl_label = "HBAO Node Status"
-    bl_options = {"INTERNAL"}
-
-    details: StringProperty(options={"SKIP_SAVE"})
-
-    @classmethod
-    def description(cls, _context, properties):
-        return properties.details
-
-    def execute(self, _context):
-        for line in self.details.splitlines():
-            self.report({"WARNING"}, f"HBAO {line}")
-        return {"FINISHED"}
 
 
 def show_messages(node, messages):
@@ -275,7 +243,7 @@ def _draw_add_menu(menu, context):
 def register():
     if "bl_rna" not in CompositorNodeHBAO.__dict__:  # kept (compat.keep_node_type_registered)
         bpy.utils.register_class(CompositorNodeHBAO)
-    bpy.utils.register_class(HBAO_OT_node_status)
+    bpy.utils.register_class(node_lines.HBAO_OT_node_status)
     for name, function in _HANDLERS:
         getattr(bpy.app.handlers, name).append(function)
     menu = compat.compositor_filter_menu()
@@ -295,6 +263,6 @@ def unregister():
         handlers = getattr(bpy.app.handlers, name)
         while function in handlers:
             handlers.remove(function)
-    bpy.utils.unregister_class(HBAO_OT_node_status)
+    bpy.utils.unregister_class(node_lines.HBAO_OT_node_status)
     if not compat.keep_node_type_registered(NODE_IDNAME):
         bpy.utils.unregister_class(CompositorNodeHBAO)

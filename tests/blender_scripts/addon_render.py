@@ -23,7 +23,8 @@ then linked by the node's Connect Passes operator after the passes are
 disabled)}], disable_normal_pass, disable_depth_pass, output_format (the main
 output's file format, default OPEN_EXR_MULTILAYER), prepare [actions before
 rendering: sync, delete_helper, delete_extra_renders, rename_helper, pick_internal_engine,
-render_the_helper, rename_node, second_scene_shares_the_tree], user_handlers (a
+render_the_helper, rename_node, second_scene_shares_the_tree, group_last_node (the last
+HBAO node moved into a node group of the artist's)], user_handlers (a
 pipeline's own render and frame change handlers, which print USER HANDLERS
 {json}: the scenes each list's handler saw, in order; render_stats leaves out
 repeats of the scene before). Prints OUTPUT SETTINGS {json} (the main output's settings after
@@ -170,6 +171,36 @@ for action in spec.get("prepare", []):
     elif action == "pick_internal_engine":  # from the Render Engine menu
         import hbao.helper_lookup
         scene.render.engine = hbao.helper_lookup.ENGINE_IDNAME
+    elif action == "group_last_node":  # an artist's node group around the last HBAO node
+        import hbao.node
+        import hbao.node_place
+        compat = blender_scenes.compat
+        last = [n for n in tree.nodes if n.bl_idname == "CompositorNodeHBAO"][-1]
+        group = bpy.data.node_groups.new("Artist Group", "CompositorNodeTree")
+        inside = group.nodes.new("CompositorNodeHBAO")
+        inside.name = last.name
+        for key in ("falloff", "integration", "half_resolution"):
+            setattr(inside, key, getattr(last, key))
+        group_in = group.nodes.new("NodeGroupInput")
+        group_out = group.nodes.new("NodeGroupOutput")
+        holder = tree.nodes.new("CompositorNodeGroup")
+        holder.node_tree = group
+        for name in ("Image", "Depth", "Normal"):
+            compat.new_group_socket(group, "INPUT", "NodeSocketColor"
+                                    if name == "Image" else "NodeSocketFloat"
+                                    if name == "Depth" else "NodeSocketVector", name)
+            group.links.new(group_in.outputs[name], inside.inputs[name])
+            for link in list(last.inputs[name].links):
+                tree.links.new(link.from_socket, holder.inputs[name])
+        for name in ("Image", "AO"):
+            compat.new_group_socket(group, "OUTPUT", "NodeSocketColor"
+                                    if name == "Image" else "NodeSocketFloat", name)
+            group.links.new(inside.outputs[name], group_out.inputs[name])
+            for link in list(last.outputs[name].links):
+                tree.links.new(holder.outputs[name], link.to_socket)
+        tree.nodes.remove(last)
+        print("GROUPED", json.dumps({n.name: hbao.node_place.at_top_level(n) for n in
+                                     [inside] + hbao.node.hbao_nodes(tree)}), flush=True)
     elif action == "second_scene_shares_the_tree":  # 5.0+: one node group, two scenes
         other = scene.copy()
         other.name = "Second"
@@ -230,7 +261,7 @@ for frame in spec.get("frames", [1]):
 # "changed since the last render" line says after each step. A step with
 # "refused" runs its "refresh", "poll", "apply", "composite_again",
 # "sync_tick", "sync_all" and "writes_allowed" where Blender refuses writes.
-hinted = next(n for n in tree.nodes if n.bl_idname == "CompositorNodeHBAO")
+hinted = next((n for n in tree.nodes if n.bl_idname == "CompositorNodeHBAO"), None)
 for step in spec.get("after_render", []):
     from hbao import node as node_module
     from hbao import recomposite, render_record, report

@@ -10,7 +10,9 @@ ui_old_file.py saved: what an artist meets on the HBAO node.
 - after the last render, the Normal input unlinked (a change that needs
   other passes, which re-compositing cannot bring: recomposite.py): the
   node's line saying that the AO shown is the last render's, and a
-  screenshot of it.
+  screenshot of it;
+- an HBAO node inside a node group of the artist's: the line that says it
+  gives no AO there, and a screenshot of it.
 
   blender --addons hbao --python ui_node.py OLD.blend -- OUT.json SHOT_DIR
 """
@@ -178,7 +180,33 @@ def changed_after_render():
     report["layout"] = {name: {"location": list(n.location), "dimensions": list(n.dimensions)}
                         for name, n in (("hbao", hbao), ("managed", managed))}
     screenshot(bpy.context.window_manager.windows[0], state.get("area"), "ui_node_changed.png")
+    report["grouped"] = grouped_node(bpy.context.window_manager.windows[0], state.get("area"))
     return finish()
+
+
+def grouped_node(window, area):
+    """An HBAO node in a node group of the artist's, the node editor inside
+    that group: the texts its buttons draw, and a screenshot of it."""
+    group = bpy.data.node_groups.new("Artist Group", "CompositorNodeTree")
+    inside = group.nodes.new(node_module.NODE_IDNAME)
+    holder = tree.nodes.new("CompositorNodeGroup")
+    holder.node_tree = group
+    holder.location = (hbao.location.x, hbao.location.y + 400)
+    texts = []
+    with override(window, area):
+        # the class's Python function: the node's own method checks for a UILayout
+        node_module.CompositorNodeHBAO.draw_buttons(inside, bpy.context, Recorder(texts))
+        area.spaces.active.path.append(group, node=holder)
+        for member in group.nodes:
+            member.select = member == inside
+        group.nodes.active = inside
+        bpy.ops.node.view_selected()
+        bpy.ops.wm.redraw_timer(type="DRAW_WIN_SWAP", iterations=2)
+    with bpy.context.temp_override(window=window, screen=window.screen):
+        bpy.ops.screen.screenshot(filepath=str(SHOTS / "ui_node_grouped.png"),
+                                  check_existing=False)
+    place = sys.modules["hbao.node_place"]
+    return {"texts": texts, "top_level": [place.at_top_level(inside), place.at_top_level(hbao)]}
 
 
 def finish():
