@@ -570,6 +570,22 @@ def test_stereo_render_renders_without_ao_and_says_so(run_in_blender, tmp_path, 
     assert list(scratch.iterdir()) == []
 
 
+def test_multi_view_with_a_view_of_its_own_renders_without_ao(run_in_blender, tmp_path,
+                                                              monkeypatch):
+    """Multi-View with a view besides left and right: the helper has that
+    view too, so its image is the render (the compositor read the helper's
+    AO pass of a view it did not have as 0: a black frame)."""
+    monkeypatch.setenv("HBAO_TEMP_DIR", str(tmp_path))
+    out, log = render(run_in_blender, tmp_path, {"stereo": "custom_view",
+                                                 "nodes": [{"radius": 1.0}]})
+    assert "stereo and multi-view renders get no AO yet" in log
+    for view in ("_L", "_R", "_C"):
+        outputs = node_outputs(out, 1, view=view)
+        assert np.all(outputs["ao"] == 1.0), view
+        assert outputs["render"].max() > 0.1, view
+        assert np.abs(outputs["image"] - outputs["render"]).max() <= EXACT, view
+
+
 def test_border_crop_render_matches_the_full_frame(run_in_blender, tmp_path):
     """A render cropped to a border region gives the same AO as the full
     frame at the same pixels, away from the crop edge by more than the

@@ -16,7 +16,7 @@ pointed at each scene's helper in turn would flip with every sync. The render
 handlers record the scene being rendered, which the engine reads."""
 import bpy
 
-from . import compat, extra_renders, writes
+from . import compat, extra_renders, helper_render_settings, writes
 from .data_edits import set_if_different
 from .helper_lookup import (ENGINE_IDNAME, HELPER_SCENE_PREFIX, MAIN_SCENE_KEY, MAIN_TREE_KEY,
                             MANAGED_NODE_KEY, helper_scene_of, is_helper, main_scene_of,
@@ -31,25 +31,10 @@ MANAGED_NODE_NAME = "HBAO Passes"
 # the HBAO node is about 555 units tall with its options and a hint line
 # (tests/test_ui.py measures it), a status line adds about 25.
 HBAO_NODE_CLEARANCE = 660
-# Render settings copied from the main scene so that the helper's result has
-# the main Render Result's size, and its views: a stereo render's compositor
-# reads each view's pass, and a helper with one view left the AO input 0 in
-# both (a black frame).
-SYNCED_RENDER_SETTINGS = (
-    "resolution_x", "resolution_y", "resolution_percentage", "pixel_aspect_x",
-    "pixel_aspect_y", "use_border", "use_crop_to_border", "border_min_x", "border_max_x",
-    "border_min_y", "border_max_y", "fps", "fps_base", "use_multiview", "views_format")
-
 # Helper scene name -> name of the scene whose render is using it now; the
 # helpers whose scene's render job runs (record_rendering .. record_render_end).
 _rendering = {}
 _in_progress = set()
-
-
-def copy_render_settings(scene, helper):
-    """Only plain values: allowed in the render job's thread too."""
-    for attribute in SYNCED_RENDER_SETTINGS:
-        set_if_different(helper.render, attribute, getattr(scene.render, attribute))
 
 
 def record_rendering(scene):
@@ -58,7 +43,7 @@ def record_rendering(scene):
     if helper is not None:
         _rendering[helper.name] = scene.name
         _in_progress.add(helper.name)
-        copy_render_settings(scene, helper)
+        helper_render_settings.copy(scene, helper)
         extra_renders.record_rendering(scene, helper)
 
 
@@ -127,7 +112,8 @@ def _configure_helper_scene(scene, helper, restructured):
     if not compat.HAS_COMPOSITING_NODE_GROUP and helper.use_nodes:
         helper.use_nodes = False
     if owner == scene:
-        copy_render_settings(scene, helper)
+        helper_render_settings.copy(scene, helper)
+        helper_render_settings.copy_views(scene, helper)
     # The helper's render needs a camera; the main cameras themselves, so that
     # their animation is evaluated at the frame being rendered in the helper's
     # depsgraph. Every scene sharing the tree brings its own.

@@ -69,6 +69,9 @@ if spec.get("widen_camera"):  # a view `widen_camera` times as wide about its ce
 if spec.get("stereo"):  # Stereoscopy on: a left and a right view, each written on its own
     scene.render.use_multiview = True
     scene.render.views_format = "STEREO_3D"
+    if spec["stereo"] == "custom_view":  # Multi-View, with a view "center" besides
+        scene.render.views_format = "MULTIVIEW"
+        scene.render.views.new("center").camera_suffix = "_C"
 if spec.get("border"):
     render_settings = scene.render
     (render_settings.border_min_x, render_settings.border_max_x,

@@ -1,0 +1,42 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""What the helper scene takes of its main scene's render settings: the
+size, so that the helper's result has the main Render Result's, and the
+views. The compositor reads each view's AO pass from the helper, and the
+helper has a view's pass only where it has the view: with one view, a
+stereo render read 0 in both (a black frame); without Multi-View's own
+views (besides left and right), those views were black."""
+from .data_edits import set_if_different
+
+SYNCED_RENDER_SETTINGS = (
+    "resolution_x", "resolution_y", "resolution_percentage", "pixel_aspect_x",
+    "pixel_aspect_y", "use_border", "use_crop_to_border", "border_min_x", "border_max_x",
+    "border_min_y", "border_max_y", "fps", "fps_base", "use_multiview", "views_format")
+VIEW_SETTINGS = ("use", "camera_suffix")
+
+
+def copy(scene, helper):
+    """Only plain values: allowed in the render job's thread too."""
+    for attribute in SYNCED_RENDER_SETTINGS:
+        set_if_different(helper.render, attribute, getattr(scene.render, attribute))
+    for view in scene.render.views:
+        own = helper.render.views.get(view.name)
+        if own is not None:
+            for attribute in VIEW_SETTINGS:
+                set_if_different(own, attribute, getattr(view, attribute))
+
+
+def copy_views(scene, helper):
+    """The helper's views made the main scene's: added, and those the main
+    scene lacks removed (left and right, which Blender keeps, switched off).
+    Main thread only: it adds and removes data."""
+    views = helper.render.views
+    for view in scene.render.views:
+        if views.get(view.name) is None:
+            views.new(view.name)
+    for own in list(views):
+        if scene.render.views.get(own.name) is None:
+            try:
+                views.remove(own)
+            except RuntimeError:  # Blender's stereo views cannot go
+                set_if_different(own, "use", False)
+    copy(scene, helper)
