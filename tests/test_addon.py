@@ -46,12 +46,15 @@ def render(run_in_blender, tmp_path, spec, env=None, name="render"):
     return out, completed.stdout
 
 
-def frame_passes(out, frame, layer="ViewLayer"):
+def frame_passes(out, frame, layer="ViewLayer", with_normal=True):
+    """(depth, normal) of the main render's view layer; normal None unless
+    with_normal."""
     path = out / f"frame_{frame:04d}.exr"
-    channels = exr.read_channels(path, [f"{layer}.Depth.Z"] + [
-        f"{layer}.Normal.{axis}" for axis in "XYZ"])
+    normal_names = [f"{layer}.Normal.{axis}" for axis in "XYZ"] if with_normal else []
+    channels = exr.read_channels(path, [f"{layer}.Depth.Z"] + normal_names)
     depth = channels[f"{layer}.Depth.Z"]
-    normal = np.stack([channels[f"{layer}.Normal.{axis}"] for axis in "XYZ"], axis=-1)
+    normal = np.stack([channels[name] for name in normal_names], axis=-1) if with_normal \
+        else None
     return depth, normal
 
 
@@ -61,9 +64,11 @@ def node_outputs(out, frame, node="HBAO0", view=""):
     wanted = [n for n in names if n.startswith(f"{node}_") or n.startswith("Render.")
               or n.startswith("CyclesAO.")]
     channels = exr.read_channels(path, wanted)
+    # Blender 3.4 leaves out a File Output input fed by a muted node: None
     result = {"ao": channels[f"{node}_AO.V"],
               "image": np.stack([channels[f"{node}_Image.{c}"] for c in "RGB"], axis=-1),
-              "render": np.stack([channels[f"Render.{c}"] for c in "RGB"], axis=-1)}
+              "render": np.stack([channels[f"Render.{c}"] for c in "RGB"], axis=-1)
+              if "Render.R" in channels else None}
     if "CyclesAO.R" in channels:
         result["cycles_ao"] = channels["CyclesAO.R"]
     return result
@@ -74,9 +79,8 @@ def camera(out, frame):
 
 
 def library_ao(native, out, frame, params, with_normal=True, layer="ViewLayer"):
-    depth, normal = frame_passes(out, frame, layer)
-    return native.compute_ao(depth, normal if with_normal else None, params=params,
-                             camera=camera(out, frame))
+    depth, normal = frame_passes(out, frame, layer, with_normal)
+    return native.compute_ao(depth, normal, params=params, camera=camera(out, frame))
 
 
 def node_params(**overrides):

@@ -217,6 +217,84 @@ def test_hbao_node_inside_a_node_group_says_why_it_gives_no_ao(run_in_blender, t
         assert np.abs(ao - expected).max() <= EXACT
 
 
+def status_lines(log):
+    return {entry["node"]: entry["status"] for entry in
+            (json.loads(text[len("STATUS "):]) for text in log.splitlines()
+             if text.startswith("STATUS "))}
+
+
+def test_render_single_layer_passes_image_through_and_says_so(run_in_blender, tmp_path,
+                                                              no_leftovers):
+    """With Render Single Layer on Blender renders no other scene, the
+    helper neither, and its AO pass read 0: a black image without a word.
+    Now the hook unlinks the nodes from it (AO 1, Image passed through), and
+    the render and the node say why."""
+    out, log = render(run_in_blender, tmp_path, {"single_layer": True,
+                                                 "nodes": [{"radius": 1.0}]})
+    assert log.count("HBAO: Render Single Layer is on") == 1, log[-3000:]
+    assert status_lines(log) == {"HBAO0": "Single Layer on: AO off"}, log[-3000:]
+    assert node_outputs(out, 1)["render"].max() > 0.1
+    assert_no_ao_and_image_unchanged(out)
+
+
+@pytest.mark.parametrize("prepare, said, short", [
+    ("layer_not_rendered", "which is not rendered (its Use for Rendering is off); AO off",
+     "Depth: layer not rendered, AO off"),
+    ("mute_render_layers", "Depth comes from a muted Render Layers node", "Depth: muted, AO off"),
+])
+def test_passes_that_blender_does_not_render_turn_the_ao_off_and_say_why(
+        run_in_blender, tmp_path, no_leftovers, prepare, said, short):
+    """A node fed by a view layer that is not rendered, or by a muted Render
+    Layers node: AO off with the reason, not a KeyError about a scratch file
+    or a failed save that blames the folder."""
+    out, log = render(run_in_blender, tmp_path, {
+        "scene": "two_layers", "prepare": [prepare],
+        "nodes": [{"name": "HBAO0", "layer": "Back", "radius": 1.0}]})
+    assert said in log, log[-3000:]
+    assert "KeyError" not in log and "cannot save" not in log, log[-3000:]
+    assert status_lines(log) == {"HBAO0": short}, log[-3000:]
+    assert np.all(node_outputs(out, 1)["ao"] == 1.0)
+
+
+@pytest.mark.parametrize("length", [56, 57])
+def test_long_view_layer_names(run_in_blender, blender, tmp_path, native, no_leftovers, length):
+    """Blender before 5.0 cuts EXR channel names at 64 bytes: a view layer
+    of 56 bytes loses its Normal pass ("<layer>.Normal.X" is 65), one of 57
+    its Depth too. The node then says so and reconstructs the normals, or
+    turns the AO off; 5.0 and later keep the names, and the AO is exact."""
+    name = "L" * length
+    out, log = render(run_in_blender, tmp_path, {"layer_name": name,
+                                                 "nodes": [{"radius": 0.8, "blur_size": 0}]})
+    assert "KeyError" not in log, log[-3000:]
+    ao = node_outputs(out, 1)["ao"]
+    params = node_params(radius=0.8, blur_size=0)
+    if blender.version_tuple >= (5, 0):
+        expected = library_ao(native, out, 1, params, layer=name)
+        assert np.abs(ao - expected).max() <= EXACT
+    elif length == 56:
+        assert "Normal comes from view layer" in log and "at most 55" in log, log[-3000:]
+        expected = library_ao(native, out, 1, params, with_normal=False, layer=name)
+        assert np.abs(ao - expected).max() <= EXACT
+    else:
+        assert "Depth comes from view layer" in log and "at most 56" in log, log[-3000:]
+        assert np.all(ao == 1.0)
+
+
+def test_a_pass_the_render_engine_does_not_make_is_not_read(run_in_blender, tmp_path, native,
+                                                            no_leftovers):
+    """A scene switched to Workbench after its passes were linked: Workbench
+    makes no Normal pass, and Blender 3.4 keeps the Normal link to the Render
+    Layers node (the socket hidden). The AO reconstructs the normals from
+    depth, as where the link is gone, instead of failing on a channel that
+    the saved file lacks."""
+    out, log = render(run_in_blender, tmp_path, {"prepare": ["switch_to_workbench"],
+                                                 "nodes": [{"radius": 0.8, "blur_size": 0}]})
+    assert "KeyError" not in log and "Rendering without AO" not in log, log[-3000:]
+    expected = library_ao(native, out, 1, node_params(radius=0.8, blur_size=0),
+                          with_normal=False)
+    assert np.abs(node_outputs(out, 1)["ao"] - expected).max() <= EXACT
+
+
 FAULT_SCRIPT = REPO / "tests" / "blender_scripts" / "fault_render.py"
 
 

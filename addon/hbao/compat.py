@@ -14,6 +14,10 @@ HAS_TREE_INTERFACE = VERSION >= (4, 0, 0)
 # 5.0 replaced scene.node_tree with scene.compositing_node_group and the
 # Composite node with the group's Group Output.
 HAS_COMPOSITING_NODE_GROUP = VERSION >= (5, 0, 0)
+# Blender before 5.0 writes an EXR channel name of at most 64 bytes
+# (EXR_TOT_MAXNAME) and cuts a longer one: "<view layer>.Normal.X" of a view
+# layer named with 56 or more bytes cannot be read back. None: no limit.
+EXR_CHANNEL_NAME_MAX = 64 if VERSION < (5, 0, 0) else None
 
 
 # 5.0 lets several scenes use one compositing node group (an ID of its own);

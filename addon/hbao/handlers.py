@@ -9,8 +9,9 @@ copy plain settings only. `blender -b ... -f N` runs them in the main thread,
 the only chance such a render has to build the hook."""
 import bpy
 
-from . import compat, helper_lookup, helper_scene, node, node_place, recomposite, writes
-from .report import in_main_thread, log, post_render_report
+from . import (compat, helper_lookup, helper_render_settings, helper_scene, node, node_place,
+               recomposite, writes)
+from .report import NodeMessage, in_main_thread, log, post_node_messages, post_render_report
 
 _sync_scheduled = False
 # How soon a sync that Blender refused (writes.py) runs again.
@@ -57,16 +58,27 @@ def _on_save_pre(*_args):
 
 @bpy.app.handlers.persistent
 def _on_render_init(scene, *_args):
-    """Once a render job: what the HBAO nodes inside node groups mean (the
-    hook computes only at the top level), in the console and the Info
-    editor; then as every frame."""
+    """Once a render job, in the console and the Info editor: what the HBAO
+    nodes inside node groups mean (the hook computes only at the top
+    level), and that Render Single Layer turns the AO off (on the nodes'
+    status lines too); then as every frame."""
     if not helper_lookup.is_helper(scene):
         tree = compat.compositor_tree(scene)
-        for group, grouped in node_place.nodes_in_groups(tree, node.is_hbao_node):
-            message = node_place.grouped_message(group, grouped)
-            log(message)
+        # (the console's text, the report's: a node's reads "HBAO node ...")
+        messages = [(text, f"HBAO {text}") for text in (
+            node_place.grouped_message(group, grouped)
+            for group, grouped in node_place.nodes_in_groups(tree, node.is_hbao_node))]
+        nodes = node.hbao_nodes(tree)
+        if nodes and not helper_render_settings.helper_renders(scene):
+            detail = helper_render_settings.SINGLE_LAYER_DETAIL
+            statuses = [NodeMessage(n.name, detail, helper_render_settings.SINGLE_LAYER_SHORT)
+                        for n in nodes]
+            post_node_messages(scene.name, [n.name for n in nodes], statuses)
+            messages.append((detail, f"HBAO: {detail}"))
+        for text, report_text in messages:
+            log(text)
             if not bpy.app.background:  # `-b`: the console has it
-                post_render_report(f"HBAO {message}")
+                post_render_report(report_text)
     _on_render_pre(scene)
 
 

@@ -42,6 +42,23 @@ def _scratch_folder():
     return folder
 
 
+# The channels of each pass read back, as Blender names them in a saved
+# multilayer EXR: "<view layer>.<pass>.<axis>".
+PASS_AXES = {"Depth": "Z", "Normal": "XYZ"}
+
+
+def pass_channels(layer, pass_name):
+    return [f"{layer}.{pass_name}.{axis}" for axis in PASS_AXES[pass_name]]
+
+
+def longest_layer_name(pass_name):
+    """The most bytes a view layer's name may have for its pass `pass_name`
+    to be read back (compat.EXR_CHANNEL_NAME_MAX), or None: any."""
+    if compat.EXR_CHANNEL_NAME_MAX is None:
+        return None
+    return compat.EXR_CHANNEL_NAME_MAX - len(pass_channels("", pass_name)[0].encode())
+
+
 def _scratch_path():
     return os.path.join(_scratch_folder(), scratch_names.name(
         os.getpid(), threading.get_ident(), next(_scratch_numbers)))
@@ -234,9 +251,9 @@ def read_passes(scene, layers):
         # interleaved (height, width, 3) image, as libhbao reads it.
         groups = {}
         for layer, with_normal in layers.items():
-            groups[("depth", layer)] = [f"{layer}.Depth.Z"]
+            groups[("depth", layer)] = pass_channels(layer, "Depth")
             if with_normal:
-                groups[("normal", layer)] = [f"{layer}.Normal.{axis}" for axis in "XYZ"]
+                groups[("normal", layer)] = pass_channels(layer, "Normal")
         read_start = _clock()
         try:
             channels = exr_passes.read_channel_groups(path, groups)

@@ -12,6 +12,19 @@ SYNCED_RENDER_SETTINGS = (
     "pixel_aspect_y", "use_border", "use_crop_to_border", "border_min_x", "border_max_x",
     "border_min_y", "border_max_y", "fps", "fps_base", "use_multiview", "views_format")
 VIEW_SETTINGS = ("use", "camera_suffix")
+# With Render Single Layer on, Blender renders no scene but the one asked
+# for, the helper neither: its AO pass would read 0, a black image. The hook
+# then unlinks the HBAO nodes from it (helper_scene.sync), and they pass
+# Image through.
+SINGLE_LAYER_DETAIL = ("Render Single Layer is on (View Layer properties): Blender then renders "
+                       "no other scene, HBAO's helper neither; AO off (the node passes Image "
+                       "through). Turn it off for AO")
+SINGLE_LAYER_SHORT = "Single Layer on: AO off"
+
+
+def helper_renders(scene):
+    """Whether Blender renders the helper with `scene`."""
+    return not scene.render.use_single_layer
 
 
 def copy(scene, helper):

@@ -233,11 +233,17 @@ def sync(scene):
         tree.nodes.remove(managed_node(tree))
     rlayers = _ensure_managed_node(tree, nodes, helper)
     _configure_helper_scene(scene, helper, new)
+    linked = helper_render_settings.helper_renders(scene)
     for node in nodes:
         output = rlayers.outputs.get(pass_name(node))
         target = node.inputs.get(AO_PASS_INPUT)
         if output is None or target is None:
             messages.append(f"node {node.name!r}: its AO pass socket is not available yet")
+            continue
+        if not linked:  # AO 1: the node passes Image through
+            for link in list(target.links):
+                tree.links.remove(link)
+            set_if_different(target, "default_value", 1.0)
             continue
         # Blender unhides linked sockets and refuses to hide them, so this one
         # link stays visible; the collapsed Render Layers node shows only it.

@@ -2,7 +2,7 @@
 """Which AO computations a frame needs: one job per HBAO node whose output
 someone looks at, with the view layer its passes come from and its
 parameters at that frame."""
-from . import compat
+from . import compat, handover
 from .helper_lookup import MANAGED_NODE_KEY
 from .node import DEPTH_INPUT, NORMAL_INPUT, hbao_nodes, pass_name
 from .report import NodeMessage, post_node_messages
@@ -37,6 +37,21 @@ def pass_source(socket, scene, expected):
     if source.identifier != expected and source.name != expected:
         return (None, f"{socket.name} is linked to the {source.name} pass, not {expected}",
                 "wrong pass")
+    if node.mute:
+        return None, f"{socket.name} comes from a muted Render Layers node ({node.name})", "muted"
+    if not source.enabled:  # Blender 3.4 keeps the link to a pass the engine does not make
+        return (None, f"{socket.name} is linked to the {expected} pass, which the render engine "
+                "does not make", "no such pass")
+    view_layer = (node.scene or scene).view_layers.get(node.layer)
+    if view_layer is not None and not view_layer.use:
+        return (None, f"{socket.name} comes from view layer {node.layer!r}, which is not rendered "
+                "(its Use for Rendering is off)", "layer not rendered")
+    longest = handover.longest_layer_name(expected)
+    if longest is not None and len(node.layer.encode()) > longest:
+        return (None, f"{socket.name} comes from view layer {node.layer!r}, whose name is too "
+                f"long for this Blender's EXR files: its {expected} pass cannot be read back "
+                f"(Blender before 5.0 cuts channel names at {compat.EXR_CHANNEL_NAME_MAX} "
+                f"bytes; rename the layer to at most {longest})", "layer name too long")
     return node.layer, None, None
 
 

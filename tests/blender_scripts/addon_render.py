@@ -24,7 +24,9 @@ disabled)}], disable_normal_pass, disable_depth_pass, output_format (the main
 output's file format, default OPEN_EXR_MULTILAYER), prepare [actions before
 rendering: sync, delete_helper, delete_extra_renders, rename_helper, pick_internal_engine,
 render_the_helper, rename_node, second_scene_shares_the_tree, group_last_node (the last
-HBAO node moved into a node group of the artist's)], user_handlers (a
+HBAO node moved into a node group of the artist's), layer_not_rendered, mute_render_layers,
+switch_to_workbench],
+layer_name (the first view layer's), single_layer (Render Single Layer on), user_handlers (a
 pipeline's own render and frame change handlers, which print USER HANDLERS
 {json}: the scenes each list's handler saw, in order; render_stats leaves out
 repeats of the scene before). Prints OUTPUT SETTINGS {json} (the main output's settings after
@@ -78,6 +80,11 @@ if spec.get("border"):
      render_settings.border_min_y, render_settings.border_max_y) = spec["border"]
     render_settings.use_border = True
     render_settings.use_crop_to_border = spec.get("crop", True)
+
+if spec.get("layer_name"):  # the first view layer renamed
+    scene.view_layers[0].name = spec["layer_name"]
+if spec.get("single_layer"):  # Render Single Layer (View Layer properties)
+    scene.render.use_single_layer = True
 
 compositor = blender_scenes.Compositor(scene)
 tree = compositor.tree
@@ -204,6 +211,13 @@ for action in spec.get("prepare", []):
         tree.nodes.remove(last)
         print("GROUPED", json.dumps({n.name: hbao.node_place.at_top_level(n) for n in
                                      [inside] + hbao.node.hbao_nodes(tree)}), flush=True)
+    elif action == "switch_to_workbench":  # the render engine changed after linking
+        scene.render.engine = "BLENDER_WORKBENCH"
+    elif action == "layer_not_rendered":  # the last view layer's Use for Rendering off
+        scene.view_layers[-1].use = False
+    elif action == "mute_render_layers":
+        for source in render_layers.values():
+            source.mute = True
     elif action == "second_scene_shares_the_tree":  # 5.0+: one node group, two scenes
         other = scene.copy()
         other.name = "Second"
