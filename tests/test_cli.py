@@ -596,6 +596,38 @@ def test_output_equal_to_input_is_refused(hbao_tool, tmp_path):
     assert not (tmp_path / "ok.exr").exists()
 
 
+def test_camera_file_is_never_an_output(hbao_tool, tmp_path):
+    """The --camera file is an input too: -o or --preview naming it (by any
+    name) is refused, and it keeps its contents."""
+    camera = tmp_path / "camera.json"
+    shutil.copyfile(camera_path("cycles_float_zip"), camera)
+    original = camera.read_bytes()
+    (tmp_path / "link.json").symlink_to(camera)
+    for target in (camera, f"{tmp_path}/./camera.json", tmp_path / "link.json"):
+        for flag in ("-o", "--preview"):
+            outputs = ["-o", tmp_path / "ok.exr", flag, target] if flag != "-o" \
+                else ["-o", target]
+            completed = run_tool(hbao_tool, fixture_path("cycles_float_zip"), *outputs,
+                                 "--camera", camera)
+            assert_clean_error(completed, EXIT_USAGE, "is the --camera file")
+            assert camera.read_bytes() == original
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["camera.json", "link.json"]
+
+
+def test_output_and_preview_naming_one_file_are_refused(hbao_tool, tmp_path):
+    """-o and --preview naming the same file by different names ("./",
+    "sub/..", a link to the other): the PNG would replace the EXR. Refused
+    before any work, nothing written, no temporary file left."""
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "link.png").symlink_to("ao.exr")
+    # (strings: pathlib would drop the "./")
+    for preview in (f"{tmp_path}/./ao.exr", f"{tmp_path}/sub/../ao.exr", tmp_path / "link.png"):
+        completed = run_tool(hbao_tool, fixture_path("cycles_float_zip"), "-o",
+                             tmp_path / "ao.exr", "--preview", preview, "--no-normals")
+        assert_clean_error(completed, EXIT_USAGE, "name the same file")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["link.png", "sub"]
+
+
 def test_existing_output_is_replaced_only_on_success(hbao_tool, tmp_path):
     output = tmp_path / "ao.exr"
     preview = tmp_path / "ao.png"
@@ -991,6 +1023,23 @@ def test_sequence_refuses_an_output_that_is_another_frames_input(hbao_tool, tmp_
                "--no-normals")
     inputs = [f"f_{frame}.exr" for frame in range(1, 10)]
     assert all((tmp_path / name).read_bytes() == before[name] for name in inputs)
+
+
+def test_sequence_refuses_outputs_that_are_another_frames_or_its_own(hbao_tool, tmp_path):
+    """A frame's preview that is another frame's output (-o 'o_#.exr'
+    --preview 'o_#0.exr': frame 1's PNG and frame 10's EXR would replace each
+    other), or each frame's preview its own output by another name: refused,
+    nothing written."""
+    for frame in (1, 2, 10):
+        shutil.copyfile(fixture_path("cycles_float_zip"), tmp_path / f"in_{frame}.exr")
+    before = sorted(p.name for p in tmp_path.iterdir())
+    crossed = run_tool(hbao_tool, tmp_path / "in_#.exr", "-o", tmp_path / "o_#.exr",
+                       "--preview", tmp_path / "o_#0.exr", "--frames", "1-2,10", "--no-normals")
+    assert_clean_error(crossed, EXIT_USAGE, "--preview of frame 1 ", "is the -o of frame 10")
+    own = run_tool(hbao_tool, tmp_path / "in_#.exr", "-o", tmp_path / "x_#.exr", "--preview",
+                   f"{tmp_path}/./x_#.exr", "--frames", "1-2", "--no-normals")
+    assert own.returncode == EXIT_USAGE and own.stderr.count("name the same file") == 2, own.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == before
 
 
 @pytest.mark.parametrize("arguments, fragment", [

@@ -18,14 +18,22 @@
 /* Refuse an output path that is the input file itself, through any name
  * (hard link, symbolic link, "./x" vs "x"): stat() identity, not strings.
  * What else may be written is atomic_file_begin()'s rule. */
+/* An output that is one of the run's input files: the EXR, or the camera
+ * file (compared by file, whatever the names). */
 static int refuse_overwriting_input(const char *output, const char *flag,
-                                    const struct stat *input_status, tool_error *error) {
-    struct stat output_status;
+                                    const struct stat *input_status, const char *camera_path,
+                                    tool_error *error) {
+    struct stat output_status, camera_status;
     if (stat(output, &output_status) != 0) return TOOL_EXIT_SUCCESS;
     if (output_status.st_dev == input_status->st_dev &&
         output_status.st_ino == input_status->st_ino)
         return tool_fail(error, TOOL_EXIT_USAGE,
                          "%s %s is the input file; refusing to overwrite it", flag, output);
+    if (camera_path != NULL && stat(camera_path, &camera_status) == 0 &&
+        S_ISREG(camera_status.st_mode) && output_status.st_dev == camera_status.st_dev &&
+        output_status.st_ino == camera_status.st_ino)
+        return tool_fail(error, TOOL_EXIT_USAGE,
+                         "%s %s is the --camera file; refusing to overwrite it", flag, output);
     return TOOL_EXIT_SUCCESS;
 }
 
@@ -149,6 +157,9 @@ static int begin_outputs(const cli_options *options, output_files *files, tool_e
     int status = atomic_file_begin(&files->exr, options->output_path, error);
     if (status == TOOL_EXIT_SUCCESS && options->preview_path != NULL)
         status = atomic_file_begin(&files->png, options->preview_path, error);
+    if (status == TOOL_EXIT_SUCCESS && atomic_file_same_destination(&files->exr, &files->png))
+        status = tool_fail(error, TOOL_EXIT_USAGE, "--preview %s and -o %s name the same file",
+                           options->preview_path, options->output_path);
     return status;
 }
 
@@ -308,9 +319,11 @@ int ao_command(const cli_options *options, tool_error *error) {
                                                      : "");
     if (!S_ISREG(input_status.st_mode))
         return tool_fail(error, TOOL_EXIT_RUNTIME, "%s is not a regular file", options->input_path);
-    int status = refuse_overwriting_input(options->output_path, "-o", &input_status, error);
+    int status = refuse_overwriting_input(options->output_path, "-o", &input_status,
+                                          options->camera_path, error);
     if (status == TOOL_EXIT_SUCCESS && options->preview_path != NULL)
-        status = refuse_overwriting_input(options->preview_path, "--preview", &input_status, error);
+        status = refuse_overwriting_input(options->preview_path, "--preview", &input_status,
+                                          options->camera_path, error);
     if (status != TOOL_EXIT_SUCCESS) return status;
 
     exr_input input;

@@ -1,4 +1,5 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
+#define _DEFAULT_SOURCE /* realpath */
 #include "atomic_file.h"
 
 #include <errno.h>
@@ -231,6 +232,32 @@ int atomic_file_begin(atomic_file *file, const char *destination, tool_error *er
                          strerror(saved));
     }
     return TOOL_EXIT_SUCCESS;
+}
+
+/* The file a begun destination will be: its directory made canonical
+ * (realpath: "./", "../" and links on the way resolved), its name kept. */
+static bool canonical_destination(const atomic_file *file, char out[PATH_MAX]) {
+    const char *slash = strrchr(file->destination, '/');
+    char directory[PATH_MAX];
+    if (slash == NULL)
+        strcpy(directory, ".");
+    else if (slash == file->destination)
+        strcpy(directory, "/");
+    else
+        snprintf(directory, sizeof directory, "%.*s", (int)(slash - file->destination),
+                 file->destination);
+    char real[PATH_MAX];
+    if (realpath(directory, real) == NULL) return false;
+    const char *name = slash != NULL ? slash + 1 : file->destination;
+    int written = snprintf(out, PATH_MAX, "%s/%s", real, name);
+    return written > 0 && written < PATH_MAX;
+}
+
+bool atomic_file_same_destination(const atomic_file *a, const atomic_file *b) {
+    if (!a->active || !b->active || a->write_through || b->write_through) return false;
+    char first[PATH_MAX], second[PATH_MAX];
+    return canonical_destination(a, first) && canonical_destination(b, second) &&
+           strcmp(first, second) == 0;
 }
 
 /* Copy the whole temporary file to the FIFO or device, in order. */

@@ -63,6 +63,11 @@ int atomic_file_begin(atomic_file *file, const char *destination, tool_error *er
  *  On failure the temporary file is removed. */
 int atomic_file_commit(atomic_file *file, tool_error *error);
 
+/** Whether two begun files would put their data in the same place (two
+ *  names of one file: "./a.exr" and "a.exr", a link and its target); never
+ *  for files written through (a FIFO, /dev/null). */
+bool atomic_file_same_destination(const atomic_file *a, const atomic_file *b);
+
 /** Remove the temporary file (no-op when nothing is pending). */
 void atomic_file_abort(atomic_file *file);
 

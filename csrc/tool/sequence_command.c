@@ -134,25 +134,34 @@ static int summarize(const sequence_run *run, tool_error *error) {
 
 /* A frame's output or preview that is another frame's input would replace
  * that frame's render before it is read (hbao 'f_#.exr' -o 'f_#0.exr'
- * --frames 1-10: frame 1 writes f_10.exr). Each frame refuses its own input
- * (ao_command); this refuses the others' by name, before any frame runs. */
-static int refuse_other_frames_inputs(const cli_options *options, int64_t count,
-                                      tool_error *error) {
+ * --frames 1-10: frame 1 writes f_10.exr); one that is another frame's
+ * preview or output, the two frames would replace each other's file
+ * (-o 'o_#.exr' --preview 'o_#0.exr'). Each frame refuses its own input
+ * and a preview that is its own output (ao_command); this refuses the
+ * others', by name, before any frame runs. */
+static int refuse_other_frames_files(const cli_options *options, int64_t count, tool_error *error) {
     const char *patterns[2] = {options->output_path, options->preview_path};
     const char *flags[2] = {"-o", "--preview"};
     char path[PATH_MAX];
     for (int64_t i = 0; i < count; ++i) {
         const int32_t frame = frame_list_at(&options->frames, i);
         for (int k = 0; k < 2; ++k) {
-            int32_t other;
-            if (patterns[k] == NULL || !frame_pattern_path(patterns[k], frame, path, sizeof path) ||
-                !frame_pattern_frame(options->input_path, path, &other) || other == frame ||
-                !frame_list_contains(&options->frames, other))
+            if (patterns[k] == NULL || !frame_pattern_path(patterns[k], frame, path, sizeof path))
                 continue;
-            return tool_fail(error, TOOL_EXIT_USAGE,
-                             "%s of frame %d (%s) is the input of frame %d: it would be "
-                             "replaced before it is read",
-                             flags[k], (int)frame, path, (int)other);
+            int32_t other;
+            if (frame_pattern_frame(options->input_path, path, &other) && other != frame &&
+                frame_list_contains(&options->frames, other))
+                return tool_fail(error, TOOL_EXIT_USAGE,
+                                 "%s of frame %d (%s) is the input of frame %d: it would be "
+                                 "replaced before it is read",
+                                 flags[k], (int)frame, path, (int)other);
+            const char *pattern = patterns[1 - k];
+            if (pattern != NULL && frame_pattern_frame(pattern, path, &other) && other != frame &&
+                frame_list_contains(&options->frames, other))
+                return tool_fail(error, TOOL_EXIT_USAGE,
+                                 "%s of frame %d (%s) is the %s of frame %d: each would replace "
+                                 "the other",
+                                 flags[k], (int)frame, path, flags[1 - k], (int)other);
         }
     }
     return TOOL_EXIT_SUCCESS;
@@ -160,7 +169,7 @@ static int refuse_other_frames_inputs(const cli_options *options, int64_t count,
 
 int sequence_command(const cli_options *options, tool_error *error) {
     const int refused =
-        refuse_other_frames_inputs(options, frame_list_count(&options->frames), error);
+        refuse_other_frames_files(options, frame_list_count(&options->frames), error);
     if (refused != TOOL_EXIT_SUCCESS) return refused;
     sequence_run run = {0};
     run.count = frame_list_count(&options->frames);
