@@ -712,6 +712,26 @@ def test_text_for_a_reader_that_left_ends_quietly(hbao_tool, arguments):
     assert (completed.returncode, completed.stderr) == (0, "")
 
 
+def test_a_preview_on_a_full_disk_says_why(hbao_tool, tmp_path):
+    """The preview's write fails with ENOSPC on a full file system (a tmpfs
+    of two pages, filled): its message gives the reason, as the EXR's does,
+    nothing is committed and no temporary file is left."""
+    folder = tmp_path / "full"
+    folder.mkdir()
+    mounted = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=8k", "tmpfs", str(folder)],
+                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    assert mounted.returncode == 0, f"cannot mount a tmpfs (root needed): {mounted.stdout}"
+    try:
+        (folder / "filler").write_bytes(b"x" * 8192)
+        completed = run_tool(hbao_tool, fixture_path("cycles_float_zip"), "-o",
+                             tmp_path / "ao.exr", "--preview", folder / "ao.png", "--no-normals")
+        assert_clean_error(completed, EXIT_RUNTIME, "ao.png", "No space left on device")
+        assert not (tmp_path / "ao.exr").exists()
+        assert sorted(p.name for p in folder.iterdir()) == ["filler"]
+    finally:
+        subprocess.run(["umount", str(folder)], check=False)
+
+
 def test_character_device_output_is_written_through(hbao_tool, tmp_path):
     """As root, a replaced /dev/null would break the system (issue 13, D3)."""
     before = os.lstat("/dev/null")
@@ -955,6 +975,67 @@ def test_sequence_redoes_frames_computed_with_other_flags(hbao_tool, tmp_path):
     assert "frame 1: " in redone.stderr and b"hbaoSettings" in foreign.read_bytes()
 
 
+def test_an_input_replaced_while_its_ao_is_computed_gets_no_output(hbao_tool, tmp_path):
+    """A farm re-renders a frame while hbao computes its AO: an output written
+    then would be the old render's AO, newer than the new render, and a
+    sequence's rerun would skip it. hbao writes nothing and says to run
+    again. (The camera file, a FIFO, holds the run after the render is
+    opened; the render is replaced meanwhile, as a renderer's save does.)"""
+    render = tmp_path / "render.exr"
+    shutil.copyfile(fixture_path("cycles_float_zip"), render)
+    camera = tmp_path / "camera.json"
+    os.mkfifo(camera)
+    output = tmp_path / "ao.exr"
+    process = subprocess.Popen([str(hbao_tool), str(render), "-o", str(output), "--camera",
+                                str(camera)], stderr=subprocess.PIPE, text=True)
+    with open(camera, "w") as writer:  # hbao has opened the render by now
+        shutil.copyfile(fixture_path("eevee_half"), tmp_path / "new.exr")
+        older = render.stat().st_mtime_ns - 10**9
+        os.utime(tmp_path / "new.exr", ns=(older, older))
+        os.replace(tmp_path / "new.exr", render)
+        writer.write(camera_path("cycles_float_zip").read_text())
+    _, stderr = process.communicate(timeout=TOOL_TIMEOUT_S)
+    completed = subprocess.CompletedProcess(process.args, process.returncode, "", stderr)
+    assert_clean_error(completed, EXIT_RUNTIME, "changed while its AO was computed")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["camera.json", "render.exr"]
+
+
+def test_sequence_output_that_is_its_own_input_is_refused_even_if_up_to_date(hbao_tool,
+                                                                             tmp_path):
+    """An input that is an earlier --keep-input output of the same settings
+    looks up to date as its own output: it is refused (exit 2), as with
+    --force, not skipped with exit 0."""
+    kept = tmp_path / "k_0001.exr"
+    run_ok(hbao_tool, fixture_path("cycles_float_zip"), "-o", kept, "--keep-input",
+           "--no-normals")
+    for extra in ([], ["--force"]):
+        completed = run_tool(hbao_tool, tmp_path / "k_####.exr", "-o", tmp_path / "k_####.exr",
+                             "--keep-input", "--no-normals", "--frames", "1", *extra)
+        assert_clean_error(completed, EXIT_USAGE, "is the input file")
+
+
+def test_sequence_reads_the_camera_file_once(hbao_tool, tmp_path):
+    """--camera /dev/stdin (or a shell's <(...)): a pipe reads once. Every
+    frame gets its camera, as from a file; a camera file that cannot be read
+    fails the run before any frame."""
+    for frame in (1, 2, 3):
+        shutil.copyfile(fixture_path("cycles_float_zip"), tmp_path / f"in_{frame}.exr")
+    arguments = [str(hbao_tool), str(tmp_path / "in_#.exr"), "-o", str(tmp_path / "p_#.exr"),
+                 "--frames", "1-3", "--camera", "/dev/stdin"]
+    piped = subprocess.run(arguments, input=camera_path("cycles_float_zip").read_text(),
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                           timeout=TOOL_TIMEOUT_S)
+    assert piped.returncode == 0, piped.stderr
+    from_file = tmp_path / "single.exr"
+    compute_ao(hbao_tool, "cycles_float_zip", from_file)
+    for frame in (1, 2, 3):
+        assert (tmp_path / f"p_{frame}.exr").read_bytes() == from_file.read_bytes()
+    missing = run_tool(hbao_tool, tmp_path / "in_#.exr", "-o", tmp_path / "m_#.exr", "--frames",
+                       "1-3", "--camera", tmp_path / "none.json")
+    assert_clean_error(missing, EXIT_RUNTIME, "none.json")
+    assert "frame" not in missing.stderr and not list(tmp_path.glob("m_*"))
+
+
 def test_sequence_redoes_frames_computed_with_another_camera(hbao_tool, tmp_path):
     """The camera file counts by what it holds, not by its time: adding a
     forgotten --camera, or naming another (older) file, recomputes."""
@@ -1096,6 +1177,7 @@ def test_a_frame_pattern_without_frames_gets_a_hint(hbao_tool, tmp_path):
     (["second.exr"], "more than one input"),
     (["--preview", ""], "empty"),
     (["--ao-channel", ""], "empty"),
+    (["--ao-channel", "A" * 256], "EXR allows 255"),
 ])
 def test_bad_flags_are_usage_errors(hbao_tool, tmp_path, arguments, fragment):
     completed = run_tool(hbao_tool, fixture_path("cycles_float_zip"), "-o", tmp_path / "o.exr",
@@ -1179,6 +1261,11 @@ def test_help_and_version(hbao_tool):
         assert flag in shown.stdout
     version = run_ok(hbao_tool, "--version").stdout
     assert version.startswith("hbao 0.3.0") and "libhbao 0.3.0" in version
+    # They win over everything else, a bad value of another flag too.
+    for arguments in (["--help", "--radius", "abc"], ["--radius", "abc", "-h"],
+                      ["x.exr", "--version", "--help"]):
+        assert run_ok(hbao_tool, *arguments).stdout == shown.stdout
+    assert run_ok(hbao_tool, "--steps", "0.5", "--version").stdout == version
 
 
 def test_info_json_is_valid_utf8_whatever_the_names_hold(hbao_tool, tmp_path):

@@ -287,6 +287,7 @@ static int check_chunks(exr_input *input, tool_error *error) {
         }
     }
     input->file_size = (int64_t)file_status.st_size;
+    input->file_status = file_status;
 fail:
     return status;
 }

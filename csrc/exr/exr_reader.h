@@ -11,6 +11,7 @@
 
 #include <openexr.h>
 #include <stdbool.h>
+#include <sys/stat.h>
 #include <stdint.h>
 
 #include "exr_stream.h"
@@ -30,7 +31,8 @@ typedef struct exr_input {
     float screen_window_width;
     exr_compression_t compression;
     exr_lineorder_t line_order;
-    int64_t file_size; /**< in bytes, when opened */
+    int64_t file_size;       /**< in bytes, when opened */
+    struct stat file_status; /**< the file as it was opened (device, inode, size, time) */
     int part_count;
     /** Threads exr_input_read decodes with (each part in bands of rows): 1
      *  after exr_input_open; the caller may raise it, up to

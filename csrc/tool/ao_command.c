@@ -37,6 +37,24 @@ static int refuse_overwriting_input(const char *output, const char *flag,
     return TOOL_EXIT_SUCCESS;
 }
 
+/* The input replaced or rewritten since it was opened (a render farm
+ * re-rendering the frame while its AO was computed): the AO is of the old
+ * render, and an output written now would be newer than the new one, so
+ * that a sequence's rerun would skip the frame. Nothing is written; a rerun
+ * computes it. */
+static int refuse_changed_input(const exr_input *input, tool_error *error) {
+    struct stat now;
+    const struct stat *then = &input->file_status;
+    if (stat(input->path, &now) == 0 && now.st_dev == then->st_dev && now.st_ino == then->st_ino &&
+        now.st_size == then->st_size && now.st_mtim.tv_sec == then->st_mtim.tv_sec &&
+        now.st_mtim.tv_nsec == then->st_mtim.tv_nsec)
+        return TOOL_EXIT_SUCCESS;
+    return tool_fail(error, TOOL_EXIT_RUNTIME,
+                     "%s changed while its AO was computed (re-rendered?); nothing written: "
+                     "run again",
+                     input->path);
+}
+
 /* Defaults, then the EXR header's pixel aspect, then the JSON file, then flags. */
 static int resolve_camera(const cli_options *options, const exr_input *input,
                           camera_settings *resolved, camera_settings *from_file,
@@ -50,7 +68,10 @@ static int resolve_camera(const cli_options *options, const exr_input *input,
         resolved->fields_set |= CAMERA_FIELD_PIXEL_ASPECT_X | CAMERA_FIELD_PIXEL_ASPECT_Y;
     }
     camera_settings_init(from_file);
-    if (options->camera_path != NULL) {
+    if (options->camera_file != NULL) {
+        *from_file = *options->camera_file;
+        camera_settings_apply(resolved, from_file);
+    } else if (options->camera_path != NULL) {
         int status = camera_json_load(options->camera_path, from_file, error);
         if (status != TOOL_EXIT_SUCCESS) return status;
         camera_settings_apply(resolved, from_file);
@@ -256,7 +277,9 @@ static int write_outputs(const cli_options *options, const exr_input *input,
             png_write_gray(files->png.fd, options->preview_path, ao + rows * input->width + columns,
                            window->max_x - window->min_x + 1, window->max_y - window->min_y + 1,
                            input->width, error);
-    /* Both files are complete: only now replace the destinations. */
+    /* Both files are complete: only now replace the destinations, unless the
+     * input changed while it was read. */
+    if (status == TOOL_EXIT_SUCCESS) status = refuse_changed_input(input, error);
     if (status == TOOL_EXIT_SUCCESS) status = atomic_file_commit(&files->exr, error);
     if (status == TOOL_EXIT_SUCCESS && options->preview_path != NULL)
         status = atomic_file_commit(&files->png, error);

@@ -8,6 +8,9 @@
 
 #include "number_parsing.h"
 
+/* The longest channel name an EXR may hold (OpenEXR's long names). */
+#define AO_CHANNEL_NAME_MAX 255
+
 typedef enum option_id {
     OPTION_OUTPUT,
     OPTION_LAYER,
@@ -201,6 +204,12 @@ static int apply_option(const option_spec *spec, const char *value, cli_options 
         case OPTION_AO_CHANNEL:
             if (value[0] == '\0')
                 return tool_fail(error, TOOL_EXIT_USAGE, "--ao-channel: the name is empty");
+            /* OpenEXR's longest channel name (its long-name header flag);
+             * found only at the write, after the whole computation */
+            if (strlen(value) > AO_CHANNEL_NAME_MAX)
+                return tool_fail(error, TOOL_EXIT_USAGE,
+                                 "--ao-channel: the name has %zu bytes; EXR allows %d",
+                                 strlen(value), AO_CHANNEL_NAME_MAX);
             options->ao_channel = value;
             break;
         case OPTION_KEEP_INPUT:
@@ -352,7 +361,7 @@ static int apply_option(const option_spec *spec, const char *value, cli_options 
         case OPTION_JSON:
             options->info_json = true;
             break;
-        case OPTION_HELP: /* handled after parsing */
+        case OPTION_HELP: /* asked_for_text, before parsing */
             break;
         case OPTION_VERSION:
             break;
@@ -438,10 +447,25 @@ static void options_init(cli_options *options) {
     camera_settings_init(&options->camera_flags);
 }
 
+/* --help (-h) or --version anywhere before "--": they win over everything
+ * else, a bad value of another flag too (hbao --radius abc --help). */
+static tool_mode asked_for_text(int argc, char **argv) {
+    bool version = false;
+    for (int i = 1; i < argc && strcmp(argv[i], "--") != 0; ++i) {
+        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) return TOOL_MODE_HELP;
+        version |= strcmp(argv[i], "--version") == 0;
+    }
+    return version ? TOOL_MODE_VERSION : TOOL_MODE_COMPUTE;
+}
+
 int cli_parse(int argc, char **argv, cli_options *options, tool_error *error) {
     options_init(options);
+    const tool_mode text = asked_for_text(argc, argv);
+    if (text != TOOL_MODE_COMPUTE) {
+        options->mode = text;
+        return TOOL_EXIT_SUCCESS;
+    }
     bool only_positionals = false;
-    bool wants_help = false, wants_version = false;
     for (int i = 1; i < argc; ++i) {
         const char *argument = argv[i];
         if (only_positionals || argument[0] != '-' || strcmp(argument, "-") == 0) {
@@ -482,16 +506,8 @@ int cli_parse(int argc, char **argv, cli_options *options, tool_error *error) {
         } else if (inline_value != NULL) {
             return tool_fail(error, TOOL_EXIT_USAGE, "--%s takes no value", spec->name);
         }
-        wants_help |= spec->id == OPTION_HELP;
-        wants_version |= spec->id == OPTION_VERSION;
         int status = apply_option(spec, value, options, error);
         if (status != TOOL_EXIT_SUCCESS) return status;
-    }
-
-    /* --help, then --version, win over everything else, as users expect. */
-    if (wants_help || wants_version) {
-        options->mode = wants_help ? TOOL_MODE_HELP : TOOL_MODE_VERSION;
-        return TOOL_EXIT_SUCCESS;
     }
 
     if (options->input_path == NULL)

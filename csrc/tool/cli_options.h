@@ -31,9 +31,13 @@ typedef struct cli_options {
     const char *output_path;
     const char *preview_path; /**< NULL: no PNG */
     const char *camera_path;  /**< NULL: no camera JSON */
-    const char *layer;        /**< NULL: first view layer with a Depth pass */
-    const char *back_layer;   /**< NULL: no back-face layer (hbao_compute_layers) */
-    const char *ao_channel;   /**< name of the output channel, "AO" by default */
+    /** What camera_path held, once read: a sequence reads the file once for
+     *  all its frames (a pipe can be read once only, and every frame gets the
+     *  same camera); NULL: each command reads it. */
+    const camera_settings *camera_file;
+    const char *layer;      /**< NULL: first view layer with a Depth pass */
+    const char *back_layer; /**< NULL: no back-face layer (hbao_compute_layers) */
+    const char *ao_channel; /**< name of the output channel, "AO" by default */
     bool keep_input;
     bool ignore_normals;
     bool crop_to_display; /**< write only the data window's part inside the display window */

@@ -3,6 +3,7 @@
 
 #include <png.h>
 #include <setjmp.h>
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -28,9 +29,11 @@ static void write_bytes(png_structp png, png_bytep data, size_t length) {
     size_t done = 0;
     while (done < length) {
         ssize_t written = write(sink->fd, data + done, length - done);
+        if (written < 0 && errno == EINTR) continue;
         if (written <= 0) {
             sink->failed = 1;
-            png_error(png, "write failed");
+            /* the reason (a full disk), not only that it failed */
+            png_error(png, written < 0 ? strerror(errno) : "write failed");
         }
         done += (size_t)written;
     }

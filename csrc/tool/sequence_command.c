@@ -11,6 +11,7 @@
 
 #include "ao_command.h"
 #include "atomic_file.h"
+#include "camera_json.h"
 #include "frame_pattern.h"
 #include "run_settings.h"
 
@@ -38,12 +39,16 @@ static bool newer_or_equal(const struct stat *a, const struct stat *b) {
  * output exists and is at least as new as the input and the camera file, the
  * preview at least as new as the EXR (ao_command writes it after the EXR, so
  * a preview left from before the EXR was last computed is stale), and the
- * EXR's header holds the settings this run would write (run_settings.h). */
+ * EXR's header holds the settings this run would write (run_settings.h).
+ * (An input re-rendered while its frame was computed gets no output:
+ * ao_command's refuse_changed_input.) */
 static bool up_to_date(const cli_options *frame) {
     struct stat input, output, other;
     if (stat(frame->input_path, &input) != 0 || stat(frame->output_path, &output) != 0 ||
         !S_ISREG(output.st_mode) || !newer_or_equal(&output, &input))
         return false;
+    /* an output that is its input: ao_command refuses it, --force or not */
+    if (output.st_dev == input.st_dev && output.st_ino == input.st_ino) return false;
     if (frame->camera_path != NULL &&
         (stat(frame->camera_path, &other) != 0 || !newer_or_equal(&output, &other)))
         return false;
@@ -51,7 +56,7 @@ static bool up_to_date(const cli_options *frame) {
         (stat(frame->preview_path, &other) != 0 || !newer_or_equal(&other, &output)))
         return false;
     char settings[RUN_SETTINGS_MAX];
-    return run_settings_text(frame, NULL, settings) &&
+    return run_settings_text(frame, frame->camera_file, settings) &&
            run_settings_match(frame->output_path, settings);
 }
 
@@ -179,6 +184,16 @@ int sequence_command(const cli_options *options, tool_error *error) {
         run.outcomes[i].frame = frame_list_at(&options->frames, i);
 
     cli_options shared = *options;
+    camera_settings camera_file;
+    if (options->camera_path != NULL) {
+        camera_settings_init(&camera_file);
+        const int status = camera_json_load(options->camera_path, &camera_file, error);
+        if (status != TOOL_EXIT_SUCCESS) {
+            free(run.outcomes);
+            return status;
+        }
+        shared.camera_file = &camera_file;
+    }
     int jobs = options->jobs < 1 ? 1 : options->jobs;
     if (jobs > run.count) jobs = (int)run.count;
     /* Frames at once share the cores: each frame's computation gets its
