@@ -10,6 +10,7 @@ scripts/setup_bpy.sh installs. Marked `ui` as well, it runs only where
 Blender has a user interface (Debian's, under Xvfb). Other tests get Debian's
 blender. The summary at the end counts the results per Blender."""
 import collections
+import contextlib
 import os
 import shutil
 import signal
@@ -67,6 +68,20 @@ def hbao_tool():
     if not TOOL.exists():
         pytest.fail(f"{TOOL} missing: build with scripts/test.sh or cmake first")
     return TOOL
+
+
+@contextlib.contextmanager
+def small_tmpfs(folder, size):
+    """`folder` (made here) as a tmpfs of `size` ("64k"), for a full disk:
+    unmounted after the block. Needs root, as the test machines have."""
+    folder.mkdir()
+    mounted = subprocess.run(["mount", "-t", "tmpfs", "-o", f"size={size}", "tmpfs", str(folder)],
+                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    assert mounted.returncode == 0, f"cannot mount a tmpfs (root needed): {mounted.stdout}"
+    try:
+        yield folder
+    finally:
+        subprocess.run(["umount", str(folder)], check=False)
 
 
 @pytest.fixture(scope="session")

@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import FIXTURES, REPO, SCRIPTS
+from conftest import FIXTURES, REPO, SCRIPTS, small_tmpfs
 
 # Every fixture that holds a Depth pass, with the view layer the tool picks.
 DEPTH_FIXTURES = ["cycles_float_zip", "cycles_half_piz", "cycles_float_none", "cycles_half_b44",
@@ -716,20 +716,13 @@ def test_a_preview_on_a_full_disk_says_why(hbao_tool, tmp_path):
     """The preview's write fails with ENOSPC on a full file system (a tmpfs
     of two pages, filled): its message gives the reason, as the EXR's does,
     nothing is committed and no temporary file is left."""
-    folder = tmp_path / "full"
-    folder.mkdir()
-    mounted = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=8k", "tmpfs", str(folder)],
-                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    assert mounted.returncode == 0, f"cannot mount a tmpfs (root needed): {mounted.stdout}"
-    try:
+    with small_tmpfs(tmp_path / "full", "8k") as folder:
         (folder / "filler").write_bytes(b"x" * 8192)
         completed = run_tool(hbao_tool, fixture_path("cycles_float_zip"), "-o",
                              tmp_path / "ao.exr", "--preview", folder / "ao.png", "--no-normals")
         assert_clean_error(completed, EXIT_RUNTIME, "ao.png", "No space left on device")
         assert not (tmp_path / "ao.exr").exists()
         assert sorted(p.name for p in folder.iterdir()) == ["filler"]
-    finally:
-        subprocess.run(["umount", str(folder)], check=False)
 
 
 def test_character_device_output_is_written_through(hbao_tool, tmp_path):

@@ -10,7 +10,7 @@ import subprocess
 import numpy as np
 import pytest
 
-from conftest import EXR_LIBRARY, REPO, run_command
+from conftest import EXR_LIBRARY, REPO, run_command, small_tmpfs
 from test_addon import EXACT, exr, library_ao, node_outputs, node_params, render
 
 pytestmark = pytest.mark.matrix
@@ -140,15 +140,8 @@ def test_file_reopened_without_the_add_on_renders_without_ao(
 def full_disk(tmp_path):
     """A 64 KiB tmpfs as the add-on's scratch folder: the Render Result of the
     test scene (about 200 KiB uncompressed) does not fit."""
-    folder = tmp_path / "full"
-    folder.mkdir()
-    mounted = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs", str(folder)],
-                             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    assert mounted.returncode == 0, f"cannot mount a tmpfs (root needed): {mounted.stdout}"
-    try:
+    with small_tmpfs(tmp_path / "full", "64k") as folder:
         yield folder
-    finally:
-        subprocess.run(["umount", str(folder)], check=False)
 
 
 def render_with_scratch_folder(run_in_blender, tmp_path, folder):
