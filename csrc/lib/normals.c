@@ -238,12 +238,25 @@ static HBAO_ALWAYS_INLINE void given_normals_row(const normal_job *job, int j) {
         float wx[CHUNK], wy[CHUNK], wz[CHUNK], z[CHUNK];
         float nx[CHUNK], ny[CHUNK], nz[CHUNK];
         int usable[CHUNK];
-        for (int k = 0; k < count; k++) {
-            const float *w = source_row + (int64_t)(i0 + k) * pixel_step;
-            wx[k] = w[0];
-            wy[k] = w[1];
-            wz[k] = w[2];
-            z[k] = depth_row[i0 + k];
+        if (count == CHUNK && pixel_step == 3) {
+            /* x, y, z interleaved (a numpy array, an EXR read) at full
+             * resolution: with the stride a constant, the compiler reads
+             * whole vectors and shuffles them, not a float at a time */
+            const float *w = source_row + (int64_t)i0 * 3;
+            for (int k = 0; k < CHUNK; k++) {
+                wx[k] = w[3 * k];
+                wy[k] = w[3 * k + 1];
+                wz[k] = w[3 * k + 2];
+                z[k] = depth_row[i0 + k];
+            }
+        } else {
+            for (int k = 0; k < count; k++) {
+                const float *w = source_row + (int64_t)(i0 + k) * pixel_step;
+                wx[k] = w[0];
+                wy[k] = w[1];
+                wz[k] = w[2];
+                z[k] = depth_row[i0 + k];
+            }
         }
         for (int k = 0; k < count; k++) {
             /* the camera-space normal, unit length */

@@ -593,6 +593,42 @@ TEST_CASE(bottom_up_rows_with_negative_stride) {
     free(normal);
 }
 
+/* Normals read as x, y, z three floats apart (normals.c's vector read of a
+ * whole chunk) or in any other layout (four floats a pixel, rows bottom-up,
+ * a row shorter than a chunk): the same AO, to the bit. */
+TEST_CASE(normal_layouts_give_the_same_ao) {
+    const int sizes[2][2] = {{203, 157}, {40, 30}}; /* chunks and a tail; a row in one tail */
+    for (int s = 0; s < 2; s++) {
+        scene_view view;
+        float *depth, *normal;
+        render_standard_view(boxes_scene(), sizes[s][0], sizes[s][1], &view, &depth, &normal);
+        const int w = view.width, h = view.height;
+        float *rgba = malloc((size_t)w * h * 4 * sizeof(float));
+        for (int j = 0; j < h; j++)
+            for (int i = 0; i < w; i++)
+                for (int c = 0; c < 4; c++)
+                    rgba[4 * ((size_t)(h - 1 - j) * w + i) + c] =
+                        c < 3 ? normal[3 * ((size_t)j * w + i) + c] : 1.0f;
+        for (int half = 0; half < 2; half++) {
+            hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+            p.half_resolution = half;
+            float *packed = run(&p, &view, depth, normal);
+            float *ao = malloc((size_t)w * h * sizeof(float));
+            const hbao_channel d = {depth, 1, w};
+            const hbao_channel n = {rgba + 4 * (size_t)(h - 1) * w, 4, -4 * (int64_t)w};
+            CHECK_RESULT(hbao_compute(&p, &view.camera, w, h, &d, &n, ao, w), HBAO_SUCCESS);
+            int mismatches = 0;
+            for (int k = 0; k < w * h; k++) mismatches += ao[k] != packed[k];
+            CHECK(mismatches == 0);
+            free(ao);
+            free(packed);
+        }
+        free(rgba);
+        free(depth);
+        free(normal);
+    }
+}
+
 /* --- stages ---------------------------------------------------------------- */
 
 TEST_CASE(half_resolution_is_close_to_full) {
@@ -1433,9 +1469,9 @@ TEST_MAIN(TEST_ENTRY(plane_facing_camera_is_unoccluded), TEST_ENTRY(tilted_plane
           TEST_ENTRY(random_and_degenerate_inputs_give_finite_ao_in_range),
           TEST_ENTRY(identical_output_for_any_thread_count),
           TEST_ENTRY(bottom_up_rows_with_negative_stride),
-          TEST_ENTRY(half_resolution_is_close_to_full), TEST_ENTRY(blur_keeps_depth_edges),
-          TEST_ENTRY(strength_is_a_power), TEST_ENTRY(background_never_occludes),
-          TEST_ENTRY(tiny_projected_radius_gives_one),
+          TEST_ENTRY(normal_layouts_give_the_same_ao), TEST_ENTRY(half_resolution_is_close_to_full),
+          TEST_ENTRY(blur_keeps_depth_edges), TEST_ENTRY(strength_is_a_power),
+          TEST_ENTRY(background_never_occludes), TEST_ENTRY(tiny_projected_radius_gives_one),
           TEST_ENTRY(simd_paths_match_scalar_reference_bit_for_bit),
           TEST_ENTRY(thin_occluders_do_not_darken_what_is_behind_them),
           TEST_ENTRY(back_face_layer_lets_light_pass_behind_a_thin_plate),
