@@ -232,7 +232,7 @@ def test_render_single_layer_passes_image_through_and_says_so(run_in_blender, tm
 
 @pytest.mark.parametrize("prepare, said, short", [
     ("layer_not_rendered", "which is not rendered (its Use for Rendering is off); AO off",
-     "Depth: layer not rendered, AO off"),
+     "Depth: not rendered, AO off"),
     ("mute_render_layers", "Depth comes from a muted Render Layers node", "Depth: muted, AO off"),
 ])
 def test_passes_that_blender_does_not_render_turn_the_ao_off_and_say_why(

@@ -110,6 +110,19 @@ def test_status_line_follows_each_f12_render(run_blender, tmp_path):
     assert statuses == {0: "", 1: "Depth not linked: AO off", 2: ""}, statuses
 
 
+def test_render_single_layer_switched_in_the_session(run_blender, tmp_path):
+    """Render Single Layer switched on in a session: the add-on unlinks the
+    node from its helper's pass before F12 (whose thread may not edit the
+    tree), the render says why there is no AO, and switched off again the
+    link comes back."""
+    completed = run_blender(SCRIPTS / "ui_single_layer.py", tmp_path / "single", ui=True)
+    log = completed.stdout
+    assert "SINGLE LAYER: DONE" in log, log[-3000:]
+    links = [line.split()[1:] for line in log.splitlines() if line.startswith("LINKED ")]
+    assert links == [["before", "True"], ["on", "False"], ["off", "True"]], log[-3000:]
+    assert 'STATUS "Single Layer on: AO off"' in log, log[-3000:]
+
+
 def test_recompositing_follows_new_settings_without_a_render(run_blender, tmp_path):
     """With the compositor open as an artist has it: after F12, a node's Radius
     quadrupled; the add-on's timer renders the helper alone from the kept

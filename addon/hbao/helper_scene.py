@@ -91,6 +91,13 @@ def _find_or_make_helper_scene(scene):
     return helper, True
 
 
+def _owner(helper, scene):
+    """The scene whose settings the helper follows between renders: the one
+    it was made for, while that one still uses it; else `scene`."""
+    owner = main_scene_of(helper)
+    return owner if owner is not None and serves(helper, owner) else scene
+
+
 def _configure_helper_scene(scene, helper, restructured):
     """Settings, camera and objects of `helper`, once the managed node of
     `scene`'s tree points at it. `restructured`: objects linked or unlinked,
@@ -101,9 +108,7 @@ def _configure_helper_scene(scene, helper, restructured):
     # so that syncing scenes that share its tree does not flip its settings
     # back and forth (each change would trigger another sync). A render
     # copies its own scene's settings (record_rendering).
-    owner = main_scene_of(helper)
-    if owner is None or not serves(helper, owner):
-        owner = scene
+    owner = _owner(helper, scene)
     # The name, not a pointer (see the module's text); also replaces the
     # pointer of a file saved by an older add-on, and follows a renamed scene.
     if helper.library is None and helper.get(MAIN_SCENE_KEY) != owner.name:
@@ -233,7 +238,10 @@ def sync(scene):
         tree.nodes.remove(managed_node(tree))
     rlayers = _ensure_managed_node(tree, nodes, helper)
     _configure_helper_scene(scene, helper, new)
-    linked = helper_render_settings.helper_renders(scene)
+    # By the owner's setting, as the helper's settings: scenes that share the
+    # tree (5.x) and differ would flip the links at each sync, and each flip
+    # schedules another.
+    linked = helper_render_settings.helper_renders(_owner(helper, scene))
     for node in nodes:
         output = rlayers.outputs.get(pass_name(node))
         target = node.inputs.get(AO_PASS_INPUT)

@@ -45,13 +45,13 @@ def pass_source(socket, scene, expected):
     view_layer = (node.scene or scene).view_layers.get(node.layer)
     if view_layer is not None and not view_layer.use:
         return (None, f"{socket.name} comes from view layer {node.layer!r}, which is not rendered "
-                "(its Use for Rendering is off)", "layer not rendered")
+                "(its Use for Rendering is off)", "not rendered")
     longest = handover.longest_layer_name(expected)
     if longest is not None and len(node.layer.encode()) > longest:
         return (None, f"{socket.name} comes from view layer {node.layer!r}, whose name is too "
                 f"long for this Blender's EXR files: its {expected} pass cannot be read back "
                 f"(Blender before 5.0 cuts channel names at {compat.EXR_CHANNEL_NAME_MAX} "
-                f"bytes; rename the layer to at most {longest})", "layer name too long")
+                f"bytes; rename the layer to at most {longest})", "name too long")
     return node.layer, None, None
 
 
