@@ -1019,6 +1019,11 @@ def test_sequence_reads_the_camera_file_once(hbao_tool, tmp_path):
                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                            timeout=TOOL_TIMEOUT_S)
     assert piped.returncode == 0, piped.stderr
+    # A pipe's time is when it was written: a rerun goes by what it holds.
+    again = subprocess.run(arguments, input=camera_path("cycles_float_zip").read_text(),
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                           timeout=TOOL_TIMEOUT_S)
+    assert again.returncode == 0 and again.stderr.count("up to date, skipped") == 3, again.stderr
     from_file = tmp_path / "single.exr"
     compute_ao(hbao_tool, "cycles_float_zip", from_file)
     for frame in (1, 2, 3):
@@ -1259,6 +1264,10 @@ def test_help_and_version(hbao_tool):
                       ["x.exr", "--version", "--help"]):
         assert run_ok(hbao_tool, *arguments).stdout == shown.stdout
     assert run_ok(hbao_tool, "--steps", "0.5", "--version").stdout == version
+    # A flag's value that reads like them is a value: no help, no success.
+    as_value = run_tool(hbao_tool, fixture_path("cycles_float_zip"), "-o", "out.exr", "--layer",
+                        "-h")
+    assert_clean_error(as_value, EXIT_RUNTIME, 'no layer "-h"')
 
 
 def test_info_json_is_valid_utf8_whatever_the_names_hold(hbao_tool, tmp_path):

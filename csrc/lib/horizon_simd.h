@@ -877,7 +877,7 @@ static VF SIMD_NAME(direction_occlusion_hbao_layers)(const hbao_settings *s,
  * 1, defaults 0.954 on 1 thread, 0.948-0.972 on 2, 8 x 6 + blur 15 0.951
  * (docs/speed.md, session 24). The AVX-512 copy pairs up to 16 as well
  * (12 KiB), with SIMD_PREFETCH_STEPS 1: bench_ab, 1080p, Intel Xeon with
- * AVX-512 (session 25), defaults 0.956-0.963 on 1 thread, 0.949-0.959 on
+ * AVX-512 (session 25), defaults 0.938-0.963 on 1 thread, 0.949-0.959 on
  * 2, half resolution 0.986 and 0.970, 8 x 6 + blur 15 0.908 and 0.921, 4K
  * 0.916. Either alone did less (pairs 1.008 at the defaults, the prefetch
  * 1.044 at half resolution). Session 11 had measured an older form of

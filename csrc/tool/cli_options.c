@@ -447,13 +447,32 @@ static void options_init(cli_options *options) {
     camera_settings_init(&options->camera_flags);
 }
 
-/* --help (-h) or --version anywhere before "--": they win over everything
- * else, a bad value of another flag too (hbao --radius abc --help). */
+/* The option an argument that starts with '-' names (NULL: none), and in
+ * *inline_value the value given with '=' (NULL: none). */
+static const option_spec *option_of(const char *argument, const char **inline_value) {
+    *inline_value = NULL;
+    if (argument[1] == '-') {
+        const char *name = argument + 2;
+        const char *equals = strchr(name, '=');
+        if (equals != NULL) *inline_value = equals + 1;
+        return find_long_option(name, equals ? (size_t)(equals - name) : strlen(name));
+    }
+    return argument[2] == '\0' ? find_short_option(argument[1]) : NULL;
+}
+
+/* --help (-h) or --version given as an option anywhere before "--": they
+ * win over everything else, a bad value of another flag too (hbao --radius
+ * abc --help). A flag's value that reads "-h" (--layer -h) is a value. */
 static tool_mode asked_for_text(int argc, char **argv) {
     bool version = false;
     for (int i = 1; i < argc && strcmp(argv[i], "--") != 0; ++i) {
-        if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) return TOOL_MODE_HELP;
-        version |= strcmp(argv[i], "--version") == 0;
+        if (argv[i][0] != '-' || strcmp(argv[i], "-") == 0) continue;
+        const char *inline_value;
+        const option_spec *spec = option_of(argv[i], &inline_value);
+        if (spec == NULL) continue;
+        if (spec->id == OPTION_HELP) return TOOL_MODE_HELP;
+        version |= spec->id == OPTION_VERSION;
+        if (spec->takes_value && inline_value == NULL) ++i; /* its value, whatever it reads */
     }
     return version ? TOOL_MODE_VERSION : TOOL_MODE_COMPUTE;
 }
@@ -480,17 +499,8 @@ int cli_parse(int argc, char **argv, cli_options *options, tool_error *error) {
             only_positionals = true;
             continue;
         }
-        const option_spec *spec = NULL;
-        const char *inline_value = NULL;
-        if (argument[1] == '-') {
-            const char *name = argument + 2;
-            const char *equals = strchr(name, '=');
-            size_t length = equals ? (size_t)(equals - name) : strlen(name);
-            spec = find_long_option(name, length);
-            if (equals != NULL) inline_value = equals + 1;
-        } else if (argument[2] == '\0') {
-            spec = find_short_option(argument[1]);
-        }
+        const char *inline_value;
+        const option_spec *spec = option_of(argument, &inline_value);
         if (spec == NULL)
             return tool_fail(error, TOOL_EXIT_USAGE, "unknown option %s (see hbao --help)",
                              argument);
@@ -567,7 +577,9 @@ void cli_print_help(FILE *stream) {
         "  -o, --output FILE       output EXR (required). Written to a temporary file\n"
         "                          .hbao-tmp-XXXXXX next to it and renamed over it when\n"
         "                          complete, so it appears whole or not at all; never the\n"
-        "                          input. A symbolic link is followed: its target is\n"
+        "                          input, the --camera file or the preview. An input\n"
+        "                          changed while its AO was computed gets no output\n"
+        "                          (exit 1). A symbolic link is followed: its target is\n"
         "                          replaced, the link kept. A FIFO or character device\n"
         "                          (/dev/null, /dev/stdout) is written through, never\n"
         "                          replaced; a reader that closes its end early is a\n"
@@ -671,8 +683,9 @@ void cli_print_help(FILE *stream) {
         "                          contents (its header's hbaoSettings), with a --preview\n"
         "                          at least as new as itself, is up to date and skipped.\n"
         "                          An output or preview name that is another listed\n"
-        "                          frame's input is refused (exit 2) before any frame\n"
-        "                          runs. One progress line per frame; every frame is\n"
+        "                          frame's input, output or preview is refused (exit 2)\n"
+        "                          before any frame runs; the camera file is read once.\n"
+        "                          One progress line per frame; every frame is\n"
         "                          attempted, and the exit status is 1 (2 for a usage\n"
         "                          error in a frame) when any failed, with the list of\n"
         "                          failed frames.\n"

@@ -49,8 +49,11 @@ static bool up_to_date(const cli_options *frame) {
         return false;
     /* an output that is its input: ao_command refuses it, --force or not */
     if (output.st_dev == input.st_dev && output.st_ino == input.st_ino) return false;
+    /* a camera file by its time too; a pipe's (--camera /dev/stdin) is the
+     * time it was written to: by what it holds only (the settings below) */
     if (frame->camera_path != NULL &&
-        (stat(frame->camera_path, &other) != 0 || !newer_or_equal(&output, &other)))
+        (stat(frame->camera_path, &other) != 0 ||
+         (S_ISREG(other.st_mode) && !newer_or_equal(&output, &other))))
         return false;
     if (frame->preview_path != NULL &&
         (stat(frame->preview_path, &other) != 0 || !newer_or_equal(&other, &output)))
