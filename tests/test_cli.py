@@ -1087,9 +1087,10 @@ def test_sequence_refuses_an_output_that_is_another_frames_input(hbao_tool, tmp_
     for frame in range(1, 11):
         shutil.copyfile(fixture_path("cycles_float_zip"), tmp_path / f"f_{frame}.exr")
     before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
-    completed = run_tool(hbao_tool, tmp_path / "f_#.exr", "-o", tmp_path / "f_#0.exr",
-                         "--frames", "1-10", "--no-normals")
-    assert_clean_error(completed, EXIT_USAGE, "-o of frame 1", "is the input of frame 10")
+    for output in (tmp_path / "f_#0.exr", f"{tmp_path}/./f_#0.exr"):  # by the file
+        completed = run_tool(hbao_tool, tmp_path / "f_#.exr", "-o", output, "--frames", "1-10",
+                             "--no-normals")
+        assert_clean_error(completed, EXIT_USAGE, "-o of frame 1", "is the input of frame 10")
     previews = run_tool(hbao_tool, tmp_path / "f_#.exr", "-o", tmp_path / "ao_#.exr",
                         "--preview", tmp_path / "f_1#.exr", "--frames", "1-12", "--no-normals")
     assert_clean_error(previews, EXIT_USAGE, "--preview of frame 1 ", "is the input of frame 11")
@@ -1112,9 +1113,10 @@ def test_sequence_refuses_outputs_that_are_another_frames_or_its_own(hbao_tool, 
     for frame in (1, 2, 10):
         shutil.copyfile(fixture_path("cycles_float_zip"), tmp_path / f"in_{frame}.exr")
     before = sorted(p.name for p in tmp_path.iterdir())
-    crossed = run_tool(hbao_tool, tmp_path / "in_#.exr", "-o", tmp_path / "o_#.exr",
-                       "--preview", tmp_path / "o_#0.exr", "--frames", "1-2,10", "--no-normals")
-    assert_clean_error(crossed, EXIT_USAGE, "--preview of frame 1 ", "is the -o of frame 10")
+    for preview in (tmp_path / "o_#0.exr", f"{tmp_path}/./o_#0.exr"):  # by the file, not the name
+        crossed = run_tool(hbao_tool, tmp_path / "in_#.exr", "-o", tmp_path / "o_#.exr",
+                           "--preview", preview, "--frames", "1-2,10", "--no-normals")
+        assert_clean_error(crossed, EXIT_USAGE, "--preview of frame 1 ", "is the -o of frame 10")
     own = run_tool(hbao_tool, tmp_path / "in_#.exr", "-o", tmp_path / "x_#.exr", "--preview",
                    f"{tmp_path}/./x_#.exr", "--frames", "1-2", "--no-normals")
     assert own.returncode == EXIT_USAGE and own.stderr.count("name the same file") == 2, own.stderr

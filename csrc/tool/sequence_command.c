@@ -1,4 +1,5 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
+#define _DEFAULT_SOURCE /* realpath */
 #include "sequence_command.h"
 
 #include <limits.h>
@@ -147,8 +148,32 @@ static int summarize(const sequence_run *run, tool_error *error) {
  * (-o 'o_#.exr' --preview 'o_#0.exr'). Each frame refuses its own input
  * and a preview that is its own output (ao_command); this refuses the
  * others', by name, before any frame runs. */
+/* `pattern` with its folder made canonical (realpath), so that names of one
+ * file compare equal ("./o_#.exr" and "o_#.exr"); as given where the folder
+ * holds the '#' run or cannot be resolved. */
+static const char *canonical_pattern(const char *pattern, char out[PATH_MAX]) {
+    if (pattern == NULL) return NULL;
+    const char *slash = strrchr(pattern, '/');
+    char folder[PATH_MAX], real[PATH_MAX];
+    const int length = slash == NULL ? 0 : (int)(slash - pattern);
+    if (slash != NULL && (memchr(pattern, '#', (size_t)length) != NULL || length >= PATH_MAX))
+        return pattern;
+    if (slash == NULL)
+        strcpy(folder, ".");
+    else if (slash == pattern)
+        strcpy(folder, "/");
+    else
+        snprintf(folder, sizeof folder, "%.*s", length, pattern);
+    if (realpath(folder, real) == NULL) return pattern;
+    const int written = snprintf(out, PATH_MAX, "%s/%s", real, slash ? slash + 1 : pattern);
+    return written > 0 && written < PATH_MAX ? out : pattern;
+}
+
 static int refuse_other_frames_files(const cli_options *options, int64_t count, tool_error *error) {
-    const char *patterns[2] = {options->output_path, options->preview_path};
+    char canonical[3][PATH_MAX];
+    const char *input = canonical_pattern(options->input_path, canonical[0]);
+    const char *patterns[2] = {canonical_pattern(options->output_path, canonical[1]),
+                               canonical_pattern(options->preview_path, canonical[2])};
     const char *flags[2] = {"-o", "--preview"};
     char path[PATH_MAX];
     for (int64_t i = 0; i < count; ++i) {
@@ -157,7 +182,7 @@ static int refuse_other_frames_files(const cli_options *options, int64_t count, 
             if (patterns[k] == NULL || !frame_pattern_path(patterns[k], frame, path, sizeof path))
                 continue;
             int32_t other;
-            if (frame_pattern_frame(options->input_path, path, &other) && other != frame &&
+            if (frame_pattern_frame(input, path, &other) && other != frame &&
                 frame_list_contains(&options->frames, other))
                 return tool_fail(error, TOOL_EXIT_USAGE,
                                  "%s of frame %d (%s) is the input of frame %d: it would be "
