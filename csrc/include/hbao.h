@@ -302,8 +302,9 @@ typedef enum hbao_param_field {
  * nearest limit and their bits (hbao_param_field) set in *clamped_fields, so
  * the caller can warn; negative threads become 0 (one per core) and a
  * non-zero half_resolution becomes 1, without a bit. Values that have no
- * nearest legal value (NaN or infinite floats, a negative radius or
- * thickness, a background_depth <= 0, unknown enum values) give
+ * nearest legal value (NaN, infinite floats but a background_depth of
+ * +infinity, a negative radius or thickness, a background_depth <= 0,
+ * unknown enum values) give
  * HBAO_ERROR_INVALID_PARAMETER, and then *clamped_fields holds the bits of
  * those invalid fields instead and *out is unchanged. `out` may be `in`;
  * clamped_fields may be NULL.

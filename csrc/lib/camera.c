@@ -167,21 +167,24 @@ hbao_result hbao_camera_crop(const hbao_camera *camera, int32_t full_width, int3
      * widths; the crop's own plane puts them at -width / 2 + shift * viewfac. */
     const double left = full.left + x;
     const double bottom = full.bottom + full.ycor * ((double)full_height - y - height);
-    const double sensor_size = full.sensor_size * scale;
-    const double ortho_scale = camera->ortho_scale * scale;
+    /* Only the projection's own size is scaled and checked: the other one
+     * (a perspective camera's ortho scale, an orthographic one's sensor)
+     * is unused, as hbao_validate_camera and hbao_compute take it. */
+    const int orthographic = camera->projection == HBAO_PROJECTION_ORTHOGRAPHIC;
+    const double size = orthographic ? camera->ortho_scale * scale : full.sensor_size * scale;
     const double shift_x = (left + 0.5 * width) / crop_viewfac;
     const double shift_y = (bottom + 0.5 * full.ycor * height) / crop_viewfac;
-    if (!fits_float(sensor_size) || !fits_float(ortho_scale) || !fits_float(shift_x) ||
-        !fits_float(shift_y))
+    if (!fits_float(size) || !fits_float(shift_x) || !fits_float(shift_y))
         return HBAO_ERROR_INVALID_CAMERA;
 
     hbao_camera out = *camera;
     out.sensor_fit = full.horizontal_fit ? HBAO_SENSOR_FIT_HORIZONTAL : HBAO_SENSOR_FIT_VERTICAL;
-    if (full.horizontal_fit)
-        out.sensor_width = (float)sensor_size;
+    if (orthographic)
+        out.ortho_scale = (float)size;
+    else if (full.horizontal_fit)
+        out.sensor_width = (float)size;
     else
-        out.sensor_height = (float)sensor_size;
-    out.ortho_scale = (float)ortho_scale;
+        out.sensor_height = (float)size;
     out.shift_x = (float)shift_x;
     out.shift_y = (float)shift_y;
     /* A sensor or ortho scale scaled below float's range is not a camera. */

@@ -38,8 +38,12 @@ static int stride_fits(int32_t pixel_stride, int64_t row_stride, int width, int 
     if (pixel_stride < channels) return 0;
     if (height == 1) return 1;
     const int64_t row_extent = (int64_t)(width - 1) * pixel_stride + channels;
-    const int64_t magnitude = row_stride < 0 ? -row_stride : row_stride;
-    return magnitude >= row_extent;
+    /* unsigned: -INT64_MIN does not fit int64_t */
+    const uint64_t magnitude = row_stride < 0 ? 0u - (uint64_t)row_stride : (uint64_t)row_stride;
+    /* and the whole channel, (height - 1) strides and a row, within int64_t's
+     * offsets (INT64_MIN's magnitude is not) */
+    return magnitude >= (uint64_t)row_extent &&
+           magnitude <= ((uint64_t)INT64_MAX - (uint64_t)row_extent) / (uint64_t)(height - 1);
 }
 
 typedef struct depth_job {

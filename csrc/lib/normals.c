@@ -222,6 +222,14 @@ static void fallback_normal(const normal_job *job, int i, int j) {
  * that is background, is marked for fallback_normal. */
 #define CHUNK 64
 
+/* 2^-64 for a vector with a component past 2^62, whose squares could
+ * overflow float; else 1 (NaN too: the length test refuses it). */
+static HBAO_ALWAYS_INLINE float shrink_factor(float x, float y, float z) {
+    const float ax = fabsf(x), ay = fabsf(y), az = fabsf(z);
+    const float largest = ax > ay ? (ax > az ? ax : az) : (ay > az ? ay : az);
+    return largest > 0x1p62f ? 0x1p-64f : 1.0f;
+}
+
 static HBAO_ALWAYS_INLINE void given_normals_row(const normal_job *job, int j) {
     hbao_grid *grid = job->grid;
     const hbao_channel *given = job->given;
@@ -259,11 +267,19 @@ static HBAO_ALWAYS_INLINE void given_normals_row(const normal_job *job, int j) {
             }
         }
         for (int k = 0; k < count; k++) {
-            /* the camera-space normal, unit length */
-            const float world_length = sqrtf(wx[k] * wx[k] + wy[k] * wy[k] + wz[k] * wz[k]);
-            const float n0 = m[0] * wx[k] + m[1] * wy[k] + m[2] * wz[k];
-            const float n1 = m[4] * wx[k] + m[5] * wy[k] + m[6] * wz[k];
-            const float n2 = m[8] * wx[k] + m[9] * wy[k] + m[10] * wz[k];
+            /* the camera-space normal, unit length. A finite normal of any
+             * length: one whose squares would overflow (a component past
+             * 2^62), or that the matrix makes so long, is scaled by 2^-64
+             * first, exactly, which leaves its direction's floats as they
+             * are (and its length above HBAO_MIN_NORMAL_LENGTH). */
+            const float w_shrink = shrink_factor(wx[k], wy[k], wz[k]);
+            const float w0 = wx[k] * w_shrink, w1 = wy[k] * w_shrink, w2 = wz[k] * w_shrink;
+            const float world_length = sqrtf(w0 * w0 + w1 * w1 + w2 * w2);
+            const float t0 = m[0] * w0 + m[1] * w1 + m[2] * w2;
+            const float t1 = m[4] * w0 + m[5] * w1 + m[6] * w2;
+            const float t2 = m[8] * w0 + m[9] * w1 + m[10] * w2;
+            const float n_shrink = shrink_factor(t0, t1, t2);
+            const float n0 = t0 * n_shrink, n1 = t1 * n_shrink, n2 = t2 * n_shrink;
             const float length = sqrtf(n0 * n0 + n1 * n1 + n2 * n2);
             const float inverse = 1.0f / length;
             const float u0 = n0 * inverse, u1 = n1 * inverse, u2 = n2 * inverse;

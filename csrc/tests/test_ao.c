@@ -629,6 +629,42 @@ TEST_CASE(normal_layouts_give_the_same_ao) {
     }
 }
 
+/* A given normal of any finite length is used: scaled by a power of two
+ * (exact), by itself or through the matrix (a world of another unit), the
+ * AO is the same to the bit, also where its squares overflow float. */
+TEST_CASE(normals_of_any_finite_length_give_the_same_ao) {
+    scene_view view;
+    float *depth, *normal;
+    render_standard_view(boxes_scene(), 96, 64, &view, &depth, &normal);
+    const size_t values = (size_t)view.width * view.height * 3;
+    float *scaled = malloc(values * sizeof(float));
+    hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+    float *reference = run(&p, &view, depth, normal);
+    /* (normal scale, matrix scale) as powers of two: the matrix's rotation
+     * rows may be up to 1e15 long (camera.c) */
+    const int exponents[][2] = {{40, 0}, {63, 0}, {64, 0}, {100, 0}, {126, 0}, {20, 49}, {70, 49}};
+    for (size_t e = 0; e < sizeof exponents / sizeof exponents[0]; e++) {
+        for (size_t k = 0; k < values; k++) scaled[k] = ldexpf(normal[k], exponents[e][0]);
+        scene_view wide = view;
+        for (int r = 0; r < 3; r++)
+            for (int c = 0; c < 3; c++)
+                wide.camera.world_to_camera[4 * r + c] =
+                    ldexpf(view.camera.world_to_camera[4 * r + c], exponents[e][1]);
+        float *ao = run(&p, &wide, depth, scaled);
+        int mismatches = 0;
+        for (int k = 0; k < view.width * view.height; k++) mismatches += ao[k] != reference[k];
+        if (mismatches != 0)
+            printf("  normals 2^%d, matrix 2^%d: %d pixels differ\n", exponents[e][0],
+                   exponents[e][1], mismatches);
+        CHECK(mismatches == 0);
+        free(ao);
+    }
+    free(reference);
+    free(scaled);
+    free(depth);
+    free(normal);
+}
+
 /* --- stages ---------------------------------------------------------------- */
 
 TEST_CASE(half_resolution_is_close_to_full) {
@@ -1469,9 +1505,11 @@ TEST_MAIN(TEST_ENTRY(plane_facing_camera_is_unoccluded), TEST_ENTRY(tilted_plane
           TEST_ENTRY(random_and_degenerate_inputs_give_finite_ao_in_range),
           TEST_ENTRY(identical_output_for_any_thread_count),
           TEST_ENTRY(bottom_up_rows_with_negative_stride),
-          TEST_ENTRY(normal_layouts_give_the_same_ao), TEST_ENTRY(half_resolution_is_close_to_full),
-          TEST_ENTRY(blur_keeps_depth_edges), TEST_ENTRY(strength_is_a_power),
-          TEST_ENTRY(background_never_occludes), TEST_ENTRY(tiny_projected_radius_gives_one),
+          TEST_ENTRY(normal_layouts_give_the_same_ao),
+          TEST_ENTRY(normals_of_any_finite_length_give_the_same_ao),
+          TEST_ENTRY(half_resolution_is_close_to_full), TEST_ENTRY(blur_keeps_depth_edges),
+          TEST_ENTRY(strength_is_a_power), TEST_ENTRY(background_never_occludes),
+          TEST_ENTRY(tiny_projected_radius_gives_one),
           TEST_ENTRY(simd_paths_match_scalar_reference_bit_for_bit),
           TEST_ENTRY(thin_occluders_do_not_darken_what_is_behind_them),
           TEST_ENTRY(back_face_layer_lets_light_pass_behind_a_thin_plate),

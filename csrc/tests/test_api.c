@@ -81,6 +81,16 @@ TEST_CASE(sizes_and_strides_are_checked) {
     hbao_channel thin_normals = {normal, 2, 3 * W};
     CHECK_RESULT(hbao_compute(&p, &c, W, H, &d, &thin_normals, ao, W), HBAO_ERROR_INVALID_STRIDE);
     CHECK_RESULT(hbao_compute(&p, &c, W, H, &d, NULL, ao, W - 1), HBAO_ERROR_INVALID_STRIDE);
+    /* strides that put the last row past int64_t's offsets: the most
+     * negative one, whose magnitude int64_t cannot hold (UBSan, in the
+     * sanitizer run, sees how it is compared), and the largest */
+    hbao_channel most_negative = {depth, 1, INT64_MIN};
+    CHECK_RESULT(hbao_compute(&p, &c, W, H, &most_negative, NULL, ao, W),
+                 HBAO_ERROR_INVALID_STRIDE);
+    CHECK_RESULT(hbao_compute(&p, &c, W, H, &d, NULL, ao + (size_t)(H - 1) * W, INT64_MIN),
+                 HBAO_ERROR_INVALID_STRIDE);
+    hbao_channel largest = {depth, 1, INT64_MAX};
+    CHECK_RESULT(hbao_compute(&p, &c, W, H, &largest, NULL, ao, W), HBAO_ERROR_INVALID_STRIDE);
     /* a single row may use any row stride */
     CHECK_RESULT(hbao_compute(&p, &c, W, 1, &d, NULL, ao, 0), HBAO_SUCCESS);
 }

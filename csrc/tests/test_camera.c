@@ -229,6 +229,35 @@ TEST_CASE(crop_rejects_bad_arguments) {
     CHECK(out.lens == 123.0f);
 }
 
+/* The size a projection does not use (a perspective camera's ortho scale,
+ * an orthographic one's sensor) may be anything, for the crop as for
+ * hbao_camera_view and hbao_compute: the crop keeps it and scales the other. */
+TEST_CASE(crop_ignores_the_size_its_projection_does_not_use) {
+    for (int orthographic = 0; orthographic < 2; orthographic++) {
+        hbao_camera camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
+        camera.projection =
+            orthographic ? HBAO_PROJECTION_ORTHOGRAPHIC : HBAO_PROJECTION_PERSPECTIVE;
+        hbao_camera odd = camera;
+        if (orthographic)
+            odd.sensor_width = NAN;
+        else
+            odd.ortho_scale = NAN;
+        hbao_view view;
+        CHECK_RESULT(hbao_camera_view(&odd, 64, 48, &view), HBAO_SUCCESS);
+        hbao_camera plain_crop, odd_crop;
+        CHECK_RESULT(hbao_camera_crop(&camera, 64, 48, -8, 4, 80, 20, &plain_crop), HBAO_SUCCESS);
+        CHECK_RESULT(hbao_camera_crop(&odd, 64, 48, -8, 4, 80, 20, &odd_crop), HBAO_SUCCESS);
+        if (orthographic) {
+            CHECK(isnan(odd_crop.sensor_width));
+            CHECK(odd_crop.ortho_scale == plain_crop.ortho_scale);
+        } else {
+            CHECK(isnan(odd_crop.ortho_scale));
+            CHECK(odd_crop.sensor_width == plain_crop.sensor_width);
+        }
+        CHECK(odd_crop.shift_x == plain_crop.shift_x && odd_crop.shift_y == plain_crop.shift_y);
+    }
+}
+
 TEST_CASE(view_rejects_bad_arguments) {
     const hbao_camera camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
     hbao_view view = {7, 1.0, 2.0, 3.0, 4.0};
@@ -440,5 +469,6 @@ TEST_MAIN(TEST_ENTRY(view_equals_the_scene_model), TEST_ENTRY(cropped_camera_kee
           TEST_ENTRY(crop_of_a_crop_equals_the_direct_crop),
           TEST_ENTRY(crop_of_the_whole_image_is_the_camera),
           TEST_ENTRY(crop_may_write_over_its_input), TEST_ENTRY(crop_rejects_bad_arguments),
+          TEST_ENTRY(crop_ignores_the_size_its_projection_does_not_use),
           TEST_ENTRY(view_rejects_bad_arguments), TEST_ENTRY(ao_of_a_crop_equals_the_full_ao),
           TEST_ENTRY(ao_with_a_guard_band_equals_the_larger_frame))
