@@ -161,6 +161,24 @@ def test_turning_off_restores_the_view_exactly(toggle_report):
     assert toggle_report["off_vs_never_max_abs"] == 0.0
 
 
+def test_user_orthographic_view_is_darkened_too(toggle_report):
+    """A user's orthographic view clips about its pivot: depths from the pivot
+    are negative in front of it, which the preview took for background (no
+    AO at all). out/test-artifacts/viewport_hbao_ortho.png shows it."""
+    assert toggle_report["ortho_darkened_fraction"] >= MIN_DARKENED_FRACTION
+
+
+def test_preview_comes_back_when_the_add_on_is_enabled_again(run_blender):
+    """Disabled and enabled again (Preferences) with a view's preview on: the
+    view previews again at once, without a toggle (enabling registers the
+    add-on where it may not read the file's data; the sync waits for the
+    main loop)."""
+    log = run_blender(SCRIPTS / "viewport_reenable.py", ui=True).stdout
+    assert "REENABLE: DONE" in log, log[-3000:]
+    handlers = [line for line in log.splitlines() if line.startswith("HANDLER ")]
+    assert handlers == ["HANDLER on True", "HANDLER enabled again True"], log[-3000:]
+
+
 def test_use_node_settings_previews_the_nodes_values(run_in_blender):
     """'Use Node Settings' previews the scene's HBAO node at the current frame
     (a keyframed Radius: 0.9 at frame 10), with no node the view's own."""

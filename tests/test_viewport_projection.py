@@ -144,6 +144,28 @@ def test_depth_coefficients_invert_projection(perspective):
         assert (a * ndc + b) / (c * ndc + d) == pytest.approx(depth, rel=1e-9)
 
 
+def test_an_orthographic_user_views_depths_are_positive():
+    """A user's orthographic view clips about its pivot (-clip_end / 2 ..
+    clip_end / 2): depths from the pivot would be <= 0, background, in front
+    of it. They are measured from just in front of the near plane instead,
+    all of them positive and their differences kept."""
+    near, far = -500.0, 500.0
+    p22, p23 = -2.0 / (far - near), -(far + near) / (far - near)
+    matrix = [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, p22, p23],
+              [0.0, 0.0, 0.0, 1.0]]
+    a, b, c, d = projection.depth_coefficients(matrix)
+    depths = []
+    # camera space z (the view looks down -z): from 1 behind the near plane,
+    # in front of the pivot, to behind it
+    for view_z in (499.0, 1.0, 0.0, -3.5, -499.0):
+        ndc = p22 * view_z + p23
+        depths.append((a * ndc + b) / (c * ndc + d))
+    assert min(depths) > 0.0
+    assert depths[2] - depths[1] == pytest.approx(1.0)
+    assert depths[3] - depths[2] == pytest.approx(3.5)
+    assert depths[0] == pytest.approx(1.0 + projection.ORTHO_NEAR_MARGIN * (far - near))
+
+
 def test_parameters_clamp_like_the_library(native):
     resolved = native.resolve_params({"directions": 100, "steps": 0, "blur_size": 99,
                                       "angle_bias_degrees": 75.0, "strength": -1.0})

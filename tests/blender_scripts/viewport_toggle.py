@@ -3,7 +3,8 @@
 the demo scene, looks through its camera in Solid shading in a 3D view filling
 the window, and takes three screenshots of that view: before the preview was
 ever on, with it on (kept as the artifact for people to look at), and after it
-was turned off again. Writes what it saw as JSON for tests/test_viewport.py.
+was turned off again; then two of a user's orthographic view, without and with
+the preview. Writes what it saw as JSON for tests/test_viewport.py.
 
     blender --factory-startup --addons hbao --python viewport_toggle.py -- OUT.json SHOT.png
 """
@@ -13,6 +14,7 @@ from pathlib import Path
 
 import bpy
 import numpy as np
+from mathutils import Euler, Vector
 
 REPO = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPO / "scripts"))
@@ -111,11 +113,37 @@ def run():
         "brightened_fraction": float((luminance_on > luminance_before + 1.0 / 255.0).mean()),
         "preview_errors": sorted(draw._reported_errors),
     })
+    user_orthographic(window, area, report, shot_path)
     print(json.dumps(report, indent=2))
     out_path.write_text(json.dumps(report, indent=2))
 
 
+def user_orthographic(window, area, report, shot_path):
+    """A user's orthographic view (numpad 5), not the camera's: it clips about
+    its pivot, so depths in front of the pivot are negative from it. The
+    preview darkens it as it does the camera's view."""
+    region = area.spaces.active.region_3d
+    region.view_perspective = "ORTHO"
+    rotation = Euler((1.05, 0.0, 0.3)).to_quaternion()
+    region.view_rotation = rotation
+    # the pivot 8 units beyond the props, so that all of them lie in front of it
+    region.view_location = Vector((0.0, 0.0, 0.5)) + 8.0 * (rotation @ Vector((0.0, 0.0, -1.0)))
+    region.view_distance = 6.0
+    off = screenshot(window, area, shot_path.with_name("viewport_ortho_off.png"))
+    with override(window, area):
+        bpy.ops.hbao.viewport_preview_toggle()
+    on = screenshot(window, area, shot_path.with_name("viewport_hbao_ortho.png"))
+    with override(window, area):
+        bpy.ops.hbao.viewport_preview_toggle()
+    darker = on.mean(axis=2) < off.mean(axis=2) - 2.0 / 255.0
+    report["ortho_darkened_fraction"] = float(darker.mean())
+    region.view_perspective = "CAMERA"
+
+
 def step():
+    # Blender 3.4 crashed (in its own code, without this add-on too) when the
+    # event loop ran again after screen_full_area from a timer: everything
+    # happens in this one call, which ends by quitting.
     try:
         run()
     finally:

@@ -33,6 +33,18 @@ def register():
     _registered = True
     if isinstance(bpy.data, bpy.types.BlendData):
         draw.sync_handler()
+    elif not bpy.app.background:
+        # Enabling the add-on (Preferences, addon_utils) registers it where
+        # bpy.data may not be read: the views it finds on, re-enabled, would
+        # stay blank until toggled. The sync waits for the main loop.
+        bpy.app.timers.register(_sync_later, first_interval=0.0)
+
+
+def _sync_later():
+    from . import draw
+    if _registered:
+        draw.sync_handler()
+    return None  # once
 
 
 def unregister():

@@ -91,12 +91,26 @@ def is_perspective_matrix(matrix):
     return abs(float(matrix[3][3])) < 0.5
 
 
+# An orthographic user view (not a camera's) clips from -clip_end / 2 to
+# +clip_end / 2 about its pivot (P23 = 0): depths measured from the pivot are
+# negative in front of it, and the AO takes a depth <= 0 for background (no AO
+# there, nor occlusion from it). An orthographic AO does not change when every
+# depth moves by the same amount (positions shift along the view; only the
+# blur's and the upsampling's depth weights, relative to the depth, soften),
+# so such a view's depths are measured from a plane this fraction of its
+# clip range in front of its near clip plane instead.
+ORTHO_NEAR_MARGIN = 1.0e-3
+
+
 def depth_coefficients(matrix):
     """(a, b, c, d) with planar depth = (a ndc + b) / (c ndc + d), ndc = 2 d_buffer - 1,
     for the depth buffer of projection `matrix`. Perspective: ndc = (P22 z + P23) / -z
     gives depth = P23 / (ndc + P22); orthographic: ndc = P22 z + P23 gives
-    depth = (P23 - ndc) / P22."""
+    depth = (P23 - ndc) / P22, moved (ORTHO_NEAR_MARGIN) where the near clip
+    plane is not in front of the view (depth <= 0 there)."""
     p22, p23 = float(matrix[2][2]), float(matrix[2][3])
     if is_perspective_matrix(matrix):
         return (0.0, p23, 1.0, p22)
-    return (-1.0 / p22, p23 / p22, 0.0, 1.0)
+    near, far = (p23 + 1.0) / p22, (p23 - 1.0) / p22
+    shift = 0.0 if near > 0.0 else ORTHO_NEAR_MARGIN * (far - near) - near
+    return (-1.0 / p22, p23 / p22 + shift, 0.0, 1.0)
