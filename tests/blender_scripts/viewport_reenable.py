@@ -5,6 +5,9 @@ Preferences (each step in its own tick of the event loop, as an artist's
 clicks are). Enabling registers the add-on where it may not read the file's
 data; the view, still "on", must preview again without a toggle. Prints
 'HANDLER <when> <bool>' (the preview's draw handler) and 'REENABLE: DONE'.
+(Maximizing the view from such a script made Blender 3.4 crash under Xvfb
+when it left the maximized screen, with the add-on's preview off too: the
+maximized view's settings were checked by hand, not here.)
 
   blender --factory-startup --addons hbao --python viewport_reenable.py
 """
@@ -24,6 +27,13 @@ def view_3d(window):
                key=lambda a: a.width * a.height)
 
 
+def override(window):
+    area = view_3d(window)
+    region = [r for r in area.regions if r.type == "WINDOW"][-1]
+    return bpy.context.temp_override(window=window, screen=window.screen, area=area,
+                                     region=region)
+
+
 def handler(when):
     draw = sys.modules["hbao.viewport.draw"]  # after enabling: the module loaded again
     print(f"HANDLER {when} {draw.handler_registered()}", flush=True)
@@ -34,10 +44,7 @@ def tick():
     step = state["tick"]
     state["tick"] += 1
     if step == 0:
-        area = view_3d(window)
-        region = next(r for r in area.regions if r.type == "WINDOW")
-        with bpy.context.temp_override(window=window, screen=window.screen, area=area,
-                                       region=region):
+        with override(window):
             bpy.ops.hbao.viewport_preview_toggle()
         handler("on")
     elif step == 1:

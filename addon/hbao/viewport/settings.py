@@ -26,6 +26,9 @@ COLLECTION_NAME = "hbao_viewport_views"
 
 # (screen pointer, area pointer) -> entry name, for the areas seen this session.
 _entry_by_area = {}
+# space pointer -> (screen name, entry name): a maximized view (Ctrl+Space)
+# moves its space into a temporary screen, where it keeps its settings.
+_entry_by_space = {}
 # Called with no arguments when a view's `enabled` changes (draw.sync_handler).
 enabled_change_callbacks = []
 
@@ -130,10 +133,26 @@ def _area_index(screen, area):
 
 
 def find(screen, area):
-    """The settings of the 3D view in `area`, or None if it has none yet. Reads
-    only, so panels and draw callbacks may call it."""
+    """The settings of the 3D view in `area`, or None if it has none yet; a
+    maximized view's are its own screen's. Reads only, so panels and draw
+    callbacks may call it."""
     if screen is None or area is None:
         return None
+    space = area.spaces.active
+    entry = _find_on_screen(screen, area)
+    if entry is not None:
+        if space is not None:
+            _entry_by_space[space.as_pointer()] = (screen.name, entry.name)
+        return entry
+    if space is not None and getattr(screen, "show_fullscreen", False):
+        home_name, name = _entry_by_space.get(space.as_pointer(), (None, None))
+        home = bpy.data.screens.get(home_name) if home_name is not None else None
+        if home is not None and home != screen:
+            return _views(home).get(name)
+    return None
+
+
+def _find_on_screen(screen, area):
     views = _views(screen)
     key = (screen.as_pointer(), area.as_pointer())
     name = _entry_by_area.get(key)
@@ -194,6 +213,7 @@ def _refresh_area_indices(*_args):
 def _forget_areas(*_args):
     """After a load: areas are new objects; entries are found by position again."""
     _entry_by_area.clear()
+    _entry_by_space.clear()
 
 
 CLASSES = (HBAOViewSettings,)
@@ -213,6 +233,7 @@ def unregister():
         while function in handlers:
             handlers.remove(function)
     _entry_by_area.clear()
+    _entry_by_space.clear()
     delattr(bpy.types.Screen, COLLECTION_NAME)
     for cls in reversed(CLASSES):
         bpy.utils.unregister_class(cls)
