@@ -161,6 +161,12 @@ def test_turning_off_restores_the_view_exactly(toggle_report):
     assert toggle_report["off_vs_never_max_abs"] == 0.0
 
 
+def test_a_maximized_view_keeps_its_preview(toggle_report):
+    """Ctrl+Space moves the view into a temporary screen: the preview turned
+    on before finds its settings there (it vanished)."""
+    assert toggle_report["maximized_keeps_settings"] is True
+
+
 def test_user_orthographic_view_is_darkened_too(toggle_report):
     """A user's orthographic view clips about its pivot: depths from the pivot
     are negative in front of it, which the preview took for background (no

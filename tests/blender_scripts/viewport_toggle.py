@@ -73,9 +73,21 @@ def run():
 
     window = bpy.context.window_manager.windows[0]
     blender_scenes.build_demo_scene(bpy.context.scene)
-    with override(window, view_3d(window)):
+    # The preview turned on in the layout's view, which is then maximized
+    # (its space moves into a temporary screen): it keeps its settings there.
+    home_area = view_3d(window)
+    with override(window, home_area):
+        bpy.ops.hbao.viewport_preview_toggle()
+    home = view_settings_module.find(window.screen, home_area)
+    with override(window, home_area):
         bpy.ops.screen.screen_full_area(use_hide_panels=True)
     area = view_3d(window)
+    maximized = view_settings_module.find(window.screen, area)
+    report_start = {"maximized_keeps_settings": window.screen.name.endswith("-nonnormal") and
+                    maximized is not None and maximized.as_pointer() == home.as_pointer() and
+                    maximized.enabled}
+    with override(window, area):
+        bpy.ops.hbao.viewport_preview_toggle()  # off again: the rest starts from "never on"
     space = area.spaces.active
     space.shading.type = "SOLID"
     space.overlay.show_overlays = False
@@ -85,7 +97,7 @@ def run():
         bpy.ops.view3d.view_center_camera()
 
     report = {"registered_add_on_viewport": viewport.is_registered(),
-              "handler_before": draw.handler_registered()}
+              "handler_before": draw.handler_registered(), **report_start}
     before = screenshot(window, area, shot_path.with_name("viewport_never_on.png"))
 
     with override(window, area):

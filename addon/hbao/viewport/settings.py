@@ -26,7 +26,7 @@ COLLECTION_NAME = "hbao_viewport_views"
 
 # (screen pointer, area pointer) -> entry name, for the areas seen this session.
 _entry_by_area = {}
-# space pointer -> (screen name, entry name): a maximized view (Ctrl+Space)
+# space pointer -> (screen name, entry name): a maximized or full-screen view
 # moves its space into a temporary screen, where it keeps its settings.
 _entry_by_space = {}
 # Called with no arguments when a view's `enabled` changes (draw.sync_handler).
@@ -144,12 +144,18 @@ def find(screen, area):
         if space is not None:
             _entry_by_space[space.as_pointer()] = (screen.name, entry.name)
         return entry
-    if space is not None and getattr(screen, "show_fullscreen", False):
+    if space is not None and _temporary(screen):
         home_name, name = _entry_by_space.get(space.as_pointer(), (None, None))
         home = bpy.data.screens.get(home_name) if home_name is not None else None
         if home is not None and home != screen:
             return _views(home).get(name)
     return None
+
+
+def _temporary(screen):
+    """A screen Blender makes for a maximized (Ctrl+Space, show_fullscreen)
+    or full-screen (Ctrl+Alt+Space) area: it names both "<screen>-nonnormal"."""
+    return getattr(screen, "show_fullscreen", False) or screen.name.endswith("-nonnormal")
 
 
 def _find_on_screen(screen, area):
