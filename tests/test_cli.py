@@ -596,6 +596,17 @@ def test_output_equal_to_input_is_refused(hbao_tool, tmp_path):
     assert not (tmp_path / "ok.exr").exists()
 
 
+def test_one_pipe_named_twice_is_refused(hbao_tool, tmp_path):
+    """-o /dev/stdout --preview /proc/self/fd/1: one pipe by two names, which
+    would get the EXR and then the PNG. Refused; nothing reaches the pipe."""
+    completed = subprocess.run(
+        [str(hbao_tool), fixture_path("cycles_float_zip"), "-o", "/dev/stdout", "--preview",
+         "/proc/self/fd/1", "--no-normals"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, timeout=TOOL_TIMEOUT_S)
+    assert completed.returncode == EXIT_USAGE, completed.stderr
+    assert b"name the same file" in completed.stderr and completed.stdout == b""
+
+
 def test_camera_file_is_never_an_output(hbao_tool, tmp_path):
     """The --camera file is an input too: -o or --preview naming it (by any
     name) is refused, and it keeps its contents."""

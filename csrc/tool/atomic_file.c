@@ -254,7 +254,15 @@ static bool canonical_destination(const atomic_file *file, char out[PATH_MAX]) {
 }
 
 bool atomic_file_same_destination(const atomic_file *a, const atomic_file *b) {
-    if (!a->active || !b->active || a->write_through || b->write_through) return false;
+    if (!a->active || !b->active) return false;
+    if (a->write_through || b->write_through) {
+        /* one FIFO or device by two names (/dev/stdout and /proc/self/fd/1):
+         * both files' bytes would go into it, one after the other */
+        struct stat first, second;
+        return a->write_through && b->write_through && stat(a->destination, &first) == 0 &&
+               stat(b->destination, &second) == 0 && first.st_dev == second.st_dev &&
+               first.st_ino == second.st_ino && first.st_rdev == second.st_rdev;
+    }
     char first[PATH_MAX], second[PATH_MAX];
     return canonical_destination(a, first) && canonical_destination(b, second) &&
            strcmp(first, second) == 0;

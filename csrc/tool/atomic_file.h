@@ -64,8 +64,8 @@ int atomic_file_begin(atomic_file *file, const char *destination, tool_error *er
 int atomic_file_commit(atomic_file *file, tool_error *error);
 
 /** Whether two begun files would put their data in the same place (two
- *  names of one file: "./a.exr" and "a.exr", a link and its target); never
- *  for files written through (a FIFO, /dev/null). */
+ *  names of one file: "./a.exr" and "a.exr", a link and its target; one
+ *  FIFO or device, /dev/stdout and /proc/self/fd/1). */
 bool atomic_file_same_destination(const atomic_file *a, const atomic_file *b);
 
 /** Remove the temporary file (no-op when nothing is pending). */
