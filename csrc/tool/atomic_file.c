@@ -1,5 +1,4 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
-#define _DEFAULT_SOURCE /* realpath */
 #include "atomic_file.h"
 
 #include <errno.h>
@@ -11,6 +10,8 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
+
+#include "canonical_path.h"
 
 /* Linux's limit on symbolic links followed in one lookup (MAXSYMLINKS). */
 #define SYMLINK_HOPS_MAX 40
@@ -234,25 +235,6 @@ int atomic_file_begin(atomic_file *file, const char *destination, tool_error *er
     return TOOL_EXIT_SUCCESS;
 }
 
-/* The file a begun destination will be: its directory made canonical
- * (realpath: "./", "../" and links on the way resolved), its name kept. */
-static bool canonical_destination(const atomic_file *file, char out[PATH_MAX]) {
-    const char *slash = strrchr(file->destination, '/');
-    char directory[PATH_MAX];
-    if (slash == NULL)
-        strcpy(directory, ".");
-    else if (slash == file->destination)
-        strcpy(directory, "/");
-    else
-        snprintf(directory, sizeof directory, "%.*s", (int)(slash - file->destination),
-                 file->destination);
-    char real[PATH_MAX];
-    if (realpath(directory, real) == NULL) return false;
-    const char *name = slash != NULL ? slash + 1 : file->destination;
-    int written = snprintf(out, PATH_MAX, "%s/%s", real, name);
-    return written > 0 && written < PATH_MAX;
-}
-
 bool atomic_file_same_destination(const atomic_file *a, const atomic_file *b) {
     if (!a->active || !b->active) return false;
     if (a->write_through || b->write_through) {
@@ -264,7 +246,7 @@ bool atomic_file_same_destination(const atomic_file *a, const atomic_file *b) {
                first.st_ino == second.st_ino && first.st_rdev == second.st_rdev;
     }
     char first[PATH_MAX], second[PATH_MAX];
-    return canonical_destination(a, first) && canonical_destination(b, second) &&
+    return canonical_path(a->destination, first) && canonical_path(b->destination, second) &&
            strcmp(first, second) == 0;
 }
 

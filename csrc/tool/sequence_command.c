@@ -1,5 +1,4 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
-#define _DEFAULT_SOURCE /* realpath */
 #include "sequence_command.h"
 
 #include <limits.h>
@@ -13,6 +12,7 @@
 #include "ao_command.h"
 #include "atomic_file.h"
 #include "camera_json.h"
+#include "canonical_path.h"
 #include "frame_pattern.h"
 #include "run_settings.h"
 
@@ -148,25 +148,14 @@ static int summarize(const sequence_run *run, tool_error *error) {
  * (-o 'o_#.exr' --preview 'o_#0.exr'). Each frame refuses its own input
  * and a preview that is its own output (ao_command); this refuses the
  * others', by name, before any frame runs. */
-/* `pattern` with its folder made canonical (realpath), so that names of one
- * file compare equal ("./o_#.exr" and "o_#.exr"); as given where the folder
- * holds the '#' run or cannot be resolved. */
+/* `pattern` with its folder made canonical (canonical_path), so that names
+ * of one file compare equal ("./o_#.exr" and "o_#.exr"); as given where the
+ * folder holds the '#' run or cannot be resolved. */
 static const char *canonical_pattern(const char *pattern, char out[PATH_MAX]) {
     if (pattern == NULL) return NULL;
     const char *slash = strrchr(pattern, '/');
-    char folder[PATH_MAX], real[PATH_MAX];
-    const int length = slash == NULL ? 0 : (int)(slash - pattern);
-    if (slash != NULL && (memchr(pattern, '#', (size_t)length) != NULL || length >= PATH_MAX))
-        return pattern;
-    if (slash == NULL)
-        strcpy(folder, ".");
-    else if (slash == pattern)
-        strcpy(folder, "/");
-    else
-        snprintf(folder, sizeof folder, "%.*s", length, pattern);
-    if (realpath(folder, real) == NULL) return pattern;
-    const int written = snprintf(out, PATH_MAX, "%s/%s", real, slash ? slash + 1 : pattern);
-    return written > 0 && written < PATH_MAX ? out : pattern;
+    if (slash != NULL && memchr(pattern, '#', (size_t)(slash - pattern)) != NULL) return pattern;
+    return canonical_path(pattern, out) ? out : pattern;
 }
 
 static int refuse_other_frames_files(const cli_options *options, int64_t count, tool_error *error) {
