@@ -114,7 +114,7 @@ int main(int argc, char **argv) {
     s.implementation = implementation;
     for (int call = 0; call < calls; call++) {
         const double start = clock_seconds(CLOCK_PROCESS_CPUTIME_ID);
-        if (hbao_finish(&s, &grid, raw, grid.depth, width, height, out, width) != HBAO_SUCCESS) {
+        if (hbao_finish(&s, &grid, raw, NULL, width, height, out, width) != HBAO_SUCCESS) {
             fprintf(stderr, "bench_blur: out of memory\n");
             return 1;
         }

@@ -304,7 +304,8 @@ static hbao_result blur_grid(const hbao_settings *settings, const hbao_grid *gri
 typedef struct upsample_job {
     const hbao_grid *grid;
     const float *grid_ao;
-    const float *depth; /* full resolution */
+    const hbao_channel *depth; /* the caller's, full resolution */
+    float background;
     int width;
     int implementation;
     float strength;
@@ -315,14 +316,16 @@ typedef struct upsample_job {
 static void upsample_output_row(void *context, int j) {
     const upsample_job *job = context;
     float *out = job->out + (int64_t)j * job->out_row_stride;
-    hbao_upsample_row(job->implementation, job->grid, job->grid_ao, job->depth, job->width, j, out);
-    /* already clamped, and 1 on background: only a strength is left to apply */
+    hbao_upsample_row(job->implementation, job->grid, job->grid_ao, job->depth, job->background,
+                      job->width, j, out);
+    /* already clamped, and 1 on background (which any strength keeps 1):
+     * only a strength is left to apply */
     if (job->strength != 1.0f)
-        write_output(job->depth + (size_t)j * job->width, out, job->width, job->strength, out);
+        for (int i = 0; i < job->width; i++) out[i] = hbao_clamp_ao(powf(out[i], job->strength));
 }
 
 hbao_result hbao_finish(const hbao_settings *settings, const hbao_grid *grid, const float *grid_ao,
-                        const float *full_depth, int width, int height, float *out,
+                        const hbao_channel *depth, int width, int height, float *out,
                         int64_t out_row_stride) {
     if (!settings->half_resolution)
         return blur_grid(settings, grid, grid_ao, settings->strength, out, out_row_stride);
@@ -340,7 +343,8 @@ hbao_result hbao_finish(const hbao_settings *settings, const hbao_grid *grid, co
     }
     upsample_job job = {grid,
                         upsampled_from,
-                        full_depth,
+                        depth,
+                        settings->background_depth,
                         width,
                         hbao_finish_implementation(settings->implementation),
                         settings->strength,

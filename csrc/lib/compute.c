@@ -53,12 +53,9 @@ typedef struct depth_job {
     float *depth;
 } depth_job;
 
-/* Dense depth with background (not finite, <= 0, >= background_depth) as 0.
- * z > 0 && z < background_depth fails for NaN, -inf and +inf (+inf < +inf
- * is false where the background depth is infinite) as for background, so no
- * isfinite() is needed. The stage is bound by memory: the dense row's loop
- * vectorized (this file at -O3 -fno-trapping-math) timed the same,
- * bench_ab_copies.sh 0.998 on 1 and 2 threads. */
+/* Dense depth (hbao_depth_value). The stage is bound by memory: the dense
+ * row's loop vectorized (this file at -O3 -fno-trapping-math) timed the
+ * same, bench_ab_copies.sh 0.998 on 1 and 2 threads. */
 static void convert_depth_row(void *context, int j) {
     const depth_job *job = context;
     const float *row = job->source->data + (int64_t)j * job->source->row_stride;
@@ -66,16 +63,19 @@ static void convert_depth_row(void *context, int j) {
     const float background = job->background_depth;
     const int64_t stride = job->source->pixel_stride;
     if (stride == 1) {
-        for (int i = 0; i < job->width; i++) {
-            const float z = row[i];
-            out[i] = z > 0.0f && z < background ? z : 0.0f;
-        }
+        for (int i = 0; i < job->width; i++) out[i] = hbao_depth_value(row[i], background);
         return;
     }
-    for (int i = 0; i < job->width; i++) {
-        const float z = row[(int64_t)i * stride];
-        out[i] = z > 0.0f && z < background ? z : 0.0f;
-    }
+    for (int i = 0; i < job->width; i++)
+        out[i] = hbao_depth_value(row[(int64_t)i * stride], background);
+}
+
+/* Whether back depth b is known behind the front depth (hbao_depth_value's):
+ * finite, behind the visible surface, not background, and the pixel not
+ * background. */
+static inline float back_value(float front, float b, float background) {
+    const int known = front > 0.0f && isfinite(b) && b > front && b < background;
+    return known ? b : INFINITY;
 }
 
 typedef struct back_job {
@@ -86,45 +86,43 @@ typedef struct back_job {
     float *back;
 } back_job;
 
-/* The back layer, dense, INFINITY where no back face is known: not finite,
- * not behind the visible surface, background, or the pixel is background. */
+/* The back layer, dense, INFINITY where no back face is known (back_value). */
 static void convert_back_row(void *context, int j) {
     const back_job *job = context;
     const float *row = job->source->data + (int64_t)j * job->source->row_stride;
     const float *front = job->front + (size_t)j * job->width;
     float *out = job->back + (size_t)j * job->width;
-    for (int i = 0; i < job->width; i++) {
-        const float b = row[(int64_t)i * job->source->pixel_stride];
-        const int known =
-            front[i] > 0.0f && isfinite(b) && b > front[i] && b < job->background_depth;
-        out[i] = known ? b : INFINITY;
-    }
+    for (int i = 0; i < job->width; i++)
+        out[i] = back_value(front[i], row[(int64_t)i * job->source->pixel_stride],
+                            job->background_depth);
 }
 
+/* The half grid's depth (and back layer), the full image's even pixels of
+ * its even rows, converted straight from the caller's channels: at half
+ * resolution no full-size converted copy is made (the upsample converts
+ * the rows it reads, upsample.c). */
 typedef struct half_depth_job {
-    const float *full;
-    int full_width;
+    const hbao_channel *source, *back_source;
+    float background_depth;
     hbao_grid *half;
+    float *half_back; /* with back_source */
 } half_depth_job;
 
 static void half_depth_row(void *context, int j) {
     const half_depth_job *job = context;
-    const float *source = job->full + (size_t)(2 * j) * job->full_width;
-    float *out = job->half->depth + (size_t)j * job->half->width;
-    for (int i = 0; i < job->half->width; i++) out[i] = source[2 * i];
-}
-
-typedef struct half_back_job {
-    const float *full;
-    int full_width, width;
-    float *half;
-} half_back_job;
-
-static void half_back_row(void *context, int j) {
-    const half_back_job *job = context;
-    const float *source = job->full + (size_t)(2 * j) * job->full_width;
-    float *out = job->half + (size_t)j * job->width;
-    for (int i = 0; i < job->width; i++) out[i] = source[2 * i];
+    const hbao_channel *source = job->source;
+    const float *row = source->data + (int64_t)(2 * j) * source->row_stride;
+    const int64_t stride = 2 * (int64_t)source->pixel_stride;
+    const size_t at = (size_t)j * job->half->width;
+    float *out = job->half->depth + at;
+    for (int i = 0; i < job->half->width; i++)
+        out[i] = hbao_depth_value(row[(int64_t)i * stride], job->background_depth);
+    if (job->back_source == NULL) return;
+    const float *backs = job->back_source->data + (int64_t)(2 * j) * job->back_source->row_stride;
+    const int64_t back_stride = 2 * (int64_t)job->back_source->pixel_stride;
+    float *back_out = job->half_back + at;
+    for (int i = 0; i < job->half->width; i++)
+        back_out[i] = back_value(out[i], backs[(int64_t)i * back_stride], job->background_depth);
 }
 
 static int any_finite(const float *values, size_t count) {
@@ -174,7 +172,6 @@ hbao_result hbao_compute_layers(const hbao_params *params, const hbao_camera *ca
         return HBAO_SUCCESS;
     }
 
-    const size_t pixels = (size_t)width * height;
     const int scale = s.half_resolution ? 2 : 1;
     hbao_grid grid;
     grid.width = (width + scale - 1) / scale;
@@ -183,59 +180,42 @@ hbao_result hbao_compute_layers(const hbao_params *params, const hbao_camera *ca
 
     /* The raw AO on the grid; the later stages (blur.c) turn it into the
      * output row by row, with no other full-size buffer. */
-    float *full_depth = hbao_scratch_take(pixels * sizeof(float));
+    float *grid_depth = hbao_scratch_take(grid_pixels * sizeof(float));
     float *grid_ao = hbao_scratch_take(grid_pixels * sizeof(float));
-    float *half_depth = s.half_resolution ? hbao_scratch_take(grid_pixels * sizeof(float)) : NULL;
-    float *full_back = back_depth != NULL ? hbao_scratch_take(pixels * sizeof(float)) : NULL;
-    float *half_back = back_depth != NULL && s.half_resolution
-                           ? hbao_scratch_take(grid_pixels * sizeof(float))
-                           : NULL;
+    float *grid_back = back_depth != NULL ? hbao_scratch_take(grid_pixels * sizeof(float)) : NULL;
     grid.normal = hbao_scratch_take((grid_pixels * 3 + HBAO_NORMAL_PADDING) * sizeof(float));
-    grid.back = NULL;
-    if (full_depth == NULL || grid_ao == NULL || grid.normal == NULL ||
-        (s.half_resolution && half_depth == NULL) || (back_depth != NULL && full_back == NULL) ||
-        (back_depth != NULL && s.half_resolution && half_back == NULL)) {
+    grid.depth = grid_depth;
+    grid.back = grid_back;
+    if (grid_depth == NULL || grid_ao == NULL || grid.normal == NULL ||
+        (back_depth != NULL && grid_back == NULL)) {
         result = HBAO_ERROR_OUT_OF_MEMORY;
         goto done;
     }
 
-    depth_job convert = {depth, s.background_depth, width, full_depth};
-    hbao_parallel_rows(s.threads, height, convert_depth_row, &convert);
-
-    if (back_depth != NULL) {
-        back_job backs = {back_depth, full_depth, s.background_depth, width, full_back};
-        hbao_parallel_rows(s.threads, height, convert_back_row, &backs);
-    }
-
-    hbao_grid_set_projection(&grid, camera, width, height, scale);
     if (s.half_resolution) {
-        grid.depth = half_depth;
-        half_depth_job halve = {full_depth, width, &grid};
+        half_depth_job halve = {depth, back_depth, s.background_depth, &grid, grid_back};
         hbao_parallel_rows(s.threads, grid.height, half_depth_row, &halve);
-        if (back_depth != NULL) {
-            half_back_job halve_back = {full_back, width, grid.width, half_back};
-            hbao_parallel_rows(s.threads, grid.height, half_back_row, &halve_back);
-            grid.back = half_back;
-        }
     } else {
-        grid.depth = full_depth;
-        grid.back = full_back;
+        depth_job convert = {depth, s.background_depth, width, grid_depth};
+        hbao_parallel_rows(s.threads, height, convert_depth_row, &convert);
+        if (back_depth != NULL) {
+            back_job backs = {back_depth, grid_depth, s.background_depth, width, grid_back};
+            hbao_parallel_rows(s.threads, height, convert_back_row, &backs);
+        }
     }
+    hbao_grid_set_projection(&grid, camera, width, height, scale);
     /* A layer with no back face known anywhere is no layer: the result is
      * hbao_compute()'s, exactly, not its sector-quantised twin. */
-    if (grid.back != NULL && !any_finite(grid.back, (size_t)grid.width * grid.height))
-        grid.back = NULL;
+    if (grid.back != NULL && !any_finite(grid.back, grid_pixels)) grid.back = NULL;
     hbao_compute_normals(&s, camera, &grid, normal, scale);
 
     hbao_compute_horizons(&s, &grid, grid_ao);
-    result = hbao_finish(&s, &grid, grid_ao, full_depth, width, height, ao, ao_row_stride);
+    result = hbao_finish(&s, &grid, grid_ao, depth, width, height, ao, ao_row_stride);
 
 done:
-    hbao_scratch_give(full_depth);
+    hbao_scratch_give(grid_depth);
     hbao_scratch_give(grid_ao);
-    hbao_scratch_give(half_depth);
-    hbao_scratch_give(full_back);
-    hbao_scratch_give(half_back);
+    hbao_scratch_give(grid_back);
     hbao_scratch_give(grid.normal);
     return result;
 }

@@ -98,16 +98,18 @@ static inline float hbao_clamp_ao(float value) {
 /* blur.c: AO on the full image from the raw AO on the grid (grid_ao, dense,
  * grid->width wide): cross-bilateral blur on depth and normals (rows, then
  * columns) on the grid -> [upsample] -> strength -> clamp to [0, 1],
- * written to out. HBAO_ERROR_OUT_OF_MEMORY if its buffers cannot be
- * allocated. */
+ * written to out. depth: the caller's depth channel, which only the half
+ * resolution's upsample reads (NULL will do at full resolution).
+ * HBAO_ERROR_OUT_OF_MEMORY if its buffers cannot be allocated. */
 hbao_result hbao_finish(const hbao_settings *settings, const hbao_grid *grid, const float *grid_ao,
-                        const float *full_depth, int width, int height, float *out,
+                        const hbao_channel *depth, int width, int height, float *out,
                         int64_t out_row_stride);
 
 /* upsample.c: full-resolution row j (width floats, into ao, in [0, 1] and 1
- * on background) of the half-resolution AO half_ao (half->width wide).
+ * on background) of the half-resolution AO half_ao (half->width wide),
+ * guided by the caller's depth channel (hbao_depth_value with background).
  * implementation: as resolved by hbao_finish_implementation(). */
 void hbao_upsample_row(int implementation, const hbao_grid *half, const float *half_ao,
-                       const float *full_depth, int width, int j, float *ao);
+                       const hbao_channel *depth, float background, int width, int j, float *ao);
 
 #endif /* HBAO_INTERNAL_FINISH_H */

@@ -50,6 +50,15 @@ typedef struct hbao_settings {
     float thickness;    /* occluder thickness, 0 = infinite (hbao_params) */
 } hbao_settings;
 
+/* A depth value as the pipeline uses it: background (not finite, <= 0,
+ * >= background_depth) as 0. z > 0 && z < background fails for NaN, -inf
+ * and +inf (+inf < +inf is false where the background depth is infinite)
+ * as for background, so no isfinite() is needed. Written as a select so
+ * that the loops calling it vectorize. */
+static inline float hbao_depth_value(float z, float background) {
+    return z > 0.0f && z < background ? z : 0.0f;
+}
+
 /* The image that horizons are searched on: the full image, or the
  * half-resolution grid. Depth is dense and positive; 0 marks background. */
 typedef struct hbao_grid {

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
 /* Joint bilateral upsampling (Kopf et al. 2007) of half-resolution AO, guided
- * by the full-resolution depth so that AO does not bleed across edges. One
+ * by the caller's full-resolution depth (guide_depth) so that AO does not
+ * bleed across edges. One
  * full-resolution row at a time, written straight into the caller's output
  * (blur.c): the AO arrives already blurred on the half grid. */
 #include <float.h>
@@ -44,6 +45,16 @@ static HBAO_ALWAYS_INLINE float finish_pixel(float z, float sum, float weight_su
                                              float nearest_ao) {
     const float blended = weight_sum > 1e-6f ? sum / weight_sum : nearest_ao;
     return hbao_clamp_ao(z > 0.0f ? blended : 1.0f);
+}
+
+/* Pixel i's depth in the caller's row z_row (stride floats apart), as the
+ * pipeline uses it (hbao_depth_value: background is 0). The upsample reads
+ * the caller's depth channel itself: no converted full-size copy is made at
+ * half resolution (bench_ab, 1080p defaults at half resolution, 0.955 on 2
+ * threads, 1.009 on 1; docs/speed.md, session 26). */
+static HBAO_ALWAYS_INLINE float guide_depth(const float *z_row, int64_t stride, float background,
+                                            int i) {
+    return hbao_depth_value(z_row[(int64_t)i * stride], background);
 }
 
 /* The half grid's two rows that a full-resolution row's candidates come
@@ -95,8 +106,8 @@ static HBAO_ALWAYS_INLINE float odd_pixel(const half_rows *h, int two_rows, floa
  * right-hand column (and rows without a row below, see upsample_row, skip
  * the bottom candidates). */
 static HBAO_ALWAYS_INLINE void upsample_rows(const hbao_grid *half, const float *half_ao,
-                                             const float *full_depth, int width, int j,
-                                             int two_rows, float *restrict out) {
+                                             const float *z_row, int64_t stride, float background,
+                                             int width, int j, int two_rows, float *restrict out) {
     const int half_width = half->width;
     const int r0 = j / 2;
     const int r1 = two_rows ? r0 + 1 : r0;
@@ -107,65 +118,76 @@ static HBAO_ALWAYS_INLINE void upsample_rows(const hbao_grid *half, const float 
     h.z_bottom = half->depth + (size_t)r1 * half_width;
     h.ao_top = half_ao + (size_t)r0 * half_width;
     h.ao_bottom = half_ao + (size_t)r1 * half_width;
-    const float *z_row = full_depth + (size_t)j * width;
     const int even_count = (width + 1) / 2; /* pixels 2k */
     const int odd_count = width / 2;        /* pixels 2k + 1 */
     /* odd pixels with a half column to their right; the last one may have
      * none (width even, half_width = width / 2) */
     const int pairs = odd_count < half_width - 1 ? odd_count : half_width - 1;
     for (int k = 0; k < pairs; k++) {
-        out[2 * k] = even_pixel(&h, two_rows, z_row[2 * k], k);
-        out[2 * k + 1] = odd_pixel(&h, two_rows, z_row[2 * k + 1], k, k + 1, 0.5f);
+        out[2 * k] = even_pixel(&h, two_rows, guide_depth(z_row, stride, background, 2 * k), k);
+        out[2 * k + 1] = odd_pixel(&h, two_rows, guide_depth(z_row, stride, background, 2 * k + 1),
+                                   k, k + 1, 0.5f);
     }
-    for (int k = pairs; k < even_count; k++) out[2 * k] = even_pixel(&h, two_rows, z_row[2 * k], k);
+    for (int k = pairs; k < even_count; k++)
+        out[2 * k] = even_pixel(&h, two_rows, guide_depth(z_row, stride, background, 2 * k), k);
     for (int k = pairs; k < odd_count; k++)
-        out[2 * k + 1] = odd_pixel(&h, two_rows, z_row[2 * k + 1], k, k, 0.0f);
+        out[2 * k + 1] =
+            odd_pixel(&h, two_rows, guide_depth(z_row, stride, background, 2 * k + 1), k, k, 0.0f);
 }
 
 /* Rows that lie on a half-grid row (and the last odd row, which has no row
  * below) have bilinear weight 0 on the row below: a candidate of weight 0
  * adds exactly nothing, so those rows skip it. */
 static HBAO_ALWAYS_INLINE void upsample_row(const hbao_grid *half, const float *half_ao,
-                                            const float *full_depth, int width, int j,
-                                            float *restrict out) {
-    if ((j & 1) && j / 2 + 1 < half->height)
-        upsample_rows(half, half_ao, full_depth, width, j, 1, out);
-    else
-        upsample_rows(half, half_ao, full_depth, width, j, 0, out);
+                                            const hbao_channel *depth, float background, int width,
+                                            int j, float *restrict out) {
+    const float *z_row = depth->data + (int64_t)j * depth->row_stride;
+    const int two_rows = (j & 1) && j / 2 + 1 < half->height;
+    if (depth->pixel_stride == 1) { /* the common layout: whole vectors */
+        if (two_rows)
+            upsample_rows(half, half_ao, z_row, 1, background, width, j, 1, out);
+        else
+            upsample_rows(half, half_ao, z_row, 1, background, width, j, 0, out);
+    } else if (two_rows) {
+        upsample_rows(half, half_ao, z_row, depth->pixel_stride, background, width, j, 1, out);
+    } else {
+        upsample_rows(half, half_ao, z_row, depth->pixel_stride, background, width, j, 0, out);
+    }
 }
 
 static void upsample_row_portable(const hbao_grid *half, const float *half_ao,
-                                  const float *full_depth, int width, int j, float *out) {
-    upsample_row(half, half_ao, full_depth, width, j, out);
+                                  const hbao_channel *depth, float background, int width, int j,
+                                  float *out) {
+    upsample_row(half, half_ao, depth, background, width, j, out);
 }
 
 #ifdef HBAO_FINISH_X86
 HBAO_TARGET_AVX2 static void upsample_row_avx2(const hbao_grid *half, const float *half_ao,
-                                               const float *full_depth, int width, int j,
-                                               float *out) {
-    upsample_row(half, half_ao, full_depth, width, j, out);
+                                               const hbao_channel *depth, float background,
+                                               int width, int j, float *out) {
+    upsample_row(half, half_ao, depth, background, width, j, out);
 }
 
 HBAO_TARGET_AVX512 static void upsample_row_avx512(const hbao_grid *half, const float *half_ao,
-                                                   const float *full_depth, int width, int j,
-                                                   float *out) {
-    upsample_row(half, half_ao, full_depth, width, j, out);
+                                                   const hbao_channel *depth, float background,
+                                                   int width, int j, float *out) {
+    upsample_row(half, half_ao, depth, background, width, j, out);
 }
 #endif
 
 void hbao_upsample_row(int implementation, const hbao_grid *half, const float *half_ao,
-                       const float *full_depth, int width, int j, float *ao) {
+                       const hbao_channel *depth, float background, int width, int j, float *ao) {
 #ifdef HBAO_FINISH_X86
     if (implementation == HBAO_IMPLEMENTATION_AVX512) {
-        upsample_row_avx512(half, half_ao, full_depth, width, j, ao);
+        upsample_row_avx512(half, half_ao, depth, background, width, j, ao);
         return;
     }
     if (implementation == HBAO_IMPLEMENTATION_AVX2) {
-        upsample_row_avx2(half, half_ao, full_depth, width, j, ao);
+        upsample_row_avx2(half, half_ao, depth, background, width, j, ao);
         return;
     }
 #else
     (void)implementation;
 #endif
-    upsample_row_portable(half, half_ao, full_depth, width, j, ao);
+    upsample_row_portable(half, half_ao, depth, background, width, j, ao);
 }

@@ -593,6 +593,76 @@ TEST_CASE(bottom_up_rows_with_negative_stride) {
     free(normal);
 }
 
+/* The depth in any layout (four floats a pixel, rows bottom-up; dense) and
+ * its background in any of its spellings (0, -1, NaN, +-inf, at or past
+ * background_depth): the same AO to the bit, at full and at half
+ * resolution, where the half grid and the upsample read the caller's
+ * channels directly (compute.c, upsample.c: no converted full-size copy),
+ * with and without a back layer and a strength. Odd sizes: the upsample's
+ * last column and row. */
+TEST_CASE(depth_layouts_and_background_spellings_give_the_same_ao) {
+    const int sizes[2][2] = {{64, 48}, {65, 47}};
+    /* the view's floor reaches from 4.25 to 8.2: the far part is background */
+    const float far = 7.0f;
+    const float spellings[7] = {0.0f, -1.0f, NAN, INFINITY, -INFINITY, far, 1e30f};
+    for (int s = 0; s < 2; s++) {
+        scene_view view;
+        float *depth, *normal;
+        render_standard_view(boxes_scene(), sizes[s][0], sizes[s][1], &view, &depth, &normal);
+        const int w = view.width, h = view.height;
+        float *back = malloc((size_t)w * h * sizeof(float));
+        float *rgba = malloc((size_t)w * h * 4 * sizeof(float));
+        float *back_pairs = malloc((size_t)w * h * 2 * sizeof(float));
+        int background = 0;
+        for (int j = 0; j < h; j++) {
+            for (int i = 0; i < w; i++) {
+                const size_t k = (size_t)j * w + i, flipped = (size_t)(h - 1 - j) * w + i;
+                const int sky = !(depth[k] > 0.0f && depth[k] < far);
+                background += sky;
+                if (sky) depth[k] = 0.0f;
+                back[k] = sky ? 0.0f : depth[k] + 0.05f;
+                rgba[4 * flipped] = sky ? spellings[k % 7] : depth[k];
+                rgba[4 * flipped + 1] = rgba[4 * flipped + 2] = rgba[4 * flipped + 3] = 7.0f;
+                back_pairs[2 * flipped] = sky ? spellings[(k + 1) % 7] : back[k];
+                back_pairs[2 * flipped + 1] = -3.0f;
+            }
+        }
+        CHECK(background > w * h / 10 && background < w * h * 9 / 10);
+        const hbao_channel d = {rgba + 4 * (size_t)(h - 1) * w, 4, -4 * (int64_t)w};
+        const hbao_channel b = {back_pairs + 2 * (size_t)(h - 1) * w, 2, -2 * (int64_t)w};
+        const hbao_channel n = {normal, 3, 3 * (int64_t)w};
+        for (int variant = 0; variant < 8; variant++) {
+            hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+            p.background_depth = far;
+            p.half_resolution = variant & 1;
+            p.strength = variant & 2 ? 1.5f : 1.0f;
+            const int layered = (variant & 4) != 0;
+            float *expected = run_layers(&p, &view, depth, normal, layered ? back : NULL);
+            float *ao = malloc((size_t)w * h * sizeof(float));
+            CHECK_RESULT(
+                hbao_compute_layers(&p, &view.camera, w, h, &d, &n, layered ? &b : NULL, ao, w),
+                HBAO_SUCCESS);
+            int differ = 0, occluded = 0;
+            for (int k = 0; k < w * h; k++) {
+                differ += memcmp(&ao[k], &expected[k], sizeof(float)) != 0;
+                occluded += expected[k] < 0.9f;
+            }
+            if (differ)
+                printf("  %dx%d, half %d, strength %g, layered %d: %d pixels differ\n", w, h,
+                       p.half_resolution, (double)p.strength, layered, differ);
+            CHECK(occluded > w * h / 50);
+            CHECK(differ == 0);
+            free(expected);
+            free(ao);
+        }
+        free(back);
+        free(rgba);
+        free(back_pairs);
+        free(depth);
+        free(normal);
+    }
+}
+
 /* Normals read as x, y, z three floats apart (normals.c's vector read of a
  * whole chunk) or in any other layout (four floats a pixel, rows bottom-up,
  * a row shorter than a chunk): the same AO, to the bit. */
@@ -1505,6 +1575,7 @@ TEST_MAIN(TEST_ENTRY(plane_facing_camera_is_unoccluded), TEST_ENTRY(tilted_plane
           TEST_ENTRY(random_and_degenerate_inputs_give_finite_ao_in_range),
           TEST_ENTRY(identical_output_for_any_thread_count),
           TEST_ENTRY(bottom_up_rows_with_negative_stride),
+          TEST_ENTRY(depth_layouts_and_background_spellings_give_the_same_ao),
           TEST_ENTRY(normal_layouts_give_the_same_ao),
           TEST_ENTRY(normals_of_any_finite_length_give_the_same_ao),
           TEST_ENTRY(half_resolution_is_close_to_full), TEST_ENTRY(blur_keeps_depth_edges),

@@ -82,7 +82,7 @@ static void compare_copies(const hbao_grid *g, const float *depth, const float *
             settings.strength = 1.0f;
             settings.threads = 1;
             settings.implementation = HBAO_IMPLEMENTATION_SCALAR;
-            CHECK_RESULT(hbao_finish(&settings, &grid, raw, depth, w, h, reference, w),
+            CHECK_RESULT(hbao_finish(&settings, &grid, raw, NULL, w, h, reference, w),
                          HBAO_SUCCESS);
             int blurred = 0;
             for (int k = 0; k < w * h; k++) blurred += depth[k] > 0.0f && reference[k] != raw[k];
@@ -91,7 +91,7 @@ static void compare_copies(const hbao_grid *g, const float *depth, const float *
                  implementation <= HBAO_IMPLEMENTATION_AVX512; implementation++) {
                 settings.implementation = implementation;
                 settings.threads = implementation == HBAO_IMPLEMENTATION_AVX2 ? 1 : 2;
-                CHECK_RESULT(hbao_finish(&settings, &grid, raw, depth, w, h, out, w), HBAO_SUCCESS);
+                CHECK_RESULT(hbao_finish(&settings, &grid, raw, NULL, w, h, out, w), HBAO_SUCCESS);
                 int differ = 0;
                 for (int k = 0; k < w * h; k++) differ += memcmp(&out[k], &reference[k], 4) != 0;
                 if (differ)
@@ -231,7 +231,7 @@ TEST_CASE(blur_follows_its_formula) {
                     settings.strength = 1.0f;
                     settings.threads = threads;
                     settings.implementation = implementation;
-                    CHECK_RESULT(hbao_finish(&settings, &grid, raw, depth, w, h, out, w),
+                    CHECK_RESULT(hbao_finish(&settings, &grid, raw, NULL, w, h, out, w),
                                  HBAO_SUCCESS);
                     int off = 0;
                     double worst = 0.0;
@@ -299,6 +299,7 @@ TEST_CASE(upsample_weights_are_bilinear_on_a_flat_depth) {
     for (size_t size = 0; size < sizeof sizes / sizeof sizes[0]; size++) {
         const int width = sizes[size][0], height = sizes[size][1];
         const hbao_grid half = half_grid_of(width, height, half_depth);
+        const hbao_channel guide = {full_depth, 1, width};
         for (int k = 0; k < width * height; k++) full_depth[k] = 2.0f;
         for (int r = 0; r < half.height; r++) {
             for (int k = 0; k < half.width; k++) {
@@ -311,7 +312,7 @@ TEST_CASE(upsample_weights_are_bilinear_on_a_flat_depth) {
             const int copy = hbao_finish_implementation(implementation);
             int wrong = 0;
             for (int j = 0; j < height; j++) {
-                hbao_upsample_row(copy, &half, half_ao, full_depth, width, j, row);
+                hbao_upsample_row(copy, &half, half_ao, &guide, INFINITY, width, j, row);
                 /* the half-grid position, the last column and row held */
                 const double y = j / 2 + 1 < half.height ? 0.5 * j : (double)(j / 2);
                 for (int i = 0; i < width; i++) {
@@ -392,6 +393,7 @@ TEST_CASE(upsample_weighs_depth_as_documented) {
     for (size_t size = 0; size < sizeof sizes / sizeof sizes[0]; size++) {
         const int width = sizes[size][0], height = sizes[size][1];
         const hbao_grid half = half_grid_of(width, height, half_depth);
+        const hbao_channel guide = {full_depth, 1, width};
         compared += width * height;
         /* the upper half's depths by column only: samples above each other
          * tie in depth */
@@ -417,7 +419,7 @@ TEST_CASE(upsample_weighs_depth_as_documented) {
             const int copy = hbao_finish_implementation(implementation);
             int off = 0;
             for (int j = 0; j < height; j++) {
-                hbao_upsample_row(copy, &half, half_ao, full_depth, width, j, row);
+                hbao_upsample_row(copy, &half, half_ao, &guide, INFINITY, width, j, row);
                 for (int i = 0; i < width; i++) {
                     double sum, gap;
                     const double expected = documented_upsample(
