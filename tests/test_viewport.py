@@ -167,6 +167,16 @@ def test_a_maximized_view_keeps_its_preview(toggle_report):
     assert toggle_report["maximized_keeps_settings"] is True
 
 
+def test_a_preview_turned_on_while_maximized_stays_on_back_home(toggle_report):
+    """A view that never had the preview, turned on while maximized: back in
+    its layout it still has it (it was lost with the temporary screen)."""
+    assert toggle_report["fresh_view_had_settings"] is False
+    assert toggle_report["fresh_on_while_maximized"] is True
+    assert toggle_report["fresh_back_home"] is True
+    assert toggle_report["fresh_keeps_preview_at_home"] is True
+    assert toggle_report["fresh_is_another_entry"] is True
+
+
 def test_user_orthographic_view_is_darkened_too(toggle_report):
     """A user's orthographic view clips about its pivot: depths from the pivot
     are negative in front of it, which the preview took for background (no

@@ -126,6 +126,7 @@ def run():
         "preview_errors": sorted(draw._reported_errors),
     })
     user_orthographic(window, area, report, shot_path)
+    turned_on_while_maximized(window, area, report)
     print(json.dumps(report, indent=2))
     out_path.write_text(json.dumps(report, indent=2))
 
@@ -150,6 +151,38 @@ def user_orthographic(window, area, report, shot_path):
     darker = on.mean(axis=2) < off.mean(axis=2) - 2.0 / 255.0
     report["ortho_darkened_fraction"] = float(darker.mean())
     region.view_perspective = "CAMERA"
+
+
+def turned_on_while_maximized(window, area, report):
+    """A view that never had the preview, turned on while maximized: on
+    return to its layout the view keeps it (its settings are made on the
+    home screen, in the place the view comes back to)."""
+    with override(window, area):
+        bpy.ops.screen.back_to_previous()
+    home = window.screen
+    # a fresh 3D view: the timeline's area turned into one
+    fresh = next(a for a in home.areas if a.type == "DOPESHEET_EDITOR")
+    fresh.type = "VIEW_3D"
+    view_settings_module = sys.modules["hbao.viewport.settings"]
+    report["fresh_view_had_settings"] = view_settings_module.find(home, fresh) is not None
+    with override(window, fresh):
+        bpy.ops.screen.screen_full_area(use_hide_panels=False)
+    maximized = view_3d(window)
+    with override(window, maximized):
+        bpy.ops.hbao.viewport_preview_toggle()
+    on = view_settings_module.find(window.screen, maximized)
+    report["fresh_on_while_maximized"] = on is not None and on.enabled
+    with override(window, maximized):
+        bpy.ops.screen.back_to_previous()
+    back = view_settings_module.find(window.screen, fresh)
+    report["fresh_back_home"] = window.screen == home
+    report["fresh_keeps_preview_at_home"] = back is not None and back.enabled
+    report["fresh_is_another_entry"] = back is not None and back.name != \
+        view_settings_module.find(home, view_3d_other(home, fresh)).name
+
+
+def view_3d_other(screen, besides):
+    return next(a for a in screen.areas if a.type == "VIEW_3D" and a != besides)
 
 
 def step():

@@ -23,6 +23,9 @@ from ..node import hbao_nodes
 from ..parameters import FALLOFF_ITEMS, INTEGRATION_ITEMS
 
 COLLECTION_NAME = "hbao_viewport_views"
+# Blender names a maximized or full-screen area's temporary screen
+# "<home screen>-nonnormal".
+TEMPORARY_SUFFIX = "-nonnormal"
 
 # (screen pointer, area pointer) -> entry name, for the areas seen this session.
 _entry_by_area = {}
@@ -155,7 +158,21 @@ def find(screen, area):
 def _temporary(screen):
     """A screen Blender makes for a maximized (Ctrl+Space, show_fullscreen)
     or full-screen (Ctrl+Alt+Space) area: it names both "<screen>-nonnormal"."""
-    return getattr(screen, "show_fullscreen", False) or screen.name.endswith("-nonnormal")
+    return getattr(screen, "show_fullscreen", False) or screen.name.endswith(TEMPORARY_SUFFIX)
+
+
+def _home_place(screen):
+    """The home screen of temporary `screen` and the area there that its view
+    left (Blender leaves an empty area in its place, and moves the view back
+    into it on return), or (None, None) where either is not found: a home
+    name too long to be kept whole, or no single empty area."""
+    if not screen.name.endswith(TEMPORARY_SUFFIX):
+        return None, None
+    home = bpy.data.screens.get(screen.name[:-len(TEMPORARY_SUFFIX)])
+    if home is None or home == screen:
+        return None, None
+    empty = [area for area in home.areas if area.type == "EMPTY"]
+    return (home, empty[0]) if len(empty) == 1 else (None, None)
 
 
 def _find_on_screen(screen, area):
@@ -180,9 +197,17 @@ def _find_on_screen(screen, area):
 
 def ensure(screen, area):
     """The settings of the 3D view in `area`, created if needed (writes the
-    Screen: call from operators, not from draw code)."""
+    Screen: call from operators, not from draw code). A maximized view's
+    are made on its home screen (_home_place), so that they are still
+    there when the view comes back."""
     entry = find(screen, area)
     if entry is not None:
+        return entry
+    home, place = _home_place(screen) if _temporary(screen) else (None, None)
+    space = area.spaces.active
+    if home is not None and space is not None:
+        entry = ensure(home, place)
+        _entry_by_space[space.as_pointer()] = (home.name, entry.name)
         return entry
     views = _views(screen)
     existing = {entry.name for entry in views}
