@@ -142,8 +142,9 @@ typedef struct hbao_params {
     /** How strongly the blur stops at depth edges; 0 = plain Gaussian.
      *  Clamped to [0, 1000]. */
     float blur_sharpness;
-    /** Non-zero: AO at half resolution, then a depth-aware upsample and the
-     *  blur at full resolution. */
+    /** Non-zero: AO at half resolution (every other pixel of every other
+     *  row), blurred there with half the taps (the same reach), then a
+     *  depth-aware upsample to full resolution. */
     int32_t half_resolution;
     /** Applied last: ao = ao^strength. 0 = no AO, 1 = as computed, larger =
      *  darker. Clamped to [0, 16]. */
@@ -395,7 +396,9 @@ HBAO_EXPORT hbao_result hbao_camera_crop(const hbao_camera *camera, int32_t full
  *                       data NULL) = face normals reconstructed from depth.
  *                       A normal shorter than 0.1 (anti-aliased edges,
  *                       background) or not finite is reconstructed too.
- * @param ao             output, width x height floats, caller-allocated
+ * @param ao             output, width x height floats, caller-allocated; it
+ *                       may share memory with the inputs (the AO written over
+ *                       its own depth): the result is the same
  * @param ao_row_stride  floats from one output row to the next (|s| >= width)
  */
 HBAO_EXPORT hbao_result hbao_compute(const hbao_params *params, const hbao_camera *camera,

@@ -54,8 +54,8 @@ typedef struct depth_job {
 } depth_job;
 
 /* Dense depth (hbao_depth_value). The stage is bound by memory: the dense
- * row's loop vectorized (this file at -O3 -fno-trapping-math) timed the
- * same, bench_ab_copies.sh 0.998 on 1 and 2 threads. */
+ * row's loop vectorized (this file compiled at -O3 -fno-trapping-math, as a
+ * trial) timed the same, bench_ab_copies.sh 0.998 on 1 and 2 threads. */
 static void convert_depth_row(void *context, int j) {
     const depth_job *job = context;
     const float *row = job->source->data + (int64_t)j * job->source->row_stride;
@@ -70,9 +70,9 @@ static void convert_depth_row(void *context, int j) {
         out[i] = hbao_depth_value(row[(int64_t)i * stride], background);
 }
 
-/* Whether back depth b is known behind the front depth (hbao_depth_value's):
- * finite, behind the visible surface, not background, and the pixel not
- * background. */
+/* The back layer's value for back depth b behind front depth `front`
+ * (hbao_depth_value's): b where it is known (finite, behind the visible
+ * surface, not background, and the pixel not background), else INFINITY. */
 static inline float back_value(float front, float b, float background) {
     const int known = front > 0.0f && isfinite(b) && b > front && b < background;
     return known ? b : INFINITY;
@@ -123,6 +123,31 @@ static void half_depth_row(void *context, int j) {
     float *back_out = job->half_back + at;
     for (int i = 0; i < job->half->width; i++)
         back_out[i] = back_value(out[i], backs[(int64_t)i * back_stride], job->background_depth);
+}
+
+/* The first and last byte address that a channel's pixels (`channels`
+ * floats each) span, from its strides; in uintptr_t arithmetic, exact for
+ * any buffer that the address space can hold. */
+static void channel_bytes(const float *data, int32_t pixel_stride, int64_t row_stride, int width,
+                          int height, int channels, uintptr_t *first, uintptr_t *last) {
+    const int64_t rows = (int64_t)(height - 1) * row_stride; /* stride_fits: in range */
+    const int64_t low = rows < 0 ? rows : 0;
+    const int64_t high = (rows > 0 ? rows : 0) + (int64_t)(width - 1) * pixel_stride + channels - 1;
+    const uintptr_t base = (uintptr_t)data;
+    *first = base + (uintptr_t)low * sizeof(float);
+    *last = base + (uintptr_t)high * sizeof(float) + (sizeof(float) - 1);
+}
+
+/* Whether the output's floats share memory with the depth channel's: the
+ * half resolution's upsample reads the depth rows while other rows of the
+ * output are written (upsample.c), so that depth is then copied first. */
+static int output_overlaps_depth(const hbao_channel *depth, const float *ao, int64_t ao_row_stride,
+                                 int width, int height) {
+    uintptr_t depth_first, depth_last, ao_first, ao_last;
+    channel_bytes(depth->data, depth->pixel_stride, depth->row_stride, width, height, 1,
+                  &depth_first, &depth_last);
+    channel_bytes(ao, 1, ao_row_stride, width, height, 1, &ao_first, &ao_last);
+    return depth_first <= ao_last && ao_first <= depth_last;
 }
 
 static int any_finite(const float *values, size_t count) {
@@ -180,6 +205,7 @@ hbao_result hbao_compute_layers(const hbao_params *params, const hbao_camera *ca
 
     /* The raw AO on the grid; the later stages (blur.c) turn it into the
      * output row by row, with no other full-size buffer. */
+    float *guide_copy = NULL; /* the upsample's, where it needs one (below) */
     float *grid_depth = hbao_scratch_take(grid_pixels * sizeof(float));
     float *grid_ao = hbao_scratch_take(grid_pixels * sizeof(float));
     float *grid_back = back_depth != NULL ? hbao_scratch_take(grid_pixels * sizeof(float)) : NULL;
@@ -192,6 +218,19 @@ hbao_result hbao_compute_layers(const hbao_params *params, const hbao_camera *ca
         goto done;
     }
 
+    /* The upsample's guide: the caller's depth, or where the output
+     * overlaps it (computed in place), a converted copy taken first. */
+    hbao_channel guide = *depth;
+    if (s.half_resolution && output_overlaps_depth(depth, ao, ao_row_stride, width, height)) {
+        guide_copy = hbao_scratch_take((size_t)width * height * sizeof(float));
+        if (guide_copy == NULL) {
+            result = HBAO_ERROR_OUT_OF_MEMORY;
+            goto done;
+        }
+        depth_job convert = {depth, s.background_depth, width, guide_copy};
+        hbao_parallel_rows(s.threads, height, convert_depth_row, &convert);
+        guide = (hbao_channel){guide_copy, 1, width}; /* background already 0 */
+    }
     if (s.half_resolution) {
         half_depth_job halve = {depth, back_depth, s.background_depth, &grid, grid_back};
         hbao_parallel_rows(s.threads, grid.height, half_depth_row, &halve);
@@ -210,9 +249,10 @@ hbao_result hbao_compute_layers(const hbao_params *params, const hbao_camera *ca
     hbao_compute_normals(&s, camera, &grid, normal, scale);
 
     hbao_compute_horizons(&s, &grid, grid_ao);
-    result = hbao_finish(&s, &grid, grid_ao, depth, width, height, ao, ao_row_stride);
+    result = hbao_finish(&s, &grid, grid_ao, &guide, width, height, ao, ao_row_stride);
 
 done:
+    hbao_scratch_give(guide_copy);
     hbao_scratch_give(grid_depth);
     hbao_scratch_give(grid_ao);
     hbao_scratch_give(grid_back);

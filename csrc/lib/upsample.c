@@ -1,9 +1,9 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
 /* Joint bilateral upsampling (Kopf et al. 2007) of half-resolution AO, guided
  * by the caller's full-resolution depth (guide_depth) so that AO does not
- * bleed across edges. One
- * full-resolution row at a time, written straight into the caller's output
- * (blur.c): the AO arrives already blurred on the half grid. */
+ * bleed across edges. One full-resolution row at a time, written straight
+ * into the caller's output (blur.c): the AO arrives already blurred on the
+ * half grid. */
 #include <float.h>
 #include <math.h>
 
@@ -51,7 +51,8 @@ static HBAO_ALWAYS_INLINE float finish_pixel(float z, float sum, float weight_su
  * pipeline uses it (hbao_depth_value: background is 0). The upsample reads
  * the caller's depth channel itself: no converted full-size copy is made at
  * half resolution (bench_ab, 1080p defaults at half resolution, 0.955 on 2
- * threads, 1.009 on 1; docs/speed.md, session 26). */
+ * threads, 0.952-0.960 on 1; docs/speed.md, session 26). Where the output
+ * overlaps that depth, compute.c hands a copy instead. */
 static HBAO_ALWAYS_INLINE float guide_depth(const float *z_row, int64_t stride, float background,
                                             int i) {
     return hbao_depth_value(z_row[(int64_t)i * stride], background);
