@@ -22,6 +22,8 @@ import bpy
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import blender_scenes  # noqa: E402  (needs the path above)
+from blender_arguments import (  # noqa: E402
+    ArgumentError, ArgumentParser, end_blender, script_arguments)
 
 EXIT_BAD_ARGUMENTS = 2
 EXIT_FAILED = 1
@@ -29,22 +31,6 @@ EXIT_FAILED = 1
 # Blender's image_settings.color_depth values for OpenEXR.
 HALF_FLOAT_DEPTH = "16"
 FULL_FLOAT_DEPTH = "32"
-
-
-class ArgumentError(Exception):
-    pass
-
-
-class ArgumentParser(argparse.ArgumentParser):
-    """argparse that raises instead of exiting, so Blender quits with our status."""
-
-    def error(self, message):
-        raise ArgumentError(message)
-
-    def exit(self, status=0, message=None):
-        if message:
-            print(message, end="", file=sys.stderr if status else sys.stdout)
-        raise SystemExit(status)
 
 
 def exr_codecs():
@@ -93,10 +79,6 @@ def parse_arguments(argv):
     if (arguments.width is None) != (arguments.height is None):
         parser.error("give both --width and --height, or neither")
     return arguments
-
-
-def script_arguments():
-    return sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
 
 
 def output_paths(out, force, png):
@@ -187,10 +169,4 @@ def main():
 
 
 if __name__ == "__main__":
-    status = main()
-    sys.stdout.flush()
-    sys.stderr.flush()
-    if status:
-        # sys.exit inside --python does not always end Blender with our status;
-        # os._exit does, once the streams are flushed.
-        os._exit(status)
+    end_blender(main())

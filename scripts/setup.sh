@@ -29,6 +29,8 @@ PACKAGES=(
     python3-pycodestyle  # the PEP 8 check of the test suite
     xvfb xauth         # F12 and viewport tests in a real window
     xdotool            # tests/test_faults_ui.py: a real Escape key press during F12
+    time               # scripts/soak.sh: GNU time's peak memory of each run
+    binutils           # readelf: tests/test_cli.py checks where the tool finds libhbao
 )
 
 missing=()

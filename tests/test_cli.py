@@ -897,6 +897,41 @@ def test_unwritable_output_folder_is_an_error(hbao_tool, tmp_path):
     assert_clean_error(completed, EXIT_RUNTIME, "no_such_folder")
 
 
+def test_the_tool_runs_from_a_workers_folder_and_an_install_prefix(hbao_tool, tmp_path):
+    """A render farm worker gets hbao and libhbao.so.0 in one folder, or a
+    `cmake --install` prefix: the tool finds its library there ($ORIGIN),
+    from any working directory, and never in the working directory itself
+    (an empty RUNPATH entry would read as ".")."""
+    runpath = subprocess.run(["readelf", "-d", str(hbao_tool)], stdout=subprocess.PIPE,
+                             text=True, check=True).stdout
+    entries = [line.split("[", 1)[1].rstrip("]").split(":") for line in runpath.splitlines()
+               if "RUNPATH" in line or "RPATH" in line]
+    assert entries and "" not in entries[0] and entries[0][0] == "$ORIGIN", runpath
+    worker = tmp_path / "worker"
+    worker.mkdir()
+    shutil.copyfile(hbao_tool, worker / "hbao")
+    (worker / "hbao").chmod(0o755)
+    shutil.copyfile(hbao_tool.parent / "libhbao.so.0", worker / "libhbao.so.0")
+    prefix = tmp_path / "prefix"
+    installed = subprocess.run(["cmake", "--install", str(hbao_tool.parent), "--prefix",
+                                str(prefix)], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                               text=True)
+    assert installed.returncode == 0, installed.stdout
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    expected = tmp_path / "built.exr"
+    compute_ao(hbao_tool, "cycles_float_zip", expected)
+    for place, tool in (("worker", worker / "hbao"), ("prefix", prefix / "bin" / "hbao")):
+        output = tmp_path / f"{place}.exr"
+        completed = subprocess.run(
+            [str(tool), str(fixture_path("cycles_float_zip")), "-o", str(output), "--camera",
+             str(camera_path("cycles_float_zip"))], cwd=elsewhere, stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE, text=True, timeout=TOOL_TIMEOUT_S,
+            env={k: v for k, v in os.environ.items() if k != "LD_LIBRARY_PATH"})
+        assert completed.returncode == 0, completed.stderr
+        assert output.read_bytes() == expected.read_bytes()
+
+
 # --- sequences -------------------------------------------------------------------
 
 def sequence_folder(tmp_path):
@@ -1073,6 +1108,123 @@ def test_sequence_redoes_frames_computed_with_another_camera(hbao_tool, tmp_path
         run_ok(hbao_tool, fixture_path(name), "-o", single, "--camera", camera_file)
         assert (folder / "ao_0001.exr").read_bytes() == single.read_bytes()
     assert "up to date" not in run().stderr
+
+
+def turned_camera(name, degrees):
+    """The fixture's camera turned about its own vertical axis."""
+    camera = json.loads(camera_path(name).read_text())
+    angle = np.radians(degrees)
+    turn = np.array([[np.cos(angle), 0, np.sin(angle), 0], [0, 1, 0, 0],
+                     [-np.sin(angle), 0, np.cos(angle), 0], [0, 0, 0, 1]])
+    camera["world_to_camera"] = (turn @ np.array(camera["world_to_camera"])).tolist()
+    return camera
+
+
+def test_sequence_takes_each_frames_camera_from_a_pattern(hbao_tool, tmp_path):
+    """An animated camera: --camera 'cam_#.json' gives each frame its own
+    camera file (the normals' rotation differs per frame), and a frame whose
+    camera file is missing fails alone. A rerun skips the frames whose camera
+    held the same, and recomputes one whose camera changed."""
+    name = "cycles_float_zip"
+    for frame in (1, 2, 3):
+        shutil.copyfile(fixture_path(name), tmp_path / f"in_{frame}.exr")
+    shutil.copyfile(camera_path(name), tmp_path / "cam_1.json")
+    (tmp_path / "cam_2.json").write_text(json.dumps(turned_camera(name, 20)))
+
+    def run(*extra):
+        return run_tool(hbao_tool, tmp_path / "in_#.exr", "-o", tmp_path / "ao_#.exr",
+                        "--frames", "1-3", "--camera", tmp_path / "cam_#.json", *extra)
+
+    completed = run()
+    assert_clean_error(completed, EXIT_RUNTIME, "1 of 3 frames failed: 3", "cam_3.json")
+    for frame in (1, 2):
+        single = tmp_path / f"single_{frame}.exr"
+        run_ok(hbao_tool, fixture_path(name), "-o", single, "--camera",
+               tmp_path / f"cam_{frame}.json")
+        assert (tmp_path / f"ao_{frame}.exr").read_bytes() == single.read_bytes()
+    assert (tmp_path / "ao_1.exr").read_bytes() != (tmp_path / "ao_2.exr").read_bytes()
+    assert not (tmp_path / "ao_3.exr").exists()
+
+    (tmp_path / "cam_2.json").write_text(json.dumps(turned_camera(name, 40)))
+    long_ago = 10**9 * 10**9  # older than every output: only its contents changed
+    os.utime(tmp_path / "cam_2.json", ns=(long_ago, long_ago))
+    shutil.copyfile(camera_path(name), tmp_path / "cam_3.json")
+    again = run()
+    assert again.returncode == 0, again.stderr
+    assert "frame 1: " in again.stderr and again.stderr.count("is up to date, skipped") == 1
+    single = tmp_path / "single_2b.exr"
+    run_ok(hbao_tool, fixture_path(name), "-o", single, "--camera", tmp_path / "cam_2.json")
+    assert (tmp_path / "ao_2.exr").read_bytes() == single.read_bytes()
+    assert (tmp_path / "ao_3.exr").read_bytes() == (tmp_path / "ao_1.exr").read_bytes()
+
+
+def test_sequence_refuses_an_output_that_is_another_frames_camera(hbao_tool, tmp_path):
+    """-o 'x_#.exr' with --camera 'x_#0.exr' --frames 1-10: frame 10's output
+    would replace frame 1's camera file before frame 1 reads it."""
+    for frame in range(1, 11):
+        shutil.copyfile(fixture_path("cycles_float_zip"), tmp_path / f"in_{frame}.exr")
+    completed = run_tool(hbao_tool, tmp_path / "in_#.exr", "-o", tmp_path / "x_#.exr",
+                         "--frames", "1-10", "--camera", tmp_path / "x_#0.exr")
+    assert_clean_error(completed, EXIT_USAGE, "is the --camera file of frame 1")
+    assert not list(tmp_path.glob("x_*"))
+
+
+EXPORT_CAMERAS = SCRIPTS / "export_cameras.py"
+SCRIPTS_IN_BLENDER = Path(__file__).resolve().parent / "blender_scripts"
+
+
+@pytest.mark.matrix
+def test_export_cameras_writes_each_frames_camera(hbao_tool, run_in_blender, blender,
+                                                  tmp_path):
+    """scripts/export_cameras.py on a .blend whose camera turns and zooms
+    (and a marker switches cameras): each frame's file holds the camera
+    Blender evaluates at that frame, which the CLI's sequence reads per frame;
+    a rerun leaves files that would not change as they are."""
+    blend, expected_path = tmp_path / "anim.blend", tmp_path / "expected.json"
+    run_in_blender(SCRIPTS_IN_BLENDER / "animated_camera.py", blend, expected_path,
+                   addon=False)
+    expected = json.loads(expected_path.read_text())
+    pattern = tmp_path / "cams" / "cam_##.json"
+    run_in_blender(EXPORT_CAMERAS, pattern, blend=blend)
+    cameras = {}
+    for frame in range(1, 5):
+        cameras[frame] = json.loads((tmp_path / "cams" / f"cam_{frame:02d}.json").read_text())
+        assert np.allclose(cameras[frame]["world_to_camera"],
+                           expected[str(frame)]["world_to_camera"], atol=1e-5), frame
+        assert cameras[frame]["lens"] == pytest.approx(expected[str(frame)]["lens"])
+    assert not np.allclose(cameras[1]["world_to_camera"], cameras[3]["world_to_camera"])
+    assert cameras[3]["lens"] == pytest.approx(1.5 * cameras[1]["lens"])
+    assert not np.allclose(cameras[3]["world_to_camera"], cameras[4]["world_to_camera"])
+    times = {p: p.stat().st_mtime_ns for p in (tmp_path / "cams").iterdir()}
+    again = run_in_blender(EXPORT_CAMERAS, pattern, "--frames", "2-3,1", blend=blend)
+    assert "0 files written, 3 already up to date" in again.stdout
+    assert {p: p.stat().st_mtime_ns for p in (tmp_path / "cams").iterdir()} == times
+    for frame in range(1, 5):
+        shutil.copyfile(fixture_path("cycles_float_zip"), tmp_path / f"in_{frame}.exr")
+    run_ok(hbao_tool, tmp_path / "in_#.exr", "-o", tmp_path / "ao_#.exr", "--frames", "1-4",
+           "--camera", tmp_path / "cams" / "cam_##.json")
+
+
+@pytest.mark.parametrize("arguments, status, fragment", [
+    (["cam.json"], EXIT_USAGE, "needs a run of '#'"),
+    (["cam_#.json", "--frames", "3-1"], EXIT_USAGE, "first to last"),
+    (["cam_#.json", "--frames", "1-3,2"], EXIT_USAGE, "overlap"),
+])
+def test_export_cameras_refuses_bad_arguments(run_blender, tmp_path, arguments, status,
+                                              fragment):
+    completed = run_blender(EXPORT_CAMERAS, *arguments, check=False)
+    assert completed.returncode == status, completed.stdout
+    assert fragment in completed.stdout
+
+
+def test_export_cameras_says_which_frame_has_no_camera(run_blender, tmp_path):
+    blend = tmp_path / "none.blend"
+    run_blender(SCRIPTS_IN_BLENDER / "animated_camera.py", blend, tmp_path / "unused.json",
+                "--no-camera", addon=False)
+    completed = run_blender(EXPORT_CAMERAS, tmp_path / "c_#.json", "--frames", "1",
+                            check=False, blend=blend)
+    assert completed.returncode == 1 and "has no camera at frame 1" in completed.stdout
+    assert not list(tmp_path.glob("c_*"))
 
 
 def test_sequence_redoes_a_preview_older_than_its_exr(hbao_tool, tmp_path):

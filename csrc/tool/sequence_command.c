@@ -80,19 +80,31 @@ static void report(sequence_run *run, const frame_outcome *outcome, const char *
     pthread_mutex_unlock(&run->lock);
 }
 
+/* A --camera name with a '#' run names each frame's own camera file, as
+ * the input names its render (an animated camera: scripts/export_cameras.py
+ * writes them); without one, every frame has the same camera, read once. */
+static bool per_frame_camera(const cli_options *options) {
+    return options->camera_path != NULL && frame_pattern_has_frame(options->camera_path);
+}
+
 static void run_frame(sequence_run *run, frame_outcome *outcome) {
     const cli_options *options = run->options;
-    char input[PATH_MAX], output[PATH_MAX], preview[PATH_MAX];
+    char input[PATH_MAX], output[PATH_MAX], preview[PATH_MAX], camera[PATH_MAX];
     cli_options frame = *options;
     tool_error error = {{0}};
     frame.mode = TOOL_MODE_COMPUTE;
     frame.input_path = input;
     frame.output_path = output;
     frame.preview_path = options->preview_path ? preview : NULL;
+    /* a camera per frame (an animated camera): read by the frame itself */
+    const bool camera_per_frame = per_frame_camera(options);
+    if (camera_per_frame) frame.camera_path = camera;
     if (!frame_pattern_path(options->input_path, outcome->frame, input, sizeof input) ||
         !frame_pattern_path(options->output_path, outcome->frame, output, sizeof output) ||
         (options->preview_path != NULL &&
-         !frame_pattern_path(options->preview_path, outcome->frame, preview, sizeof preview))) {
+         !frame_pattern_path(options->preview_path, outcome->frame, preview, sizeof preview)) ||
+        (camera_per_frame &&
+         !frame_pattern_path(options->camera_path, outcome->frame, camera, sizeof camera))) {
         outcome->status = tool_fail(&error, TOOL_EXIT_USAGE, "a path is too long");
     } else if (!options->force && up_to_date(&frame)) {
         outcome->skipped = true;
@@ -159,8 +171,13 @@ static const char *canonical_pattern(const char *pattern, char out[PATH_MAX]) {
 }
 
 static int refuse_other_frames_files(const cli_options *options, int64_t count, tool_error *error) {
-    char canonical[3][PATH_MAX];
-    const char *input = canonical_pattern(options->input_path, canonical[0]);
+    char canonical[4][PATH_MAX];
+    /* the frames' input files: renders, and cameras where each has its own */
+    const char *inputs[2] = {canonical_pattern(options->input_path, canonical[0]),
+                             per_frame_camera(options)
+                                 ? canonical_pattern(options->camera_path, canonical[3])
+                                 : NULL};
+    const char *input_names[2] = {"input", "--camera file"};
     const char *patterns[2] = {canonical_pattern(options->output_path, canonical[1]),
                                canonical_pattern(options->preview_path, canonical[2])};
     const char *flags[2] = {"-o", "--preview"};
@@ -171,12 +188,13 @@ static int refuse_other_frames_files(const cli_options *options, int64_t count, 
             if (patterns[k] == NULL || !frame_pattern_path(patterns[k], frame, path, sizeof path))
                 continue;
             int32_t other;
-            if (frame_pattern_frame(input, path, &other) && other != frame &&
-                frame_list_contains(&options->frames, other))
-                return tool_fail(error, TOOL_EXIT_USAGE,
-                                 "%s of frame %d (%s) is the input of frame %d: it would be "
-                                 "replaced before it is read",
-                                 flags[k], (int)frame, path, (int)other);
+            for (int in = 0; in < 2; ++in)
+                if (inputs[in] != NULL && frame_pattern_frame(inputs[in], path, &other) &&
+                    other != frame && frame_list_contains(&options->frames, other))
+                    return tool_fail(error, TOOL_EXIT_USAGE,
+                                     "%s of frame %d (%s) is the %s of frame %d: it would be "
+                                     "replaced before it is read",
+                                     flags[k], (int)frame, path, input_names[in], (int)other);
             const char *pattern = patterns[1 - k];
             if (pattern != NULL && frame_pattern_frame(pattern, path, &other) && other != frame &&
                 frame_list_contains(&options->frames, other))
@@ -202,7 +220,7 @@ int sequence_command(const cli_options *options, tool_error *error) {
 
     cli_options shared = *options;
     camera_settings camera_file;
-    if (options->camera_path != NULL) {
+    if (options->camera_path != NULL && !per_frame_camera(options)) {
         camera_settings_init(&camera_file);
         const int status = camera_json_load(options->camera_path, &camera_file, error);
         if (status != TOOL_EXIT_SUCCESS) {

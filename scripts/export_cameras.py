@@ -1,0 +1,148 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Writes a scene's camera, frame by frame, as the JSON that the `hbao` CLI
+reads with --camera: for a sequence whose camera moves (or changes lens, or
+is switched by markers), each frame needs its own.
+
+    blender -b scene.blend [-S SCENE] --python scripts/export_cameras.py -- \\
+        'cam_####.json' [--frames 1-250]
+    hbao 'render_####.exr' -o 'ao_####.exr' --camera 'cam_####.json' --frames 1-250
+
+The run of '#' is the frame number, zero-padded to the run's length, as the
+CLI and Blender name frames. Frames: as the CLI's --frames (1-250,
+1-10,20,30-40); by default the scene's range and step. The scene is the
+file's active one, or the one Blender's -S names (before --python). Each
+frame's camera is the scene's at that frame, evaluated (animation,
+constraints, parents), by the add-on's own camera rule
+(hbao.camera.camera_from_blender). A file that
+already holds what would be written is left as it is, its time too, so that
+a rerun of the CLI's sequence does not recompute that frame; the others are
+written whole (a temporary file renamed over them). Exit status 2 for bad
+arguments, 1 when a frame has no camera the CLI can use or a file cannot be
+written.
+"""
+import argparse
+import json
+import os
+import re
+import sys
+import tempfile
+from pathlib import Path
+
+import bpy
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from blender_arguments import (  # noqa: E402
+    ArgumentError, ArgumentParser, end_blender, script_arguments)
+
+try:
+    import hbao  # noqa: F401  (the enabled add-on, or this checkout's below)
+except ImportError:
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "addon"))
+from hbao import camera as camera_model  # noqa: E402
+
+EXIT_BAD_ARGUMENTS = 2
+EXIT_FAILED = 1
+# The CLI's frames (Blender's MAXFRAME).
+FRAME_MAX = 1048574
+
+
+def frame_list(text):
+    """[frames] of "1-250" or "1-10,20,30-40", in the order given."""
+    frames = []
+    for part in text.split(","):
+        match = re.fullmatch(r"\s*(\d+)\s*(?:-\s*(\d+)\s*)?", part)
+        if match is None:
+            raise argparse.ArgumentTypeError(f"{text!r} is not a frame list like 1-250")
+        first = int(match.group(1))
+        last = int(match.group(2)) if match.group(2) is not None else first
+        if first > last or last > FRAME_MAX:
+            raise argparse.ArgumentTypeError(f"{part.strip()!r}: frames run from 0 to "
+                                             f"{FRAME_MAX}, first to last")
+        frames.extend(range(first, last + 1))
+    if len(set(frames)) != len(frames):
+        raise argparse.ArgumentTypeError(f"{text!r}: ranges overlap")
+    return frames
+
+
+def frame_path(pattern, frame):
+    """`pattern` with its last '#' run replaced by `frame`, zero-padded to
+    the run's length (a longer number in full), as the CLI names frames."""
+    runs = list(re.finditer(r"#+", pattern))
+    run = runs[-1]
+    return pattern[:run.start()] + f"{frame:0{len(run.group())}d}" + pattern[run.end():]
+
+
+def arguments():
+    argv = script_arguments()
+    parser = ArgumentParser(prog="export_cameras.py", description=__doc__.split("\n\n")[0])
+    parser.add_argument("pattern", help="output name with a run of '#' for the frame number")
+    parser.add_argument("--frames", type=frame_list, help="frames to write (default: the "
+                        "scene's range)")
+    parsed = parser.parse_args(argv)
+    if "#" not in parsed.pattern:
+        raise ArgumentError(f"{parsed.pattern!r} needs a run of '#' for the frame number, "
+                            f"e.g. cam_####.json")
+    return parsed
+
+
+def scene_frames(scene):
+    if scene.frame_start < 0:
+        raise ArgumentError(f"the scene's range starts at frame {scene.frame_start}: the CLI "
+                            f"takes frames from 0; give --frames")
+    return list(range(scene.frame_start, scene.frame_end + 1, scene.frame_step))
+
+
+def camera_at(scene, frame):
+    """The scene camera's description at `frame`, evaluated."""
+    scene.frame_set(frame)
+    if scene.camera is None:
+        raise camera_model.CameraError(f"scene {scene.name!r} has no camera at frame {frame}")
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    return camera_model.camera_from_blender(scene, scene.camera.evaluated_get(depsgraph))
+
+
+def write_if_changed(path, text):
+    """Write `text` to `path` whole, unless it already holds it. Returns
+    whether it was written."""
+    try:
+        if path.read_text(encoding="utf-8") == text:
+            return False
+    except (FileNotFoundError, UnicodeDecodeError):
+        pass
+    path.parent.mkdir(parents=True, exist_ok=True)
+    descriptor, temporary = tempfile.mkstemp(prefix=".export-cameras-", dir=path.parent)
+    try:
+        with os.fdopen(descriptor, "w", encoding="utf-8") as stream:
+            stream.write(text)
+        os.replace(temporary, path)
+    except BaseException:
+        os.unlink(temporary)
+        raise
+    return True
+
+
+def main():
+    try:
+        parsed = arguments()
+        scene = bpy.context.scene
+        frames = parsed.frames if parsed.frames is not None else scene_frames(scene)
+    except ArgumentError as error:
+        print(f"export_cameras.py: error: {error}", file=sys.stderr)
+        return EXIT_BAD_ARGUMENTS
+    except SystemExit as done:  # --help
+        return done.code or 0
+    written = 0
+    try:
+        for frame in frames:
+            text = json.dumps(camera_at(scene, frame), indent=2) + "\n"
+            written += write_if_changed(Path(frame_path(parsed.pattern, frame)), text)
+    except (camera_model.CameraError, OSError) as error:
+        print(f"export_cameras.py: error: {error}", file=sys.stderr)
+        return EXIT_FAILED
+    print(f"export_cameras.py: {len(frames)} frames, {written} files written, "
+          f"{len(frames) - written} already up to date")
+    return 0
+
+
+if __name__ == "__main__":
+    end_blender(main())
