@@ -173,10 +173,9 @@ static const char *canonical_pattern(const char *pattern, char out[PATH_MAX]) {
 static int refuse_other_frames_files(const cli_options *options, int64_t count, tool_error *error) {
     char canonical[4][PATH_MAX];
     /* the frames' input files: renders, and cameras where each has its own */
-    const char *inputs[2] = {canonical_pattern(options->input_path, canonical[0]),
-                             per_frame_camera(options)
-                                 ? canonical_pattern(options->camera_path, canonical[3])
-                                 : NULL};
+    const char *inputs[2] = {
+        canonical_pattern(options->input_path, canonical[0]),
+        per_frame_camera(options) ? canonical_pattern(options->camera_path, canonical[3]) : NULL};
     const char *input_names[2] = {"input", "--camera file"};
     const char *patterns[2] = {canonical_pattern(options->output_path, canonical[1]),
                                canonical_pattern(options->preview_path, canonical[2])};
