@@ -161,6 +161,17 @@ def test_turning_off_restores_the_view_exactly(toggle_report):
     assert toggle_report["off_vs_never_max_abs"] == 0.0
 
 
+def test_a_tiny_clip_start_gives_no_false_occlusion(toggle_report):
+    """Clip Start 0.001, Clip End 10000: the depth buffer's steps are a
+    thousandth of the depth at 10 units, which the preview took for bumps
+    (0.38 of the view darkened, against 0.18 at the default range). Its
+    tangent test now allows for the buffer's rounding
+    (projection.depth_buffer_precision)."""
+    default = toggle_report["clip_default_darkened_fraction"]
+    assert default >= MIN_DARKENED_FRACTION
+    assert toggle_report["clip_tiny_darkened_fraction"] <= default + 0.02
+
+
 def test_a_maximized_view_keeps_its_preview(toggle_report):
     """Ctrl+Space moves the view into a temporary screen: the preview turned
     on before finds its settings there (it vanished)."""

@@ -144,6 +144,28 @@ def test_depth_coefficients_invert_projection(perspective):
         assert (a * ndc + b) / (c * ndc + d) == pytest.approx(depth, rel=1e-9)
 
 
+@pytest.mark.parametrize("perspective", [True, False])
+@pytest.mark.parametrize("near, far", [(0.01, 1000.0), (0.001, 10000.0), (0.5, 80.0)])
+def test_depth_buffer_precision_bounds_a_buffer_steps_rounding(perspective, near, far):
+    """The bound is the derivative's: one step of the stored depth (2^-24)
+    moves the linearised depth by depth_buffer_precision's bound /
+    DEPTH_BUFFER_MARGIN, relative to the depth, to first order (measured
+    with a step a millionth as large, where float64 still resolves it)."""
+    camera = {"type": "PERSP" if perspective else "ORTHO", "ortho_scale": 5.0}
+    matrix = _camera_matrix(projection.frame_from_camera(camera, 40, 30), near=near, far=far)
+    a, b, c, d = projection.depth_coefficients(matrix)
+    precision = projection.depth_buffer_precision(matrix)
+    scale = 1e-6
+    step = 2.0 * projection.DEPTH_BUFFER_STEP * scale  # in ndc = 2 d - 1
+    for depth in (2.0 * near, 1.0, 7.25, 0.5 * far):
+        z = -depth
+        ndc = (matrix[2][2] * z + matrix[2][3]) / (matrix[3][2] * z + matrix[3][3])
+        moved = (a * (ndc + step) + b) / (c * (ndc + step) + d)
+        relative = abs(moved - depth) / depth / scale
+        bound = precision * (depth if perspective else 1.0 / depth)
+        assert bound / projection.DEPTH_BUFFER_MARGIN == pytest.approx(relative, rel=1e-2)
+
+
 def test_an_orthographic_user_views_depths_are_positive():
     """A user's orthographic view clips about its pivot (-clip_end / 2 ..
     clip_end / 2): depths from the pivot would be <= 0, background, in front

@@ -126,6 +126,7 @@ def run():
         "preview_errors": sorted(draw._reported_errors),
     })
     user_orthographic(window, area, report, shot_path)
+    tiny_clip_start(window, area, report, shot_path)
     turned_on_while_maximized(window, area, report)
     print(json.dumps(report, indent=2))
     out_path.write_text(json.dumps(report, indent=2))
@@ -151,6 +152,28 @@ def user_orthographic(window, area, report, shot_path):
     darker = on.mean(axis=2) < off.mean(axis=2) - 2.0 / 255.0
     report["ortho_darkened_fraction"] = float(darker.mean())
     region.view_perspective = "CAMERA"
+
+
+def tiny_clip_start(window, area, report, shot_path):
+    """The camera's view with Clip Start 0.001 and Clip End 10000: the depth
+    buffer's steps are then a thousandth of the depth at 10 units, and the
+    preview took them for bumps (streaks of false occlusion on the floor).
+    The preview's darkening is measured as with the default clip range."""
+    camera = bpy.context.scene.camera.data
+    clip = camera.clip_start, camera.clip_end
+    darkened = {}
+    for name, (start, end) in (("default", clip), ("tiny", (0.001, 10000.0))):
+        camera.clip_start, camera.clip_end = start, end
+        off = screenshot(window, area, shot_path.with_name(f"viewport_clip_{name}_off.png"))
+        with override(window, area):
+            bpy.ops.hbao.viewport_preview_toggle()
+        on = screenshot(window, area, shot_path.with_name(f"viewport_clip_{name}.png"))
+        with override(window, area):
+            bpy.ops.hbao.viewport_preview_toggle()
+        darkened[name] = float((on.mean(axis=2) < off.mean(axis=2) - 2.0 / 255.0).mean())
+    camera.clip_start, camera.clip_end = clip
+    report["clip_default_darkened_fraction"] = darkened["default"]
+    report["clip_tiny_darkened_fraction"] = darkened["tiny"]
 
 
 def turned_on_while_maximized(window, area, report):

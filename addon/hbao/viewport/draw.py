@@ -111,7 +111,9 @@ def draw_preview(ao_pipeline, matrix, params):
         linear_depth = ao_pipeline.linearize(depth_buffer_texture,
                                              projection.depth_coefficients(matrix),
                                              half=bool(params.get("half_resolution")))
-        ao_texture = ao_pipeline.ambient_occlusion(linear_depth, frame, params)
+        ao_texture = ao_pipeline.ambient_occlusion(
+            linear_depth, frame, params,
+            buffer_precision=projection.depth_buffer_precision(matrix))
         # Our passes bound their own framebuffers; draw back into the view.
         gpu.state.viewport_set(x, y, width, height)
         pipeline.composite(ao_texture, params["strength"], (x, y))

@@ -134,8 +134,11 @@ float occlusion(ivec2 p)
     vec3 normal = texelFetch(normal_texture, ivec2(p.x, image_size.y - 1 - p.y), 0).xyz;
     float n_dot_v = dot(normal, view);
     /* docs/algorithm.md, "Depth precision": what rounding the depths can
-     * raise a sample above the tangent plane. */
-    float height_tolerance = depth_precision
+     * raise a sample above the tangent plane; depth_precision.y: the
+     * viewport's depth buffer's (projection.depth_buffer_precision). */
+    float rounding = depth_precision.x
+                   + depth_precision.y * (perspective != 0 ? z : 1.0 / z);
+    float height_tolerance = rounding
                            * abs(perspective != 0 ? dot(normal, position) : normal.z * position.z);
     /* docs/algorithm.md, "Thickness" (csrc/lib/internal_hbao.h,
      * hbao_near_limit): samples nearer than this are occluders wholly in

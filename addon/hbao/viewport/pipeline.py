@@ -167,12 +167,16 @@ class AOPipeline:
             _draw_quad("upsample")
 
     def ambient_occlusion(self, depth_texture, frame, params,
-                          depth_precision=shader_sources.FLOAT_DEPTH_PRECISION):
+                          depth_precision=shader_sources.FLOAT_DEPTH_PRECISION,
+                          buffer_precision=0.0):
         """Blurred AO (before strength) of a planar-depth texture, as an R32F
         texture the size of `frame`. `params` as native.resolve_params returns
         (half_resolution: the search on the half grid, as the library does);
         `depth_precision` bounds the depth's rounding relative to the depth
-        (docs/algorithm.md, "Depth precision")."""
+        (docs/algorithm.md, "Depth precision"), and `buffer_precision` that of
+        the depth buffer it was linearised from (projection.depth_buffer_precision;
+        0: none, a float depth given as it is)."""
+        depth_precision = (depth_precision, buffer_precision)
         width, height = frame.width, frame.height
         half = bool(params.get("half_resolution"))
         self._ensure_size(width, height, half)

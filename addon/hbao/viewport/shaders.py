@@ -43,7 +43,7 @@ _DEFINITIONS = {
         _CAMERA_CONSTANTS + [
             ("FLOAT", "radius"), ("FLOAT", "angle_bias"), ("INT", "directions"),
             ("INT", "steps"), ("INT", "falloff"), ("INT", "integration"),
-            ("FLOAT", "depth_precision"), ("FLOAT", "thickness")],
+            ("VEC2", "depth_precision"), ("FLOAT", "thickness")],
         ["depth_texture", "normal_texture"],
         shader_sources.AO_DEFINES),
     "halve": lambda: _create_info(
