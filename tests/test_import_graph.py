@@ -15,7 +15,8 @@ BPY_FREE_MODULES = ("hbao", "hbao.parameters", "hbao.library_loading", "hbao.nat
                     "hbao.exr_passes", "hbao.camera", "hbao.guard_geometry", "hbao.timing_line",
                     "hbao.scratch_names", "hbao.viewport",
                     "hbao.viewport.projection", "hbao.viewport.shader_sources",
-                    "hbao.viewport.horizon_sources")
+                    "hbao.viewport.horizon_sources", "hbao.viewport.normal_sources",
+                    "hbao.viewport.camera_sources")
 # Issue 8: a file past about 300 lines was doing several jobs.
 MAX_MODULE_LINES = 300
 

@@ -59,7 +59,8 @@ UNOCCLUDED_CASES = {"grazing_hbao", "grazing_cosine", "one_row_hbao", "one_row_h
 EXPECTED_CASES = {"persp_cosine", "persp_hbao", "persp_cosine_no_falloff", "shifted_hbao_bias",
                   "ortho_cosine", "persp_cosine_blur", "persp_hbao_blur_strength",
                   "ortho_cosine_blur", "persp_cosine_thickness", "persp_cosine_half",
-                  "persp_hbao_half_blur", "ortho_cosine_half_odd"} | UNOCCLUDED_CASES
+                  "persp_hbao_half_blur", "ortho_cosine_half_odd", "persp_cosine_half_depth",
+                  "ortho_hbao_half_depth"} | UNOCCLUDED_CASES
 
 # The preview multiplies the view by AO <= 1: it may only darken. 8-bit
 # screenshots: one code value of slack for rounding.
@@ -119,6 +120,10 @@ _LIBRARY_CONSTANTS = [
      "HBAO_FLOAT_DEPTH_PRECISION"),
     ("UPSAMPLE_SHARPNESS", shader_sources.UPSAMPLE_DEFINES["UPSAMPLE_SHARPNESS"],
      "internal_hbao.h", "HBAO_UPSAMPLE_SHARPNESS"),
+    ("HALF_DEPTH_PRECISION", shader_sources.NORMAL_DEFINES["HALF_DEPTH_PRECISION"],
+     "internal_hbao.h", "HBAO_HALF_DEPTH_PRECISION"),
+    ("HALF_DEPTH_FIT_REACH", shader_sources.NORMAL_DEFINES["HALF_DEPTH_FIT_REACH"],
+     "normals.c", "HALF_DEPTH_FIT_REACH"),
 ]
 
 

@@ -148,9 +148,9 @@ def test_depth_coefficients_invert_projection(perspective):
 @pytest.mark.parametrize("near, far", [(0.01, 1000.0), (0.001, 10000.0), (0.5, 80.0)])
 def test_depth_buffer_precision_bounds_a_buffer_steps_rounding(perspective, near, far):
     """The bound is the derivative's: one step of the stored depth (2^-24)
-    moves the linearised depth by depth_buffer_precision's bound /
-    DEPTH_BUFFER_MARGIN, relative to the depth, to first order (measured
-    with a step a millionth as large, where float64 still resolves it)."""
+    moves the linearised depth by depth_buffer_precision's bound, relative
+    to the depth, to first order (measured with a step a millionth as large,
+    where float64 still resolves it)."""
     camera = {"type": "PERSP" if perspective else "ORTHO", "ortho_scale": 5.0}
     matrix = _camera_matrix(projection.frame_from_camera(camera, 40, 30), near=near, far=far)
     a, b, c, d = projection.depth_coefficients(matrix)
@@ -163,7 +163,7 @@ def test_depth_buffer_precision_bounds_a_buffer_steps_rounding(perspective, near
         moved = (a * (ndc + step) + b) / (c * (ndc + step) + d)
         relative = abs(moved - depth) / depth / scale
         bound = precision * (depth if perspective else 1.0 / depth)
-        assert bound / projection.DEPTH_BUFFER_MARGIN == pytest.approx(relative, rel=1e-2)
+        assert bound == pytest.approx(relative, rel=1e-2)
 
 
 def test_an_orthographic_user_views_depths_are_positive():

@@ -21,7 +21,7 @@ if str(REPO / "addon") not in sys.path:
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from hbao import native  # noqa: E402
-from hbao.viewport import pipeline, projection  # noqa: E402
+from hbao.viewport import pipeline, projection, shader_sources  # noqa: E402
 import timer_guard  # noqa: E402
 
 if bpy.app.background and hasattr(gpu, "init"):
@@ -80,7 +80,17 @@ CASES = [
     # A view one pixel tall at half resolution: a half grid of one row.
     ("one_row_hbao_half", PERSPECTIVE_CAMERA,
      {"integration": "HBAO", "blur_size": 0, "half_resolution": 1}, {"size": (WIDTH + 1, 1)}),
+    # Depths rounded to half floats (EEVEE's Depth pass): the library sees it
+    # from the values and fits its tangents along runs of pixels; the preview
+    # is told the rounding (as its depth buffer's, far away with a tiny Clip
+    # Start) and fits them the same way.
+    ("persp_cosine_half_depth", PERSPECTIVE_CAMERA, {"blur_size": 0}, {"half_depth": True}),
+    ("ortho_hbao_half_depth", ORTHOGRAPHIC_CAMERA,
+     {"integration": "HBAO", "blur_size": 0, "radius": 0.8}, {"half_depth": True}),
 ]
+# The rounding of half floats relative to the value (csrc/lib/internal_hbao.h,
+# HBAO_HALF_DEPTH_PRECISION).
+HALF_DEPTH_PRECISION = 2.0 ** -10
 # The floor's height (camera space) in the cases that do not give their own.
 FLOOR_Y = -1.0
 
@@ -139,7 +149,7 @@ def synthetic_depth(frame, floor_y=FLOOR_Y):
     return np.where(np.isfinite(depth), depth, 1e10).astype(np.float32)
 
 
-def glsl_ao(depth, frame, params):
+def glsl_ao(depth, frame, params, depth_precision):
     """The preview pipeline's AO of `depth` (top row first): uploaded bottom-up as
     OpenGL wants, AO + blur passes, then the composite pass multiplying a white
     float target, read back and flipped to top-down."""
@@ -147,7 +157,8 @@ def glsl_ao(depth, frame, params):
     upload = gpu.types.Buffer("FLOAT", width * height, depth[::-1].ravel().tolist())
     depth_texture = gpu.types.GPUTexture((width, height), format="R32F", data=upload)
     ao_pipeline = pipeline.AOPipeline()
-    ao_texture = ao_pipeline.ambient_occlusion(depth_texture, frame, params)
+    ao_texture = ao_pipeline.ambient_occlusion(depth_texture, frame, params,
+                                               depth_precision=depth_precision)
     result = gpu.types.GPUTexture((width, height), format="RGBA32F")
     framebuffer = gpu.types.GPUFrameBuffer(color_slots=result)
     with framebuffer.bind():
@@ -199,9 +210,13 @@ def main():
         frame = projection.frame_from_camera(camera, width, height)
         viewport_frame = blender_frame(camera, width, height)
         depth = synthetic_depth(frame, scene.get("floor_y", FLOOR_Y))
+        depth_precision = shader_sources.FLOAT_DEPTH_PRECISION
+        if scene.get("half_depth"):
+            depth = depth.astype(np.float16).astype(np.float32)
+            depth_precision = HALF_DEPTH_PRECISION
         reference = native.compute_ao(depth, None, camera=camera,
                                       params=dict(params, threads=1))
-        preview = glsl_ao(depth, viewport_frame, params)
+        preview = glsl_ao(depth, viewport_frame, params, depth_precision)
         difference = np.abs(preview.astype(np.float64) - reference)
         report["cases"][name] = {
             "frame_vs_blender_matrix": frame_difference(frame, viewport_frame),

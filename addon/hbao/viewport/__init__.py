@@ -3,8 +3,8 @@
 3D viewport in Solid and Material Preview shading, per 3D view, from the
 sidebar's "HBAO" tab. No native library needed: it runs on the GPU.
 
-    projection.py, shader_sources.py,
-    horizon_sources.py                                no bpy (plain pytest)
+    projection.py, shader_sources.py, camera_sources.py,
+    normal_sources.py, horizon_sources.py             no bpy (plain pytest)
     shaders.py, pipeline.py                           gpu passes
     settings.py                                       per-view settings on the Screen
     draw.py                                           the draw handler (only while on)

@@ -1,81 +1,9 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
-"""GLSL of the preview's normal and AO passes: csrc/lib/normals.c and
-csrc/lib/horizon.c, following docs/algorithm.md. Fragment bodies only:
-shader_sources.py puts the shared camera model (depth_at, position_at,
-view_vector, is_background) in front of them and holds the constants they
-are compiled with (AO_DEFINES). Plain strings, no bpy."""
-
-# Camera-space normals reconstructed from depth, facing the viewer
-# (docs/algorithm.md, "Normals"; the rule for float depth, which the
-# preview's is: see shader_sources.FLOAT_DEPTH_PRECISION); (0, 0, 1) on
-# background, as csrc/lib/normals.c writes there.
-NORMALS = """
-/* One axis of the reconstructed tangent: the neighbour difference with the
- * smaller depth change (the one before wins a tie, as in csrc/lib/normals.c);
- * false when neither neighbour is usable. */
-bool tangent_along(ivec2 p, ivec2 axis, float z, vec3 position, out vec3 tangent)
-{
-    ivec2 after = p + axis;
-    ivec2 before = p - axis;
-    float z_after = all(lessThan(after, image_size)) ? depth_at(after) : 0.0;
-    float z_before = all(greaterThanEqual(before, ivec2(0))) ? depth_at(before) : 0.0;
-    bool has_after = !is_background(z_after);
-    bool has_before = !is_background(z_before);
-    if (has_before && (!has_after || abs(z_before - z) <= abs(z_after - z))) {
-        tangent = position - position_at(before, z_before);
-        return true;
-    }
-    if (has_after) {
-        tangent = position_at(after, z_after) - position;
-        return true;
-    }
-    return false;
-}
-
-vec3 reconstructed_normal(ivec2 p, float z, vec3 position, vec3 view)
-{
-    vec3 dx, dy;
-    bool have_x = tangent_along(p, ivec2(1, 0), z, position, dx);
-    bool have_y = tangent_along(p, ivec2(0, 1), z, position, dy);
-    vec3 n;
-    if (have_x && have_y) {
-        n = cross(dx, dy);
-    }
-    else if (have_x || have_y) {
-        /* One axis only (a strip one pixel wide or tall): V made
-         * perpendicular to that tangent, so that every sample, which lies
-         * along that axis, has elevation 0 on a plane. */
-        vec3 t = have_x ? dx : dy;
-        float t2 = dot(t, t);
-        if (!(t2 > 0.0) || isinf(t2)) {
-            return view;
-        }
-        n = view - t * (dot(view, t) / t2);
-    }
-    else {
-        return view;
-    }
-    float len = length(n);
-    if (!(len > 0.0) || isinf(len)) {
-        return view;
-    }
-    n /= len;
-    return dot(n, view) < 0.0 ? -n : n;
-}
-
-void main()
-{
-    ivec2 row_up = ivec2(gl_FragCoord.xy);
-    ivec2 p = ivec2(row_up.x, image_size.y - 1 - row_up.y);
-    float z = depth_at(p);
-    if (is_background(z)) {
-        frag_output = vec4(0.0, 0.0, 1.0, 0.0);
-        return;
-    }
-    vec3 position = position_at(p, z);
-    frag_output = vec4(reconstructed_normal(p, z, position, view_vector(position)), 0.0);
-}
-"""
+"""GLSL of the preview's AO pass: csrc/lib/horizon.c, following
+docs/algorithm.md. A fragment body: shader_sources.py puts the shared camera
+model (camera_sources.py: depth_at, position_at, view_vector, is_background,
+the depth's rounding) in front of it and holds the constants it is compiled
+with (AO_DEFINES). Plain strings, no bpy."""
 
 # The horizon search and its integration (csrc/lib/horizon.c, scalar
 # reference), one fragment per pixel, with the step length of the pixel's
@@ -134,10 +62,8 @@ float occlusion(ivec2 p)
     vec3 normal = texelFetch(normal_texture, ivec2(p.x, image_size.y - 1 - p.y), 0).xyz;
     float n_dot_v = dot(normal, view);
     /* docs/algorithm.md, "Depth precision": what rounding the depths can
-     * raise a sample above the tangent plane; depth_precision.y: the
-     * viewport's depth buffer's (projection.depth_buffer_precision). */
-    float rounding = depth_precision.x
-                   + depth_precision.y * (perspective != 0 ? z : 1.0 / z);
+     * raise a sample above the tangent plane. */
+    float rounding = depth_precision.x + DEPTH_BUFFER_MARGIN * buffer_rounding(z);
     float height_tolerance = rounding
                            * abs(perspective != 0 ? dot(normal, position) : normal.z * position.z);
     /* docs/algorithm.md, "Thickness" (csrc/lib/internal_hbao.h,

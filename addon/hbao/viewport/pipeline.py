@@ -95,6 +95,7 @@ class AOPipeline:
             shader.uniform_float("origin", (frame.origin_x, frame.origin_y))
             shader.uniform_int("perspective", 1 if frame.perspective else 0)
             shader.uniform_float("background_depth", params["background_depth"])
+            shader.uniform_float("depth_precision", depth_precision)
 
         shader = shaders.get("normals")
         with normals.framebuffer.bind():
@@ -113,7 +114,6 @@ class AOPipeline:
             shader.uniform_int("falloff", parameters.FALLOFF_VALUES[params["falloff"]])
             shader.uniform_int("integration",
                                parameters.INTEGRATION_VALUES[params["integration"]])
-            shader.uniform_float("depth_precision", depth_precision)
             shader.uniform_float("thickness", params["thickness"])
             _draw_quad("ao")
 

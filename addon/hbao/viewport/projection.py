@@ -120,20 +120,22 @@ def depth_coefficients(matrix):
 # 24-bit normalised integer (Blender 3.4's), or a float in [0.5, 1) (a 32-bit
 # float buffer, where all but the nearest depths lie).
 DEPTH_BUFFER_STEP = 2.0 ** -24
-# The rounding of the pixel's depth and of its sample's, and samples a little
-# deeper than the pixel (the term grows with the depth): a step's effect
-# taken four times.
+# The steps the preview's tangent test allows for: the rounding of the
+# pixel's depth and of its sample's, and samples a little deeper than the
+# pixel (the term grows with the depth).
 DEPTH_BUFFER_MARGIN = 4.0
 
 
 def depth_buffer_precision(matrix):
-    """How much the depth buffer of projection `matrix` rounds a linearised
-    depth, relative to the depth (docs/algorithm.md, "Depth precision"): per
-    unit of depth in perspective (a step of ndc = 2 d - 1 moves depth = P23 /
-    (ndc + P22) by depth^2 / |P23| per unit of ndc: a small Clip Start makes
-    far depths coarse), or times the depth's inverse in orthographic views
-    (depth moves by 1 / |P22| per unit of ndc, the same everywhere). The
-    preview adds it to the float depth's own rounding."""
+    """How much one step of the depth buffer of projection `matrix` moves a
+    linearised depth, relative to the depth (docs/algorithm.md, "Depth
+    precision"): per unit of depth in perspective (a step of ndc = 2 d - 1
+    moves depth = P23 / (ndc + P22) by depth^2 / |P23| per unit of ndc: a
+    small Clip Start makes far depths coarse), or times the depth's inverse
+    in orthographic views (depth moves by 1 / |P22| per unit of ndc, the same
+    everywhere). The preview's tangent test allows for DEPTH_BUFFER_MARGIN
+    such steps beside the float depth's own rounding, and its normals are
+    fitted where a step reaches a half float's."""
     p22, p23 = float(matrix[2][2]), float(matrix[2][3])
-    ndc_step = DEPTH_BUFFER_MARGIN * 2.0 * DEPTH_BUFFER_STEP
+    ndc_step = 2.0 * DEPTH_BUFFER_STEP
     return ndc_step / abs(p23 if is_perspective_matrix(matrix) else p22)

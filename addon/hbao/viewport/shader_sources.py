@@ -13,13 +13,15 @@ csrc/lib/normals.c) -> AO (csrc/lib/horizon.c) -> blur along rows, then
 columns (csrc/lib/blur.c) -> composite. The normals are a texture of their
 own because both the AO pass and the blur read them, as both read the
 library's grid->normal. The normal and AO passes' GLSL is in
-horizon_sources.py. At half resolution (csrc/lib/compute.c): linearize ->
+normal_sources.py and horizon_sources.py, the camera model they share in
+camera_sources.py. At half resolution (csrc/lib/compute.c): linearize ->
 halve (every other pixel of every other row) -> normals and AO on the half
 grid -> blur on the half grid (half the taps, csrc/lib/blur.c) -> upsample
 (csrc/lib/upsample.c) -> composite.
 """
 from ..parameters import FALLOFF_VALUES, INTEGRATION_VALUES
-from . import horizon_sources
+from . import horizon_sources, normal_sources, projection
+from .camera_sources import CAMERA, COMMON
 
 # A full-screen quad given in normalised device coordinates: no matrices, so it
 # draws the same in POST_VIEW (3D matrices bound) and into our own framebuffers.
@@ -43,40 +45,9 @@ void main()
 }
 """
 
-# Shared by every pass after linearize: the background test.
-COMMON = """
-#define PI 3.14159265358979323846
-
-/* Not finite, <= 0 or >= background_depth: written so that NaN is background. */
-bool is_background(float z)
-{
-    return !(z > 0.0 && z < background_depth);
-}
-"""
-
-# Shared by the normal and AO passes: depth and position of a pixel (i, j),
-# j from the top, through the camera model of docs/algorithm.md.
-CAMERA = COMMON + """
-float depth_at(ivec2 p)
-{
-    return texelFetch(depth_texture, ivec2(p.x, image_size.y - 1 - p.y), 0).r;
-}
-
-vec3 position_at(ivec2 p, float z)
-{
-    float x = origin.x + (float(p.x) + 0.5) * pixel_size.x;
-    float y = origin.y + (float(image_size.y - 1 - p.y) + 0.5) * pixel_size.y;
-    return perspective != 0 ? vec3(x * z, y * z, -z) : vec3(x, y, -z);
-}
-
-vec3 view_vector(vec3 position)
-{
-    return perspective != 0 ? normalize(-position) : vec3(0.0, 0.0, 1.0);
-}
-"""
-
-# The normal and AO passes (horizon_sources.py) on the camera model.
-NORMAL_FRAGMENT = CAMERA + horizon_sources.NORMALS
+# The normal and AO passes (normal_sources.py, horizon_sources.py) on the
+# camera model (camera_sources.py).
+NORMAL_FRAGMENT = CAMERA + normal_sources.NORMALS
 AO_FRAGMENT = CAMERA + horizon_sources.HORIZON_SEARCH
 
 # The range weight F of the blur and the upsample (csrc/lib/internal_finish.h,
@@ -239,9 +210,11 @@ void main()
 
 # The depth's rounding relative to the depth (docs/algorithm.md, "Depth
 # precision"): the library's for float depth, 2^-23 (csrc/lib/internal_hbao.h,
-# HBAO_FLOAT_DEPTH_PRECISION). The preview's depth is float: linearised in
-# float from the viewport's depth buffer, never half floats, so the preview
-# neither tests for half floats nor fits half-float normals.
+# HBAO_FLOAT_DEPTH_PRECISION). The preview's depth is float, linearised from
+# the viewport's depth buffer, whose own rounding the preview adds
+# (projection.depth_buffer_precision); it never tests for half floats, but
+# fits the normals where the rounding reaches the half floats'
+# (NORMAL_DEFINES).
 FLOAT_DEPTH_PRECISION = 1.1920929e-7
 
 # Falloff and integration enum values as the shader sees them (the header's,
@@ -255,6 +228,9 @@ AO_DEFINES = {
     # csrc/lib/internal_hbao.h, HBAO_BLOCK_PIXELS: the pixels of a block,
     # which share one step length (tests/test_viewport.py compares the two).
     "BLOCK_PIXELS": 16,
+    # The depth buffer's steps that the tangent test allows for
+    # (projection.DEPTH_BUFFER_MARGIN).
+    "DEPTH_BUFFER_MARGIN": projection.DEPTH_BUFFER_MARGIN,
 }
 
 # The range weight's (FALLOFF): csrc/lib/internal_finish.h,
@@ -270,6 +246,18 @@ UPSAMPLE_DEFINES = {
     # (tests/test_viewport.py compares the two).
     "UPSAMPLE_SHARPNESS": 16.0,
     **FALLOFF_DEFINES,
+}
+
+NORMAL_DEFINES = {
+    # csrc/lib/internal_hbao.h, HBAO_HALF_DEPTH_PRECISION: from this rounding
+    # on, a tangent is fitted along a run of pixels (csrc/lib/normals.c,
+    # fit_tangent), whose reach is HALF_DEPTH_FIT_REACH there
+    # (tests/test_viewport.py compares them).
+    "HALF_DEPTH_PRECISION": 9.765625e-4,
+    "HALF_DEPTH_FIT_REACH": 8,
+    # The preview's own: a depth buffer step that tilts a one-pixel tangent
+    # by more than this (in radians, about 3 degrees) fits the tangents too.
+    "BUFFER_FIT_SLOPE": 0.05,
 }
 
 BLUR_DEFINES = {

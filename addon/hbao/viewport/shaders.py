@@ -27,7 +27,8 @@ def _create_info(fragment_source, push_constants, samplers, defines=None,
 
 # What the passes that place pixels in camera space (shader_sources.CAMERA) read.
 _CAMERA_CONSTANTS = [("IVEC2", "image_size"), ("VEC2", "pixel_size"), ("VEC2", "origin"),
-                     ("INT", "perspective"), ("FLOAT", "background_depth")]
+                     ("INT", "perspective"), ("FLOAT", "background_depth"),
+                     ("VEC2", "depth_precision")]
 
 _DEFINITIONS = {
     "linearize": lambda: _create_info(
@@ -37,13 +38,14 @@ _DEFINITIONS = {
     "normals": lambda: _create_info(
         shader_sources.NORMAL_FRAGMENT,
         _CAMERA_CONSTANTS,
-        ["depth_texture"]),
+        ["depth_texture"],
+        shader_sources.NORMAL_DEFINES),
     "ao": lambda: _create_info(
         shader_sources.AO_FRAGMENT,
         _CAMERA_CONSTANTS + [
             ("FLOAT", "radius"), ("FLOAT", "angle_bias"), ("INT", "directions"),
             ("INT", "steps"), ("INT", "falloff"), ("INT", "integration"),
-            ("VEC2", "depth_precision"), ("FLOAT", "thickness")],
+            ("FLOAT", "thickness")],
         ["depth_texture", "normal_texture"],
         shader_sources.AO_DEFINES),
     "halve": lambda: _create_info(
