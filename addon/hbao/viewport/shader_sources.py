@@ -256,8 +256,8 @@ NORMAL_DEFINES = {
     "HALF_DEPTH_PRECISION": 9.765625e-4,
     "HALF_DEPTH_FIT_REACH": 8,
     # The preview's own: a depth buffer step that tilts a one-pixel tangent
-    # by more than this (in radians, about 3 degrees) fits the tangents too.
-    "BUFFER_FIT_SLOPE": 0.05,
+    # by more than this (in radians, about 9 degrees) fits the tangents too.
+    "BUFFER_FIT_SLOPE": 0.15,
 }
 
 BLUR_DEFINES = {
