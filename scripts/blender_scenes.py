@@ -223,11 +223,13 @@ def make_orthographic(scene, ortho_scale=None):
 
 
 def camera_description(scene):
-    """The scene camera as the JSON object the `hbao` CLI reads with --camera.
+    """The scene camera as the JSON object the `hbao` CLI reads with --camera:
+    the camera of the image Blender writes (a cropped border render's is the
+    crop's; Blender writes the crop as a whole image).
 
     Keys are Blender's own property names; world_to_camera is row-major. The
     add-on's own reading of the camera makes it, so tests and the add-on agree."""
-    return camera_model.camera_from_blender(scene)
+    return camera_model.camera_for_render_result(scene)
 
 
 # --- compositor wiring (every Blender version, through the add-on's compat) ---

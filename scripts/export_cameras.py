@@ -12,11 +12,12 @@ CLI and Blender name frames. Frames: as the CLI's --frames (1-250,
 1-10,20,30-40); by default the scene's range and step. The scene is the
 file's active one, or the one Blender's -S names (before --python). Each
 frame's camera is the scene's at that frame, evaluated (animation,
-constraints, parents), by the add-on's own camera rule
-(hbao.camera.camera_from_blender). A file that
-already holds what would be written is left as it is, its time too, so that
-a rerun of the CLI's sequence does not recompute that frame; the others are
-written whole (a temporary file renamed over them). Exit status 2 for bad
+constraints, parents, Time Remapping; a cropped border render's camera is
+the crop's), by the add-on's own camera rule
+(hbao.camera.camera_for_render_result). A file that already holds what
+would be written is left as it is, its time too, so that a rerun of the
+CLI's sequence does not recompute that frame; the others are written whole
+(a temporary file renamed over them). Exit status 2 for bad
 arguments, 1 when a frame has no camera the CLI can use or a file cannot be
 written.
 """
@@ -98,7 +99,8 @@ def camera_at(scene, frame):
     if scene.camera is None:
         raise camera_model.CameraError(f"scene {scene.name!r} has no camera at frame {frame}")
     depsgraph = bpy.context.evaluated_depsgraph_get()
-    return camera_model.camera_from_blender(scene, scene.camera.evaluated_get(depsgraph))
+    # the camera of the image written: a cropped border's own
+    return camera_model.camera_for_render_result(scene, scene.camera.evaluated_get(depsgraph))
 
 
 def write_if_changed(path, text):

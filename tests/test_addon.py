@@ -147,9 +147,29 @@ def test_connect_passes_button_turns_passes_on_and_links_them(
     assert ao.min() < 0.9 and np.abs(ao - expected).max() <= EXACT
 
 
-def test_node_ao_matches_cli(run_in_blender, tmp_path, hbao_tool):
-    """The same passes through the command-line tool (its own OpenEXR reader)."""
+def test_time_remapped_animated_camera_gets_the_rendered_cameras_ao(
+        run_in_blender, tmp_path, native):
+    """Time Remapping 100 -> 50: frame 2 shows the time of frame 1, and the
+    camera moves. The node's AO is the library's with the camera Blender
+    rendered (it took the camera at frame 2's own time: the helper scene did
+    not have the remapping; a farm check found it)."""
+    spec = {"frames": [2], "animate_camera": True, "time_remap": [100, 50],
+            "nodes": [{"radius": 0.7, "blur_size": 0}]}
+    out, _ = render(run_in_blender, tmp_path, spec)
+    expected = library_ao(native, out, 2, node_params(radius=0.7, blur_size=0))
+    assert np.abs(node_outputs(out, 2)["ao"] - expected).max() <= EXACT
+
+
+@pytest.mark.parametrize("border", [None, [0.2, 0.75, 0.1, 0.8]], ids=["frame", "cropped_border"])
+def test_node_ao_matches_cli_with_the_written_camera(run_in_blender, tmp_path, hbao_tool,
+                                                     border):
+    """The CLI on the saved passes with the camera written beside them
+    (blender_scenes.camera_description, as scripts/export_cameras.py writes
+    it) gives the node's AO, for a cropped border render too: Blender writes
+    the crop as a whole image, so the camera must be the crop's."""
     spec = {"nodes": [{"radius": 0.7, "blur_size": 0}]}
+    if border:
+        spec["border"] = border
     out, _ = render(run_in_blender, tmp_path, spec)
     cli_out = out / "cli_ao.exr"
     completed = subprocess.run(
@@ -159,7 +179,9 @@ def test_node_ao_matches_cli(run_in_blender, tmp_path, hbao_tool):
         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     assert completed.returncode == 0, completed.stdout
     cli_ao = exr.read_channels(cli_out, ["AO"])["AO"]
-    assert np.abs(node_outputs(out, 1)["ao"] - cli_ao).max() <= EXACT
+    node_ao = node_outputs(out, 1)["ao"]
+    assert cli_ao.shape == node_ao.shape and node_ao.min() < 0.9
+    assert np.abs(node_ao - cli_ao).max() <= EXACT
 
 
 def test_keyframed_radius_and_value_node(run_in_blender, tmp_path, native):

@@ -10,7 +10,10 @@ from .data_edits import set_if_different
 SYNCED_RENDER_SETTINGS = (
     "resolution_x", "resolution_y", "resolution_percentage", "pixel_aspect_x",
     "pixel_aspect_y", "use_border", "use_crop_to_border", "border_min_x", "border_max_x",
-    "border_min_y", "border_max_y", "fps", "fps_base", "use_multiview", "views_format")
+    "border_min_y", "border_max_y", "fps", "fps_base", "use_multiview", "views_format",
+    # Time Remapping: the helper's depsgraph evaluates the main scene's
+    # camera at the helper's time, which must be the one rendered.
+    "frame_map_old", "frame_map_new")
 VIEW_SETTINGS = ("use", "camera_suffix")
 # With Render Single Layer on, Blender renders no scene but the one asked
 # for, the helper neither: its AO pass would read 0, a black image. The hook

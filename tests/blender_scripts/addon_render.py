@@ -14,7 +14,9 @@ Spec keys (all optional): resolution [w, h], samples, engine, scene
 ("corner" | "two_layers"), frames [..], ao_reference (distance: adds Cycles'
 AO pass), orthographic, widen_camera (factor), dump_back_faces (writes
 <out>/back_<NNNN>.npy: the back faces render's Depth, top row first), border
-[min_x, max_x, min_y, max_y] (a border render cropped to it), save_blend
+[min_x, max_x, min_y, max_y] (a border render cropped to it; with crop false, not
+cropped), animate_camera (the camera turns and moves over frames 1-5),
+time_remap [old, new] (Time Remapping), save_blend
 (path: saved after the setup, before rendering), nodes: [{name, layer, normal
 (bool), radius, keyframes [[frame, radius], ..], radius_from_value_node,
 falloff, integration, blur_size, angle_bias, directions, steps, strength,
@@ -80,6 +82,16 @@ if spec.get("border"):
      render_settings.border_min_y, render_settings.border_max_y) = spec["border"]
     render_settings.use_border = True
     render_settings.use_crop_to_border = spec.get("crop", True)
+if spec.get("animate_camera"):  # the camera turns and moves from frame 1 to frame 5
+    moving = scene.camera
+    moving.keyframe_insert("rotation_euler", frame=1)
+    moving.keyframe_insert("location", frame=1)
+    moving.rotation_euler.z += 0.3
+    moving.location.x += 0.8
+    moving.keyframe_insert("rotation_euler", frame=5)
+    moving.keyframe_insert("location", frame=5)
+if spec.get("time_remap"):  # Time Remapping [old, new]: frame f shows the time f * new / old
+    scene.render.frame_map_old, scene.render.frame_map_new = spec["time_remap"]
 
 if spec.get("layer_name"):  # the first view layer renamed
     scene.view_layers[0].name = spec["layer_name"]
