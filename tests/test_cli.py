@@ -520,6 +520,36 @@ def test_normals_without_a_matrix_warn(hbao_tool, tmp_path):
         assert quiet.stderr == ""
 
 
+def test_a_camera_file_without_its_matrix_is_an_error_where_normals_are_used(
+        hbao_tool, tmp_path):
+    """A camera file (even "{}": valid JSON) without world_to_camera would
+    turn the Normal pass by the identity and the frame would succeed, wrong
+    (a farm keeps it): an error, in a sequence that frame's. With
+    --no-normals or --world-to-camera it is a complete camera."""
+    partial = tmp_path / "partial.json"
+    camera = json.loads(camera_path("cycles_float_zip").read_text())
+    matrix = camera.pop("world_to_camera")
+    partial.write_text(json.dumps(camera))
+    for content in ("{}", json.dumps(camera)):
+        partial.write_text(content)
+        completed = run_tool(hbao_tool, fixture_path("cycles_float_zip"), "-o",
+                             tmp_path / "o.exr", "--camera", partial)
+        assert_clean_error(completed, EXIT_RUNTIME, "partial.json has no world_to_camera")
+        assert not (tmp_path / "o.exr").exists()
+    run_ok(hbao_tool, fixture_path("cycles_float_zip"), "-o", tmp_path / "n.exr", "--camera",
+           partial, "--no-normals")
+    flat = " ".join(str(v) for row in matrix for v in row)
+    run_ok(hbao_tool, fixture_path("cycles_float_zip"), "-o", tmp_path / "m.exr", "--camera",
+           partial, "--world-to-camera", flat)
+    expected = tmp_path / "expected.exr"
+    compute_ao(hbao_tool, "cycles_float_zip", expected)
+    from hbao import exr_passes
+    assert np.array_equal(exr_passes.read_channels(tmp_path / "m.exr", ["AO"])["AO"],
+                          exr_passes.read_channels(expected, ["AO"])["AO"])
+    no_camera = run_tool(hbao_tool, fixture_path("cycles_float_zip"), "-o", tmp_path / "w.exr")
+    assert no_camera.returncode == 0 and "no world-to-camera matrix" in no_camera.stderr
+
+
 @pytest.mark.parametrize("content, fragment", [
     ("{", "not valid JSON"),
     ('{"type": "PANO"}', '"type"'),

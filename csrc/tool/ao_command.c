@@ -313,6 +313,16 @@ int ao_compute_input(const cli_options *options, exr_input *input, ao_buffers *b
     status = read_passes(input, &passes, use_normals,
                          options->back_layer != NULL ? &back_passes : NULL, buffers, error);
     if (status != TOOL_EXIT_SUCCESS) return status;
+    /* A camera file meant to describe the camera: without the matrix, the
+     * normals would be turned wrongly and the frame would still succeed
+     * (a farm would keep it). Without any camera, a warning, as before. */
+    if (use_normals && !(camera.fields_set & CAMERA_FIELD_WORLD_TO_CAMERA) &&
+        options->camera_path != NULL)
+        return tool_fail(error, TOOL_EXIT_RUNTIME,
+                         "%s has no world_to_camera, which the Normal pass (%s, in world space) "
+                         "needs; add it (scripts/export_cameras.py writes it), or give "
+                         "--world-to-camera or --no-normals",
+                         options->camera_path, passes.normal[0]);
     if (use_normals && !(camera.fields_set & CAMERA_FIELD_WORLD_TO_CAMERA))
         tool_warn("the Normal pass (%s) is in world space but no world-to-camera matrix was "
                   "given; using the identity, which is right only for a camera at the origin "
