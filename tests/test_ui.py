@@ -34,7 +34,8 @@ def ui_report(run_blender, tmp_path_factory):
 
 def test_old_file_gets_integer_sockets_and_keeps_values_links_keyframes(ui_report):
     upgrade = ui_report["upgrade"]
-    assert upgrade["socket_types"] == {"Radius": "NodeSocketFloat",
+    # Radius in scene units since group version 4 (Blender 3.4's socket type)
+    assert upgrade["socket_types"] == {"Radius": "NodeSocketFloatDistance",
                                        "Directions": "NodeSocketInt",
                                        "Steps": "NodeSocketInt",
                                        "Blur Size": "NodeSocketInt"}

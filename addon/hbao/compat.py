@@ -172,10 +172,18 @@ def scene_of_tree(tree):
     return None
 
 
-def new_group_socket(tree, in_out, socket_type, name):
-    """Add an input ('INPUT') or output ('OUTPUT') to a node group's interface."""
+def new_group_socket(tree, in_out, socket_type, name, subtype=None):
+    """Add an input ('INPUT') or output ('OUTPUT') to a node group's interface;
+    `subtype` ("DISTANCE") gives a float socket its unit: a property of the
+    socket from 4.0, a socket type of its own before
+    (NodeSocketFloatDistance)."""
     if HAS_TREE_INTERFACE:
-        return tree.interface.new_socket(name, in_out=in_out, socket_type=socket_type)
+        socket = tree.interface.new_socket(name, in_out=in_out, socket_type=socket_type)
+        if subtype is not None:
+            socket.subtype = subtype
+        return socket
+    if subtype is not None:
+        socket_type += subtype.title()
     sockets = tree.inputs if in_out == "INPUT" else tree.outputs
     return sockets.new(socket_type, name)
 

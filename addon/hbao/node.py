@@ -80,23 +80,24 @@ class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
                               default=_D["integration"], update=_settings_changed)
     half_resolution: BoolProperty(
         name="Half Resolution", default=False, update=_settings_changed,
-        description="Compute AO at half resolution and upsample it, depth-aware (faster)")
+        description="Compute the AO on every other pixel and upsample it, edge-aware: about 3 "
+                    "times faster, a little softer")
     guard_band: FloatProperty(
         name="Guard Band", default=0.0, min=0.0, max=100.0 * guard_geometry.MAX_GUARD_BAND,
         subtype="PERCENTAGE", update=_extra_render_changed,
-        description="Occluders outside the frame: an extra Cycles render (1 sample, Depth and "
-                    "Normal only) through a wider camera sees this far past each side, in % of "
-                    "the frame. Darkens borders that come out too bright. 0 = off")
+        description="Darkens image borders that come out too bright, by also looking this far "
+                    "past each side (% of the frame); costs a quick extra render (Cycles, 1 "
+                    "sample, Depth and Normal only). 0 = off")
     back_faces: BoolProperty(
         name="Back Faces", default=False, update=_extra_render_changed,
-        description="Thickness from an extra Cycles render of the back faces (1 sample, Depth "
-                    "only): light passes between an object and the surface behind it, which "
-                    "removes the dark halo around foreground objects")
+        description="Lets light pass between an object and the surface behind it, which "
+                    "removes the dark halo around foreground objects; costs a quick extra "
+                    "render of the back faces (Cycles, 1 sample, Depth only)")
     blur_sharpness: FloatProperty(
         name="Blur Sharpness", default=_D["blur_sharpness"], min=0.0,
         max=parameters.MAX_BLUR_SHARPNESS, soft_max=64.0,
         update=_settings_changed,
-        description="How strongly the blur stops at depth edges; 0 = plain Gaussian")
+        description=parameters.DESCRIPTIONS["blur_sharpness"])
     pass_index: IntProperty(name="Pass Index", default=0, min=0,
                             description="Number of the AO pass the render hook fills for "
                                         "this node")
@@ -149,7 +150,8 @@ class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
     def draw_buttons_ext(self, context, layout):
         self.draw_buttons(context, layout)
         layout.prop(self, "blur_sharpness")
-        layout.label(text=f"AO pass: {pass_name(self)}")
+        # where the render hook delivers this node's AO (into its hidden input)
+        layout.label(text=f"AO arrives as pass \"{pass_name(self)}\"")
 
     def draw_label(self):
         return "HBAO"

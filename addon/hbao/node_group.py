@@ -13,7 +13,9 @@ GROUP_TREE_NAME = ".HBAO"
 # and the nodes using them keep their values and links (upgrade_group_tree).
 # 2: Directions, Steps and Blur Size became integer sockets.
 # 3: a Thickness socket after Strength.
-GROUP_TREE_VERSION = 3
+# 4: tooltips on every input, Radius and Thickness in scene units, no value
+#    fields on Depth, Normal and the hidden AO pass input.
+GROUP_TREE_VERSION = 4
 GROUP_VERSION_KEY = "hbao_group_version"
 
 IMAGE_INPUT = "Image"
@@ -33,15 +35,16 @@ _D = parameters.DEFAULTS
 
 
 def _value_input(key):
-    """(params key, default, socket min, socket max, socket type) of a value
-    socket: the library's limits (parameters.LIMITS); whole-number parameters
-    get integer sockets, so the node shows 4, not 4.000."""
+    """(params key, default, socket min, socket max, socket type, subtype) of a
+    value socket: the library's limits (parameters.LIMITS); whole-number
+    parameters get integer sockets, so the node shows 4, not 4.000; lengths
+    show the scene's unit (1 m)."""
     if key in ("radius", "thickness"):
-        return key, float(_D[key]), 0.0, MAX_LENGTH, "NodeSocketFloat"
+        return key, float(_D[key]), 0.0, MAX_LENGTH, "NodeSocketFloat", "DISTANCE"
     low, high, whole = parameters.LIMITS[key]
     if whole:
-        return key, int(_D[key]), int(low), int(high), "NodeSocketInt"
-    return key, float(_D[key]), float(low), float(high), "NodeSocketFloat"
+        return key, int(_D[key]), int(low), int(high), "NodeSocketInt", None
+    return key, float(_D[key]), float(low), float(high), "NodeSocketFloat", None
 
 
 # The parameters an artist can animate or drive with a Value node: one socket
@@ -54,25 +57,40 @@ VALUE_INPUTS = {
 }
 
 
-def _new_input(tree, socket_type, name, default=None, minimum=None, maximum=None):
-    socket = compat.new_group_socket(tree, "INPUT", socket_type, name)
+def _new_input(tree, socket_type, name, default=None, minimum=None, maximum=None,
+               subtype=None, description="", hide_value=False):
+    socket = compat.new_group_socket(tree, "INPUT", socket_type, name, subtype)
     if default is not None:
         socket.default_value = default
     if minimum is not None:
         socket.min_value = minimum
         socket.max_value = maximum
+    socket.description = description
+    socket.hide_value = hide_value
     return socket
+
+
+# The tooltips of the inputs that are not parameters.
+IMAGE_TIP = "The render to multiply by the AO (Render Layers' Image)"
+DEPTH_TIP = "Render Layers' Depth pass (link it: the AO is computed from it)"
+NORMAL_TIP = "Render Layers' Normal pass; unlinked, normals are worked out from the depth"
+AO_PASS_TIP = ("Filled by the add-on's helper render with this node's AO: leave it linked "
+               "(the node's sidebar names the pass)")
 
 
 def _build_group_tree(tree):
     tree.nodes.clear()
     compat.clear_group_interface(tree)
-    _new_input(tree, "NodeSocketColor", IMAGE_INPUT, (1.0, 1.0, 1.0, 1.0))
-    _new_input(tree, "NodeSocketFloat", DEPTH_INPUT, 0.0)
-    _new_input(tree, "NodeSocketVector", NORMAL_INPUT)
-    for name, (_key, default, minimum, maximum, socket_type) in VALUE_INPUTS.items():
-        _new_input(tree, socket_type, name, default, minimum, maximum)
-    _new_input(tree, "NodeSocketFloat", AO_PASS_INPUT, 1.0, 0.0, 1.0)
+    _new_input(tree, "NodeSocketColor", IMAGE_INPUT, (1.0, 1.0, 1.0, 1.0),
+               description=IMAGE_TIP)
+    _new_input(tree, "NodeSocketFloat", DEPTH_INPUT, 0.0, description=DEPTH_TIP,
+               hide_value=True)
+    _new_input(tree, "NodeSocketVector", NORMAL_INPUT, description=NORMAL_TIP, hide_value=True)
+    for name, (key, default, minimum, maximum, socket_type, subtype) in VALUE_INPUTS.items():
+        _new_input(tree, socket_type, name, default, minimum, maximum, subtype,
+                   parameters.DESCRIPTIONS[key])
+    _new_input(tree, "NodeSocketFloat", AO_PASS_INPUT, 1.0, 0.0, 1.0,
+               description=AO_PASS_TIP, hide_value=True)
     compat.new_group_socket(tree, "OUTPUT", "NodeSocketColor", IMAGE_OUTPUT)
     compat.new_group_socket(tree, "OUTPUT", "NodeSocketFloat", AO_OUTPUT)
 

@@ -67,14 +67,34 @@ LABELS = {
     "thickness": "Thickness",
 }
 
+# What each setting does, as the node's socket and the viewport panel's
+# setting say it in their tooltips: the effect first, then the cost.
+DESCRIPTIONS = {
+    "radius": "How far away, in scene units, an occluder still shades a point (like Cycles' AO "
+              "Distance)",
+    "angle_bias_degrees": "Occluders less than this many degrees above the surface are "
+                          "ignored: raise it if flat or finely tessellated surfaces look dirty",
+    "directions": "Directions searched around each pixel: more is smoother and slower",
+    "steps": "Samples along each direction: more finds thinner occluders, and is slower",
+    "blur_size": "Width in pixels of the edge-aware blur that hides the sampling pattern; 0 or "
+                 "1 = no blur (the pattern shows)",
+    "blur_sharpness": "How strongly the blur stops at depth edges; 0 = a plain blur",
+    "strength": "How dark the AO is: 1 as computed, 2 darker, 0.5 lighter, 0 none (the AO is "
+                "raised to this power)",
+    "thickness": "How thick occluders are taken to be, in scene units: an object more than "
+                 "this in front of a surface does not shade it (no dark halo behind it). 0 = "
+                 "no limit",
+}
+
 # The menus of the node and of the viewport panel: (identifier, name, tip).
 FALLOFF_ITEMS = [
-    ("QUADRATIC", "Quadratic", "Occluders count less with distance: 1 - (d/radius)^2"),
-    ("NONE", "None", "Every occluder inside the radius counts fully"),
+    ("QUADRATIC", "Quadratic", "Occluders count less the farther they are: 1 - (d/radius)^2"),
+    ("NONE", "None", "Every occluder inside the radius counts fully, as in Cycles' AO"),
 ]
 INTEGRATION_ITEMS = [
-    ("COSINE", "Cosine", "Cosine-weighted visibility, as Cycles' AO pass measures it"),
-    ("HBAO", "HBAO", "Bavoil & Sainz: the occluded fraction of the hemisphere"),
+    ("COSINE", "Cosine", "Weighs the sky by its angle to the surface, as Cycles' AO pass does"),
+    ("HBAO", "HBAO", "The classic HBAO measure (the share of the sky hidden): darker in "
+                     "creases than Cycles"),
 ]
 
 # The blur (csrc/lib/compute.c and blur.c): a kernel of size b has radius

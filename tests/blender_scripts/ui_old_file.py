@@ -18,9 +18,9 @@ import blender_scenes  # noqa: E402
 node_group = sys.modules["hbao.node_group"]
 # The version-1 layout: every value socket a float.
 node_group.GROUP_TREE_VERSION = 1
-for name, (key, default, low, high, _type) in list(node_group.VALUE_INPUTS.items()):
+for name, (key, default, low, high, _type, _subtype) in list(node_group.VALUE_INPUTS.items()):
     node_group.VALUE_INPUTS[name] = (key, float(default), float(low), float(high),
-                                     "NodeSocketFloat")
+                                     "NodeSocketFloat", None)
 
 scene = blender_scenes.build_corner_scene(bpy.context.scene, (96, 64), "CYCLES", 4)
 compositor = blender_scenes.Compositor(scene)

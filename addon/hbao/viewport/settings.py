@@ -48,6 +48,7 @@ def _redraw(_self, context):
 
 
 _D = parameters.DEFAULTS
+_TIPS = parameters.DESCRIPTIONS
 
 
 class HBAOViewSettings(bpy.types.PropertyGroup):
@@ -65,37 +66,34 @@ class HBAOViewSettings(bpy.types.PropertyGroup):
                     "values at the current frame), so the view shows what the render will")
     radius: FloatProperty(
         name="Radius", default=_D["radius"], min=0.0, soft_max=10.0, unit="LENGTH",
-        update=_redraw, description="AO radius in scene units")
+        update=_redraw, description=_TIPS["radius"])
     angle_bias_degrees: FloatProperty(
         name="Angle Bias", default=_D["angle_bias_degrees"], min=0.0,
         max=parameters.MAX_ANGLE_BIAS_DEGREES, update=_redraw,
-        description="Occluders less than this many degrees above the surface are "
-                    "ignored")
+        description=_TIPS["angle_bias_degrees"])
     directions: IntProperty(
         name="Directions", default=_D["directions"], min=1, max=parameters.MAX_DIRECTIONS,
-        update=_redraw, description="Directions searched around each pixel")
+        update=_redraw, description=_TIPS["directions"])
     steps: IntProperty(
         name="Steps", default=_D["steps"], min=1, max=parameters.MAX_STEPS,
-        update=_redraw, description="Samples per direction")
+        update=_redraw, description=_TIPS["steps"])
     falloff: EnumProperty(name="Falloff", items=FALLOFF_ITEMS, default=_D["falloff"],
                           update=_redraw)
     integration: EnumProperty(name="Integration", items=INTEGRATION_ITEMS,
                               default=_D["integration"], update=_redraw)
     blur_size: IntProperty(
         name="Blur Size", default=_D["blur_size"], min=0, max=parameters.MAX_BLUR_SIZE,
-        update=_redraw, description="Width in pixels of the depth-aware blur; 0 or 1 = none")
+        update=_redraw, description=_TIPS["blur_size"])
     blur_sharpness: FloatProperty(
         name="Blur Sharpness", default=_D["blur_sharpness"], min=0.0,
-        max=parameters.MAX_BLUR_SHARPNESS, soft_max=50.0, update=_redraw,
-        description="How strongly the blur stops at depth edges")
+        max=parameters.MAX_BLUR_SHARPNESS, soft_max=64.0, update=_redraw,
+        description=_TIPS["blur_sharpness"])
     strength: FloatProperty(
         name="Strength", default=_D["strength"], min=0.0, max=parameters.MAX_STRENGTH,
-        soft_max=4.0, update=_redraw, description="AO is raised to this power")
+        soft_max=4.0, update=_redraw, description=_TIPS["strength"])
     thickness: FloatProperty(
         name="Thickness", default=_D["thickness"], min=0.0, soft_max=2.0, unit="LENGTH",
-        update=_redraw,
-        description="Occluders are taken as this thick: a surface nearer than the pixel by "
-                    "more than this does not shade it. 0 = infinitely thick")
+        update=_redraw, description=_TIPS["thickness"])
     half_resolution: BoolProperty(
         name="Half Resolution", default=False, update=_redraw,
         description="Search the horizons on every other pixel of every other row and "
