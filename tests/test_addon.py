@@ -448,6 +448,10 @@ def test_missing_normal_pass_is_enabled_with_a_message(run_in_blender, tmp_path,
     spec = {"disable_normal_pass": True, "nodes": [{"radius": 0.8}]}
     out, log = render(run_in_blender, tmp_path, spec)
     assert "enabled the Normal pass of view layer 'ViewLayer'" in log
+    # the node says so after the render (its plan's messages replaced it)
+    statuses = [json.loads(line[len("STATUS "):]) for line in log.splitlines()
+                if line.startswith("STATUS ")]
+    assert statuses == [{"node": "HBAO0", "status": "Normal pass turned on"}], statuses
     expected = library_ao(native, out, 1, node_params(radius=0.8))
     assert np.abs(node_outputs(out, 1)["ao"] - expected).max() <= EXACT
 
@@ -456,7 +460,11 @@ def test_missing_library_renders_without_ao_and_says_so(run_in_blender, tmp_path
     missing = tmp_path / "no" / "libhbao.so"
     out, log = render(run_in_blender, tmp_path, {"nodes": [{"radius": 1.0}]},
                       env={"HBAO_LIBRARY": str(missing)})
-    assert f"libhbao not found at {missing}" in log
+    assert f"libhbao not found at {missing}: the add-on is incomplete" in log
+    # the node says so too (an artist's review found nothing in the UI)
+    statuses = [json.loads(line[len("STATUS "):]) for line in log.splitlines()
+                if line.startswith("STATUS ")]
+    assert statuses == [{"node": "HBAO0", "status": "Library not loaded: AO off"}], statuses
     outputs = node_outputs(out, 1)
     assert np.all(outputs["ao"] == 1.0)
     assert np.abs(outputs["image"] - outputs["render"]).max() <= EXACT

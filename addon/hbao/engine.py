@@ -16,7 +16,7 @@ from . import (ao_cache, exr_passes, handover, layer_passes, native, recomposite
 from .helper_lookup import ENGINE_IDNAME, is_helper, pass_names_for_helper
 from .helper_scene import rendered_for_a_scene, scene_for_render
 from .planning import node_names, plan
-from .report import log, post_node_messages, post_render_report
+from .report import NodeMessage, log, post_node_messages, post_render_report
 
 # The prefix of the passes this engine fills (node.pass_name's).
 PASS_PREFIX = "HBAO "
@@ -90,7 +90,7 @@ def compute_passes(engine, depsgraph, width, height, request=None):
     rendered: for the render of its main scene, or for `request`
     (recomposite.Request) from the passes of the last render."""
     helper = _original(depsgraph.scene)
-    main = bpy.data.scenes.get(request.main) if request else scene_for_render(helper)
+    main = main_of(helper, request)
     if main is None:
         raise RuntimeError(f"scene {helper.name!r} is not an HBAO helper scene")
     frame = request.frame if request else main.frame_current + main.frame_subframe
@@ -182,6 +182,25 @@ NOT_FOR_RENDERING = ("HBAO: \"{label}\" is the HBAO add-on's internal engine and
                      "and add the HBAO node in the Compositor.")
 
 
+# A node's status line when a native library cannot be loaded (the full
+# text, in the tooltip and the render's report, says what to do).
+LIBRARY_SHORT = "Library not loaded: AO off"
+
+
+def main_of(helper, request):
+    """The main scene a render of `helper` is for (the request's, when
+    re-compositing), or None."""
+    return bpy.data.scenes.get(request.main) if request else scene_for_render(helper)
+
+
+def _tell_nodes(main, short, detail):
+    """The same message on every HBAO node of `main`."""
+    if main is None:
+        return
+    names = node_names(main)
+    post_node_messages(main.name, names, [NodeMessage(name, detail, short) for name in names])
+
+
 def render_helper(engine, depsgraph):
     """HBAOPassEngine.render(): fill every registered AO pass, 1 where it failed."""
     scene = _original(depsgraph.scene)
@@ -209,6 +228,7 @@ def render_helper(engine, depsgraph):
             results = {}
             _cache.clear()  # nothing kept that this render's record would not match
             _report_failure(engine, f"{error} Rendering without AO.")
+            _tell_nodes(main_of(scene, request), LIBRARY_SHORT, f"{error} Rendering without AO.")
         except Exception as error:  # the render must complete: AO = 1
             results = {}
             _cache.clear()

@@ -97,10 +97,10 @@ class NativeLibrary:
         name = self.name
         if not path.is_file():
             raise self.error_class(
-                f"{name} not found at {path}. Build it with `cmake -S . -B build && cmake "
-                f"--build build` and copy build/{self.file_name} to {self.default_path.parent}/ "
-                f"(scripts/install_addon.sh does both), or set {self.environment_variable} "
-                f"to its path.")
+                f"{name} not found at {path}: the add-on is incomplete. Reinstall it from its "
+                f"zip, which carries the library; from a source checkout, "
+                f"scripts/install_addon.sh builds and installs it (or build it with CMake and "
+                f"set {self.environment_variable} to build/{self.file_name}).")
         try:
             library = ctypes.CDLL(str(path))
         except OSError as error:

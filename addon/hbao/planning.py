@@ -5,7 +5,7 @@ parameters at that frame."""
 from . import compat, handover
 from .helper_lookup import MANAGED_NODE_KEY
 from .node import DEPTH_INPUT, NORMAL_INPUT, hbao_nodes, pass_name
-from .report import NodeMessage, post_node_messages
+from .report import NodeMessage, post_node_messages, take_changes
 from .socket_values import node_params, upstream
 
 
@@ -91,7 +91,7 @@ def plan(main, frame):
     """The AO computations `main` needs at `frame`: ([Job], [NodeMessage]).
     The messages are also posted for the nodes' status lines (each node of
     the tree gets its own, or none: a good frame clears an old status)."""
-    jobs, warnings = [], []
+    jobs, warnings = [], take_changes(main.name)
     nodes = hbao_nodes(compat.compositor_tree(main))
     for node in nodes:
         if node.mute:

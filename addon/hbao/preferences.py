@@ -22,12 +22,30 @@ class HBAOPreferences(bpy.types.AddonPreferences):
     bl_idname = _ADDON_NAME
 
     def draw(self, _context):
-        if not _messages:
-            self.layout.label(text="HBAO: Compositor > Add > Filter > HBAO; viewport: "
-                                   "sidebar, HBAO tab")
+        layout = self.layout
+        column = layout.column(align=True)
+        column.label(text="Compositor node: Add > Filter > HBAO", icon="NODETREE")
+        column.label(text="Viewport preview: 3D view sidebar (N), HBAO tab", icon="VIEW3D")
+        _library_status(layout.column(align=True))
         for message in _messages:
             for sentence in message.split(". "):
-                self.layout.label(text=sentence.rstrip("."), icon="INFO")
+                layout.label(text=sentence.rstrip("."), icon="INFO")
+
+
+def _library_status(layout):
+    """Whether the native libraries load (a missing one turns the AO off:
+    the node and the preview say so when they run)."""
+    from . import exr_passes, native  # not at import: they need no bpy, this module does
+    for label, load in (("AO library", native.load_library),
+                        ("EXR library", exr_passes.load_library)):
+        try:
+            load()
+        except Exception as error:  # missing, or not this add-on's
+            layout.label(text=f"{label}: not loaded, no AO", icon="ERROR")
+            for sentence in str(error).split(". "):
+                layout.label(text=sentence.rstrip("."), icon="BLANK1")
+        else:
+            layout.label(text=f"{label}: loaded", icon="CHECKMARK")
 
 
 def register():

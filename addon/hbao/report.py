@@ -91,3 +91,19 @@ def return_node_messages(scene_name, statuses):
     """Give back what take_node_messages gave for `scene_name` and could not
     be shown yet, unless a render posted newer messages meanwhile."""
     _pending_node_messages.setdefault(scene_name, statuses)
+
+
+# Scene name -> [NodeMessage] of what the render hook changed for a render
+# (a pass turned on), which that render's plan shows beside its own.
+_changes_for_render = {}
+
+
+def note_change(scene_name, message):
+    """Keep `message` (a NodeMessage) for the plan of `scene_name`'s next
+    render, which would otherwise replace it on the node. Any thread."""
+    _changes_for_render.setdefault(scene_name, []).append(message)
+
+
+def take_changes(scene_name):
+    """The messages note_change() kept for `scene_name`, once."""
+    return _changes_for_render.pop(scene_name, [])

@@ -19,6 +19,15 @@ _handler = None
 # Region pointer -> AOPipeline; each keeps targets the size of its region.
 _pipelines = {}
 _reported_errors = set()
+# Area pointer -> why its preview draws nothing (the sidebar panel shows it);
+# gone once the view draws again.
+_view_errors = {}
+
+
+def view_error(area):
+    """Why the preview of the 3D view in `area` failed the last time it was
+    drawn, or None."""
+    return _view_errors.get(area.as_pointer()) if area is not None else None
 
 
 def handler_registered():
@@ -69,11 +78,18 @@ def _draw():
         if len(_pipelines) > 1:
             _forget_closed_views(context.window_manager)
         draw_preview(ao_pipeline, region_3d.window_matrix, view_settings.params())
+        _view_errors.pop(context.area.as_pointer(), None)
     except Exception as error:  # never let the preview break the viewport
-        message = f"{type(error).__name__}: {error}"
+        message = str(error) or type(error).__name__
+        area_key = context.area.as_pointer()
+        if _view_errors.get(area_key) != message:
+            _view_errors[area_key] = message
+            for region in context.area.regions:  # the sidebar shows it
+                if region.type == "UI":
+                    region.tag_redraw()
         if message not in _reported_errors:
             _reported_errors.add(message)
-            print(f"HBAO viewport preview failed: {message}")
+            print(f"HBAO viewport preview failed: {type(error).__name__}: {message}")
 
 
 def _forget_closed_views(window_manager):

@@ -1,6 +1,8 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """The sidebar panel (N panel, tab "HBAO") and the operator that turns the
 preview on and off for one 3D view."""
+import textwrap
+
 import bpy
 
 from . import draw, settings
@@ -20,6 +22,44 @@ class HBAO_OT_viewport_preview_toggle(bpy.types.Operator):
         view_settings = settings.ensure(context.screen, context.area)
         view_settings.enabled = not view_settings.enabled  # the update syncs the handler
         return {"FINISHED"}
+
+
+# About how wide a character of the interface's text is, in pixels at a
+# resolution scale of 1, and what a box and an icon take of a line.
+CHARACTER_PIXELS = 7.0
+LINE_MARGIN_PIXELS = 50
+
+
+def _wrapped_label(layout, context, text, icon):
+    """`text` as lines that fit the sidebar's width, the first with `icon`."""
+    scale = context.preferences.system.ui_scale
+    characters = max(16, int((context.region.width - LINE_MARGIN_PIXELS * scale) /
+                             (CHARACTER_PIXELS * scale)))
+    for number, line in enumerate(textwrap.wrap(text, characters)):
+        layout.label(text=line, icon=icon if number == 0 else "BLANK1")
+
+
+def _node_summary(layout, context, view_settings, node):
+    """What the preview takes from `node` (its values at the current frame),
+    read-only: they are edited on the node."""
+    _wrapped_label(layout, context, f"Node \"{node.name}\"'s values (edit them there):",
+                   "NODE")
+    try:
+        params = view_settings.params(context.scene)
+    except Exception as error:  # the library missing, or a value it refuses
+        _wrapped_label(layout, context, str(error), "ERROR")
+        return
+    unit = context.scene.unit_settings
+    radius = bpy.utils.units.to_string(unit.system, "LENGTH", params["radius"] * unit.scale_length)
+    lines = [f"Radius {radius}", f"Strength {params['strength']:g}",
+             f"{params['directions']} directions x {params['steps']} steps",
+             f"Angle bias {params['angle_bias_degrees']:g} degrees",
+             f"Blur size {params['blur_size']}",
+             f"{params['integration'].title()}, falloff {params['falloff'].lower()}"]
+    if params.get("half_resolution"):
+        lines.append("Half resolution")
+    for line in lines:
+        layout.label(text=line)
 
 
 class VIEW3D_PT_hbao_preview(bpy.types.Panel):
@@ -42,17 +82,24 @@ class VIEW3D_PT_hbao_preview(bpy.types.Panel):
                             text="Turn On", icon="SHADING_SOLID")
             return
         if context.space_data.shading.type not in draw.SHADINGS:
-            layout.label(text="Shows in Solid and Material Preview", icon="INFO")
+            layout.label(text="Solid or Material Preview only", icon="INFO")
+        error = draw.view_error(context.area) if view_settings.enabled else None
+        if error:
+            _wrapped_label(layout.box(), context, f"No preview: {error}", "ERROR")
+        # check boxes with their label beside them: the split layout cut
+        # "Use Node Settings" and "Half Resolution" short in the sidebar
+        layout.prop(view_settings, "use_node_settings")
         layout.use_property_split = True
         layout.use_property_decorate = False
-        layout.prop(view_settings, "use_node_settings")
         node = view_settings.settings_node(context.scene) \
             if view_settings.use_node_settings else None
-        if view_settings.use_node_settings:
-            layout.label(text=f"Node \"{node.name}\"" if node else "No HBAO node: using these",
-                         icon="NODE" if node else "INFO")
+        if view_settings.use_node_settings and node is None:
+            layout.label(text="No HBAO node: using these", icon="INFO")
+        if node is not None:
+            _node_summary(layout.box(), context, view_settings, node)
+            return
         column = layout.column()
-        column.active = view_settings.enabled and node is None
+        column.active = view_settings.enabled
         column.prop(view_settings, "radius")
         column.prop(view_settings, "strength")
         column.prop(view_settings, "angle_bias_degrees")
@@ -62,12 +109,15 @@ class VIEW3D_PT_hbao_preview(bpy.types.Panel):
         column.prop(view_settings, "steps")
         column.prop(view_settings, "falloff")
         column.prop(view_settings, "integration")
-        column.prop(view_settings, "half_resolution")
         column.separator()
         column.prop(view_settings, "blur_size")
         row = column.row()
         row.active = view_settings.blur_size >= 2
-        row.prop(view_settings, "blur_sharpness")
+        row.prop(view_settings, "blur_sharpness", text="Sharpness")
+        column.separator()
+        flags = column.column()
+        flags.use_property_split = False
+        flags.prop(view_settings, "half_resolution")
 
 
 CLASSES = (HBAO_OT_viewport_preview_toggle, VIEW3D_PT_hbao_preview)
