@@ -20,7 +20,7 @@ bl_info = {
     "author": "HBAO contributors",
     "version": (0, 3, 0),
     "blender": (3, 4, 0),
-    "location": "Compositor > Add > Filter > HBAO",
+    "location": "Compositor > Add > Filter > HBAO; 3D View > Sidebar > HBAO",
     "description": "Horizon-based ambient occlusion from the Depth and Normal passes",
     "category": "Compositing",
     "doc_url": "",

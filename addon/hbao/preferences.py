@@ -1,9 +1,14 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """The add-on's preferences panel: where a message about this Blender
 (too old, newer than tested) stays visible after the console has scrolled."""
+import textwrap
+
 import bpy
 
 from .report import log
+
+# Characters a line of the preferences holds at the window's usual width.
+LINE_CHARACTERS = 90
 
 # The package name Blender knows the add-on by: "hbao" as a legacy add-on,
 # "bl_ext.<repository>.hbao" as an extension.
@@ -42,8 +47,8 @@ def _library_status(layout):
             load()
         except Exception as error:  # missing, or not this add-on's
             layout.label(text=f"{label}: not loaded, no AO", icon="ERROR")
-            for sentence in str(error).split(". "):
-                layout.label(text=sentence.rstrip("."), icon="BLANK1")
+            for line in textwrap.wrap(str(error), LINE_CHARACTERS):
+                layout.label(text=line, icon="BLANK1")
         else:
             layout.label(text=f"{label}: loaded", icon="CHECKMARK")
 
