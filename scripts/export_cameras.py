@@ -43,15 +43,22 @@ from hbao import camera as camera_model  # noqa: E402
 
 EXIT_BAD_ARGUMENTS = 2
 EXIT_FAILED = 1
-# The CLI's frames (Blender's MAXFRAME).
+# The CLI's frames (Blender's MAXFRAME) and its most ranges in --frames
+# (csrc/tool/frame_pattern.h: FRAME_MAX, FRAME_RANGES_MAX; tests/test_cli.py
+# compares them).
 FRAME_MAX = 1048574
+FRAME_RANGES_MAX = 64
 
 
 def frame_list(text):
-    """[frames] of "1-250" or "1-10,20,30-40", in the order given."""
+    """[frames] of "1-250" or "1-10,20,30-40", in the order given: what the
+    CLI's --frames takes (no spaces, up to FRAME_RANGES_MAX ranges)."""
     frames = []
-    for part in text.split(","):
-        match = re.fullmatch(r"\s*(\d+)\s*(?:-\s*(\d+)\s*)?", part)
+    parts = text.split(",")
+    if len(parts) > FRAME_RANGES_MAX:
+        raise argparse.ArgumentTypeError(f"{text!r}: more than {FRAME_RANGES_MAX} ranges")
+    for part in parts:
+        match = re.fullmatch(r"(\d+)(?:-(\d+))?", part)
         if match is None:
             raise argparse.ArgumentTypeError(f"{text!r} is not a frame list like 1-250")
         first = int(match.group(1))
@@ -114,6 +121,11 @@ def write_if_changed(path, text):
     path.parent.mkdir(parents=True, exist_ok=True)
     descriptor, temporary = tempfile.mkstemp(prefix=".export-cameras-", dir=path.parent)
     try:
+        # mkstemp makes the file its owner's only: a farm's workers, another
+        # user, must read it, as a file the shell creates
+        umask = os.umask(0)
+        os.umask(umask)
+        os.fchmod(descriptor, 0o666 & ~umask)
         with os.fdopen(descriptor, "w", encoding="utf-8") as stream:
             stream.write(text)
         os.replace(temporary, path)

@@ -14,6 +14,7 @@ How outputs are checked without a hand-written EXR parser:
 import json
 import os
 import random
+import re
 import resource
 import shutil
 import signal
@@ -1188,6 +1189,22 @@ def test_sequence_takes_each_frames_camera_from_a_pattern(hbao_tool, tmp_path):
     assert (tmp_path / "ao_3.exr").read_bytes() == (tmp_path / "ao_1.exr").read_bytes()
 
 
+def test_a_camera_in_a_folder_with_a_hash_is_one_camera(hbao_tool, tmp_path):
+    """Only a '#' in the camera's file name makes it per frame: a camera in
+    a folder like 'shot#1' is read once, as before per-frame cameras (a
+    review found every frame failing on 'shot11/cam.json')."""
+    folder = tmp_path / "shot#1"
+    folder.mkdir()
+    shutil.copyfile(camera_path("cycles_float_zip"), folder / "cam.json")
+    for frame in (1, 2):
+        shutil.copyfile(fixture_path("cycles_float_zip"), tmp_path / f"in_{frame}.exr")
+    run_ok(hbao_tool, tmp_path / "in_#.exr", "-o", tmp_path / "ao_#.exr", "--frames", "1-2",
+           "--camera", folder / "cam.json")
+    single = tmp_path / "single.exr"
+    compute_ao(hbao_tool, "cycles_float_zip", single)
+    assert (tmp_path / "ao_2.exr").read_bytes() == single.read_bytes()
+
+
 def test_sequence_refuses_an_output_that_is_another_frames_camera(hbao_tool, tmp_path):
     """-o 'x_#.exr' with --camera 'x_#0.exr' --frames 1-10: frame 10's output
     would replace frame 1's camera file before frame 1 reads it."""
@@ -1225,6 +1242,8 @@ def test_export_cameras_writes_each_frames_camera(hbao_tool, run_in_blender, ble
     assert not np.allclose(cameras[1]["world_to_camera"], cameras[3]["world_to_camera"])
     assert cameras[3]["lens"] == pytest.approx(1.5 * cameras[1]["lens"])
     assert not np.allclose(cameras[3]["world_to_camera"], cameras[4]["world_to_camera"])
+    # readable by the farm's other users, as a file the shell makes (umask 022)
+    assert all(p.stat().st_mode & 0o777 == 0o644 for p in (tmp_path / "cams").iterdir())
     times = {p: p.stat().st_mtime_ns for p in (tmp_path / "cams").iterdir()}
     again = run_in_blender(EXPORT_CAMERAS, pattern, "--frames", "2-3,1", blend=blend)
     assert "0 files written, 3 already up to date" in again.stdout
@@ -1235,10 +1254,23 @@ def test_export_cameras_writes_each_frames_camera(hbao_tool, run_in_blender, ble
            "--camera", tmp_path / "cams" / "cam_##.json")
 
 
+def test_export_cameras_frames_are_the_clis():
+    """The script takes --frames as the CLI does: its limits are the CLI's
+    (csrc/tool/frame_pattern.h)."""
+    header = (REPO / "csrc" / "tool" / "frame_pattern.h").read_text()
+    script = EXPORT_CAMERAS.read_text()
+    for name in ("FRAME_MAX", "FRAME_RANGES_MAX"):
+        in_header = re.search(rf"#define {name} (\d+)", header).group(1)
+        assert re.search(rf"^{name} = {in_header}$", script, re.M), name
+
+
 @pytest.mark.parametrize("arguments, status, fragment", [
     (["cam.json"], EXIT_USAGE, "needs a run of '#'"),
     (["cam_#.json", "--frames", "3-1"], EXIT_USAGE, "first to last"),
     (["cam_#.json", "--frames", "1-3,2"], EXIT_USAGE, "overlap"),
+    (["cam_#.json", "--frames", "1-3, 5"], EXIT_USAGE, "not a frame list"),
+    (["cam_#.json", "--frames", ",".join(str(2 * k) for k in range(65))], EXIT_USAGE,
+     "more than 64 ranges"),
 ])
 def test_export_cameras_refuses_bad_arguments(run_blender, tmp_path, arguments, status,
                                               fragment):

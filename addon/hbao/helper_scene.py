@@ -23,7 +23,7 @@ from .helper_lookup import (ENGINE_IDNAME, HELPER_SCENE_PREFIX, MAIN_SCENE_KEY, 
                             managed_node, scenes_pointing_at, scenes_served_by, serves)
 from .node import (AO_PASS_INPUT, DEPTH_INPUT, NORMAL_INPUT, hbao_nodes, next_pass_index,
                    pass_name)
-from .report import NodeMessage, log, note_change
+from .report import NodeMessage, in_main_thread, log, note_change
 from .socket_values import upstream
 
 MANAGED_NODE_NAME = "HBAO Passes"
@@ -164,9 +164,12 @@ def enable_needed_passes(scene, tree):
                 log(message)
                 # on the node and in the render's report, as the render's
                 # own messages are (which would otherwise replace it)
-                note_change(scene.name, NodeMessage(
+                change = NodeMessage(
                     node.name, f"the {label} pass of view layer {view_layer.name!r} was off; "
-                    f"the add-on turned it on (the node reads it)", f"{label} pass turned on"))
+                    f"the add-on turned it on (the node reads it)", f"{label} pass turned on")
+                note_change(scene.name, change)
+                if in_main_thread():  # outside a render: on the node now, as well
+                    node.status = change.short
     return messages
 
 

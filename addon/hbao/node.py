@@ -80,8 +80,7 @@ class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
                               default=_D["integration"], update=_settings_changed)
     half_resolution: BoolProperty(
         name="Half Resolution", default=False, update=_settings_changed,
-        description="Compute the AO on every other pixel and upsample it, edge-aware: about 3 "
-                    "times faster, a little softer")
+        description=parameters.DESCRIPTIONS["half_resolution"])
     guard_band: FloatProperty(
         name="Guard Band", default=0.0, min=0.0, max=100.0 * guard_geometry.MAX_GUARD_BAND,
         subtype="PERCENTAGE", update=_extra_render_changed,

@@ -84,7 +84,16 @@ DESCRIPTIONS = {
     "thickness": "How thick occluders are taken to be, in scene units: an object more than "
                  "this in front of a surface does not shade it (no dark halo behind it). 0 = "
                  "no limit",
+    "half_resolution": "Compute the AO on every other pixel of every other row and upsample "
+                       "it, edge-aware: about 3 times faster, a little softer",
 }
+
+
+def item_name(items, identifier):
+    """The name a menu's `items` (FALLOFF_ITEMS, INTEGRATION_ITEMS) show for
+    `identifier`."""
+    return next((name for key, name, _tip in items if key == identifier), identifier)
+
 
 # The menus of the node and of the viewport panel: (identifier, name, tip).
 FALLOFF_ITEMS = [

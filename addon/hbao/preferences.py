@@ -1,10 +1,9 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """The add-on's preferences panel: where a message about this Blender
 (too old, newer than tested) stays visible after the console has scrolled."""
-import textwrap
-
 import bpy
 
+from . import ui_text
 from .report import log
 
 # Characters a line of the preferences holds at the window's usual width.
@@ -47,8 +46,7 @@ def _library_status(layout):
             load()
         except Exception as error:  # missing, or not this add-on's
             layout.label(text=f"{label}: not loaded, no AO", icon="ERROR")
-            for line in textwrap.wrap(str(error), LINE_CHARACTERS):
-                layout.label(text=line, icon="BLANK1")
+            ui_text.labels(layout, str(error), LINE_CHARACTERS, "BLANK1")
         else:
             layout.label(text=f"{label}: loaded", icon="CHECKMARK")
 

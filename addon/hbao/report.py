@@ -94,16 +94,20 @@ def return_node_messages(scene_name, statuses):
 
 
 # Scene name -> [NodeMessage] of what the render hook changed for a render
-# (a pass turned on), which that render's plan shows beside its own.
+# (a pass turned on), which that render's plan shows beside its own. The
+# render thread and the main thread both note and take them.
 _changes_for_render = {}
+_changes_lock = threading.Lock()
 
 
 def note_change(scene_name, message):
     """Keep `message` (a NodeMessage) for the plan of `scene_name`'s next
     render, which would otherwise replace it on the node. Any thread."""
-    _changes_for_render.setdefault(scene_name, []).append(message)
+    with _changes_lock:
+        _changes_for_render.setdefault(scene_name, []).append(message)
 
 
 def take_changes(scene_name):
     """The messages note_change() kept for `scene_name`, once."""
-    return _changes_for_render.pop(scene_name, [])
+    with _changes_lock:
+        return _changes_for_render.pop(scene_name, [])

@@ -65,6 +65,11 @@ bool frame_pattern_has_frame(const char *pattern) {
     return strchr(pattern, '#') != NULL;
 }
 
+bool frame_pattern_has_frame_in_name(const char *pattern) {
+    const char *slash = strrchr(pattern, '/');
+    return strchr(slash != NULL ? slash + 1 : pattern, '#') != NULL;
+}
+
 bool frame_pattern_path(const char *pattern, int32_t frame, char *path, size_t size) {
     const char *run_end = strrchr(pattern, '#');
     if (run_end == NULL) {

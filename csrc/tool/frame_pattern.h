@@ -39,6 +39,9 @@ int32_t frame_list_at(const frame_list *list, int64_t index);
 /** True when `pattern` holds a '#'. */
 bool frame_pattern_has_frame(const char *pattern);
 
+/** True when the file name of `pattern` (after its last '/') holds a '#'. */
+bool frame_pattern_has_frame_in_name(const char *pattern);
+
 /** `pattern` with its last '#' run replaced by `frame`; false when the
  *  result does not fit in `size` bytes. */
 bool frame_pattern_path(const char *pattern, int32_t frame, char *path, size_t size);

@@ -80,11 +80,13 @@ static void report(sequence_run *run, const frame_outcome *outcome, const char *
     pthread_mutex_unlock(&run->lock);
 }
 
-/* A --camera name with a '#' run names each frame's own camera file, as
- * the input names its render (an animated camera: scripts/export_cameras.py
- * writes them); without one, every frame has the same camera, read once. */
+/* A --camera file name with a '#' run names each frame's own camera file,
+ * as the input names its render (an animated camera:
+ * scripts/export_cameras.py writes them); without one (a '#' in a folder's
+ * name only, as before per-frame cameras), every frame has the same camera,
+ * read once. */
 static bool per_frame_camera(const cli_options *options) {
-    return options->camera_path != NULL && frame_pattern_has_frame(options->camera_path);
+    return options->camera_path != NULL && frame_pattern_has_frame_in_name(options->camera_path);
 }
 
 static void run_frame(sequence_run *run, frame_outcome *outcome) {
@@ -153,8 +155,9 @@ static int summarize(const sequence_run *run, tool_error *error) {
                      (long long)run->count, list);
 }
 
-/* A frame's output or preview that is another frame's input would replace
- * that frame's render before it is read (hbao 'f_#.exr' -o 'f_#0.exr'
+/* A frame's output or preview that is another frame's input (its render,
+ * or its camera file where each frame has one) would replace it before it
+ * is read (hbao 'f_#.exr' -o 'f_#0.exr'
  * --frames 1-10: frame 1 writes f_10.exr); one that is another frame's
  * preview or output, the two frames would replace each other's file
  * (-o 'o_#.exr' --preview 'o_#0.exr'). Each frame refuses its own input

@@ -24,6 +24,11 @@ _reported_errors = set()
 _view_errors = {}
 
 
+def _forget_error(area):
+    if area is not None:
+        _view_errors.pop(area.as_pointer(), None)
+
+
 def view_error(area):
     """Why the preview of the 3D view in `area` failed the last time it was
     drawn, or None."""
@@ -66,9 +71,11 @@ def _draw():
     space = context.space_data
     region_3d = context.region_data
     if space is None or region_3d is None or space.shading.type not in SHADINGS:
+        _forget_error(context.area)  # not drawn: nothing failed
         return
     view_settings = settings.find(context.screen, context.area)
     if view_settings is None or not view_settings.enabled:
+        _forget_error(context.area)
         return
     try:
         key = context.region.as_pointer()

@@ -20,8 +20,8 @@ bool usable_depth(ivec2 q, out float zq)
     return !is_background(zq);
 }
 
-/* Coarse depth (rounded to at least HALF_DEPTH_PRECISION of itself: half
- * floats, or a far depth of a view with a tiny Clip Start) steps in stairs:
+/* Coarse depth (half floats, or a far depth of a view with a tiny Clip
+ * Start: coarse_depth) steps in stairs:
  * the tangent along an axis is the least-squares line through the run of up
  * to HALF_DEPTH_FIT_REACH pixels on each side that continues the surface
  * (docs/algorithm.md, "Normals"; csrc/lib/normals.c, fit_tangent). */

@@ -1,10 +1,9 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """The sidebar panel (N panel, tab "HBAO") and the operator that turns the
 preview on and off for one 3D view."""
-import textwrap
-
 import bpy
 
+from .. import parameters, ui_text
 from . import draw, settings
 
 
@@ -24,19 +23,20 @@ class HBAO_OT_viewport_preview_toggle(bpy.types.Operator):
         return {"FINISHED"}
 
 
-# About how wide a character of the interface's text is, in pixels at a
-# resolution scale of 1, and what a box and an icon take of a line.
-CHARACTER_PIXELS = 7.0
-LINE_MARGIN_PIXELS = 50
-
-
 def _wrapped_label(layout, context, text, icon):
     """`text` as lines that fit the sidebar's width, the first with `icon`."""
-    scale = context.preferences.system.ui_scale
-    characters = max(16, int((context.region.width - LINE_MARGIN_PIXELS * scale) /
-                             (CHARACTER_PIXELS * scale)))
-    for number, line in enumerate(textwrap.wrap(text, characters)):
-        layout.label(text=line, icon=icon if number == 0 else "BLANK1")
+    characters = ui_text.characters_for(context.region.width,
+                                        context.preferences.system.ui_scale)
+    ui_text.labels(layout, text, characters, icon)
+
+
+def _length(context, value):
+    """A length in scene units as Blender's fields show it (the unit
+    system's scale applies only where there is a unit system)."""
+    unit = context.scene.unit_settings
+    if unit.system == "NONE":
+        return f"{value:g}"
+    return bpy.utils.units.to_string(unit.system, "LENGTH", value * unit.scale_length)
 
 
 def _node_summary(layout, context, view_settings, node):
@@ -49,13 +49,15 @@ def _node_summary(layout, context, view_settings, node):
     except Exception as error:  # the library missing, or a value it refuses
         _wrapped_label(layout, context, str(error), "ERROR")
         return
-    unit = context.scene.unit_settings
-    radius = bpy.utils.units.to_string(unit.system, "LENGTH", params["radius"] * unit.scale_length)
-    lines = [f"Radius {radius}", f"Strength {params['strength']:g}",
+    lines = [f"Radius {_length(context, params['radius'])}",
+             f"Strength {params['strength']:g}",
              f"{params['directions']} directions x {params['steps']} steps",
              f"Angle bias {params['angle_bias_degrees']:g} degrees",
-             f"Blur size {params['blur_size']}",
-             f"{params['integration'].title()}, falloff {params['falloff'].lower()}"]
+             f"Thickness {_length(context, params['thickness'])}"
+             if params["thickness"] > 0.0 else "Thickness: no limit",
+             f"Blur size {params['blur_size']}, sharpness {params['blur_sharpness']:g}",
+             f"{parameters.item_name(parameters.INTEGRATION_ITEMS, params['integration'])}, "
+             f"falloff {parameters.item_name(parameters.FALLOFF_ITEMS, params['falloff'])}"]
     if params.get("half_resolution"):
         lines.append("Half resolution")
     for line in lines:

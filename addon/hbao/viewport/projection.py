@@ -135,7 +135,8 @@ def depth_buffer_precision(matrix):
     in orthographic views (depth moves by 1 / |P22| per unit of ndc, the same
     everywhere). The preview's tangent test allows for DEPTH_BUFFER_MARGIN
     such steps beside the float depth's own rounding, and its normals are
-    fitted where a step reaches a half float's."""
+    fitted where one step over a pixel's width tilts a tangent by more than
+    BUFFER_FIT_SLOPE (shader_sources.NORMAL_DEFINES)."""
     p22, p23 = float(matrix[2][2]), float(matrix[2][3])
     ndc_step = 2.0 * DEPTH_BUFFER_STEP
     return ndc_step / abs(p23 if is_perspective_matrix(matrix) else p22)

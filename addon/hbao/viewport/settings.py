@@ -96,8 +96,7 @@ class HBAOViewSettings(bpy.types.PropertyGroup):
         update=_redraw, description=_TIPS["thickness"])
     half_resolution: BoolProperty(
         name="Half Resolution", default=False, update=_redraw,
-        description="Search the horizons on every other pixel of every other row and "
-                    "upsample, as the node's Half Resolution does: about 3 times faster")
+        description=_TIPS["half_resolution"])
 
     def params(self, scene=None):
         """The C library's parameters (native.compute_ao's dict) this view

@@ -213,8 +213,8 @@ void main()
 # HBAO_FLOAT_DEPTH_PRECISION). The preview's depth is float, linearised from
 # the viewport's depth buffer, whose own rounding the preview adds
 # (projection.depth_buffer_precision); it never tests for half floats, but
-# fits the normals where the rounding reaches the half floats'
-# (NORMAL_DEFINES).
+# fits the normals as for them where a buffer step is coarse
+# (NORMAL_DEFINES: BUFFER_FIT_SLOPE).
 FLOAT_DEPTH_PRECISION = 1.1920929e-7
 
 # Falloff and integration enum values as the shader sees them (the header's,
