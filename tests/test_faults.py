@@ -13,6 +13,8 @@ import pytest
 from conftest import EXR_LIBRARY, REPO, run_command, small_tmpfs
 from test_addon import EXACT, exr, library_ao, node_outputs, node_params, render
 
+SCRIPTS = REPO / "tests" / "blender_scripts"
+
 pytestmark = pytest.mark.matrix
 RENDER_SCRIPT = REPO / "tests" / "blender_scripts" / "addon_render.py"
 
@@ -351,3 +353,30 @@ def test_helper_scene_rendered_by_the_artist_explains_itself(run_in_blender, tmp
     assert ("\".HBAO passes Scene\" is the HBAO add-on's helper scene and renders nothing by "
             "itself. Switch back to scene \"Scene\"") in log, log[-3000:]
     assert "AO pass(es)" not in log and "Traceback" not in log
+
+
+def _render_twice(run_in_blender, tmp_path, case):
+    completed = run_in_blender(SCRIPTS / "render_twice.py", case, tmp_path)
+    log = completed.stdout
+    second = log[log.index("SECOND RENDER"):]
+    after = json.loads(next(line for line in log.splitlines()
+                            if line.startswith("AFTER "))[len("AFTER "):])
+    return second, after
+
+
+def test_deleting_the_last_node_removes_the_hook_before_the_next_render(
+        run_in_blender, tmp_path):
+    """A script deletes the only HBAO node and renders again (`-b`: no timer
+    syncs): the render is plain, says nothing about the helper scene (it
+    said the artist had rendered the helper), and the helper is gone."""
+    second, after = _render_twice(run_in_blender, tmp_path, "delete_last_node")
+    assert "helper scene" not in second, second[-2000:]
+    assert after["scenes"] == ["Scene"], after
+
+
+def test_a_panoramic_camera_says_so_on_the_node(run_in_blender, tmp_path):
+    """A camera the library cannot model turns the AO off: the render's
+    report said why, the node said nothing."""
+    second, after = _render_twice(run_in_blender, tmp_path, "panoramic_camera")
+    assert "is PANO" in second, second[-2000:]
+    assert after["statuses"] == {"HBAO0": "Camera: AO off"}, after

@@ -15,8 +15,8 @@ from . import (ao_cache, exr_passes, handover, layer_passes, native, recomposite
                timing_line)
 from .helper_lookup import ENGINE_IDNAME, is_helper, pass_names_for_helper
 from .helper_scene import rendered_for_a_scene, scene_for_render
-from .planning import node_names, plan
-from .report import NodeMessage, log, post_node_messages, post_render_report
+from .planning import node_names, plan, tell_all_nodes
+from .report import log, post_node_messages, post_render_report
 
 # The prefix of the passes this engine fills (node.pass_name's).
 PASS_PREFIX = "HBAO "
@@ -193,14 +193,6 @@ def main_of(helper, request):
     return bpy.data.scenes.get(request.main) if request else scene_for_render(helper)
 
 
-def _tell_nodes(main, short, detail):
-    """The same message on every HBAO node of `main`."""
-    if main is None:
-        return
-    names = node_names(main)
-    post_node_messages(main.name, names, [NodeMessage(name, detail, short) for name in names])
-
-
 def render_helper(engine, depsgraph):
     """HBAOPassEngine.render(): fill every registered AO pass, 1 where it failed."""
     scene = _original(depsgraph.scene)
@@ -228,11 +220,18 @@ def render_helper(engine, depsgraph):
             results = {}
             _cache.clear()  # nothing kept that this render's record would not match
             _report_failure(engine, f"{error} Rendering without AO.")
-            _tell_nodes(main_of(scene, request), LIBRARY_SHORT, f"{error} Rendering without AO.")
+            tell_all_nodes(main_of(scene, request), LIBRARY_SHORT, f"{error} Rendering without AO.")
+        except camera_model.CameraError as error:  # a camera the library cannot model
+            results = {}
+            _report_failure(engine, f"{error}. Rendering without AO.")
+            tell_all_nodes(main_of(scene, request), "Camera: AO off",
+                           f"{error}. Rendering without AO.")
         except Exception as error:  # the render must complete: AO = 1
             results = {}
             _cache.clear()
-            _report_failure(engine, f"{type(error).__name__}: {error}. Rendering without AO.")
+            detail = f"{type(error).__name__}: {error}. Rendering without AO."
+            _report_failure(engine, detail)
+            tell_all_nodes(main_of(scene, request), "Error: AO off (see Info)", detail)
         write_start = time.perf_counter()
         for layer in result.layers:
             for render_pass in layer.passes:

@@ -89,6 +89,7 @@ def _on_render_pre(scene, *_args):
     recomposite.cancel_all()  # a render of any scene needs the cores
     tree = compat.compositor_tree(scene)
     if not node.hbao_nodes(tree):
+        _unhook_before_render(scene)
         return
     try:
         if in_main_thread():
@@ -99,6 +100,22 @@ def _on_render_pre(scene, *_args):
         helper_scene.record_rendering(scene)
     except Exception as error:
         log(f"could not prepare the HBAO hook of {scene.name!r}: {error}")
+
+
+def _unhook_before_render(scene):
+    """The last HBAO node deleted since the last sync (a script in `blender
+    -b`, where no timer syncs): the hook goes now where Blender allows it;
+    in F12's render thread, where it cannot, the helper still renders for
+    this scene (its engine computes no AO, and says nothing)."""
+    if helper_lookup.helper_scene_of(scene) is None:
+        return
+    try:
+        if in_main_thread():
+            helper_scene.sync(scene)
+        else:
+            helper_scene.record_rendering(scene)
+    except Exception as error:
+        log(f"could not remove the HBAO hook of {scene.name!r}: {error}")
 
 
 @bpy.app.handlers.persistent

@@ -103,3 +103,12 @@ def plan(main, frame):
             jobs.append(job)
     post_node_messages(main.name, node_names(main), warnings)
     return jobs, warnings
+
+
+def tell_all_nodes(main, short, detail):
+    """The same message on every HBAO node of `main` (None: nothing): a
+    render whose AO failed as a whole."""
+    if main is None:
+        return
+    names = node_names(main)
+    post_node_messages(main.name, names, [NodeMessage(name, detail, short) for name in names])
