@@ -7,8 +7,8 @@ is switched by markers), each frame needs its own.
         'cam_####.json' [--frames 1-250]
     hbao 'render_####.exr' -o 'ao_####.exr' --camera 'cam_####.json' --frames 1-250
 
-The run of '#' is the frame number, zero-padded to the run's length, as the
-CLI and Blender name frames. Frames: as the CLI's --frames (1-250,
+The run of '#' (in the file's name, which ends in .json) is the frame
+number, zero-padded to the run's length, as the CLI and Blender name frames. Frames: as the CLI's --frames (1-250,
 1-10,20,30-40); by default the scene's range and step. The scene is the
 file's active one, or the one Blender's -S names (before --python). Each
 frame's camera is the scene's at that frame, evaluated (animation,
@@ -87,9 +87,16 @@ def arguments():
     parser.add_argument("--frames", type=frame_list, help="frames to write (default: the "
                         "scene's range)")
     parsed = parser.parse_args(argv)
-    if "#" not in parsed.pattern:
-        raise ArgumentError(f"{parsed.pattern!r} needs a run of '#' for the frame number, "
-                            f"e.g. cam_####.json")
+    name = os.path.basename(parsed.pattern)
+    # The CLI takes a camera per frame only from a '#' in the file's name
+    # (csrc/tool/sequence_command.c, per_frame_camera); and a camera file is
+    # JSON: a render's name given by mistake must not be written over.
+    if "#" not in name:
+        raise ArgumentError(f"{parsed.pattern!r} needs a run of '#' for the frame number in "
+                            f"its file name, e.g. cam_####.json")
+    if not name.lower().endswith(".json"):
+        raise ArgumentError(f"{parsed.pattern!r}: camera files end in .json (a render's name "
+                            f"given by mistake would be written over)")
     return parsed
 
 

@@ -1266,6 +1266,8 @@ def test_export_cameras_frames_are_the_clis():
 
 @pytest.mark.parametrize("arguments, status, fragment", [
     (["cam.json"], EXIT_USAGE, "needs a run of '#'"),
+    (["shot#/cam.json"], EXIT_USAGE, "in its file name"),
+    (["render_####.exr"], EXIT_USAGE, "camera files end in .json"),
     (["cam_#.json", "--frames", "3-1"], EXIT_USAGE, "first to last"),
     (["cam_#.json", "--frames", "1-3,2"], EXIT_USAGE, "overlap"),
     (["cam_#.json", "--frames", "1-3, 5"], EXIT_USAGE, "not a frame list"),
@@ -1274,9 +1276,11 @@ def test_export_cameras_frames_are_the_clis():
 ])
 def test_export_cameras_refuses_bad_arguments(run_blender, tmp_path, arguments, status,
                                               fragment):
-    completed = run_blender(EXPORT_CAMERAS, *arguments, check=False)
+    completed = run_blender(EXPORT_CAMERAS, tmp_path / arguments[0], *arguments[1:],
+                            check=False)
     assert completed.returncode == status, completed.stdout
     assert fragment in completed.stdout
+    assert not any(tmp_path.rglob("*")), "nothing is written"
 
 
 def test_export_cameras_says_which_frame_has_no_camera(run_blender, tmp_path):
