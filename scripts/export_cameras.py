@@ -8,8 +8,9 @@ is switched by markers), each frame needs its own.
     hbao 'render_####.exr' -o 'ao_####.exr' --camera 'cam_####.json' --frames 1-250
 
 The run of '#' (in the file's name, which ends in .json) is the frame
-number, zero-padded to the run's length, as the CLI and Blender name frames. Frames: as the CLI's --frames (1-250,
-1-10,20,30-40); by default the scene's range and step. The scene is the
+number, zero-padded to the run's length, as the CLI and Blender name frames.
+Frames: as the CLI's --frames (1-250, 1-10,20,30-40); by default the scene's
+range and step. The scene is the
 file's active one, or the one Blender's -S names (before --python). Each
 frame's camera is the scene's at that frame, evaluated (animation,
 constraints, parents, Time Remapping; a cropped border render's camera is
