@@ -12,7 +12,7 @@ import numpy as np
 
 from . import camera as camera_model
 from . import (ao_cache, exr_passes, handover, layer_passes, native, recomposite, render_record,
-               timing_line)
+               strip_cameras, timing_line)
 from .helper_lookup import ENGINE_IDNAME, is_helper, pass_names_for_helper
 from .helper_scene import rendered_for_a_scene, scene_for_render
 from .planning import node_names, plan, tell_all_nodes
@@ -29,7 +29,7 @@ _cache = ao_cache.last_render
 
 
 def _evaluated_camera(main, depsgraph):
-    camera = main.camera
+    camera = strip_cameras.rendered_camera(main)  # a sequencer strip's override too
     if camera is None:
         return None
     try:

@@ -15,7 +15,7 @@ before the helper's: when the helper's engine runs, their Render Results
 hold this frame's passes (docs/blender-integration.md)."""
 import bpy
 
-from . import back_material, compat, guard_geometry, writes
+from . import back_material, compat, guard_geometry, strip_cameras, writes
 from .data_edits import set_if_different
 from .report import log
 
@@ -276,4 +276,6 @@ def for_render(main, helper, kind):
         return None, "its render is not set up yet (it is made when the setting changes)"
     if main.render.use_border:
         return None, "border renders have none"
+    if strip_cameras.override_for(main) is not None:
+        return None, "a Video Sequencer strip renders the scene through another camera"
     return scene, None

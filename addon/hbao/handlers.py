@@ -10,7 +10,7 @@ the only chance such a render has to build the hook."""
 import bpy
 
 from . import (compat, helper_lookup, helper_render_settings, helper_scene, node, node_place,
-               recomposite, writes)
+               recomposite, strip_cameras, writes)
 from .report import NodeMessage, in_main_thread, log, post_node_messages, post_render_report
 
 _sync_scheduled = False
@@ -46,6 +46,7 @@ def schedule_sync():
 def _on_load_post(*_args):
     global _sync_scheduled
     _sync_scheduled = False  # opening a file removed the timer, if it waited
+    strip_cameras.forget_jobs()
     _sync_all_or_later()
 
 
@@ -62,6 +63,7 @@ def _on_render_init(scene, *_args):
     nodes inside node groups mean (the hook computes only at the top
     level), and that Render Single Layer turns the AO off (on the nodes'
     status lines too); then as every frame."""
+    strip_cameras.job_started(scene)
     if not helper_lookup.is_helper(scene):
         tree = compat.compositor_tree(scene)
         # (the console's text, the report's: a node's reads "HBAO node ...")
@@ -120,6 +122,7 @@ def _unhook_before_render(scene):
 
 @bpy.app.handlers.persistent
 def _on_render_end(scene, *_args):
+    strip_cameras.job_ended(scene)
     if not helper_lookup.is_helper(scene):
         helper_scene.record_render_end(scene)
 

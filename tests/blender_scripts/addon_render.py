@@ -16,7 +16,10 @@ AO pass), orthographic, widen_camera (factor), dump_back_faces (writes
 <out>/back_<NNNN>.npy: the back faces render's Depth, top row first), border
 [min_x, max_x, min_y, max_y] (a border render cropped to it; with crop false, not
 cropped), animate_camera (the camera turns and moves over frames 1-5),
-time_remap [old, new] (Time Remapping), save_blend
+time_remap [old, new] (Time Remapping), sequencer ("override": a scene "Edit" shows the
+scene in a Video Sequencer strip through a camera override, "Strip Camera"; "two_cameras": and
+in a second strip above it through the scene's camera; each frame renders Edit first, keeping
+the nodes' file as strip_nodes_<NNNN>.exr, then the scene through Strip Camera), save_blend
 (path: saved after the setup, before rendering), nodes: [{name, layer, normal
 (bool), radius, keyframes [[frame, radius], ..], radius_from_value_node,
 falloff, integration, blur_size, angle_bias, directions, steps, strength,
@@ -92,6 +95,22 @@ if spec.get("animate_camera"):  # the camera turns and moves from frame 1 to fra
     moving.keyframe_insert("location", frame=5)
 if spec.get("time_remap"):  # Time Remapping [old, new]: frame f shows the time f * new / old
     scene.render.frame_map_old, scene.render.frame_map_new = spec["time_remap"]
+edit = None  # sequencer: the scene that shows `scene` in Video Sequencer strips
+if spec.get("sequencer"):
+    strip_camera = scene.camera.copy()
+    strip_camera.data = scene.camera.data.copy()
+    strip_camera.name = "Strip Camera"
+    scene.collection.objects.link(strip_camera)
+    strip_camera.location.x -= 0.6
+    strip_camera.rotation_euler.z -= 0.2
+    strip_camera.data.lens *= 0.8
+    edit = bpy.data.scenes.new("Edit")
+    edit.render.resolution_x, edit.render.resolution_y = resolution
+    editor = edit.sequence_editor_create()
+    strips = editor.strips if hasattr(editor, "strips") else editor.sequences
+    strips.new_scene("Shot", scene, channel=1, frame_start=1).scene_camera = strip_camera
+    if spec["sequencer"] == "two_cameras":  # a second strip above, through the scene's camera
+        strips.new_scene("Shot again", scene, channel=2, frame_start=1)
 
 if spec.get("layer_name"):  # the first view layer renamed
     scene.view_layers[0].name = spec["layer_name"]
@@ -266,6 +285,13 @@ if spec.get("save_blend"):
 
 
 for frame in spec.get("frames", [1]):
+    if edit is not None:  # the sequencer's render first, its nodes_ file kept as strip_nodes_
+        edit.frame_set(frame)
+        edit.render.filepath = os.path.join(out_dir, f"edit_{frame:04d}")
+        bpy.ops.render.render(write_still=True, scene=edit.name)
+        os.replace(os.path.join(out_dir, f"nodes_{frame:04d}.exr"),
+                   os.path.join(out_dir, f"strip_nodes_{frame:04d}.exr"))
+        scene.camera = strip_camera  # then the scene itself through the strip's camera
     scene.frame_set(frame)
     with open(os.path.join(out_dir, f"camera_{frame:04d}.json"), "w") as stream:
         json.dump(blender_scenes.camera_description(scene), stream)
