@@ -46,10 +46,10 @@ def render(run_in_blender, tmp_path, spec, env=None, name="render"):
     return out, completed.stdout
 
 
-def frame_passes(out, frame, layer="ViewLayer", with_normal=True):
-    """(depth, normal) of the main render's view layer; normal None unless
-    with_normal."""
-    path = out / f"frame_{frame:04d}.exr"
+def frame_passes(out, frame, layer="ViewLayer", with_normal=True, view=""):
+    """(depth, normal) of the main render's view layer (of a stereo render's
+    view with file suffix `view`); normal None unless with_normal."""
+    path = out / f"frame_{frame:04d}{view}.exr"
     normal_names = [f"{layer}.Normal.{axis}" for axis in "XYZ"] if with_normal else []
     channels = exr.read_channels(path, [f"{layer}.Depth.Z"] + normal_names)
     depth = channels[f"{layer}.Depth.Z"]
@@ -74,13 +74,13 @@ def node_outputs(out, frame, node="HBAO0", view=""):
     return result
 
 
-def camera(out, frame):
-    return json.loads((out / f"camera_{frame:04d}.json").read_text())
+def camera(out, frame, view=""):
+    return json.loads((out / f"camera_{frame:04d}{view}.json").read_text())
 
 
-def library_ao(native, out, frame, params, with_normal=True, layer="ViewLayer"):
-    depth, normal = frame_passes(out, frame, layer, with_normal)
-    return native.compute_ao(depth, normal, params=params, camera=camera(out, frame))
+def library_ao(native, out, frame, params, with_normal=True, layer="ViewLayer", view=""):
+    depth, normal = frame_passes(out, frame, layer, with_normal, view)
+    return native.compute_ao(depth, normal, params=params, camera=camera(out, frame, view))
 
 
 def node_params(**overrides):
@@ -618,40 +618,34 @@ def test_border_edges_round_as_blender_rounds_them(run_in_blender, tmp_path, cro
     assert np.abs(inside - full[rows, columns]).mean() < 0.05
 
 
-def test_stereo_render_renders_without_ao_and_says_so(run_in_blender, tmp_path, monkeypatch):
-    """With Stereoscopy on, the compositor reads each view's pass: the helper
-    had one view, so the AO input was 0 in both and the frame black, and the
-    hand-over's save wrote a scratch file per view that nothing removed.
-    Now the helper has the main scene's views, the engine says that stereo
-    gets no AO, and each view's image is the render."""
+@pytest.mark.parametrize("stereo, views", [(True, ("_L", "_R")),
+                                           ("custom_view", ("_L", "_R", "_C"))],
+                         ids=["stereo_3d", "multi_view"])
+def test_stereo_and_multi_view_renders_get_each_views_ao(run_in_blender, tmp_path, monkeypatch,
+                                                         native, stereo, views):
+    """Each view's AO is the library's from that view's passes and camera:
+    Stereo 3D's eyes (the right one moved and, off-axis, shifted; the test
+    works them out from the camera's Stereoscopy settings) and Multi-View's
+    cameras named by view suffix. Before, the AO was off (1) in every view
+    with a message. The helper has the main scene's views, so the
+    compositor reads each view's pass (with one view the frame was black),
+    and every view's scratch file is removed."""
     scratch = tmp_path / "scratch"
     scratch.mkdir()
     monkeypatch.setenv("HBAO_TEMP_DIR", str(scratch))
-    out, log = render(run_in_blender, tmp_path, {"stereo": True, "nodes": [{"radius": 1.0}]})
-    assert "stereo and multi-view renders get no AO yet" in log
-    assert "Rendering without AO" in log
-    for view in ("_L", "_R"):
+    out, log = render(run_in_blender, tmp_path, {"stereo": stereo,
+                                                 "nodes": [{"radius": 0.7, "blur_size": 0}]})
+    expected = {view: library_ao(native, out, 1, node_params(radius=0.7, blur_size=0), view=view)
+                for view in views}
+    for view in views:
         outputs = node_outputs(out, 1, view=view)
-        assert np.all(outputs["ao"] == 1.0)
+        assert expected[view].min() < 0.9, view
+        assert np.abs(outputs["ao"] - expected[view]).max() <= EXACT, view
         assert outputs["render"].max() > 0.1  # a render, not a black frame
-        assert np.abs(outputs["image"] - outputs["render"]).max() <= EXACT
+    # the views differ: a view's AO through another view's camera would not match
+    assert np.abs(expected[views[0]] - expected[views[1]]).max() > 0.1
+    assert "Rendering without AO" not in log
     assert list(scratch.iterdir()) == []
-
-
-def test_multi_view_with_a_view_of_its_own_renders_without_ao(run_in_blender, tmp_path,
-                                                              monkeypatch):
-    """Multi-View with a view besides left and right: the helper has that
-    view too, so its image is the render (the compositor read the helper's
-    AO pass of a view it did not have as 0: a black frame)."""
-    monkeypatch.setenv("HBAO_TEMP_DIR", str(tmp_path))
-    out, log = render(run_in_blender, tmp_path, {"stereo": "custom_view",
-                                                 "nodes": [{"radius": 1.0}]})
-    assert "stereo and multi-view renders get no AO yet" in log
-    for view in ("_L", "_R", "_C"):
-        outputs = node_outputs(out, 1, view=view)
-        assert np.all(outputs["ao"] == 1.0), view
-        assert outputs["render"].max() > 0.1, view
-        assert np.abs(outputs["image"] - outputs["render"]).max() <= EXACT, view
 
 
 def test_border_crop_render_matches_the_full_frame(run_in_blender, tmp_path):

@@ -22,3 +22,13 @@ def test_names_before_session_19_and_other_files():
     for other in ("hbao-passes-notes.exr", "hbao-passes-4242-1-2.exr.tmp",
                   "hbao-passes--1-2.exr", "render-4242-1-2.exr", "hbao-passes-4242.exr"):
         assert scratch_names.process_of(other) is None, other
+
+
+def test_a_stereo_renders_view_files():
+    """A stereo or multi-view save writes a file per view, its file suffix
+    before the extension (handover.view_path): recognised as the same
+    process's, so that a killed Blender's view files are removed too."""
+    name = scratch_names.name(4242, 139872, 7)
+    for suffix in ("_L", "_R", "-center view"):
+        assert scratch_names.process_of(name[:-len(".exr")] + suffix + ".exr") == 4242, suffix
+    assert scratch_names.process_of("hbao-passes-4242-139872-7_L.exr.tmp") is None

@@ -88,10 +88,12 @@ def crop_camera(description, width, height, border):
     return native.camera_crop(description, width, height, x0, height - y1, x1 - x0, y1 - y0)
 
 
-def camera_for_render_result(scene, camera_object=None):
-    """camera_from_blender(), turned into the camera of the cropped image
-    (crop_camera) when the scene renders a cropped border."""
-    description = camera_from_blender(scene, camera_object)
+def camera_for_render_result(scene, camera_object=None, description=None):
+    """camera_from_blender() (or `description`, a view's), turned into the
+    camera of the cropped image (crop_camera) when the scene renders a
+    cropped border."""
+    if description is None:
+        description = camera_from_blender(scene, camera_object)
     render = scene.render
     if not (render.use_border and render.use_crop_to_border):
         return description

@@ -11,84 +11,29 @@ import bpy
 import numpy as np
 
 from . import camera as camera_model
-from . import (ao_cache, exr_passes, handover, layer_passes, native, recomposite, render_record,
-               strip_cameras, timing_line)
+from . import (ao_cache, exr_passes, handover, job_inputs, layer_passes, native, recomposite,
+               render_record, timing_line)
 from .helper_lookup import ENGINE_IDNAME, is_helper, pass_names_for_helper
 from .helper_scene import rendered_for_a_scene, scene_for_render
 from .planning import node_names, plan, tell_all_nodes
-from .report import log, post_node_messages, post_render_report
+from .report import log, post_render_report
 
 # The prefix of the passes this engine fills (node.pass_name's).
 PASS_PREFIX = "HBAO "
-MULTIVIEW_UNSUPPORTED = ("stereo and multi-view renders get no AO yet (turn Stereoscopy off in "
-                         "the Output properties for AO)")
-
 # The last render's passes and AO, reused for the same passes and settings,
 # and by re-compositing (recomposite.py).
 _cache = ao_cache.last_render
-
-
-def _evaluated_camera(main, depsgraph):
-    camera = strip_cameras.rendered_camera(main)  # a sequencer strip's override too
-    if camera is None:
-        return None
-    try:
-        return camera.evaluated_get(depsgraph)
-    except (RuntimeError, ReferenceError, TypeError):
-        return camera
 
 
 def _original(scene):
     return scene.original if hasattr(scene, "original") else scene
 
 
-def _handed_over(engine, depsgraph, helper, main, jobs, warnings):
-    """(inputs_of, timings): the passes of the render that has just ended,
-    saved and read back; inputs_of(job) gives a job's (AOInputs, depth,
-    normal, ExtraPasses or None)."""
-    # Fail early, before the save, if a library is missing.
-    exr_passes.load_library()
-    camera = camera_model.camera_for_render_result(main, _evaluated_camera(main, depsgraph))
-    channels, timings = handover.read_main_passes(main, jobs)
-    extra, extra_warnings = layer_passes.read(helper, main, jobs, timings)
-    for warning in extra_warnings:
-        _report(engine, f"HBAO {warning}")
-        log(warning)
-    if extra_warnings:  # the nodes' status lines show them with the plan's
-        post_node_messages(main.name, node_names(main), warnings + extra_warnings)
-
-    def inputs_of(job):
-        depth = channels[("depth", job.layer)]
-        normal = channels[("normal", job.layer)] if job.with_normal else None
-        inputs = ao_cache.AOInputs(job.params, camera, layer_passes.settings_of(job, extra),
-                                   (depth, normal) + layer_passes.arrays_of(job, extra))
-        return inputs, depth, normal, extra
-
-    return inputs_of, timings
-
-
-def _kept(main, request):
-    """(inputs_of, timings) as _handed_over's, from the passes that the last
-    render handed over (re-compositing with new settings, recomposite.py):
-    no save and no read; the changed nodes' AO is in the cache already."""
-
-    def inputs_of(job):
-        entry = _cache.entry((main.name, job.pass_name))
-        if entry is None:
-            raise RuntimeError(f"the passes of {job.node_name!r} are no longer kept: render "
-                               f"again")
-        kept = entry[0]
-        inputs = ao_cache.AOInputs(job.params, kept.camera, kept.settings, kept.arrays)
-        extra = layer_passes.extra_of(kept.settings, kept.arrays)
-        return inputs, kept.arrays[0], kept.arrays[1], extra
-
-    return inputs_of, {"kept": request.ao_seconds}
-
-
 def compute_passes(engine, depsgraph, width, height, request=None):
-    """{pass name: bottom-up (height, width) AO} for the helper being
-    rendered: for the render of its main scene, or for `request`
-    (recomposite.Request) from the passes of the last render."""
+    """{(view, pass name): bottom-up (height, width) AO} for the helper being
+    rendered (the view None without Stereoscopy): for the render of its main
+    scene, or for `request` (recomposite.Request) from the passes of the
+    last render."""
     helper = _original(depsgraph.scene)
     main = main_of(helper, request)
     if main is None:
@@ -103,15 +48,12 @@ def compute_passes(engine, depsgraph, width, height, request=None):
         if request is not None:
             request.completed = True
         return {}
-    if main.render.use_multiview:
-        # Each view would need its own passes and camera; the save of a
-        # multi-view Render Result writes one file per view besides.
-        raise RuntimeError(MULTIVIEW_UNSUPPORTED)
     native.load_library()
     if request:
-        inputs_of, timings = _kept(main, request)
+        inputs_of, timings, views = job_inputs.kept(main, request, _cache)
     else:
-        inputs_of, timings = _handed_over(engine, depsgraph, helper, main, jobs, warnings)
+        inputs_of, timings, views = job_inputs.handed_over(
+            engine, depsgraph, helper, main, jobs, warnings, lambda text: _report(engine, text))
 
     results = {}
     # Esc: Blender asks through test_break(); the passes are left at 1 and
@@ -123,13 +65,15 @@ def compute_passes(engine, depsgraph, width, height, request=None):
         return {}
     compute_time = 0.0
     fresh = {}
-    for index, job in enumerate(jobs):
+    every_job = [(view, job) for view in views for job in jobs]
+    for index, (view, job) in enumerate(every_job):
         if engine.test_break():
             log("render cancelled: AO left out")
             _cache.clear()
             return {}
-        engine.update_stats("HBAO", f"{job.node_name}: computing AO ({index + 1}/{len(jobs)})")
-        inputs, depth, normal, extra = inputs_of(job)
+        engine.update_stats("HBAO", f"{job.node_name}: computing AO ({index + 1}/"
+                                    f"{len(every_job)})")
+        inputs, depth, normal, extra = inputs_of(job, view)
         # A border render without its crop: the main Render Result is the
         # whole frame (background outside the border), the helper's only
         # the border. The AO is the whole frame's, cut to the border.
@@ -138,7 +82,7 @@ def compute_passes(engine, depsgraph, width, height, request=None):
             raise RuntimeError(f"the Render Result is {depth.shape[1]}x{depth.shape[0]}, the "
                                f"helper scene renders {width}x{height}")
         compute_start = time.perf_counter()
-        key = (main.name, job.pass_name)
+        key = job_inputs.cache_key(main, job, view)
         ao = _cache.get(key, inputs)
         if ao is None:
             ao = layer_passes.compute(job, depth, normal, inputs.camera, extra)
@@ -148,9 +92,9 @@ def compute_passes(engine, depsgraph, width, height, request=None):
         if border is not None:  # bottom-up rows, as the border's y
             x0, x1, y0, y1 = border
             ao = np.ascontiguousarray(ao[y0:y1, x0:x1])
-        results[job.pass_name] = ao
+        results[(view, job.pass_name)] = ao
         compute_time += time.perf_counter() - compute_start
-        engine.update_progress((index + 1) / len(jobs))
+        engine.update_progress((index + 1) / len(every_job))
     _cache.keep_only(fresh)
     timings["ao"] = compute_time
     engine.hbao_timings = timings
@@ -233,11 +177,13 @@ def render_helper(engine, depsgraph):
             _report_failure(engine, detail)
             tell_all_nodes(main_of(scene, request), "Error: AO off (see Info)", detail)
         write_start = time.perf_counter()
+        stereo = any(view is not None for view, _name in results)
         for layer in result.layers:
             for render_pass in layer.passes:
                 if not render_pass.name.startswith(PASS_PREFIX):
                     continue
-                ao = results.get(render_pass.name)
+                view = result.views[render_pass.view_id].name if stereo else None
+                ao = results.get((view, render_pass.name))
                 if ao is None or ao.size != width * height:
                     ao = np.ones((height, width), np.float32)
                 render_pass.rect.foreach_set(ao.reshape(-1))

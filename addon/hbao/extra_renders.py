@@ -276,6 +276,8 @@ def for_render(main, helper, kind):
         return None, "its render is not set up yet (it is made when the setting changes)"
     if main.render.use_border:
         return None, "border renders have none"
+    if main.render.use_multiview:
+        return None, "stereo and multi-view renders have none"
     if strip_cameras.override_for(main) is not None:
         return None, "a Video Sequencer strip renders the scene through another camera"
     return scene, None

@@ -206,9 +206,17 @@ def _wait_for_older_removals():
         thread.join()
 
 
-def save_passes(scene, path):
+def view_path(path, file_suffix):
+    """Where a stereo render's save to `path` writes a view: suffix first."""
+    stem, extension = os.path.splitext(path)
+    return stem + file_suffix + extension
+
+
+def save_passes(scene, path, view_paths=()):
     """Write `scene`'s current Render Result to `path`, uncompressed 32-bit
-    multilayer EXR, leaving the scene's output settings as they were."""
+    multilayer EXR, leaving the scene's output settings as they were. A
+    stereo or multi-view render is written as a file per view, to
+    `view_paths`."""
     image = _render_result_image()
     if image is None:
         raise RuntimeError("Blender has no Render Result image to read the passes from")
@@ -218,10 +226,15 @@ def save_passes(scene, path):
         compat.set_multilayer_exr(settings)
         settings.color_depth = "32"
         settings.exr_codec = "NONE"
+        if view_paths:  # a file per view, whatever the artist's output (side by side, ...)
+            settings.views_format = "INDIVIDUAL"
         # The Render Result of the scene given, not only its settings.
         try:
             image.save_render(path, scene=scene)
         except RuntimeError as error:  # Blender's message names neither folder nor cause
+            # 3.4 to 5.3 say that a multi-view save failed after writing every view
+            if view_paths and all(os.path.exists(view) for view in view_paths):
+                return
             raise RuntimeError(
                 f"cannot save the passes for the AO in {os.path.dirname(path)} ({error}); "
                 f"{SCRATCH_FOLDER_VARIABLE} names a writable folder for them") from error
@@ -231,21 +244,29 @@ def save_passes(scene, path):
         compat.restore_image_settings(settings, saved)
 
 
-def read_passes(scene, layers):
+def read_passes(scene, layers, views=None):
     """{("depth", layer): (H, W), ("normal", layer): (H, W, 3)} float32, top
     row first, of `scene`'s Render Result, for `layers` {view layer name:
-    whether its normal is wanted}; and the seconds the save and the read
-    took."""
+    whether its normal is wanted}; with `views` [(view name, file suffix)]
+    of a stereo or multi-view render, {view name: those} instead; and the
+    seconds the save and the read took."""
     global _stale_files_checked
     if not _stale_files_checked:  # a process's first hand-over, which need not wait for it
         _stale_files_checked = True
         _in_background(_remove_stale_files)
     _wait_for_older_removals()
+    channels, timings = _save_and_read(scene, layers, views)
+    return channels[None] if views is None else channels, timings
+
+
+def _save_and_read(scene, layers, views):
     path = _scratch_path()
+    files = {None: path} if views is None else {
+        name: view_path(path, suffix) for name, suffix in views}
     timings = {}
     try:
         start = _clock()
-        save_passes(scene, path)
+        save_passes(scene, path, [] if views is None else list(files.values()))
         timings["save"] = _clock() - start
         # One decode pass: each layer's depth, and its normal as one
         # interleaved (height, width, 3) image, as libhbao reads it.
@@ -256,7 +277,8 @@ def read_passes(scene, layers):
                 groups[("normal", layer)] = pass_channels(layer, "Normal")
         read_start = _clock()
         try:
-            channels = exr_passes.read_channel_groups(path, groups)
+            channels = {view: exr_passes.read_channel_groups(file, groups)
+                        for view, file in files.items()}
         except (exr_passes.EXRFormatError, exr_passes.EXRFileError) as error:
             # Blender's save does not say when the folder filled up: the
             # file is then cut short.
@@ -265,13 +287,14 @@ def read_passes(scene, layers):
                 f"it full? {SCRATCH_FOLDER_VARIABLE} names another folder for them") from error
         timings["read"] = _clock() - read_start
     finally:
-        _remove_later(path)
+        for file in set(files.values()) | {path}:
+            _remove_later(file)
     return channels, timings
 
 
-def read_main_passes(main, jobs):
+def read_main_passes(main, jobs, views=None):
     """read_passes() of the view layers and normals that `jobs` read."""
     layers = {}
     for job in jobs:
         layers[job.layer] = layers.get(job.layer, False) or job.with_normal
-    return read_passes(main, layers)
+    return read_passes(main, layers, views)

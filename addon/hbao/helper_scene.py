@@ -16,7 +16,7 @@ pointed at each scene's helper in turn would flip with every sync. The render
 handlers record the scene being rendered, which the engine reads."""
 import bpy
 
-from . import compat, extra_renders, helper_render_settings, strip_cameras, writes
+from . import compat, extra_renders, helper_render_settings, view_cameras, writes
 from .data_edits import set_if_different
 from .helper_lookup import (ENGINE_IDNAME, HELPER_SCENE_PREFIX, MAIN_SCENE_KEY, MAIN_TREE_KEY,
                             MANAGED_NODE_KEY, helper_scene_of, is_helper, main_scene_of,
@@ -122,8 +122,8 @@ def _configure_helper_scene(scene, helper, restructured):
     # The helper's render needs a camera; the main cameras themselves, so that
     # their animation is evaluated at the frame being rendered in the helper's
     # depsgraph. Every scene sharing the tree brings its own, and those that
-    # sequencer strips show it through.
-    cameras = strip_cameras.cameras_of(scenes_served_by(helper))
+    # sequencer strips and stereo views show it through.
+    cameras = view_cameras.render_cameras(scenes_served_by(helper))
     for camera in cameras:
         if helper.collection.objects.get(camera.name) != camera:
             helper.collection.objects.link(camera)

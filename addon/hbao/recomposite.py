@@ -120,8 +120,8 @@ def _needs_refresh(main, helper):
     pass is gone once it renders again, so a mismatch found then would
     leave the compositor without AO."""
     record = render_record.last_render(main.name)
-    # Stereo and multi-view renders get no AO (engine.MULTIVIEW_UNSUPPORTED):
-    # nothing to refresh, and a refresh would fail.
+    # A stereo or multi-view render's passes are kept per view, which a
+    # refresh does not read (job_inputs.kept): such a render is done again.
     if record is None or helper.render.use_border or main.render.use_multiview:
         return None
     frame, signatures, identity = record

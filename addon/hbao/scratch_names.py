@@ -3,14 +3,16 @@
 the add-on, which makes them and removes those of ended Blenders, and for
 the soak, which looks for any left behind. bpy-free.
 
-    hbao-passes-<process id>-<thread id>-<number>.exr
+    hbao-passes-<process id>-<thread id>-<number>[<view's file suffix>].exr
 
 Before session 19 a name had no number; such a file is still recognised,
 so that it is removed once it is stale."""
 import re
 
 PREFIX = "hbao-passes-"
-_NAME = re.compile(re.escape(PREFIX) + r"(\d+)-\d+(?:-\d+)?\.exr")
+# A stereo or multi-view render's save adds each view's file suffix before
+# the extension (handover.view_path).
+_NAME = re.compile(re.escape(PREFIX) + r"(\d+)-\d+(?:-\d+)?(?:[^/]*)\.exr")
 
 
 def name(process, thread, number):

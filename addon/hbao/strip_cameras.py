@@ -58,20 +58,16 @@ def _shows(strip, scene, frame):
             and strip.frame_final_start <= frame < strip.frame_final_end)
 
 
-def cameras_of(scenes):
-    """The cameras `scenes` render through: their own, and the overrides of
-    the strips of any scene that show them (the helper links them all, so
-    that its depsgraph evaluates their animation)."""
-    cameras = [scene.camera for scene in scenes]
+def strip_overrides(scenes):
+    """The Camera overrides of the strips of any scene that show one of
+    `scenes`."""
+    cameras = []
     for other in bpy.data.scenes:
         for strip in _strips(other):
-            if strip.type == "SCENE" and strip.scene in scenes:
-                cameras.append(getattr(strip, "scene_camera", None))
-    unique = []
-    for camera in cameras:
-        if camera is not None and camera not in unique:
-            unique.append(camera)
-    return unique
+            camera = getattr(strip, "scene_camera", None)
+            if strip.type == "SCENE" and strip.scene in scenes and camera is not None:
+                cameras.append(camera)
+    return cameras
 
 
 class AmbiguousStrips(CameraError):

@@ -12,7 +12,9 @@ both uncompressed 32-bit float. Usage:
 
 Spec keys (all optional): resolution [w, h], samples, engine, scene
 ("corner" | "two_layers"), frames [..], ao_reference (distance: adds Cycles'
-AO pass), orthographic, widen_camera (factor), dump_back_faces (writes
+AO pass), stereo (true: Stereo 3D; "custom_view": Multi-View with a view "center" besides left and
+right, each through its own camera Camera_L, Camera_C, Camera_R; writes camera_<NNNN><view's file
+suffix>.json too), orthographic, widen_camera (factor), dump_back_faces (writes
 <out>/back_<NNNN>.npy: the back faces render's Depth, top row first), border
 [min_x, max_x, min_y, max_y] (a border render cropped to it; with crop false, not
 cropped), animate_camera (the camera turns and moves over frames 1-5),
@@ -79,6 +81,14 @@ if spec.get("stereo"):  # Stereoscopy on: a left and a right view, each written 
     if spec["stereo"] == "custom_view":  # Multi-View, with a view "center" besides
         scene.render.views_format = "MULTIVIEW"
         scene.render.views.new("center").camera_suffix = "_C"
+        # each view's own camera: Camera_C the scene's, Camera_L and Camera_R beside it
+        scene.camera.name = "Camera_C"
+        for suffix, step in (("_L", -0.3), ("_R", 0.25)):
+            eye = scene.camera.copy()
+            eye.name = "Camera" + suffix
+            eye.location.x += step
+            eye.rotation_euler.z += step * 0.2
+            scene.collection.objects.link(eye)
 if spec.get("border"):
     render_settings = scene.render
     (render_settings.border_min_x, render_settings.border_max_x,
@@ -284,6 +294,38 @@ if spec.get("save_blend"):
     sys.exit(0)
 
 
+def stereo_eye(scene, right):
+    """A camera object where Stereo 3D puts an eye: worked out here from
+    the camera's Stereoscopy settings (pivot Left: the left eye is the camera;
+    the right one an interocular distance along the camera's x, its shift
+    off-axis by the distance over the convergence distance), for the tests'
+    reference, apart from the add-on's way (RenderEngine.camera_model_matrix)."""
+    import mathutils
+    camera = scene.camera
+    stereo = camera.data.stereo
+    assert stereo.pivot == "LEFT" and camera.data.sensor_fit == "AUTO"
+    if not right:
+        return camera
+    eye = camera.copy()
+    eye.data = camera.data.copy()
+    eye.matrix_world = camera.matrix_world @ mathutils.Matrix.Translation(
+        (stereo.interocular_distance, 0.0, 0.0))
+    if stereo.convergence_mode == "OFFAXIS":
+        eye.data.shift_x -= (stereo.interocular_distance / camera.data.sensor_width
+                             * camera.data.lens / stereo.convergence_distance)
+    return eye
+
+
+def view_cameras(scene):
+    """{file suffix: the camera JSON of that view} of a stereo render."""
+    from hbao import camera as camera_model
+    if scene.render.views_format == "STEREO_3D":
+        return {"_L": camera_model.camera_for_render_result(scene, stereo_eye(scene, False)),
+                "_R": camera_model.camera_for_render_result(scene, stereo_eye(scene, True))}
+    return {view.file_suffix: camera_model.camera_for_render_result(
+        scene, scene.objects["Camera" + view.camera_suffix]) for view in scene.render.views}
+
+
 for frame in spec.get("frames", [1]):
     if edit is not None:  # the sequencer's render first, its nodes_ file kept as strip_nodes_
         edit.frame_set(frame)
@@ -295,6 +337,10 @@ for frame in spec.get("frames", [1]):
     scene.frame_set(frame)
     with open(os.path.join(out_dir, f"camera_{frame:04d}.json"), "w") as stream:
         json.dump(blender_scenes.camera_description(scene), stream)
+    if spec.get("stereo"):
+        for suffix, description in view_cameras(scene).items():
+            with open(os.path.join(out_dir, f"camera_{frame:04d}{suffix}.json"), "w") as stream:
+                json.dump(description, stream)
     # Still renders do not replace '#' in the path: name the frame here.
     scene.render.filepath = os.path.join(out_dir, f"frame_{frame:04d}")
     if render_scene_name is None:
