@@ -232,6 +232,16 @@ def test_render_single_layer_passes_image_through_and_says_so(run_in_blender, tm
     assert_no_ao_and_image_unchanged(out)
 
 
+def test_compositing_off_says_that_the_render_has_no_ao(run_in_blender, tmp_path, no_leftovers):
+    """With Compositing off Blender runs no compositor: the render is written
+    without AO, and the render's report and the node say why (nothing did)."""
+    out, log = render(run_in_blender, tmp_path, {"prepare": ["compositing_off"],
+                                                 "nodes": [{"radius": 1.0}]})
+    assert log.count("HBAO: Compositing is off") == 1, log[-3000:]
+    assert status_lines(log) == {"HBAO0": "Compositing off: no AO"}, log[-3000:]
+    assert (out / "frame_0001.exr").exists() and not (out / "nodes_0001.exr").exists()
+
+
 @pytest.mark.parametrize("prepare, said, short", [
     ("layer_not_rendered", "which is not rendered (its Use for Rendering is off); AO off",
      "Depth: not rendered, AO off"),

@@ -71,10 +71,15 @@ def _on_render_init(scene, *_args):
             node_place.grouped_message(group, grouped)
             for group, grouped in node_place.nodes_in_groups(tree, node.is_hbao_node))]
         nodes = node.hbao_nodes(tree)
-        if nodes and not helper_render_settings.helper_renders(scene):
-            detail = helper_render_settings.SINGLE_LAYER_DETAIL
-            statuses = [NodeMessage(n.name, detail, helper_render_settings.SINGLE_LAYER_SHORT)
-                        for n in nodes]
+        settings = helper_render_settings
+        off = (None if not nodes else
+               (settings.COMPOSITING_OFF_DETAIL, settings.COMPOSITING_OFF_SHORT)
+               if not settings.compositor_runs(scene) else
+               (settings.SINGLE_LAYER_DETAIL, settings.SINGLE_LAYER_SHORT)
+               if not settings.helper_renders(scene) else None)
+        if off is not None:
+            detail, short = off
+            statuses = [NodeMessage(n.name, detail, short) for n in nodes]
             post_node_messages(scene.name, [n.name for n in nodes], statuses)
             messages.append((detail, f"HBAO: {detail}"))
         for text, report_text in messages:

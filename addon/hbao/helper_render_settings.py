@@ -5,6 +5,7 @@ views. The compositor reads each view's AO pass from the helper, and the
 helper has a view's pass only where it has the view: with one view, a
 stereo render read 0 in both (a black frame); without Multi-View's own
 views (besides left and right), those views were black."""
+from . import compat
 from .data_edits import set_if_different
 
 SYNCED_RENDER_SETTINGS = (
@@ -23,6 +24,21 @@ SINGLE_LAYER_DETAIL = ("Render Single Layer is on (View Layer properties): Blend
                        "no other scene, HBAO's helper neither; AO off (the node passes Image "
                        "through). Turn it off for AO")
 SINGLE_LAYER_SHORT = "Single Layer on: AO off"
+
+
+# With Compositing off (Output properties, Post Processing), or, before 5.0,
+# Use Nodes off in the compositor, Blender runs no compositor: no HBAO node
+# either, and the written render has no AO.
+COMPOSITING_OFF_DETAIL = ("Compositing is off (Output properties > Post Processing, or the "
+                          "compositor's Use Nodes): Blender runs no compositor, HBAO's nodes "
+                          "neither, and writes the render without AO. Turn it on for AO")
+COMPOSITING_OFF_SHORT = "Compositing off: no AO"
+
+
+def compositor_runs(scene):
+    """Whether a render of `scene` runs its compositor."""
+    return scene.render.use_compositing and (compat.HAS_COMPOSITING_NODE_GROUP
+                                             or scene.use_nodes)
 
 
 def helper_renders(scene):

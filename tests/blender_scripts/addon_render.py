@@ -29,10 +29,10 @@ thickness, guard_band, back_faces, mute, connect_with_operator (left unlinked,
 then linked by the node's Connect Passes operator after the passes are
 disabled)}], disable_normal_pass, disable_depth_pass, output_format (the main
 output's file format, default OPEN_EXR_MULTILAYER), prepare [actions before
-rendering: sync, delete_helper, delete_extra_renders, rename_helper, pick_internal_engine,
-render_the_helper, rename_node, second_scene_shares_the_tree, group_last_node (the last
-HBAO node moved into a node group of the artist's), layer_not_rendered, mute_render_layers,
-switch_to_workbench],
+rendering: sync, compositing_off, delete_helper, delete_extra_renders, rename_helper,
+pick_internal_engine, render_the_helper, rename_node, second_scene_shares_the_tree,
+group_last_node (the last HBAO node moved into a node group of the artist's),
+layer_not_rendered, mute_render_layers, switch_to_workbench],
 layer_name (the first view layer's), single_layer (Render Single Layer on), user_handlers (a
 pipeline's own render and frame change handlers, which print USER HANDLERS
 {json}: the scenes each list's handler saw, in order; render_stats leaves out
@@ -252,6 +252,8 @@ for action in spec.get("prepare", []):
         tree.nodes.remove(last)
         print("GROUPED", json.dumps({n.name: hbao.node_place.at_top_level(n) for n in
                                      [inside] + hbao.node.hbao_nodes(tree)}), flush=True)
+    elif action == "compositing_off":  # Output properties > Post Processing > Compositing
+        scene.render.use_compositing = False
     elif action == "switch_to_workbench":  # the render engine changed after linking
         scene.render.engine = "BLENDER_WORKBENCH"
     elif action == "layer_not_rendered":  # the last view layer's Use for Rendering off
