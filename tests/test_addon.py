@@ -160,15 +160,22 @@ def test_time_remapped_animated_camera_gets_the_rendered_cameras_ao(
     assert np.abs(node_outputs(out, 2)["ao"] - expected).max() <= EXACT
 
 
-def test_sequencer_strip_camera_override_gets_that_cameras_ao(run_in_blender, tmp_path, native):
+@pytest.mark.parametrize("sequencer", ["override", "other_frame", "muted_meta", "nested"])
+def test_sequencer_strip_camera_override_gets_that_cameras_ao(run_in_blender, tmp_path, native,
+                                                              sequencer):
     """A Video Sequencer scene strip with a Camera override renders the
     scene through that camera: the node's AO in the sequencer's render is
     the library's with that camera, as when the scene itself renders
     through it (the scene camera's turned the normals by the wrong matrix,
-    silently; found by an exploratory run). The back faces render follows
-    the scene camera: through the strip it is left out, and the node says so."""
-    spec = {"sequencer": "override", "nodes": [{"radius": 0.7, "blur_size": 0},
-                                               {"radius": 0.7, "blur_size": 0, "back_faces": True}]}
+    silently; found by an exploratory run). So too beside a strip through
+    the scene's camera that shows another frame of the scene or lies in a
+    muted meta strip (the AO was off: "different cameras"), and where the
+    sequencer is itself shown by another's strip (the scene camera's AO,
+    silently). The back faces render follows the scene camera: through the
+    strip it is left out, and the node says so."""
+    spec = {"sequencer": sequencer,
+            "nodes": [{"radius": 0.7, "blur_size": 0},
+                      {"radius": 0.7, "blur_size": 0, "back_faces": True}]}
     out, log = render(run_in_blender, tmp_path, spec)
     params = node_params(radius=0.7, blur_size=0)
     expected = library_ao(native, out, 1, params)
@@ -190,7 +197,8 @@ def test_sequencer_strips_with_two_cameras_at_one_frame_turn_the_ao_off(run_in_b
     out, log = render(run_in_blender, tmp_path, spec)
     through_strip = exr.read_channels(out / "strip_nodes_0001.exr", ["HBAO0_AO.V"])["HBAO0_AO.V"]
     assert through_strip.min() == 1.0
-    assert "in strips with different cameras ('Camera', 'Strip Camera')" in log
+    assert ("the Video Sequencer strips 'Shot', 'Shot again' show scene 'Scene' at its frame 1 "
+            "through different cameras ('Camera', 'Strip Camera')") in log
     assert node_outputs(out, 1)["ao"].min() < 0.9  # the scene's own render has its AO
 
 
@@ -646,6 +654,19 @@ def test_stereo_and_multi_view_renders_get_each_views_ao(run_in_blender, tmp_pat
     assert np.abs(expected[views[0]] - expected[views[1]]).max() > 0.1
     assert "Rendering without AO" not in log
     assert list(scratch.iterdir()) == []
+
+
+def test_a_mono_render_after_a_stereo_one_gets_its_ao(run_in_blender, tmp_path):
+    """Stereoscopy turned off after a stereo render whose output is one side
+    by side image: the hand-over's save of the mono frame failed in 3.4 and
+    4.5 (AO off, the message blamed the folder), as the stereo save had left
+    Blender asking for a Stereo 3D layout (found by an exploratory run)."""
+    out, log = render(run_in_blender, tmp_path, {
+        "stereo": True, "stereo_off_from_frame": 2, "frames": [1, 2], "output_format": "PNG",
+        "output_views_format": "STEREO_3D", "nodes": [{"radius": 0.7, "blur_size": 0}]})
+    assert "Rendering without AO" not in log, log[-3000:]
+    assert node_outputs(out, 1, view="_L")["ao"].min() < 0.9
+    assert node_outputs(out, 2)["ao"].min() < 0.9
 
 
 def test_border_crop_render_matches_the_full_frame(run_in_blender, tmp_path):

@@ -226,8 +226,8 @@ def save_passes(scene, path, view_paths=()):
         compat.set_multilayer_exr(settings)
         settings.color_depth = "32"
         settings.exr_codec = "NONE"
-        if view_paths:  # a file per view, whatever the artist's output (side by side, ...)
-            settings.views_format = "INDIVIDUAL"
+        # a file per view (3.4 and 4.5 refuse a mono save as Stereo 3D side by side)
+        settings.views_format = "INDIVIDUAL"
         # The Render Result of the scene given, not only its settings.
         try:
             image.save_render(path, scene=scene)

@@ -9,9 +9,13 @@ helper's engine sees no override, and the saved Render Result carries no
 camera name before the render ends. What the add-on can see is the nesting
 of render jobs: the sequencer's scene starts its job, then each strip's
 scene starts one of its own inside it (render_init .. render_complete or
-render_cancel, handlers.py), at the frame the strip maps to. The strips of
-the enclosing job's scene that show this scene at that scene's current
-frame name the camera."""
+render_cancel, handlers.py), at the frame the strip maps to. The strips that
+the enclosing job's scene shows at its current frame (inside meta strips and
+through strips whose input is another scene's sequencer too; not muted, nor
+on a muted channel or in a muted meta) and that show this scene at its
+current frame name the camera. The frame a strip shows is worked out for
+strips at their own speed; where none matches (speed or retiming changed),
+every strip shown now counts."""
 import bpy
 
 from .camera import CameraError
@@ -50,12 +54,57 @@ def _strips(scene):
     return list(strips if strips is not None else getattr(editor, "sequences_all", []))
 
 
-def _shows(strip, scene, frame):
-    """Whether `strip` renders `scene` through a camera at the sequencer's
-    `frame` (a strip whose input is the scene's own sequencer does not)."""
-    return (strip.type == "SCENE" and strip.scene == scene and not strip.mute
-            and getattr(strip, "scene_input", "CAMERA") == "CAMERA"
-            and strip.frame_final_start <= frame < strip.frame_final_end)
+def _children(holder):
+    """The strips of a sequence editor or meta strip, not those inside
+    them (5.0 renamed sequences to strips)."""
+    strips = getattr(holder, "strips", None)
+    return list(strips if strips is not None else getattr(holder, "sequences", []))
+
+
+def _channel_muted(holder, number):
+    channels = getattr(holder, "channels", None)  # 3.3+
+    try:
+        return bool(channels is not None and channels[number].mute)
+    except (IndexError, KeyError, TypeError):
+        return False
+
+
+def _shown(holder, frame):
+    """The strips of `holder` (an editor or meta) that show at `frame`."""
+    for strip in _children(holder):
+        if strip.mute or _channel_muted(holder, strip.channel) \
+                or not strip.frame_final_start <= frame < strip.frame_final_end:
+            continue
+        if strip.type == "META":
+            yield from _shown(strip, frame)
+        else:
+            yield strip
+
+
+def _scene_frame(strip, frame):
+    """The frame of its scene that scene strip `strip` shows at its
+    sequencer's `frame`, for a strip at its own speed."""
+    return (strip.scene.frame_start + frame - strip.frame_start
+            + getattr(strip, "animation_offset_start", 0))
+
+
+def _showing(sequencer_scene, frame, scene, depth=0):
+    """[(strip, the frame of `scene` it shows)] of the scene strips that show
+    `scene` through a camera when `sequencer_scene`'s sequencer shows
+    `frame`."""
+    editor = getattr(sequencer_scene, "sequence_editor", None)
+    if editor is None or depth > 8:
+        return []
+    found = []
+    for strip in _shown(editor, frame):
+        if strip.type != "SCENE" or strip.scene is None:
+            continue
+        if getattr(strip, "scene_input", "CAMERA") == "SEQUENCER":
+            if strip.scene != sequencer_scene:
+                found += _showing(strip.scene, _scene_frame(strip, frame), scene, depth + 1)
+        elif strip.scene == scene:
+            found.append((strip, _scene_frame(strip, frame)))
+    return found
 
 
 def strip_overrides(scenes):
@@ -85,19 +134,24 @@ def override_for(scene):
     outer = bpy.data.scenes.get(_jobs[at - 1]) if at > 0 else None
     if outer is None:
         return None
-    frame = outer.frame_current
+    showing = _showing(outer, outer.frame_current, scene)
+    now = scene.frame_current + scene.frame_subframe
+    strips = [strip for strip, frame in showing if abs(frame - now) < 1e-3] or \
+        [strip for strip, _frame in showing]
     cameras = []
-    for strip in _strips(outer):
-        if _shows(strip, scene, frame):
-            camera = getattr(strip, "scene_camera", None) or scene.camera
-            if camera not in cameras:
-                cameras.append(camera)
+    for strip in strips:
+        camera = getattr(strip, "scene_camera", None) or scene.camera
+        if camera not in cameras:
+            cameras.append(camera)
     if len(cameras) > 1:
-        names = ", ".join(sorted(repr(getattr(camera, "name", None)) for camera in cameras))
+        names = ", ".join(repr(name) for name in sorted(getattr(camera, "name", "none")
+                                                        for camera in cameras))
+        strip_names = ", ".join(repr(name) for name in sorted(strip.name for strip in strips))
         raise AmbiguousStrips(
-            f"the Video Sequencer of scene {outer.name!r} shows scene {scene.name!r} at frame "
-            f"{frame} in strips with different cameras ({names}): which one is rendering "
-            f"cannot be told. Give each camera's strip its own frames, or a copy of the scene")
+            f"the Video Sequencer strips {strip_names} show scene {scene.name!r} at its frame "
+            f"{scene.frame_current} through different cameras ({names}): which one is "
+            f"rendering cannot be told. Give each camera's strip its own frames, or a copy of "
+            f"the scene")
     camera = cameras[0] if cameras else None
     return camera if camera != scene.camera else None
 

@@ -14,14 +14,17 @@ Spec keys (all optional): resolution [w, h], samples, engine, scene
 ("corner" | "two_layers"), frames [..], ao_reference (distance: adds Cycles'
 AO pass), stereo (true: Stereo 3D; "custom_view": Multi-View with a view "center" besides left and
 right, each through its own camera Camera_L, Camera_C, Camera_R; writes camera_<NNNN><view's file
-suffix>.json too), orthographic, widen_camera (factor), dump_back_faces (writes
-<out>/back_<NNNN>.npy: the back faces render's Depth, top row first), border
+suffix>.json too), stereo_off_from_frame (Stereoscopy turned off from that frame on),
+output_views_format (the main output's views format), orthographic, widen_camera (factor),
+dump_back_faces (writes <out>/back_<NNNN>.npy: the back faces render's Depth, top row first), border
 [min_x, max_x, min_y, max_y] (a border render cropped to it; with crop false, not
 cropped), animate_camera (the camera turns and moves over frames 1-5),
 time_remap [old, new] (Time Remapping), sequencer ("override": a scene "Edit" shows the
-scene in a Video Sequencer strip through a camera override, "Strip Camera"; "two_cameras": and
-in a second strip above it through the scene's camera; each frame renders Edit first, keeping
-the nodes' file as strip_nodes_<NNNN>.exr, then the scene through Strip Camera), save_blend
+scene in a Video Sequencer strip through a camera override, "Strip Camera"; and in a second strip
+through the scene's camera, "two_cameras": at the same frames, "other_frame": showing its frame 11
+at frame 1, "muted_meta": inside a muted meta strip; "nested": Edit shown by a strip of scene
+"Outer" whose input is Edit's sequencer; each frame renders Edit (Outer) first, keeping the nodes'
+file as strip_nodes_<NNNN>.exr, then the scene through Strip Camera), save_blend
 (path: saved after the setup, before rendering), nodes: [{name, layer, normal
 (bool), radius, keyframes [[frame, radius], ..], radius_from_value_node,
 falloff, integration, blur_size, angle_bias, directions, steps, strength,
@@ -119,8 +122,24 @@ if spec.get("sequencer"):
     editor = edit.sequence_editor_create()
     strips = editor.strips if hasattr(editor, "strips") else editor.sequences
     strips.new_scene("Shot", scene, channel=1, frame_start=1).scene_camera = strip_camera
-    if spec["sequencer"] == "two_cameras":  # a second strip above, through the scene's camera
+    # a second strip of the scene, through the scene's camera: at the same frames, ...
+    if spec["sequencer"] == "two_cameras":
         strips.new_scene("Shot again", scene, channel=2, frame_start=1)
+    elif spec["sequencer"] == "other_frame":  # ... showing its frame 11 at frame 1, ...
+        strips.new_scene("Shot later", scene, channel=2, frame_start=-9)
+    elif spec["sequencer"] == "muted_meta":  # ... or inside a muted meta strip
+        muted = strips.new_scene("Shot muted", scene, channel=3, frame_start=1)
+        meta = strips.new_meta("Muted", channel=2, frame_start=1)
+        muted.move_to_meta(meta)
+        meta.mute = True
+    elif spec["sequencer"] == "nested":  # Edit shown by another sequencer, "Outer"
+        outer = bpy.data.scenes.new("Outer")
+        outer.render.resolution_x, outer.render.resolution_y = resolution
+        outer_editor = outer.sequence_editor_create()
+        outer_strips = outer_editor.strips if hasattr(outer_editor, "strips") \
+            else outer_editor.sequences
+        outer_strips.new_scene("Edit", edit, channel=1, frame_start=1).scene_input = "SEQUENCER"
+        edit = outer  # rendered instead
 
 if spec.get("layer_name"):  # the first view layer renamed
     scene.view_layers[0].name = spec["layer_name"]
@@ -190,6 +209,8 @@ if output_format.startswith("OPEN_EXR"):
     scene.render.image_settings.color_depth = "32"
     scene.render.image_settings.exr_codec = "NONE"
 scene.render.use_file_extension = True
+if spec.get("output_views_format"):  # a stereo output's layout (STEREO_3D: side by side, ...)
+    scene.render.image_settings.views_format = spec["output_views_format"]
 
 
 def helper_scenes():
@@ -336,6 +357,8 @@ for frame in spec.get("frames", [1]):
         os.replace(os.path.join(out_dir, f"nodes_{frame:04d}.exr"),
                    os.path.join(out_dir, f"strip_nodes_{frame:04d}.exr"))
         scene.camera = strip_camera  # then the scene itself through the strip's camera
+    if spec.get("stereo_off_from_frame", frame + 1) <= frame:
+        scene.render.use_multiview = False
     scene.frame_set(frame)
     with open(os.path.join(out_dir, f"camera_{frame:04d}.json"), "w") as stream:
         json.dump(blender_scenes.camera_description(scene), stream)
