@@ -12,8 +12,9 @@ PACKAGE = REPO / "addon" / "hbao"
 # What tests, benchmarks and scripts import without Blender.
 BPY_FREE_MODULES = ("hbao", "hbao.parameters", "hbao.library_loading", "hbao.native",
                     "hbao.native_structs", "hbao.native_library", "hbao.native_params",
-                    "hbao.exr_passes", "hbao.camera", "hbao.guard_geometry", "hbao.timing_line",
-                    "hbao.scratch_names", "hbao.viewport",
+                    "hbao.exr_passes", "hbao.view_files", "hbao.camera",
+                    "hbao.guard_geometry", "hbao.timing_line", "hbao.scratch_names",
+                    "hbao.viewport",
                     "hbao.viewport.projection", "hbao.viewport.shader_sources",
                     "hbao.viewport.horizon_sources", "hbao.viewport.normal_sources",
                     "hbao.viewport.camera_sources")

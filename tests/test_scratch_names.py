@@ -26,7 +26,7 @@ def test_names_before_session_19_and_other_files():
 
 def test_a_stereo_renders_view_files():
     """A stereo or multi-view save writes a file per view, its file suffix
-    before the extension (handover.view_path): recognised as the same
+    before the extension (view_files.view_path): recognised as the same
     process's, so that a killed Blender's view files are removed too."""
     name = scratch_names.name(4242, 139872, 7)
     for suffix in ("_L", "_R", "-center view"):

@@ -40,6 +40,13 @@ class AOInputs:
 _PROBE_STRIDE = 4099
 
 
+def key(scene_name, pass_name, view=None):
+    """The cache's key of the AO of pass `pass_name` of scene `scene_name`'s
+    render, in `view` of a stereo render (None: a mono render's, which
+    re-compositing reads)."""
+    return (scene_name, pass_name) if view is None else (scene_name, pass_name, view)
+
+
 def _bits(array):
     """The array flat, floats as the unsigned integers of their bits."""
     flat = np.ascontiguousarray(array).reshape(-1)

@@ -82,7 +82,7 @@ def compute_passes(engine, depsgraph, width, height, request=None):
             raise RuntimeError(f"the Render Result is {depth.shape[1]}x{depth.shape[0]}, the "
                                f"helper scene renders {width}x{height}")
         compute_start = time.perf_counter()
-        key = job_inputs.cache_key(main, job, view)
+        key = ao_cache.key(main.name, job.pass_name, view)
         ao = _cache.get(key, inputs)
         if ao is None:
             ao = layer_passes.compute(job, depth, normal, inputs.camera, extra)

@@ -72,11 +72,11 @@ def _on_render_init(scene, *_args):
             for group, grouped in node_place.nodes_in_groups(tree, node.is_hbao_node))]
         nodes = node.hbao_nodes(tree)
         settings = helper_render_settings
-        off = (None if not nodes else
-               (settings.COMPOSITING_OFF_DETAIL, settings.COMPOSITING_OFF_SHORT)
-               if not settings.compositor_runs(scene) else
-               (settings.SINGLE_LAYER_DETAIL, settings.SINGLE_LAYER_SHORT)
-               if not settings.helper_renders(scene) else None)
+        off = None
+        if nodes and not settings.compositor_runs(scene):
+            off = (settings.COMPOSITING_OFF_DETAIL, settings.COMPOSITING_OFF_SHORT)
+        elif nodes and not settings.helper_renders(scene):
+            off = (settings.SINGLE_LAYER_DETAIL, settings.SINGLE_LAYER_SHORT)
         if off is not None:
             detail, short = off
             statuses = [NodeMessage(n.name, detail, short) for n in nodes]
@@ -109,6 +109,12 @@ def _on_render_pre(scene, *_args):
         log(f"could not prepare the HBAO hook of {scene.name!r}: {error}")
 
 
+@bpy.app.handlers.persistent
+def _on_frame_render_pre(scene, *_args):
+    strip_cameras.frame_started(scene)
+    _on_render_pre(scene)
+
+
 def _unhook_before_render(scene):
     """The last HBAO node deleted since the last sync (a script in `blender
     -b`, where no timer syncs): the hook goes now where Blender allows it;
@@ -137,7 +143,10 @@ def _on_depsgraph_update_post(scene, *_args):
     if helper_lookup.is_helper(scene) or not in_main_thread():
         return
     tree = compat.compositor_tree(scene)
-    if node.hbao_nodes(tree) or helper_lookup.managed_node(tree) is not None:
+    # (a sequencer's strips may show an HBAO scene through a camera the
+    # helper must link: view_cameras.render_cameras)
+    if node.hbao_nodes(tree) or helper_lookup.managed_node(tree) is not None \
+            or getattr(scene, "sequence_editor", None) is not None:
         schedule_sync()
 
 
@@ -145,7 +154,7 @@ _HANDLERS = (
     (bpy.app.handlers.load_post, _on_load_post),
     (bpy.app.handlers.save_pre, _on_save_pre),
     (bpy.app.handlers.render_init, _on_render_init),
-    (bpy.app.handlers.render_pre, _on_render_pre),
+    (bpy.app.handlers.render_pre, _on_frame_render_pre),
     (bpy.app.handlers.render_complete, _on_render_end),
     (bpy.app.handlers.render_cancel, _on_render_end),
     (bpy.app.handlers.depsgraph_update_post, _on_depsgraph_update_post),

@@ -13,7 +13,7 @@ from time import perf_counter as _clock
 
 import bpy
 
-from . import compat, exr_passes, scratch_names
+from . import compat, exr_passes, scratch_names, view_files
 from .report import log
 
 
@@ -206,17 +206,10 @@ def _wait_for_older_removals():
         thread.join()
 
 
-def view_path(path, file_suffix):
-    """Where a stereo render's save to `path` writes a view: suffix first."""
-    stem, extension = os.path.splitext(path)
-    return stem + file_suffix + extension
-
-
-def save_passes(scene, path, view_paths=()):
+def save_passes(scene, path, views=None):
     """Write `scene`'s current Render Result to `path`, uncompressed 32-bit
-    multilayer EXR, leaving the scene's output settings as they were. A
-    stereo or multi-view render is written as a file per view, to
-    `view_paths`."""
+    multilayer EXR, leaving the scene's output settings as they were; a
+    stereo render's `views` [(view name, file suffix)] as view_files.py says."""
     image = _render_result_image()
     if image is None:
         raise RuntimeError("Blender has no Render Result image to read the passes from")
@@ -228,12 +221,11 @@ def save_passes(scene, path, view_paths=()):
         settings.exr_codec = "NONE"
         # a file per view (3.4 and 4.5 refuse a mono save as Stereo 3D side by side)
         settings.views_format = "INDIVIDUAL"
-        # The Render Result of the scene given, not only its settings.
-        try:
+        try:  # the Render Result of the scene given, not only its settings
             image.save_render(path, scene=scene)
-        except RuntimeError as error:  # Blender's message names neither folder nor cause
-            # 3.4 to 5.3 say that a multi-view save failed after writing every view
-            if view_paths and all(os.path.exists(view) for view in view_paths):
+        except RuntimeError as error:  # Blender's message names neither folder nor cause,
+            # and 3.4 to 5.3 say that a multi-view save failed after writing every view
+            if view_files.saved(path, views):
                 return
             raise RuntimeError(
                 f"cannot save the passes for the AO in {os.path.dirname(path)} ({error}); "
@@ -261,15 +253,14 @@ def read_passes(scene, layers, views=None):
 
 def _save_and_read(scene, layers, views):
     path = _scratch_path()
-    files = {None: path} if views is None else {
-        name: view_path(path, suffix) for name, suffix in views}
+    files = view_files.files(path, views)
     timings = {}
     try:
         start = _clock()
-        save_passes(scene, path, [] if views is None else list(files.values()))
+        save_passes(scene, path, views)
         timings["save"] = _clock() - start
-        # One decode pass: each layer's depth, and its normal as one
-        # interleaved (height, width, 3) image, as libhbao reads it.
+        files = view_files.files(path, views)
+        # One decode pass: each layer's depth, its normal as one (H, W, 3) image.
         groups = {}
         for layer, with_normal in layers.items():
             groups[("depth", layer)] = pass_channels(layer, "Depth")
@@ -277,8 +268,9 @@ def _save_and_read(scene, layers, views):
                 groups[("normal", layer)] = pass_channels(layer, "Normal")
         read_start = _clock()
         try:
-            channels = {view: exr_passes.read_channel_groups(file, groups)
-                        for view, file in files.items()}
+            channels = {view: exr_passes.read_channel_groups(
+                file, view_files.channel_groups(file, view, groups))
+                for view, file in files.items()}
         except (exr_passes.EXRFormatError, exr_passes.EXRFileError) as error:
             # Blender's save does not say when the folder filled up: the
             # file is then cut short.
@@ -294,7 +286,6 @@ def _save_and_read(scene, layers, views):
 
 def read_main_passes(main, jobs, views=None):
     """read_passes() of the view layers and normals that `jobs` read."""
-    layers = {}
-    for job in jobs:
-        layers[job.layer] = layers.get(job.layer, False) or job.with_normal
+    layers = {job.layer: any(other.with_normal for other in jobs if other.layer == job.layer)
+              for job in jobs}
     return read_passes(main, layers, views)

@@ -27,7 +27,7 @@ def _cameras(engine, depsgraph, main):
     if views is None:
         return {None: camera_model.camera_for_render_result(main, camera)}
     if camera is None:
-        camera_model.camera_from_blender(main)  # raises CameraError: no camera
+        raise camera_model.CameraError(f"scene {main.name!r} has no camera")
     return {name: view_cameras.camera_of_view(engine, main, camera, name,
                                               lambda obj: _evaluated(obj, depsgraph))
             for name, _suffix in views}
@@ -70,7 +70,7 @@ def kept(main, request, cache):
     no read; the changed nodes' AO is in the cache already."""
 
     def inputs_of(job, _view):
-        entry = cache.entry((main.name, job.pass_name))
+        entry = cache.entry(ao_cache.key(main.name, job.pass_name))
         if entry is None:
             raise RuntimeError(f"the passes of {job.node_name!r} are no longer kept: render "
                                f"again")
@@ -81,9 +81,3 @@ def kept(main, request, cache):
         return inputs, kept_inputs.arrays[0], kept_inputs.arrays[1], extra
 
     return inputs_of, {"kept": request.ao_seconds}, [None]
-
-
-def cache_key(main, job, view):
-    """The AO cache's key of `job`'s AO in `view` (recomposite.py looks up
-    those of the view None)."""
-    return (main.name, job.pass_name) if view is None else (main.name, job.pass_name, view)

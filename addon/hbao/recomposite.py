@@ -138,7 +138,7 @@ def _needs_refresh(main, helper):
         except Exception:  # the next render says what is wrong
             return None
         if job is not None:
-            kept = ao_cache.last_render.entry((main.name, job.pass_name))
+            kept = ao_cache.last_render.entry(ao_cache.key(main.name, job.pass_name))
             width, height = camera_model.render_size(helper)
             if kept is None or kept[0].arrays[0].shape != (height, width):
                 return None
@@ -159,7 +159,7 @@ def _work(main, jobs):
     for job in jobs:
         if job is None:
             continue
-        key = (main.name, job.pass_name)
+        key = ao_cache.key(main.name, job.pass_name)
         kept = ao_cache.last_render.entry(key)[0]
         inputs = ao_cache.AOInputs(job.params, kept.camera, kept.settings, kept.arrays)
         work.append((key, job, inputs, layer_passes.extra_of(kept.settings, kept.arrays)))

@@ -11,7 +11,7 @@ import re
 
 PREFIX = "hbao-passes-"
 # A stereo or multi-view render's save adds each view's file suffix before
-# the extension (handover.view_path).
+# the extension (view_files.view_path).
 _NAME = re.compile(re.escape(PREFIX) + r"(\d+)-\d+(?:-\d+)?(?:[^/]*)\.exr")
 
 

@@ -12,31 +12,51 @@ scene starts one of its own inside it (render_init .. render_complete or
 render_cancel, handlers.py), at the frame the strip maps to. The strips that
 the enclosing job's scene shows at its current frame (inside meta strips and
 through strips whose input is another scene's sequencer too; not muted, nor
-on a muted channel or in a muted meta) and that show this scene at its
-current frame name the camera. The frame a strip shows is worked out for
-strips at their own speed; where none matches (speed or retiming changed),
-every strip shown now counts."""
+on a muted channel or in a muted meta; not below an opaque Replace strip,
+unless only such a strip shows this scene, as an effect's input may) and
+that show this scene at its current frame name the camera. The frame a strip
+shows is worked out for strips at their own speed; where none matches (speed
+or retiming changed), every strip shown now counts.
+
+Not seen: the sequencer's Rendered preview in a window renders its scene
+strips without a render job around them, so they get the scene camera's AO."""
 import bpy
 
 from .camera import CameraError
 from .report import log
 
-# The scenes whose render jobs run now, by name, outermost first.
+# The render jobs running now, outermost first: [scene name, whether its
+# first frame has begun (render_pre)].
 _jobs = []
 
 
 def job_started(scene):
-    """render_init: `scene`'s job begins (inside the jobs still running)."""
-    if scene.name in _jobs:  # an earlier job of it never ended: what it held ended too
-        del _jobs[_jobs.index(scene.name):]
-    _jobs.append(scene.name)
+    """render_init: `scene`'s job begins (inside the jobs still running). A
+    job whose frame never began has ended: an animation that could not start
+    (a movie it cannot write, ...) calls neither render_complete nor
+    render_cancel, and every job inside another begins after its frame has."""
+    _jobs[:] = [job for job in _jobs if job[1] and job[0] != scene.name]
+    _jobs.append([scene.name, False])
+
+
+def frame_started(scene):
+    """render_pre: a frame of `scene`'s job begins."""
+    for job in reversed(_jobs):
+        if job[0] == scene.name:
+            job[1] = True
+            return
+
+
+def _job_names():
+    return [name for name, _began in _jobs]
 
 
 def job_ended(scene):
     """render_complete or render_cancel: `scene`'s job ends, and with it any
     job inside it."""
-    if scene.name in _jobs:
-        del _jobs[len(_jobs) - 1 - _jobs[::-1].index(scene.name):]
+    names = _job_names()
+    if scene.name in names:
+        del _jobs[len(names) - 1 - names[::-1].index(scene.name):]
 
 
 def forget_jobs():
@@ -69,16 +89,22 @@ def _channel_muted(holder, number):
         return False
 
 
-def _shown(holder, frame):
-    """The strips of `holder` (an editor or meta) that show at `frame`."""
-    for strip in _children(holder):
+def _shown(holder, frame, covered):
+    """The strips of `holder` (an editor or meta) that show at `frame`; with
+    `covered` False, only from the top channel down to the first that
+    replaces what lies below it (Blender renders those below only as an
+    effect strip's inputs)."""
+    for strip in sorted(_children(holder), key=lambda strip: -strip.channel):
         if strip.mute or _channel_muted(holder, strip.channel) \
                 or not strip.frame_final_start <= frame < strip.frame_final_end:
             continue
         if strip.type == "META":
-            yield from _shown(strip, frame)
+            yield from _shown(strip, frame, covered)
         else:
             yield strip
+        if not covered and getattr(strip, "blend_type", None) == "REPLACE" \
+                and getattr(strip, "blend_alpha", 1.0) >= 1.0:
+            return
 
 
 def _scene_frame(strip, frame):
@@ -88,20 +114,21 @@ def _scene_frame(strip, frame):
             + getattr(strip, "animation_offset_start", 0))
 
 
-def _showing(sequencer_scene, frame, scene, depth=0):
+def _showing(sequencer_scene, frame, scene, covered=False, depth=0):
     """[(strip, the frame of `scene` it shows)] of the scene strips that show
-    `scene` through a camera when `sequencer_scene`'s sequencer shows
-    `frame`."""
+    `scene` through a camera when `sequencer_scene`'s sequencer shows `frame`
+    (_shown's `covered`)."""
     editor = getattr(sequencer_scene, "sequence_editor", None)
     if editor is None or depth > 8:
         return []
     found = []
-    for strip in _shown(editor, frame):
+    for strip in _shown(editor, frame, covered):
         if strip.type != "SCENE" or strip.scene is None:
             continue
         if getattr(strip, "scene_input", "CAMERA") == "SEQUENCER":
             if strip.scene != sequencer_scene:
-                found += _showing(strip.scene, _scene_frame(strip, frame), scene, depth + 1)
+                found += _showing(strip.scene, _scene_frame(strip, frame), scene, covered,
+                                  depth + 1)
         elif strip.scene == scene:
             found.append((strip, _scene_frame(strip, frame)))
     return found
@@ -128,13 +155,15 @@ def override_for(scene):
     for the scene's own (no strip: a render of the scene itself). Raises
     AmbiguousStrips where strips at the same frame use different cameras:
     which of them is rendering cannot be told."""
-    if scene.name not in _jobs:
+    names = _job_names()
+    if scene.name not in names:
         return None
-    at = len(_jobs) - 1 - _jobs[::-1].index(scene.name)
-    outer = bpy.data.scenes.get(_jobs[at - 1]) if at > 0 else None
+    at = len(names) - 1 - names[::-1].index(scene.name)
+    outer = bpy.data.scenes.get(names[at - 1]) if at > 0 else None
     if outer is None:
         return None
-    showing = _showing(outer, outer.frame_current, scene)
+    showing = _showing(outer, outer.frame_current, scene) or \
+        _showing(outer, outer.frame_current, scene, covered=True)
     now = scene.frame_current + scene.frame_subframe
     strips = [strip for strip, frame in showing if abs(frame - now) < 1e-3] or \
         [strip for strip, _frame in showing]

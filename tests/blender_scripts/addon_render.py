@@ -12,19 +12,22 @@ both uncompressed 32-bit float. Usage:
 
 Spec keys (all optional): resolution [w, h], samples, engine, scene
 ("corner" | "two_layers"), frames [..], ao_reference (distance: adds Cycles'
-AO pass), stereo (true: Stereo 3D; "custom_view": Multi-View with a view "center" besides left and
-right, each through its own camera Camera_L, Camera_C, Camera_R; writes camera_<NNNN><view's file
-suffix>.json too), stereo_off_from_frame (Stereoscopy turned off from that frame on),
-output_views_format (the main output's views format), orthographic, widen_camera (factor),
-dump_back_faces (writes <out>/back_<NNNN>.npy: the back faces render's Depth, top row first), border
+AO pass), stereo (true: Stereo 3D; "one_view": with its right view off; "custom_view":
+Multi-View with a view "center" besides left and right, each through its own camera Camera_L,
+Camera_C, Camera_R; writes camera_<NNNN><view's file suffix>.json too), stereo_off_from_frame
+(Stereoscopy turned off from that frame on), output_views_format (the main output's views
+format), orthographic, widen_camera (factor), dump_back_faces (writes <out>/back_<NNNN>.npy: the
+back faces render's Depth, top row first), border
 [min_x, max_x, min_y, max_y] (a border render cropped to it; with crop false, not
 cropped), animate_camera (the camera turns and moves over frames 1-5),
 time_remap [old, new] (Time Remapping), sequencer ("override": a scene "Edit" shows the
 scene in a Video Sequencer strip through a camera override, "Strip Camera"; and in a second strip
 through the scene's camera, "two_cameras": at the same frames, "other_frame": showing its frame 11
 at frame 1, "muted_meta": inside a muted meta strip; "nested": Edit shown by a strip of scene
-"Outer" whose input is Edit's sequencer; each frame renders Edit (Outer) first, keeping the nodes'
-file as strip_nodes_<NNNN>.exr, then the scene through Strip Camera), save_blend
+"Outer" whose input is Edit's sequencer; "covered": Shot replaces a strip of the scene below it;
+each frame renders Edit (Outer) first, keeping the nodes' file as strip_nodes_<NNNN>.exr, then the
+scene through Strip Camera; "failed_movie": an animation render of Edit to a movie that cannot
+be written, then the scene's frames through its own camera), save_blend
 (path: saved after the setup, before rendering), nodes: [{name, layer, normal
 (bool), radius, keyframes [[frame, radius], ..], radius_from_value_node,
 falloff, integration, blur_size, angle_bias, directions, steps, strength,
@@ -81,6 +84,8 @@ if spec.get("widen_camera"):  # a view `widen_camera` times as wide about its ce
 if spec.get("stereo"):  # Stereoscopy on: a left and a right view, each written on its own
     scene.render.use_multiview = True
     scene.render.views_format = "STEREO_3D"
+    if spec["stereo"] == "one_view":  # Stereo 3D with the right view switched off
+        scene.render.views["right"].use = False
     if spec["stereo"] == "custom_view":  # Multi-View, with a view "center" besides
         scene.render.views_format = "MULTIVIEW"
         scene.render.views.new("center").camera_suffix = "_C"
@@ -121,7 +126,8 @@ if spec.get("sequencer"):
     edit.render.resolution_x, edit.render.resolution_y = resolution
     editor = edit.sequence_editor_create()
     strips = editor.strips if hasattr(editor, "strips") else editor.sequences
-    strips.new_scene("Shot", scene, channel=1, frame_start=1).scene_camera = strip_camera
+    shot = strips.new_scene("Shot", scene, channel=1, frame_start=1)
+    shot.scene_camera = strip_camera
     # a second strip of the scene, through the scene's camera: at the same frames, ...
     if spec["sequencer"] == "two_cameras":
         strips.new_scene("Shot again", scene, channel=2, frame_start=1)
@@ -132,6 +138,21 @@ if spec.get("sequencer"):
         meta = strips.new_meta("Muted", channel=2, frame_start=1)
         muted.move_to_meta(meta)
         meta.mute = True
+    elif spec["sequencer"] == "covered":  # ... under Shot, which replaces what lies below
+        shot.channel = 2
+        shot.blend_type = "REPLACE"
+        strips.new_scene("Shot below", scene, channel=1, frame_start=1)
+    elif spec["sequencer"] == "failed_movie":  # Edit's animation cannot write its movie
+        movie = edit.render.image_settings
+        if hasattr(movie, "media_type"):
+            movie.media_type = "VIDEO"
+        movie.file_format = "FFMPEG"
+        edit.render.filepath = "/dev/null/hbao-test/movie_"
+        try:
+            print("MOVIE", bpy.ops.render.render(animation=True, scene=edit.name), flush=True)
+        except RuntimeError as error:
+            print("MOVIE FAILED", error, flush=True)
+        edit = None  # then the scene renders through its own camera
     elif spec["sequencer"] == "nested":  # Edit shown by another sequencer, "Outer"
         outer = bpy.data.scenes.new("Outer")
         outer.render.resolution_x, outer.render.resolution_y = resolution
