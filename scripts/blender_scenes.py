@@ -15,7 +15,7 @@ import sys
 from pathlib import Path
 
 import bpy
-from mathutils import Vector
+from mathutils import Matrix, Vector
 
 try:
     import hbao  # noqa: F401  (the enabled add-on, or this checkout's below)
@@ -230,6 +230,37 @@ def camera_description(scene):
     Keys are Blender's own property names; world_to_camera is row-major. The
     add-on's own reading of the camera makes it, so tests and the add-on agree."""
     return camera_model.camera_for_render_result(scene)
+
+
+def stereo_eye(scene, right):
+    """A camera object where Stereo 3D puts an eye: worked out here from
+    the camera's Stereoscopy settings (pivot Left: the left eye is the camera;
+    the right one an interocular distance along the camera's x, its shift
+    off-axis by the distance over the convergence distance), for the tests'
+    reference, apart from the add-on's way (RenderEngine.camera_model_matrix)."""
+    camera = scene.camera
+    stereo = camera.data.stereo
+    assert stereo.pivot == "LEFT" and camera.data.sensor_fit == "AUTO"
+    if not right:
+        return camera
+    eye = camera.copy()
+    eye.data = camera.data.copy()
+    eye.matrix_world = camera.matrix_world @ Matrix.Translation(
+        (stereo.interocular_distance, 0.0, 0.0))
+    if stereo.convergence_mode == "OFFAXIS":
+        eye.data.shift_x -= (stereo.interocular_distance / camera.data.sensor_width
+                             * camera.data.lens / stereo.convergence_distance)
+    return eye
+
+
+def view_camera_descriptions(scene):
+    """{file suffix: the camera JSON of that view} of a stereo render, for
+    the tests' reference."""
+    if scene.render.views_format == "STEREO_3D":
+        return {"_L": camera_model.camera_for_render_result(scene, stereo_eye(scene, False)),
+                "_R": camera_model.camera_for_render_result(scene, stereo_eye(scene, True))}
+    return {view.file_suffix: camera_model.camera_for_render_result(
+        scene, scene.objects["Camera" + view.camera_suffix]) for view in scene.render.views}
 
 
 # --- compositor wiring (every Blender version, through the add-on's compat) ---

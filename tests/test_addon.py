@@ -858,15 +858,21 @@ def _camera_of(blender, user_scripts, blend, tmp_path):
 
 
 @pytest.mark.ui
-def test_f12_render_in_the_ui_job_thread(run_in_blender, tmp_path, native):
+@pytest.mark.parametrize("views", [[""], ["_L", "_R"]], ids=["mono", "stereo"])
+def test_f12_render_in_the_ui_job_thread(run_in_blender, tmp_path, native, views):
+    """F12 in a window renders in a job thread, the engine too (with Stereo
+    3D, each eye from the engine's own camera calls there)."""
     out = tmp_path / "f12"
-    completed = run_in_blender(SCRIPTS / "addon_f12.py", out, ui=True)
+    completed = run_in_blender(SCRIPTS / "addon_f12.py", out, *(["stereo"] if views[0] else []),
+                               ui=True)
     assert "F12: RENDERED" in completed.stdout, completed.stdout[-3000:]
     assert "pass hand-over" in completed.stdout
-    ao = node_outputs(out, 1)["ao"]
-    expected = library_ao(native, out, 1, node_params(radius=0.9))
-    assert ao.min() < 0.9
-    assert np.abs(ao - expected).max() <= EXACT
+    assert "Rendering without AO" not in completed.stdout, completed.stdout[-3000:]
+    for view in views:
+        ao = node_outputs(out, 1, view=view)["ao"]
+        expected = library_ao(native, out, 1, node_params(radius=0.9), view=view)
+        assert ao.min() < 0.9
+        assert np.abs(ao - expected).max() <= EXACT, view
 
 
 def test_eevee_main_engine(run_in_blender, tmp_path, native):

@@ -4,14 +4,19 @@ render in the render job thread (render.render('INVOKE_DEFAULT') from a
 timer), waits for render_complete, saves the Render Result and the node's AO
 (File Output), then quits.
 
-  blender --addons hbao --python addon_f12.py -- <out dir>
+  blender --addons hbao --python addon_f12.py -- <out dir> [stereo]
+
+With "stereo", Stereo 3D is on: the Render Result and the node's AO are
+saved per view (_L, _R), with each eye's camera_0001_<view>.json.
 """
 import os
 import sys
 
 import bpy
 
-out_dir = sys.argv[sys.argv.index("--") + 1]
+arguments = sys.argv[sys.argv.index("--") + 1:]
+out_dir = arguments[0]
+stereo = arguments[1:] == ["stereo"]
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(REPO, "scripts"))
 import blender_scenes  # noqa: E402
@@ -26,9 +31,15 @@ hbao = blender_scenes.hbao_test_tree(scene, out_dir)
 hbao.inputs["Radius"].default_value = 0.9
 os.makedirs(out_dir, exist_ok=True)
 bpy.context.view_layer.update()  # matrix_world of the new camera
-with open(os.path.join(out_dir, "camera_0001.json"), "w") as stream:
-    import json
-    json.dump(blender_scenes.camera_description(scene), stream)
+cameras = {"": blender_scenes.camera_description(scene)}
+if stereo:
+    scene.render.use_multiview = True
+    scene.render.views_format = "STEREO_3D"
+    cameras.update(blender_scenes.view_camera_descriptions(scene))
+for suffix, description in cameras.items():
+    with open(os.path.join(out_dir, f"camera_0001{suffix}.json"), "w") as stream:
+        import json
+        json.dump(description, stream)
 
 state = {"done": False, "started": None}
 
@@ -59,8 +70,11 @@ def wait_and_quit():
     settings.file_format = "OPEN_EXR_MULTILAYER"
     settings.color_depth = "32"
     settings.exr_codec = "NONE"
-    bpy.data.images["Render Result"].save_render(os.path.join(out_dir, "frame_0001.exr"),
-                                                 scene=scene)
+    try:
+        bpy.data.images["Render Result"].save_render(os.path.join(out_dir, "frame_0001.exr"),
+                                                     scene=scene)
+    except RuntimeError as error:  # a stereo save says so after writing every view
+        print("F12: save said", error)
     print("F12: RENDERED")
     timer_guard.quit_blender()
     return None

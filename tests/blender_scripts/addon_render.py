@@ -338,38 +338,6 @@ if spec.get("save_blend"):
     sys.exit(0)
 
 
-def stereo_eye(scene, right):
-    """A camera object where Stereo 3D puts an eye: worked out here from
-    the camera's Stereoscopy settings (pivot Left: the left eye is the camera;
-    the right one an interocular distance along the camera's x, its shift
-    off-axis by the distance over the convergence distance), for the tests'
-    reference, apart from the add-on's way (RenderEngine.camera_model_matrix)."""
-    import mathutils
-    camera = scene.camera
-    stereo = camera.data.stereo
-    assert stereo.pivot == "LEFT" and camera.data.sensor_fit == "AUTO"
-    if not right:
-        return camera
-    eye = camera.copy()
-    eye.data = camera.data.copy()
-    eye.matrix_world = camera.matrix_world @ mathutils.Matrix.Translation(
-        (stereo.interocular_distance, 0.0, 0.0))
-    if stereo.convergence_mode == "OFFAXIS":
-        eye.data.shift_x -= (stereo.interocular_distance / camera.data.sensor_width
-                             * camera.data.lens / stereo.convergence_distance)
-    return eye
-
-
-def view_cameras(scene):
-    """{file suffix: the camera JSON of that view} of a stereo render."""
-    from hbao import camera as camera_model
-    if scene.render.views_format == "STEREO_3D":
-        return {"_L": camera_model.camera_for_render_result(scene, stereo_eye(scene, False)),
-                "_R": camera_model.camera_for_render_result(scene, stereo_eye(scene, True))}
-    return {view.file_suffix: camera_model.camera_for_render_result(
-        scene, scene.objects["Camera" + view.camera_suffix]) for view in scene.render.views}
-
-
 for frame in spec.get("frames", [1]):
     if edit is not None:  # the sequencer's render first, its nodes_ file kept as strip_nodes_
         edit.frame_set(frame)
@@ -384,7 +352,7 @@ for frame in spec.get("frames", [1]):
     with open(os.path.join(out_dir, f"camera_{frame:04d}.json"), "w") as stream:
         json.dump(blender_scenes.camera_description(scene), stream)
     if spec.get("stereo"):
-        for suffix, description in view_cameras(scene).items():
+        for suffix, description in blender_scenes.view_camera_descriptions(scene).items():
             with open(os.path.join(out_dir, f"camera_{frame:04d}{suffix}.json"), "w") as stream:
                 json.dump(description, stream)
     # Still renders do not replace '#' in the path: name the frame here.
