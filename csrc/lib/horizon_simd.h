@@ -157,9 +157,10 @@ typedef struct SIMD_NAME(fetch) {
  * for a step whose lanes all lie inside the image (a `plain` step, the
  * common case) what its fetch needs: the index of the lanes' depths in
  * phase_depth, its grid row and ox as a float. Arrays hold whole vectors:
- * HBAO_MAX_STEPS + SIMD_LANES entries. Planning the next direction during
- * a search (AVX2, when it searched a block in two halves): 2 threads 0.99,
- * 0.977, 1.049 (half), 1 thread 0.95, 0.86, 1.046: not kept. */
+ * HBAO_MAX_STEPS + SIMD_LANES entries. Directions are planned ahead of
+ * their search (SIMD_PLAN_AHEAD); an earlier form, the next direction
+ * planned during a search (AVX2, when it searched a block in two halves),
+ * measured 0.99, 0.977, 1.049 (half) on 2 threads: not kept then. */
 #define SIMD_STEP_ROOM (HBAO_MAX_STEPS + SIMD_LANES)
 typedef struct SIMD_NAME(steps) {
     int count; /* the steps before the first that lies a whole image away */
@@ -883,6 +884,19 @@ static VF SIMD_NAME(direction_occlusion_hbao_layers)(const hbao_settings *s,
  * 1.044 at half resolution). Session 11 had measured an older form of
  * pairs slower on an AMD EPYC with AVX-512 (1.03-1.04), not re-measured. */
 #define SIMD_DIRECTION_GROUP 8
+/* How many directions' steps block_ao keeps planned and prefetched: the
+ * first SIMD_PLAN_AHEAD of a group before any search, then, as direction k
+ * is searched, direction k + SIMD_PLAN_AHEAD - 1, into the plan of k - 1.
+ * A step's depths were asked of the memory only just before its own
+ * direction's search; now the searches of the directions before it cover
+ * the wait. bench_ab, 1080p, Intel Xeon with AVX-512 (session 27),
+ * bit-identical, against planning each direction just before its search:
+ * defaults 0.944 on 1 thread, 0.974-0.976 on 2; 8 x 6 + blur 15 0.920 and
+ * 0.921; back faces 0.975 and 0.984; half resolution 1.020 and 0.997; 4K
+ * 0.929 and 0.926; AVX2 on the same machine: defaults 1.008 and
+ * 1.013, 8 x 6 + blur 15 0.970 and 0.974. 8 ahead instead of 4: 16
+ * directions 0.988, 4 and 8 directions 1.003-1.013. */
+#define SIMD_PLAN_AHEAD 4
 #if SIMD_PAIRED_DIRECTIONS > SIMD_DIRECTION_GROUP
 #define SIMD_SLICE_ROOM SIMD_PAIRED_DIRECTIONS
 #else
@@ -1004,20 +1018,30 @@ static void SIMD_NAME(block_ao)(const hbao_horizon_job *job, int x0, int x1, int
                 (b.v, b.n, b.n_cross_v, b.n_dot_v, dc, ds, cosine, &slices[k], NULL);
             }
         }
+        SIMD_NAME(steps) plans[SIMD_PLAN_AHEAD];
+        for (int k = 0; k < count && k < SIMD_PLAN_AHEAD; k++) {
+            SIMD_NAME(plan_steps)
+            (&b, direction_cos[first + k], direction_sin[first + k], s->steps, &plans[k]);
+            SIMD_NAME(prefetch_steps)(&b, &plans[k]);
+        }
         for (int k = 0; k < count; k++) {
             const SIMD_NAME(slice) *sl = &slices[k];
             const VM lanes = cosine ? M_AND(active, sl->usable) : active;
+            SIMD_NAME(steps) *t = &plans[k % SIMD_PLAN_AHEAD];
+            const int next = k + SIMD_PLAN_AHEAD - 1; /* into the plan of direction k - 1 */
+            if (k > 0 && next < count) {
+                SIMD_NAME(steps) *later = &plans[next % SIMD_PLAN_AHEAD];
+                SIMD_NAME(plan_steps)
+                (&b, direction_cos[first + next], direction_sin[first + next], s->steps, later);
+                SIMD_NAME(prefetch_steps)(&b, later);
+            }
             if (!M_ANY(lanes)) continue;
-            SIMD_NAME(steps) t;
-            SIMD_NAME(plan_steps)
-            (&b, direction_cos[first + k], direction_sin[first + k], s->steps, &t);
-            SIMD_NAME(prefetch_steps)(&b, &t);
             if (cosine) {
                 VF open;
                 const VF occlusion =
                     layers
-                        ? SIMD_NAME(direction_occlusion_cosine_layers)(s, &b, lanes, &t, sl, &open)
-                        : SIMD_NAME(direction_occlusion_cosine)(s, &b, lanes, &t, sl, &open);
+                        ? SIMD_NAME(direction_occlusion_cosine_layers)(s, &b, lanes, t, sl, &open)
+                        : SIMD_NAME(direction_occlusion_cosine)(s, &b, lanes, t, sl, &open);
                 visible_sum =
                     V_SELECT(lanes, visible_sum,
                              V_ADD(visible_sum, V_MUL(sl->np_length, V_SUB(open, occlusion))));
@@ -1025,8 +1049,8 @@ static void SIMD_NAME(block_ao)(const hbao_horizon_job *job, int x0, int x1, int
             } else {
                 occlusion_sum =
                     V_ADD(occlusion_sum,
-                          layers ? SIMD_NAME(direction_occlusion_hbao_layers)(s, &b, active, &t, sl)
-                                 : SIMD_NAME(direction_occlusion_hbao)(s, &b, active, &t, sl));
+                          layers ? SIMD_NAME(direction_occlusion_hbao_layers)(s, &b, active, t, sl)
+                                 : SIMD_NAME(direction_occlusion_hbao)(s, &b, active, t, sl));
             }
         }
     }
