@@ -656,8 +656,10 @@ def test_stereo_and_multi_view_renders_get_each_views_ao(run_in_blender, tmp_pat
     scratch = tmp_path / "scratch"
     scratch.mkdir()
     monkeypatch.setenv("HBAO_TEMP_DIR", str(scratch))
-    out, log = render(run_in_blender, tmp_path, {"stereo": stereo,
-                                                 "nodes": [{"radius": 0.7, "blur_size": 0}]})
+    out, log = render(run_in_blender, tmp_path, {
+        "stereo": stereo, "nodes": [{"radius": 0.7, "blur_size": 0},
+                                    {"name": "HBAO1", "radius": 0.7, "blur_size": 0,
+                                     "guard_band": 10.0, "back_faces": True}]})
 
     def suffix(name, view):  # with one view on, 3.4 writes the render without its suffix
         return view if (out / f"{name}_0001{view}.exr").exists() else ""
@@ -672,6 +674,12 @@ def test_stereo_and_multi_view_renders_get_each_views_ao(run_in_blender, tmp_pat
         assert expected[view].min() < 0.9, view
         assert np.abs(outputs["ao"] - expected[view]).max() <= EXACT, view
         assert outputs["render"].max() > 0.1  # a render, not a black frame
+        # guard band and back faces: left out, and their scenes not rendered in vain
+        guarded = node_outputs(out, 1, node="HBAO1", view=suffix("nodes", view))["ao"]
+        assert np.abs(guarded - expected[view]).max() <= EXACT, view
+    assert "no guard band: stereo and multi-view renders have none" in log
+    assert "no back faces: stereo and multi-view renders have none" in log
+    assert "EXTRA SCENES []" in log
     # the views differ: a view's AO through another view's camera would not match
     assert len(views) == 1 or np.abs(expected[views[0]] - expected[views[1]]).max() > 0.1
     assert "Rendering without AO" not in log

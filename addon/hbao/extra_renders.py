@@ -249,7 +249,7 @@ def sync(main, tree, nodes, helper, view_layer):
     again, after theirs (render order)."""
     extra_nodes = []
     for kind in KINDS:
-        if main.camera is None or not _wanted(kind, nodes):
+        if main.camera is None or main.render.use_multiview or not _wanted(kind, nodes):
             remove(helper, tree, kind)
         else:
             extra_nodes.append(_sync_kind(main, tree, nodes, helper, view_layer, kind))
@@ -271,13 +271,13 @@ def record_rendering(main, helper):
 def for_render(main, helper, kind):
     """(the extra scene, None) when its render can be used for `main`'s
     render now, else (None, why not)."""
+    if main.render.use_border:
+        return None, "border renders have none"
+    if main.render.use_multiview:  # (sync removes their scenes: nothing renders in vain)
+        return None, "stereo and multi-view renders have none"
     scene = scene_of(helper, kind)
     if scene is None:
         return None, "its render is not set up yet (it is made when the setting changes)"
-    if main.render.use_border:
-        return None, "border renders have none"
-    if main.render.use_multiview:
-        return None, "stereo and multi-view renders have none"
     if strip_cameras.override_for(main) is not None:
         return None, "a Video Sequencer strip renders the scene through another camera"
     return scene, None

@@ -475,6 +475,9 @@ for step in spec.get("after_render", []):
 for node in tree.nodes:  # what each node's status line says after the renders
     if node.bl_idname == "CompositorNodeHBAO":
         print("STATUS", json.dumps({"node": node.name, "status": node.status}))
+# the guard band's and back faces' scenes that exist after the renders
+print("EXTRA SCENES", json.dumps(sorted(s.name for s in bpy.data.scenes
+                                        if s.get("hbao_guard_for"))))
 settings = scene.render.image_settings
 print("OUTPUT SETTINGS", json.dumps({
     "file_format": settings.file_format, "color_depth": settings.color_depth,
