@@ -47,16 +47,18 @@ def frame_started(scene):
             return
 
 
-def _job_names():
-    return [name for name, _began in _jobs]
+def _innermost_job(scene):
+    """The index in _jobs of `scene`'s innermost job, or None."""
+    names = [name for name, _began in _jobs]
+    return len(names) - 1 - names[::-1].index(scene.name) if scene.name in names else None
 
 
 def job_ended(scene):
     """render_complete or render_cancel: `scene`'s job ends, and with it any
     job inside it."""
-    names = _job_names()
-    if scene.name in names:
-        del _jobs[len(names) - 1 - names[::-1].index(scene.name):]
+    at = _innermost_job(scene)
+    if at is not None:
+        del _jobs[at:]
 
 
 def forget_jobs():
@@ -64,21 +66,19 @@ def forget_jobs():
     del _jobs[:]
 
 
-def _strips(scene):
-    """Every strip of `scene`'s sequencer, inside meta strips too (5.0
-    renamed sequences_all to strips_all)."""
-    editor = getattr(scene, "sequence_editor", None)
-    if editor is None:
-        return []
-    strips = getattr(editor, "strips_all", None)
-    return list(strips if strips is not None else getattr(editor, "sequences_all", []))
-
-
 def _children(holder):
     """The strips of a sequence editor or meta strip, not those inside
     them (5.0 renamed sequences to strips)."""
     strips = getattr(holder, "strips", None)
     return list(strips if strips is not None else getattr(holder, "sequences", []))
+
+
+def _every_strip(holder):
+    """The strips of `holder`, inside its meta strips too."""
+    for strip in _children(holder):
+        yield strip
+        if strip.type == "META":
+            yield from _every_strip(strip)
 
 
 def _channel_muted(holder, number):
@@ -139,7 +139,8 @@ def strip_overrides(scenes):
     `scenes`."""
     cameras = []
     for other in bpy.data.scenes:
-        for strip in _strips(other):
+        editor = getattr(other, "sequence_editor", None)
+        for strip in _every_strip(editor) if editor is not None else ():
             camera = getattr(strip, "scene_camera", None)
             if strip.type == "SCENE" and strip.scene in scenes and camera is not None:
                 cameras.append(camera)
@@ -155,11 +156,8 @@ def override_for(scene):
     for the scene's own (no strip: a render of the scene itself). Raises
     AmbiguousStrips where strips at the same frame use different cameras:
     which of them is rendering cannot be told."""
-    names = _job_names()
-    if scene.name not in names:
-        return None
-    at = len(names) - 1 - names[::-1].index(scene.name)
-    outer = bpy.data.scenes.get(names[at - 1]) if at > 0 else None
+    at = _innermost_job(scene)
+    outer = bpy.data.scenes.get(_jobs[at - 1][0]) if at else None  # (None or 0: no outer job)
     if outer is None:
         return None
     showing = _showing(outer, outer.frame_current, scene) or \
