@@ -5,6 +5,8 @@ hand-over gives its scratch files (tests/blender_scripts/scratch_removal.py
 removes real ones)."""
 import fnmatch
 
+import pytest
+
 from conftest import REPO  # noqa: F401  (puts the add-on on sys.path)
 from hbao import scratch_names
 
@@ -32,3 +34,15 @@ def test_a_stereo_renders_view_files():
     for suffix in ("_L", "_R", "-center view"):
         assert scratch_names.process_of(name[:-len(".exr")] + suffix + ".exr") == 4242, suffix
     assert scratch_names.process_of("hbao-passes-4242-139872-7_L.exr.tmp") is None
+
+
+def test_view_files_stay_beside_the_scratch_file(tmp_path):
+    """Each view's file lies beside the scratch file, named with its suffix;
+    a suffix that would reach another folder (where the save would write and
+    the removal then delete an artist's file) is refused before the save."""
+    from hbao import view_files
+    path = str(tmp_path / scratch_names.name(4242, 1, 0))
+    files = view_files.files(path, [("left", "_L"), ("right", "_R")])
+    assert files == {"left": path[:-4] + "_L.exr", "right": path[:-4] + "_R.exr"}
+    with pytest.raises(ValueError, match="folder separator"):
+        view_files.files(path, [("left", "_L"), ("right", "/../../home/artist/shot")])

@@ -22,6 +22,10 @@ def files(path, views):
     [(view name, file suffix)], or {None: path} for views None (mono)."""
     if views is None:
         return {None: path}
+    for name, suffix in views:  # the save, and then the removal, would reach another folder
+        if "/" in suffix or os.sep in suffix:
+            raise ValueError(f"view {name!r}'s file suffix {suffix!r} holds a folder separator: "
+                             f"no AO for its render (Output properties > Views)")
     found = {name: view_path(path, suffix) for name, suffix in views}
     if len(found) == 1 and not os.path.exists(*found.values()) and os.path.exists(path):
         return dict.fromkeys(found, path)
