@@ -46,6 +46,14 @@ def render(run_in_blender, tmp_path, spec, env=None, name="render"):
     return out, completed.stdout
 
 
+def extra_renders(log):
+    """{render: the guard band and back faces scenes it rendered} from
+    addon_render.py's EXTRA RENDERS lines ("frame 1", "sequencer 1")."""
+    found = [json.loads(line[len("EXTRA RENDERS "):]) for line in log.splitlines()
+             if line.startswith("EXTRA RENDERS ")]
+    return {entry["render"]: entry["scenes"] for entry in found}
+
+
 def frame_passes(out, frame, layer="ViewLayer", with_normal=True, view=""):
     """(depth, normal) of the main render's view layer (of a stereo render's
     view with file suffix `view`); normal None unless with_normal."""
@@ -172,11 +180,13 @@ def test_sequencer_strip_camera_override_gets_that_cameras_ao(run_in_blender, tm
     the scene's camera that shows another frame of the scene or lies in a
     muted meta strip (the AO was off: "different cameras"), and where the
     sequencer is itself shown by another's strip (the scene camera's AO,
-    silently). The back faces render follows the scene camera: through the
-    strip it is left out, and the node says so."""
+    silently). The guard band and back faces renders follow the scene
+    camera: through the strip they are left out, the node says so, and
+    their scenes do not render in vain; the scene's own render after it
+    renders them."""
     spec = {"sequencer": sequencer,
             "nodes": [{"radius": 0.7, "blur_size": 0},
-                      {"radius": 0.7, "blur_size": 0, "back_faces": True}]}
+                      {"radius": 0.7, "blur_size": 0, "back_faces": True, "guard_band": 10.0}]}
     out, log = render(run_in_blender, tmp_path, spec)
     params = node_params(radius=0.7, blur_size=0)
     expected = library_ao(native, out, 1, params)
@@ -186,8 +196,15 @@ def test_sequencer_strip_camera_override_gets_that_cameras_ao(run_in_blender, tm
         assert np.abs(through_strip[f"{node}_AO.V"] - expected).max() <= EXACT, node
     assert np.abs(node_outputs(out, 1)["ao"] - expected).max() <= EXACT
     assert "through camera 'Strip Camera'" in log
-    assert "no back faces: a Video Sequencer strip renders the scene through another camera" \
-        in log
+    for kind in ("guard band", "back faces"):
+        assert f"no {kind}: a Video Sequencer strip renders the scene through another camera" \
+            in log, kind
+    rendered = extra_renders(log)
+    # (a strip showing another frame through the scene camera uses them)
+    used = [".HBAO back faces Scene", ".HBAO guard band Scene"] if sequencer == "other_frame" \
+        else []
+    assert sorted(rendered["sequencer 1"]) == used, rendered
+    assert sorted(rendered["frame 1"]) == [".HBAO back faces Scene", ".HBAO guard band Scene"]
 
 
 def test_a_sequencer_animation_that_could_not_start_leaves_no_strip_camera(
@@ -743,6 +760,7 @@ def test_guard_band_sees_occluders_outside_the_frame(run_in_blender, tmp_path, n
                        "nodes": [dict(node, name="HBAO0"),
                                  dict(node, name="HBAO1", guard_band=12.5)]})
     assert "guard band" in log and "no guard band" not in log, log[-3000:]
+    assert extra_renders(log)["frame 1"] == [".HBAO guard band Scene"]
     wide_out, _ = render(run_in_blender, tmp_path,
                          {"resolution": [int(width * scale), int(height * scale)],
                           "widen_camera": scale, "nodes": [node]}, name="wide")
@@ -766,7 +784,7 @@ def test_border_render_gets_no_guard_band_and_says_so(run_in_blender, tmp_path, 
     """A border render (cropped) with a guard band asked for: the extra
     render cannot be used; the AO is exactly the library's on the cropped
     render without a band, the render's report says why and the node shows
-    it."""
+    it; the guard band's scene does not render in vain."""
     node = {"radius": 0.8, "blur_size": 0}
     out, log = render(run_in_blender, tmp_path, {"border": [0.25, 0.75, 0.25, 0.75],
                                                  "nodes": [dict(node, guard_band=10.0)]})
@@ -774,6 +792,7 @@ def test_border_render_gets_no_guard_band_and_says_so(run_in_blender, tmp_path, 
     statuses = [json.loads(line[len("STATUS "):]) for line in log.splitlines()
                 if line.startswith("STATUS ")]
     assert statuses == [{"node": "HBAO0", "status": "No guard band"}], statuses
+    assert extra_renders(log) == {"frame 1": []}
     # The camera written beside the render is the crop's (pixels 24-72 of 96
     # and 16-48 of 64, from the bottom: blender_scenes.camera_description).
     depth, normal = frame_passes(out, 1)

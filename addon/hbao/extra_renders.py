@@ -260,9 +260,27 @@ def sync(main, tree, nodes, helper, view_layer):
                                  for node in extra_nodes)
 
 
+def _left_out(main):
+    """Why `main`'s render cannot use the extra renders now, or None."""
+    if main.render.use_border:
+        return "border renders have none"
+    if main.render.use_multiview:  # (sync removes their scenes)
+        return "stereo and multi-view renders have none"
+    if strip_cameras.override_for(main) is not None:
+        return "a Video Sequencer strip renders the scene through another camera"
+    return None
+
+
 def record_rendering(main, helper):
-    """At the start of `main`'s render (any thread): the guard camera follows
-    the scene camera's settings, which may be animated."""
+    """At the start of `main`'s render and of its frames (any thread): the
+    guard camera follows the scene camera (maybe animated); an extra scene
+    whose render the frame cannot use has its view layer off (a plain
+    setting), so Blender does not render it (about 0.3 s a frame each)."""
+    wanted = _left_out(main) is None
+    for kind in KINDS:
+        scene = scene_of(helper, kind)
+        if scene is not None:
+            set_if_different(scene.view_layers[0], "use", wanted)
     guard = scene_of(helper, GUARD)
     if guard is not None:
         copy_camera(main, guard)
@@ -271,13 +289,12 @@ def record_rendering(main, helper):
 def for_render(main, helper, kind):
     """(the extra scene, None) when its render can be used for `main`'s
     render now, else (None, why not)."""
-    if main.render.use_border:
-        return None, "border renders have none"
-    if main.render.use_multiview:  # (sync removes their scenes: nothing renders in vain)
-        return None, "stereo and multi-view renders have none"
+    reason = _left_out(main)
+    if reason is not None:
+        return None, reason
     scene = scene_of(helper, kind)
     if scene is None:
         return None, "its render is not set up yet (it is made when the setting changes)"
-    if strip_cameras.override_for(main) is not None:
-        return None, "a Video Sequencer strip renders the scene through another camera"
+    if not scene.view_layers[0].use:  # record_rendering did not run: its result is stale
+        return None, "its render did not run for this frame"
     return scene, None

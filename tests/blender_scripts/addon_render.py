@@ -327,6 +327,25 @@ def user_handler(list_name):
     return handler
 
 
+# The guard band's and back faces' scenes each render renders: Blender sets
+# each scene it renders to the frame (frame_change_pre), these too.
+extra_rendered = []
+
+
+@bpy.app.handlers.persistent
+def note_extra_render(scene, *_args):
+    if scene.get("hbao_guard_for"):
+        extra_rendered.append(scene.name)
+
+
+def print_extra_renders(render_name):
+    print("EXTRA RENDERS", json.dumps({"render": render_name, "scenes": extra_rendered}),
+          flush=True)
+    extra_rendered.clear()
+
+
+bpy.app.handlers.frame_change_pre.append(note_extra_render)
+
 if spec.get("user_handlers"):
     for list_name in USER_HANDLER_LISTS:
         if hasattr(bpy.app.handlers, list_name):
@@ -343,6 +362,7 @@ for frame in spec.get("frames", [1]):
         edit.frame_set(frame)
         edit.render.filepath = os.path.join(out_dir, f"edit_{frame:04d}")
         bpy.ops.render.render(write_still=True, scene=edit.name)
+        print_extra_renders(f"sequencer {frame}")
         os.replace(os.path.join(out_dir, f"nodes_{frame:04d}.exr"),
                    os.path.join(out_dir, f"strip_nodes_{frame:04d}.exr"))
         scene.camera = strip_camera  # then the scene itself through the strip's camera
@@ -362,6 +382,7 @@ for frame in spec.get("frames", [1]):
     else:
         bpy.data.scenes[render_scene_name].render.filepath = scene.render.filepath
         bpy.ops.render.render(write_still=True, scene=render_scene_name)
+    print_extra_renders(f"frame {frame}")
     if spec.get("dump_back_faces"):  # the back faces render's Depth, as the engine read it
         import numpy as np
         from hbao import extra_renders, handover
