@@ -234,6 +234,25 @@ def test_sequencer_strips_with_two_cameras_at_one_frame_turn_the_ao_off(run_in_b
     assert node_outputs(out, 1)["ao"].min() < 0.9  # the scene's own render has its AO
 
 
+def test_a_camera_scaled_unevenly_gets_the_ao_of_the_unscaled_one(run_in_blender, tmp_path):
+    """Blender renders through a camera object as if it were unscaled (it
+    normalises the axes of its matrix), so a camera scaled by (1, 2, 0.5)
+    gives the same passes; its node AO must be the same too. The normals
+    were turned by the scaled matrix: AO off by up to 0.31, silently."""
+    node = {"radius": 0.7, "blur_size": 0}
+    plain, _ = render(run_in_blender, tmp_path, {"nodes": [node]}, name="plain")
+    scaled, log = render(run_in_blender, tmp_path, {"nodes": [node],
+                                                    "camera_scale": [1.0, 2.0, 0.5]},
+                         name="scaled")
+    assert "without AO" not in log, log[-3000:]
+    for plain_pass, scaled_pass in zip(frame_passes(plain, 1), frame_passes(scaled, 1)):
+        assert np.abs(plain_pass - scaled_pass).max() <= 1e-6  # Blender: the same render
+    expected = node_outputs(plain, 1)["ao"]
+    assert expected.min() < 0.9
+    # (1e-5: the two matrices' inverses round differently; measured 3e-8)
+    assert np.abs(node_outputs(scaled, 1)["ao"] - expected).max() <= 1e-5
+
+
 @pytest.mark.parametrize("border", [None, [0.2, 0.75, 0.1, 0.8]], ids=["frame", "cropped_border"])
 def test_node_ao_matches_cli_with_the_written_camera(run_in_blender, tmp_path, hbao_tool,
                                                      border):

@@ -20,7 +20,7 @@ def camera_from_blender(scene, camera_object=None):
         kind = getattr(camera, "type", "not a camera")
         raise CameraError(f"camera {camera_object.name!r} is {kind}: HBAO supports "
                           f"perspective and orthographic cameras")
-    world_to_camera = camera_object.matrix_world.inverted_safe()
+    world_to_camera = model_matrix(camera_object.matrix_world).inverted_safe()
     render = scene.render
     return {
         "type": camera.type,
@@ -35,6 +35,22 @@ def camera_from_blender(scene, camera_object=None):
         "pixel_aspect_y": float(render.pixel_aspect_y),
         "world_to_camera": [[float(v) for v in row] for row in world_to_camera],
     }
+
+
+def model_matrix(matrix_world):
+    """A camera object's matrix as Blender renders through it: each axis of
+    unit length (BKE_camera_multiview_model_matrix normalises them), so a
+    scaled camera, or one whose parent is scaled, renders as unscaled. The
+    library turns the Normal pass by this matrix's inverse: with the scale
+    left in, a camera scaled unevenly turned the normals askew (AO off by up
+    to 0.3, silently)."""
+    matrix = matrix_world.copy()
+    for axis in range(3):
+        length = matrix.col[axis].xyz.length
+        if length > 0.0:
+            for row in range(3):
+                matrix[row][axis] /= length
+    return matrix
 
 
 def render_size(scene):

@@ -16,8 +16,9 @@ AO pass), stereo (true: Stereo 3D; "one_view": with its right view off; "custom_
 Multi-View with a view "center" besides left and right, each through its own camera Camera_L,
 Camera_C, Camera_R; writes camera_<NNNN><view's file suffix>.json too), stereo_off_from_frame
 (Stereoscopy turned off from that frame on), output_views_format (the main output's views
-format), orthographic, widen_camera (factor), dump_back_faces (writes <out>/back_<NNNN>.npy: the
-back faces render's Depth, top row first), border
+format), orthographic, camera_scale [x, y, z] (the camera object's scale), widen_camera
+(factor), dump_back_faces (writes <out>/back_<NNNN>.npy: the back faces render's Depth, top row
+first), border
 [min_x, max_x, min_y, max_y] (a border render cropped to it; with crop false, not
 cropped), animate_camera (the camera turns and moves over frames 1-5),
 time_remap [old, new] (Time Remapping), sequencer ("override": a scene "Edit" shows the
@@ -75,6 +76,8 @@ if spec.get("ao_reference"):
     blender_scenes.configure_ao_reference(scene, spec["ao_reference"])
 if spec.get("orthographic"):
     blender_scenes.make_orthographic(scene)
+if spec.get("camera_scale"):  # the camera object scaled (Blender renders as unscaled)
+    scene.camera.scale = spec["camera_scale"]
 if spec.get("widen_camera"):  # a view `widen_camera` times as wide about its centre
     lens = scene.camera.data
     for name in ("sensor_width", "sensor_height", "ortho_scale"):
