@@ -3,6 +3,7 @@
 96x64, few samples): tests/blender_scripts/addon_render.py builds the scene,
 this file checks the EXRs Blender wrote."""
 import json
+import os
 import subprocess
 
 import numpy as np
@@ -320,6 +321,24 @@ def test_unchanged_frame_reuses_its_ao(run_in_blender, tmp_path, native):
         fixed = node_outputs(out, frame, "Fixed")["ao"]
         expected = library_ao(native, out, frame, node_params(radius=0.3, blur_size=0))
         assert np.abs(fixed - expected).max() <= EXACT
+
+
+def test_the_ao_uses_the_threads_blender_renders_with(run_in_blender, tmp_path, native):
+    """The AO (and the passes' read) runs on as many threads as Blender
+    renders the scene with (RenderSettings.threads: `-t N`, else Fixed,
+    else one per CPU), so a farm worker held to N threads stays there; the
+    timing line says how many. The number is no setting of the AO (the
+    same for any number): frame 2, the same passes on other threads,
+    reuses frame 1's AO."""
+    spec = {"frames": [1, 2, 3], "render_threads": {"1": 1, "2": 3, "3": 0},
+            "nodes": [{"radius": 0.6, "blur_size": 0}]}
+    out, log = render(run_in_blender, tmp_path, spec)
+    figures = [timing_line.parse(line) for line in log.splitlines()
+               if line.startswith("HBAO: 1 AO pass(es) ")]
+    assert [f["threads"] for f in figures] == [1, 3, os.cpu_count()], log[-3000:]
+    assert [f["reused"] for f in figures] == [0, 1, 1]
+    expected = library_ao(native, out, 1, node_params(radius=0.6, blur_size=0))
+    assert np.abs(node_outputs(out, 1)["ao"] - expected).max() <= EXACT
 
 
 def printed_hints(log):

@@ -13,7 +13,7 @@ from time import perf_counter as _clock
 
 import bpy
 
-from . import compat, exr_passes, scratch_names, view_files
+from . import compat, exr_passes, render_threads, scratch_names, view_files
 from .report import log
 
 
@@ -236,22 +236,22 @@ def save_passes(scene, path, views=None):
         compat.restore_image_settings(settings, saved)
 
 
-def read_passes(scene, layers, views=None):
+def read_passes(scene, layers, views=None, threads=0):
     """{("depth", layer): (H, W), ("normal", layer): (H, W, 3)} float32, top
     row first, of `scene`'s Render Result, for `layers` {view layer name:
     whether its normal is wanted}; with `views` [(view name, file suffix)]
     of a stereo or multi-view render, {view name: those} instead; and the
-    seconds the save and the read took."""
+    seconds the save and the read (by `threads`, 0: one per core) took."""
     global _stale_files_checked
     if not _stale_files_checked:  # a process's first hand-over, which need not wait for it
         _stale_files_checked = True
         _in_background(_remove_stale_files)
     _wait_for_older_removals()
-    channels, timings = _save_and_read(scene, layers, views)
+    channels, timings = _save_and_read(scene, layers, views, threads)
     return channels[None] if views is None else channels, timings
 
 
-def _save_and_read(scene, layers, views):
+def _save_and_read(scene, layers, views, threads):
     path = _scratch_path()
     files = view_files.files(path, views)
     timings = {}
@@ -269,7 +269,7 @@ def _save_and_read(scene, layers, views):
         read_start = _clock()
         try:
             channels = {view: exr_passes.read_channel_groups(
-                file, view_files.channel_groups(file, view, groups))
+                file, view_files.channel_groups(file, view, groups), threads)
                 for view, file in files.items()}
         except (exr_passes.EXRFormatError, exr_passes.EXRFileError) as error:
             # Blender's save does not say when the folder filled up: the
@@ -288,4 +288,4 @@ def read_main_passes(main, jobs, views=None):
     """read_passes() of the view layers and normals that `jobs` read."""
     layers = {job.layer: any(other.with_normal for other in jobs if other.layer == job.layer)
               for job in jobs}
-    return read_passes(main, layers, views)
+    return read_passes(main, layers, views, render_threads.count(main))

@@ -6,7 +6,7 @@ depth and over the frame with its guard band, cropped back to the frame
 import numpy as np
 
 from . import camera as camera_model
-from . import extra_renders, guard_geometry, handover, native
+from . import extra_renders, guard_geometry, handover, native, render_threads
 from .report import NodeMessage
 
 
@@ -29,7 +29,8 @@ def _read_kind(helper, main, kind, wanting, timings, messages):
                                  f"No {kind.name}") for job in wanting]
         return None
     layer = scene.view_layers[0].name
-    channels, kind_timings = handover.read_passes(scene, {layer: kind.wants_normal})
+    channels, kind_timings = handover.read_passes(scene, {layer: kind.wants_normal},
+                                                  threads=render_threads.count(main))
     for name, seconds in kind_timings.items():
         timings[f"{kind.name} {name}"] = seconds
     return scene, {key: channels[(key, layer)] for key, _layer in channels}
@@ -91,10 +92,11 @@ def compute(job, depth, normal, camera, extra):
     faces and over the frame and its band when `extra` has them and the job
     wants them."""
     back = extra.back_depth if extra is not None and job.back_faces else None
+    params = dict(job.params, threads=job.threads)
     if extra is None or extra.guard_depth is None or job.guard_band <= 0.0:
         # The EXR's rows run top-down, a render pass bottom-up: views flipped, no copy.
-        return native.compute_ao(depth[::-1], _flipped(normal), params=job.params,
-                                 camera=camera, bottom_up=True, back_depth=_flipped(back))
+        return native.compute_ao(depth[::-1], _flipped(normal), params=params, camera=camera,
+                                 bottom_up=True, back_depth=_flipped(back))
     height, width = depth.shape
     band = guard_geometry.band_pixels(width, height, job.guard_band)
     columns, rows = band
@@ -109,6 +111,6 @@ def compute(job, depth, normal, camera, extra):
     # The frame with its band is a crop reaching past the frame's image.
     wide_camera = camera_model.crop_camera(camera, width, height,
                                            (-columns, width + columns, -rows, height + rows))
-    wide = native.compute_ao(wide_depth[::-1], _flipped(wide_normal), params=job.params,
+    wide = native.compute_ao(wide_depth[::-1], _flipped(wide_normal), params=params,
                              camera=wide_camera, bottom_up=True, back_depth=_flipped(wide_back))
     return guard_geometry.crop_band(wide, band)

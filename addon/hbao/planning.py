@@ -2,7 +2,7 @@
 """Which AO computations a frame needs: one job per HBAO node whose output
 someone looks at, with the view layer its passes come from and its
 parameters at that frame."""
-from . import compat, handover
+from . import compat, handover, render_threads
 from .helper_lookup import MANAGED_NODE_KEY
 from .node import DEPTH_INPUT, NORMAL_INPUT, hbao_nodes, pass_name
 from .report import NodeMessage, post_node_messages, take_changes
@@ -10,12 +10,15 @@ from .socket_values import node_params, upstream
 
 
 class Job:
-    def __init__(self, node, layer, with_normal, params):
+    def __init__(self, node, layer, with_normal, params, threads):
         self.node_name = node.name
         self.pass_name = pass_name(node)
         self.layer = layer
         self.with_normal = with_normal
         self.params = params
+        # the AO's threads (render_threads): not a parameter, as the AO
+        # is the same for any number, so they change no cache or record
+        self.threads = threads
         # of the frame on each side, guard_geometry's
         self.guard_band = node.guard_band / 100.0
         self.back_faces = node.back_faces
@@ -79,7 +82,8 @@ def plan_node(node, main, frame, warnings):
         warnings.append(NodeMessage(node.name, "Normal comes from another view layer than "
                                     "Depth; reconstructing normals from depth",
                                     "Normal: other layer, ignored"))
-    return Job(node, depth_layer, normal_layer == depth_layer, params)
+    return Job(node, depth_layer, normal_layer == depth_layer, params,
+               render_threads.count(main))
 
 
 def node_names(main):

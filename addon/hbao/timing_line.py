@@ -3,7 +3,7 @@
 render stats), and the one parser of it that the benchmarks and the soak
 read it with. bpy-free.
 
-    2 AO pass(es) 1920x1080 in 190 ms: AO 120 ms (1 of 2 unchanged: reused),
+    2 AO pass(es) 1920x1080 in 190 ms: AO 120 ms on 8 threads (1 of 2 unchanged: reused),
     pass hand-over 70 ms (save 50, read 14, write 6)[, re-composited ...]
     [, guard band passes 80 ms][, back faces passes 75 ms]
 """
@@ -11,7 +11,8 @@ import re
 
 _LINE = re.compile(
     r"(?P<passes>\d+) AO pass\(es\) (?P<width>\d+)x(?P<height>\d+) in (?P<total_ms>\d+) ms: "
-    r"AO (?P<ao_ms>\d+) ms(?: \((?P<reused>\d+) of \d+ unchanged: reused\))?, "
+    r"AO (?P<ao_ms>\d+) ms(?: on (?P<threads>\d+) threads?)?"
+    r"(?: \((?P<reused>\d+) of \d+ unchanged: reused\))?, "
     r"pass hand-over (?P<handover_ms>\d+) ms "
     r"\(save (?P<save_ms>\d+), read (?P<read_ms>\d+), write (?P<write_ms>\d+)\)"
     r"(?P<recomposited>, re-composited)?")
@@ -22,13 +23,16 @@ def format_line(count, width, height, total, timings):
     """The line for a helper render of `count` AO passes: `total` and the
     values of `timings` in seconds (save, read, write, ao, kept, and
     "<kind> save" and "<kind> read" for each extra render's passes,
-    layer_passes.py), `timings["cached"]` the passes reused."""
+    layer_passes.py), `timings["cached"]` the passes reused and
+    `timings["threads"]` the AO's threads."""
     milliseconds = {name: timings.get(name, 0.0) * 1000 for name in ("save", "read", "write",
                                                                      "ao")}
     handover_ms = milliseconds["save"] + milliseconds["read"] + milliseconds["write"]
     cached = f" ({timings['cached']} of {count} unchanged: reused)" if "cached" in timings else ""
+    threads = timings.get("threads")
+    on = "" if threads is None else f" on {threads} thread{'' if threads == 1 else 's'}"
     line = (f"{count} AO pass(es) {width}x{height} in {total * 1000:.0f} ms: AO "
-            f"{milliseconds['ao']:.0f} ms{cached}, pass hand-over {handover_ms:.0f} ms "
+            f"{milliseconds['ao']:.0f} ms{on}{cached}, pass hand-over {handover_ms:.0f} ms "
             f"(save {milliseconds['save']:.0f}, read {milliseconds['read']:.0f}, write "
             f"{milliseconds['write']:.0f})")
     if "kept" in timings:
@@ -44,8 +48,9 @@ def parse(text):
     """The figures of the timing line found in `text` (a log line, with or
     without the "HBAO: " prefix), or None: passes, width, height and the
     milliseconds as ints (total_ms, ao_ms, handover_ms, save_ms, read_ms,
-    write_ms), reused (passes whose AO was reused, 0 if none), recomposited
-    (bool) and extras_ms ({kind: ms} for the extra renders' passes)."""
+    write_ms), threads (the AO's, 0 where the line has none), reused (passes
+    whose AO was reused, 0 if none), recomposited (bool) and extras_ms
+    ({kind: ms} for the extra renders' passes)."""
     match = _LINE.search(text)
     if match is None:
         return None

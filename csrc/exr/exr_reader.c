@@ -1,4 +1,7 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
+#ifdef __linux__
+#define _GNU_SOURCE /* hbao_cpus.h: sched_getaffinity */
+#endif
 #include "exr_reader.h"
 
 #include <limits.h>
@@ -12,6 +15,7 @@
 
 #include "exr_stream.h"
 #include "hbao.h"
+#include "hbao_cpus.h"
 
 /* OpenEXRCore reports details (which attribute is bad, which chunk is
  * corrupt) through a callback rather than the result code. The callback runs
@@ -380,9 +384,8 @@ fail:
     return status;
 }
 
-int exr_online_cores(void) {
-    const long cores = sysconf(_SC_NPROCESSORS_ONLN);
-    return cores < 1 ? 1 : cores > INT_MAX ? INT_MAX : (int)cores;
+int exr_usable_cores(void) {
+    return hbao_usable_cpus();
 }
 
 int exr_input_find_channel(const exr_input *input, const char *name) {

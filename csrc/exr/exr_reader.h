@@ -73,9 +73,9 @@ int exr_input_open(exr_input *input, const char *path, tool_error *error);
 int exr_input_read(exr_input *input, const exr_channel_request *requests, int count,
                    tool_error *error);
 
-/** The cores online (at least 1): the threads a caller reads and computes
- *  with when nobody asked for a number. */
-int exr_online_cores(void);
+/** The cores this process may run on (at least 1; hbao_cpus.h): the threads
+ *  a caller reads and computes with when nobody asked for a number. */
+int exr_usable_cores(void);
 
 /** Index of the channel called `name`, or -1. */
 int exr_input_find_channel(const exr_input *input, const char *name);

@@ -116,7 +116,7 @@ void hbao_exr_size(const hbao_exr_file *file, int32_t *width, int32_t *height) {
 void hbao_exr_set_threads(hbao_exr_file *file, int32_t threads) {
     if (file == NULL) return;
     /* exr_input_read caps it at EXR_MAX_READ_THREADS and at the rows */
-    file->input.threads = threads > 0 ? threads : exr_online_cores();
+    file->input.threads = threads > 0 ? threads : exr_usable_cores();
 }
 
 int32_t hbao_exr_channel_count(const hbao_exr_file *file) {

@@ -149,8 +149,9 @@ typedef struct hbao_params {
     /** Applied last: ao = ao^strength. 0 = no AO, 1 = as computed, larger =
      *  darker. Clamped to [0, 16]. */
     float strength;
-    /** Worker threads; 0 (or less) = one per available core. Clamped to at
-     *  most 256. */
+    /** Worker threads; 0 (or less) = one per core this process may run on
+     *  (its CPU affinity, which taskset or a container's cpuset narrow).
+     *  Clamped to at most 256. */
     int32_t threads;
     /** Depths at or beyond this are background. Must be > 0. */
     float background_depth;

@@ -230,6 +230,8 @@ void hbao_parallel_rows(int threads, int rows, hbao_row_job job, void *context);
  * buffer is kept for the next call (hbao_release_memory frees them). */
 void *hbao_scratch_take(size_t bytes);
 void hbao_scratch_give(void *memory);
+/* The threads "one per core" gives (threads = 0): the CPUs this process may
+ * run on (hbao_cpus.h), at most HBAO_MAX_THREADS. */
 int hbao_available_cores(void);
 
 /* compute.c: the pipeline's settings from params (resolved within their

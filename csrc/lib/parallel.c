@@ -2,10 +2,13 @@
 /* Rows handed out to worker threads from a shared counter. Which thread
  * computes a row never changes the row's values, so results are identical
  * for any number of threads. */
+#ifdef __linux__
+#define _GNU_SOURCE /* hbao_cpus.h: sched_getaffinity */
+#endif
 #include <pthread.h>
 #include <stdatomic.h>
-#include <unistd.h>
 
+#include "hbao_cpus.h"
 #include "internal_hbao.h"
 
 /* Rows taken per grab: enough to keep the counter off the hot path, few
@@ -32,9 +35,8 @@ static void *drain_rows(void *argument) {
 }
 
 int hbao_available_cores(void) {
-    const long cores = sysconf(_SC_NPROCESSORS_ONLN);
-    if (cores < 1) return 1;
-    return cores > HBAO_MAX_THREADS ? HBAO_MAX_THREADS : (int)cores;
+    const int cores = hbao_usable_cpus();
+    return cores > HBAO_MAX_THREADS ? HBAO_MAX_THREADS : cores;
 }
 
 void hbao_parallel_rows(int threads, int rows, hbao_row_job job, void *context) {

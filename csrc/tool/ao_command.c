@@ -309,7 +309,7 @@ int ao_compute_input(const cli_options *options, exr_input *input, ao_buffers *b
         if (status != TOOL_EXIT_SUCCESS) return status;
     }
     /* The passes are decoded with as many threads as the AO is computed. */
-    input->threads = options->params.threads > 0 ? options->params.threads : exr_online_cores();
+    input->threads = options->params.threads > 0 ? options->params.threads : exr_usable_cores();
     status = read_passes(input, &passes, use_normals,
                          options->back_layer != NULL ? &back_passes : NULL, buffers, error);
     if (status != TOOL_EXIT_SUCCESS) return status;

@@ -236,7 +236,7 @@ int sequence_command(const cli_options *options, tool_error *error) {
     /* Frames at once share the cores: each frame's computation gets its
      * part, unless --threads says otherwise. */
     if (shared.params.threads == 0 && jobs > 1) {
-        shared.params.threads = exr_online_cores() / jobs;
+        shared.params.threads = exr_usable_cores() / jobs;
         if (shared.params.threads < 1) shared.params.threads = 1;
     }
     run.options = &shared;

@@ -40,7 +40,8 @@ rendering: sync, compositing_off, delete_helper, delete_extra_renders, rename_he
 pick_internal_engine, render_the_helper, rename_node, second_scene_shares_the_tree,
 group_last_node (the last HBAO node moved into a node group of the artist's),
 layer_not_rendered, mute_render_layers, switch_to_workbench],
-layer_name (the first view layer's), single_layer (Render Single Layer on), user_handlers (a
+render_threads ({frame: the Performance panel's threads, 0 for Auto}), layer_name (the first
+view layer's), single_layer (Render Single Layer on), user_handlers (a
 pipeline's own render and frame change handlers, which print USER HANDLERS
 {json}: the scenes each list's handler saw, in order; render_stats leaves out
 repeats of the scene before). Prints OUTPUT SETTINGS {json} (the main output's settings after
@@ -378,6 +379,10 @@ for frame in spec.get("frames", [1]):
         for suffix, description in blender_scenes.view_camera_descriptions(scene).items():
             with open(os.path.join(out_dir, f"camera_{frame:04d}{suffix}.json"), "w") as stream:
                 json.dump(description, stream)
+    threads = spec.get("render_threads", {}).get(str(frame))
+    if threads is not None:  # the Performance panel's threads: 0 Auto, else Fixed
+        scene.render.threads_mode = "FIXED" if threads else "AUTO"
+        scene.render.threads = max(threads, 1)
     # Still renders do not replace '#' in the path: name the frame here.
     scene.render.filepath = os.path.join(out_dir, f"frame_{frame:04d}")
     if render_scene_name is None:

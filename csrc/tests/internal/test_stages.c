@@ -5,6 +5,10 @@
  * upsample's weights, the blur's and the upsample's formulas, the normals,
  * the settings hbao_compute derives). Linked with the library's own objects
  * (CMakeLists.txt, hbao_add_internal_executable). */
+#ifdef __linux__
+#define _GNU_SOURCE /* sched_setaffinity */
+#include <sched.h>
+#endif
 #include <stdint.h>
 
 #include "internal_finish.h"
@@ -650,6 +654,34 @@ TEST_CASE(given_normals_face_the_viewer_along_its_ray) {
     }
 }
 
+/* threads = 0 is one thread per CPU the process may run on: with its
+ * affinity narrowed to one CPU (as taskset, a container's cpuset or a farm
+ * scheduler narrows it), one thread, not one per CPU online (on this
+ * project's 2-core machines, 2). */
+TEST_CASE(default_threads_follow_the_cpus_the_process_may_use) {
+#ifdef __linux__
+    cpu_set_t allowed;
+    CHECK(sched_getaffinity(0, sizeof allowed, &allowed) == 0);
+    hbao_params params = HBAO_PARAMS_DEFAULT_INITIALIZER;
+    params.threads = 0;
+    hbao_settings all;
+    CHECK_RESULT(hbao_settings_make(&params, &all), HBAO_SUCCESS);
+    CHECK(all.threads ==
+          (CPU_COUNT(&allowed) < HBAO_MAX_THREADS ? CPU_COUNT(&allowed) : HBAO_MAX_THREADS));
+    int first = 0;
+    while (!CPU_ISSET(first, &allowed)) first++;
+    cpu_set_t one;
+    CPU_ZERO(&one);
+    CPU_SET(first, &one);
+    CHECK(sched_setaffinity(0, sizeof one, &one) == 0);
+    hbao_settings narrowed;
+    const hbao_result result = hbao_settings_make(&params, &narrowed);
+    CHECK(sched_setaffinity(0, sizeof allowed, &allowed) == 0);
+    CHECK_RESULT(result, HBAO_SUCCESS);
+    CHECK(narrowed.threads == 1);
+#endif
+}
+
 TEST_MAIN(TEST_ENTRY(blur_copies_agree_on_background_at_every_sharpness),
           TEST_ENTRY(blur_follows_its_formula), TEST_ENTRY(half_resolution_blur_reaches_as_far),
           TEST_ENTRY(upsample_weights_are_bilinear_on_a_flat_depth),
@@ -657,4 +689,5 @@ TEST_MAIN(TEST_ENTRY(blur_copies_agree_on_background_at_every_sharpness),
           TEST_ENTRY(face_normals_keep_to_their_side_of_a_step),
           TEST_ENTRY(depth_precision_is_told_from_every_row),
           TEST_ENTRY(given_normals_too_short_give_the_face_normal),
-          TEST_ENTRY(given_normals_face_the_viewer_along_its_ray))
+          TEST_ENTRY(given_normals_face_the_viewer_along_its_ray),
+          TEST_ENTRY(default_threads_follow_the_cpus_the_process_may_use))
