@@ -53,13 +53,20 @@ def model_matrix(matrix_world):
     return matrix
 
 
+def full_size(render):
+    """(width, height) in pixels of the whole image `render` (a scene's
+    RenderSettings) renders: resolution times percentage in integers, as
+    Blender's BKE_render_resolution (in floats, 200 at 58 % gave 115, not
+    116: a cropped border's camera was then worked out on the wrong size)."""
+    percentage = render.resolution_percentage
+    return render.resolution_x * percentage // 100, render.resolution_y * percentage // 100
+
+
 def render_size(scene):
-    """(width, height) in pixels of the scene's Render Result: resolution times
-    percentage, cropped to the border when the border is cropped."""
+    """(width, height) in pixels of the scene's Render Result: full_size(),
+    cropped to the border when the border is cropped."""
     render = scene.render
-    scale = render.resolution_percentage / 100.0
-    width = int(render.resolution_x * scale)
-    height = int(render.resolution_y * scale)
+    width, height = full_size(render)
     if render.use_border and render.use_crop_to_border:
         x0, x1, y0, y1 = _border_pixels(render, width, height)
         return x1 - x0, y1 - y0
@@ -113,6 +120,5 @@ def camera_for_render_result(scene, camera_object=None, description=None):
     render = scene.render
     if not (render.use_border and render.use_crop_to_border):
         return description
-    scale = render.resolution_percentage / 100.0
-    width, height = int(render.resolution_x * scale), int(render.resolution_y * scale)
+    width, height = full_size(render)
     return crop_camera(description, width, height, _border_pixels(render, width, height))

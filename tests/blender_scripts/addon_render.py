@@ -18,9 +18,9 @@ Camera_C, Camera_R; writes camera_<NNNN><view's file suffix>.json too), stereo_o
 (Stereoscopy turned off from that frame on), output_views_format (the main output's views
 format), orthographic, camera_scale [x, y, z] (the camera object's scale), widen_camera
 (factor), dump_back_faces (writes <out>/back_<NNNN>.npy: the back faces render's Depth, top row
-first), border
-[min_x, max_x, min_y, max_y] (a border render cropped to it; with crop false, not
-cropped), animate_camera (the camera turns and moves over frames 1-5),
+first), border [min_x, max_x, min_y, max_y] (a border render cropped to it; with crop false, not
+cropped), percentage (the resolution percentage), animate_camera (the camera turns and moves over
+frames 1-5),
 time_remap [old, new] (Time Remapping), sequencer ("override": a scene "Edit" shows the
 scene in a Video Sequencer strip through a camera override, "Strip Camera"; and in a second strip
 through the scene's camera, "two_cameras": at the same frames, "other_frame": showing its frame 11
@@ -101,6 +101,8 @@ if spec.get("stereo"):  # Stereoscopy on: a left and a right view, each written 
             eye.location.x += step
             eye.rotation_euler.z += step * 0.2
             scene.collection.objects.link(eye)
+if spec.get("percentage"):  # the render's resolution percentage
+    scene.render.resolution_percentage = spec["percentage"]
 if spec.get("border"):
     render_settings = scene.render
     (render_settings.border_min_x, render_settings.border_max_x,
