@@ -16,7 +16,8 @@ AO pass), stereo (true: Stereo 3D; "one_view": with its right view off; "custom_
 Multi-View with a view "center" besides left and right, each through its own camera Camera_L,
 Camera_C, Camera_R; writes camera_<NNNN><view's file suffix>.json too), stereo_off_from_frame
 (Stereoscopy turned off from that frame on), output_views_format (the main output's views
-format), orthographic, camera_scale [x, y, z] (the camera object's scale), widen_camera
+format), orthographic, camera_scale [x, y, z] (the camera object's scale), camera_rig [x, y, z] (the
+camera parented to an empty of that scale, where it was), widen_camera
 (factor), dump_back_faces (writes <out>/back_<NNNN>.npy: the back faces render's Depth, top row
 first), border [min_x, max_x, min_y, max_y] (a border render cropped to it; with crop false, not
 cropped), percentage (the resolution percentage), animate_camera (the camera turns and moves over
@@ -77,6 +78,12 @@ if spec.get("ao_reference"):
     blender_scenes.configure_ao_reference(scene, spec["ao_reference"])
 if spec.get("orthographic"):
     blender_scenes.make_orthographic(scene)
+if spec.get("camera_rig"):  # the camera inside an empty of this scale, where it was
+    rig = bpy.data.objects.new("Rig", None)
+    scene.collection.objects.link(rig)
+    rig.scale = spec["camera_rig"]
+    scene.camera.parent = rig  # its rotation kept: sheared unless the scale is even
+    scene.camera.location = [a / b for a, b in zip(scene.camera.location, rig.scale)]
 if spec.get("camera_scale"):  # the camera object scaled (Blender renders as unscaled)
     scene.camera.scale = spec["camera_scale"]
 if spec.get("widen_camera"):  # a view `widen_camera` times as wide about its centre
@@ -375,8 +382,12 @@ for frame in spec.get("frames", [1]):
     if spec.get("stereo_off_from_frame", frame + 1) <= frame:
         scene.render.use_multiview = False
     scene.frame_set(frame)
+    try:
+        description = blender_scenes.camera_description(scene)
+    except ValueError as error:  # a camera the add-on cannot model (it says why)
+        description = {"error": str(error)}
     with open(os.path.join(out_dir, f"camera_{frame:04d}.json"), "w") as stream:
-        json.dump(blender_scenes.camera_description(scene), stream)
+        json.dump(description, stream)
     if spec.get("stereo"):
         for suffix, description in blender_scenes.view_camera_descriptions(scene).items():
             with open(os.path.join(out_dir, f"camera_{frame:04d}{suffix}.json"), "w") as stream:
