@@ -289,3 +289,11 @@ def set_image_format(image_format, file_format):
         image_format.media_type = ("MULTI_LAYER_IMAGE" if file_format == "OPEN_EXR_MULTILAYER"
                                    else "IMAGE")
     image_format.file_format = file_format
+
+
+def motion_blur_position(scene):
+    """START, CENTER or END: where Cycles' shutter lies about the frame
+    (RenderSettings from 4.2, Cycles' own settings before)."""
+    holder = scene.render if hasattr(scene.render, "motion_blur_position") else \
+        getattr(scene, "cycles", None)
+    return getattr(holder, "motion_blur_position", "CENTER")

@@ -20,12 +20,14 @@ format), orthographic, camera_scale [x, y, z] (the camera object's scale), camer
 camera parented to an empty of that scale, where it was), widen_camera
 (factor), dump_back_faces (writes <out>/back_<NNNN>.npy: the back faces render's Depth, top row
 first), border [min_x, max_x, min_y, max_y] (a border render cropped to it; with crop false, not
-cropped), percentage (the resolution percentage), animate_camera (the camera turns and moves over
-frames 1-5),
-time_remap [old, new] (Time Remapping), sequencer ("override": a scene "Edit" shows the
-scene in a Video Sequencer strip through a camera override, "Strip Camera"; and in a second strip
-through the scene's camera, "two_cameras": at the same frames, "other_frame": showing its frame 11
-at frame 1, "muted_meta": inside a muted meta strip; "nested": Edit shown by a strip of scene
+cropped), percentage (the resolution percentage), subframe (each frame rendered at that
+subframe), motion_blur ("START", "CENTER" or "END": Cycles' camera motion blur, shutter 1 frame;
+the camera written is the one at the shutter's middle), animate_camera (the camera turns and
+moves over frames 1-5), time_remap [old, new] (Time Remapping), sequencer ("override": a scene
+"Edit" shows the scene in a Video Sequencer strip through a camera override, "Strip Camera";
+and in a second strip through the scene's camera, "two_cameras": at the same frames,
+"other_frame": showing its frame 11 at frame 1, "muted_meta": inside a muted meta strip;
+"nested": Edit shown by a strip of scene
 "Outer" whose input is Edit's sequencer; "covered": Shot replaces a strip of the scene below it;
 each frame renders Edit (Outer) first, keeping the nodes' file as strip_nodes_<NNNN>.exr, then the
 scene through Strip Camera; "failed_movie": an animation render of Edit to a movie that cannot
@@ -49,6 +51,7 @@ repeats of the scene before). Prints OUTPUT SETTINGS {json} (the main output's s
 the renders), STATUS {json} (each node's status line) and RENDERED.
 """
 import json
+import math
 import os
 import sys
 import threading
@@ -108,6 +111,13 @@ if spec.get("stereo"):  # Stereoscopy on: a left and a right view, each written 
             eye.location.x += step
             eye.rotation_euler.z += step * 0.2
             scene.collection.objects.link(eye)
+if spec.get("motion_blur"):  # Cycles' camera motion blur, this shutter Position, 1 frame long
+    scene.render.use_motion_blur = True
+    scene.render.motion_blur_shutter = 1.0
+    if hasattr(scene.render, "motion_blur_position"):  # 4.2+
+        scene.render.motion_blur_position = spec["motion_blur"]
+    else:
+        scene.cycles.motion_blur_position = spec["motion_blur"]
 if spec.get("percentage"):  # the render's resolution percentage
     scene.render.resolution_percentage = spec["percentage"]
 if spec.get("border"):
@@ -381,11 +391,16 @@ for frame in spec.get("frames", [1]):
         scene.camera = strip_camera  # then the scene itself through the strip's camera
     if spec.get("stereo_off_from_frame", frame + 1) <= frame:
         scene.render.use_multiview = False
-    scene.frame_set(frame)
+    # The camera written is the one at the time the passes show: the
+    # subframe rendered, or the middle of a motion blur shutter of 1 frame.
+    shutter_middle = {"START": 0.5, "END": -0.5}.get(spec.get("motion_blur"), 0.0)
+    camera_time = frame + spec.get("subframe", 0.0) + shutter_middle
+    scene.frame_set(math.floor(camera_time), subframe=camera_time - math.floor(camera_time))
     try:
         description = blender_scenes.camera_description(scene)
     except ValueError as error:  # a camera the add-on cannot model (it says why)
         description = {"error": str(error)}
+    scene.frame_set(frame, subframe=spec.get("subframe", 0.0))  # the time rendered
     with open(os.path.join(out_dir, f"camera_{frame:04d}.json"), "w") as stream:
         json.dump(description, stream)
     if spec.get("stereo"):
