@@ -1127,7 +1127,7 @@ def test_scratch_files_are_removed_beside_the_render_two_at_most(run_in_blender,
 
 def test_scratch_file_stays_until_the_ao_is_computed(run_in_blender, tmp_path, monkeypatch):
     """The removal of a frame's scratch file, the kernel freeing its pages,
-    waits until the frame's AO is computed (handover.removals_after), so
+    waits until the frame's AO is computed (scratch_files.removals_after), so
     that it does not compete with the AO's threads; then it goes. Two frames,
     two nodes each: at every AO the frame's own file is in the folder, and
     the folder is empty after Blender ends."""
@@ -1145,7 +1145,7 @@ def test_scratch_file_stays_until_the_ao_is_computed(run_in_blender, tmp_path, m
     seen = json.loads(line[len("SCRATCH AT AO "):])
     assert len(seen) == 4, seen
     # This process's scratch files are numbered in the order saved
-    # (handover._scratch_path): frame 1's ends in -0.exr, frame 2's in -1.exr.
+    # (scratch_files.path_in): frame 1's ends in -0.exr, frame 2's in -1.exr.
     for at_ao, number in zip(seen, (0, 0, 1, 1)):
         assert any(name.endswith(f"-{number}.exr") for name in at_ao), seen
     assert list(scratch.iterdir()) == []

@@ -5,6 +5,7 @@ completes (exit 0, the image written), the console says why AO is missing
 (the same text reaches the render window's report), no temporary file is
 left, and the user's output settings are as they were."""
 import json
+import os
 import subprocess
 
 import numpy as np
@@ -167,6 +168,28 @@ def test_full_disk_renders_without_ao_leaves_nothing_and_restores_settings(
     assert f"cannot read back the passes saved in {full_disk}" in log, log[-3000:]
     assert "is it full? HBAO_TEMP_DIR names another folder" in log
     assert list(full_disk.iterdir()) == []
+
+
+def test_passes_that_do_not_fit_in_the_first_scratch_folder_go_to_the_next(
+        run_in_blender, tmp_path, native, full_disk):
+    """HBAO_TEMP_DIR lists folders to try in turn (by default /dev/shm, then
+    the system's temporary folder: a container's /dev/shm is 64 MB, less
+    than a 1080p render's Combined, Depth and Normal, and every frame lost
+    its AO there). The Render Result does not fit in the first: it is
+    saved in the second, the AO is the library's, the log says where, and
+    neither folder keeps a file."""
+    second = tmp_path / "second"
+    second.mkdir()
+    node = {"radius": 1.0, "blur_size": 0}
+    out, log = render(run_in_blender, tmp_path, {"nodes": [node]},
+                      env={"HBAO_TEMP_DIR": f"{full_disk}{os.pathsep}{second}"})
+    assert "without AO" not in log, log[-3000:]
+    assert f"cannot read back the passes saved in {full_disk}" in log
+    assert f"saving them in {second} instead" in log
+    expected = library_ao(native, out, 1, node_params(**node))
+    assert expected.min() < 0.9
+    assert np.abs(node_outputs(out, 1)["ao"] - expected).max() <= EXACT
+    assert list(full_disk.iterdir()) == [] and list(second.iterdir()) == []
 
 
 def test_scratch_folder_that_cannot_be_written_says_which_and_how(run_in_blender, tmp_path):

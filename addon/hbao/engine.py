@@ -12,7 +12,7 @@ import numpy as np
 
 from . import camera as camera_model
 from . import (ao_cache, exr_passes, handover, job_inputs, layer_passes, native, recomposite,
-               render_record, timing_line)
+               render_record, scratch_files, timing_line)
 from .helper_lookup import ENGINE_IDNAME, is_helper, pass_names_for_helper
 from .helper_scene import rendered_for_a_scene, scene_for_render
 from .planning import node_names, plan, tell_all_nodes
@@ -158,8 +158,8 @@ def render_helper(engine, depsgraph):
     width, height = result.resolution_x, result.resolution_y
     try:
         try:
-            # The scratch files go once the AO is computed (handover.removals_after).
-            with handover.removals_after():
+            # The scratch files go once the AO is computed (scratch_files.removals_after).
+            with scratch_files.removals_after():
                 results = compute_passes(engine, depsgraph, width, height, request)
         except (native.HBAOLibraryError, exr_passes.EXRLibraryError) as error:
             results = {}

@@ -33,7 +33,7 @@ def helper_scenes():
 
 
 if fault == "unreadable_save":
-    # The add-on's own naming (handover._scratch_path): the test checks the
+    # The add-on's own naming (scratch_files.path_in): the test checks the
     # link is gone afterwards, so a changed name fails it rather than passing.
     link = os.path.join(os.environ["HBAO_TEMP_DIR"],
                         f"hbao-passes-{os.getpid()}-{threading.get_ident()}-0.exr")

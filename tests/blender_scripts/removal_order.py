@@ -3,7 +3,7 @@
 add-on's AO computation watched. Each time a node's AO has been computed,
 the names in the scratch folder (HBAO_TEMP_DIR) are noted: the frame's
 scratch file must still be there, its removal left until the AO is done
-(handover.removals_after). Prints them as 'SCRATCH AT AO <json>'.
+(scratch_files.removals_after). Prints them as 'SCRATCH AT AO <json>'.
 
   blender -b --addons hbao --python removal_order.py -- '<json spec>' <out dir>
 """

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """Run in every Blender of the matrix by tests/test_addon.py: the hand-over
-removes its scratch files in threads of their own (handover._remove_later),
+removes its scratch files in threads of their own (scratch_files.remove_later),
 and before each save waits for every removal but the latest, so that at most
 two scratch files exist at a time. Here the removals are held back until
 released, to see who waits for whom; where no thread can be started, the
@@ -20,11 +20,11 @@ import threading
 import time
 
 import bpy
-from hbao import handover
+from hbao import handover, scratch_files
 
 folder = sys.argv[sys.argv.index("--") + 1]
 release = threading.Event()
-remove = handover._remove
+remove = scratch_files._remove
 
 
 def held_back(path):
@@ -34,18 +34,18 @@ def held_back(path):
     remove(path)
 
 
-handover._remove = held_back  # the add-on's own function, not Blender's
+scratch_files._remove = held_back  # the add-on's own function, not Blender's
 paths = []
 for number in range(3):
     path = os.path.join(folder, f"hbao-passes-test-{number}.exr")
     with open(path, "wb") as scratch:
         scratch.write(b"\0" * 4096)
-    handover._remove_later(path)
+    scratch_files.remove_later(path)
     paths.append(path)
 assert all(os.path.exists(path) for path in paths)
 
 # The next save waits for the first two removals, not for the third.
-waiter = threading.Thread(target=handover._wait_for_older_removals)
+waiter = threading.Thread(target=scratch_files.wait_for_older_removals)
 waiter.start()
 time.sleep(0.3)
 assert waiter.is_alive(), "the save did not wait for the older removals"
@@ -56,7 +56,7 @@ assert not os.path.exists(paths[0]) and not os.path.exists(paths[1]), os.listdir
 
 # A save right after waits for nothing: the third removal is the latest.
 start = time.perf_counter()
-handover._wait_for_older_removals()
+scratch_files.wait_for_older_removals()
 assert time.perf_counter() - start < 0.5
 assert os.path.exists(paths[2]), "the latest removal should still be pending"
 
@@ -73,7 +73,7 @@ path = os.path.join(folder, "hbao-passes-test-3.exr")
 open(path, "wb").close()
 threading.Thread.start = refuse
 try:
-    handover._remove_later(path)
+    scratch_files.remove_later(path)
 finally:
     threading.Thread.start = start_thread
 assert not os.path.exists(path), "the file was not removed without a thread"
@@ -82,16 +82,16 @@ assert not os.path.exists(path), "the file was not removed without a thread"
 # the block ends, however it ends: here by an error.
 path = os.path.join(folder, "hbao-passes-test-4.exr")
 open(path, "wb").close()
-started = len(handover._removals)
+started = len(scratch_files._removals)
 try:
-    with handover.removals_after():
-        handover._remove_later(path)
-        assert len(handover._removals) == started, "a removal started within the block"
+    with scratch_files.removals_after():
+        scratch_files.remove_later(path)
+        assert len(scratch_files._removals) == started, "a removal started within the block"
         raise KeyError("the AO failed")
 except KeyError:
     pass
-assert len(handover._removals) == started + 1, "the block's end started no removal"
-handover._removals[-1].join(30)
+assert len(scratch_files._removals) == started + 1, "the block's end started no removal"
+scratch_files._removals[-1].join(30)
 assert not os.path.exists(path), "the file was not removed after the block"
 
 # A block within a block leaves its files to the outer one, and another
@@ -99,28 +99,28 @@ assert not os.path.exists(path), "the file was not removed after the block"
 inner_path, other_path = (os.path.join(folder, f"hbao-passes-test-{n}.exr") for n in (5, 6))
 for made in (inner_path, other_path):
     open(made, "wb").close()
-with handover.removals_after():
-    with handover.removals_after():
-        handover._remove_later(inner_path)
-    assert len(handover._removals) == started + 1, "the inner block's end started a removal"
-    other = threading.Thread(target=handover._remove_later, args=(other_path,))
+with scratch_files.removals_after():
+    with scratch_files.removals_after():
+        scratch_files.remove_later(inner_path)
+    assert len(scratch_files._removals) == started + 1, "the inner block's end started a removal"
+    other = threading.Thread(target=scratch_files.remove_later, args=(other_path,))
     other.start()
     other.join(30)
-    assert len(handover._removals) == started + 2, "another thread's removal was held back"
-    handover._removals[-1].join(30)
+    assert len(scratch_files._removals) == started + 2, "another thread's removal was held back"
+    scratch_files._removals[-1].join(30)
     assert not os.path.exists(other_path)
     assert os.path.exists(inner_path)
-handover._removals[-1].join(30)
+scratch_files._removals[-1].join(30)
 assert not os.path.exists(inner_path), "the file was not removed after the outer block"
 
 
 # Files left by Blenders that ended (killed, or os._exit before the removal
 # thread was done) go at a process's first hand-over: only files older than
-# handover.STALE_AGE_S, of processes that have ended.
-os.environ[handover.SCRATCH_FOLDER_VARIABLE] = folder
+# scratch_files.STALE_AGE_S, of processes that have ended.
+os.environ[scratch_files.SCRATCH_FOLDER_VARIABLE] = folder
 ended = subprocess.Popen(["true"])
 ended.wait()
-old = time.time() - handover.STALE_AGE_S - 60
+old = time.time() - scratch_files.STALE_AGE_S - 60
 names = {"stale": (f"hbao-passes-{ended.pid}-1-7.exr", old),
          "stale, before session 19's numbers": (f"hbao-passes-{ended.pid}-1.exr", old),
          "fresh": (f"hbao-passes-{ended.pid}-1-8.exr", None),
@@ -132,7 +132,7 @@ for name, mtime in names.values():
     open(path, "wb").close()
     if mtime is not None:
         os.utime(path, (mtime, mtime))
-removed = sorted(os.path.basename(path) for path in handover.remove_stale_scratch_files())
+removed = sorted(os.path.basename(path) for path in scratch_files.remove_stale_scratch_files())
 expected = sorted(names[kind][0] for kind in ("stale", "stale, before session 19's numbers"))
 assert removed == expected, (removed, expected)
 for kind in ("fresh", "this process's", "not a scratch file", "no process id"):
@@ -147,7 +147,7 @@ stale = os.path.join(folder, names["stale"][0])
 open(stale, "wb").close()
 os.utime(stale, (old, old))
 cleanup_release = threading.Event()
-remove_stale = handover.remove_stale_scratch_files
+remove_stale = scratch_files.remove_stale_scratch_files
 
 
 def held_cleanup():
@@ -155,8 +155,8 @@ def held_cleanup():
     return remove_stale()
 
 
-handover.remove_stale_scratch_files = held_cleanup
-handover._stale_files_checked = False
+scratch_files.remove_stale_scratch_files = held_cleanup
+scratch_files._stale_files_checked = False
 try:
     start = time.perf_counter()
     try:
@@ -168,7 +168,7 @@ try:
     assert os.path.exists(stale), "the stale file went before its removal was released"
 finally:
     cleanup_release.set()
-for thread in list(handover._removals):
+for thread in list(scratch_files._removals):
     thread.join(30)
 assert not os.path.exists(stale), "the first hand-over did not remove the stale file"
 print("REMOVAL OK", flush=True)

@@ -1,0 +1,196 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Where the hand-over's scratch files go (handover.py saves the Render
+Result there and reads it back) and how they are removed: in the
+background, after the AO; those of Blenders that have ended, at the first
+hand-over. bpy-free; their names are scratch_names.py's."""
+import contextlib
+import itertools
+import os
+import tempfile
+import threading
+import time
+
+from . import scratch_names
+from .report import log
+
+# Environment variable naming the folder for the scratch EXR instead of the
+# default; several, separated by os.pathsep (':'), are tried in turn.
+SCRATCH_FOLDER_VARIABLE = "HBAO_TEMP_DIR"
+# Memory-backed where there is one: the file lives for milliseconds.
+MEMORY_FOLDER = "/dev/shm"
+
+
+def folders():
+    """The folders to save the scratch file in, in the order to try them:
+    HBAO_TEMP_DIR's; by default the memory-backed folder, then the system's
+    temporary folder, for a Render Result that does not fit in memory (a
+    container's /dev/shm is 64 MB by default, less than a 1080p render's
+    Combined, Depth and Normal)."""
+    configured = os.environ.get(SCRATCH_FOLDER_VARIABLE)
+    if configured:
+        return [folder for folder in configured.split(os.pathsep) if folder] or [configured]
+    memory = [MEMORY_FOLDER] if os.path.isdir(MEMORY_FOLDER) and \
+        os.access(MEMORY_FOLDER, os.W_OK) else []
+    return memory + [tempfile.gettempdir()]
+
+
+# Each scratch file its own number: the last one may still be being removed
+# (remove_later) when the next is saved.
+_scratch_numbers = itertools.count()
+
+
+def path_in(folder):
+    """A new scratch file's path in `folder`."""
+    return os.path.join(folder, scratch_names.name(
+        os.getpid(), threading.get_ident(), next(_scratch_numbers)))
+
+
+def _process_ended(pid):
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return True
+    except (OSError, OverflowError):  # another user's (alive), or no process id at all
+        return False
+    return False
+
+
+# A scratch file lives for a second at most; one this old is left over.
+STALE_AGE_S = 600
+
+
+def remove_stale_scratch_files():
+    """Remove the scratch files of Blender processes that have ended: one
+    killed while it handed passes over, or a bpy script that ended by
+    os._exit before its removal thread was done. Only files older than
+    STALE_AGE_S: a process of another PID namespace that shares the folder
+    looks ended from here, but its files are never that old. A file of a
+    running process, or one this user may not remove, is left alone.
+    Returns the paths removed."""
+    removed = []
+    for folder in folders():
+        try:
+            names = os.listdir(folder)
+        except OSError:
+            continue
+        now = time.time()
+        for name in names:
+            process = scratch_names.process_of(name)
+            if process is None or not _process_ended(process):
+                continue
+            path = os.path.join(folder, name)
+            try:
+                if now - os.stat(path).st_mtime < STALE_AGE_S:
+                    continue
+                os.remove(path)
+                removed.append(path)
+            except OSError:
+                pass
+    return removed
+
+
+_stale_files_checked = False
+
+
+def remove_stale_once():
+    """At a process's first hand-over: remove_stale_scratch_files() in the
+    background (that hand-over need not wait for it)."""
+    global _stale_files_checked
+    if not _stale_files_checked:
+        _stale_files_checked = True
+        _in_background(_remove_stale_files)
+
+
+def _remove(path):
+    try:
+        os.remove(path)
+    except FileNotFoundError:
+        pass
+    except OSError as error:
+        log(f"could not remove the scratch file {path}: {error}")
+
+
+# The removals started and not yet waited for.
+_removals = []
+_removals_lock = threading.Lock()
+
+
+def _in_background(removal, *args):
+    """removal(*args) in a thread of its own, counted among the removals
+    that the next save waits for. Freeing a large file's pages is the
+    kernel's work, and long: a 1920x1080 render with 81 channels, 672 MB,
+    took 115 ms on tmpfs (docs/speed.md, session 19), which the render need
+    not wait for (nor the AO share the cores with: removals_after). Not a
+    daemon thread: Python waits for it before the process ends, so no
+    scratch file outlives Blender (a process that ends by os._exit skips
+    that wait: scripts/bpy_blender.py waits first). Where no thread can be
+    started (the process has run out of them), it runs at once, and the
+    render waits for it."""
+    thread = threading.Thread(target=removal, args=args, name="hbao-scratch-removal")
+    try:
+        thread.start()
+    except RuntimeError as error:
+        log(f"removing scratch files in the render's own thread: {error}")
+        removal(*args)
+        return
+    with _removals_lock:
+        _removals.append(thread)
+
+
+# The scratch files whose removal waits for the end of a removals_after()
+# block of this thread; None outside one.
+_deferred = threading.local()
+
+
+def remove_later(path):
+    """Remove `path` in the background (_in_background), or at the end of
+    the removals_after() block this thread is in."""
+    waiting = getattr(_deferred, "paths", None)
+    if waiting is not None:
+        waiting.append(path)
+    else:
+        _in_background(_remove, path)
+
+
+@contextlib.contextmanager
+def removals_after():
+    """Within the block, the hand-over's scratch files are removed only when
+    it ends (however it ends), all of them by one removal in the background.
+    The engine computes the AO in such a block: the removal's kernel work
+    then runs beside what Blender does after the AO, not beside the AO's
+    threads, which keep every core busy (docs/speed.md, session 23). A
+    block within a block of the same thread leaves its files to the outer
+    one; other threads' removals are not held back."""
+    outer = getattr(_deferred, "paths", None)
+    _deferred.paths = [] if outer is None else outer
+    try:
+        yield
+    finally:
+        if outer is None:
+            waiting, _deferred.paths = _deferred.paths, None
+            if waiting:
+                _in_background(_remove_all, waiting)
+
+
+def _remove_all(paths):
+    for path in paths:
+        _remove(path)
+
+
+def _remove_stale_files():
+    for stale in remove_stale_scratch_files():
+        log(f"removed {stale}, left by a Blender that has ended")
+
+
+def wait_for_older_removals():
+    """Before the next save: every removal but the latest done, so that
+    besides the files being saved and read, only the latest removal's may
+    still exist (a frame's, up to three with a guard band and back faces:
+    removals_after), however quickly frames follow each other; a frame's
+    second save (a guard band's, a back face layer's) does not wait for the
+    removal before it."""
+    with _removals_lock:
+        older = _removals[:-1]
+        del _removals[:-1]
+    for thread in older:
+        thread.join()
