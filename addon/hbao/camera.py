@@ -23,9 +23,10 @@ def camera_from_blender(scene, camera_object=None):
     to_world = model_matrix(camera_object.matrix_world)
     if shear(to_world) > SHEAR_TOLERANCE:
         raise CameraError(
-            f"camera {camera_object.name!r} is sheared (its parent is scaled unevenly and the "
-            f"camera turned inside it): Blender renders a sheared view, which HBAO does not "
-            f"model. Apply the parent's scale (Object > Apply > Scale) or scale it evenly")
+            f"camera {camera_object.name!r} is sheared (its matrix's axes are not square: a "
+            f"parent scaled unevenly with the camera turned inside it, or a constraint): "
+            f"Blender renders a sheared view, which HBAO does not model. Apply the parent's "
+            f"scale (Object > Apply > Scale) or scale it evenly")
     world_to_camera = to_world.inverted_safe()
     render = scene.render
     return {

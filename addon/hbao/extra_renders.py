@@ -15,7 +15,9 @@ before the helper's: when the helper's engine runs, their Render Results
 hold this frame's passes (docs/blender-integration.md)."""
 import bpy
 
-from . import back_material, compat, guard_geometry, strip_cameras, writes
+from . import back_material, camera_time, compat, guard_camera, guard_geometry, strip_cameras, \
+    writes
+from .camera import CameraError
 from .data_edits import set_if_different
 from .report import log
 
@@ -41,8 +43,6 @@ KINDS = (GUARD, BACK)
 EXTRA_KEY = "hbao_guard_for"
 # ID property on the guard scene: how much wider its camera sees.
 SCALE_KEY = "hbao_guard_scale"
-CAMERA_SETTINGS = ("type", "lens", "sensor_width", "sensor_height", "sensor_fit", "shift_x",
-                   "shift_y", "ortho_scale", "clip_start", "clip_end")
 
 
 def is_extra(scene):
@@ -72,42 +72,6 @@ def node_of(tree, kind):
         if node.bl_idname == "CompositorNodeRLayers" and node.get(kind.node_key):
             return node
     return None
-
-
-# --- the guard band's camera ------------------------------------------------
-
-def copy_camera(main, guard):
-    """The guard camera's settings from the scene camera's, widened. Plain
-    values only: allowed in the render job's thread."""
-    source = main.camera
-    target = guard.camera
-    if source is None or target is None or source.type != "CAMERA":
-        return
-    values = {name: getattr(source.data, name) for name in CAMERA_SETTINGS}
-    widened = guard_geometry.widened_camera(values, guard.get(SCALE_KEY, 1.0))
-    for name in CAMERA_SETTINGS:
-        set_if_different(target.data, name, widened[name])
-    set_if_different(target.data.dof, "use_dof", False)
-    for name in ("pixel_aspect_x", "pixel_aspect_y"):
-        set_if_different(guard.render, name, getattr(main.render, name))
-
-
-def _guard_camera(main, guard):
-    camera = guard.camera
-    if camera is None or camera == main.camera:
-        data = bpy.data.cameras.new(GUARD.prefix + main.name)
-        camera = bpy.data.objects.new(GUARD.prefix + main.name, data)
-
-        def remove():
-            bpy.data.objects.remove(camera)
-            bpy.data.cameras.remove(data)
-        with writes.whole_or_removed(remove):
-            camera.constraints.new("COPY_TRANSFORMS")
-            guard.camera = camera
-    constraint = camera.constraints[0] if camera.constraints else None
-    if constraint is not None and constraint.target != main.camera:
-        constraint.target = main.camera
-    return camera
 
 
 # --- shared -------------------------------------------------------------------
@@ -212,7 +176,7 @@ def _sync_kind(main, tree, nodes, helper, view_layer, kind):
         scale = guard_geometry.guard_scale(wanted_fraction(nodes))
         if scene.get(SCALE_KEY) != scale:
             scene[SCALE_KEY] = scale
-        extra_objects = [_guard_camera(main, scene)]
+        extra_objects = [guard_camera.follow(main, scene, GUARD.prefix + main.name)]
     else:
         if scene.camera != main.camera:
             scene.camera = main.camera
@@ -224,7 +188,7 @@ def _sync_kind(main, tree, nodes, helper, view_layer, kind):
     if view_layer is not None and layers.layer_collection is not None:
         _mirror_exclusions(view_layer.layer_collection, layers.layer_collection)
     if kind is GUARD:
-        copy_camera(main, scene)
+        guard_camera.copy_settings(main, scene, scene.get(SCALE_KEY, 1.0))
     node = node_of(tree, kind)
     if node is None:
         node = tree.nodes.new("CompositorNodeRLayers")
@@ -261,13 +225,20 @@ def sync(main, tree, nodes, helper, view_layer):
 
 
 def _left_out(main):
-    """Why `main`'s render cannot use the extra renders now, or None."""
+    """Why `main`'s render cannot use the extra renders now, or None. They
+    follow the scene camera at the whole frame (Blender renders them there)."""
     if main.render.use_border:
         return "border renders have none"
     if main.render.use_multiview:  # (sync removes their scenes)
         return "stereo and multi-view renders have none"
-    if strip_cameras.override_for(main) is not None:
-        return "a Video Sequencer strip renders the scene through another camera"
+    if camera_time.of(main) != main.frame_current:
+        return ("the passes show the camera at another time than the frame (a subframe, or "
+                "motion blur's shutter Start or End)")
+    try:
+        if strip_cameras.override_for(main) is not None:
+            return "a Video Sequencer strip renders the scene through another camera"
+    except CameraError:  # (two strips, two cameras: the AO is off, and says why)
+        return "Video Sequencer strips render the scene through other cameras"
     return None
 
 
@@ -283,7 +254,7 @@ def record_rendering(main, helper):
             set_if_different(scene.view_layers[0], "use", wanted)
     guard = scene_of(helper, GUARD)
     if guard is not None:
-        copy_camera(main, guard)
+        guard_camera.copy_settings(main, guard, guard.get(SCALE_KEY, 1.0))
 
 
 def for_render(main, helper, kind):

@@ -96,6 +96,7 @@ def _save_and_read(scene, layers, views, threads, folder):
     path = scratch_files.path_in(folder)
     files = view_files.files(path, views)
     timings = {}
+    folder_failed = False
     try:
         start = _clock()
         save_passes(scene, path, views)
@@ -120,9 +121,16 @@ def _save_and_read(scene, layers, views, threads, folder):
                 f"{scratch_files.SCRATCH_FOLDER_VARIABLE} names another folder for them"
             ) from error
         timings["read"] = _clock() - read_start
+    except ScratchFolderError:
+        folder_failed = True
+        raise
     finally:
-        for file in set(files.values()) | {path}:
-            scratch_files.remove_later(file)
+        paths = set(files.values()) | {path}
+        if folder_failed:
+            scratch_files.failed(folder, paths)
+        else:
+            for file in paths:
+                scratch_files.remove_later(file)
     return channels, timings
 
 

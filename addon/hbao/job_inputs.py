@@ -6,7 +6,8 @@ re-compositing with new settings, the passes the last render kept."""
 import contextlib
 import math
 
-from . import ao_cache, compat, exr_passes, handover, layer_passes, strip_cameras, view_cameras
+from . import (ao_cache, camera_time, exr_passes, handover, layer_passes, strip_cameras,
+               view_cameras)
 from . import camera as camera_model
 from .planning import node_names
 from .report import log, post_node_messages
@@ -21,29 +22,15 @@ def _evaluated(obj, depsgraph):
         return obj
 
 
-def camera_time(main):
-    """The time (frame and subframe) whose camera `main`'s passes show: the
-    frame Blender renders, which may be a subframe (frame_set(f, subframe)),
-    and with Cycles' camera motion blur the middle of the shutter, whose
-    samples' depths average about that camera's (the shutter opens at the
-    frame with Position Start, closes there with End)."""
-    time = main.frame_current + main.frame_subframe
-    render = main.render
-    if render.use_motion_blur and render.engine == "CYCLES":
-        shift = {"START": 0.5, "END": -0.5}.get(compat.motion_blur_position(main), 0.0)
-        time += shift * render.motion_blur_shutter
-    return time
-
-
 @contextlib.contextmanager
 def _at_camera_time(engine, depsgraph, main):
     """The helper's depsgraph, which Blender evaluates at the whole frame,
-    evaluated at camera_time(main) instead where that differs (the linked
+    evaluated at camera_time.of(main) instead where that differs (the linked
     cameras' animation then is that time's: up to 0.16 of AO off before,
     found by an exploratory run), and at its own time again after."""
     evaluated = depsgraph.scene_eval
     frame, subframe = evaluated.frame_current, evaluated.frame_subframe
-    time = camera_time(main)
+    time = camera_time.of(main)
     if time == frame + subframe:
         yield
         return

@@ -20,18 +20,33 @@ SCRATCH_FOLDER_VARIABLE = "HBAO_TEMP_DIR"
 MEMORY_FOLDER = "/dev/shm"
 
 
+# Folders that failed to take a scratch file in this process: tried last.
+_failed = []
+
+
 def folders():
     """The folders to save the scratch file in, in the order to try them:
     HBAO_TEMP_DIR's; by default the memory-backed folder, then the system's
     temporary folder, for a Render Result that does not fit in memory (a
     container's /dev/shm is 64 MB by default, less than a 1080p render's
-    Combined, Depth and Normal)."""
-    configured = os.environ.get(SCRATCH_FOLDER_VARIABLE)
-    if configured:
-        return [folder for folder in configured.split(os.pathsep) if folder] or [configured]
-    memory = [MEMORY_FOLDER] if os.path.isdir(MEMORY_FOLDER) and \
-        os.access(MEMORY_FOLDER, os.W_OK) else []
-    return memory + [tempfile.gettempdir()]
+    Combined, Depth and Normal). A folder that failed (failed()) comes
+    last, so later hand-overs do not fill it again first."""
+    configured = os.environ.get(SCRATCH_FOLDER_VARIABLE, "")
+    listed = [folder for folder in configured.split(os.pathsep) if folder]
+    if not listed:
+        memory = [MEMORY_FOLDER] if os.path.isdir(MEMORY_FOLDER) and \
+            os.access(MEMORY_FOLDER, os.W_OK) else []
+        listed = memory + [tempfile.gettempdir()]
+    return sorted(listed, key=lambda folder: folder in _failed)  # (a stable sort)
+
+
+def failed(folder, paths):
+    """`folder` could not take a scratch file: tried last from now on, and
+    its `paths` removed at once (in the background), not after the AO, so
+    that a full folder is free again for other programs."""
+    if folder not in _failed:
+        _failed.append(folder)
+    _in_background(_remove_all, list(paths))
 
 
 # Each scratch file its own number: the last one may still be being removed

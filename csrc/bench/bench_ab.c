@@ -15,7 +15,9 @@
  * --back-faces: with a back-face layer every surface 0.3 deep, as
  * bench_speed's back-face row (hbao_compute_layers; without it the same
  * function with no layer, which is hbao_compute). */
+#ifndef _GNU_SOURCE
 #define _GNU_SOURCE /* RTLD_DEEPBIND */
+#endif
 #include <dlfcn.h>
 
 #include "bench_common.h"

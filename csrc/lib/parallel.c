@@ -2,7 +2,7 @@
 /* Rows handed out to worker threads from a shared counter. Which thread
  * computes a row never changes the row's values, so results are identical
  * for any number of threads. */
-#ifdef __linux__
+#if defined(__linux__) && !defined(_GNU_SOURCE)
 #define _GNU_SOURCE /* hbao_cpus.h: sched_getaffinity */
 #endif
 #include <pthread.h>

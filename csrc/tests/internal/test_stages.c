@@ -6,7 +6,9 @@
  * the settings hbao_compute derives). Linked with the library's own objects
  * (CMakeLists.txt, hbao_add_internal_executable). */
 #ifdef __linux__
+#ifndef _GNU_SOURCE
 #define _GNU_SOURCE /* sched_setaffinity */
+#endif
 #include <sched.h>
 #endif
 #include <stdint.h>
@@ -661,7 +663,9 @@ TEST_CASE(given_normals_face_the_viewer_along_its_ray) {
 TEST_CASE(default_threads_follow_the_cpus_the_process_may_use) {
 #ifdef __linux__
     cpu_set_t allowed;
-    CHECK(sched_getaffinity(0, sizeof allowed, &allowed) == 0);
+    /* (more CPUs than a cpu_set_t holds: the library counts the CPUs
+     * online there, and this test has nothing to narrow) */
+    if (sched_getaffinity(0, sizeof allowed, &allowed) != 0) return;
     hbao_params params = HBAO_PARAMS_DEFAULT_INITIALIZER;
     params.threads = 0;
     hbao_settings all;
