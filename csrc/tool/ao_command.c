@@ -289,7 +289,7 @@ static int write_outputs(const cli_options *options, const exr_input *input,
 int ao_compute_input(const cli_options *options, exr_input *input, ao_buffers *buffers,
                      tool_error *error) {
     blender_passes passes;
-    int status = blender_find_passes(input, options->layer, &passes, error);
+    int status = blender_find_passes(input, options->layer, options->back_layer, &passes, error);
     if (status != TOOL_EXIT_SUCCESS) return status;
 
     camera_settings camera;
@@ -305,7 +305,7 @@ int ao_compute_input(const cli_options *options, exr_input *input, ao_buffers *b
 
     blender_passes back_passes;
     if (options->back_layer != NULL) {
-        status = blender_find_passes(input, options->back_layer, &back_passes, error);
+        status = blender_find_passes(input, options->back_layer, NULL, &back_passes, error);
         if (status != TOOL_EXIT_SUCCESS) return status;
     }
     /* The passes are decoded with as many threads as the AO is computed. */

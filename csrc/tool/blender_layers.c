@@ -68,8 +68,8 @@ static int fail_listing_layers(const exr_input *input, const char *problem, tool
                      problem, list);
 }
 
-int blender_find_passes(const exr_input *input, const char *requested, blender_passes *passes,
-                        tool_error *error) {
+int blender_find_passes(const exr_input *input, const char *requested, const char *excluded,
+                        blender_passes *passes, tool_error *error) {
     if (requested != NULL) {
         char depth[BLENDER_CHANNEL_NAME_MAX];
         if (!set_name(depth, requested, (int)strlen(requested), depth_suffix))
@@ -82,11 +82,30 @@ int blender_find_passes(const exr_input *input, const char *requested, blender_p
         }
         return fill_passes(input, requested, (int)strlen(requested), depth, true, passes, error);
     }
+    /* The one layer with a Depth pass (the back layer left out): with
+     * several, which one a render's node reads cannot be told from the file
+     * (a default by name took "ViewLayer.001" over "ViewLayer", silently). */
+    const char *chosen = NULL;
+    int chosen_length = 0, candidates = 0;
     for (int c = 0; c < input->channels->num_channels; ++c) {
         const char *name = input->channels->entries[c].name.str;
-        int length = depth_layer_length(name);
-        if (length >= 0) return fill_passes(input, name, length, name, true, passes, error);
+        const int length = depth_layer_length(name);
+        if (length < 0) continue;
+        if (excluded != NULL && (size_t)length == strlen(excluded) &&
+            strncmp(name, excluded, (size_t)length) == 0)
+            continue;
+        if (candidates++ == 0) {
+            chosen = name;
+            chosen_length = length;
+        }
     }
+    if (candidates > 1)
+        return fail_listing_layers(input,
+                                   "the Depth pass is in several view layers; choose one with "
+                                   "--layer NAME",
+                                   error);
+    if (chosen != NULL)
+        return fill_passes(input, chosen, chosen_length, chosen, true, passes, error);
     static const char *const plain_depth[] = {"Depth.Z", "Z"};
     for (int i = 0; i < 2; ++i)
         if (exr_input_find_channel(input, plain_depth[i]) >= 0)

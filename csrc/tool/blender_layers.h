@@ -23,12 +23,13 @@ typedef struct blender_passes {
 } blender_passes;
 
 /**
- * Choose the layer: `requested` when not NULL, else the first layer (in the
- * channel list's alphabetical order) with a Depth pass, else a plain
- * "Depth.Z" or "Z" channel. Fails listing the layers that do exist.
+ * Choose the layer: `requested` when not NULL, else the one layer with a
+ * Depth pass other than `excluded` (the back layer, or NULL), else a plain
+ * "Depth.Z" or "Z" channel. Fails listing the layers that do exist, also
+ * where several layers could be meant.
  */
-int blender_find_passes(const exr_input *input, const char *requested, blender_passes *passes,
-                        tool_error *error);
+int blender_find_passes(const exr_input *input, const char *requested, const char *excluded,
+                        blender_passes *passes, tool_error *error);
 
 /** Number of layers with a Depth pass; their names go to `names` (up to `capacity`). */
 int blender_depth_layers(const exr_input *input, const char **names, int capacity);
