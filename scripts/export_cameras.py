@@ -13,8 +13,9 @@ Frames: as the CLI's --frames (1-250, 1-10,20,30-40); by default the scene's
 range and step. The scene is the
 file's active one, or the one Blender's -S names (before --python). Each
 frame's camera is the scene's at that frame, evaluated (animation,
-constraints, parents, Time Remapping; a cropped border render's camera is
-the crop's), by the add-on's own camera rule
+constraints, parents, Time Remapping; with Cycles' camera motion blur at the
+middle of the shutter; a cropped border render's camera is the crop's), by
+the add-on's own camera rule
 (hbao.camera.camera_for_render_result). A file that already holds what
 would be written is left as it is, its time too, so that a rerun of the
 CLI's sequence does not recompute that frame; the others are written whole
@@ -24,6 +25,7 @@ written.
 """
 import argparse
 import json
+import math
 import os
 import re
 import sys
@@ -41,6 +43,7 @@ try:
 except ImportError:
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "addon"))
 from hbao import camera as camera_model  # noqa: E402
+from hbao import camera_time  # noqa: E402
 
 EXIT_BAD_ARGUMENTS = 2
 EXIT_FAILED = 1
@@ -109,13 +112,21 @@ def scene_frames(scene):
 
 
 def camera_at(scene, frame):
-    """The scene camera's description at `frame`, evaluated."""
+    """The scene camera's description at `frame`, evaluated at the time the
+    frame's passes show it (hbao.camera_time: with Cycles' camera motion
+    blur, the middle of the shutter, as the node takes it; the camera
+    object is the frame's, which markers may switch)."""
     scene.frame_set(frame)
-    if scene.camera is None:
+    camera = scene.camera
+    if camera is None:
         raise camera_model.CameraError(f"scene {scene.name!r} has no camera at frame {frame}")
+    time = camera_time.of(scene)
+    if time != frame:
+        whole = math.floor(time)
+        scene.frame_set(whole, subframe=time - whole)
     depsgraph = bpy.context.evaluated_depsgraph_get()
     # the camera of the image written: a cropped border's own
-    return camera_model.camera_for_render_result(scene, scene.camera.evaluated_get(depsgraph))
+    return camera_model.camera_for_render_result(scene, camera.evaluated_get(depsgraph))
 
 
 def write_if_changed(path, text):

@@ -1270,6 +1270,31 @@ def test_export_cameras_writes_each_frames_camera(hbao_tool, run_in_blender, ble
            "--camera", tmp_path / "cams" / "cam_##.json")
 
 
+@pytest.mark.matrix
+def test_export_cameras_takes_the_shutter_middle_with_motion_blur(
+        run_in_blender, blender, tmp_path):
+    """With Cycles' camera motion blur the passes show the camera at the
+    middle of the shutter, as the node takes it: half a frame on with
+    Position Start and a shutter of a frame. export_cameras.py wrote the
+    camera at the frame: the CLI's AO then was 0.02-0.23 off the node's
+    (found by an exploratory run). The camera object stays the frame's (a
+    marker switches it at frame 4)."""
+    blend, expected_path = tmp_path / "anim.blend", tmp_path / "expected.json"
+    run_in_blender(SCRIPTS_IN_BLENDER / "animated_camera.py", blend, expected_path,
+                   "--motion-blur-start", addon=False)
+    expected = json.loads(expected_path.read_text())
+    pattern = tmp_path / "cams" / "cam_##.json"
+    run_in_blender(EXPORT_CAMERAS, pattern, blend=blend)
+    for frame in range(1, 5):
+        written = json.loads((tmp_path / "cams" / f"cam_{frame:02d}.json").read_text())
+        assert np.allclose(written["world_to_camera"], expected[str(frame)]["world_to_camera"],
+                           atol=1e-5), frame
+        assert written["lens"] == pytest.approx(expected[str(frame)]["lens"]), frame
+    # the camera turns between frames 1 and 3: at the frame it differs
+    assert not np.allclose(expected["1"]["world_to_camera"], expected["1"]["at_frame"],
+                           atol=1e-3)
+
+
 def test_export_cameras_frames_are_the_clis():
     """The script takes --frames as the CLI does: its limits are the CLI's
     (csrc/tool/frame_pattern.h)."""

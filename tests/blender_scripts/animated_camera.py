@@ -4,9 +4,14 @@
 BLEND, and writes what Blender itself says each frame's camera is (its
 evaluated world matrix inverted, its lens) as JSON, for
 tests/test_cli.py's check of scripts/export_cameras.py. With --no-camera,
-the scene is saved without any camera instead.
+the scene is saved without any camera instead. With --motion-blur-start,
+Cycles' camera motion blur is on (a shutter of 1 frame opening at the
+frame): each frame's camera is then the frame's camera object at the middle
+of the shutter, half a frame on (and "at_frame" holds its matrix at the
+frame itself).
 
     blender -b --python animated_camera.py -- BLEND EXPECTED.json [--no-camera]
+        [--motion-blur-start]
 """
 import json
 import sys
@@ -46,14 +51,26 @@ def main():
     scene.collection.objects.link(other)
     scene.timeline_markers.new("switch", frame=4).camera = other
     scene.timeline_markers.new("first", frame=1).camera = camera
+    shutter_middle = 0.0
+    if "--motion-blur-start" in arguments:
+        scene.render.engine = "CYCLES"
+        scene.render.use_motion_blur = True
+        scene.render.motion_blur_shutter = 1.0
+        settings = scene.render if hasattr(scene.render, "motion_blur_position") else scene.cycles
+        settings.motion_blur_position = "START"
+        shutter_middle = 0.5
     expected = {}
     for frame in range(1, 5):
         scene.frame_set(frame)
+        chosen = scene.camera  # (markers switch it at the frame)
+        at_frame = chosen.evaluated_get(bpy.context.evaluated_depsgraph_get()).matrix_world
+        at_frame = [list(row) for row in at_frame.inverted()]
+        scene.frame_set(frame, subframe=shutter_middle)
         depsgraph = bpy.context.evaluated_depsgraph_get()
-        seen = scene.camera.evaluated_get(depsgraph)
+        seen = chosen.evaluated_get(depsgraph)
         expected[frame] = {"world_to_camera": [list(row) for row in
                                                seen.matrix_world.inverted()],
-                           "lens": seen.data.lens, "name": scene.camera.name}
+                           "lens": seen.data.lens, "name": chosen.name, "at_frame": at_frame}
     scene.frame_set(1)
     bpy.ops.wm.save_as_mainfile(filepath=blend)
     Path(expected_path).write_text(json.dumps(expected))
