@@ -16,7 +16,11 @@ frame's camera is the scene's at that frame, evaluated (animation,
 constraints, parents, Time Remapping; with Cycles' camera motion blur at the
 middle of the shutter; a cropped border render's camera is the crop's), by
 the add-on's own camera rule
-(hbao.camera.camera_for_render_result). A file that already holds what
+(hbao.camera.camera_for_render_result). With Stereoscopy each view gets a
+file of its own, named with the view's file suffix before `.json`
+('cam_0001_L.json', as Blender names the view's render 'render_0001_L.exr'):
+a Stereo 3D eye's camera as Blender places it, a Multi-View view's own
+camera. A file that already holds what
 would be written is left as it is, its time too, so that a rerun of the
 CLI's sequence does not recompute that frame; the others are written whole
 (a temporary file renamed over them). Exit status 2 for bad
@@ -43,7 +47,7 @@ try:
 except ImportError:
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "addon"))
 from hbao import camera as camera_model  # noqa: E402
-from hbao import camera_time  # noqa: E402
+from hbao import camera_time, stereo_eyes, view_cameras, view_files  # noqa: E402
 
 EXIT_BAD_ARGUMENTS = 2
 EXIT_FAILED = 1
@@ -111,11 +115,16 @@ def scene_frames(scene):
     return list(range(scene.frame_start, scene.frame_end + 1, scene.frame_step))
 
 
-def camera_at(scene, frame):
-    """The scene camera's description at `frame`, evaluated at the time the
-    frame's passes show it (hbao.camera_time: with Cycles' camera motion
-    blur, the middle of the shutter, as the node takes it; the camera
-    object is the frame's, which markers may switch)."""
+STEREO_SETTINGS = ("interocular_distance", "convergence_distance", "convergence_mode", "pivot")
+
+
+def cameras_at(scene, frame):
+    """{view's file suffix: camera description} of `frame` ("" alone
+    without Stereoscopy): the scene camera evaluated at the time the frame's
+    passes show it (hbao.camera_time: with Cycles' camera motion blur, the
+    middle of the shutter, as the node takes it; the camera object is the
+    frame's, which markers may switch); a Stereo 3D eye's as Blender places
+    it (hbao.stereo_eyes), a Multi-View view's through its own camera."""
     scene.frame_set(frame)
     camera = scene.camera
     if camera is None:
@@ -125,8 +134,22 @@ def camera_at(scene, frame):
         whole = math.floor(time)
         scene.frame_set(whole, subframe=time - whole)
     depsgraph = bpy.context.evaluated_depsgraph_get()
+    views = view_cameras.rendered_views(scene)
     # the camera of the image written: a cropped border's own
-    return camera_model.camera_for_render_result(scene, camera.evaluated_get(depsgraph))
+    if views is None:
+        return {"": camera_model.camera_for_render_result(scene, camera.evaluated_get(depsgraph))}
+    found = {}
+    for name, suffix in views:
+        if scene.render.views_format == "MULTIVIEW":
+            seen = view_cameras.multiview_camera(scene, camera, name).evaluated_get(depsgraph)
+            found[suffix] = camera_model.camera_for_render_result(scene, seen)
+            continue
+        seen = camera.evaluated_get(depsgraph)
+        stereo = {key: getattr(seen.data.stereo, key) for key in STEREO_SETTINGS}
+        eye = stereo_eyes.eye(camera_model.camera_from_blender(scene, seen), stereo,
+                              left=name != "right")
+        found[suffix] = camera_model.camera_for_render_result(scene, description=eye)
+    return found
 
 
 def write_if_changed(path, text):
@@ -164,16 +187,19 @@ def main():
         return EXIT_BAD_ARGUMENTS
     except SystemExit as done:  # --help
         return done.code or 0
-    written = 0
+    written = files = 0
     try:
         for frame in frames:
-            text = json.dumps(camera_at(scene, frame), indent=2) + "\n"
-            written += write_if_changed(Path(frame_path(parsed.pattern, frame)), text)
+            for suffix, camera in cameras_at(scene, frame).items():
+                text = json.dumps(camera, indent=2) + "\n"
+                path = view_files.view_path(frame_path(parsed.pattern, frame), suffix)
+                written += write_if_changed(Path(path), text)
+                files += 1
     except (camera_model.CameraError, OSError) as error:
         print(f"export_cameras.py: error: {error}", file=sys.stderr)
         return EXIT_FAILED
     print(f"export_cameras.py: {len(frames)} frames, {written} files written, "
-          f"{len(frames) - written} already up to date")
+          f"{files - written} already up to date")
     return 0
 
 

@@ -1295,6 +1295,52 @@ def test_export_cameras_takes_the_shutter_middle_with_motion_blur(
                            atol=1e-3)
 
 
+@pytest.mark.matrix
+@pytest.mark.parametrize("stereo", [
+    {"stereo": True},
+    {"stereo": True, "stereo_settings": {"convergence_mode": "TOE", "pivot": "CENTER",
+                                         "interocular_distance": 0.3}},
+    {"stereo": True, "stereo_settings": {"convergence_mode": "TOE", "pivot": "RIGHT",
+                                         "interocular_distance": 0.3}},
+    {"stereo": True, "stereo_settings": {"convergence_mode": "PARALLEL", "pivot": "CENTER",
+                                         "interocular_distance": 0.3}},
+    {"stereo": True, "stereo_settings": {"pivot": "RIGHT", "interocular_distance": 0.3}},
+    {"stereo": "custom_view"}],
+    ids=["offaxis_left", "toe_center", "toe_right", "parallel_center", "offaxis_right",
+         "multi_view"])
+def test_export_cameras_writes_each_views_camera(run_in_blender, blender, hbao_tool, tmp_path,
+                                                 stereo):
+    """With Stereoscopy, export_cameras.py writes a camera per view
+    (cam_0001_L.json beside render_0001_L.exr): a Stereo 3D eye as Blender
+    places it (stereo_eyes.py, in each convergence mode and pivot), a
+    Multi-View view's own camera. It wrote the scene camera alone: the CLI's
+    AO of the right eye was 0.40 off the node's (found by an exploratory
+    run). The CLI on each view's passes with that view's file gives the
+    node's AO, which Blender's own placement of the eye gave (the engine's
+    camera_model_matrix)."""
+    from test_addon import exr, node_outputs, render
+    blend = tmp_path / "stereo.blend"
+    node = {"radius": 0.7, "blur_size": 0}
+    out, _ = render(run_in_blender, tmp_path, dict(stereo, nodes=[node],
+                                                   save_blend_after=str(blend)))
+    pattern = tmp_path / "cams" / "cam_####.json"
+    run_in_blender(EXPORT_CAMERAS, pattern, "--frames", "1", blend=blend)
+    suffixes = ["_L", "_R"] + (["_C"] if stereo["stereo"] == "custom_view" else [])
+    cameras = {}
+    for suffix in suffixes:
+        cameras[suffix] = json.loads((tmp_path / "cams" / f"cam_0001{suffix}.json").read_text())
+        run_ok(hbao_tool, out / f"frame_0001{suffix}.exr", "-o", tmp_path / f"ao{suffix}.exr",
+               "--camera", tmp_path / "cams" / f"cam_0001{suffix}.json", "--radius", "0.7",
+               "--blur", "0")
+        cli = exr.read_channels(tmp_path / f"ao{suffix}.exr", ["AO"])["AO"]
+        node_ao = node_outputs(out, 1, view=suffix)["ao"]
+        assert node_ao.min() < 0.9, suffix
+        # (the eyes' matrices in float64 here, in float32 in Blender)
+        assert np.abs(cli - node_ao).max() <= 2e-4, suffix
+    assert not np.allclose(cameras["_L"]["world_to_camera"], cameras["_R"]["world_to_camera"])
+    assert not list((tmp_path / "cams").glob("cam_0001.json"))  # no mono camera beside them
+
+
 def test_export_cameras_frames_are_the_clis():
     """The script takes --frames as the CLI does: its limits are the CLI's
     (csrc/tool/frame_pattern.h)."""

@@ -14,7 +14,8 @@ BPY_FREE_MODULES = ("hbao", "hbao.parameters", "hbao.library_loading", "hbao.nat
                     "hbao.native_structs", "hbao.native_library", "hbao.native_params",
                     "hbao.exr_passes", "hbao.view_files", "hbao.camera",
                     "hbao.guard_geometry", "hbao.timing_line", "hbao.scratch_names",
-                    "hbao.render_threads", "hbao.scratch_files", "hbao.viewport",
+                    "hbao.render_threads", "hbao.scratch_files", "hbao.stereo_eyes",
+                    "hbao.viewport",
                     "hbao.viewport.projection", "hbao.viewport.shader_sources",
                     "hbao.viewport.horizon_sources", "hbao.viewport.normal_sources",
                     "hbao.viewport.camera_sources")

@@ -10,45 +10,43 @@ both uncompressed 32-bit float. Usage:
 
   blender -b --addons hbao --python addon_render.py -- '<json spec>' <out dir>
 
-Spec keys (all optional): resolution [w, h], samples, engine, scene
-("corner" | "two_layers"), frames [..], ao_reference (distance: adds Cycles'
-AO pass), stereo (true: Stereo 3D; "one_view": with its right view off; "custom_view":
-Multi-View with a view "center" besides left and right, each through its own camera Camera_L,
-Camera_C, Camera_R; writes camera_<NNNN><view's file suffix>.json too), stereo_off_from_frame
-(Stereoscopy turned off from that frame on), output_views_format (the main output's views
-format), orthographic, camera_scale [x, y, z] (the camera object's scale), camera_rig [x, y, z] (the
-camera parented to an empty of that scale, where it was), widen_camera
-(factor), dump_back_faces (writes <out>/back_<NNNN>.npy: the back faces render's Depth, top row
-first), border [min_x, max_x, min_y, max_y] (a border render cropped to it; with crop false, not
-cropped), percentage (the resolution percentage), subframe (each frame rendered at that
-subframe), motion_blur ("START", "CENTER" or "END": Cycles' camera motion blur, shutter 1 frame;
-the camera written is the one at the shutter's middle), animate_camera (the camera turns and
-moves over frames 1-5), time_remap [old, new] (Time Remapping), sequencer ("override": a scene
-"Edit" shows the scene in a Video Sequencer strip through a camera override, "Strip Camera";
-and in a second strip through the scene's camera, "two_cameras": at the same frames,
-"other_frame": showing its frame 11 at frame 1, "muted_meta": inside a muted meta strip;
-"nested": Edit shown by a strip of scene
-"Outer" whose input is Edit's sequencer; "covered": Shot replaces a strip of the scene below it;
-each frame renders Edit (Outer) first, keeping the nodes' file as strip_nodes_<NNNN>.exr, then the
-scene through Strip Camera; "failed_movie": an animation render of Edit to a movie that cannot
-be written, then the scene's frames through its own camera), save_blend
-(path: saved after the setup, before rendering), nodes: [{name, layer, normal
-(bool), radius, keyframes [[frame, radius], ..], radius_from_value_node,
-falloff, integration, blur_size, angle_bias, directions, steps, strength,
-thickness, guard_band, back_faces, mute, connect_with_operator (left unlinked,
-then linked by the node's Connect Passes operator after the passes are
-disabled)}], disable_normal_pass, disable_depth_pass, output_format (the main
-output's file format, default OPEN_EXR_MULTILAYER), prepare [actions before
-rendering: sync, compositing_off, delete_helper, delete_extra_renders, rename_helper,
-pick_internal_engine, render_the_helper, rename_node, second_scene_shares_the_tree,
-group_last_node (the last HBAO node moved into a node group of the artist's),
-layer_not_rendered, mute_render_layers, switch_to_workbench],
-render_threads ({frame: the Performance panel's threads, 0 for Auto}), layer_name (the first
-view layer's), single_layer (Render Single Layer on), user_handlers (a
-pipeline's own render and frame change handlers, which print USER HANDLERS
-{json}: the scenes each list's handler saw, in order; render_stats leaves out
-repeats of the scene before). Prints OUTPUT SETTINGS {json} (the main output's settings after
-the renders), STATUS {json} (each node's status line) and RENDERED.
+Spec keys (all optional): resolution [w, h], samples, engine, scene ("corner" | "two_layers"),
+frames [..], ao_reference (distance: adds Cycles' AO pass), stereo (true: Stereo 3D; "one_view":
+with its right view off; "custom_view": Multi-View with a view "center" besides left and right,
+each through its own camera Camera_L, Camera_C, Camera_R; writes camera_<NNNN><view's file
+suffix>.json too), stereo_settings {convergence_mode, pivot, interocular_distance, ...: the
+camera's Stereoscopy settings; no view camera written then}, stereo_off_from_frame (Stereoscopy
+turned off from that frame on), output_views_format (the main output's views format), orthographic,
+camera_scale [x, y, z] (the camera object's scale), camera_rig [x, y, z] (the camera parented to an
+empty of that scale, where it was), widen_camera (factor), dump_back_faces (writes
+<out>/back_<NNNN>.npy: the back faces render's Depth, top row first), border [min_x, max_x, min_y,
+max_y] (a border render cropped to it; with crop false, not cropped), percentage (the resolution
+percentage), subframe (each frame rendered at that subframe), motion_blur ("START", "CENTER" or
+"END": Cycles' camera motion blur, shutter 1 frame; the camera written is the one at the shutter's
+middle), animate_camera (the camera turns and moves over frames 1-5), time_remap [old, new] (Time
+Remapping), sequencer ("override": a scene "Edit" shows the scene in a Video Sequencer strip
+through a camera override, "Strip Camera"; and in a second strip through the scene's camera,
+"two_cameras": at the same frames, "other_frame": showing its frame 11 at frame 1, "muted_meta":
+inside a muted meta strip; "nested": Edit shown by a strip of scene "Outer" whose input is Edit's
+sequencer; "covered": Shot replaces a strip of the scene below it; each frame renders Edit (Outer)
+first, keeping the nodes' file as strip_nodes_<NNNN>.exr, then the scene through Strip Camera;
+"failed_movie": an animation render of Edit to a movie that cannot be written, then the scene's
+frames through its own camera), save_blend_after (path: the file saved after the renders),
+save_blend (path: saved after the setup, before rendering), nodes: [{name, layer, normal (bool),
+radius, keyframes [[frame, radius], ..], radius_from_value_node, falloff, integration, blur_size,
+angle_bias, directions, steps, strength, thickness, guard_band, back_faces, mute,
+connect_with_operator (left unlinked, then linked by the node's Connect Passes operator after the
+passes are disabled)}], disable_normal_pass, disable_depth_pass, output_format (the main output's
+file format, default OPEN_EXR_MULTILAYER), prepare [actions before rendering: sync,
+compositing_off, delete_helper, delete_extra_renders, rename_helper, pick_internal_engine,
+render_the_helper, rename_node, second_scene_shares_the_tree, group_last_node (the last HBAO node
+moved into a node group of the artist's), layer_not_rendered, mute_render_layers,
+switch_to_workbench], render_threads ({frame: the Performance panel's threads, 0 for Auto}),
+layer_name (the first view layer's), single_layer (Render Single Layer on), user_handlers (a
+pipeline's own render and frame change handlers, which print USER HANDLERS {json}: the scenes each
+list's handler saw, in order; render_stats leaves out repeats of the scene before). Prints OUTPUT
+SETTINGS {json} (the main output's settings after the renders), STATUS {json} (each node's status
+line) and RENDERED.
 """
 import json
 import math
@@ -111,6 +109,8 @@ if spec.get("stereo"):  # Stereoscopy on: a left and a right view, each written 
             eye.location.x += step
             eye.rotation_euler.z += step * 0.2
             scene.collection.objects.link(eye)
+for key, value in spec.get("stereo_settings", {}).items():  # the camera's Stereoscopy panel
+    setattr(scene.camera.data.stereo, key, value)
 if spec.get("motion_blur"):  # Cycles' camera motion blur, this shutter Position, 1 frame long
     scene.render.use_motion_blur = True
     scene.render.motion_blur_shutter = 1.0
@@ -403,7 +403,7 @@ for frame in spec.get("frames", [1]):
     scene.frame_set(frame, subframe=spec.get("subframe", 0.0))  # the time rendered
     with open(os.path.join(out_dir, f"camera_{frame:04d}.json"), "w") as stream:
         json.dump(description, stream)
-    if spec.get("stereo"):
+    if spec.get("stereo") and not spec.get("stereo_settings"):  # (the reference's cases)
         for suffix, description in blender_scenes.view_camera_descriptions(scene).items():
             with open(os.path.join(out_dir, f"camera_{frame:04d}{suffix}.json"), "w") as stream:
                 json.dump(description, stream)
@@ -542,4 +542,6 @@ print("OUTPUT SETTINGS", json.dumps({
     "use_exr_interleave": getattr(settings, "use_exr_interleave", None)}))
 if spec.get("user_handlers"):
     print("USER HANDLERS", json.dumps(seen_by_user_handlers))
+if spec.get("save_blend_after"):  # (for a script on the file: export_cameras.py)
+    bpy.ops.wm.save_as_mainfile(filepath=spec["save_blend_after"])
 print("RENDERED", json.dumps({"frames": spec.get("frames", [1])}))
