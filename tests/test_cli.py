@@ -510,6 +510,52 @@ def test_missing_depth_pass_is_an_error(hbao_tool, tmp_path):
     assert not output.exists() and leftover_temporary_files(tmp_path) == []
 
 
+def test_a_multi_view_render_in_one_file_says_to_save_each_view_alone(hbao_tool, tmp_path):
+    """Views Format Multi-View saves every view in one file (3.4 and 4.5:
+    channels "ViewLayer.Depth.left.Z"): the tool reads one view, from a
+    file of its own, with that view's camera. It said "enable the Z/Depth
+    pass", which was wrong (found by an exploratory run); now it names the
+    views and how to save them."""
+    depth = np.full((8, 8), 3.0, np.float32)
+    source = tmp_path / "views.exr"
+    source.write_bytes(scanline_exr({"ViewLayer.Depth.left.Z": depth,
+                                     "ViewLayer.Depth.right.Z": depth}, 8, 8))
+    completed = run_tool(hbao_tool, source, "-o", tmp_path / "ao.exr", "--no-normals")
+    assert_clean_error(completed, EXIT_RUNTIME, 'holds the views "left", "right"',
+                       "Views Format: Individual", "export_cameras.py")
+    assert "enable the Z/Depth pass" not in completed.stderr
+    assert not (tmp_path / "ao.exr").exists()
+
+
+def test_a_file_output_nodes_depth_and_a_constant_depth(hbao_tool, tmp_path):
+    """A File Output node's Depth input writes "Depth.V" (its Normal
+    "Normal.X/Y/Z"): read as a render's Depth.Z is. A depth that is the
+    same everywhere (Blender writes a single-layer EXR's Z as 1 where the
+    Composite node's Z input is unlinked) gives AO 1 everywhere: the tool
+    warns, where it said nothing (found by an exploratory run); a frame of
+    background alone does not warn."""
+    depth = np.full((48, 64), 5.0, np.float32)
+    depth[20:30, 20:30] = 4.5
+    flags = ("--no-normals", "--radius", "2", "--blur", "0")
+    outputs = {}
+    for name in ("Depth.V", "Depth.Z"):
+        source = tmp_path / f"{name}.exr"
+        source.write_bytes(scanline_exr({name: depth}, 64, 48))
+        outputs[name] = tmp_path / f"ao_{name}.exr"
+        completed = run_ok(hbao_tool, source, "-o", outputs[name], *flags)
+        assert "every pixel's depth" not in completed.stderr
+    from hbao import exr_passes
+    ao = [exr_passes.read_channels(outputs[name], ["AO"])["AO"] for name in outputs]
+    assert ao[0].min() < 0.99 and np.array_equal(ao[0], ao[1])
+    for value, warned in ((1.0, True), (1e10, False), (65504.0, False)):
+        source = tmp_path / "flat.exr"
+        source.write_bytes(scanline_exr({"Z": np.full((48, 64), value, np.float32)}, 64, 48))
+        completed = run_ok(hbao_tool, source, "-o", tmp_path / "flat_ao.exr", *flags)
+        assert ("every pixel's depth (Z) is 1: the AO is 1 everywhere" in completed.stderr) \
+            == warned, (value, completed.stderr)
+        assert exr_passes.read_channels(tmp_path / "flat_ao.exr", ["AO"])["AO"].min() == 1.0
+
+
 # --- camera ------------------------------------------------------------------
 
 def test_camera_flags_override_the_file(hbao_tool, tmp_path):

@@ -286,6 +286,22 @@ static int write_outputs(const cli_options *options, const exr_input *input,
     return status;
 }
 
+/* A depth that is the same everywhere gives AO 1 everywhere: Blender writes
+ * a single-layer EXR's Z as 1 where the Composite node's Z input is not
+ * linked, and the frame would pass as done. */
+static void warn_if_depth_is_constant(const exr_input *input, const char *channel,
+                                      const float *depth, float background_depth) {
+    const size_t count = (size_t)input->width * (size_t)input->height;
+    /* (a frame of background alone, an empty shot, says nothing) */
+    if (count < 2 || !(depth[0] > 0.0f) || !(depth[0] < background_depth)) return;
+    for (size_t i = 1; i < count; ++i)
+        if (depth[i] != depth[0]) return;
+    tool_warn("%s: every pixel's depth (%s) is %g: the AO is 1 everywhere. A single-layer EXR "
+              "holds Blender's depth only where the Composite node's Z input is linked; or "
+              "save a multilayer EXR",
+              input->path, channel, (double)depth[0]);
+}
+
 int ao_compute_input(const cli_options *options, exr_input *input, ao_buffers *buffers,
                      tool_error *error) {
     blender_passes passes;
@@ -330,6 +346,8 @@ int ao_compute_input(const cli_options *options, exr_input *input, ao_buffers *b
                   "--no-normals to reconstruct normals from depth",
                   passes.normal[0]);
 
+    warn_if_depth_is_constant(input, passes.depth, buffers->depth,
+                              options->params.background_depth);
     hbao_channel depth = {buffers->depth, 1, input->width};
     hbao_channel normal = {buffers->normal, 3, (int64_t)input->width * 3};
     hbao_channel back = {buffers->back, 1, input->width};

@@ -49,7 +49,45 @@ static int fill_passes(const exr_input *input, const char *layer, int layer_leng
     return TOOL_EXIT_SUCCESS;
 }
 
+/* Whether `name` is "<layer>.Depth.<view>.Z", a view's Depth pass as
+ * Blender names it in a multi-view render saved as one file; the view's
+ * name (its length) in *view. */
+static bool view_depth_name(const char *name, const char **view, int *view_length) {
+    const char *pass = strstr(name, ".Depth.");
+    if (pass == NULL) return false;
+    const char *start = pass + strlen(".Depth."), *end = strrchr(start, '.');
+    if (end == NULL || end == start || strcmp(end, ".Z") != 0) return false;
+    *view = start;
+    *view_length = (int)(end - start);
+    return true;
+}
+
+/* A multi-view render saved as one file (Views Format: Multi-View): the
+ * tool reads one view from one file, with that view's camera. */
+static int fail_on_views(const exr_input *input, tool_error *error) {
+    char views[300] = "";
+    int count = 0;
+    for (int c = 0; c < input->channels->num_channels; ++c) {
+        const char *view = NULL;
+        int length = 0;
+        if (!view_depth_name(input->channels->entries[c].name.str, &view, &length)) continue;
+        const size_t used = strlen(views);
+        snprintf(views + used, sizeof views - used, "%s\"%.*s\"", used ? ", " : "", length, view);
+        ++count;
+    }
+    if (count == 0) return TOOL_EXIT_SUCCESS;
+    return tool_fail(error, TOOL_EXIT_RUNTIME,
+                     "%s: holds the views %s of a multi-view render in one file; the tool reads "
+                     "one view from a file of its own: save each view to its own file (Output "
+                     "properties > Views > Views Format: Individual, as render_0001_L.exr) and "
+                     "run the tool on each with that view's camera (scripts/export_cameras.py "
+                     "writes one per view)",
+                     input->path, views);
+}
+
 static int fail_listing_layers(const exr_input *input, const char *problem, tool_error *error) {
+    const int views = fail_on_views(input, error);
+    if (views != TOOL_EXIT_SUCCESS) return views;
     char list[600] = "";
     for (int c = 0; c < input->channels->num_channels; ++c) {
         const char *name = input->channels->entries[c].name.str;
@@ -106,9 +144,10 @@ int blender_find_passes(const exr_input *input, const char *requested, const cha
                                    error);
     if (chosen != NULL)
         return fill_passes(input, chosen, chosen_length, chosen, true, passes, error);
-    static const char *const plain_depth[] = {"Depth.Z", "Z"};
-    for (int i = 0; i < 2; ++i)
+    /* A File Output node's Depth input writes "Depth.V" beside "Normal.X" */
+    static const char *const plain_depth[] = {"Depth.Z", "Depth.V", "Z"};
+    for (int i = 0; i < 3; ++i)
         if (exr_input_find_channel(input, plain_depth[i]) >= 0)
-            return fill_passes(input, "", 0, plain_depth[i], i == 0, passes, error);
+            return fill_passes(input, "", 0, plain_depth[i], i < 2, passes, error);
     return fail_listing_layers(input, "no Depth pass", error);
 }
