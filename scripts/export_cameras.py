@@ -9,8 +9,8 @@ is switched by markers), each frame needs its own.
 
 The run of '#' (in the file's name, which ends in .json) is the frame
 number, zero-padded to the run's length, as the CLI and Blender name frames.
-Frames: as the CLI's --frames (1-250, 1-10,20,30-40); by default the scene's
-range and step. The scene is the
+Frames: as the CLI's --frames (1-250, 1-10,20,30-40, 1-250x2 for every second
+frame); by default the scene's range and step. The scene is the
 file's active one, or the one Blender's -S names (before --python). Each
 frame's camera is the scene's at that frame, evaluated (animation,
 constraints, parents, Time Remapping; with Cycles' camera motion blur at the
@@ -59,22 +59,25 @@ FRAME_RANGES_MAX = 64
 
 
 def frame_list(text):
-    """[frames] of "1-250" or "1-10,20,30-40", in the order given: what the
-    CLI's --frames takes (no spaces, up to FRAME_RANGES_MAX ranges)."""
+    """[frames] of "1-250", "1-10,20,30-40" or "1-250x2" (every second
+    frame), in the order given: what the CLI's --frames takes (no spaces, up
+    to FRAME_RANGES_MAX ranges, no frame twice)."""
     frames = []
     parts = text.split(",")
     if len(parts) > FRAME_RANGES_MAX:
         raise argparse.ArgumentTypeError(f"{text!r}: more than {FRAME_RANGES_MAX} ranges")
     for part in parts:
-        match = re.fullmatch(r"(\d+)(?:-(\d+))?", part)
+        match = re.fullmatch(r"(\d+)(?:-(\d+)(?:x(\d+))?)?", part)
         if match is None:
             raise argparse.ArgumentTypeError(f"{text!r} is not a frame list like 1-250")
         first = int(match.group(1))
         last = int(match.group(2)) if match.group(2) is not None else first
-        if first > last or last > FRAME_MAX:
+        step = int(match.group(3)) if match.group(3) is not None else 1
+        if first > last or last > FRAME_MAX or not 1 <= step <= FRAME_MAX:
             raise argparse.ArgumentTypeError(f"{part.strip()!r}: frames run from 0 to "
-                                             f"{FRAME_MAX}, first to last")
-        frames.extend(range(first, last + 1))
+                                             f"{FRAME_MAX}, first to last, by a step of 1 "
+                                             f"or more")
+        frames.extend(range(first, last + 1, step))
     if len(set(frames)) != len(frames):
         raise argparse.ArgumentTypeError(f"{text!r}: ranges overlap")
     return frames

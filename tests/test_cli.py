@@ -1132,6 +1132,27 @@ def test_an_input_replaced_while_its_ao_is_computed_gets_no_output(hbao_tool, tm
     assert sorted(p.name for p in tmp_path.iterdir()) == ["camera.json", "render.exr"]
 
 
+def test_sequence_of_every_second_frame(hbao_tool, tmp_path):
+    """A render with Blender's Frame Step 2 writes frames 1, 3, 5: the
+    sequence "1-6x2" computes those (1-6 failed on each missing frame, and
+    listing them took a range each, at most 64; found by an exploratory
+    run). No frame may be in two ranges: "1-9x2,2-10x2" share none,
+    "1-9x2,5" and "1-10x3,4-7x3" do."""
+    for frame in (1, 3, 5):
+        shutil.copyfile(fixture_path("cycles_float_zip"), tmp_path / f"in_{frame}.exr")
+    run_ok(hbao_tool, tmp_path / "in_#.exr", "-o", tmp_path / "ao_#.exr", "--frames", "1-6x2",
+           "--no-normals")
+    assert sorted(p.name for p in tmp_path.glob("ao_*")) == ["ao_1.exr", "ao_3.exr", "ao_5.exr"]
+    for frames, accepted in (("1-9x2,2-10x2", True), ("0-1048574x1048574", True),
+                             ("1-9x2,5", False), ("1-10x3,4-7x3", False), ("1-9x0", False),
+                             ("5x2", False), ("1-9x", False), ("1-9x-2", False)):
+        completed = run_tool(hbao_tool, tmp_path / "none_#.exr", "-o", tmp_path / "x_#.exr",
+                             "--frames", frames, "--no-normals")
+        # accepted: the frames are tried (and fail: no input); refused: a usage error
+        assert completed.returncode == (EXIT_RUNTIME if accepted else EXIT_USAGE), \
+            (frames, completed.stderr)
+
+
 def test_sequence_output_that_is_its_own_input_is_refused_even_if_up_to_date(hbao_tool,
                                                                              tmp_path):
     """An input that is an earlier --keep-input output of the same settings
@@ -1309,6 +1330,8 @@ def test_export_cameras_writes_each_frames_camera(hbao_tool, run_in_blender, ble
     times = {p: p.stat().st_mtime_ns for p in (tmp_path / "cams").iterdir()}
     again = run_in_blender(EXPORT_CAMERAS, pattern, "--frames", "2-3,1", blend=blend)
     assert "0 files written, 3 already up to date" in again.stdout
+    stepped = run_in_blender(EXPORT_CAMERAS, pattern, "--frames", "1-4x3", blend=blend)
+    assert "2 frames, 0 files written, 2 already up to date" in stepped.stdout  # 1 and 4
     assert {p: p.stat().st_mtime_ns for p in (tmp_path / "cams").iterdir()} == times
     for frame in range(1, 5):
         shutil.copyfile(fixture_path("cycles_float_zip"), tmp_path / f"in_{frame}.exr")
@@ -1403,6 +1426,8 @@ def test_export_cameras_frames_are_the_clis():
     (["render_####.exr"], EXIT_USAGE, "camera files end in .json"),
     (["cam_#.json", "--frames", "3-1"], EXIT_USAGE, "first to last"),
     (["cam_#.json", "--frames", "1-3,2"], EXIT_USAGE, "overlap"),
+    (["cam_#.json", "--frames", "1-9x2,5"], EXIT_USAGE, "overlap"),
+    (["cam_#.json", "--frames", "1-9x0"], EXIT_USAGE, "by a step of 1 or more"),
     (["cam_#.json", "--frames", "1-3, 5"], EXIT_USAGE, "not a frame list"),
     (["cam_#.json", "--frames", ",".join(str(2 * k) for k in range(65))], EXIT_USAGE,
      "more than 64 ranges"),

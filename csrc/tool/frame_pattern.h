@@ -18,7 +18,8 @@
 #define FRAME_RANGES_MAX 64
 
 typedef struct frame_range {
-    int32_t first, last; /* inclusive, first <= last */
+    int32_t first, last; /* inclusive, first <= last; last is a frame of the range */
+    int32_t step;        /* >= 1: every step-th frame from first ("1-250x2") */
 } frame_range;
 
 typedef struct frame_list {
@@ -26,8 +27,9 @@ typedef struct frame_list {
     int range_count;
 } frame_list;
 
-/** Parse "1-250", "7", "1-10,20-30": true on success; ranges must not
- *  overlap. */
+/** Parse "1-250", "7", "1-10,20-30", "1-250x2" (every second frame, as a
+ *  render with Blender's Frame Step 2 writes them): true on success; no
+ *  frame may be in two ranges. */
 bool frame_list_parse(const char *text, frame_list *list);
 
 /** The number of frames in the list. */
