@@ -527,6 +527,23 @@ def test_a_multi_view_render_in_one_file_says_to_save_each_view_alone(hbao_tool,
     assert not (tmp_path / "ao.exr").exists()
 
 
+@pytest.mark.matrix
+def test_a_multi_view_file_written_by_blender_says_to_save_each_view_alone(
+        run_in_blender, blender, hbao_tool, tmp_path):
+    """The same for the multi-view file Blender really writes: 3.4 and 4.5
+    name its channels with the views, 5.x writes a part per view with the
+    same channel names (the tool said "channel names must be unique across
+    parts", not why)."""
+    from test_addon import render
+    out, _ = render(run_in_blender, tmp_path, {"stereo": True, "output_views_format": "MULTIVIEW",
+                                               "nodes": [{"radius": 0.7}]})
+    completed = run_tool(hbao_tool, out / "frame_0001.exr", "-o", tmp_path / "ao.exr",
+                         "--no-normals")
+    assert_clean_error(completed, EXIT_RUNTIME, "holds the views", '"left"', '"right"',
+                       "Views Format: Individual")
+    assert not (tmp_path / "ao.exr").exists()
+
+
 def test_a_file_output_nodes_depth_and_a_constant_depth(hbao_tool, tmp_path):
     """A File Output node's Depth input writes "Depth.V" (its Normal
     "Normal.X/Y/Z"): read as a render's Depth.Z is. A depth that is the

@@ -98,6 +98,16 @@ static const char *part_name(const exr_input *input, int part) {
     return name;
 }
 
+/* The view a part holds (its "view" attribute: a multi-view file), or NULL. */
+static const char *part_view(const exr_input *input, int part) {
+    const char *view = NULL;
+    int32_t length = 0;
+    if (exr_attr_get_string(input->context, part, "view", &length, &view) != EXR_ERR_SUCCESS ||
+        view == NULL || length <= 0)
+        return NULL;
+    return view;
+}
+
 static bool same_box(const exr_attr_box2i_t *a, const exr_attr_box2i_t *b) {
     return a->min.x == b->min.x && a->min.y == b->min.y && a->max.x == b->max.x &&
            a->max.y == b->max.y;
@@ -231,6 +241,17 @@ static int collect_channels(exr_input *input, tool_error *error) {
     for (int c = 1; c < count; ++c) {
         if (strcmp(entries[c - 1].name.str, entries[c].name.str) == 0) {
             const int first = input->channel_parts[c - 1], second = input->channel_parts[c];
+            const char *first_view = part_view(input, first),
+                       *second_view = part_view(input, second);
+            if (first_view != NULL && second_view != NULL && strcmp(first_view, second_view) != 0) {
+                /* Blender 5 saves a multi-view render in one file as a part
+                 * per view (and pass), each with the same channel names */
+                status = tool_fail(error, TOOL_EXIT_RUNTIME,
+                                   "%s: holds the views \"%s\" and \"%s\" of a multi-view render "
+                                   "in one file (parts %d and %d); " EXR_VIEWS_APART_ADVICE,
+                                   input->path, first_view, second_view, first, second);
+                break;
+            }
             status = tool_fail(error, TOOL_EXIT_RUNTIME,
                                "%s: channel %s is in part %d (\"%s\") and in part %d (\"%s\"); "
                                "channel names must be unique across parts",

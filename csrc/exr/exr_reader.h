@@ -73,6 +73,13 @@ int exr_input_open(exr_input *input, const char *path, tool_error *error);
 int exr_input_read(exr_input *input, const exr_channel_request *requests, int count,
                    tool_error *error);
 
+/** What to do with a multi-view render saved in one file (the reader's
+ *  part per view, the tool's view-named channels say it). */
+#define EXR_VIEWS_APART_ADVICE                                                                     \
+    "the tool reads one view from a file of its own: save each view to its own file (Output "      \
+    "properties > Views > Views Format: Individual, as render_0001_L.exr) and run the tool on "    \
+    "each with that view's camera (scripts/export_cameras.py writes one per view)"
+
 /** The cores this process may run on (at least 1; hbao_cpus.h): the threads
  *  a caller reads and computes with when nobody asked for a number. */
 int exr_usable_cores(void);

@@ -76,13 +76,10 @@ static int fail_on_views(const exr_input *input, tool_error *error) {
         ++count;
     }
     if (count == 0) return TOOL_EXIT_SUCCESS;
-    return tool_fail(error, TOOL_EXIT_RUNTIME,
-                     "%s: holds the views %s of a multi-view render in one file; the tool reads "
-                     "one view from a file of its own: save each view to its own file (Output "
-                     "properties > Views > Views Format: Individual, as render_0001_L.exr) and "
-                     "run the tool on each with that view's camera (scripts/export_cameras.py "
-                     "writes one per view)",
-                     input->path, views);
+    return tool_fail(
+        error, TOOL_EXIT_RUNTIME,
+        "%s: holds the views %s of a multi-view render in one file; " EXR_VIEWS_APART_ADVICE,
+        input->path, views);
 }
 
 static int fail_listing_layers(const exr_input *input, const char *problem, tool_error *error) {
