@@ -546,11 +546,12 @@ def test_a_multi_view_file_written_by_blender_says_to_save_each_view_alone(
 
 def test_a_file_output_nodes_depth_and_a_constant_depth(hbao_tool, tmp_path):
     """A File Output node's Depth input writes "Depth.V" (its Normal
-    "Normal.X/Y/Z"): read as a render's Depth.Z is. A depth that is the
-    same everywhere (Blender writes a single-layer EXR's Z as 1 where the
-    Composite node's Z input is unlinked) gives AO 1 everywhere: the tool
-    warns, where it said nothing (found by an exploratory run); a frame of
-    background alone does not warn."""
+    "Normal.X/Y/Z"): read as a render's Depth.Z is. A layer without its
+    Normal pass says so (the normals were reconstructed silently). A depth
+    that is the same everywhere (Blender writes a single-layer EXR's Z as 1
+    where the Composite node's Z input is unlinked) gives AO 1 everywhere:
+    the tool warns, where it said nothing (found by an exploratory run); a
+    frame of background alone does not warn."""
     depth = np.full((48, 64), 5.0, np.float32)
     depth[20:30, 20:30] = 4.5
     flags = ("--no-normals", "--radius", "2", "--blur", "0")
@@ -564,6 +565,14 @@ def test_a_file_output_nodes_depth_and_a_constant_depth(hbao_tool, tmp_path):
     from hbao import exr_passes
     ao = [exr_passes.read_channels(outputs[name], ["AO"])["AO"] for name in outputs]
     assert ao[0].min() < 0.99 and np.array_equal(ao[0], ao[1])
+    # a layer without its Normal pass (Blender before 5.0 cuts the names of
+    # a view layer named with 56 bytes or more): said, unless --no-normals
+    source = tmp_path / "layer.exr"
+    source.write_bytes(scanline_exr({"Long.Depth.Z": depth}, 64, 48))
+    said = run_ok(hbao_tool, source, "-o", tmp_path / "layer_ao.exr", "--radius", "2")
+    assert "no Normal pass (Long.Normal.X/Y/Z): normals are reconstructed" in said.stderr
+    quiet = run_ok(hbao_tool, source, "-o", tmp_path / "layer_ao.exr", *flags)
+    assert "Normal" not in quiet.stderr
     for value, warned in ((1.0, True), (1e10, False), (65504.0, False)):
         source = tmp_path / "flat.exr"
         source.write_bytes(scanline_exr({"Z": np.full((48, 64), value, np.float32)}, 64, 48))

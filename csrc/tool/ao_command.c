@@ -312,6 +312,12 @@ int ao_compute_input(const cli_options *options, exr_input *input, ao_buffers *b
     status = resolve_camera(options, input, &camera, &buffers->camera_file, error);
     if (status != TOOL_EXIT_SUCCESS) return status;
     const bool use_normals = passes.has_normal && !options->ignore_normals;
+    /* (Blender before 5.0 cuts channel names past 64 bytes: a view layer
+     * named with 56 bytes or more loses its Normal pass so) */
+    if (passes.normal_expected && !passes.has_normal && !options->ignore_normals)
+        tool_warn("%s: no Normal pass (%.*sX/Y/Z): normals are reconstructed from depth; "
+                  "--no-normals does so without this warning",
+                  input->path, (int)strlen(passes.normal[0]) - 1, passes.normal[0]);
     hbao_camera cropped;
     const hbao_result cropping = camera_for_data_window(&camera.camera, &input->display_window,
                                                         &input->data_window, &cropped);

@@ -38,7 +38,7 @@ static int fill_passes(const exr_input *input, const char *layer, int layer_leng
     if (!set_name(passes->layer, layer, layer_length, "") ||
         !set_name(passes->depth, depth_channel, (int)strlen(depth_channel), ""))
         return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: channel name too long", input->path);
-    passes->has_normal = look_for_normals;
+    passes->has_normal = passes->normal_expected = look_for_normals;
     for (int axis = 0; axis < 3 && passes->has_normal; ++axis) {
         char prefix[BLENDER_CHANNEL_NAME_MAX];
         if (!set_name(prefix, layer, layer_length, layer_length > 0 ? "." : "") ||

@@ -19,7 +19,8 @@ typedef struct blender_passes {
     char layer[BLENDER_CHANNEL_NAME_MAX]; /**< "" for a file without layers */
     char depth[BLENDER_CHANNEL_NAME_MAX];
     char normal[3][BLENDER_CHANNEL_NAME_MAX];
-    bool has_normal; /**< all three normal channels exist */
+    bool has_normal;      /**< all three normal channels exist */
+    bool normal_expected; /**< a layer (or Depth.Z / Depth.V): a Normal pass may be there */
 } blender_passes;
 
 /**
