@@ -259,6 +259,28 @@ def test_a_camera_scaled_unevenly_gets_the_ao_of_the_unscaled_one(run_in_blender
     assert np.abs(node_outputs(scaled, 1)["ao"] - expected).max() <= 1e-5
 
 
+def position_misfit(native, out, frame, description):
+    """The median distance between where `description` (a camera dict)
+    puts each foreground pixel's Depth and where Cycles' Position pass says
+    its surface is: small for the camera the passes were rendered through
+    (blurred passes fit no camera exactly)."""
+    layer = "ViewLayer"
+    names = [f"{layer}.Depth.Z"] + [f"{layer}.Position.{axis}" for axis in "XYZ"]
+    channels = exr.read_channels(out / f"frame_{frame:04d}.exr", names)
+    depth = channels[names[0]]
+    height, width = depth.shape
+    view = native.camera_view(description, width, height)
+    columns = view.origin_x + (np.arange(width) + 0.5) * view.pixel_size_x
+    rows = view.origin_y + (np.arange(height)[::-1] + 0.5) * view.pixel_size_y  # top row first
+    x, y = np.meshgrid(columns, rows)
+    points = np.stack([x * depth, y * depth, -depth, np.ones_like(depth)], axis=-1)
+    to_world = np.linalg.inv(np.array(description["world_to_camera"], dtype=np.float64))
+    world = points @ to_world.T
+    position = np.stack([channels[name] for name in names[1:]], axis=-1)
+    foreground = depth < 1e9
+    return float(np.median(np.linalg.norm(world[..., :3] - position, axis=-1)[foreground]))
+
+
 @pytest.mark.parametrize("time", [{"subframe": 0.5}, {"motion_blur": "START"},
                                   {"motion_blur": "END"}, {"motion_blur": "CENTER"}],
                          ids=["subframe", "blur_start", "blur_end", "blur_center"])
@@ -269,19 +291,25 @@ def test_a_moving_camera_at_the_time_its_passes_show(run_in_blender, tmp_path, n
     took the camera at the whole frame: 0.03 to 0.16 off with a camera
     moving 0.2 units a frame (found by an exploratory run, against Cycles'
     Position pass). The node's AO is the library's with the camera that
-    the test script evaluates at that time itself. The guard band and back
+    the test script evaluates at that time itself, and that camera fits
+    Cycles' Position pass better than the whole frame's. The guard band and back
     faces, which Blender renders at the whole frame, are left out of the
     other times (not rendered, and the node says why: a review found them
     stitched to the passes from another time)."""
     node = {"radius": 0.7, "blur_size": 0}
     nodes = [node, dict(node, name="HBAO1", guard_band=10.0, back_faces=True)]
     out, log = render(run_in_blender, tmp_path, dict(time, frames=[2], animate_camera=True,
-                                                     nodes=nodes))
+                                                     position_pass=True, nodes=nodes))
     assert "without AO" not in log, log[-3000:]
     expected = library_ao(native, out, 2, node_params(**node))
     assert expected.min() < 0.9
     assert np.abs(node_outputs(out, 2)["ao"] - expected).max() <= EXACT
     other_time = time.get("motion_blur") != "CENTER"
+    if other_time:  # that time's camera puts the Depth on Cycles' Position pass, not the frame's
+        at_frame = json.loads((out / "camera_at_frame_0002.json").read_text())
+        fits = [position_misfit(native, out, 2, description)
+                for description in (camera(out, 2), at_frame)]
+        assert fits[0] < 0.7 * fits[1], fits
     for kind in ("guard band", "back faces"):
         assert (f"no {kind}: the passes show the camera at another time than the frame"
                 in log) == other_time, kind

@@ -23,9 +23,10 @@ empty of that scale, where it was), widen_camera (factor), dump_back_faces (writ
 max_y] (a border render cropped to it; with crop false, not cropped), percentage (the resolution
 percentage), subframe (each frame rendered at that subframe), motion_blur ("START", "CENTER" or
 "END": Cycles' camera motion blur, shutter 1 frame; the camera written is the one at the shutter's
-middle), animate_camera (the camera turns and moves over frames 1-5), time_remap [old, new] (Time
-Remapping), sequencer ("override": a scene "Edit" shows the scene in a Video Sequencer strip
-through a camera override, "Strip Camera"; and in a second strip through the scene's camera,
+middle, and camera_at_frame_<NNNN>.json the one at the whole frame), position_pass (Cycles'
+Position pass on), animate_camera (the camera turns and moves over frames 1-5), time_remap [old,
+new] (Time Remapping), sequencer ("override": a scene "Edit" shows the scene in a Video Sequencer
+strip through a camera override, "Strip Camera"; and in a second strip through the scene's camera,
 "two_cameras": at the same frames, "other_frame": showing its frame 11 at frame 1, "muted_meta":
 inside a muted meta strip; "nested": Edit shown by a strip of scene "Outer" whose input is Edit's
 sequencer; "covered": Shot replaces a strip of the scene below it; each frame renders Edit (Outer)
@@ -111,6 +112,9 @@ if spec.get("stereo"):  # Stereoscopy on: a left and a right view, each written 
             scene.collection.objects.link(eye)
 for key, value in spec.get("stereo_settings", {}).items():  # the camera's Stereoscopy panel
     setattr(scene.camera.data.stereo, key, value)
+if spec.get("position_pass"):  # Cycles' Position pass: where each pixel's surface is
+    for view_layer in scene.view_layers:
+        view_layer.use_pass_position = True
 if spec.get("motion_blur"):  # Cycles' camera motion blur, this shutter Position, 1 frame long
     scene.render.use_motion_blur = True
     scene.render.motion_blur_shutter = 1.0
@@ -403,6 +407,11 @@ for frame in spec.get("frames", [1]):
     scene.frame_set(frame, subframe=spec.get("subframe", 0.0))  # the time rendered
     with open(os.path.join(out_dir, f"camera_{frame:04d}.json"), "w") as stream:
         json.dump(description, stream)
+    if camera_time != frame:  # and the camera at the whole frame, for comparison
+        scene.frame_set(frame)
+        with open(os.path.join(out_dir, f"camera_at_frame_{frame:04d}.json"), "w") as stream:
+            json.dump(blender_scenes.camera_description(scene), stream)
+        scene.frame_set(frame, subframe=spec.get("subframe", 0.0))
     if spec.get("stereo") and not spec.get("stereo_settings"):  # (the reference's cases)
         for suffix, description in blender_scenes.view_camera_descriptions(scene).items():
             with open(os.path.join(out_dir, f"camera_{frame:04d}{suffix}.json"), "w") as stream:
