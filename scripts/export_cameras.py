@@ -39,6 +39,7 @@ from pathlib import Path
 import bpy
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+import frame_lists  # noqa: E402
 from blender_arguments import (  # noqa: E402
     ArgumentError, ArgumentParser, end_blender, script_arguments)
 
@@ -51,36 +52,14 @@ from hbao import camera_time, stereo_eyes, view_cameras, view_files  # noqa: E40
 
 EXIT_BAD_ARGUMENTS = 2
 EXIT_FAILED = 1
-# The CLI's frames (Blender's MAXFRAME) and its most ranges in --frames
-# (csrc/tool/frame_pattern.h: FRAME_MAX, FRAME_RANGES_MAX; tests/test_cli.py
-# compares them).
-FRAME_MAX = 1048574
-FRAME_RANGES_MAX = 64
 
 
 def frame_list(text):
-    """[frames] of "1-250", "1-10,20,30-40" or "1-250x2" (every second
-    frame), in the order given: what the CLI's --frames takes (no spaces, up
-    to FRAME_RANGES_MAX ranges, no frame twice)."""
-    frames = []
-    parts = text.split(",")
-    if len(parts) > FRAME_RANGES_MAX:
-        raise argparse.ArgumentTypeError(f"{text!r}: more than {FRAME_RANGES_MAX} ranges")
-    for part in parts:
-        match = re.fullmatch(r"(\d+)(?:-(\d+)(?:x(\d+))?)?", part)
-        if match is None:
-            raise argparse.ArgumentTypeError(f"{text!r} is not a frame list like 1-250")
-        first = int(match.group(1))
-        last = int(match.group(2)) if match.group(2) is not None else first
-        step = int(match.group(3)) if match.group(3) is not None else 1
-        if first > last or last > FRAME_MAX or not 1 <= step <= FRAME_MAX:
-            raise argparse.ArgumentTypeError(f"{part.strip()!r}: frames run from 0 to "
-                                             f"{FRAME_MAX}, first to last, by a step of 1 "
-                                             f"or more")
-        frames.extend(range(first, last + 1, step))
-    if len(set(frames)) != len(frames):
-        raise argparse.ArgumentTypeError(f"{text!r}: ranges overlap")
-    return frames
+    """frame_lists.parse() for argparse."""
+    try:
+        return frame_lists.parse(text)
+    except ValueError as error:
+        raise argparse.ArgumentTypeError(str(error)) from error
 
 
 def frame_path(pattern, frame):

@@ -544,10 +544,42 @@ def test_a_multi_view_file_written_by_blender_says_to_save_each_view_alone(
     assert not (tmp_path / "ao.exr").exists()
 
 
+def test_a_single_view_file_and_the_layers_listed(hbao_tool, tmp_path):
+    """Blender 3.4 saves a render with one view on with the view in its
+    channel names ("ViewLayer.Depth.left.Z"): the tool reads that view (it
+    refused the file as one of several views: found by a review), with its
+    Normal pass. A layer named by --back-layer is not listed among the
+    layers to choose from."""
+    depth = np.full((48, 64), 5.0, np.float32)
+    depth[20:30, 20:30] = 4.5
+    normal = {axis: np.full((48, 64), value, np.float32)
+              for axis, value in (("X", 0.0), ("Y", -1.0), ("Z", 0.0))}
+    outputs = []
+    for view in (".left", ""):
+        channels = {f"ViewLayer.Depth{view}.Z": depth}
+        channels.update({f"ViewLayer.Normal{view}.{axis}": value
+                         for axis, value in normal.items()})
+        source = tmp_path / f"view{view}.exr"
+        source.write_bytes(scanline_exr(channels, 64, 48))
+        outputs.append(tmp_path / f"ao{view}.exr")
+        run_ok(hbao_tool, source, "-o", outputs[-1], "--radius", "2", "--blur", "0",
+               "--world-to-camera", "1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1")
+    from hbao import exr_passes
+    ao = [exr_passes.read_channels(path, ["AO"])["AO"] for path in outputs]
+    assert ao[0].min() < 0.99 and np.array_equal(ao[0], ao[1])
+    source = tmp_path / "three.exr"
+    source.write_bytes(scanline_exr({f"{name}.Depth.Z": depth for name in "ABC"}, 64, 48))
+    listed = run_tool(hbao_tool, source, "-o", tmp_path / "x.exr", "--back-layer", "C")
+    assert_clean_error(listed, EXIT_RUNTIME, 'several view layers', '"A", "B"')
+    assert '"C"' not in listed.stderr
+
+
 def test_a_file_output_nodes_depth_and_a_constant_depth(hbao_tool, tmp_path):
     """A File Output node's Depth input writes "Depth.V" (its Normal
-    "Normal.X/Y/Z"): read as a render's Depth.Z is. A layer without its
-    Normal pass says so (the normals were reconstructed silently). A depth
+    "Normal.X/Y/Z"): read as a render's Depth.Z is. A layer named too long
+    for Blender before 5.0 to keep its Normal pass (56 bytes) says so (the
+    normals were reconstructed silently); a short one of Depth alone, a
+    choice, stays quiet. A depth
     that is the same everywhere (Blender writes a single-layer EXR's Z as 1
     where the Composite node's Z input is unlinked) gives AO 1 everywhere:
     the tool warns, where it said nothing (found by an exploratory run); a
@@ -565,14 +597,15 @@ def test_a_file_output_nodes_depth_and_a_constant_depth(hbao_tool, tmp_path):
     from hbao import exr_passes
     ao = [exr_passes.read_channels(outputs[name], ["AO"])["AO"] for name in outputs]
     assert ao[0].min() < 0.99 and np.array_equal(ao[0], ao[1])
-    # a layer without its Normal pass (Blender before 5.0 cuts the names of
-    # a view layer named with 56 bytes or more): said, unless --no-normals
-    source = tmp_path / "layer.exr"
-    source.write_bytes(scanline_exr({"Long.Depth.Z": depth}, 64, 48))
-    said = run_ok(hbao_tool, source, "-o", tmp_path / "layer_ao.exr", "--radius", "2")
-    assert "no Normal pass (Long.Normal.X/Y/Z): normals are reconstructed" in said.stderr
-    quiet = run_ok(hbao_tool, source, "-o", tmp_path / "layer_ao.exr", *flags)
-    assert "Normal" not in quiet.stderr
+    long_name = "L" * 56
+    for layer, warned in ((long_name, True), ("Short", False)):
+        source = tmp_path / "layer.exr"
+        source.write_bytes(scanline_exr({f"{layer}.Depth.Z": depth}, 64, 48))
+        said = run_ok(hbao_tool, source, "-o", tmp_path / "layer_ao.exr", "--radius", "2")
+        assert (f"no Normal pass ({layer}.Normal.X/Y/Z): normals are reconstructed"
+                in said.stderr) == warned, said.stderr
+        quiet = run_ok(hbao_tool, source, "-o", tmp_path / "layer_ao.exr", *flags)
+        assert "Normal" not in quiet.stderr
     for value, warned in ((1.0, True), (1e10, False), (65504.0, False)):
         source = tmp_path / "flat.exr"
         source.write_bytes(scanline_exr({"Z": np.full((48, 64), value, np.float32)}, 64, 48))
@@ -1356,13 +1389,17 @@ def test_export_cameras_writes_each_frames_camera(hbao_tool, run_in_blender, ble
     times = {p: p.stat().st_mtime_ns for p in (tmp_path / "cams").iterdir()}
     again = run_in_blender(EXPORT_CAMERAS, pattern, "--frames", "2-3,1", blend=blend)
     assert "0 files written, 3 already up to date" in again.stdout
-    stepped = run_in_blender(EXPORT_CAMERAS, pattern, "--frames", "1-4x3", blend=blend)
-    assert "2 frames, 0 files written, 2 already up to date" in stepped.stdout  # 1 and 4
     assert {p: p.stat().st_mtime_ns for p in (tmp_path / "cams").iterdir()} == times
     for frame in range(1, 5):
         shutil.copyfile(fixture_path("cycles_float_zip"), tmp_path / f"in_{frame}.exr")
     run_ok(hbao_tool, tmp_path / "in_#.exr", "-o", tmp_path / "ao_#.exr", "--frames", "1-4",
            "--camera", tmp_path / "cams" / "cam_##.json")
+    # every third frame from 1: frames 1 (up to date) and 4 (written again), not 2 or 3
+    for frame in (2, 3, 4):
+        (tmp_path / "cams" / f"cam_{frame:02d}.json").unlink()
+    stepped = run_in_blender(EXPORT_CAMERAS, pattern, "--frames", "1-4x3", blend=blend)
+    assert "2 frames, 1 files written, 1 already up to date" in stepped.stdout
+    assert sorted(p.name for p in (tmp_path / "cams").iterdir()) == ["cam_01.json", "cam_04.json"]
 
 
 @pytest.mark.matrix
@@ -1436,14 +1473,41 @@ def test_export_cameras_writes_each_views_camera(run_in_blender, blender, hbao_t
     assert not list((tmp_path / "cams").glob("cam_0001.json"))  # no mono camera beside them
 
 
-def test_export_cameras_frames_are_the_clis():
-    """The script takes --frames as the CLI does: its limits are the CLI's
-    (csrc/tool/frame_pattern.h)."""
+FRAME_LISTS = [
+    "1", "0", "1-250", "1-10,20,30-40", "1-250x2", "1-9x2,2-10x2", "0-1048574x1048574",
+    "1048574", "1048575", "0-1048575", "3-1", "1-3,2", "1-9x2,5", "1-10x3,4-7x3", "1-9x0",
+    "5x2", "1-9x", "1-9x-2", "x2", "-1", "1-", "1,,2", "", " 1", "1 ", "+1", "1-3, 5",
+    "\u0661", "\u0661-\u0663", "\uff10", "0000000000000001", "00000000000000001-2",
+    "000000000000001", "1-2x000000000000002", "1-4x3", "10-1x1",
+    ",".join(str(2 * k) for k in range(64)), ",".join(str(2 * k) for k in range(65)),
+    ",".join(f"{k}-1048574x64" for k in range(63)) + ",5"]
+
+
+def test_export_cameras_frames_are_the_clis(hbao_tool, tmp_path):
+    """The script takes --frames as the CLI does (scripts/frame_lists.py;
+    the CLI's parser is csrc/tool/frame_pattern.c): its limits are the
+    CLI's, and each list of a table is taken by both or by neither, with
+    the same frames (the script took Unicode digits and 16-digit numbers
+    that the CLI refuses: found by a review)."""
+    import frame_lists
     header = (REPO / "csrc" / "tool" / "frame_pattern.h").read_text()
-    script = EXPORT_CAMERAS.read_text()
     for name in ("FRAME_MAX", "FRAME_RANGES_MAX"):
-        in_header = re.search(rf"#define {name} (\d+)", header).group(1)
-        assert re.search(rf"^{name} = {in_header}$", script, re.M), name
+        in_header = int(re.search(rf"#define {name} (\d+)", header).group(1))
+        assert getattr(frame_lists, name) == in_header, name
+    for text in FRAME_LISTS:
+        try:
+            frames = frame_lists.parse(text)
+        except ValueError:
+            frames = None
+        completed = run_tool(hbao_tool, tmp_path / "none_#.exr", "-o", tmp_path / "x_#.exr",
+                             "--frames", text, "--no-normals", "-j", "32")
+        # taken: every frame tried, each failing (no input); refused: a usage error
+        assert completed.returncode == (EXIT_USAGE if frames is None else EXIT_RUNTIME), \
+            (text[:40], completed.stderr[-300:])
+        if frames is not None and len(frames) < 50:
+            failed = re.search(r"failed: ([0-9, ]+)", completed.stderr)
+            assert failed and [int(f) for f in failed.group(1).split(", ")] == frames, \
+                (text, completed.stderr[-300:])
 
 
 @pytest.mark.parametrize("arguments, status, fragment", [
@@ -1543,7 +1607,7 @@ def test_sequence_refuses_outputs_that_are_another_frames_or_its_own(hbao_tool, 
     (["in_#.exr", "-o", "ao_#.exr", "--frames", "3-1"], "--frames"),
     (["in_#.exr", "-o", "ao_#.exr", "--frames", "-1"], "--frames"),
     (["in_#.exr", "-o", "ao_#.exr", "--frames", "1-2,"], "--frames"),
-    (["in_#.exr", "-o", "ao_#.exr", "--frames", "1-5,5-7"], "none twice"),
+    (["in_#.exr", "-o", "ao_#.exr", "--frames", "1-5,5-7"], "no frame twice"),
     (["in_#.exr", "-o", "ao_#.exr", "--frames", "1-2", "--jobs", "0"], "--jobs"),
     (["in.exr", "-o", "ao.exr", "--jobs", "2"], "go with --frames"),
     (["in.exr", "-o", "ao.exr", "--force"], "go with --frames"),

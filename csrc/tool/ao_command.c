@@ -312,12 +312,16 @@ int ao_compute_input(const cli_options *options, exr_input *input, ao_buffers *b
     status = resolve_camera(options, input, &camera, &buffers->camera_file, error);
     if (status != TOOL_EXIT_SUCCESS) return status;
     const bool use_normals = passes.has_normal && !options->ignore_normals;
-    /* (Blender before 5.0 cuts channel names past 64 bytes: a view layer
-     * named with 56 bytes or more loses its Normal pass so) */
-    if (passes.normal_expected && !passes.has_normal && !options->ignore_normals)
+    /* Blender before 5.0 cuts channel names past 64 bytes: a view layer
+     * named with 56 bytes or more loses its Normal pass so (a layer of
+     * Depth alone, by choice, is read as it is, quietly) */
+    if (passes.normal_expected && !passes.has_normal && !options->ignore_normals &&
+        strlen(passes.layer) >= BLENDER_NORMAL_LAYER_NAME_MAX)
         tool_warn("%s: no Normal pass (%.*sX/Y/Z): normals are reconstructed from depth; "
-                  "--no-normals does so without this warning",
-                  input->path, (int)strlen(passes.normal[0]) - 1, passes.normal[0]);
+                  "Blender before 5.0 cuts the Normal pass's channel names of a view layer "
+                  "named with %d bytes or more",
+                  input->path, (int)strlen(passes.normal[0]) - 1, passes.normal[0],
+                  BLENDER_NORMAL_LAYER_NAME_MAX);
     hbao_camera cropped;
     const hbao_result cropping = camera_for_data_window(&camera.camera, &input->display_window,
                                                         &input->data_window, &cropped);
@@ -352,8 +356,9 @@ int ao_compute_input(const cli_options *options, exr_input *input, ao_buffers *b
                   "--no-normals to reconstruct normals from depth",
                   passes.normal[0]);
 
-    warn_if_depth_is_constant(input, passes.depth, buffers->depth,
-                              options->params.background_depth);
+    if (strcmp(passes.depth, "Z") == 0) /* a single-layer EXR's */
+        warn_if_depth_is_constant(input, passes.depth, buffers->depth,
+                                  options->params.background_depth);
     hbao_channel depth = {buffers->depth, 1, input->width};
     hbao_channel normal = {buffers->normal, 3, (int64_t)input->width * 3};
     hbao_channel back = {buffers->back, 1, input->width};

@@ -82,7 +82,44 @@ static int fail_on_views(const exr_input *input, tool_error *error) {
         input->path, views);
 }
 
-static int fail_listing_layers(const exr_input *input, const char *problem, tool_error *error) {
+/* A render with a single view on, which Blender 3.4 saves with the view in
+ * its channel names ("ViewLayer.Depth.left.Z", "ViewLayer.Normal.left.X"):
+ * that view's passes, true; false where the file holds no such view or
+ * several. */
+static bool one_view_passes(const exr_input *input, blender_passes *passes) {
+    const char *depth = NULL;
+    for (int c = 0; c < input->channels->num_channels; ++c) {
+        const char *view = NULL;
+        int length = 0;
+        const char *name = input->channels->entries[c].name.str;
+        if (!view_depth_name(name, &view, &length)) continue;
+        if (depth != NULL) return false;
+        depth = name;
+    }
+    if (depth == NULL) return false;
+    const char *view = NULL;
+    int view_length = 0;
+    view_depth_name(depth, &view, &view_length);
+    const int layer_length = (int)(strstr(depth, ".Depth.") - depth);
+    memset(passes, 0, sizeof *passes);
+    if (!set_name(passes->layer, depth, layer_length, "") ||
+        !set_name(passes->depth, depth, (int)strlen(depth), ""))
+        return false;
+    passes->has_normal = passes->normal_expected = true;
+    static const char axes[3] = {'X', 'Y', 'Z'};
+    for (int axis = 0; axis < 3; ++axis) {
+        const int written =
+            snprintf(passes->normal[axis], BLENDER_CHANNEL_NAME_MAX, "%.*s.Normal.%.*s.%c",
+                     layer_length, depth, view_length, view, axes[axis]);
+        if (written < 0 || written >= BLENDER_CHANNEL_NAME_MAX) return false;
+        passes->has_normal =
+            passes->has_normal && exr_input_find_channel(input, passes->normal[axis]) >= 0;
+    }
+    return true;
+}
+
+static int fail_listing_layers(const exr_input *input, const char *problem, const char *excluded,
+                               tool_error *error) {
     const int views = fail_on_views(input, error);
     if (views != TOOL_EXIT_SUCCESS) return views;
     char list[600] = "";
@@ -90,6 +127,9 @@ static int fail_listing_layers(const exr_input *input, const char *problem, tool
         const char *name = input->channels->entries[c].name.str;
         int length = depth_layer_length(name);
         if (length < 0) continue;
+        if (excluded != NULL && (size_t)length == strlen(excluded) &&
+            strncmp(name, excluded, (size_t)length) == 0)
+            continue;
         size_t used = strlen(list);
         snprintf(list + used, sizeof list - used, "%s\"%.*s\"", used ? ", " : "", length, name);
     }
@@ -113,7 +153,7 @@ int blender_find_passes(const exr_input *input, const char *requested, const cha
             char problem[BLENDER_CHANNEL_NAME_MAX + 64];
             snprintf(problem, sizeof problem, "no layer \"%s\" with a Depth pass (%s)", requested,
                      depth);
-            return fail_listing_layers(input, problem, error);
+            return fail_listing_layers(input, problem, NULL, error);
         }
         return fill_passes(input, requested, (int)strlen(requested), depth, true, passes, error);
     }
@@ -138,7 +178,7 @@ int blender_find_passes(const exr_input *input, const char *requested, const cha
         return fail_listing_layers(input,
                                    "the Depth pass is in several view layers; choose one with "
                                    "--layer NAME",
-                                   error);
+                                   excluded, error);
     if (chosen != NULL)
         return fill_passes(input, chosen, chosen_length, chosen, true, passes, error);
     /* A File Output node's Depth input writes "Depth.V" beside "Normal.X" */
@@ -146,5 +186,6 @@ int blender_find_passes(const exr_input *input, const char *requested, const cha
     for (int i = 0; i < 3; ++i)
         if (exr_input_find_channel(input, plain_depth[i]) >= 0)
             return fill_passes(input, "", 0, plain_depth[i], i < 2, passes, error);
-    return fail_listing_layers(input, "no Depth pass", error);
+    if (one_view_passes(input, passes)) return TOOL_EXIT_SUCCESS;
+    return fail_listing_layers(input, "no Depth pass", NULL, error);
 }

@@ -14,6 +14,9 @@
 #include "tool_error.h"
 
 #define BLENDER_CHANNEL_NAME_MAX 512
+/** Blender before 5.0 cuts EXR channel names to 63 bytes: a view layer named
+ *  with this many bytes or more loses its Normal pass ("<layer>.Normal.X"). */
+#define BLENDER_NORMAL_LAYER_NAME_MAX 56
 
 typedef struct blender_passes {
     char layer[BLENDER_CHANNEL_NAME_MAX]; /**< "" for a file without layers */

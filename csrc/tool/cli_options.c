@@ -345,8 +345,9 @@ static int apply_option(const option_spec *spec, const char *value, cli_options 
         case OPTION_FRAMES:
             if (!frame_list_parse(value, &options->frames))
                 return tool_fail(error, TOOL_EXIT_USAGE,
-                                 "--frames: \"%s\" is not a frame list like 1-250 or 1-10,20 "
-                                 "(frames in [0, %d], at most %d ranges, none twice)",
+                                 "--frames: \"%s\" is not a frame list like 1-250, 1-10,20 or "
+                                 "1-250x2 (frames in [0, %d], at most %d ranges, no frame "
+                                 "twice)",
                                  value, FRAME_MAX, FRAME_RANGES_MAX);
             break;
         case OPTION_JOBS:
@@ -589,8 +590,9 @@ void cli_print_help(FILE *stream) {
         "  --layer NAME            view layer to use (channels NAME.Depth.Z and, if\n"
         "                          present, NAME.Normal.X/Y/Z). Default: the one layer\n"
         "                          with a Depth pass (besides --back-layer; with several,\n"
-        "                          an error lists them); a plain `Depth.Z` or `Z` channel\n"
-        "                          is used if no layer has one.\n"
+        "                          an error lists them); a plain `Depth.Z`, `Depth.V` (a\n"
+        "                          File Output node's) or `Z` channel is used if no layer\n"
+        "                          has one.\n"
         "  --back-layer NAME       view layer whose Depth pass holds the back faces (a\n"
         "                          layer rendered with front faces transparent, e.g. a\n"
         "                          material override, 1 sample): an occluder then spans\n"
