@@ -13,7 +13,7 @@ Frames: as the CLI's --frames (1-250, 1-10,20,30-40, 1-250x2 for every second
 frame); by default the scene's range and step. The scene is the
 file's active one, or the one Blender's -S names (before --python). Each
 frame's camera is the scene's at that frame, evaluated (animation,
-constraints, parents, Time Remapping; with Cycles' camera motion blur at the
+constraints, parents, Time Remapping; with camera motion blur at the
 middle of the shutter; a cropped border render's camera is the crop's), by
 the add-on's own camera rule
 (hbao.camera.camera_for_render_result). With Stereoscopy each view gets a
@@ -103,7 +103,7 @@ STEREO_SETTINGS = ("interocular_distance", "convergence_distance", "convergence_
 def cameras_at(scene, frame):
     """{view's file suffix: camera description} of `frame` ("" alone
     without Stereoscopy): the scene camera evaluated at the time the frame's
-    passes show it (hbao.camera_time: with Cycles' camera motion blur, the
+    passes show it (hbao.camera_time: with camera motion blur, the
     middle of the shutter, as the node takes it; the camera object is the
     frame's, which markers may switch); a Stereo 3D eye's as Blender places
     it (hbao.stereo_eyes), a Multi-View view's through its own camera."""

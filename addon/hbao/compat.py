@@ -11,12 +11,10 @@ MIN_SUPPORTED_VERSION = (3, 4, 0)
 NEWEST_KNOWN_VERSION = (5, 3)
 # 4.0 replaced tree.inputs/outputs with tree.interface.
 HAS_TREE_INTERFACE = VERSION >= (4, 0, 0)
-# 5.0 replaced scene.node_tree with scene.compositing_node_group and the
-# Composite node with the group's Group Output.
+# 5.0: scene.compositing_node_group (a group with a Group Output) for node_tree.
 HAS_COMPOSITING_NODE_GROUP = VERSION >= (5, 0, 0)
-# Blender before 5.0 writes an EXR channel name of at most 64 bytes
-# (EXR_TOT_MAXNAME) and cuts a longer one: "<view layer>.Normal.X" of a view
-# layer named with 56 or more bytes cannot be read back. None: no limit.
+# Blender before 5.0 cuts an EXR channel name past 64 bytes (EXR_TOT_MAXNAME): a
+# view layer named with 56 bytes or more loses "<layer>.Normal.X". None: no limit.
 EXR_CHANNEL_NAME_MAX = 64 if VERSION < (5, 0, 0) else None
 
 
@@ -27,18 +25,14 @@ TREES_SHARED_BETWEEN_SCENES = HAS_COMPOSITING_NODE_GROUP
 # ShaderNodeValue in 5.x files and menus (old files may still hold either).
 VALUE_NODE_IDNAMES = ("CompositorNodeValue", "ShaderNodeValue")
 # 3.4 frees a node type that Python unregisters while an evaluated copy of a
-# tree (the view layer's depsgraph keeps one after any evaluation, a render
-# too) still holds nodes of that type: freeing the copy later reads the
-# freed type. Blender disables every add-on before it frees its data as it
-# quits or loads factory settings, so each quit after a render with an HBAO
-# node read freed memory (a crash under --debug-memory). On these versions
-# the node type stays registered while Blender may still read it
-# (keep_node_type_registered). 4.5 and 5.x are unaffected; the versions
-# between are untested and treated as 3.4.
+# tree (a depsgraph's, after any evaluation) still holds nodes of that type,
+# and reads it when it frees the copy, as it quits (a crash under
+# --debug-memory): there the type stays registered while Blender may read
+# it (keep_node_type_registered, docs/blender-integration.md). 4.5 and 5.x
+# are unaffected; the versions between are untested and treated as 3.4.
 NODE_TYPE_FREED_UNDER_EVALUATED_COPIES = VERSION < (4, 5, 0)
-# Image settings that saving a Render Result reads, in the order they must be
-# restored: 5.0's media_type decides which file formats are valid, so it
-# comes before file_format, and the format before its options.
+# Image settings that saving a Render Result reads, in the order they are
+# restored (5.0's media_type decides the valid formats, a format its options).
 SAVED_IMAGE_SETTINGS = ("media_type", "file_format", "color_mode", "color_depth", "exr_codec",
                         "use_exr_interleave", "use_preview", "use_zbuffer", "views_format")
 
@@ -291,9 +285,16 @@ def set_image_format(image_format, file_format):
     image_format.file_format = file_format
 
 
-def motion_blur_position(scene):
-    """START, CENTER or END: where Cycles' shutter lies about the frame
-    (RenderSettings from 4.2, Cycles' own settings before)."""
-    holder = scene.render if hasattr(scene.render, "motion_blur_position") else \
-        getattr(scene, "cycles", None)
-    return getattr(holder, "motion_blur_position", "CENTER")
+def motion_blur(scene):
+    """(START, CENTER or END, shutter in frames) of the camera motion blur of
+    the scene's engine, or None: 3.4's EEVEE keeps its own (scene.eevee),
+    Cycles its position before 4.2; the rest is RenderSettings'."""
+    render, eevee = scene.render, getattr(scene, "eevee", None)
+    if render.engine == "BLENDER_EEVEE" and VERSION < (4, 2, 0):
+        return (eevee.motion_blur_position, eevee.motion_blur_shutter) \
+            if eevee.use_motion_blur else None
+    if not render.use_motion_blur or render.engine not in ("CYCLES", engine_identifier(
+            "BLENDER_EEVEE")):
+        return None
+    holder = render if hasattr(render, "motion_blur_position") else scene.cycles
+    return holder.motion_blur_position, render.motion_blur_shutter

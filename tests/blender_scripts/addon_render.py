@@ -22,7 +22,7 @@ empty of that scale, where it was), widen_camera (factor), dump_back_faces (writ
 <out>/back_<NNNN>.npy: the back faces render's Depth, top row first), border [min_x, max_x, min_y,
 max_y] (a border render cropped to it; with crop false, not cropped), percentage (the resolution
 percentage), subframe (each frame rendered at that subframe), motion_blur ("START", "CENTER" or
-"END": Cycles' camera motion blur, shutter 1 frame; the camera written is the one at the shutter's
+"END": camera motion blur, shutter 1 frame; the camera written is the one at the shutter's
 middle, and camera_at_frame_<NNNN>.json the one at the whole frame), position_pass (Cycles'
 Position pass on), animate_camera (the camera turns and moves over frames 1-5), time_remap [old,
 new] (Time Remapping), sequencer ("override": a scene "Edit" shows the scene in a Video Sequencer
@@ -115,13 +115,17 @@ for key, value in spec.get("stereo_settings", {}).items():  # the camera's Stere
 if spec.get("position_pass"):  # Cycles' Position pass: where each pixel's surface is
     for view_layer in scene.view_layers:
         view_layer.use_pass_position = True
-if spec.get("motion_blur"):  # Cycles' camera motion blur, this shutter Position, 1 frame long
+if spec.get("motion_blur"):  # camera motion blur, this shutter Position, 1 frame long
     scene.render.use_motion_blur = True
     scene.render.motion_blur_shutter = 1.0
     if hasattr(scene.render, "motion_blur_position"):  # 4.2+
         scene.render.motion_blur_position = spec["motion_blur"]
     else:
         scene.cycles.motion_blur_position = spec["motion_blur"]
+    if bpy.app.version < (4, 2, 0):  # 3.4's EEVEE keeps its own
+        scene.eevee.use_motion_blur = True
+        scene.eevee.motion_blur_shutter = 1.0
+        scene.eevee.motion_blur_position = spec["motion_blur"]
 if spec.get("percentage"):  # the render's resolution percentage
     scene.render.resolution_percentage = spec["percentage"]
 if spec.get("border"):
