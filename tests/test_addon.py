@@ -259,6 +259,31 @@ def test_a_camera_scaled_unevenly_gets_the_ao_of_the_unscaled_one(run_in_blender
     assert np.abs(node_outputs(scaled, 1)["ao"] - expected).max() <= 1e-5
 
 
+def test_the_sky_at_clip_end_is_background(run_in_blender, tmp_path, native):
+    """EEVEE in 4.5 and 5.0 writes the sky's Depth as the camera's Clip End
+    (or a rounding of it) where 3.4 writes 65504 and 5.3 1e10: the sky was
+    then a wall at Clip End, and took AO from what stood near it (0.52 off,
+    the sky darkened: found by an exploratory run). A depth at Clip End is
+    background: AO 1, and the rest is the library's AO with that
+    background."""
+    node = {"radius": 1.0, "blur_size": 0}
+    out, log = render(run_in_blender, tmp_path, {
+        "engine": "BLENDER_EEVEE", "samples": 1, "clip_end": 5.6, "camera_tilt": 0.2,
+        "nodes": [node]})
+    assert "without AO" not in log, log[-3000:]
+    depth, normal = frame_passes(out, 1)
+    description = camera(out, 1)
+    assert description["clip_end"] == pytest.approx(5.6)
+    background = np.float32(5.6 * (1 - 1e-5))
+    sky = depth >= background
+    assert 50 < sky.sum() < depth.size - 50, sky.sum()  # sky and geometry both in view
+    ao = node_outputs(out, 1)["ao"]
+    assert ao.min() < 0.9 and np.all(ao[sky] == 1.0)
+    expected = native.compute_ao(depth, normal, camera=description,
+                                 params=dict(node_params(**node), background_depth=background))
+    assert np.abs(ao - expected).max() <= EXACT
+
+
 def position_misfit(native, out, frame, description):
     """The median distance between where `description` (a camera dict)
     puts each foreground pixel's Depth and where Cycles' Position pass says

@@ -41,6 +41,7 @@ def camera_from_blender(scene, camera_object=None):
         "pixel_aspect_x": float(render.pixel_aspect_x),
         "pixel_aspect_y": float(render.pixel_aspect_y),
         "world_to_camera": [[float(v) for v in row] for row in world_to_camera],
+        "clip_end": float(camera.clip_end),
     }
 
 
@@ -74,6 +75,22 @@ def shear(matrix):
     """The largest |cosine| between two axes of a model_matrix()."""
     axes = [matrix.col[axis].xyz for axis in range(3)]
     return max(abs(axes[0].dot(axes[1])), abs(axes[0].dot(axes[2])), abs(axes[1].dot(axes[2])))
+
+
+# EEVEE in 4.5 and 5.0 writes the sky's Depth as the camera's Clip End, or a
+# rounding of it (8.99996 for 9, 5.600006 for 5.6), where 3.4 writes 65504
+# and 5.3 1e10: a depth within this fraction of Clip End, or past it, is
+# background (nothing is rendered there). Otherwise the sky was a wall at
+# Clip End and took AO from what stands near it (0.52 off: found by an
+# exploratory run).
+CLIP_END_MARGIN = 1e-5
+
+
+def background_depth(description, depth):
+    """The background depth for a render through camera dict `description`:
+    `depth` (the parameter's), or less, from its Clip End."""
+    clip_end = description.get("clip_end")
+    return depth if clip_end is None else min(depth, clip_end * (1.0 - CLIP_END_MARGIN))
 
 
 def full_size(render):

@@ -92,7 +92,8 @@ def compute(job, depth, normal, camera, extra):
     faces and over the frame and its band when `extra` has them and the job
     wants them."""
     back = extra.back_depth if extra is not None and job.back_faces else None
-    params = dict(job.params, threads=job.threads)
+    params = dict(job.params, threads=job.threads, background_depth=camera_model.background_depth(
+        camera, job.params["background_depth"]))
     if extra is None or extra.guard_depth is None or job.guard_band <= 0.0:
         # The EXR's rows run top-down, a render pass bottom-up: views flipped, no copy.
         return native.compute_ao(depth[::-1], _flipped(normal), params=params, camera=camera,

@@ -17,37 +17,37 @@ each through its own camera Camera_L, Camera_C, Camera_R; writes camera_<NNNN><v
 suffix>.json too), stereo_settings {convergence_mode, pivot, interocular_distance, ...: the
 camera's Stereoscopy settings; no view camera written then}, stereo_off_from_frame (Stereoscopy
 turned off from that frame on), output_views_format (the main output's views format), orthographic,
-camera_scale [x, y, z] (the camera object's scale), camera_rig [x, y, z] (the camera parented to an
-empty of that scale, where it was), widen_camera (factor), dump_back_faces (writes
-<out>/back_<NNNN>.npy: the back faces render's Depth, top row first), border [min_x, max_x, min_y,
-max_y] (a border render cropped to it; with crop false, not cropped), percentage (the resolution
-percentage), subframe (each frame rendered at that subframe), motion_blur ("START", "CENTER" or
-"END": camera motion blur, shutter 1 frame; the camera written is the one at the shutter's
-middle, and camera_at_frame_<NNNN>.json the one at the whole frame), position_pass (Cycles'
-Position pass on), animate_camera (the camera turns and moves over frames 1-5), time_remap [old,
-new] (Time Remapping), sequencer ("override": a scene "Edit" shows the scene in a Video Sequencer
-strip through a camera override, "Strip Camera"; and in a second strip through the scene's camera,
-"two_cameras": at the same frames, "other_frame": showing its frame 11 at frame 1, "muted_meta":
-inside a muted meta strip; "nested": Edit shown by a strip of scene "Outer" whose input is Edit's
-sequencer; "covered": Shot replaces a strip of the scene below it; each frame renders Edit (Outer)
-first, keeping the nodes' file as strip_nodes_<NNNN>.exr, then the scene through Strip Camera;
-"failed_movie": an animation render of Edit to a movie that cannot be written, then the scene's
-frames through its own camera), save_blend_after (path: the file saved after the renders),
-save_blend (path: saved after the setup, before rendering), nodes: [{name, layer, normal (bool),
-radius, keyframes [[frame, radius], ..], radius_from_value_node, falloff, integration, blur_size,
-angle_bias, directions, steps, strength, thickness, guard_band, back_faces, mute,
-connect_with_operator (left unlinked, then linked by the node's Connect Passes operator after the
-passes are disabled)}], disable_normal_pass, disable_depth_pass, output_format (the main output's
-file format, default OPEN_EXR_MULTILAYER), prepare [actions before rendering: sync,
-compositing_off, delete_helper, delete_extra_renders, rename_helper, pick_internal_engine,
-render_the_helper, rename_node, second_scene_shares_the_tree, group_last_node (the last HBAO node
-moved into a node group of the artist's), layer_not_rendered, mute_render_layers,
-switch_to_workbench], render_threads ({frame: the Performance panel's threads, 0 for Auto}),
-layer_name (the first view layer's), single_layer (Render Single Layer on), user_handlers (a
-pipeline's own render and frame change handlers, which print USER HANDLERS {json}: the scenes each
-list's handler saw, in order; render_stats leaves out repeats of the scene before). Prints OUTPUT
-SETTINGS {json} (the main output's settings after the renders), STATUS {json} (each node's status
-line) and RENDERED.
+clip_end (the camera's), camera_tilt (radians the camera turns up), camera_scale [x, y, z] (the
+camera object's scale), camera_rig [x, y, z] (the camera parented to an empty of that scale, where
+it was), widen_camera (factor), dump_back_faces (writes <out>/back_<NNNN>.npy: the back faces
+render's Depth, top row first), border [min_x, max_x, min_y, max_y] (a border render cropped to it;
+with crop false, not cropped), percentage (the resolution percentage), subframe (each frame
+rendered at that subframe), motion_blur ("START", "CENTER" or "END": camera motion blur, shutter 1
+frame; the camera written is the one at the shutter's middle, and camera_at_frame_<NNNN>.json the
+one at the whole frame), position_pass (Cycles' Position pass on), animate_camera (the camera turns
+and moves over frames 1-5), time_remap [old, new] (Time Remapping), sequencer ("override": a scene
+"Edit" shows the scene in a Video Sequencer strip through a camera override, "Strip Camera"; and in
+a second strip through the scene's camera, "two_cameras": at the same frames, "other_frame":
+showing its frame 11 at frame 1, "muted_meta": inside a muted meta strip; "nested": Edit shown by a
+strip of scene "Outer" whose input is Edit's sequencer; "covered": Shot replaces a strip of the
+scene below it; each frame renders Edit (Outer) first, keeping the nodes' file as
+strip_nodes_<NNNN>.exr, then the scene through Strip Camera; "failed_movie": an animation render of
+Edit to a movie that cannot be written, then the scene's frames through its own camera),
+save_blend_after (path: the file saved after the renders), save_blend (path: saved after the setup,
+before rendering), nodes: [{name, layer, normal (bool), radius, keyframes [[frame, radius], ..],
+radius_from_value_node, falloff, integration, blur_size, angle_bias, directions, steps, strength,
+thickness, guard_band, back_faces, mute, connect_with_operator (left unlinked, then linked by the
+node's Connect Passes operator after the passes are disabled)}], disable_normal_pass,
+disable_depth_pass, output_format (the main output's file format, default OPEN_EXR_MULTILAYER),
+prepare [actions before rendering: sync, compositing_off, delete_helper, delete_extra_renders,
+rename_helper, pick_internal_engine, render_the_helper, rename_node, second_scene_shares_the_tree,
+group_last_node (the last HBAO node moved into a node group of the artist's), layer_not_rendered,
+mute_render_layers, switch_to_workbench], render_threads ({frame: the Performance panel's threads,
+0 for Auto}), layer_name (the first view layer's), single_layer (Render Single Layer on),
+user_handlers (a pipeline's own render and frame change handlers, which print USER HANDLERS {json}:
+the scenes each list's handler saw, in order; render_stats leaves out repeats of the scene before).
+Prints OUTPUT SETTINGS {json} (the main output's settings after the renders), STATUS {json} (each
+node's status line) and RENDERED.
 """
 import json
 import math
@@ -80,6 +80,10 @@ if spec.get("ao_reference"):
     blender_scenes.configure_ao_reference(scene, spec["ao_reference"])
 if spec.get("orthographic"):
     blender_scenes.make_orthographic(scene)
+if spec.get("clip_end"):  # the camera's Clip End
+    scene.camera.data.clip_end = spec["clip_end"]
+if spec.get("camera_tilt"):  # the camera turned up (radians about its x axis)
+    scene.camera.rotation_euler.x += spec["camera_tilt"]
 if spec.get("camera_rig"):  # the camera inside an empty of this scale, where it was
     rig = bpy.data.objects.new("Rig", None)
     scene.collection.objects.link(rig)
