@@ -574,6 +574,38 @@ def test_a_single_view_file_and_the_layers_listed(hbao_tool, tmp_path):
     assert '"C"' not in listed.stderr
 
 
+def test_the_sky_at_the_cameras_clip_end_is_background(hbao_tool, tmp_path):
+    """EEVEE in 4.5 and 5.0 writes the sky's Depth as the camera's Clip End
+    (5.600006 for 5.6): with the camera file's clip_end (export_cameras.py
+    writes it) such a depth is background, AO 1, as the node takes it; it
+    was a wall that took AO from what stood before it. The margin is the
+    add-on's (addon/hbao/camera.py)."""
+    from hbao import camera as camera_model
+    header = (REPO / "csrc" / "tool" / "camera_settings.h").read_text()
+    margin = float(re.search(r"#define CAMERA_CLIP_END_MARGIN (\S+)", header).group(1))
+    assert margin == camera_model.CLIP_END_MARGIN
+    depth = np.full((48, 64), 5.0, np.float32)
+    depth[:16] = 5.600006  # the sky, above a box standing before the wall
+    depth[16:30, 20:40] = 4.5
+    source = tmp_path / "sky.exr"
+    source.write_bytes(scanline_exr({"ViewLayer.Depth.Z": depth}, 64, 48))
+    ao = {}
+    for name, description in (("with", {"lens": 20.0, "clip_end": 5.6}),
+                              ("without", {"lens": 20.0})):
+        (tmp_path / f"{name}.json").write_text(json.dumps(description))
+        run_ok(hbao_tool, source, "-o", tmp_path / f"{name}.exr", "--camera",
+               tmp_path / f"{name}.json", "--radius", "2", "--blur", "0")
+        from hbao import exr_passes
+        ao[name] = exr_passes.read_channels(tmp_path / f"{name}.exr", ["AO"])["AO"]
+    assert ao["without"][:16].min() < 0.9  # the sky as a wall: shaded by the box
+    assert np.all(ao["with"][:16] == 1.0)
+    assert ao["with"][16:].min() < 0.9  # the box and wall keep their AO
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps({"clip_end": -1}))
+    refused = run_tool(hbao_tool, source, "-o", tmp_path / "bad.exr", "--camera", bad)
+    assert_clean_error(refused, EXIT_RUNTIME, '"clip_end" must be > 0')
+
+
 def test_a_file_output_nodes_depth_and_a_constant_depth(hbao_tool, tmp_path):
     """A File Output node's Depth input writes "Depth.V" (its Normal
     "Normal.X/Y/Z"): read as a render's Depth.Z is. A layer named too long

@@ -362,10 +362,12 @@ int ao_compute_input(const cli_options *options, exr_input *input, ao_buffers *b
     hbao_channel depth = {buffers->depth, 1, input->width};
     hbao_channel normal = {buffers->normal, 3, (int64_t)input->width * 3};
     hbao_channel back = {buffers->back, 1, input->width};
-    hbao_result result =
-        hbao_compute_layers(&options->params, &cropped, input->width, input->height, &depth,
-                            use_normals ? &normal : NULL, buffers->back != NULL ? &back : NULL,
-                            buffers->ao, input->width);
+    /* a sky written at the camera's clip end (EEVEE in 4.5 and 5.0) is background */
+    hbao_params params = options->params;
+    params.background_depth = camera_background_depth(&camera, params.background_depth);
+    hbao_result result = hbao_compute_layers(
+        &params, &cropped, input->width, input->height, &depth, use_normals ? &normal : NULL,
+        buffers->back != NULL ? &back : NULL, buffers->ao, input->width);
     if (result != HBAO_SUCCESS)
         return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: cannot compute AO: %s", options->input_path,
                          hbao_result_message(result));

@@ -143,6 +143,16 @@ int camera_json_parse(const char *text, const char *source, camera_settings *set
         }
         settings->fields_set |= field->field;
     }
+    const cJSON *clip_end = cJSON_GetObjectItemCaseSensitive(root, "clip_end");
+    if (clip_end != NULL) {
+        status = read_number(clip_end, "\"clip_end\"", source, &settings->clip_end, error);
+        if (status != TOOL_EXIT_SUCCESS) goto done;
+        if (!(settings->clip_end > 0.0f)) {
+            status = tool_fail(error, TOOL_EXIT_RUNTIME, "%s: \"clip_end\" must be > 0", source);
+            goto done;
+        }
+        settings->fields_set |= CAMERA_FIELD_CLIP_END;
+    }
     status = read_matrix(root, settings, source, error);
 done:
     cJSON_Delete(root);

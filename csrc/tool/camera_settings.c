@@ -6,7 +6,14 @@
 void camera_settings_init(camera_settings *settings) {
     hbao_camera defaults = HBAO_CAMERA_DEFAULT_INITIALIZER;
     settings->camera = defaults;
+    settings->clip_end = 0.0f;
     settings->fields_set = 0;
+}
+
+float camera_background_depth(const camera_settings *settings, float background_depth) {
+    if (!(settings->fields_set & CAMERA_FIELD_CLIP_END)) return background_depth;
+    const float at_clip_end = (float)((double)settings->clip_end * (1.0 - CAMERA_CLIP_END_MARGIN));
+    return at_clip_end < background_depth ? at_clip_end : background_depth;
 }
 
 void camera_settings_apply(camera_settings *base, const camera_settings *override) {
@@ -25,6 +32,7 @@ void camera_settings_apply(camera_settings *base, const camera_settings *overrid
     if (set & CAMERA_FIELD_PIXEL_ASPECT_Y) to->pixel_aspect_y = from->pixel_aspect_y;
     if (set & CAMERA_FIELD_WORLD_TO_CAMERA)
         memcpy(to->world_to_camera, from->world_to_camera, sizeof to->world_to_camera);
+    if (set & CAMERA_FIELD_CLIP_END) base->clip_end = override->clip_end;
     base->fields_set |= set;
 }
 

@@ -25,13 +25,25 @@ enum {
     CAMERA_FIELD_ORTHO_SCALE = 1u << 7,
     CAMERA_FIELD_PIXEL_ASPECT_X = 1u << 8,
     CAMERA_FIELD_PIXEL_ASPECT_Y = 1u << 9,
-    CAMERA_FIELD_WORLD_TO_CAMERA = 1u << 10
+    CAMERA_FIELD_WORLD_TO_CAMERA = 1u << 10,
+    CAMERA_FIELD_CLIP_END = 1u << 11 /**< clip_end, not an hbao_camera field */
 };
+
+/** A depth within this fraction of the camera's clip end, or past it, is
+ *  background: EEVEE in Blender 4.5 and 5.0 writes the sky's depth as the
+ *  clip end, or a rounding of it (addon/hbao/camera.py's CLIP_END_MARGIN,
+ *  held to this by tests/test_cli.py). */
+#define CAMERA_CLIP_END_MARGIN 1e-5
 
 typedef struct camera_settings {
     hbao_camera camera; /**< only the fields named in fields_set are meaningful */
+    float clip_end;     /**< Blender's camera clip_end (CAMERA_FIELD_CLIP_END) */
     uint32_t fields_set;
 } camera_settings;
+
+/** `background_depth`, or less where the settings know the camera's clip
+ *  end (CAMERA_CLIP_END_MARGIN). */
+float camera_background_depth(const camera_settings *settings, float background_depth);
 
 /** No field set; the values are Blender's defaults. */
 void camera_settings_init(camera_settings *settings);
