@@ -58,10 +58,14 @@ def test_fixtures_hold_the_expected_layers_and_passes(run_blender, tmp_path):
             assert set(description["layers"][layer]) == passes, (name, layer)
 
 
-def check_camera_description(camera, name):
-    assert set(camera) == set(CAMERA_KEYS), name
-    for key, kind in CAMERA_KEYS.items():
+def check_camera_description(camera, name, written_now=False):
+    """`camera` has CAMERA_KEYS and, written by today's scripts (not the
+    fixtures' older files), the camera's clip_end too."""
+    keys = dict(CAMERA_KEYS, clip_end=float) if written_now else CAMERA_KEYS
+    assert set(camera) == set(keys), name
+    for key, kind in keys.items():
         assert isinstance(camera[key], kind), (name, key)
+    assert camera.get("clip_end", 1.0) > 0, name
     assert camera["type"] in ("PERSP", "ORTHO"), name
     assert camera["sensor_fit"] in ("AUTO", "HORIZONTAL", "VERTICAL"), name
     assert camera["lens"] > 0 and camera["ortho_scale"] > 0, name
@@ -117,7 +121,7 @@ def test_render_passes_writes_what_was_asked_and_keeps_existing_files(run_blende
     assert completed.returncode == 0, completed.stdout[-3000:]
     exr = tmp_path / "small.exr"
     camera = json.loads((tmp_path / "small.camera.json").read_text())
-    check_camera_description(camera, "small")
+    check_camera_description(camera, "small", written_now=True)
     assert camera["type"] == "ORTHO"
 
     found = passes_found(run_blender, tmp_path, [exr])[str(exr)]
