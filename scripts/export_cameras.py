@@ -48,7 +48,7 @@ try:
 except ImportError:
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "addon"))
 from hbao import camera as camera_model  # noqa: E402
-from hbao import camera_time, stereo_eyes, view_cameras, view_files  # noqa: E402
+from hbao import camera_time, compat, stereo_eyes, view_cameras, view_files  # noqa: E402
 
 EXIT_BAD_ARGUMENTS = 2
 EXIT_FAILED = 1
@@ -122,6 +122,8 @@ def cameras_at(scene, frame):
         return {"": camera_model.camera_for_render_result(scene, camera.evaluated_get(depsgraph))}
     found = {}
     for name, suffix in views:
+        if len(views) == 1 and compat.SINGLE_VIEW_WITHOUT_SUFFIX:  # as Blender names the render
+            suffix = ""
         if scene.render.views_format == "MULTIVIEW":
             seen = view_cameras.multiview_camera(scene, camera, name).evaluated_get(depsgraph)
             found[suffix] = camera_model.camera_for_render_result(scene, seen)

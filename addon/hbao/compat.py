@@ -18,9 +18,10 @@ HAS_COMPOSITING_NODE_GROUP = VERSION >= (5, 0, 0)
 EXR_CHANNEL_NAME_MAX = 64 if VERSION < (5, 0, 0) else None
 
 
-# 5.0 lets several scenes use one compositing node group (an ID of its own);
-# before, each scene's tree was embedded in the scene.
+# 5.0 lets several scenes share one compositing node group (an ID of its own).
 TREES_SHARED_BETWEEN_SCENES = HAS_COMPOSITING_NODE_GROUP
+# A stereo render with one view on: render_0001.exr in 3.4, _L.exr in 4.5+.
+SINGLE_VIEW_WITHOUT_SUFFIX = VERSION < (4, 5, 0)
 # The Value node's idname: the compositor's own until 4.x, the shared
 # ShaderNodeValue in 5.x files and menus (old files may still hold either).
 VALUE_NODE_IDNAMES = ("CompositorNodeValue", "ShaderNodeValue")
@@ -31,8 +32,7 @@ VALUE_NODE_IDNAMES = ("CompositorNodeValue", "ShaderNodeValue")
 # it (keep_node_type_registered, docs/blender-integration.md). 4.5 and 5.x
 # are unaffected; the versions between are untested and treated as 3.4.
 NODE_TYPE_FREED_UNDER_EVALUATED_COPIES = VERSION < (4, 5, 0)
-# Image settings that saving a Render Result reads, in the order they are
-# restored (5.0's media_type decides the valid formats, a format its options).
+# Image settings a Render Result's save reads, in their order of restoring.
 SAVED_IMAGE_SETTINGS = ("media_type", "file_format", "color_mode", "color_depth", "exr_codec",
                         "use_exr_interleave", "use_preview", "use_zbuffer", "views_format")
 
