@@ -118,6 +118,13 @@ static bool one_view_passes(const exr_input *input, blender_passes *passes) {
     return true;
 }
 
+/* Whether the layer prefix of `name` (its first `length` bytes) is `layer`
+ * (NULL: no layer). */
+static bool is_layer(const char *name, int length, const char *layer) {
+    return layer != NULL && (size_t)length == strlen(layer) &&
+           strncmp(name, layer, (size_t)length) == 0;
+}
+
 static int fail_listing_layers(const exr_input *input, const char *problem, const char *excluded,
                                tool_error *error) {
     const int views = fail_on_views(input, error);
@@ -127,9 +134,7 @@ static int fail_listing_layers(const exr_input *input, const char *problem, cons
         const char *name = input->channels->entries[c].name.str;
         int length = depth_layer_length(name);
         if (length < 0) continue;
-        if (excluded != NULL && (size_t)length == strlen(excluded) &&
-            strncmp(name, excluded, (size_t)length) == 0)
-            continue;
+        if (is_layer(name, length, excluded)) continue;
         size_t used = strlen(list);
         snprintf(list + used, sizeof list - used, "%s\"%.*s\"", used ? ", " : "", length, name);
     }
@@ -166,9 +171,7 @@ int blender_find_passes(const exr_input *input, const char *requested, const cha
         const char *name = input->channels->entries[c].name.str;
         const int length = depth_layer_length(name);
         if (length < 0) continue;
-        if (excluded != NULL && (size_t)length == strlen(excluded) &&
-            strncmp(name, excluded, (size_t)length) == 0)
-            continue;
+        if (is_layer(name, length, excluded)) continue;
         if (candidates++ == 0) {
             chosen = name;
             chosen_length = length;
