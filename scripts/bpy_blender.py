@@ -15,6 +15,7 @@ frame (-f) or the animation (-a) to -o, or run SCRIPT with sys.argv ending in
 import argparse
 import os
 import runpy
+import shutil
 import sys
 import threading
 import time
@@ -92,9 +93,20 @@ def wait_for_python_threads(timeout_s=60.0):
             thread.join(max(0.0, deadline - time.monotonic()))
 
 
+def remove_session_temp_folder():
+    """Blender's WM_exit removes the folder it made for its session
+    (bpy.app.tempdir, "blender_XXXXXX" in TMPDIR); this stand-in leaves
+    through os._exit, which would leave one such folder per run."""
+    bpy = sys.modules.get("bpy")
+    folder = bpy.app.tempdir if bpy is not None else ""
+    if folder and os.path.basename(os.path.normpath(folder)).startswith("blender_"):
+        shutil.rmtree(folder, ignore_errors=True)
+
+
 if __name__ == "__main__":
     status = main(sys.argv[1:])
     wait_for_python_threads()
+    remove_session_temp_folder()
     # bpy 4.5's module can deadlock in its C++ static destructors at exit
     # (its delayed file-close thread still waits on the condition variable
     # being destroyed; seen after a render whose render_pre handler changed

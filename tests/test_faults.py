@@ -23,13 +23,20 @@ RENDER_SCRIPT = REPO / "tests" / "blender_scripts" / "addon_render.py"
 @pytest.fixture
 def no_leftovers(tmp_path, monkeypatch):
     """The add-on's scratch folder (HBAO_TEMP_DIR, where it writes the Render
-    Result for its own reading) is private to the test and empty after it."""
+    Result for its own reading) is private to the test and empty after it;
+    so is Blender's own temporary folder (TMPDIR: Blender's session folder,
+    which it removes as it exits)."""
     scratch = tmp_path / "scratch"
+    system_temp = tmp_path / "tmp"
     scratch.mkdir()
+    system_temp.mkdir()
     monkeypatch.setenv("HBAO_TEMP_DIR", str(scratch))
+    monkeypatch.setenv("TMPDIR", str(system_temp))
     yield scratch
     left = sorted(p.name for p in scratch.iterdir())
     assert not left, f"temporary files left behind: {left}"
+    left = sorted(p.name for p in system_temp.iterdir())
+    assert not left, f"Blender's temporary folders left behind: {left}"
 
 
 def output_settings(log):
