@@ -1229,3 +1229,29 @@ def test_scratch_file_stays_until_the_ao_is_computed(run_in_blender, tmp_path, m
     for at_ao, number in zip(seen, (0, 0, 1, 1)):
         assert any(name.endswith(f"-{number}.exr") for name in at_ao), seen
     assert list(scratch.iterdir()) == []
+
+
+def test_an_appended_scene_uses_the_add_ons_one_group_upgraded(run_in_blender, tmp_path):
+    """File > Append of a scene saved by an older add-on into a file that has
+    the add-on's group: the appended node moves to that one group (no
+    ".HBAO.001" beside it, left at the old layout with float sockets) and
+    keeps its values, link and keyframes (ui_old_file.py: Directions 8, Steps
+    from a Value node, Blur Size keyed 3 at frame 1 and 9 at frame 11)."""
+    old = tmp_path / "old.blend"
+    saved = run_in_blender(SCRIPTS / "ui_old_file.py", old)
+    assert "OLD SOCKET NodeSocketFloat" in saved.stdout, saved.stdout[-3000:]
+    out = tmp_path / "out"
+    out.mkdir()
+    completed = run_in_blender(SCRIPTS / "addon_append_groups.py", old, out)
+    line = next((text for text in completed.stdout.splitlines() if text.startswith("GROUPS ")),
+                None)
+    assert line is not None, completed.stdout[-3000:]
+    report = json.loads(line[len("GROUPS "):])
+    assert report["groups"] == [".HBAO"] and report["used"] == [".HBAO"], report
+    assert report["socket_types"] == {name: "NodeSocketInt"
+                                      for name in ("Directions", "Steps", "Blur Size")}, report
+    assert report["directions"] == 8 and report["steps_source"] == ["Steps Value"], report
+    assert report["depth_linked"], report
+    assert report["blur_at_1"] == 3 and report["blur_at_11"] == 9, report
+    assert "without AO" not in completed.stdout, completed.stdout[-3000:]
+    assert (out / "frame.png").is_file(), completed.stdout[-3000:]

@@ -18,9 +18,28 @@ _sync_scheduled = False
 _REFUSED_RETRY_S = 0.25
 
 
+def _adopt_group_copies(scenes):
+    """The HBAO nodes that came with a group of their own (File > Append) use
+    the shared one (node_group.adopt_group_copies). Returns whether Blender
+    refused the write for the moment. Not at a render's start: bpy 5.3
+    crashed when a node's group changed in render_pre."""
+    try:
+        node.adopt_group_copies_of(scenes)
+    except Exception as error:  # never break the user's session
+        if writes.writes_refused(error):
+            return True
+        log(f"could not give the HBAO nodes the add-on's group: {error}")
+    return False
+
+
+def _sync_everything():
+    """Every scene's nodes and hook; whether Blender refused a write."""
+    return _adopt_group_copies(bpy.data.scenes) or helper_scene.sync_all()
+
+
 def _timer_sync():
     global _sync_scheduled
-    if not writes.writes_allowed() or helper_scene.sync_all():
+    if not writes.writes_allowed() or _sync_everything():
         return _REFUSED_RETRY_S  # still scheduled
     _sync_scheduled = False
     return None  # run once
@@ -28,7 +47,7 @@ def _timer_sync():
 
 def _sync_all_or_later():
     """sync_all() from a handler; what Blender refused waits for the timer."""
-    if helper_scene.sync_all():
+    if _sync_everything():
         log("Blender refused to update the HBAO hook just now; it is updated later "
             "(or at the render)")
         schedule_sync()

@@ -12,8 +12,8 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, St
 
 from . import compat, guard_geometry, node_lines, node_place, parameters, report, writes
 from .node_group import (AO_OUTPUT, AO_PASS_INPUT, DEPTH_INPUT, GROUP_TREE_NAME,  # noqa: F401
-                         IMAGE_INPUT, IMAGE_OUTPUT, NORMAL_INPUT, VALUE_INPUTS, group_tree,
-                         upgrade_group_tree)
+                         IMAGE_INPUT, IMAGE_OUTPUT, NORMAL_INPUT, VALUE_INPUTS,
+                         adopt_group_copies, group_tree, upgrade_group_tree)
 from .parameters import FALLOFF_ITEMS, INTEGRATION_ITEMS
 
 NODE_IDNAME = "CompositorNodeHBAO"
@@ -34,6 +34,13 @@ def is_hbao_node(node):
 def hbao_nodes(tree):
     """The HBAO nodes at the top level of a compositor tree."""
     return [node for node in tree.nodes if is_hbao_node(node)] if tree else []
+
+
+def adopt_group_copies_of(scenes):
+    """node_group.adopt_group_copies for the HBAO nodes of `scenes`'
+    compositor trees (5.x scenes may share one)."""
+    trees = {tree.as_pointer(): tree for tree in map(compat.compositor_tree, scenes) if tree}
+    return adopt_group_copies([node for tree in trees.values() for node in hbao_nodes(tree)])
 
 
 def pass_name(node):

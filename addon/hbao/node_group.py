@@ -135,6 +135,11 @@ def _output_links(node):
             for socket in node.outputs for link in socket.links]
 
 
+def _node_state(node):
+    """What _restore needs to give `node` its values and links again."""
+    return {socket.name: _socket_state(socket) for socket in node.inputs}, _output_links(node)
+
+
 def _restore(node, states, targets):
     tree = node.id_data
     for output_name, to_name, index in targets:
@@ -161,11 +166,31 @@ def upgrade_group_tree():
     tree = bpy.data.node_groups.get(GROUP_TREE_NAME)
     if tree is None or _is_current(tree) or tree.library is not None:
         return
-    saved = [(node, {socket.name: _socket_state(socket) for socket in node.inputs},
-              _output_links(node)) for node in _users(tree)]
+    saved = [(node, *_node_state(node)) for node in _users(tree)]
     _build_group_tree(tree)
     for node, states, targets in saved:
         _restore(node, states, targets)
+
+
+def adopt_group_copies(nodes):
+    """Point each of `nodes` (HBAO nodes) that uses another local group than
+    the shared one at the shared, current group, keeping its values and
+    links: File > Append brings an appended scene's own copy (".HBAO.001"),
+    perhaps of an older layout, which upgrade_group_tree does not see. A copy
+    left without users is removed. Returns how many nodes moved."""
+    strays = [node for node in nodes if node.node_tree is None or (
+        node.node_tree.name != GROUP_TREE_NAME and node.node_tree.library is None)]
+    if not strays:
+        return 0
+    shared = group_tree()
+    for node in strays:
+        copy = node.node_tree
+        states, targets = _node_state(node)
+        node.node_tree = shared
+        _restore(node, states, targets)
+        if copy is not None and copy.users == int(copy.use_fake_user):
+            bpy.data.node_groups.remove(copy)
+    return len(strays)
 
 
 def group_tree():
