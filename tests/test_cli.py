@@ -742,6 +742,24 @@ def test_corrupt_truncated_empty_and_missing_inputs(hbao_tool, tmp_path):
     assert leftover_temporary_files(tmp_path) == []
 
 
+def test_an_input_that_is_a_folder_or_a_fifo_says_so_and_never_waits(hbao_tool, tmp_path):
+    """--info on a FIFO waited for a writer forever (the AO refused it); a
+    folder's message was OpenEXR's read error. Both modes now say what the
+    path is; a camera file that is a folder says why it cannot be read."""
+    folder = tmp_path / "folder.exr"
+    folder.mkdir()
+    fifo = tmp_path / "fifo.exr"
+    os.mkfifo(fifo)
+    for path, kind in ((folder, "a directory"), (fifo, "a FIFO")):
+        for arguments in ([path, "-o", tmp_path / "out.exr"], ["--info", path]):
+            completed = run_tool(hbao_tool, *arguments)
+            assert_clean_error(completed, EXIT_RUNTIME, f"{path} is {kind}, not an EXR file")
+    assert not (tmp_path / "out.exr").exists()
+    camera = run_tool(hbao_tool, fixture_path("cycles_float_zip"), "-o", tmp_path / "out.exr",
+                      "--camera", folder)
+    assert_clean_error(camera, EXIT_RUNTIME, f"cannot read camera file {folder}: Is a directory")
+
+
 def test_fuzzed_inputs_never_crash(hbao_tool, tmp_path):
     """Random truncations and byte changes of every fixture, through
     scripts/fuzz_cli.sh (the one mutation loop): always exit 0, or 1 with a
@@ -1081,6 +1099,47 @@ def test_unwritable_output_folder_is_an_error(hbao_tool, tmp_path):
     assert_clean_error(completed, EXIT_RUNTIME, "no_such_folder")
 
 
+def run_with_closed(tool, closing, *arguments):
+    """The tool started with some standard descriptors closed (`closing`:
+    bash redirections such as ">&-")."""
+    script = 'exec "$0" "$@" ' + closing
+    return subprocess.run(["bash", "-c", script, str(tool)] + [str(a) for a in arguments],
+                          stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                          timeout=TOOL_TIMEOUT_S)
+
+
+def test_closed_standard_descriptors_are_never_the_tools_files(hbao_tool, tmp_path):
+    """A caller that closed stdout (`>&-`): the input, opened first, would
+    take descriptor 1, and -o /dev/stdout named the input, which the AO then
+    replaced. With all three closed, the temporary outputs took 1 and 2 and
+    the tool's warning and progress lines went into them. Each closed one is
+    /dev/null now: the input is kept and the outputs are a normal run's."""
+    source = tmp_path / "render.exr"
+    shutil.copyfile(fixture_path("cycles_float_zip"), source)
+    before = source.read_bytes()
+    camera = camera_path("cycles_float_zip")
+    for closing in (">&-", "2>&- >&-"):
+        completed = run_with_closed(hbao_tool, closing, source, "-o", "/dev/stdout",
+                                    "--camera", camera)
+        assert completed.returncode == 0 and source.read_bytes() == before, closing
+    # a warning (normals without a camera matrix) and a sequence's progress
+    expected = tmp_path / "expected"
+    expected.mkdir()
+    run_ok(hbao_tool, source, "-o", expected / "a.exr", "--preview", expected / "a.png")
+    folder = tmp_path / "closed"
+    folder.mkdir()
+    for frame in (1, 2, 3):
+        shutil.copyfile(source, folder / f"render_{frame}.exr")
+    closed = run_with_closed(hbao_tool, "<&- >&- 2>&-", folder / "render_#.exr", "-o",
+                             folder / "ao_#.exr", "--preview", folder / "ao_#.png",
+                             "--frames", "1-3", "--jobs", "2")
+    assert closed.returncode == 0
+    for frame in (1, 2, 3):
+        assert (folder / f"ao_{frame}.exr").read_bytes() == (expected / "a.exr").read_bytes()
+        assert (folder / f"ao_{frame}.png").read_bytes() == (expected / "a.png").read_bytes()
+    assert source.read_bytes() == before
+
+
 def test_the_tool_runs_from_a_workers_folder_and_an_install_prefix(hbao_tool, tmp_path):
     """A render farm worker gets hbao and libhbao.so.0 in one folder, or a
     `cmake --install` prefix: the tool finds its library there ($ORIGIN),
@@ -1196,6 +1255,33 @@ def test_sequence_redoes_frames_computed_with_other_flags(hbao_tool, tmp_path):
     redone = run_sequence(hbao_tool, folder, "--radius", "0.5")
     assert redone.stderr.count("is up to date, skipped") == 2
     assert "frame 1: " in redone.stderr and b"hbaoSettings" in foreign.read_bytes()
+
+
+def test_sequence_redoes_frames_whose_camera_clip_end_changed(hbao_tool, tmp_path):
+    """The camera file's clip_end decides which depths are background: a
+    rerun with one that differs only there recomputes (it was taken as up
+    to date: the stamp left clip_end out)."""
+    folder = tmp_path / "sequence"
+    folder.mkdir()
+    shutil.copyfile(fixture_path("cycles_float_zip"), folder / "render_0001.exr")
+    camera = json.loads(camera_path("cycles_float_zip").read_text())
+    cameras = {}
+    for name, clip_end in (("far", 100.0), ("near", 5.5)):
+        cameras[name] = tmp_path / f"{name}.json"
+        cameras[name].write_text(json.dumps(dict(camera, clip_end=clip_end)))
+    os.utime(folder / "render_0001.exr", (1e9, 1e9))
+    for path in cameras.values():
+        os.utime(path, (1e9, 1e9))  # both older than any output
+    outputs = {}
+    for name in ("far", "near"):
+        completed = run_ok(hbao_tool, folder / "render_####.exr", "-o", folder / "ao_####.exr",
+                           "--camera", cameras[name], "--frames", "1")
+        assert "up to date" not in completed.stderr, (name, completed.stderr)
+        outputs[name] = (folder / "ao_0001.exr").read_bytes()
+        single = tmp_path / f"single_{name}.exr"
+        run_ok(hbao_tool, folder / "render_0001.exr", "-o", single, "--camera", cameras[name])
+        assert outputs[name] == single.read_bytes(), name
+    assert outputs["far"] != outputs["near"]
 
 
 def test_an_input_replaced_while_its_ao_is_computed_gets_no_output(hbao_tool, tmp_path):

@@ -317,10 +317,26 @@ fail:
     return status;
 }
 
+/* What a path that is not a regular file is, for its message. */
+static const char *file_kind(mode_t mode) {
+    if (S_ISDIR(mode)) return "a directory";
+    if (S_ISFIFO(mode)) return "a FIFO";
+    if (S_ISCHR(mode)) return "a character device";
+    if (S_ISBLK(mode)) return "a block device";
+    if (S_ISSOCK(mode)) return "a socket";
+    return "not a regular file";
+}
+
 int exr_input_open(exr_input *input, const char *path, tool_error *error) {
     memset(input, 0, sizeof *input); /* input->stream: not open */
     input->path = path;
     input->threads = 1;
+    /* Only a regular file is read: opening a FIFO waits for a writer
+     * (hbao --info FIFO hung), and a folder's read error says nothing. */
+    struct stat file;
+    if (stat(path, &file) == 0 && !S_ISREG(file.st_mode))
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "%s is %s, not an EXR file", path,
+                         file_kind(file.st_mode));
     exr_clear_last_error();
     exr_context_initializer_t initializer = exr_quiet_initializer();
     exr_stream_open(&input->stream, path, &initializer);

@@ -381,8 +381,7 @@ int ao_command(const cli_options *options, tool_error *error) {
             error, TOOL_EXIT_RUNTIME, "cannot open %s: %s%s", options->input_path, strerror(errno),
             strchr(options->input_path, '#') != NULL ? " (for an image sequence, give --frames)"
                                                      : "");
-    if (!S_ISREG(input_status.st_mode))
-        return tool_fail(error, TOOL_EXIT_RUNTIME, "%s is not a regular file", options->input_path);
+    /* (an input that is not a regular file: exr_input_open says what it is) */
     int status = refuse_overwriting_input(options->output_path, "-o", &input_status,
                                           options->camera_path, error);
     if (status == TOOL_EXIT_SUCCESS && options->preview_path != NULL)

@@ -169,12 +169,15 @@ int camera_json_load(const char *path, camera_settings *settings, tool_error *er
         fclose(file);
         return tool_fail(error, TOOL_EXIT_RUNTIME, "out of memory");
     }
+    errno = 0;
     size_t length = fread(text, 1, CAMERA_JSON_MAX_BYTES + 1, file);
-    int read_failed = ferror(file);
+    const int read_errno = ferror(file) ? errno : 0; /* a folder: EISDIR */
+    const int read_failed = ferror(file);
     fclose(file);
     int status;
     if (read_failed)
-        status = tool_fail(error, TOOL_EXIT_RUNTIME, "cannot read camera file %s", path);
+        status = tool_fail(error, TOOL_EXIT_RUNTIME, "cannot read camera file %s: %s", path,
+                           read_errno != 0 ? strerror(read_errno) : "read error");
     else if (length > CAMERA_JSON_MAX_BYTES)
         status = tool_fail(error, TOOL_EXIT_RUNTIME, "camera file %s is larger than %d bytes", path,
                            CAMERA_JSON_MAX_BYTES);

@@ -4,8 +4,10 @@
  * See `hbao --help` (cli_options.c) for the command line.
  */
 #include <errno.h>
+#include <fcntl.h>
 #include <signal.h>
 #include <stdio.h>
+#include <unistd.h>
 
 #include "ao_command.h"
 #include "cli_options.h"
@@ -20,7 +22,31 @@ static void print_version(void) {
            HBAO_VERSION_PATCH, version / 10000, version / 100 % 100, version % 100);
 }
 
+/* A standard descriptor the caller closed (`>&-`, a daemon) would be the
+ * next file the tool opens: the input, whose name /dev/stdout would then
+ * be, so that -o /dev/stdout replaced it; or a temporary output, which the
+ * tool's own messages would then be written into. Each closed one is
+ * opened on /dev/null first (open takes the lowest free descriptor).
+ * False where that fails. */
+static bool open_closed_standard_descriptors(void) {
+    for (int fd = 0; fd <= 2; ++fd) {
+        if (fcntl(fd, F_GETFD) != -1 || errno != EBADF) continue;
+        const int opened = open("/dev/null", fd == 0 ? O_RDONLY : O_WRONLY);
+        if (opened != fd) {
+            if (opened >= 0) close(opened);
+            return false;
+        }
+    }
+    return true;
+}
+
 int main(int argc, char **argv) {
+    if (!open_closed_standard_descriptors()) {
+        /* stderr may be the closed one: the exit status says it */
+        fprintf(stderr, "hbao: error: a standard descriptor is closed and /dev/null cannot "
+                        "be opened in its place\n");
+        return TOOL_EXIT_RUNTIME;
+    }
     /* A reader that closes its pipe (hbao ... -o /dev/stdout | head) makes a
      * write fail with EPIPE, an error like any other (its message, exit 1,
      * the temporary files removed), instead of killing the tool mid-write. */

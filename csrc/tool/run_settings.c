@@ -36,6 +36,10 @@ static void append_camera(char *text, size_t *used, const camera_settings *setti
            (double)c->shift_x, (double)c->shift_y, (double)c->ortho_scale,
            (double)c->pixel_aspect_x, (double)c->pixel_aspect_y);
     for (int i = 0; i < 16; ++i) append(text, used, " %.9g", (double)c->world_to_camera[i]);
+    /* which depths are background (camera_background_depth); its bit is in
+     * fields_set */
+    if (settings->fields_set & CAMERA_FIELD_CLIP_END)
+        append(text, used, " clip end %.9g", (double)settings->clip_end);
 }
 
 bool run_settings_text(const cli_options *options, const camera_settings *camera_file,
