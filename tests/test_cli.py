@@ -1257,6 +1257,27 @@ def test_sequence_redoes_frames_computed_with_other_flags(hbao_tool, tmp_path):
     assert "frame 1: " in redone.stderr and b"hbaoSettings" in foreign.read_bytes()
 
 
+def test_sequence_redoes_an_output_cut_short_or_damaged_since(hbao_tool, tmp_path):
+    """An output whose header is whole but whose pixels are not (cut short by
+    an interrupted copy, its end overwritten) is not up to date: it was
+    skipped with exit 0, though it could not be read."""
+    folder, sources = sequence_folder(tmp_path)
+    run_sequence(hbao_tool, folder)
+    expected = {frame: (folder / f"ao_{frame:04d}.exr").read_bytes() for frame in sources}
+    cut = folder / "ao_0001.exr"
+    cut.write_bytes(expected[1][:2000])
+    damaged = folder / "ao_0002.exr"
+    damaged.write_bytes(expected[2][:-200] + bytes(200))
+    for path in (cut, damaged):
+        preview = path.with_suffix(".png")
+        os.utime(preview, (path.stat().st_mtime + 1,) * 2)  # the preview is not what is stale
+    rerun = run_sequence(hbao_tool, folder)
+    assert rerun.stderr.count("is up to date, skipped") == 1, rerun.stderr  # frame 4
+    assert "frame 4: " in rerun.stderr and "ao_0004.exr is up to date" in rerun.stderr
+    for frame in sources:
+        assert (folder / f"ao_{frame:04d}.exr").read_bytes() == expected[frame]
+
+
 def test_sequence_redoes_frames_whose_camera_clip_end_changed(hbao_tool, tmp_path):
     """The camera file's clip_end decides which depths are background: a
     rerun with one that differs only there recomputes (it was taken as up
@@ -1706,6 +1727,38 @@ def test_sequence_refuses_an_output_that_is_another_frames_input(hbao_tool, tmp_
                "--no-normals")
     inputs = [f"f_{frame}.exr" for frame in range(1, 10)]
     assert all((tmp_path / name).read_bytes() == before[name] for name in inputs)
+
+
+def test_sequence_refuses_an_output_that_links_to_another_frames_input(hbao_tool, tmp_path):
+    """Output names that are links to another listed frame's render or
+    camera file (a symbolic link, a hard link) would replace that file: the
+    name checks cannot see it, the file's identity does. Nothing written."""
+    camera = camera_path("cycles_float_zip").read_text()
+    for frame in (1, 2, 3):
+        shutil.copyfile(fixture_path("cycles_float_zip"), tmp_path / f"render_{frame}.exr")
+        (tmp_path / f"cam_{frame}.json").write_text(camera)
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    links = [(lambda: (tmp_path / "ao_2.exr").symlink_to("render_3.exr"), "the input of frame 3"),
+             (lambda: os.link(tmp_path / "render_3.exr", tmp_path / "ao_2.exr"),
+              "the input of frame 3"),
+             (lambda: (tmp_path / "ao_1.exr").symlink_to(tmp_path / "cam_3.json"),
+              "the --camera file of frame 3")]
+    for make_link, fragment in links:
+        make_link()
+        completed = run_tool(hbao_tool, tmp_path / "render_#.exr", "-o", tmp_path / "ao_#.exr",
+                             "--camera", tmp_path / "cam_#.json", "--frames", "1-3")
+        assert_clean_error(completed, EXIT_USAGE, fragment, "another name")
+        assert {p.name: p.read_bytes() for p in tmp_path.iterdir()
+                if p.name in before} == before
+        for name in ("ao_1.exr", "ao_2.exr"):
+            if os.path.lexists(tmp_path / name):
+                os.unlink(tmp_path / name)
+    # one render linked as every frame's input (a still): each output is new
+    for frame in (1, 2, 3):
+        os.unlink(tmp_path / f"render_{frame}.exr")
+        (tmp_path / f"render_{frame}.exr").symlink_to(fixture_path("cycles_float_zip"))
+    run_ok(hbao_tool, tmp_path / "render_#.exr", "-o", tmp_path / "ao_#.exr", "--camera",
+           tmp_path / "cam_#.json", "--frames", "1-3")
 
 
 def test_sequence_refuses_outputs_that_are_another_frames_or_its_own(hbao_tool, tmp_path):

@@ -12,6 +12,7 @@
 #include "ao_command.h"
 #include "atomic_file.h"
 #include "camera_json.h"
+#include "exr_reader.h"
 #include "canonical_path.h"
 #include "frame_pattern.h"
 #include "run_settings.h"
@@ -36,11 +37,36 @@ static bool newer_or_equal(const struct stat *a, const struct stat *b) {
     return a->st_mtim.tv_nsec >= b->st_mtim.tv_nsec;
 }
 
+/* The output's AO channel decodes whole (every chunk listed, inside the
+ * file and, where compressed, inflating): an output cut short or damaged
+ * since the tool wrote it (an interrupted copy, rsync --inplace) is redone,
+ * not skipped with its header intact. A read of one channel a skipped
+ * frame. */
+static bool output_decodes(const cli_options *frame) {
+    exr_input output;
+    tool_error ignored = {{0}};
+    if (exr_input_open(&output, frame->output_path, &ignored) != TOOL_EXIT_SUCCESS) return false;
+    bool decodes = false;
+    float *pixels = exr_input_find_channel(&output, frame->ao_channel) < 0
+                        ? NULL
+                        : malloc((size_t)output.width * (size_t)output.height * sizeof *pixels);
+    if (pixels != NULL) {
+        const exr_channel_request request = {frame->ao_channel, EXR_PIXEL_FLOAT, (uint8_t *)pixels,
+                                             (int32_t)sizeof *pixels,
+                                             (int64_t)output.width * (int64_t)sizeof *pixels};
+        decodes = exr_input_read(&output, &request, 1, &ignored) == TOOL_EXIT_SUCCESS;
+    }
+    free(pixels);
+    exr_input_close(&output);
+    return decodes;
+}
+
 /* Up to date, as make decides, and computed with the same flags: every
  * output exists and is at least as new as the input and the camera file, the
  * preview at least as new as the EXR (ao_command writes it after the EXR, so
  * a preview left from before the EXR was last computed is stale), and the
- * EXR's header holds the settings this run would write (run_settings.h).
+ * EXR's header holds the settings this run would write (run_settings.h)
+ * and its AO decodes (output_decodes).
  * (An input re-rendered while its frame was computed gets no output:
  * ao_command's refuse_changed_input.) */
 static bool up_to_date(const cli_options *frame) {
@@ -61,7 +87,7 @@ static bool up_to_date(const cli_options *frame) {
         return false;
     char settings[RUN_SETTINGS_MAX];
     return run_settings_text(frame, frame->camera_file, settings) &&
-           run_settings_match(frame->output_path, settings);
+           run_settings_match(frame->output_path, settings) && output_decodes(frame);
 }
 
 static void report(sequence_run *run, const frame_outcome *outcome, const char *output,
@@ -162,7 +188,7 @@ static int summarize(const sequence_run *run, tool_error *error) {
  * preview or output, the two frames would replace each other's file
  * (-o 'o_#.exr' --preview 'o_#0.exr'). Each frame refuses its own input
  * and a preview that is its own output (ao_command); this refuses the
- * others', by name, before any frame runs. */
+ * others' before any frame runs: by name, and by file (frame_file). */
 /* `pattern` with its folder made canonical (canonical_path), so that names
  * of one file compare equal ("./o_#.exr" and "o_#.exr"); as given where the
  * folder holds the '#' run or cannot be resolved. */
@@ -171,6 +197,58 @@ static const char *canonical_pattern(const char *pattern, char out[PATH_MAX]) {
     const char *slash = strrchr(pattern, '/');
     if (slash != NULL && memchr(pattern, '#', (size_t)(slash - pattern)) != NULL) return pattern;
     return canonical_path(pattern, out) ? out : pattern;
+}
+
+/* An input file of a listed frame, by identity: an output name that is a
+ * link to it, or another (hard) link of it, names it too. */
+typedef struct frame_file {
+    dev_t device;
+    ino_t inode;
+    int32_t frame;
+    int kind; /* 0: the render, 1: the frame's --camera file */
+} frame_file;
+
+static int compare_frame_files(const void *a, const void *b) {
+    const frame_file *x = a, *y = b;
+    if (x->device != y->device) return x->device < y->device ? -1 : 1;
+    if (x->inode != y->inode) return x->inode < y->inode ? -1 : 1;
+    return 0;
+}
+
+/* The listed frames' input files that exist, sorted by identity (NULL and
+ * *found 0 where none, or no memory: the names' checks still run). */
+static frame_file *frames_input_files(const char *const inputs[2], const frame_list *frames,
+                                      int64_t count, size_t *found) {
+    *found = 0;
+    frame_file *files = malloc((size_t)count * 2 * sizeof *files);
+    if (files == NULL) return NULL;
+    char path[PATH_MAX];
+    struct stat status;
+    for (int64_t i = 0; i < count; ++i) {
+        const int32_t frame = frame_list_at(frames, i);
+        for (int kind = 0; kind < 2; ++kind)
+            if (inputs[kind] != NULL &&
+                frame_pattern_path(inputs[kind], frame, path, sizeof path) &&
+                stat(path, &status) == 0 && S_ISREG(status.st_mode))
+                files[(*found)++] = (frame_file){status.st_dev, status.st_ino, frame, kind};
+    }
+    qsort(files, *found, sizeof *files, compare_frame_files);
+    return files;
+}
+
+/* The first of `files` that is the file at `path` and belongs to a frame
+ * other than `frame`, or NULL. */
+static const frame_file *other_frames_file(const frame_file *files, size_t found, const char *path,
+                                           int32_t frame) {
+    struct stat status;
+    if (files == NULL || stat(path, &status) != 0) return NULL;
+    const frame_file key = {status.st_dev, status.st_ino, 0, 0};
+    const frame_file *hit = bsearch(&key, files, found, sizeof *files, compare_frame_files);
+    if (hit == NULL) return NULL;
+    while (hit > files && compare_frame_files(hit - 1, &key) == 0) --hit;
+    for (; hit < files + found && compare_frame_files(hit, &key) == 0; ++hit)
+        if (hit->frame != frame) return hit;
+    return NULL;
 }
 
 static int refuse_other_frames_files(const cli_options *options, int64_t count, tool_error *error) {
@@ -184,6 +262,9 @@ static int refuse_other_frames_files(const cli_options *options, int64_t count, 
                                canonical_pattern(options->preview_path, canonical[2])};
     const char *flags[2] = {"-o", "--preview"};
     char path[PATH_MAX];
+    size_t found;
+    frame_file *files = frames_input_files(inputs, &options->frames, count, &found);
+    int status = TOOL_EXIT_SUCCESS;
     for (int64_t i = 0; i < count; ++i) {
         const int32_t frame = frame_list_at(&options->frames, i);
         for (int k = 0; k < 2; ++k) {
@@ -192,21 +273,36 @@ static int refuse_other_frames_files(const cli_options *options, int64_t count, 
             int32_t other;
             for (int in = 0; in < 2; ++in)
                 if (inputs[in] != NULL && frame_pattern_frame(inputs[in], path, &other) &&
-                    other != frame && frame_list_contains(&options->frames, other))
-                    return tool_fail(error, TOOL_EXIT_USAGE,
-                                     "%s of frame %d (%s) is the %s of frame %d: it would be "
-                                     "replaced before it is read",
-                                     flags[k], (int)frame, path, input_names[in], (int)other);
+                    other != frame && frame_list_contains(&options->frames, other)) {
+                    status = tool_fail(error, TOOL_EXIT_USAGE,
+                                       "%s of frame %d (%s) is the %s of frame %d: it would be "
+                                       "replaced before it is read",
+                                       flags[k], (int)frame, path, input_names[in], (int)other);
+                    goto done;
+                }
+            const frame_file *same = other_frames_file(files, found, path, frame);
+            if (same != NULL) {
+                status = tool_fail(error, TOOL_EXIT_USAGE,
+                                   "%s of frame %d (%s) is the %s of frame %d by another name (a "
+                                   "link): it would be replaced",
+                                   flags[k], (int)frame, path, input_names[same->kind],
+                                   (int)same->frame);
+                goto done;
+            }
             const char *pattern = patterns[1 - k];
             if (pattern != NULL && frame_pattern_frame(pattern, path, &other) && other != frame &&
-                frame_list_contains(&options->frames, other))
-                return tool_fail(error, TOOL_EXIT_USAGE,
-                                 "%s of frame %d (%s) is the %s of frame %d: each would replace "
-                                 "the other",
-                                 flags[k], (int)frame, path, flags[1 - k], (int)other);
+                frame_list_contains(&options->frames, other)) {
+                status = tool_fail(error, TOOL_EXIT_USAGE,
+                                   "%s of frame %d (%s) is the %s of frame %d: each would replace "
+                                   "the other",
+                                   flags[k], (int)frame, path, flags[1 - k], (int)other);
+                goto done;
+            }
         }
     }
-    return TOOL_EXIT_SUCCESS;
+done:
+    free(files);
+    return status;
 }
 
 int sequence_command(const cli_options *options, tool_error *error) {
