@@ -1250,8 +1250,8 @@ def test_sequence_redoes_frames_computed_with_other_flags(hbao_tool, tmp_path):
         assert (folder / f"ao_{frame:04d}.exr").read_bytes() == single.read_bytes()
     same = run_sequence(hbao_tool, folder, "--radius", "0.5", "--threads", "1")
     assert same.stderr.count("is up to date, skipped") == 3  # threads change no value
-    foreign = folder / "ao_0001.exr"
-    foreign.write_bytes(fixture_path(sources[1]).read_bytes())  # newer, no hbaoSettings
+    foreign = folder / "ao_0001.exr"  # newer, no hbaoSettings (not a render: no Depth)
+    foreign.write_bytes(scanline_exr({"AO": np.ones((4, 4), np.float32)}, 4, 4))
     redone = run_sequence(hbao_tool, folder, "--radius", "0.5")
     assert redone.stderr.count("is up to date, skipped") == 2
     assert "frame 1: " in redone.stderr and b"hbaoSettings" in foreign.read_bytes()
@@ -1720,12 +1720,15 @@ def test_sequence_refuses_an_output_that_is_another_frames_input(hbao_tool, tmp_
     assert_clean_error(previews, EXIT_USAGE, "--preview of frame 1 ", "is the input of frame 11")
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
     # A name that only looks like another frame's is no input of this run: a
-    # frame not listed (f_10.exr with frames 1-9), or a number the input's
-    # pattern never writes (f_01.exr: f_# writes frame 1 as f_1.exr).
-    for output in ("f_#0.exr", "f_0#.exr"):
-        run_ok(hbao_tool, tmp_path / "f_#.exr", "-o", tmp_path / output, "--frames", "1-9",
-               "--no-normals")
-    inputs = [f"f_{frame}.exr" for frame in range(1, 10)]
+    # number the input's pattern never writes (f_01.exr: f_# writes frame 1
+    # as f_1.exr); a frame not listed (f_10.exr with frames 1-9) is not
+    # either, but it is a render, which no frame replaces (the frame fails).
+    run_ok(hbao_tool, tmp_path / "f_#.exr", "-o", tmp_path / "f_0#.exr", "--frames", "1-9",
+           "--no-normals")
+    unlisted = run_tool(hbao_tool, tmp_path / "f_#.exr", "-o", tmp_path / "f_#0.exr",
+                        "--frames", "1-9", "--no-normals")
+    assert_clean_error(unlisted, EXIT_USAGE, "1 of 9 frames failed: 1", "f_10.exr is a render")
+    inputs = [f"f_{frame}.exr" for frame in range(1, 11)]
     assert all((tmp_path / name).read_bytes() == before[name] for name in inputs)
 
 
@@ -1759,6 +1762,30 @@ def test_sequence_refuses_an_output_that_links_to_another_frames_input(hbao_tool
         (tmp_path / f"render_{frame}.exr").symlink_to(fixture_path("cycles_float_zip"))
     run_ok(hbao_tool, tmp_path / "render_#.exr", "-o", tmp_path / "ao_#.exr", "--camera",
            tmp_path / "cam_#.json", "--frames", "1-3")
+
+
+def test_an_output_that_is_a_render_is_never_replaced(hbao_tool, tmp_path):
+    """-o 'render_00#0.exr' --frames 1-2 names render_0010.exr and
+    render_0020.exr: renders of frames the run does not list (another farm
+    task's), which it replaced. An existing -o with a Depth pass and no
+    hbaoSettings (not an hbao output) is refused, in one run and in a
+    sequence; an hbao output with the passes copied (--keep-input) is still
+    replaced."""
+    for frame in (1, 2, 10, 20):
+        shutil.copyfile(fixture_path("cycles_float_zip"), tmp_path / f"render_{frame:04d}.exr")
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    sequence = run_tool(hbao_tool, tmp_path / "render_####.exr", "-o",
+                        tmp_path / "render_00#0.exr", "--frames", "1-2", "--no-normals")
+    assert_clean_error(sequence, EXIT_USAGE, "2 of 2 frames failed",
+                       f"-o {tmp_path / 'render_0010.exr'} is a render")
+    single = run_tool(hbao_tool, tmp_path / "render_0001.exr", "-o",
+                      tmp_path / "render_0002.exr", "--no-normals")
+    assert_clean_error(single, EXIT_USAGE, "is a render (it has a Depth pass)")
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+    kept = tmp_path / "kept.exr"
+    for _ in range(2):  # written, then replaced by the same run
+        run_ok(hbao_tool, tmp_path / "render_0001.exr", "-o", kept, "--keep-input",
+               "--no-normals")
 
 
 def test_sequence_refuses_outputs_that_are_another_frames_or_its_own(hbao_tool, tmp_path):

@@ -99,3 +99,10 @@ bool run_settings_match(const char *path, const char *text) {
     exr_finish(&context);
     return match;
 }
+
+bool run_settings_stamped(exr_const_context_t context) {
+    const char *stored = NULL;
+    int32_t length = 0;
+    return exr_attr_get_string(context, 0, RUN_SETTINGS_ATTRIBUTE, &length, &stored) ==
+           EXR_ERR_SUCCESS;
+}

@@ -5,6 +5,7 @@
 #ifndef HBAO_TOOL_RUN_SETTINGS_H
 #define HBAO_TOOL_RUN_SETTINGS_H
 
+#include <openexr.h>
 #include <stdbool.h>
 
 #include "cli_options.h"
@@ -33,5 +34,9 @@ bool run_settings_text(const cli_options *options, const camera_settings *camera
 /** Whether the EXR at `path` holds RUN_SETTINGS_ATTRIBUTE equal to `text`
  *  (false when it cannot be read or has no such attribute). */
 bool run_settings_match(const char *path, const char *text);
+
+/** Whether the EXR opened as `context` holds RUN_SETTINGS_ATTRIBUTE in its
+ *  first part: it is an hbao output. */
+bool run_settings_stamped(exr_const_context_t context);
 
 #endif /* HBAO_TOOL_RUN_SETTINGS_H */
