@@ -760,6 +760,23 @@ def test_an_input_that_is_a_folder_or_a_fifo_says_so_and_never_waits(hbao_tool, 
     assert_clean_error(camera, EXIT_RUNTIME, f"cannot read camera file {folder}: Is a directory")
 
 
+def test_long_paths_keep_their_reason_and_say_which_path(hbao_tool, tmp_path):
+    """A message about a 3000-byte path ends with its reason (1024 bytes of
+    message cut it off), and a sequence's name past the system's limit says
+    which flag's it is."""
+    deep = tmp_path.joinpath(*(["d" * 200] * 15)) / "ao.exr"  # folders that do not exist
+    completed = run_tool(hbao_tool, fixture_path("cycles_float_zip"), "-o", deep,
+                         "--no-normals")
+    assert completed.returncode == EXIT_RUNTIME, completed.stderr
+    assert completed.stderr.rstrip().endswith("No such file or directory"), completed.stderr
+    for frame in (1, 2):
+        shutil.copyfile(fixture_path("cycles_float_zip"), tmp_path / f"in_{frame}.exr")
+    pattern = str(tmp_path / ("p" * 200)) + "/" * 2000 + "x" * 1900 + "_#.png"
+    sequence = run_tool(hbao_tool, tmp_path / "in_#.exr", "-o", tmp_path / "ao_#.exr",
+                        "--preview", pattern, "--frames", "1-2", "--no-normals")
+    assert_clean_error(sequence, EXIT_USAGE, "--preview of this frame would be 4096 bytes")
+
+
 def test_fuzzed_inputs_never_crash(hbao_tool, tmp_path):
     """Random truncations and byte changes of every fixture, through
     scripts/fuzz_cli.sh (the one mutation loop): always exit 0, or 1 with a

@@ -18,7 +18,11 @@ enum {
     TOOL_EXIT_USAGE = 2    /**< bad command line: unknown flag, bad number, ... */
 };
 
-#define TOOL_ERROR_MESSAGE_SIZE 1024
+/* Room for three paths of the system's PATH_MAX (4096 on Linux) and the
+ * words around them: a message names the input, an output and a camera file
+ * at most, and its reason ("No such file or directory") comes last, where
+ * 1024 bytes cut it off a long path's message. */
+#define TOOL_ERROR_MESSAGE_SIZE (3 * 4096 + 1024)
 
 typedef struct tool_error {
     char message[TOOL_ERROR_MESSAGE_SIZE];

@@ -127,13 +127,19 @@ static void run_frame(sequence_run *run, frame_outcome *outcome) {
     /* a camera per frame (an animated camera): read by the frame itself */
     const bool camera_per_frame = per_frame_camera(options);
     if (camera_per_frame) frame.camera_path = camera;
-    if (!frame_pattern_path(options->input_path, outcome->frame, input, sizeof input) ||
-        !frame_pattern_path(options->output_path, outcome->frame, output, sizeof output) ||
-        (options->preview_path != NULL &&
-         !frame_pattern_path(options->preview_path, outcome->frame, preview, sizeof preview)) ||
-        (camera_per_frame &&
-         !frame_pattern_path(options->camera_path, outcome->frame, camera, sizeof camera))) {
-        outcome->status = tool_fail(&error, TOOL_EXIT_USAGE, "a path is too long");
+    const char *patterns[4] = {options->input_path, options->output_path, options->preview_path,
+                               camera_per_frame ? options->camera_path : NULL};
+    char *paths[4] = {input, output, preview, camera};
+    static const char *const names[4] = {"the input", "-o", "--preview", "--camera"};
+    int too_long = -1;
+    for (int k = 0; k < 4 && too_long < 0; ++k)
+        if (patterns[k] != NULL &&
+            !frame_pattern_path(patterns[k], outcome->frame, paths[k], PATH_MAX))
+            too_long = k;
+    if (too_long >= 0) {
+        outcome->status = tool_fail(&error, TOOL_EXIT_USAGE,
+                                    "%s of this frame would be %d bytes or longer (%s): too long",
+                                    names[too_long], PATH_MAX, patterns[too_long]);
     } else if (!options->force && up_to_date(&frame)) {
         outcome->skipped = true;
         outcome->status = TOOL_EXIT_SUCCESS;
