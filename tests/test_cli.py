@@ -1029,15 +1029,38 @@ def ignore_hangup():
     signal.signal(signal.SIGHUP, signal.SIG_IGN)
 
 
-def signal_during_run(command, outputs, temporaries, signal_number, preexec_fn):
-    """Starts the tool, waits until its `temporaries` temporary files exist
-    (so that the signal falls inside the run), sends the signal and returns
-    the finished process."""
+def open_temporary_files(pid, folder):
+    """The temporary files process `pid` holds in `folder`: named ones
+    (.hbao-tmp-), and unnamed ones (O_TMPFILE: "folder/#123 (deleted)")."""
+    found = 0
+    for entry in Path(f"/proc/{pid}/fd").iterdir():
+        try:
+            target = os.readlink(entry)
+        except OSError:  # closed meanwhile
+            continue
+        if target.startswith(f"{folder}/") and (
+                ".hbao-tmp-" in target or target.startswith(f"{folder}/#")):
+            found += 1
+    return found
+
+
+# HBAO_TMPFILE=0: named temporary files (.hbao-tmp-), which the tool removes
+# when a signal ends it; by default they are unnamed until their rename
+# (O_TMPFILE), so that no kill leaves one.
+TEMPORARY_KINDS = {"unnamed": None, "named": {"HBAO_TMPFILE": "0"}}
+
+
+def signal_during_run(command, outputs, temporaries, signal_number, preexec_fn, env=None):
+    """Starts the tool, waits until it holds its `temporaries` temporary
+    files (so that the signal falls inside the run), sends the signal and
+    returns the finished process."""
     process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                               preexec_fn=preexec_fn)
+                               preexec_fn=preexec_fn,
+                               env=None if env is None else dict(os.environ, **env))
     try:
         deadline = time.monotonic() + TOOL_TIMEOUT_S
-        while len(leftover_temporary_files(outputs)) < temporaries and process.poll() is None:
+        while open_temporary_files(process.pid, outputs) < temporaries \
+                and process.poll() is None:
             assert time.monotonic() < deadline
             time.sleep(0.005)
         # All temporary files existed while the tool was still running:
@@ -1051,11 +1074,15 @@ def signal_during_run(command, outputs, temporaries, signal_number, preexec_fn):
     return process
 
 
-@pytest.mark.parametrize("signal_number, frames", [
-    (signal.SIGINT, 1), (signal.SIGTERM, 1), (signal.SIGHUP, 1),
+@pytest.mark.parametrize("signal_number, frames, kind", [
+    (number, frames, kind) for kind in TEMPORARY_KINDS
     # Two frames at once (--jobs 2): four temporary files, from two threads.
-    (signal.SIGTERM, 2)])
-def test_signal_removes_the_temporary_files(hbao_tool, tmp_path, signal_number, frames):
+    for number, frames in ((signal.SIGINT, 1), (signal.SIGTERM, 1), (signal.SIGHUP, 1),
+                           (signal.SIGTERM, 2))] + [
+    # No handler runs: only unnamed temporary files leave nothing (a farm's
+    # hard kill, the out-of-memory killer); a named one outlives it.
+    (signal.SIGKILL, 2, "unnamed")])
+def test_signal_removes_the_temporary_files(hbao_tool, tmp_path, signal_number, frames, kind):
     outputs = tmp_path / "out"
     outputs.mkdir()
     if frames == 1:
@@ -1069,7 +1096,7 @@ def test_signal_removes_the_temporary_files(hbao_tool, tmp_path, signal_number, 
                    "--preview", str(outputs / "ao_#.png"), "--frames", f"1-{frames}",
                    "--jobs", str(frames)] + SLOW_RUN
     process = signal_during_run(command, outputs, 2 * frames, signal_number,
-                                default_signal_actions)
+                                default_signal_actions, TEMPORARY_KINDS[kind])
     # The exit status says the signal ended the run.
     assert process.returncode == -signal_number, process.stderr.read()
     assert list(outputs.iterdir()) == []

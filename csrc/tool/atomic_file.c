@@ -1,4 +1,7 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
+#if defined(__linux__) && !defined(_GNU_SOURCE)
+#define _GNU_SOURCE /* O_TMPFILE */
+#endif
 #include "atomic_file.h"
 
 #include <errno.h>
@@ -7,6 +10,7 @@
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <stdint.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -137,6 +141,39 @@ static int follow_symbolic_links(const char *path, char resolved[PATH_MAX], tool
     }
 }
 
+/* The destination's directory: "." for a bare name, else the path up to its
+ * last slash ("/" for a file at the root). False when too long. */
+static bool destination_directory(const atomic_file *file, char directory[PATH_MAX]) {
+    const char *slash = strrchr(file->destination, '/');
+    if (slash == NULL) {
+        strcpy(directory, ".");
+        return true;
+    }
+    const int length = slash == file->destination ? 1 : (int)(slash - file->destination);
+    return snprintf(directory, PATH_MAX, "%.*s", length, file->destination) < PATH_MAX;
+}
+
+/* An unnamed file in the destination's directory (Linux's O_TMPFILE), named
+ * only at commit: a run killed by a signal no handler sees (SIGKILL, the
+ * out-of-memory killer, a farm's hard timeout) leaves nothing behind. The
+ * name is given through /proc/self/fd (linkat), so this needs /proc; -1
+ * where either is missing (file systems without O_TMPFILE: NFS before 4.2,
+ * some FUSE ones), and the named temporary below is used instead. */
+static int open_unnamed_in_directory(const atomic_file *file) {
+#ifdef O_TMPFILE
+    /* HBAO_TMPFILE=0: named temporaries only (the tests' way to the other
+     * path; a file system whose O_TMPFILE misbehaves) */
+    const char *wanted = getenv("HBAO_TMPFILE");
+    if (wanted != NULL && strcmp(wanted, "0") == 0) return -1;
+    char directory[PATH_MAX];
+    if (access("/proc/self/fd", X_OK) != 0 || !destination_directory(file, directory)) return -1;
+    return open(directory, O_TMPFILE | O_WRONLY | O_CLOEXEC, 0600);
+#else
+    (void)file;
+    return -1;
+#endif
+}
+
 /* A temporary file in the destination's directory, so that rename() stays
  * on one file system; the leading dot keeps it out of casual listings. The
  * name has a fixed length, whatever the destination's. */
@@ -147,6 +184,11 @@ static int create_named_temporary(atomic_file *file, tool_error *error) {
                            "%.*s.hbao-tmp-XXXXXX", directory_length, file->destination);
     if (written < 0 || (size_t)written >= sizeof file->temporary_path)
         return tool_fail(error, TOOL_EXIT_USAGE, "output path too long: %s", file->name);
+    file->fd = open_unnamed_in_directory(file);
+    if (file->fd >= 0) {
+        file->unnamed = true; /* temporary_path: the template of its name at commit */
+        return TOOL_EXIT_SUCCESS;
+    }
     sigset_t previous;
     block_cleanup_signals(&previous);
     file->fd = mkstemp(file->temporary_path);
@@ -290,6 +332,28 @@ static int copy_through(atomic_file *file, tool_error *error) {
     return status;
 }
 
+/* Gives the unnamed file a fresh name from its template (".hbao-tmp-"
+ * and six characters), recorded for the signal handler; called with the
+ * cleanup signals blocked and the slots locked. 0, or -1 with errno set. */
+static int name_unnamed(atomic_file *file) {
+    static const char letters[] = "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789";
+    char proc_path[64];
+    snprintf(proc_path, sizeof proc_path, "/proc/self/fd/%d", file->fd);
+    char *suffix = file->temporary_path + strlen(file->temporary_path) - 6;
+    unsigned long seed = (unsigned long)getpid() * 2654435761ul ^ (unsigned long)(uintptr_t)file;
+    for (int attempt = 0; attempt < 100; ++attempt) {
+        seed = seed * 6364136223846793005ul + 1442695040888963407ul;
+        for (int k = 0; k < 6; ++k) suffix[k] = letters[(seed >> (8 * k + 10)) % 62];
+        if (linkat(AT_FDCWD, proc_path, AT_FDCWD, file->temporary_path, AT_SYMLINK_FOLLOW) == 0) {
+            file->unnamed = false;
+            file->cleanup_slot = claim_cleanup_slot(file->temporary_path);
+            return 0;
+        }
+        if (errno != EEXIST) return -1;
+    }
+    return -1;
+}
+
 int atomic_file_commit(atomic_file *file, tool_error *error) {
     if (!file->active) return tool_fail(error, TOOL_EXIT_RUNTIME, "internal: nothing to commit");
     if (file->write_through) {
@@ -297,23 +361,30 @@ int atomic_file_commit(atomic_file *file, tool_error *error) {
         atomic_file_abort(file);
         return status;
     }
-    if (fsync(file->fd) != 0 || close(file->fd) != 0) {
+    if (fsync(file->fd) != 0) {
         int saved = errno;
-        file->fd = -1;
         atomic_file_abort(file);
         return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot write %s: %s", file->name,
                          strerror(saved));
     }
-    file->fd = -1;
     sigset_t previous;
     block_cleanup_signals(&previous);
-    int renamed = rename(file->temporary_path, file->destination);
+    int renamed = file->unnamed ? name_unnamed(file) : 0;
+    if (renamed == 0) renamed = rename(file->temporary_path, file->destination);
     int saved = errno;
     if (renamed == 0) {
         release_cleanup_slot(file);
         file->active = false;
     }
     restore_signals(&previous);
+    if (renamed == 0 && close(file->fd) != 0) {
+        /* (written and flushed: the file is whole under its name) */
+        saved = errno;
+        file->fd = -1;
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot write %s: %s", file->name,
+                         strerror(saved));
+    }
+    if (renamed == 0) file->fd = -1;
     if (renamed != 0) {
         atomic_file_abort(file);
         return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot create %s: %s", file->name,
@@ -327,7 +398,8 @@ void atomic_file_abort(atomic_file *file) {
     file->fd = -1;
     sigset_t previous;
     block_cleanup_signals(&previous);
-    if (file->active && file->temporary_path[0] != '\0') unlink(file->temporary_path);
+    if (file->active && !file->unnamed && file->temporary_path[0] != '\0')
+        unlink(file->temporary_path);
     release_cleanup_slot(file);
     file->active = false;
     restore_signals(&previous);

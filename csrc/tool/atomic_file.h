@@ -4,9 +4,11 @@
  * something that is not a regular file:
  *
  * - a regular file (or a name that does not exist yet): the data goes to a
- *   temporary file `.hbao-tmp-XXXXXX` in the destination's directory, which
- *   is renamed over the destination only once everything has been written
- *   and flushed. A failed run removes its temporary file and leaves any
+ *   temporary file in the destination's directory, which is renamed over
+ *   the destination only once everything has been written and flushed. It
+ *   is unnamed (O_TMPFILE) until then where the file system and /proc allow,
+ *   so that a run killed by any means leaves nothing; else, and for the
+ *   moment between its naming and the rename, it is `.hbao-tmp-XXXXXX`. A failed run removes its temporary file and leaves any
  *   existing destination as it was. The temporary name has a fixed length,
  *   so that any legal destination name (up to NAME_MAX) works.
  * - a symbolic link: followed (also a dangling one); its final target is
@@ -47,6 +49,7 @@ typedef struct atomic_file {
     char temporary_path[PATH_MAX]; /**< empty when the temporary file is unnamed */
     bool active;                   /**< begun, not yet committed or aborted */
     bool write_through;            /**< FIFO or character device: copy, do not rename */
+    bool unnamed;                  /**< O_TMPFILE: no name until commit (nothing to remove) */
     int cleanup_slot;              /**< the signal handler's record of temporary_path, or -1 */
 } atomic_file;
 
