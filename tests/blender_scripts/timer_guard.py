@@ -9,10 +9,15 @@ on a Blender left idle.
   import timer_guard
 """
 import os
+import sys
 import traceback
 
 import bpy
 from hbao import writes  # the scripts run with the add-on enabled
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(
+    os.path.abspath(__file__)))), "scripts"))
+from bpy_blender import remove_session_temp_folder  # noqa: E402
 
 
 def give_up(message):
@@ -68,6 +73,21 @@ def guarded_timer(step, first_interval):
             print("SCRIPT ERROR in the timer:", traceback.format_exc(), sep="\n", flush=True)
             os._exit(1)
     bpy.app.timers.register(guarded, first_interval=first_interval)
+
+
+def end_now(status=0):
+    """Ends Blender at once with `status`, its session's temporary folder
+    removed as its own exit removes it: for a script after which the event
+    loop must not run again. Blender 3.4 crashes (in its own code, without
+    this add-on too) on the event loop's next pass after
+    screen.screen_full_area ran from a timer, and quit_blender() only
+    schedules the quit, which a draw in another thread can hold up for a
+    pass or more (the crash then blamed the last operator, the preview's
+    toggle: /tmp/blender.crash.txt, a test_viewport flake)."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    remove_session_temp_folder()
+    os._exit(status)
 
 
 QUIT_GRACE_S = 30.0

@@ -10,6 +10,7 @@ the preview. Writes what it saw as JSON for tests/test_viewport.py.
 """
 import json
 import sys
+import traceback
 from pathlib import Path
 
 import bpy
@@ -209,13 +210,16 @@ def view_3d_other(screen, besides):
 
 
 def step():
-    # Blender 3.4 crashed (in its own code, without this add-on too) when the
-    # event loop ran again after screen_full_area from a timer: everything
-    # happens in this one call, which ends by quitting.
+    # Blender 3.4 crashes (in its own code, without this add-on too) when the
+    # event loop runs again after screen_full_area from a timer: everything
+    # happens in this one call, which ends Blender at once (a scheduled quit
+    # can wait a pass of the event loop: timer_guard.end_now).
     try:
         run()
-    finally:
-        timer_guard.quit_blender()
+    except Exception:
+        print("SCRIPT ERROR:", traceback.format_exc(), sep="\n", flush=True)
+        timer_guard.end_now(1)
+    timer_guard.end_now(0)
 
 
 # The window exists only once the event loop runs: start from a timer.
