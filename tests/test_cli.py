@@ -1862,6 +1862,10 @@ def test_sequence_refuses_outputs_that_are_another_frames_or_its_own(hbao_tool, 
     (["in.exr", "-o", "ao.exr", "--jobs", "2"], "go with --frames"),
     (["in.exr", "-o", "ao.exr", "--force"], "go with --frames"),
     (["--info", "in_#.exr", "--frames", "1"], "drop --frames"),
+    # "-" is no file name here (it made a file called "-")
+    (["in.exr", "-o", "-"], '-o is "-": give /dev/stdout'),
+    (["in.exr", "-o", "ao.exr", "--preview", "-"], '--preview is "-"'),
+    (["-", "-o", "ao.exr"], 'the input is "-"'),
 ])
 def test_bad_sequence_flags_are_usage_errors(hbao_tool, tmp_path, arguments, fragment):
     completed = run_tool(hbao_tool, *arguments)

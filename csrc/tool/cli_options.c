@@ -546,6 +546,20 @@ int cli_parse(int argc, char **argv, cli_options *options, tool_error *error) {
         (options->preview_path != NULL && options->preview_path[0] == '\0') ||
         options->input_path[0] == '\0')
         return tool_fail(error, TOOL_EXIT_USAGE, "a file name is empty");
+    /* "-" is no file name here: a file called "-" is rarely meant */
+    if (strcmp(options->input_path, "-") == 0)
+        return tool_fail(error, TOOL_EXIT_USAGE,
+                         "the input is \"-\": the tool reads an EXR file, not standard input "
+                         "(./- for a file named -)");
+    const char *dash = strcmp(options->output_path, "-") == 0 ? "-o"
+                       : options->preview_path != NULL && strcmp(options->preview_path, "-") == 0
+                           ? "--preview"
+                           : NULL;
+    if (dash != NULL)
+        return tool_fail(error, TOOL_EXIT_USAGE,
+                         "%s is \"-\": give /dev/stdout for standard output, or ./- for a file "
+                         "named -",
+                         dash);
     if (options->preview_path != NULL && strcmp(options->preview_path, options->output_path) == 0)
         return tool_fail(error, TOOL_EXIT_USAGE, "--preview and -o name the same file");
     if (sequence) {
