@@ -1777,35 +1777,53 @@ def test_sequence_refuses_an_output_that_is_another_frames_input(hbao_tool, tmp_
 
 
 def test_sequence_refuses_an_output_that_links_to_another_frames_input(hbao_tool, tmp_path):
-    """Output names that are links to another listed frame's render or
-    camera file (a symbolic link, a hard link) would replace that file: the
-    name checks cannot see it, the file's identity does. Nothing written."""
+    """An output name that is a symbolic link to another listed frame's
+    render or camera file, or a render that is a symbolic link to another
+    frame's output name: writing that output would replace the file behind
+    the link. The names differ, so only the files' identity shows it:
+    refused, nothing written. A hard link is no such case (the rename
+    replaces that name only): it runs, the other name keeps its file."""
     camera = camera_path("cycles_float_zip").read_text()
     for frame in (1, 2, 3):
         shutil.copyfile(fixture_path("cycles_float_zip"), tmp_path / f"render_{frame}.exr")
         (tmp_path / f"cam_{frame}.json").write_text(camera)
     before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
-    links = [(lambda: (tmp_path / "ao_2.exr").symlink_to("render_3.exr"), "the input of frame 3"),
-             (lambda: os.link(tmp_path / "render_3.exr", tmp_path / "ao_2.exr"),
-              "the input of frame 3"),
-             (lambda: (tmp_path / "ao_1.exr").symlink_to(tmp_path / "cam_3.json"),
-              "the --camera file of frame 3")]
-    for make_link, fragment in links:
-        make_link()
-        completed = run_tool(hbao_tool, tmp_path / "render_#.exr", "-o", tmp_path / "ao_#.exr",
-                             "--camera", tmp_path / "cam_#.json", "--frames", "1-3")
-        assert_clean_error(completed, EXIT_USAGE, fragment, "another name")
-        assert {p.name: p.read_bytes() for p in tmp_path.iterdir()
-                if p.name in before} == before
-        for name in ("ao_1.exr", "ao_2.exr"):
-            if os.path.lexists(tmp_path / name):
-                os.unlink(tmp_path / name)
+
+    def run():
+        return run_tool(hbao_tool, tmp_path / "render_#.exr", "-o", tmp_path / "ao_#.exr",
+                        "--camera", tmp_path / "cam_#.json", "--frames", "1-3")
+
+    def unchanged():
+        return {p.name: p.read_bytes() for p in tmp_path.iterdir() if p.name in before} == before
+
+    for name, target, fragment in (("ao_2.exr", "render_3.exr", "the input of frame 3"),
+                                   ("ao_1.exr", "cam_3.json", "the --camera file of frame 3")):
+        (tmp_path / name).symlink_to(target)
+        assert_clean_error(run(), EXIT_USAGE, fragment, "through a symbolic link")
+        assert unchanged()
+        os.unlink(tmp_path / name)
+    # render_3.exr a link to frame 2's output name (the output existing)
+    shutil.copyfile(fixture_path("cycles_float_zip"), tmp_path / "ao_2.exr")
+    os.unlink(tmp_path / "render_3.exr")
+    (tmp_path / "render_3.exr").symlink_to("ao_2.exr")
+    assert_clean_error(run(), EXIT_USAGE, "-o of frame 2", "the input of frame 3")
+    os.unlink(tmp_path / "render_3.exr")
+    os.rename(tmp_path / "ao_2.exr", tmp_path / "render_3.exr")
+    assert unchanged()
+    # A hard link: the run goes on (frames 1 and 3 written); frame 2 alone
+    # stops, its output being a render (test below), and nothing changes.
+    os.link(tmp_path / "render_3.exr", tmp_path / "ao_2.exr")
+    completed = run()
+    assert_clean_error(completed, EXIT_USAGE, "1 of 3 frames failed: 2", "ao_2.exr is a render")
+    assert "symbolic link" not in completed.stderr and (tmp_path / "ao_3.exr").is_file()
+    assert unchanged()
+    os.unlink(tmp_path / "ao_2.exr")
     # one render linked as every frame's input (a still): each output is new
     for frame in (1, 2, 3):
         os.unlink(tmp_path / f"render_{frame}.exr")
         (tmp_path / f"render_{frame}.exr").symlink_to(fixture_path("cycles_float_zip"))
     run_ok(hbao_tool, tmp_path / "render_#.exr", "-o", tmp_path / "ao_#.exr", "--camera",
-           tmp_path / "cam_#.json", "--frames", "1-3")
+           tmp_path / "cam_#.json", "--frames", "1-3", "--force")
 
 
 def test_an_output_that_is_a_render_is_never_replaced(hbao_tool, tmp_path):

@@ -44,7 +44,9 @@ extern "C" {
  *  so that a binding can refuse a library it was not written for. */
 #define HBAO_EXR_INTERFACE_VERSION 2
 
-/** A message buffer of this size holds every message the library writes. */
+/** A message buffer of this size holds the library's messages, but for
+ *  those that name paths of a thousand bytes or more: they are cut to fit
+ *  (never overrun). */
 #define HBAO_EXR_MESSAGE_SIZE 1024
 
 /* One list generates the result codes and their messages (see

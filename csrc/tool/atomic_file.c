@@ -174,6 +174,8 @@ static int open_unnamed_in_directory(const atomic_file *file) {
 #endif
 }
 
+static int name_unnamed(atomic_file *file);
+
 /* A temporary file in the destination's directory, so that rename() stays
  * on one file system; the leading dot keeps it out of casual listings. The
  * name has a fixed length, whatever the destination's. */
@@ -186,8 +188,26 @@ static int create_named_temporary(atomic_file *file, tool_error *error) {
         return tool_fail(error, TOOL_EXIT_USAGE, "output path too long: %s", file->name);
     file->fd = open_unnamed_in_directory(file);
     if (file->fd >= 0) {
-        file->unnamed = true; /* temporary_path: the template of its name at commit */
-        return TOOL_EXIT_SUCCESS;
+        /* A second unnamed file, named and removed at once: so that naming
+         * works here (a file system or sandbox may allow O_TMPFILE and not
+         * the link) is known now, not after the work. (A file, once
+         * linked, cannot be linked again after its unlink.) */
+        atomic_file probe = *file;
+        probe.fd = open_unnamed_in_directory(file);
+        sigset_t blocked;
+        block_cleanup_signals(&blocked);
+        const bool nameable = probe.fd >= 0 && name_unnamed(&probe) == 0;
+        if (nameable) {
+            unlink(probe.temporary_path);
+            release_cleanup_slot(&probe);
+        }
+        restore_signals(&blocked);
+        if (probe.fd >= 0) close(probe.fd);
+        if (nameable) {
+            file->unnamed = true; /* temporary_path: the template of its name at commit */
+            return TOOL_EXIT_SUCCESS;
+        }
+        close(file->fd);
     }
     sigset_t previous;
     block_cleanup_signals(&previous);
@@ -340,9 +360,9 @@ static int name_unnamed(atomic_file *file) {
     char proc_path[64];
     snprintf(proc_path, sizeof proc_path, "/proc/self/fd/%d", file->fd);
     char *suffix = file->temporary_path + strlen(file->temporary_path) - 6;
-    unsigned long seed = (unsigned long)getpid() * 2654435761ul ^ (unsigned long)(uintptr_t)file;
+    uint64_t seed = (uint64_t)getpid() * 2654435761u ^ (uint64_t)(uintptr_t)file;
     for (int attempt = 0; attempt < 100; ++attempt) {
-        seed = seed * 6364136223846793005ul + 1442695040888963407ul;
+        seed = seed * 6364136223846793005u + 1442695040888963407u;
         for (int k = 0; k < 6; ++k) suffix[k] = letters[(seed >> (8 * k + 10)) % 62];
         if (linkat(AT_FDCWD, proc_path, AT_FDCWD, file->temporary_path, AT_SYMLINK_FOLLOW) == 0) {
             file->unnamed = false;
@@ -367,24 +387,34 @@ int atomic_file_commit(atomic_file *file, tool_error *error) {
         return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot write %s: %s", file->name,
                          strerror(saved));
     }
+    /* The unnamed file gets its name first; then the file is closed (a
+     * close error leaves the destination as it was), then renamed. */
     sigset_t previous;
     block_cleanup_signals(&previous);
-    int renamed = file->unnamed ? name_unnamed(file) : 0;
-    if (renamed == 0) renamed = rename(file->temporary_path, file->destination);
+    int named = file->unnamed ? name_unnamed(file) : 0;
     int saved = errno;
+    restore_signals(&previous);
+    if (named != 0) {
+        atomic_file_abort(file);
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot create %s: %s", file->name,
+                         strerror(saved));
+    }
+    const int closed = close(file->fd);
+    saved = errno;
+    file->fd = -1;
+    if (closed != 0) {
+        atomic_file_abort(file);
+        return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot write %s: %s", file->name,
+                         strerror(saved));
+    }
+    block_cleanup_signals(&previous);
+    const int renamed = rename(file->temporary_path, file->destination);
+    saved = errno;
     if (renamed == 0) {
         release_cleanup_slot(file);
         file->active = false;
     }
     restore_signals(&previous);
-    if (renamed == 0 && close(file->fd) != 0) {
-        /* (written and flushed: the file is whole under its name) */
-        saved = errno;
-        file->fd = -1;
-        return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot write %s: %s", file->name,
-                         strerror(saved));
-    }
-    if (renamed == 0) file->fd = -1;
     if (renamed != 0) {
         atomic_file_abort(file);
         return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot create %s: %s", file->name,

@@ -8,8 +8,9 @@
  *   the destination only once everything has been written and flushed. It
  *   is unnamed (O_TMPFILE) until then where the file system and /proc allow,
  *   so that a run killed by any means leaves nothing; else, and for the
- *   moment between its naming and the rename, it is `.hbao-tmp-XXXXXX`. A failed run removes its temporary file and leaves any
- *   existing destination as it was. The temporary name has a fixed length,
+ *   moment between its naming and the rename, it is `.hbao-tmp-XXXXXX`.
+ *   A failed run removes its temporary file and leaves any existing
+ *   destination as it was. The temporary name has a fixed length,
  *   so that any legal destination name (up to NAME_MAX) works.
  * - a symbolic link: followed (also a dangling one); its final target is
  *   replaced as above and the link itself is kept.
@@ -46,7 +47,8 @@ typedef struct atomic_file {
     int fd;                        /**< open on the temporary file; -1 once closed */
     const char *name;              /**< the destination as the user gave it, for messages */
     char destination[PATH_MAX];    /**< symbolic links followed */
-    char temporary_path[PATH_MAX]; /**< empty when the temporary file is unnamed */
+    char temporary_path[PATH_MAX]; /**< its name; while unnamed, the name it will get;
+                                        empty for write_through */
     bool active;                   /**< begun, not yet committed or aborted */
     bool write_through;            /**< FIFO or character device: copy, do not rename */
     bool unnamed;                  /**< O_TMPFILE: no name until commit (nothing to remove) */

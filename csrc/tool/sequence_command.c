@@ -12,8 +12,8 @@
 #include "ao_command.h"
 #include "atomic_file.h"
 #include "camera_json.h"
-#include "exr_reader.h"
 #include "canonical_path.h"
+#include "exr_reader.h"
 #include "frame_pattern.h"
 #include "run_settings.h"
 
@@ -40,7 +40,7 @@ static bool newer_or_equal(const struct stat *a, const struct stat *b) {
 /* The output's AO channel decodes whole (every chunk listed, inside the
  * file and, where compressed, inflating): an output cut short or damaged
  * since the tool wrote it (an interrupted copy, rsync --inplace) is redone,
- * not skipped with its header intact. A read of one channel a skipped
+ * not skipped with its header intact. A read of one channel per skipped
  * frame. */
 static bool output_decodes(const cli_options *frame) {
     exr_input output;
@@ -206,12 +206,15 @@ static const char *canonical_pattern(const char *pattern, char out[PATH_MAX]) {
 }
 
 /* An input file of a listed frame, by identity: an output name that is a
- * link to it, or another (hard) link of it, names it too. */
+ * symbolic link to it (the rename replaces the link's target), or a name
+ * the input's own symbolic link points to, names it too. (A hard link
+ * does not: the rename replaces that name only.) */
 typedef struct frame_file {
     dev_t device;
     ino_t inode;
     int32_t frame;
-    int kind; /* 0: the render, 1: the frame's --camera file */
+    int kind;          /* 0: the render, 1: the frame's --camera file */
+    bool through_link; /* the input's name is a symbolic link */
 } frame_file;
 
 static int compare_frame_files(const void *a, const void *b) {
@@ -229,31 +232,33 @@ static frame_file *frames_input_files(const char *const inputs[2], const frame_l
     frame_file *files = malloc((size_t)count * 2 * sizeof *files);
     if (files == NULL) return NULL;
     char path[PATH_MAX];
-    struct stat status;
+    struct stat status, name;
     for (int64_t i = 0; i < count; ++i) {
         const int32_t frame = frame_list_at(frames, i);
         for (int kind = 0; kind < 2; ++kind)
             if (inputs[kind] != NULL &&
                 frame_pattern_path(inputs[kind], frame, path, sizeof path) &&
-                stat(path, &status) == 0 && S_ISREG(status.st_mode))
-                files[(*found)++] = (frame_file){status.st_dev, status.st_ino, frame, kind};
+                stat(path, &status) == 0 && S_ISREG(status.st_mode) && lstat(path, &name) == 0)
+                files[(*found)++] =
+                    (frame_file){status.st_dev, status.st_ino, frame, kind, S_ISLNK(name.st_mode)};
     }
     qsort(files, *found, sizeof *files, compare_frame_files);
     return files;
 }
 
-/* The first of `files` that is the file at `path` and belongs to a frame
- * other than `frame`, or NULL. */
+/* The first of `files` that belongs to a frame other than `frame` and that
+ * writing `path` would replace (frame_file), or NULL. */
 static const frame_file *other_frames_file(const frame_file *files, size_t found, const char *path,
                                            int32_t frame) {
-    struct stat status;
-    if (files == NULL || stat(path, &status) != 0) return NULL;
-    const frame_file key = {status.st_dev, status.st_ino, 0, 0};
+    struct stat status, name;
+    if (files == NULL || stat(path, &status) != 0 || lstat(path, &name) != 0) return NULL;
+    const bool output_linked = S_ISLNK(name.st_mode);
+    const frame_file key = {status.st_dev, status.st_ino, 0, 0, false};
     const frame_file *hit = bsearch(&key, files, found, sizeof *files, compare_frame_files);
     if (hit == NULL) return NULL;
     while (hit > files && compare_frame_files(hit - 1, &key) == 0) --hit;
     for (; hit < files + found && compare_frame_files(hit, &key) == 0; ++hit)
-        if (hit->frame != frame) return hit;
+        if (hit->frame != frame && (output_linked || hit->through_link)) return hit;
     return NULL;
 }
 
@@ -289,8 +294,8 @@ static int refuse_other_frames_files(const cli_options *options, int64_t count, 
             const frame_file *same = other_frames_file(files, found, path, frame);
             if (same != NULL) {
                 status = tool_fail(error, TOOL_EXIT_USAGE,
-                                   "%s of frame %d (%s) is the %s of frame %d by another name (a "
-                                   "link): it would be replaced",
+                                   "%s of frame %d (%s) is the %s of frame %d through a symbolic "
+                                   "link: it would be replaced",
                                    flags[k], (int)frame, path, input_names[same->kind],
                                    (int)same->frame);
                 goto done;
