@@ -14,6 +14,7 @@ frame (-f) or the animation (-a) to -o, or run SCRIPT with sys.argv ending in
 """
 import argparse
 import os
+import re
 import runpy
 import shutil
 import sys
@@ -96,10 +97,14 @@ def wait_for_python_threads(timeout_s=60.0):
 def remove_session_temp_folder():
     """Blender's WM_exit removes the folder it made for its session
     (bpy.app.tempdir, "blender_XXXXXX" in TMPDIR); this stand-in leaves
-    through os._exit, which would leave one such folder per run."""
+    through os._exit, which would leave one such folder per run. Where
+    Blender could not make one, bpy.app.tempdir is the base folder itself,
+    which is left alone: only a folder named as Blender names a session's
+    is removed."""
     bpy = sys.modules.get("bpy")
-    folder = bpy.app.tempdir if bpy is not None else ""
-    if folder and os.path.basename(os.path.normpath(folder)).startswith("blender_"):
+    folder = os.path.normpath(bpy.app.tempdir) if bpy is not None and bpy.app.tempdir else ""
+    if re.fullmatch(r"blender_[A-Za-z0-9]{6}", os.path.basename(folder)) \
+            and os.path.isdir(folder) and not os.path.islink(folder):
         shutil.rmtree(folder, ignore_errors=True)
 
 

@@ -31,7 +31,8 @@ def no_leftovers(tmp_path, monkeypatch):
     scratch.mkdir()
     system_temp.mkdir()
     monkeypatch.setenv("HBAO_TEMP_DIR", str(scratch))
-    monkeypatch.setenv("TMPDIR", str(system_temp))
+    for name in ("TMPDIR", "TMP"):  # Blender reads TMP first
+        monkeypatch.setenv(name, str(system_temp))
     yield scratch
     left = sorted(p.name for p in scratch.iterdir())
     assert not left, f"temporary files left behind: {left}"
@@ -212,6 +213,34 @@ def test_scratch_folder_that_cannot_be_written_says_which_and_how(run_in_blender
     assert "HBAO_TEMP_DIR names a writable folder" in log
 
 
+def test_a_scratch_folder_that_does_not_exist_is_not_made(run_in_blender, tmp_path, native,
+                                                          no_leftovers):
+    """A mistyped HBAO_TEMP_DIR folder: Blender's save made it (parents too)
+    and the passes went there, silently, the folder left behind (an
+    exploratory run). It is skipped with a message naming it; the next
+    folder takes the passes; a read-only folder's skipped removal says
+    nothing (it said it could not remove a file that never was)."""
+    missing = tmp_path / "missing" / "sub"
+    read_only = tmp_path / "read-only"
+    read_only.mkdir()
+    mounted = subprocess.run(["mount", "-t", "tmpfs", "-o", "ro,size=1m", "tmpfs",
+                              str(read_only)], stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                             text=True)
+    assert mounted.returncode == 0, f"cannot mount a tmpfs (root needed): {mounted.stdout}"
+    node = {"radius": 1.0, "blur_size": 0}
+    try:
+        out, log = render(run_in_blender, tmp_path, {"nodes": [node]}, env={
+            "HBAO_TEMP_DIR": os.pathsep.join([str(missing), str(read_only), str(no_leftovers)])})
+    finally:
+        subprocess.run(["umount", str(read_only)], check=False)
+    assert f"the scratch folder {missing} does not exist" in log, log[-3000:]
+    assert f"cannot save the passes for the AO in {read_only}" in log, log[-3000:]
+    assert not (tmp_path / "missing").exists()
+    assert "could not remove" not in log and "without AO" not in log, log[-3000:]
+    expected = library_ao(native, out, 1, node_params(**node))
+    assert np.abs(node_outputs(out, 1)["ao"] - expected).max() <= EXACT
+
+
 @pytest.mark.min_blender(5, 0)
 def test_two_scenes_sharing_one_compositing_group(run_in_blender, tmp_path, native,
                                                   no_leftovers):
@@ -343,6 +372,20 @@ def render_with_fault(run_in_blender, tmp_path, spec, fault):
     completed = run_in_blender(FAULT_SCRIPT, json.dumps(spec), out, fault)
     assert "RENDERED" in completed.stdout, completed.stdout[-3000:]
     return out, completed.stdout
+
+
+def test_an_interrupted_hand_over_renders_the_image_without_ao(run_in_blender, tmp_path,
+                                                               no_leftovers):
+    """Ctrl-C in a bpy render while the add-on's Python runs raises
+    KeyboardInterrupt there, which the engine's `except Exception` let
+    through: the AO passes stayed unfilled (0) and the frame was saved
+    black, exit 0 (an exploratory run, bpy 5.3). Injected: the hand-over's
+    save raises it. The passes say no AO (1): the image is the render."""
+    out, log = render_with_fault(run_in_blender, tmp_path, {"nodes": [{"radius": 1.0}]},
+                                 "interrupted")
+    assert "FAULT interrupted" in log, log[-3000:]
+    assert "interrupted while the AO was computed" in log, log[-3000:]
+    assert_no_ao_and_image_unchanged(out)
 
 
 def test_unreadable_saved_passes_render_without_ao(run_in_blender, tmp_path, no_leftovers):

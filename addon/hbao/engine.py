@@ -138,6 +138,23 @@ def main_of(helper, request):
     return bpy.data.scenes.get(request.main) if request else scene_for_render(helper)
 
 
+INTERRUPTED = "interrupted while the AO was computed: this frame renders without AO"
+
+
+def _fill_passes(result, results, width, height):
+    """Each registered AO pass of `result` gets its computed AO, or 1 (no AO)."""
+    stereo = any(view is not None for view, _name in results)
+    for layer in result.layers:
+        for render_pass in layer.passes:
+            if not render_pass.name.startswith(PASS_PREFIX):
+                continue
+            view = result.views[render_pass.view_id].name if stereo else None
+            ao = results.get((view, render_pass.name))
+            if ao is None or ao.size != width * height:
+                ao = np.ones((height, width), np.float32)
+            render_pass.rect.foreach_set(ao.reshape(-1))
+
+
 def render_helper(engine, depsgraph):
     """HBAOPassEngine.render(): fill every registered AO pass, 1 where it failed."""
     scene = _original(depsgraph.scene)
@@ -156,6 +173,7 @@ def render_helper(engine, depsgraph):
     # smaller than engine.resolution_x/y (the full frame).
     result = engine.begin_result(0, 0, engine.resolution_x, engine.resolution_y)
     width, height = result.resolution_x, result.resolution_y
+    filled = False
     try:
         try:
             # The scratch files go once the AO is computed (scratch_files.removals_after).
@@ -178,17 +196,14 @@ def render_helper(engine, depsgraph):
             _report_failure(engine, detail)
             tell_all_nodes(main_of(scene, request), "Error: AO off (see Info)", detail)
         write_start = time.perf_counter()
-        stereo = any(view is not None for view, _name in results)
-        for layer in result.layers:
-            for render_pass in layer.passes:
-                if not render_pass.name.startswith(PASS_PREFIX):
-                    continue
-                view = result.views[render_pass.view_id].name if stereo else None
-                ao = results.get((view, render_pass.name))
-                if ao is None or ao.size != width * height:
-                    ao = np.ones((height, width), np.float32)
-                render_pass.rect.foreach_set(ao.reshape(-1))
+        _fill_passes(result, results, width, height)
+        filled = True
     finally:
+        if not filled:
+            # Interrupted (bpy: Ctrl-C raises KeyboardInterrupt here): the
+            # passes say no AO, not the zeros that would black the image.
+            _fill_passes(result, {}, width, height)
+            log(INTERRUPTED)
         engine.end_result(result)
     timings = dict(engine.hbao_timings)
     timings["write"] = time.perf_counter() - write_start

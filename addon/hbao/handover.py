@@ -98,6 +98,10 @@ def _save_and_read(scene, layers, views, threads, folder):
     timings = {}
     folder_failed = False
     try:
+        if not os.path.isdir(folder):  # Blender's save would make it, and leave it
+            raise ScratchFolderError(
+                f"the scratch folder {folder} does not exist; "
+                f"{scratch_files.SCRATCH_FOLDER_VARIABLE} names existing folders for the passes")
         start = _clock()
         save_passes(scene, path, views)
         timings["save"] = _clock() - start

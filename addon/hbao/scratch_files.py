@@ -117,6 +117,8 @@ def remove_stale_once():
 
 
 def _remove(path):
+    if not os.path.lexists(path):  # (a read-only folder says EROFS for it)
+        return
     try:
         os.remove(path)
     except FileNotFoundError:

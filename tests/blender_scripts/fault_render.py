@@ -11,6 +11,9 @@ Faults:
                     hand-over saves the process's first scratch file) is a link
                     to /dev/null: the save "succeeds", the file read back is
                     empty.
+  interrupted       the hand-over raises KeyboardInterrupt (what Ctrl-C does
+                    to a bpy render while Python runs): the frame must not
+                    get the zeros of an unfilled pass (a black image).
   helper_resized    after the hook synced the helper scene, its
                     resolution_percentage is halved (meant to make its pass
                     smaller than the Render Result; Blender renders it at full
@@ -48,6 +51,16 @@ elif fault == "helper_resized":
                 print("FAULT resized", helper.name, flush=True)
 
     bpy.app.handlers.render_pre.append(_resize_helper)
+elif fault == "interrupted":
+    handover = sys.modules["hbao.handover"]
+    save_passes = handover.save_passes
+
+    def _interrupted_save(*args, **kwargs):
+        handover.save_passes = save_passes  # once
+        print("FAULT interrupted", flush=True)
+        raise KeyboardInterrupt
+
+    handover.save_passes = _interrupted_save
 else:
     raise ValueError(f"unknown fault {fault!r}")
 
