@@ -2,6 +2,8 @@
 """The group tree every HBAO node shares: its sockets (which carry the
 artist's values), its contents (Image x AO pass), and its upgrade when a file
 saved with an older layout is opened."""
+import json
+
 import bpy
 
 from . import compat, parameters
@@ -159,17 +161,39 @@ def _restore(node, states, targets):
             tree.links.new(tree.nodes[from_name].outputs[index], socket)
 
 
+# A node's values and links, kept on the node itself (an ID property) while
+# its group changes: a restore that Blender refuses midway (writes.py) is
+# finished by the next sync instead of losing them.
+PENDING_KEY = "hbao_pending_restore"
+
+
+def _keep_state(node):
+    if PENDING_KEY not in node:  # (an unfinished one is the older, right state)
+        node[PENDING_KEY] = json.dumps(_node_state(node))
+
+
+def _finish_restores(nodes):
+    for node in nodes:
+        if PENDING_KEY in node:
+            _restore(node, *json.loads(node[PENDING_KEY]))
+            del node[PENDING_KEY]
+
+
 def upgrade_group_tree():
     """Rebuild an outdated shared group in place (same name, same socket
     order, so keyframes stay on their sockets), keeping each node's values and
     links. Called after a file is loaded."""
     tree = bpy.data.node_groups.get(GROUP_TREE_NAME)
-    if tree is None or _is_current(tree) or tree.library is not None:
+    if tree is None or tree.library is not None:
         return
-    saved = [(node, *_node_state(node)) for node in _users(tree)]
+    users = _users(tree)
+    _finish_restores(users)
+    if _is_current(tree):
+        return
+    for node in users:
+        _keep_state(node)
     _build_group_tree(tree)
-    for node, states, targets in saved:
-        _restore(node, states, targets)
+    _finish_restores(users)
 
 
 def adopt_group_copies(nodes):
@@ -177,7 +201,12 @@ def adopt_group_copies(nodes):
     the shared one at the shared, current group, keeping its values and
     links: File > Append brings an appended scene's own copy (".HBAO.001"),
     perhaps of an older layout, which upgrade_group_tree does not see. A copy
-    left without users is removed. Returns how many nodes moved."""
+    left without users is removed (one with a fake user, or an asset, is
+    kept). Nodes in linked or overridden trees are left alone. Returns how
+    many nodes moved."""
+    nodes = [node for node in nodes if node.id_data.library is None and
+             getattr(node.id_data, "override_library", None) is None]
+    _finish_restores(nodes)
     strays = [node for node in nodes if node.node_tree is None or (
         node.node_tree.name != GROUP_TREE_NAME and node.node_tree.library is None)]
     if not strays:
@@ -185,10 +214,10 @@ def adopt_group_copies(nodes):
     shared = group_tree()
     for node in strays:
         copy = node.node_tree
-        states, targets = _node_state(node)
+        _keep_state(node)
         node.node_tree = shared
-        _restore(node, states, targets)
-        if copy is not None and copy.users == int(copy.use_fake_user):
+        _finish_restores([node])
+        if copy is not None and copy.users == 0:
             bpy.data.node_groups.remove(copy)
     return len(strays)
 

@@ -216,7 +216,7 @@ def step():
     # can wait a pass of the event loop: timer_guard.end_now).
     try:
         run()
-    except Exception:
+    except BaseException:  # SystemExit too: the event loop must not run again
         print("SCRIPT ERROR:", traceback.format_exc(), sep="\n", flush=True)
         timer_guard.end_now(1)
     timer_guard.end_now(0)
