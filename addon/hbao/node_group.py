@@ -142,12 +142,21 @@ def _node_state(node):
     return {socket.name: _socket_state(socket) for socket in node.inputs}, _output_links(node)
 
 
+def _socket_of(tree, node_name, sockets, index):
+    """tree.nodes[node_name].<sockets>[index], or None where that node or
+    socket is gone (a restore finished later, after an edit)."""
+    other = tree.nodes.get(node_name)
+    collection = getattr(other, sockets, ())
+    return collection[index] if other is not None and 0 <= index < len(collection) else None
+
+
 def _restore(node, states, targets):
     tree = node.id_data
     for output_name, to_name, index in targets:
         output = node.outputs.get(output_name)
-        if output is not None:
-            tree.links.new(output, tree.nodes[to_name].inputs[index])
+        target = _socket_of(tree, to_name, "inputs", index)
+        if output is not None and target is not None:
+            tree.links.new(output, target)
     for name, (value, sources) in states.items():
         socket = node.inputs.get(name)
         if socket is None:
@@ -158,7 +167,9 @@ def _restore(node, states, targets):
         except (TypeError, ValueError):
             pass  # a socket whose kind changed beyond a number: keep its default
         for from_name, index in sources:
-            tree.links.new(tree.nodes[from_name].outputs[index], socket)
+            source = _socket_of(tree, from_name, "outputs", index)
+            if source is not None:
+                tree.links.new(source, socket)
 
 
 # A node's values and links, kept on the node itself (an ID property) while
