@@ -1255,3 +1255,19 @@ def test_an_appended_scene_uses_the_add_ons_one_group_upgraded(run_in_blender, t
     assert report["blur_at_1"] == 3 and report["blur_at_11"] == 9, report
     assert "without AO" not in completed.stdout, completed.stdout[-3000:]
     assert (out / "frame.png").is_file(), completed.stdout[-3000:]
+
+
+def test_a_group_rebuild_refused_midway_keeps_the_nodes_values(run_in_blender):
+    """Blender may refuse a write midway (writes.py): a rebuild of the
+    shared group stopped after two sockets lost the node's values and links
+    once the next sync finished it (a review found it). They are kept on the
+    node until a whole group takes them back."""
+    completed = run_in_blender(SCRIPTS / "refused_group_rebuild.py")
+    line = next((text for text in completed.stdout.splitlines() if text.startswith("STATE ")),
+                None)
+    assert line is not None, completed.stdout[-3000:]
+    state = json.loads(line[len("STATE "):])
+    assert state["refused"] and state["current"] and not state["pending"], state
+    assert state["radius"] == 3.5 and state["directions"] == 7, state
+    assert state["strength_from"] == ["Strength Value"] and state["depth_linked"], state
+    assert state["ao_pass_default"] == 1.0, state

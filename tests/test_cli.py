@@ -1799,9 +1799,19 @@ def test_sequence_refuses_an_output_that_links_to_another_frames_input(hbao_tool
     for name, target, fragment in (("ao_2.exr", "render_3.exr", "the input of frame 3"),
                                    ("ao_1.exr", "cam_3.json", "the --camera file of frame 3")):
         (tmp_path / name).symlink_to(target)
-        assert_clean_error(run(), EXIT_USAGE, fragment, "through a symbolic link")
+        assert_clean_error(run(), EXIT_USAGE, fragment, "by another path")
         assert unchanged()
         os.unlink(tmp_path / name)
+    # a folder that is a link: p_3/ is the folder of frame 3's render
+    for frame in (1, 2, 3):
+        (tmp_path / f"in_{frame}").mkdir()
+        shutil.copyfile(fixture_path("cycles_float_zip"), tmp_path / f"in_{frame}" / "r.exr")
+    (tmp_path / "p_2").symlink_to("in_3")
+    folders = run_tool(hbao_tool, tmp_path / "in_#" / "r.exr", "-o", tmp_path / "o_#.exr",
+                       "--preview", tmp_path / "p_#" / "r.exr", "--frames", "1-3",
+                       "--no-normals")
+    assert_clean_error(folders, EXIT_USAGE, "--preview of frame 2", "the input of frame 3")
+    assert (tmp_path / "in_3" / "r.exr").read_bytes() == before["render_3.exr"]
     # render_3.exr a link to frame 2's output name (the output existing)
     shutil.copyfile(fixture_path("cycles_float_zip"), tmp_path / "ao_2.exr")
     os.unlink(tmp_path / "render_3.exr")
@@ -1815,7 +1825,7 @@ def test_sequence_refuses_an_output_that_links_to_another_frames_input(hbao_tool
     os.link(tmp_path / "render_3.exr", tmp_path / "ao_2.exr")
     completed = run()
     assert_clean_error(completed, EXIT_USAGE, "1 of 3 frames failed: 2", "ao_2.exr is a render")
-    assert "symbolic link" not in completed.stderr and (tmp_path / "ao_3.exr").is_file()
+    assert "another path" not in completed.stderr and (tmp_path / "ao_3.exr").is_file()
     assert unchanged()
     os.unlink(tmp_path / "ao_2.exr")
     # one render linked as every frame's input (a still): each output is new

@@ -138,7 +138,7 @@ def main_of(helper, request):
     return bpy.data.scenes.get(request.main) if request else scene_for_render(helper)
 
 
-INTERRUPTED = "interrupted while the AO was computed: this frame renders without AO"
+INTERRUPTED = "stopped while the AO was computed: this frame renders without AO"
 
 
 def _fill_passes(result, results, width, height):
@@ -199,12 +199,14 @@ def render_helper(engine, depsgraph):
         _fill_passes(result, results, width, height)
         filled = True
     finally:
-        if not filled:
-            # Interrupted (bpy: Ctrl-C raises KeyboardInterrupt here): the
-            # passes say no AO, not the zeros that would black the image.
-            _fill_passes(result, {}, width, height)
-            log(INTERRUPTED)
-        engine.end_result(result)
+        try:
+            if not filled:
+                # Interrupted (bpy: Ctrl-C raises KeyboardInterrupt here):
+                # the passes say no AO, not the zeros that would black the image.
+                log(INTERRUPTED)
+                _fill_passes(result, {}, width, height)
+        finally:
+            engine.end_result(result)
     timings = dict(engine.hbao_timings)
     timings["write"] = time.perf_counter() - write_start
     if results:

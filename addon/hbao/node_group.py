@@ -184,22 +184,35 @@ def _keep_state(node):
 
 
 def _finish_restores(nodes):
+    """The pending restores of `nodes` whose group is whole: not of a node
+    whose shared group is still outdated, or half rebuilt (a rebuild that
+    Blender refused midway: upgrade_group_tree finishes it first)."""
     for node in nodes:
-        if PENDING_KEY in node:
-            _restore(node, *json.loads(node[PENDING_KEY]))
-            del node[PENDING_KEY]
+        if PENDING_KEY not in node:
+            continue
+        tree = node.node_tree
+        if tree is not None and tree.name == GROUP_TREE_NAME and not _is_current(tree):
+            continue
+        try:
+            states, targets = json.loads(node[PENDING_KEY])
+            if not isinstance(states, dict) or not isinstance(targets, list):
+                raise ValueError("not a node state")
+        except (TypeError, ValueError):  # not this add-on's state: nothing to restore
+            states, targets = {}, []
+        _restore(node, states, targets)
+        del node[PENDING_KEY]
 
 
 def upgrade_group_tree():
     """Rebuild an outdated shared group in place (same name, same socket
     order, so keyframes stay on their sockets), keeping each node's values and
-    links. Called after a file is loaded."""
+    links. Called after a file is loaded, and before groups are adopted."""
     tree = bpy.data.node_groups.get(GROUP_TREE_NAME)
     if tree is None or tree.library is not None:
         return
     users = _users(tree)
-    _finish_restores(users)
     if _is_current(tree):
+        _finish_restores(users)
         return
     for node in users:
         _keep_state(node)
@@ -217,6 +230,7 @@ def adopt_group_copies(nodes):
     many nodes moved."""
     nodes = [node for node in nodes if node.id_data.library is None and
              getattr(node.id_data, "override_library", None) is None]
+    upgrade_group_tree()  # an outdated or half rebuilt shared group first
     _finish_restores(nodes)
     strays = [node for node in nodes if node.node_tree is None or (
         node.node_tree.name != GROUP_TREE_NAME and node.node_tree.library is None)]

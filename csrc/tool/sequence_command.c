@@ -1,4 +1,5 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
+#define _DEFAULT_SOURCE /* realpath */
 #include "sequence_command.h"
 
 #include <limits.h>
@@ -205,16 +206,17 @@ static const char *canonical_pattern(const char *pattern, char out[PATH_MAX]) {
     return canonical_path(pattern, out) ? out : pattern;
 }
 
-/* An input file of a listed frame, by identity: an output name that is a
- * symbolic link to it (the rename replaces the link's target), or a name
- * the input's own symbolic link points to, names it too. (A hard link
- * does not: the rename replaces that name only.) */
+/* An input file of a listed frame, by identity: an output that resolves to
+ * the same directory entry (through a symbolic link of the name or of a
+ * folder, a bind mount) would replace it. One file by two names (a hard
+ * link) is no such case: the rename replaces that name only; a file with
+ * several names is compared by its resolved path (realpath). */
 typedef struct frame_file {
     dev_t device;
     ino_t inode;
     int32_t frame;
-    int kind;          /* 0: the render, 1: the frame's --camera file */
-    bool through_link; /* the input's name is a symbolic link */
+    int kind;   /* 0: the render, 1: the frame's --camera file */
+    char *path; /* as the frame names it (owned) */
 } frame_file;
 
 static int compare_frame_files(const void *a, const void *b) {
@@ -232,33 +234,47 @@ static frame_file *frames_input_files(const char *const inputs[2], const frame_l
     frame_file *files = malloc((size_t)count * 2 * sizeof *files);
     if (files == NULL) return NULL;
     char path[PATH_MAX];
-    struct stat status, name;
+    struct stat status;
     for (int64_t i = 0; i < count; ++i) {
         const int32_t frame = frame_list_at(frames, i);
-        for (int kind = 0; kind < 2; ++kind)
-            if (inputs[kind] != NULL &&
-                frame_pattern_path(inputs[kind], frame, path, sizeof path) &&
-                stat(path, &status) == 0 && S_ISREG(status.st_mode) && lstat(path, &name) == 0)
-                files[(*found)++] =
-                    (frame_file){status.st_dev, status.st_ino, frame, kind, S_ISLNK(name.st_mode)};
+        for (int kind = 0; kind < 2; ++kind) {
+            if (inputs[kind] == NULL ||
+                !frame_pattern_path(inputs[kind], frame, path, sizeof path) ||
+                stat(path, &status) != 0 || !S_ISREG(status.st_mode))
+                continue;
+            char *copy = strdup(path);
+            if (copy == NULL) continue; /* (out of memory: the names' checks still run) */
+            files[(*found)++] = (frame_file){status.st_dev, status.st_ino, frame, kind, copy};
+        }
     }
     qsort(files, *found, sizeof *files, compare_frame_files);
     return files;
+}
+
+static void free_frame_files(frame_file *files, size_t found) {
+    for (size_t i = 0; i < found && files != NULL; ++i) free(files[i].path);
+    free(files);
+}
+
+/* Whether `a` and `b`, two names of one file, resolve to one path. */
+static bool same_resolved_path(const char *a, const char *b) {
+    char first[PATH_MAX], second[PATH_MAX];
+    return realpath(a, first) != NULL && realpath(b, second) != NULL && strcmp(first, second) == 0;
 }
 
 /* The first of `files` that belongs to a frame other than `frame` and that
  * writing `path` would replace (frame_file), or NULL. */
 static const frame_file *other_frames_file(const frame_file *files, size_t found, const char *path,
                                            int32_t frame) {
-    struct stat status, name;
-    if (files == NULL || stat(path, &status) != 0 || lstat(path, &name) != 0) return NULL;
-    const bool output_linked = S_ISLNK(name.st_mode);
-    const frame_file key = {status.st_dev, status.st_ino, 0, 0, false};
+    struct stat status;
+    if (files == NULL || stat(path, &status) != 0) return NULL;
+    const frame_file key = {status.st_dev, status.st_ino, 0, 0, NULL};
     const frame_file *hit = bsearch(&key, files, found, sizeof *files, compare_frame_files);
     if (hit == NULL) return NULL;
     while (hit > files && compare_frame_files(hit - 1, &key) == 0) --hit;
     for (; hit < files + found && compare_frame_files(hit, &key) == 0; ++hit)
-        if (hit->frame != frame && (output_linked || hit->through_link)) return hit;
+        if (hit->frame != frame && (status.st_nlink == 1 || same_resolved_path(path, hit->path)))
+            return hit;
     return NULL;
 }
 
@@ -294,8 +310,8 @@ static int refuse_other_frames_files(const cli_options *options, int64_t count, 
             const frame_file *same = other_frames_file(files, found, path, frame);
             if (same != NULL) {
                 status = tool_fail(error, TOOL_EXIT_USAGE,
-                                   "%s of frame %d (%s) is the %s of frame %d through a symbolic "
-                                   "link: it would be replaced",
+                                   "%s of frame %d (%s) is the %s of frame %d by another path (a "
+                                   "symbolic link): it would be replaced",
                                    flags[k], (int)frame, path, input_names[same->kind],
                                    (int)same->frame);
                 goto done;
@@ -312,7 +328,7 @@ static int refuse_other_frames_files(const cli_options *options, int64_t count, 
         }
     }
 done:
-    free(files);
+    free_frame_files(files, found);
     return status;
 }
 
