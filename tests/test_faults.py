@@ -36,7 +36,8 @@ def no_leftovers(tmp_path, monkeypatch):
     yield scratch
     left = sorted(p.name for p in scratch.iterdir())
     assert not left, f"temporary files left behind: {left}"
-    left = sorted(p.name for p in system_temp.iterdir())
+    # (Blender's own quit.blend, which a window's quit saves there, is no leftover)
+    left = sorted(p.name for p in system_temp.iterdir() if p.name.startswith("blender_"))
     assert not left, f"Blender's temporary folders left behind: {left}"
 
 
@@ -209,8 +210,8 @@ def test_scratch_folder_that_cannot_be_written_says_which_and_how(run_in_blender
     blocked = tmp_path / "a file, not a folder"
     blocked.write_text("")
     log = render_with_scratch_folder(run_in_blender, tmp_path, blocked)
-    assert f"cannot save the passes for the AO in {blocked}" in log, log[-3000:]
-    assert "HBAO_TEMP_DIR names a writable folder" in log
+    assert f"the scratch folder {blocked} is not a folder" in log, log[-3000:]
+    assert "HBAO_TEMP_DIR names existing folders" in log
 
 
 def test_a_scratch_folder_that_does_not_exist_is_not_made(run_in_blender, tmp_path, native,
@@ -233,7 +234,7 @@ def test_a_scratch_folder_that_does_not_exist_is_not_made(run_in_blender, tmp_pa
             "HBAO_TEMP_DIR": os.pathsep.join([str(missing), str(read_only), str(no_leftovers)])})
     finally:
         subprocess.run(["umount", str(read_only)], check=False)
-    assert f"the scratch folder {missing} does not exist" in log, log[-3000:]
+    assert f"the scratch folder {missing} does not exist;" in log, log[-3000:]
     assert f"cannot save the passes for the AO in {read_only}" in log, log[-3000:]
     assert not (tmp_path / "missing").exists()
     assert "could not remove" not in log and "without AO" not in log, log[-3000:]

@@ -100,7 +100,8 @@ def _save_and_read(scene, layers, views, threads, folder):
     try:
         if not os.path.isdir(folder):  # Blender's save would make it, and leave it
             raise ScratchFolderError(
-                f"the scratch folder {folder} does not exist (or is no folder); "
+                f"the scratch folder {folder} "
+                f"{'is not a folder' if os.path.exists(folder) else 'does not exist'}; "
                 f"{scratch_files.SCRATCH_FOLDER_VARIABLE} names existing folders for the passes")
         start = _clock()
         save_passes(scene, path, views)
