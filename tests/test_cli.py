@@ -1812,10 +1812,12 @@ def test_sequence_refuses_an_output_that_links_to_another_frames_input(hbao_tool
                        "--no-normals")
     assert_clean_error(folders, EXIT_USAGE, "--preview of frame 2", "the input of frame 3")
     assert (tmp_path / "in_3" / "r.exr").read_bytes() == before["render_3.exr"]
-    # render_3.exr a link to frame 2's output name (the output existing)
-    shutil.copyfile(fixture_path("cycles_float_zip"), tmp_path / "ao_2.exr")
+    # render_3.exr a link to frame 2's output name, not written yet, then existing
     os.unlink(tmp_path / "render_3.exr")
     (tmp_path / "render_3.exr").symlink_to("ao_2.exr")
+    assert_clean_error(run(), EXIT_USAGE, "-o of frame 2", "the input of frame 3")
+    assert not (tmp_path / "ao_1.exr").exists()
+    shutil.copyfile(fixture_path("cycles_float_zip"), tmp_path / "ao_2.exr")
     assert_clean_error(run(), EXIT_USAGE, "-o of frame 2", "the input of frame 3")
     os.unlink(tmp_path / "render_3.exr")
     os.rename(tmp_path / "ao_2.exr", tmp_path / "render_3.exr")

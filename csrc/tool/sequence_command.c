@@ -215,8 +215,9 @@ typedef struct frame_file {
     dev_t device;
     ino_t inode;
     int32_t frame;
-    int kind;   /* 0: the render, 1: the frame's --camera file */
-    char *path; /* as the frame names it (owned) */
+    int kind;      /* 0: the render, 1: the frame's --camera file */
+    char *path;    /* as the frame names it (owned); for a dangling link, where it points */
+    bool dangling; /* a symbolic link to a file not there yet (device, inode 0) */
 } frame_file;
 
 static int compare_frame_files(const void *a, const void *b) {
@@ -224,6 +225,22 @@ static int compare_frame_files(const void *a, const void *b) {
     if (x->device != y->device) return x->device < y->device ? -1 : 1;
     if (x->inode != y->inode) return x->inode < y->inode ? -1 : 1;
     return 0;
+}
+
+/* Where the symbolic link at `path`, whose target does not exist (yet),
+ * points: its folder made canonical (canonical_path). False for anything
+ * else. */
+static bool dangling_link_target(const char *path, char target[PATH_MAX]) {
+    struct stat status;
+    char link[PATH_MAX], joined[PATH_MAX];
+    if (lstat(path, &status) != 0 || !S_ISLNK(status.st_mode)) return false;
+    const ssize_t length = readlink(path, link, sizeof link - 1);
+    if (length < 0) return false;
+    link[length] = '\0';
+    const char *slash = strrchr(path, '/');
+    const int folder = link[0] == '/' || slash == NULL ? 0 : (int)(slash - path + 1);
+    const int written = snprintf(joined, sizeof joined, "%.*s%s", folder, path, link);
+    return written > 0 && written < PATH_MAX && canonical_path(joined, target);
 }
 
 /* The listed frames' input files that exist, sorted by identity (NULL and
@@ -238,13 +255,16 @@ static frame_file *frames_input_files(const char *const inputs[2], const frame_l
     for (int64_t i = 0; i < count; ++i) {
         const int32_t frame = frame_list_at(frames, i);
         for (int kind = 0; kind < 2; ++kind) {
-            if (inputs[kind] == NULL ||
-                !frame_pattern_path(inputs[kind], frame, path, sizeof path) ||
-                stat(path, &status) != 0 || !S_ISREG(status.st_mode))
+            if (inputs[kind] == NULL || !frame_pattern_path(inputs[kind], frame, path, sizeof path))
                 continue;
-            char *copy = strdup(path);
+            char target[PATH_MAX];
+            const bool exists = stat(path, &status) == 0;
+            if (exists ? !S_ISREG(status.st_mode) : !dangling_link_target(path, target)) continue;
+            char *copy = strdup(exists ? path : target);
             if (copy == NULL) continue; /* (out of memory: the names' checks still run) */
-            files[(*found)++] = (frame_file){status.st_dev, status.st_ino, frame, kind, copy};
+            files[(*found)++] =
+                exists ? (frame_file){status.st_dev, status.st_ino, frame, kind, copy, false}
+                       : (frame_file){0, 0, frame, kind, copy, true};
         }
     }
     qsort(files, *found, sizeof *files, compare_frame_files);
@@ -267,8 +287,16 @@ static bool same_resolved_path(const char *a, const char *b) {
 static const frame_file *other_frames_file(const frame_file *files, size_t found, const char *path,
                                            int32_t frame) {
     struct stat status;
-    if (files == NULL || stat(path, &status) != 0) return NULL;
-    const frame_file key = {status.st_dev, status.st_ino, 0, 0, NULL};
+    if (files == NULL) return NULL;
+    if (stat(path, &status) != 0) {
+        /* not there yet: another frame's input may be a link to it */
+        char canonical[PATH_MAX];
+        if (!canonical_path(path, canonical)) return NULL;
+        for (size_t i = 0; i < found && files[i].dangling; ++i)
+            if (files[i].frame != frame && strcmp(files[i].path, canonical) == 0) return &files[i];
+        return NULL;
+    }
+    const frame_file key = {status.st_dev, status.st_ino, 0, 0, NULL, false};
     const frame_file *hit = bsearch(&key, files, found, sizeof *files, compare_frame_files);
     if (hit == NULL) return NULL;
     while (hit > files && compare_frame_files(hit - 1, &key) == 0) --hit;
