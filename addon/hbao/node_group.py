@@ -6,7 +6,7 @@ import json
 
 import bpy
 
-from . import compat, parameters
+from . import compat, parameters, socket_keys
 
 # One group tree shared by every HBAO node (the values live on each node's
 # own sockets). The leading dot hides it from data-block menus.
@@ -120,46 +120,15 @@ def _users(tree):
             if getattr(node, "node_tree", None) == tree]
 
 
-def _socket_keys(socket):
-    """The keyframes on a value socket: [frame, value, interpolation, easing,
-    handle types and handles] each. bpy 5.3 deletes a socket's F-Curve with
-    the group socket that the rebuild removes (4.5 and 5.0 keep it)."""
-    if hasattr(socket.default_value, "__len__"):
-        return []
-    fcurve = compat.find_fcurve(socket.id_data, socket.path_from_id("default_value"))
-    return [[key.co[0], key.co[1], key.interpolation, key.easing, key.handle_left_type,
-             key.handle_right_type, list(key.handle_left), list(key.handle_right)]
-            for key in (fcurve.keyframe_points if fcurve is not None else ())]
-
-
-def _restore_keys(socket, keys):
-    """The socket's keyframes again, where its F-Curve is gone."""
-    path = socket.path_from_id("default_value")
-    if not keys or compat.find_fcurve(socket.id_data, path) is not None:
-        return
-    for frame, value, *_rest in keys:
-        socket.default_value = int(round(value)) if isinstance(socket.default_value, int) \
-            else value
-        socket.keyframe_insert("default_value", frame=frame)
-    fcurve = compat.find_fcurve(socket.id_data, path)
-    by_frame = {key[0]: key for key in keys}
-    for point in (fcurve.keyframe_points if fcurve is not None else ()):
-        key = by_frame.get(point.co[0])
-        if key is not None:
-            point.interpolation, point.easing = key[2], key[3]
-            point.handle_left_type, point.handle_right_type = key[4], key[5]
-            point.handle_left, point.handle_right = key[6], key[7]
-
-
 def _socket_state(socket):
     """What rebuilding the group's interface would lose: the socket's value,
     where its links come from, by node name and output index (sockets are new
-    objects after the rebuild), and its keyframes (_socket_keys)."""
+    objects after the rebuild), and its keyframes (socket_keys)."""
     value = socket.default_value
     value = tuple(value) if hasattr(value, "__len__") else value
     sources = [(link.from_node.name, list(link.from_node.outputs).index(link.from_socket))
                for link in socket.links]
-    return value, sources, _socket_keys(socket)
+    return value, sources, socket_keys.saved(socket)
 
 
 def _output_links(node):
@@ -193,7 +162,7 @@ def _restore(node, states, targets):
         if socket is None:
             continue
         try:
-            _restore_keys(socket, keys[0] if keys else [])
+            socket_keys.restore(socket, keys[0] if keys else [])
         except (TypeError, ValueError, RuntimeError):
             pass  # keys of a socket whose kind changed: its value below
         try:

@@ -114,7 +114,7 @@ static void release_cleanup_slot(atomic_file *file) {
 
 /* Follow `path` while it is a symbolic link (a dangling one too: writing
  * through it creates its target, as `echo > link` does). */
-static int follow_symbolic_links(const char *path, char resolved[PATH_MAX], tool_error *error) {
+int atomic_file_follow_links(const char *path, char resolved[PATH_MAX], tool_error *error) {
     if (strlen(path) >= PATH_MAX)
         return tool_fail(error, TOOL_EXIT_USAGE, "output path too long: %s", path);
     strcpy(resolved, path);
@@ -271,7 +271,7 @@ int atomic_file_begin(atomic_file *file, const char *destination, tool_error *er
         strcpy(file->destination, destination);
     } else {
         /* The rename must replace the link's target, not the link. */
-        status = follow_symbolic_links(destination, file->destination, error);
+        status = atomic_file_follow_links(destination, file->destination, error);
         if (status != TOOL_EXIT_SUCCESS) return status;
     }
 

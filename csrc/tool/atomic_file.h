@@ -64,6 +64,10 @@ typedef struct atomic_file {
  *  be written. */
 int atomic_file_begin(atomic_file *file, const char *destination, tool_error *error);
 
+/** `path` with its symbolic links followed, a dangling one too (where
+ *  atomic_file_begin writes a regular file): the name that is replaced. */
+int atomic_file_follow_links(const char *path, char resolved[PATH_MAX], tool_error *error);
+
 /** Flush the temporary file and put it in place (rename or copy through).
  *  On failure the temporary file is removed. */
 int atomic_file_commit(atomic_file *file, tool_error *error);

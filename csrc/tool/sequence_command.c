@@ -222,25 +222,26 @@ typedef struct frame_file {
 
 static int compare_frame_files(const void *a, const void *b) {
     const frame_file *x = a, *y = b;
+    if (x->dangling != y->dangling) return x->dangling ? -1 : 1; /* those first */
     if (x->device != y->device) return x->device < y->device ? -1 : 1;
     if (x->inode != y->inode) return x->inode < y->inode ? -1 : 1;
     return 0;
 }
 
-/* Where the symbolic link at `path`, whose target does not exist (yet),
- * points: its folder made canonical (canonical_path). False for anything
- * else. */
+/* `path` with its symbolic links followed (as an output is written), its
+ * folder made canonical. */
+static bool final_path(const char *path, char out[PATH_MAX]) {
+    char followed[PATH_MAX];
+    tool_error ignored = {{0}};
+    return atomic_file_follow_links(path, followed, &ignored) == TOOL_EXIT_SUCCESS &&
+           canonical_path(followed, out);
+}
+
+/* Where the symbolic link (or chain of them) at `path`, whose target does
+ * not exist (yet), ends (final_path). False for anything else. */
 static bool dangling_link_target(const char *path, char target[PATH_MAX]) {
     struct stat status;
-    char link[PATH_MAX], joined[PATH_MAX];
-    if (lstat(path, &status) != 0 || !S_ISLNK(status.st_mode)) return false;
-    const ssize_t length = readlink(path, link, sizeof link - 1);
-    if (length < 0) return false;
-    link[length] = '\0';
-    const char *slash = strrchr(path, '/');
-    const int folder = link[0] == '/' || slash == NULL ? 0 : (int)(slash - path + 1);
-    const int written = snprintf(joined, sizeof joined, "%.*s%s", folder, path, link);
-    return written > 0 && written < PATH_MAX && canonical_path(joined, target);
+    return lstat(path, &status) == 0 && S_ISLNK(status.st_mode) && final_path(path, target);
 }
 
 /* The listed frames' input files that exist, sorted by identity (NULL and
@@ -289,9 +290,10 @@ static const frame_file *other_frames_file(const frame_file *files, size_t found
     struct stat status;
     if (files == NULL) return NULL;
     if (stat(path, &status) != 0) {
-        /* not there yet: another frame's input may be a link to it */
+        /* not there yet: another frame's input may be a link to where it
+         * will be written */
         char canonical[PATH_MAX];
-        if (!canonical_path(path, canonical)) return NULL;
+        if (found == 0 || !files[0].dangling || !final_path(path, canonical)) return NULL;
         for (size_t i = 0; i < found && files[i].dangling; ++i)
             if (files[i].frame != frame && strcmp(files[i].path, canonical) == 0) return &files[i];
         return NULL;
@@ -326,20 +328,24 @@ static int refuse_other_frames_files(const cli_options *options, int64_t count, 
             if (patterns[k] == NULL || !frame_pattern_path(patterns[k], frame, path, sizeof path))
                 continue;
             int32_t other;
-            for (int in = 0; in < 2; ++in)
-                if (inputs[in] != NULL && frame_pattern_frame(inputs[in], path, &other) &&
+            /* the name, and where a link at it writes (an input not there yet) */
+            char written[PATH_MAX];
+            const bool linked = final_path(path, written) && strcmp(written, path) != 0;
+            for (int in = 0; in < 4; ++in)
+                if (inputs[in % 2] != NULL && (in < 2 || linked) &&
+                    frame_pattern_frame(inputs[in % 2], in < 2 ? path : written, &other) &&
                     other != frame && frame_list_contains(&options->frames, other)) {
                     status = tool_fail(error, TOOL_EXIT_USAGE,
                                        "%s of frame %d (%s) is the %s of frame %d: it would be "
                                        "replaced before it is read",
-                                       flags[k], (int)frame, path, input_names[in], (int)other);
+                                       flags[k], (int)frame, path, input_names[in % 2], (int)other);
                     goto done;
                 }
             const frame_file *same = other_frames_file(files, found, path, frame);
             if (same != NULL) {
                 status = tool_fail(error, TOOL_EXIT_USAGE,
                                    "%s of frame %d (%s) is the %s of frame %d by another path (a "
-                                   "symbolic link): it would be replaced",
+                                   "symbolic link): it would be written before it is read",
                                    flags[k], (int)frame, path, input_names[same->kind],
                                    (int)same->frame);
                 goto done;
