@@ -78,7 +78,7 @@ def read_passes(scene, layers, views=None, threads=0):
     of a stereo or multi-view render, {view name: those} instead; and the
     seconds the save and the read (by `threads`, 0: one per core) took.
     Saved in the first of scratch_files.folders() that takes the file."""
-    scratch_files.remove_stale_once()
+    scratch_files.remove_stale_now_and_then()
     scratch_files.wait_for_older_removals()
     folders = scratch_files.folders()
     for index, folder in enumerate(folders):

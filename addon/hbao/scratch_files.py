@@ -104,15 +104,20 @@ def remove_stale_scratch_files():
     return removed
 
 
-_stale_files_checked = False
+_stale_files_checked_at = None  # time.monotonic() of the last look
 
 
-def remove_stale_once():
-    """At a process's first hand-over: remove_stale_scratch_files() in the
-    background (that hand-over need not wait for it)."""
-    global _stale_files_checked
-    if not _stale_files_checked:
-        _stale_files_checked = True
+def remove_stale_now_and_then():
+    """At a process's first hand-over, and again at the first after
+    STALE_AGE_S more: remove_stale_scratch_files() in the background (a
+    hand-over need not wait for it). A long animation started just after a
+    Blender was killed removes that Blender's file once it is old enough
+    (an 8K frame's is about a gigabyte of /dev/shm), not only the next
+    Blender to start ten minutes later."""
+    global _stale_files_checked_at
+    now = time.monotonic()
+    if _stale_files_checked_at is None or now - _stale_files_checked_at >= STALE_AGE_S:
+        _stale_files_checked_at = now
         _in_background(_remove_stale_files)
 
 

@@ -156,7 +156,7 @@ def held_cleanup():
 
 
 scratch_files.remove_stale_scratch_files = held_cleanup
-scratch_files._stale_files_checked = False
+scratch_files._stale_files_checked_at = None
 try:
     start = time.perf_counter()
     try:
@@ -171,4 +171,25 @@ finally:
 for thread in list(scratch_files._removals):
     thread.join(30)
 assert not os.path.exists(stale), "the first hand-over did not remove the stale file"
+
+# A file left meanwhile (a Blender killed while this one renders an animation):
+# the next hand-overs within STALE_AGE_S do not look again; the first after it does.
+open(stale, "wb").close()
+os.utime(stale, (old, old))
+
+
+def hand_over():
+    try:
+        handover.read_passes(bpy.context.scene, {})
+    except RuntimeError:  # nothing rendered, as above
+        pass
+    for thread in list(scratch_files._removals):
+        thread.join(30)
+
+
+hand_over()
+assert os.path.exists(stale), "a hand-over looked for stale files again at once"
+scratch_files._stale_files_checked_at -= scratch_files.STALE_AGE_S
+hand_over()
+assert not os.path.exists(stale), "a hand-over STALE_AGE_S later did not remove the stale file"
 print("REMOVAL OK", flush=True)
