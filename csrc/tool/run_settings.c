@@ -7,7 +7,6 @@
 #include <string.h>
 
 #include "camera_json.h"
-#include "exr_reader.h"
 
 /* Appends to text[*used ...]; *used past RUN_SETTINGS_MAX - 1 marks a text that
  * did not fit. */
@@ -83,26 +82,27 @@ bool run_settings_text(const cli_options *options, const camera_settings *camera
     return used < RUN_SETTINGS_MAX - 1;
 }
 
-bool run_settings_match(const char *path, const char *text) {
-    exr_context_t context = NULL;
-    exr_context_initializer_t initializer = exr_quiet_initializer();
-    if (exr_start_read(&context, path, &initializer) != EXR_ERR_SUCCESS) {
-        if (context != NULL) exr_finish(&context);
-        return false;
-    }
+/* The stamp of the EXR opened as `context`, or NULL with *length 0. */
+static const char *stamp(exr_const_context_t context, int32_t *length) {
     const char *stored = NULL;
-    int32_t length = 0;
-    const bool match = exr_attr_get_string(context, 0, RUN_SETTINGS_ATTRIBUTE, &length, &stored) ==
-                           EXR_ERR_SUCCESS &&
-                       stored != NULL && length >= 0 && (size_t)length == strlen(text) &&
-                       memcmp(stored, text, (size_t)length) == 0;
-    exr_finish(&context);
-    return match;
+    *length = 0;
+    if (exr_attr_get_string(context, 0, RUN_SETTINGS_ATTRIBUTE, length, &stored) !=
+            EXR_ERR_SUCCESS ||
+        stored == NULL || *length < 0) {
+        *length = 0;
+        return NULL;
+    }
+    return stored;
+}
+
+bool run_settings_match(exr_const_context_t context, const char *text) {
+    int32_t length;
+    const char *stored = stamp(context, &length);
+    return stored != NULL && (size_t)length == strlen(text) &&
+           memcmp(stored, text, (size_t)length) == 0;
 }
 
 bool run_settings_stamped(exr_const_context_t context) {
-    const char *stored = NULL;
-    int32_t length = 0;
-    return exr_attr_get_string(context, 0, RUN_SETTINGS_ATTRIBUTE, &length, &stored) ==
-           EXR_ERR_SUCCESS;
+    int32_t length;
+    return stamp(context, &length) != NULL;
 }

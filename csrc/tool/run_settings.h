@@ -31,9 +31,9 @@
 bool run_settings_text(const cli_options *options, const camera_settings *camera_file,
                        char text[RUN_SETTINGS_MAX]);
 
-/** Whether the EXR at `path` holds RUN_SETTINGS_ATTRIBUTE equal to `text`
- *  (false when it cannot be read or has no such attribute). */
-bool run_settings_match(const char *path, const char *text);
+/** Whether the EXR opened as `context` holds RUN_SETTINGS_ATTRIBUTE equal
+ *  to `text` in its first part (false without such an attribute). */
+bool run_settings_match(exr_const_context_t context, const char *text);
 
 /** Whether the EXR opened as `context` holds RUN_SETTINGS_ATTRIBUTE in its
  *  first part: it is an hbao output. */

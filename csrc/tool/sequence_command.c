@@ -38,28 +38,29 @@ static bool newer_or_equal(const struct stat *a, const struct stat *b) {
     return a->st_mtim.tv_nsec >= b->st_mtim.tv_nsec;
 }
 
-/* The output's AO channel decodes whole (every chunk listed, inside the
- * file and, where compressed, inflating): an output cut short or damaged
- * since the tool wrote it (an interrupted copy, rsync --inplace) is redone,
- * not skipped with its header intact. A read of one channel per skipped
- * frame. */
-static bool output_decodes(const cli_options *frame) {
+/* The output holds `settings` (its stamp) and its AO channel decodes whole
+ * (every chunk listed, inside the file and, where compressed, inflating):
+ * an output cut short or damaged since the tool wrote it (an interrupted
+ * copy, rsync --inplace) is redone, not skipped with its header intact.
+ * One open and a read of one channel per skipped frame. */
+static bool output_is_whole(const cli_options *frame, const char *settings) {
     exr_input output;
     tool_error ignored = {{0}};
     if (exr_input_open(&output, frame->output_path, &ignored) != TOOL_EXIT_SUCCESS) return false;
-    bool decodes = false;
-    float *pixels = exr_input_find_channel(&output, frame->ao_channel) < 0
+    bool whole = false;
+    float *pixels = !run_settings_match(output.context, settings) ||
+                            exr_input_find_channel(&output, frame->ao_channel) < 0
                         ? NULL
                         : malloc((size_t)output.width * (size_t)output.height * sizeof *pixels);
     if (pixels != NULL) {
         const exr_channel_request request = {frame->ao_channel, EXR_PIXEL_FLOAT, (uint8_t *)pixels,
                                              (int32_t)sizeof *pixels,
                                              (int64_t)output.width * (int64_t)sizeof *pixels};
-        decodes = exr_input_read(&output, &request, 1, &ignored) == TOOL_EXIT_SUCCESS;
+        whole = exr_input_read(&output, &request, 1, &ignored) == TOOL_EXIT_SUCCESS;
     }
     free(pixels);
     exr_input_close(&output);
-    return decodes;
+    return whole;
 }
 
 /* Up to date, as make decides, and computed with the same flags: every
@@ -67,7 +68,7 @@ static bool output_decodes(const cli_options *frame) {
  * preview at least as new as the EXR (ao_command writes it after the EXR, so
  * a preview left from before the EXR was last computed is stale), and the
  * EXR's header holds the settings this run would write (run_settings.h)
- * and its AO decodes (output_decodes).
+ * and its AO decodes (output_is_whole).
  * (An input re-rendered while its frame was computed gets no output:
  * ao_command's refuse_changed_input.) */
 static bool up_to_date(const cli_options *frame) {
@@ -88,7 +89,7 @@ static bool up_to_date(const cli_options *frame) {
         return false;
     char settings[RUN_SETTINGS_MAX];
     return run_settings_text(frame, frame->camera_file, settings) &&
-           run_settings_match(frame->output_path, settings) && output_decodes(frame);
+           output_is_whole(frame, settings);
 }
 
 static void report(sequence_run *run, const frame_outcome *outcome, const char *output,
@@ -330,17 +331,19 @@ static int refuse_other_frames_files(const cli_options *options, int64_t count, 
             int32_t other;
             /* the name, and where a link at it writes (an input not there yet) */
             char written[PATH_MAX];
-            const bool linked = final_path(path, written) && strcmp(written, path) != 0;
-            for (int in = 0; in < 4; ++in)
-                if (inputs[in % 2] != NULL && (in < 2 || linked) &&
-                    frame_pattern_frame(inputs[in % 2], in < 2 ? path : written, &other) &&
-                    other != frame && frame_list_contains(&options->frames, other)) {
-                    status = tool_fail(error, TOOL_EXIT_USAGE,
-                                       "%s of frame %d (%s) is the %s of frame %d: it would be "
-                                       "replaced before it is read",
-                                       flags[k], (int)frame, path, input_names[in % 2], (int)other);
-                    goto done;
-                }
+            const char *names[2] = {
+                path, final_path(path, written) && strcmp(written, path) != 0 ? written : NULL};
+            for (int n = 0; n < 2; ++n)
+                for (int in = 0; in < 2; ++in)
+                    if (names[n] != NULL && inputs[in] != NULL &&
+                        frame_pattern_frame(inputs[in], names[n], &other) && other != frame &&
+                        frame_list_contains(&options->frames, other)) {
+                        status = tool_fail(error, TOOL_EXIT_USAGE,
+                                           "%s of frame %d (%s) is the %s of frame %d: it would "
+                                           "be replaced before it is read",
+                                           flags[k], (int)frame, path, input_names[in], (int)other);
+                        goto done;
+                    }
             const frame_file *same = other_frames_file(files, found, path, frame);
             if (same != NULL) {
                 status = tool_fail(error, TOOL_EXIT_USAGE,
