@@ -212,12 +212,9 @@ def upgrade_group_tree():
     order, so keyframes stay on their sockets), keeping each node's values and
     links. Called after a file is loaded, and before groups are adopted."""
     tree = bpy.data.node_groups.get(GROUP_TREE_NAME)
-    if tree is None or tree.library is not None:
-        return
+    if tree is None or tree.library is not None or _is_current(tree):
+        return  # (a restore left pending on a whole group: adopt_group_copies, every sync)
     users = _users(tree)
-    if _is_current(tree):
-        _finish_restores(users)
-        return
     for node in users:
         _keep_state(node)
     _build_group_tree(tree)
