@@ -1292,3 +1292,22 @@ def test_a_file_with_the_old_group_keeps_its_keyframes_in_every_blender(run_in_b
                                      for name in ("Directions", "Steps", "Blur Size")}, state
     assert state["directions"] == 8 and state["steps_source"] == ["Steps Value"], state
     assert state["blur"] == [3, 6, 9], state
+    # Everything set on a curve is kept, not its keys alone (5.3 deleted the
+    # modifiers, easing and keyframe types with the curve).
+    curve = state["radius_curve"]
+    assert curve is not None, state
+    assert curve["first"] == ["BACK", "EASE_OUT", 2.5] and curve["last_type"] == "BREAKDOWN"
+    assert curve["extrapolation"] == "LINEAR", curve
+    assert curve["modifiers"] == [
+        ["CYCLES", "REPEAT_OFFSET", 3], ["NOISE", True, 40.0, 50.0, pytest.approx(0.02)],
+        ["ENVELOPE", True, 52.0, 58.0, [[55.0, pytest.approx(0.4), pytest.approx(0.9)]]]], curve
+    before = json.loads(next(text for text in saved.stdout.splitlines()
+                             if text.startswith("OLD RADIUS "))[len("OLD RADIUS "):])
+    assert {frame: curve["values"][frame] for frame in before} == before, (before, curve)
+    # ... and so is a driver (5.3 deleted it too), its curve's modifiers (the
+    # Generator that driver_add gives it in some versions) as they were.
+    modifiers = int(next(text for text in saved.stdout.splitlines()
+                         if text.startswith("OLD DRIVER MODIFIERS ")).split()[-1])
+    assert state["drivers"] == [["Thickness", "0.25 + 0.001 * frame + 0.0 * x", [
+        ["frame", "SINGLE_PROP", "SCENE", "Scene", "frame_current", "LOC_X"],
+        ["x", "TRANSFORMS", "OBJECT", "Camera", "", "LOC_X"]], modifiers]], state
