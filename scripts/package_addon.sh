@@ -42,10 +42,16 @@ for licence in /usr/share/doc/libopenexr*/copyright; do
 done
 ZIP="$REPO/dist/hbao-$VERSION.zip"
 rm -f "$ZIP"
+# Each folder has an entry of its own ("hbao/" first): Blender's Install with
+# Overwrite removes the folders and files a zip names at its top level, and a
+# zip of files alone names none, so it was extracted over the old add-on,
+# rewriting the library a running copy has mapped (a crash, SIGBUS).
 (cd "$STAGE" && python3 -c '
 import sys, zipfile, os
 with zipfile.ZipFile(sys.argv[1], "w", zipfile.ZIP_DEFLATED) as archive:
-    for root, _dirs, files in os.walk("hbao"):
+    for root, dirs, files in os.walk("hbao"):
+        dirs.sort()
+        archive.write(root)
         for name in sorted(files):
             archive.write(os.path.join(root, name))
 ' "$ZIP")
