@@ -22,6 +22,11 @@ render cycles_float_zip --scene demo --codec ZIP --ao-distance 1.0
 render cycles_half_piz --scene demo --half --codec PIZ --ao-distance 1.0
 render cycles_float_none --scene demo --codec NONE
 render cycles_half_b44 --scene demo --half --codec B44
+# 33 rows: B44's last chunk holds one row, which it cannot make smaller, so it
+# is stored uncompressed (OpenEXRCore 3.1 misread such chunks); its twin in ZIP
+# holds the same Depth, and Normal to the last float bit (a second render).
+render cycles_half_b44_tail --scene demo --half --codec B44 --height 33
+render cycles_half_zip_tail --scene demo --half --codec ZIP --height 33
 render eevee_half --scene demo --engine BLENDER_EEVEE --half --codec ZIP
 render ortho_float --scene demo --ortho --codec ZIP
 render two_layers --scene two_layers --codec ZIP
@@ -49,6 +54,8 @@ Each NAME.exr has a NAME.camera.json (Blender's camera properties, the format of
 | cycles_half_piz | the same scene, 16-bit half colour depth, PIZ (Blender keeps Depth/Normal float) |
 | cycles_float_none | uncompressed |
 | cycles_half_b44 | half float, B44 compression (Blender offers B44 for half only) |
+| cycles_half_b44_tail | the same, 64x33: the last chunk (one row) stored uncompressed |
+| cycles_half_zip_tail | its twin in ZIP: the same Depth, Normal to the last float bit (a second render) |
 | eevee_half | EEVEE, half float: background depth 65504 |
 | ortho_float | orthographic camera |
 | two_layers | two view layers with different content |
@@ -56,7 +63,7 @@ Each NAME.exr has a NAME.camera.json (Blender's camera properties, the format of
 
 Blender 5 multi-part files, written by Blender 5.0.1 (PyPI's \`bpy\` 5.0.1) through
 \`scripts/render_blender5_multipart.py\`, 48x32, 2 samples: one render of a cube on a
-floor, saved three ways. \`make_fixtures.sh\` renders them when \`BPY5_PYTHON\` names a
+floor, saved four ways. \`make_fixtures.sh\` renders them when \`BPY5_PYTHON\` names a
 Python that has that \`bpy\`.
 
 | file | what |
@@ -64,4 +71,5 @@ Python that has that \`bpy\`.
 | blender5_cycles_multipart | Blender 5's default multilayer layout: 3 parts (Combined, Depth, Normal), 32-bit float, ZIP |
 | blender5_cycles_multipart_interleaved | the same pixels in one part (\`use_exr_interleave\`) |
 | blender5_half_piz_multipart | the same render, 3 parts, half-float Combined (Depth and Normal stay float), PIZ |
+| blender5_half_b44_multipart | the same, B44: the float Depth and Normal parts' chunks stored uncompressed |
 README

@@ -34,7 +34,7 @@ from conftest import FIXTURES, REPO, SCRIPTS, small_tmpfs
 
 # Every fixture that holds a Depth pass, with the view layer the tool picks.
 DEPTH_FIXTURES = ["cycles_float_zip", "cycles_half_piz", "cycles_float_none", "cycles_half_b44",
-                  "eevee_half", "ortho_float", "two_layers"]
+                  "cycles_half_b44_tail", "eevee_half", "ortho_float", "two_layers"]
 # Fixtures read back pixel by pixel through Blender (one per engine and projection,
 # plus the half-float twin of cycles_float_zip).
 READBACK_FIXTURES = ["cycles_float_zip", "cycles_half_piz", "eevee_half", "ortho_float"]

@@ -42,6 +42,10 @@ THREADS = 4
 # cJSON prints a double with 15 significant digits when that reads back
 # within DBL_EPSILON relative (else with 17): twice DBL_EPSILON bounds it.
 JSON_RELATIVE_TOLERANCE = 2 * np.finfo(np.float64).eps
+# Two Cycles renders of one scene hold the same Depth, and Normal passes that
+# may differ in the last float bits (samples summed across threads; 6e-8 in
+# the B44 twins): far below any decoding error, which is of the values' size.
+HALF_TWIN_NORMAL_TOLERANCE = 1e-6
 
 
 # The add-on imports as a package without Blender.
@@ -639,3 +643,21 @@ def test_corrupt_offset_tables_never_give_wrong_pixels(library, blender_exrs, tm
             for channel in names:
                 assert np.array_equal(channels[channel], reference[channel],
                                       equal_nan=True), (name, threads)
+
+
+def test_b44_chunks_stored_uncompressed_read_as_their_zip_twin():
+    """cycles_half_b44_tail (64 x 33, half colour depth, B44) and its ZIP twin
+    cycles_half_zip_tail are renders of one scene (tests/fixtures/README.md).
+    Blender keeps Depth and Normal float, which B44 cannot shrink, so a chunk
+    that is mostly float, here the last (one row), is stored uncompressed;
+    OpenEXRCore 3.1 ran B44's decoder over it: a depth of 2e-6 and normals of
+    5.5 in the last row, read without an error. Depth is the same to the bit
+    in both renders; Normal to the last float bit (HALF_TWIN_NORMAL_TOLERANCE)."""
+    names = ["ViewLayer.Depth.Z"] + [f"ViewLayer.Normal.{axis}" for axis in "XYZ"]
+    b44 = exr.read_channels(FIXTURES / "cycles_half_b44_tail.exr", names)
+    zip_twin = exr.read_channels(FIXTURES / "cycles_half_zip_tail.exr", names)
+    assert b44[names[0]].shape == (33, 64)
+    assert np.array_equal(b44[names[0]], zip_twin[names[0]])
+    for name in names[1:]:
+        np.testing.assert_allclose(b44[name], zip_twin[name], rtol=0,
+                                   atol=HALF_TWIN_NORMAL_TOLERANCE, err_msg=name)

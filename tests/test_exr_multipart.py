@@ -3,8 +3,8 @@
 their full names) through the `hbao` tool and libhbao_exr.
 
 The fixtures (scripts/render_blender5_multipart.py, Blender 5.0.1) are one
-render saved three ways: multi-part 32-bit float ZIP, the same as a single
-part (use_exr_interleave), and multi-part half-float PIZ. OpenEXR's own tools
+render saved four ways: multi-part 32-bit float ZIP, the same as a single
+part (use_exr_interleave), and multi-part half-float PIZ and B44. OpenEXR's own tools
 (exrheader, exrmultipart: Debian package openexr) say what the files hold and
 make the files the reader must refuse, so no EXR is parsed or written by hand
 here.
@@ -24,6 +24,7 @@ from conftest import FIXTURES, REPO
 MULTIPART = "blender5_cycles_multipart"
 INTERLEAVED = "blender5_cycles_multipart_interleaved"
 HALF_PIZ = "blender5_half_piz_multipart"
+HALF_B44 = "blender5_half_b44_multipart"
 LAYER = "ViewLayer"
 DEPTH = f"{LAYER}.Depth.Z"
 NORMALS = [f"{LAYER}.Normal.{axis}" for axis in "XYZ"]
@@ -235,6 +236,23 @@ def test_half_piz_multipart_gives_the_same_ao(hbao_tool, tmp_path):
         np.testing.assert_allclose(half[channel_name], full[channel_name],
                                    rtol=HALF_RELATIVE_TOLERANCE, atol=0)
     assert np.array_equal(compute_ao(hbao_tool, fixture(HALF_PIZ), tmp_path / "half.exr"),
+                          compute_ao(hbao_tool, fixture(MULTIPART), tmp_path / "full.exr"))
+
+
+def test_half_b44_multipart_gives_the_same_ao(hbao_tool, tmp_path):
+    """B44 compresses half channels only: the float Depth and Normal parts
+    cannot be made smaller, and each of their chunks is stored uncompressed,
+    which OpenEXRCore 3.1 decoded as B44 (the Normal part scrambled: AO off
+    by up to 0.97, exit 0). They are the float render's pixels exactly."""
+    parts, text = exrheader(fixture(HALF_B44))
+    assert text.count("compression (type compression): b44") == 3
+    assert set(parts[2].values()) == {"32-bit floating-point"}
+    names = [DEPTH] + NORMALS
+    b44 = exr.read_channels(fixture(HALF_B44), names)
+    full = exr.read_channels(fixture(MULTIPART), names)
+    for channel_name in names:
+        assert np.array_equal(b44[channel_name], full[channel_name]), channel_name
+    assert np.array_equal(compute_ao(hbao_tool, fixture(HALF_B44), tmp_path / "b44.exr"),
                           compute_ao(hbao_tool, fixture(MULTIPART), tmp_path / "full.exr"))
 
 

@@ -481,6 +481,17 @@ static void scatter_line(const uint8_t *from, int size, int32_t width, uint8_t *
     }
 }
 
+/* A chunk whose packed size is its unpacked size was stored uncompressed: a
+ * writer does so when compression would not make it smaller (OpenEXR's rule
+ * for every codec). OpenEXRCore 3.1 still ran B44's decoder over such a chunk
+ * (a B44 file's float Depth and Normal, which B44 leaves as they are), giving
+ * garbage without an error; its bytes are the pixels. */
+static exr_result_t copy_stored_chunk(exr_decode_pipeline_t *decode) {
+    if (decode->unpacked_buffer != decode->packed_buffer)
+        memcpy(decode->unpacked_buffer, decode->packed_buffer, decode->chunk.packed_size);
+    return EXR_ERR_SUCCESS;
+}
+
 /* Decode the requests that name channels of `part`, for the chunks that
  * start at rows first_y .. last_y of the file (a band; every chunk of the
  * part when the band is the whole data window); the other requests are left
@@ -578,6 +589,8 @@ static int read_band(exr_input *input, int part, const exr_channel_request *requ
         }
         CHECK_EXR(exr_decoding_choose_default_routines(input->context, part, &decoder),
                   "cannot decode this channel layout");
+        if (decoder.decompress_fn != NULL && chunk.packed_size == chunk.unpacked_size)
+            decoder.decompress_fn = copy_stored_chunk;
         /* The stream skips and gathers reads only where OpenEXRCore chose
          * its direct read, which neither decompresses nor unpacks: its other
          * routines read their input back within exr_decoding_run. */
