@@ -394,6 +394,29 @@ def build_corner_scene(scene=None, resolution=(96, 64), engine="CYCLES",
     return scene
 
 
+def build_low_poly_scene(scene=None, resolution=(96, 64), engine="CYCLES",
+                         samples=DEFAULT_SAMPLES):
+    """The corner scene's room with coarse meshes shaded smooth, as artists
+    leave them: an icosphere, a six-sided cylinder, a cube and a five-sided
+    cone. Their shading normals lean past their outlines, and Cycles from 4.x
+    writes such normals facing away from the camera."""
+    scene = build_corner_scene(scene, resolution, engine, samples, with_props=False)
+    props = scene.collection.children[PROPS_COLLECTION]
+    material = _material("Props", (0.6, 0.6, 0.6))
+    shapes = (
+        (bpy.ops.mesh.primitive_ico_sphere_add, "Ico",
+         {"radius": 0.5, "subdivisions": 1, "location": (-0.9, -0.2, 0.5)}),
+        (bpy.ops.mesh.primitive_cylinder_add, "Cylinder",
+         {"radius": 0.4, "depth": 1.2, "vertices": 6, "location": (0.3, 0.2, 0.6)}),
+        (bpy.ops.mesh.primitive_cube_add, "Cube", {"size": 0.7, "location": (1.3, -0.6, 0.35)}),
+        (bpy.ops.mesh.primitive_cone_add, "Cone",
+         {"radius1": 0.8, "depth": 0.5, "vertices": 5, "location": (0.0, -1.4, 0.25)}),
+    )
+    for operator, name, arguments in shapes:
+        _smooth(_add(operator, props, material, name, **arguments))
+    return scene
+
+
 def build_two_layer_scene(scene=None, resolution=(96, 64), engine="CYCLES",
                           samples=DEFAULT_SAMPLES):
     """The corner scene with two view layers, both with Depth and Normal:
@@ -504,4 +527,5 @@ SCENE_BUILDERS = {
     "demo": build_demo_scene,
     "corner": build_corner_scene,
     "two_layers": build_two_layer_scene,
+    "low_poly": build_low_poly_scene,
 }

@@ -215,6 +215,51 @@ static void fallback_normal(const normal_job *job, int i, int j) {
     for (int c = 0; c < 3; c++) hbao_grid_normal_row(grid, j, c)[i] = n[c];
 }
 
+/* A given normal u (unit, in grid->normal) that faces away from the viewer,
+ * dot(u, V) < 0, turned to face it, one of two ways. A surface seen from
+ * behind (a single-sided plane, whose pass holds its front's normal): -u.
+ * A surface that faces the camera under a shading normal tilted past its
+ * outline (smooth shading of a coarse mesh, a bump; Cycles from 4.x writes
+ * these): u mirrored across the plane perpendicular to V, u - 2 dot(u, V)
+ * V, which faces the viewer as much as u faced away and keeps its tilt;
+ * turned round, such a normal pointed into the surface, which then hid
+ * itself (AO 0.03 where Cycles gives 0.63). The face normal from depth
+ * tells the cases apart: the candidate nearer to it; on a tie (where depth
+ * gives no face normal, which is then V), -u. A normal more than 30 degrees
+ * past edge-on (dot(u, V) < -1/2) is no tilted shading normal: -u. */
+#define HBAO_MOST_TILT_PAST_EDGE_ON (-0.5f)
+static void turn_to_viewer(const normal_job *job, int i, int j) {
+    hbao_grid *grid = job->grid;
+    float u[3], v[3], face[3];
+    for (int c = 0; c < 3; c++) u[c] = hbao_grid_normal_row(grid, j, c)[i];
+    if (grid->orthographic) {
+        v[0] = 0.0f;
+        v[1] = 0.0f;
+        v[2] = 1.0f;
+    } else {
+        /* V at any depth: the direction (-x, -y, 1), which no depth overflows */
+        const float x = ((float)i + grid->x_offset) * grid->x_step;
+        const float y = hbao_grid_y(grid, j);
+        const float length = sqrtf(x * x + y * y + 1.0f);
+        v[0] = -x / length;
+        v[1] = -y / length;
+        v[2] = 1.0f / length;
+    }
+    const float u_dot_v = u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+    if (!(u_dot_v < 0.0f)) return; /* edge-on, to rounding: u as it is */
+    if (u_dot_v < HBAO_MOST_TILT_PAST_EDGE_ON) {
+        for (int c = 0; c < 3; c++) hbao_grid_normal_row(grid, j, c)[i] = -u[c];
+        return;
+    }
+    face_normal(grid, i, j, face);
+    float mirror[3];
+    for (int c = 0; c < 3; c++) mirror[c] = u[c] - 2.0f * u_dot_v * v[c];
+    const float mirror_agrees = mirror[0] * face[0] + mirror[1] * face[1] + mirror[2] * face[2];
+    const float turned_agrees = -(u[0] * face[0] + u[1] * face[1] + u[2] * face[2]);
+    const int keep_tilt = mirror_agrees > turned_agrees;
+    for (int c = 0; c < 3; c++) hbao_grid_normal_row(grid, j, c)[i] = keep_tilt ? mirror[c] : -u[c];
+}
+
 /* The given normals of CHUNK pixels at a time, in lanes (no FMA
  * contraction: internal_finish.h), so every compiled copy gives the same
  * normals: world to camera space, scaled to unit length by one reciprocal,
@@ -245,7 +290,7 @@ static HBAO_ALWAYS_INLINE void given_normals_row(const normal_job *job, int j) {
         const int count = grid->width - i0 < CHUNK ? grid->width - i0 : CHUNK;
         float wx[CHUNK], wy[CHUNK], wz[CHUNK], z[CHUNK];
         float nx[CHUNK], ny[CHUNK], nz[CHUNK];
-        int usable[CHUNK];
+        int usable[CHUNK], away[CHUNK];
         if (count == CHUNK && pixel_step == 3) {
             /* x, y, z interleaved (a numpy array, an EXR read) at full
              * resolution: with the stride a constant, the compiler reads
@@ -295,10 +340,10 @@ static HBAO_ALWAYS_INLINE void given_normals_row(const normal_job *job, int j) {
              * depth in the float range overflows it. */
             const float x = ((float)(i0 + k) + grid->x_offset) * grid->x_step;
             const float facing = orthographic ? u2 : u2 - (u0 * x + u1 * y);
-            const int flip = facing < 0.0f;
-            nx[k] = flip ? -u0 : u0;
-            ny[k] = flip ? -u1 : u1;
-            nz[k] = flip ? -u2 : u2;
+            away[k] = facing < 0.0f;
+            nx[k] = u0;
+            ny[k] = u1;
+            nz[k] = u2;
         }
         /* a whole chunk in copies of a constant size, which compile to
          * vector moves; spelled out, since a loop over the three made GCC
@@ -314,11 +359,17 @@ static HBAO_ALWAYS_INLINE void given_normals_row(const normal_job *job, int j) {
             memcpy(out[1] + i0, ny, bytes);
             memcpy(out[2] + i0, nz, bytes);
         }
-        int any_unusable = 0;
-        for (int k = 0; k < count; k++) any_unusable |= !usable[k];
+        int any_unusable = 0, any_away = 0;
+        for (int k = 0; k < count; k++) {
+            any_unusable |= !usable[k];
+            any_away |= usable[k] & away[k];
+        }
         if (any_unusable)
             for (int k = 0; k < count; k++)
                 if (!usable[k]) fallback_normal(job, i0 + k, j);
+        if (any_away)
+            for (int k = 0; k < count; k++)
+                if (usable[k] & away[k]) turn_to_viewer(job, i0 + k, j);
     }
 }
 

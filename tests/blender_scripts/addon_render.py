@@ -10,7 +10,8 @@ both uncompressed 32-bit float. Usage:
 
   blender -b --addons hbao --python addon_render.py -- '<json spec>' <out dir>
 
-Spec keys (all optional): resolution [w, h], samples, engine, scene ("corner" | "two_layers"),
+Spec keys (all optional): resolution [w, h], samples, engine, scene (a name of
+blender_scenes.SCENE_BUILDERS: "corner", "two_layers", "low_poly", "demo"),
 frames [..], ao_reference (distance: adds Cycles' AO pass), stereo (true: Stereo 3D; "one_view":
 with its right view off; "custom_view": Multi-View with a view "center" besides left and right,
 each through its own camera Camera_L, Camera_C, Camera_R; writes camera_<NNNN><view's file
@@ -72,10 +73,7 @@ resolution = tuple(spec.get("resolution", (96, 64)))
 samples = spec.get("samples", 4)
 engine = spec.get("engine", "CYCLES")
 scene = bpy.context.scene
-if spec.get("scene", "corner") == "two_layers":
-    blender_scenes.build_two_layer_scene(scene, resolution, engine, samples)
-else:
-    blender_scenes.build_corner_scene(scene, resolution, engine, samples)
+blender_scenes.SCENE_BUILDERS[spec.get("scene", "corner")](scene, resolution, engine, samples)
 if spec.get("ao_reference"):
     blender_scenes.configure_ao_reference(scene, spec["ao_reference"])
 if spec.get("orthographic"):

@@ -495,6 +495,14 @@ static int normals_off(const hbao_grid *grid, const int *select, float x, float 
     return off;
 }
 
+/* Whether pixel k's normal is within 1e-5 of expected[0..3) */
+static int normal_near(const hbao_grid *grid, int k, const float expected[3]) {
+    float n[3];
+    hbao_grid_normal_at(grid, k % grid->width, k / grid->width, n);
+    return fabsf(n[0] - expected[0]) <= 1e-5f && fabsf(n[1] - expected[1]) <= 1e-5f &&
+           fabsf(n[2] - expected[2]) <= 1e-5f;
+}
+
 /* Normals from depth take, along each axis, the neighbour whose depth
  * changes least, so that a step does not bend them: on planes facing the
  * camera, at 5.1 and 8.3 (or, as half floats, 5 and 8, fitted along runs)
@@ -602,7 +610,7 @@ TEST_CASE(given_normals_too_short_give_the_face_normal) {
 TEST_CASE(given_normals_face_the_viewer_along_its_ray) {
     enum { w = 150, h = 7 };
     static float depth[w * h], normal[3 * w * h + HBAO_NORMAL_PADDING], given[3 * w * h];
-    static float expected[3 * w * h];
+    static float expected[3 * w * h], mirrored[3 * w * h];
     static const float scales[] = {1.0f, 1e-45f, 1e-40f, 1e-30f, 1e25f, 8e37f};
     for (int run = 0; run < 2 * (int)(sizeof scales / sizeof scales[0]); run++) {
         const int projection = run & 1;
@@ -634,7 +642,11 @@ TEST_CASE(given_normals_face_the_viewer_along_its_ray) {
             length = sqrt(length);
             for (int c = 0; c < 3; c++) {
                 given[3 * k + c] = (float)n[c];
+                /* facing away: turned round, -n, or mirrored across the
+                 * plane perpendicular to the ray, t + 0.02 v, as the face
+                 * normal decides (given_normals_choose_how_to_face_the_viewer) */
                 expected[3 * k + c] = (float)(sign * n[c] / length);
+                mirrored[3 * k + c] = (float)((t[c] + 0.02 * v[c]) / length);
             }
         }
         for (int implementation = HBAO_IMPLEMENTATION_SCALAR;
@@ -642,15 +654,78 @@ TEST_CASE(given_normals_face_the_viewer_along_its_ray) {
             hbao_grid grid;
             make_normals(&grid, w, h, depth, normal, given, &camera, implementation, 2);
             int off = 0;
-            for (int k = 0; k < w * h; k++) {
-                float n[3];
-                hbao_grid_normal_at(&grid, k % w, k / w, n);
-                for (int c = 0; c < 3; c++) off += !(fabsf(n[c] - expected[3 * k + c]) <= 1e-5f);
-            }
+            for (int k = 0; k < w * h; k++)
+                off += !(normal_near(&grid, k, expected + 3 * k) ||
+                         (k % 2 == 1 && normal_near(&grid, k, mirrored + 3 * k)));
             if (off)
-                printf("  %s, depth scale %g, implementation %d: %d components off\n",
+                printf("  %s, depth scale %g, implementation %d: %d normals off\n",
                        projection ? "orthographic" : "perspective", (double)scale, implementation,
                        off);
+            CHECK(off == 0);
+        }
+    }
+}
+
+/* A given normal that faces away from the viewer is turned to face it as
+ * the surface's depth says. On a plane facing the camera (tilted up, its
+ * normal N), in perspective and orthographic: shading normals tilted 3
+ * degrees past edge-on to the ray (smooth shading of a coarse mesh, a bump:
+ * Cycles 4.x and 5.x write such normals) are mirrored across the plane
+ * perpendicular to the ray and keep their tilt towards N (turned round, they
+ * pointed into the surface, which then hid itself: AO near 0 where Cycles
+ * gives 0.6); the pass of a plane seen from behind, -N, is turned round to
+ * N. Every copy. */
+TEST_CASE(given_normals_choose_how_to_face_the_viewer) {
+    enum { w = 96, h = 64 };
+    static float depth[w * h], normal[3 * w * h + HBAO_NORMAL_PADDING], given[3 * w * h];
+    static float expected[3 * w * h];
+    const double plane[3] = {0.0, 0.6, 0.8}; /* N, unit; the plane N . P = -4 */
+    for (int run = 0; run < 4; run++) {
+        const int orthographic = run & 1, seen_from_behind = run >> 1;
+        hbao_camera camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
+        camera.projection =
+            orthographic ? HBAO_PROJECTION_ORTHOGRAPHIC : HBAO_PROJECTION_PERSPECTIVE;
+        hbao_view view;
+        CHECK_RESULT(hbao_camera_view(&camera, w, h, &view), HBAO_SUCCESS);
+        for (int k = 0; k < w * h; k++) {
+            const int i = k % w, j = k / w;
+            const double x = view.origin_x + (i + 0.5) * view.pixel_size_x;
+            const double y = view.origin_y + (h - 1 - j + 0.5) * view.pixel_size_y;
+            /* the plane's depth along the pixel's ray, and V there */
+            depth[k] = orthographic ? (float)((4.0 + plane[1] * y) / plane[2])
+                                    : (float)(4.0 / (plane[2] - plane[1] * y));
+            double v[3] = {orthographic ? 0.0 : -x, orthographic ? 0.0 : -y, 1.0};
+            const double v_length = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+            for (int c = 0; c < 3; c++) v[c] /= v_length;
+            const double n_dot_v = plane[0] * v[0] + plane[1] * v[1] + plane[2] * v[2];
+            double u[3], u_length = 0.0;
+            for (int c = 0; c < 3; c++) {
+                /* N tilted past edge-on: its part along V made -0.05 */
+                u[c] = seen_from_behind ? -plane[c] : plane[c] - (n_dot_v + 0.05) * v[c];
+                u_length += u[c] * u[c];
+            }
+            u_length = sqrt(u_length);
+            double u_dot_v = 0.0;
+            for (int c = 0; c < 3; c++) {
+                u[c] /= u_length;
+                u_dot_v += u[c] * v[c];
+            }
+            for (int c = 0; c < 3; c++) {
+                given[3 * k + c] = (float)u[c];
+                expected[3 * k + c] =
+                    (float)(seen_from_behind ? -u[c] : u[c] - 2.0 * u_dot_v * v[c]);
+            }
+        }
+        for (int implementation = HBAO_IMPLEMENTATION_SCALAR;
+             implementation <= HBAO_IMPLEMENTATION_AVX512; implementation++) {
+            hbao_grid grid;
+            make_normals(&grid, w, h, depth, normal, given, &camera, implementation, 2);
+            int off = 0;
+            for (int k = 0; k < w * h; k++) off += !normal_near(&grid, k, expected + 3 * k);
+            if (off)
+                printf("  %s, %s, implementation %d: %d normals off\n",
+                       orthographic ? "orthographic" : "perspective",
+                       seen_from_behind ? "seen from behind" : "tilted", implementation, off);
             CHECK(off == 0);
         }
     }
@@ -694,4 +769,5 @@ TEST_MAIN(TEST_ENTRY(blur_copies_agree_on_background_at_every_sharpness),
           TEST_ENTRY(depth_precision_is_told_from_every_row),
           TEST_ENTRY(given_normals_too_short_give_the_face_normal),
           TEST_ENTRY(given_normals_face_the_viewer_along_its_ray),
+          TEST_ENTRY(given_normals_choose_how_to_face_the_viewer),
           TEST_ENTRY(default_threads_follow_the_cpus_the_process_may_use))
