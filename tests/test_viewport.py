@@ -60,7 +60,7 @@ EXPECTED_CASES = {"persp_cosine", "persp_hbao", "persp_cosine_no_falloff", "shif
                   "ortho_cosine", "persp_cosine_blur", "persp_hbao_blur_strength",
                   "ortho_cosine_blur", "persp_cosine_thickness", "persp_cosine_half",
                   "persp_hbao_half_blur", "ortho_cosine_half_odd", "persp_cosine_half_depth",
-                  "ortho_hbao_half_depth"} | UNOCCLUDED_CASES
+                  "ortho_hbao_half_depth", "persp_cosine_near_posts"} | UNOCCLUDED_CASES
 
 # The preview multiplies the view by AO <= 1: it may only darken. 8-bit
 # screenshots: one code value of slack for rounding.
@@ -110,6 +110,8 @@ def test_glsl_matches_library(match_report, case):
 _LIBRARY_CONSTANTS = [
     ("BLOCK_PIXELS", shader_sources.AO_DEFINES["BLOCK_PIXELS"], "internal_hbao.h",
      "HBAO_BLOCK_PIXELS"),
+    ("BLOCK_DEPTH_RATIO", shader_sources.AO_DEFINES["BLOCK_DEPTH_RATIO"], "internal_hbao.h",
+     "HBAO_BLOCK_DEPTH_RATIO"),
     ("NORMAL_SHARPNESS", shader_sources.BLUR_DEFINES["NORMAL_SHARPNESS"], "internal_finish.h",
      "HBAO_BLUR_NORMAL_SHARPNESS"),
     ("FALLOFF_REACH", shader_sources.FALLOFF_DEFINES["FALLOFF_REACH"], "internal_finish.h",

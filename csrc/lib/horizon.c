@@ -554,15 +554,43 @@ float hbao_block_step_at(const hbao_settings *s, const hbao_grid *g, float neare
     return largest >= 1.0f ? (largest - 1.0f) / (float)s->steps : HBAO_BLOCK_UNSAMPLED;
 }
 
-float hbao_block_step(const horizon_job *job, int x0, int x1, int j, int a) {
-    const hbao_settings *s = job->settings;
-    const hbao_grid *g = job->grid;
-    float nearest = INFINITY;
-    for (int i = x0 + a; i < x1; i += 4) {
-        const float z = g->depth[(size_t)j * g->width + i];
-        if (z > 0.0f && z < nearest) nearest = z;
+int hbao_block_classes(const hbao_settings *s, const hbao_grid *g, const float z[HBAO_BLOCK_PIXELS],
+                       float class_step[HBAO_BLOCK_PIXELS],
+                       unsigned class_lanes[HBAO_BLOCK_PIXELS]) {
+    unsigned left = 0;
+    for (int k = 0; k < HBAO_BLOCK_PIXELS; k++)
+        if (z[k] > 0.0f && z[k] < INFINITY) left |= 1u << k;
+    int classes = 0;
+    while (left != 0) {
+        float nearest = INFINITY;
+        for (int k = 0; k < HBAO_BLOCK_PIXELS; k++)
+            if ((left >> k & 1u) && z[k] < nearest) nearest = z[k];
+        const float reach = g->orthographic ? INFINITY : HBAO_BLOCK_DEPTH_RATIO * nearest;
+        unsigned lanes = 0;
+        for (int k = 0; k < HBAO_BLOCK_PIXELS; k++)
+            if ((left >> k & 1u) && z[k] <= reach) lanes |= 1u << k;
+        class_step[classes] = hbao_block_step_at(s, g, nearest);
+        class_lanes[classes] = lanes;
+        classes++;
+        left &= ~lanes;
     }
-    return hbao_block_step_at(s, g, nearest);
+    return classes;
+}
+
+void hbao_block_steps(const horizon_job *job, int x0, int x1, int j, int a,
+                      float step[HBAO_BLOCK_PIXELS]) {
+    const hbao_grid *g = job->grid;
+    float z[HBAO_BLOCK_PIXELS], class_step[HBAO_BLOCK_PIXELS];
+    unsigned class_lanes[HBAO_BLOCK_PIXELS];
+    for (int k = 0; k < HBAO_BLOCK_PIXELS; k++) {
+        const int i = x0 + a + 4 * k;
+        z[k] = i < x1 ? g->depth[(size_t)j * g->width + i] : 0.0f;
+        step[k] = HBAO_BLOCK_UNSAMPLED;
+    }
+    const int classes = hbao_block_classes(job->settings, g, z, class_step, class_lanes);
+    for (int c = 0; c < classes; c++)
+        for (int k = 0; k < HBAO_BLOCK_PIXELS; k++)
+            if (class_lanes[c] >> k & 1u) step[k] = class_step[c];
 }
 
 /* Pixels are visited tile by tile: a pixel's samples spread over the whole
@@ -610,9 +638,10 @@ static void horizon_tile(void *context, int tile) {
             } else {
                 float *out = job->ao + (size_t)j * width;
                 for (int a = 0; a < 4; a++) {
-                    const float step_px = hbao_block_step(job, s0, s1, j, a);
+                    float step[HBAO_BLOCK_PIXELS];
+                    hbao_block_steps(job, s0, s1, j, a, step);
                     for (int i = s0 + a; i < s1; i += 4)
-                        out[i] = hbao_horizon_pixel(job, i, j, step_px);
+                        out[i] = hbao_horizon_pixel(job, i, j, step[(i - s0) / 4]);
                 }
             }
         }

@@ -980,14 +980,24 @@ static VM SIMD_NAME(block_setup)(const hbao_horizon_job *job, int x0, int j, int
     return active;
 }
 
-/* The AO of the block of phase a at x0 in row j (its pixels before x1),
- * with the block's step step_px: each direction's steps are planned, then
- * searched. */
+/* The lanes whose bits are set in `lanes` (bit k: lane k) */
+static inline VM SIMD_NAME(lane_mask)(unsigned lanes) {
+    return V_GT(I_TO_F(I_AND(I_SET((int)lanes), I_SLLV(I_SET(1), I_LANES))), V_SET(0.0f));
+}
+
+/* Every lane of a block (HBAO_BLOCK_PIXELS bits) */
+#define SIMD_ALL_LANES ((1u << HBAO_BLOCK_PIXELS) - 1u)
+
+/* The AO of the lanes `lanes` (a class: hbao_block_classes; bit k: lane k)
+ * of the block of phase a at x0 in row j (its pixels before x1), with the
+ * class's step step_px: each direction's steps are planned, then searched.
+ * Writes those lanes' pixels only. */
 static void SIMD_NAME(block_ao)(const hbao_horizon_job *job, int x0, int x1, int j, int a,
-                                float step_px) {
+                                float step_px, unsigned lanes_wanted) {
     const hbao_settings *s = job->settings;
     SIMD_NAME(block) b;
-    const VM active = SIMD_NAME(block_setup)(job, x0, j, a, step_px, &b);
+    VM active = SIMD_NAME(block_setup)(job, x0, j, a, step_px, &b);
+    if (lanes_wanted != SIMD_ALL_LANES) active = M_AND(active, SIMD_NAME(lane_mask)(lanes_wanted));
     const int live = M_ANY(active);
     const int cosine = s->integration == HBAO_INTEGRATION_COSINE;
     const int layers = job->phase_back != NULL;
@@ -1072,26 +1082,51 @@ static void SIMD_NAME(block_ao)(const hbao_horizon_job *job, int x0, int x1, int
     float *out = job->ao + (size_t)j * job->grid->width;
     for (int k = 0; k < SIMD_LANES; k++) {
         const int i = b.first_i + 4 * k;
-        if (i < x1) out[i] = result[k];
+        if (i < x1 && (lanes_wanted == SIMD_ALL_LANES || (lanes_wanted >> k & 1u)))
+            out[i] = result[k];
     }
 }
 
-/* hbao_block_step, its minimum taken over the block's row of phase_depth
- * (the same depths, padded with background beyond the image's width): two
- * loads instead of 16 strided ones. */
-static float SIMD_NAME(block_step)(const hbao_horizon_job *job, int x0, int j, int a) {
+/* The block's row of phase_depth (its depths, padded with background
+ * beyond the image's width) */
+static inline const float *SIMD_NAME(block_depths)(const hbao_horizon_job *job, int x0, int j,
+                                                   int a) {
     const hbao_grid *g = job->grid;
-    const float *row = job->phase_depth + ((size_t)a * g->height + j) * job->phase_width + x0 / 4;
-    VF nearest = V_SET(INFINITY);
-    for (int first = 0; first < HBAO_BLOCK_PIXELS; first += SIMD_LANES) {
-        const VF z = V_LOADU(row + first);
-        nearest = V_SELECT(M_AND(V_GT(z, V_SET(0.0f)), V_LT(z, nearest)), nearest, z);
-    }
+    return job->phase_depth + ((size_t)a * g->height + j) * job->phase_width + x0 / 4;
+}
+
+/* The step of a block that is one class (hbao_block_classes), or
+ * HBAO_BLOCK_CLASSES where it is several: its nearest foreground depth, and
+ * whether any lies beyond the class it leads, from one load, not 16 strided
+ * ones. */
+#define HBAO_BLOCK_CLASSES (-2.0f)
+static inline float SIMD_NAME(block_step)(const hbao_horizon_job *job, int x0, int j, int a) {
+    const VF z = V_LOADU(SIMD_NAME(block_depths)(job, x0, j, a));
+    const VM foreground = M_AND(V_GT(z, V_SET(0.0f)), V_LT(z, V_SET(INFINITY)));
     float lanes[SIMD_LANES];
-    V_STOREU(lanes, nearest);
-    float least = lanes[0];
-    for (int k = 1; k < SIMD_LANES; k++) least = lanes[k] < least ? lanes[k] : least;
-    return hbao_block_step_at(job->settings, g, least);
+    V_STOREU(lanes, V_SELECT(foreground, V_SET(INFINITY), z));
+    float nearest = lanes[0];
+    for (int k = 1; k < SIMD_LANES; k++) nearest = lanes[k] < nearest ? lanes[k] : nearest;
+    const hbao_grid *g = job->grid;
+    const float step = hbao_block_step_at(job->settings, g, nearest);
+    if (step < 0.0f || g->orthographic) return step;
+    const VM beyond = V_GT(z, V_SET(HBAO_BLOCK_DEPTH_RATIO * nearest));
+    return M_ANY(M_AND(foreground, beyond)) ? HBAO_BLOCK_CLASSES : step;
+}
+
+/* A block of several classes: each class searched with its own step. */
+static void SIMD_NAME(block_in_classes)(const hbao_horizon_job *job, int x0, int x1, int j, int a) {
+    float z[HBAO_BLOCK_PIXELS], class_step[HBAO_BLOCK_PIXELS];
+    unsigned class_lanes[HBAO_BLOCK_PIXELS];
+    const float *row = SIMD_NAME(block_depths)(job, x0, j, a);
+    for (int k = 0; k < HBAO_BLOCK_PIXELS; k++) z[k] = row[k];
+    float *out = job->ao + (size_t)j * job->grid->width;
+    for (int i = x0 + a; i < x1; i += 4) out[i] = 1.0f; /* the lanes of no class */
+    const int classes = hbao_block_classes(job->settings, job->grid, z, class_step, class_lanes);
+    for (int c = 0; c < classes; c++) {
+        if (class_step[c] < 0.0f) continue; /* no lane sampled: 1, as written */
+        SIMD_NAME(block_ao)(job, x0, x1, j, a, class_step[c], class_lanes[c]);
+    }
 }
 
 /* The span's normals in the next row, which the tile computes next: its
@@ -1115,7 +1150,7 @@ static void SIMD_NAME(span)(const hbao_horizon_job *job, int x0, int x1, int j) 
     int unsampled = 0;
     for (int a = 0; a < 4; a++) {
         step[a] = SIMD_NAME(block_step)(job, x0, j, a);
-        unsampled += step[a] < 0.0f;
+        unsampled += step[a] == HBAO_BLOCK_UNSAMPLED;
     }
     if (unsampled == 4) { /* the whole span, in one contiguous run */
         for (int i = x0; i < x1; i++) out[i] = 1.0f;
@@ -1123,10 +1158,12 @@ static void SIMD_NAME(span)(const hbao_horizon_job *job, int x0, int x1, int j) 
     }
     for (int a = 0; a < 4; a++) {
         const float step_px = step[a];
-        if (step_px < 0.0f) { /* no lane active: block_ao's result, without its set-up */
+        if (step_px == HBAO_BLOCK_CLASSES) {
+            SIMD_NAME(block_in_classes)(job, x0, x1, j, a);
+        } else if (step_px < 0.0f) { /* no lane active: block_ao's result, without its set-up */
             for (int i = x0 + a; i < x1; i += 4) out[i] = 1.0f;
-            continue;
+        } else {
+            SIMD_NAME(block_ao)(job, x0, x1, j, a, step_px, SIMD_ALL_LANES);
         }
-        SIMD_NAME(block_ao)(job, x0, x1, j, a, step_px);
     }
 }

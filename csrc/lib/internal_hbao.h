@@ -270,10 +270,11 @@ typedef struct hbao_horizon_job {
 /* The horizon search works on blocks: the HBAO_BLOCK_PIXELS pixels
  * i = x0 + a + 4 k of one row (x0 a multiple of 4 * HBAO_BLOCK_PIXELS,
  * phase a in 0..3, k in 0..HBAO_BLOCK_PIXELS-1) share a pattern cell, so
- * they march the same directions with the same jitter; they also share one
- * step length, from the largest projected radius among them, so every step
- * is one pixel offset for all of them and their depths are one contiguous
- * load from phase_depth (docs/algorithm.md, "Per-pixel sampling"). */
+ * they march the same directions with the same jitter; the pixels of a
+ * class (hbao_block_classes) also share one step length, from the largest
+ * projected radius among them, so every step is one pixel offset for all of
+ * them and their depths are one contiguous load from phase_depth
+ * (docs/algorithm.md, "Per-pixel sampling"). */
 #define HBAO_BLOCK_PIXELS 16
 #define HBAO_BLOCK_SPAN (4 * HBAO_BLOCK_PIXELS) /* columns a block spans */
 /* Floats after grid->normal's last row: more than a block spans, so that a
@@ -281,14 +282,36 @@ typedef struct hbao_horizon_job {
  * on, even in the z row of the grid's last row. */
 #define HBAO_NORMAL_PADDING (2 * HBAO_BLOCK_SPAN)
 
-/* The step length in pixels, (R_block - 1) / steps, of the block of phase a
- * that starts at column x0 of row j (pixels before x1 only); negative
- * (HBAO_BLOCK_UNSAMPLED) when no pixel of it is sampled: all background, or
- * every projected radius under a pixel, so every AO there is 1. */
+/* A step length in pixels, (R - 1) / steps for the largest projected
+ * radius R of the pixels that share it; negative (HBAO_BLOCK_UNSAMPLED)
+ * where none of them is sampled (every projected radius under a pixel), so
+ * every AO there is 1. From the nearest foreground depth of those pixels
+ * (INFINITY: none). */
 #define HBAO_BLOCK_UNSAMPLED (-1.0f)
-float hbao_block_step(const hbao_horizon_job *job, int x0, int x1, int j, int a);
-/* ... from the block's nearest foreground depth (INFINITY: none) */
 float hbao_block_step_at(const hbao_settings *settings, const hbao_grid *grid, float nearest);
+
+/* A block's pixels in classes that each share one step length: the nearest
+ * foreground depth z0 leads the first class, of the depths up to
+ * HBAO_BLOCK_DEPTH_RATIO z0 (in perspective; in an orthographic view every
+ * depth has one projected radius, and all are one class); the nearest depth
+ * beyond leads the next class, and so on. One step length for a whole
+ * block took every step of a pixel far behind a near one (an object at
+ * the lens) past that pixel's own radius, so its AO was 1: a light band 64
+ * columns wide with hard edges. Within a class a pixel spends at least a
+ * quarter of its steps inside its radius. Most blocks are one class. */
+#define HBAO_BLOCK_DEPTH_RATIO 4.0f
+/* z: the block's depths, lane k at column x0 + a + 4 k, 0 past the image
+ * (those of no class: background, <= 0, +inf or NaN). Fills each class's
+ * step length and lanes (bit k: lane k), nearest class first, and returns
+ * how many there are (0 to HBAO_BLOCK_PIXELS). */
+int hbao_block_classes(const hbao_settings *settings, const hbao_grid *grid,
+                       const float z[HBAO_BLOCK_PIXELS], float class_step[HBAO_BLOCK_PIXELS],
+                       unsigned class_lanes[HBAO_BLOCK_PIXELS]);
+/* The step length of each pixel of the block of phase a that starts at
+ * column x0 of row j (pixels before x1 only): its class's, or
+ * HBAO_BLOCK_UNSAMPLED for a pixel of no class. */
+void hbao_block_steps(const hbao_horizon_job *job, int x0, int x1, int j, int a,
+                      float step[HBAO_BLOCK_PIXELS]);
 
 /* The pixel offset (ox, oy) of step `step` along direction (dc, ds) of a
  * block: floor(0.5 + dc t), floor(0.5 - ds t / ycor), t = 1 + (step +

@@ -28,6 +28,9 @@ if bpy.app.background and hasattr(gpu, "init"):
     gpu.init()  # 5.2+: an offscreen GPU context without a window
 
 WIDTH, HEIGHT = 200, 150
+# (depth, first columns) of posts four columns wide at the lens, each inside
+# a 64-column span of the scene behind them (depths 3 to 8)
+NEAR_POSTS = (0.3, (66, 130))
 PERSPECTIVE_CAMERA = {"type": "PERSP", "lens": 35.0, "sensor_width": 36.0,
                       "sensor_height": 24.0, "sensor_fit": "AUTO"}
 # Pixels 1.5x as tall as wide, lens shifted: the non-square, off-centre frame.
@@ -36,7 +39,8 @@ SHIFTED_CAMERA = dict(PERSPECTIVE_CAMERA, shift_x=0.1, shift_y=-0.05,
 ORTHOGRAPHIC_CAMERA = {"type": "ORTHO", "ortho_scale": 7.0, "sensor_fit": "AUTO"}
 
 # The compared cases: (name, camera, parameters[, scene]); scene may set the
-# floor's height ("floor_y", camera space) and the image's "size". Blur off
+# floor's height ("floor_y", camera space), the image's "size" and
+# "near_posts" (columns at the lens: NEAR_POSTS). Blur off
 # shows the horizon search alone; blur on adds the two bilateral passes.
 CASES = [
     ("persp_cosine", PERSPECTIVE_CAMERA, {"blur_size": 0}),
@@ -53,6 +57,9 @@ CASES = [
     # Occluders 0.3 thick: the box and the sphere no longer darken the wall
     # behind them, but still the floor they stand on.
     ("persp_cosine_thickness", PERSPECTIVE_CAMERA, {"blur_size": 0, "thickness": 0.3}),
+    # Posts at the lens, in blocks of the scene behind them: those blocks
+    # march in classes of one step length each (hbao_block_classes).
+    ("persp_cosine_near_posts", PERSPECTIVE_CAMERA, {"blur_size": 0}, {"near_posts": True}),
     # The eye 0.05 above the floor, V nearly in its plane: snapped samples on
     # the floor lie within gamma of V, and only "rising at least as steeply as
     # V" keeps them from counting as past the normal (docs/algorithm.md, "The
@@ -210,6 +217,9 @@ def main():
         frame = projection.frame_from_camera(camera, width, height)
         viewport_frame = blender_frame(camera, width, height)
         depth = synthetic_depth(frame, scene.get("floor_y", FLOOR_Y))
+        if scene.get("near_posts"):
+            for first in NEAR_POSTS[1]:
+                depth[:, first:first + 4] = NEAR_POSTS[0]
         depth_precision = shader_sources.FLOAT_DEPTH_PRECISION
         if scene.get("half_depth"):
             depth = depth.astype(np.float16).astype(np.float32)

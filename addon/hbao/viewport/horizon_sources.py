@@ -18,27 +18,43 @@ float radius_in_pixels(float z)
     return perspective != 0 ? radius / (pixel_size.x * z) : radius / pixel_size.x;
 }
 
-/* R_block: the largest R_px >= 1 among the BLOCK_PIXELS pixels x0 + a + 4 k
- * of p's row (x0 a multiple of 4 BLOCK_PIXELS, a = p.x & 3), which march
- * with one step length in the library (csrc/lib/horizon.c, hbao_block_step).
- * R_px falls as the depth grows, in floats too (rounding is monotonic), and
- * p itself is in the block with R_px >= 1, so R_block is the R_px of the
- * block's nearest depth: one division instead of sixteen. */
+/* R_block: the largest R_px >= 1 among the pixels of p's class in its block,
+ * the BLOCK_PIXELS pixels x0 + a + 4 k of p's row (x0 a multiple of 4
+ * BLOCK_PIXELS, a = p.x & 3), which march with one step length in the
+ * library (csrc/lib/horizon.c, hbao_block_classes): the nearest depth z0
+ * leads a class of the depths up to BLOCK_DEPTH_RATIO z0, the nearest
+ * beyond leads the next, and so on. R_px falls as the depth grows, in
+ * floats too (rounding is monotonic), and p itself is in the block with
+ * R_px >= 1, so R_block is the R_px of the class's nearest depth: one
+ * division instead of sixteen. */
 float block_radius(ivec2 p, float z)
 {
     if (perspective == 0) {
-        return radius_in_pixels(z); /* the same for every pixel */
+        return radius_in_pixels(z); /* the same for every pixel: one class */
     }
     int first = (p.x / (4 * BLOCK_PIXELS)) * (4 * BLOCK_PIXELS) + (p.x & 3);
     int last = min(first + 4 * BLOCK_PIXELS, image_size.x);
-    float nearest = z;
+    float leader = z;
     for (int i = first; i < last; i += 4) {
         float zi = depth_at(ivec2(i, p.y));
         if (!is_background(zi)) {
-            nearest = min(nearest, zi);
+            leader = min(leader, zi);
         }
     }
-    return radius_in_pixels(nearest);
+    /* the next class's leader while p lies beyond this one's: at most one
+     * class a pixel, and p's own depth ends the walk */
+    for (int c = 1; c < BLOCK_PIXELS && z > BLOCK_DEPTH_RATIO * leader; c++) {
+        float reach = BLOCK_DEPTH_RATIO * leader;
+        float next = z;
+        for (int i = first; i < last; i += 4) {
+            float zi = depth_at(ivec2(i, p.y));
+            if (!is_background(zi) && zi > reach) {
+                next = min(next, zi);
+            }
+        }
+        leader = next;
+    }
+    return radius_in_pixels(leader);
 }
 
 /* Cosine-weighted visibility of a half slice from V up to angle h. */
