@@ -71,7 +71,9 @@ def register():
 
 
 def unregister():
-    from . import preferences
+    from . import hook_release, preferences
+    if _registered:  # enabled for this Blender: a hook to let go of
+        hook_release.release_all()
     while _registered:
         module = _registered.pop()
         try:

@@ -189,6 +189,7 @@ def _ensure_managed_node(tree, nodes, helper):
             rlayers.hide = True
     if rlayers.scene != helper:
         rlayers.scene = helper
+    set_if_different(rlayers, "mute", False)  # as hook_release.py leaves it
     # Missing (new node) or unavailable (file loaded before the engine was
     # registered): re-assigning the layer makes Blender ask the engine for
     # its passes again.

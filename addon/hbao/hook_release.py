@@ -1,0 +1,43 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The hook let go when the add-on is disabled in a session (Preferences,
+Reload Scripts, before a removal, as Blender quits).
+
+Each HBAO node's AO pass input is linked to the managed Render Layers node,
+whose helper scene only the add-on's engine renders. Disabled, Blender
+renders that scene with another engine, which writes no such pass: the node
+read 0 and the final image was black (Blender 3.4, which keeps the node's
+class, and bpy 5.3). So the pass input is unlinked (its value is then 1: the
+node passes Image through) and the managed node muted, so that Blender does
+not render the helper scene at all. Enabled again, the add-on's sync links
+and unmutes them (helper_scene.py)."""
+import bpy
+
+from . import compat
+from .data_edits import set_if_different
+from .helper_lookup import managed_node
+from .node import AO_PASS_INPUT, hbao_nodes
+from .report import log
+
+
+def release_all():
+    """Every scene's hook let go; a scene that Blender will not let change
+    now (writes.py) keeps its own, said in the console."""
+    for scene in list(getattr(bpy.data, "scenes", ())):
+        try:
+            _release(compat.compositor_tree(scene))
+        except Exception as error:  # the rest of the add-on still goes
+            log(f"could not let go of the HBAO hook of {scene.name!r}: {error}")
+
+
+def _release(tree):
+    rlayers = managed_node(tree)
+    if rlayers is None:
+        return
+    for node in hbao_nodes(tree):
+        target = node.inputs.get(AO_PASS_INPUT)
+        if target is None:
+            continue
+        for link in list(target.links):
+            tree.links.remove(link)
+        set_if_different(target, "default_value", 1.0)
+    set_if_different(rlayers, "mute", True)
