@@ -128,6 +128,10 @@ def test_node_ao_matches_library_cycles_and_composites_image_times_ao(
     assert error <= CYCLES_MEAN_ERROR_TOLERANCE
 
 
+# The mean |AO difference| between the corner scene and the same scene 2^14
+# times larger: Cycles' rays round differently at another scale, so depths
+# move in their last bits and some steps snap to a neighbouring pixel.
+SCALED_SCENE_MEAN_DIFFERENCE = 0.01
 # Two renders of one scene in one Blender (Cycles' fixed seed): the same
 # floats, but for the last bits where threads sum samples in another order.
 SAME_RENDER_TOLERANCE = 1e-5
@@ -335,6 +339,23 @@ def test_the_sky_at_clip_end_is_background(run_in_blender, tmp_path, native):
     expected = native.compute_ao(depth, normal, camera=description,
                                  params=dict(node_params(**node), background_depth=background))
     assert np.abs(ao - expected).max() <= EXACT
+
+
+def test_a_scene_past_65504_units_gets_its_ao(run_in_blender, tmp_path):
+    """The corner scene 2^14 times larger (depths about 70000 to 120000, the
+    radius and the camera's clip range too), as a scene modelled in
+    centimetres is past 655 m: every depth past 65504 was background, the AO
+    1 everywhere, silently (an exploratory run). The background is now what
+    lies at Clip End (camera.background_depth), and the AO is the unscaled
+    scene's, but for Cycles' own rounding of the larger scene's rays."""
+    ao = {}
+    for name, scale in (("plain", 1.0), ("scaled", 2.0 ** 14)):
+        out, _ = render(run_in_blender, tmp_path, {
+            "scene_scale": scale, "nodes": [{"radius": 1.0 * scale, "blur_size": 0}]}, name=name)
+        ao[name] = node_outputs(out, 1)["ao"]
+    assert ao["plain"].min() < 0.7
+    difference = np.abs(ao["scaled"] - ao["plain"])
+    assert difference.mean() <= SCALED_SCENE_MEAN_DIFFERENCE, difference.mean()
 
 
 def position_misfit(native, out, frame, description):

@@ -574,6 +574,44 @@ def test_a_single_view_file_and_the_layers_listed(hbao_tool, tmp_path):
     assert '"C"' not in listed.stderr
 
 
+def test_geometry_past_65504_is_geometry_under_the_cameras_clip_end(hbao_tool, tmp_path):
+    """A scene modelled in centimetres, or at kilometres: the tool took the
+    smaller of 65504 and the camera's clip end for the background, so every
+    depth past 65504 was background and the AO 1 everywhere, silently (an
+    exploratory run). The scene below scaled by 2^14 (depths 75366 to
+    91750, radius and clip end too) now gives its AO bit for bit (hbao.h,
+    "Scale"); a depth of exactly 65504, EEVEE's half-float sky, is still
+    background (here a strip in front of the box: the AO that a depth of
+    1e10 there gives)."""
+    scale = np.float32(2.0 ** 14)
+    # no depth a half float (the library would take the image for EEVEE's
+    # half-float Depth and allow for its rounding)
+    depth = np.full((48, 64), 5.1, np.float32)
+    depth[:16] = 5.600006  # the sky at the clip end, above a box before the wall
+    depth[16:30, 20:40] = 4.6
+    ao = {}
+    for name, image, lengths in (("plain", depth, 1.0), ("scaled", depth * scale, scale),
+                                 ("half_sky", depth * scale, scale),
+                                 ("far_sky", depth * scale, scale)):
+        image = image.copy()
+        if name == "half_sky":
+            image[36:40, 8:56] = 65504.0
+        elif name == "far_sky":
+            image[36:40, 8:56] = 1e10
+        (tmp_path / f"{name}.exr").write_bytes(scanline_exr({"ViewLayer.Depth.Z": image}, 64, 48))
+        (tmp_path / f"{name}.json").write_text(
+            json.dumps({"lens": 20.0, "clip_end": float(np.float32(5.6) * lengths)}))
+        run_ok(hbao_tool, tmp_path / f"{name}.exr", "-o", tmp_path / f"{name}_ao.exr",
+               "--camera", tmp_path / f"{name}.json", "--radius", repr(float(2.0 * lengths)),
+               "--blur", "0")
+        from hbao import exr_passes
+        ao[name] = exr_passes.read_channels(tmp_path / f"{name}_ao.exr", ["AO"])["AO"]
+    assert ao["plain"].min() < 0.9  # the box's foot and the wall's corner
+    assert np.array_equal(ao["scaled"], ao["plain"])
+    assert np.array_equal(ao["half_sky"], ao["far_sky"])
+    assert not np.array_equal(ao["half_sky"], ao["scaled"])  # the strip mattered
+
+
 def test_the_sky_at_the_cameras_clip_end_is_background(hbao_tool, tmp_path):
     """EEVEE in 4.5 and 5.0 writes the sky's Depth as the camera's Clip End
     (5.600006 for 5.6): with the camera file's clip_end (export_cameras.py

@@ -88,9 +88,13 @@ CLIP_END_MARGIN = 1e-5
 
 def background_depth(description, depth):
     """The background depth for a render through camera dict `description`:
-    `depth` (the parameter's), or less, from its Clip End."""
+    a hair short of its Clip End (nothing is rendered past it, and geometry
+    up to it is geometry, past 65504 too: a scene modelled in centimetres
+    had AO 1 everywhere beyond 655 m), or `depth` (the parameter's) where
+    it has none. libhbao takes 65504 itself, EEVEE's half-float sky, for
+    background at any background depth."""
     clip_end = description.get("clip_end")
-    return depth if clip_end is None else min(depth, clip_end * (1.0 - CLIP_END_MARGIN))
+    return depth if clip_end is None else clip_end * (1.0 - CLIP_END_MARGIN)
 
 
 def full_size(render):

@@ -23,9 +23,12 @@
  *   buffer (Blender's render passes, OpenGL) is described with a pointer to
  *   its last row and a negative row stride.
  * - Strides count floats, not bytes.
- * - Background: a depth that is not finite, <= 0, or >= params.background_depth
- *   (Cycles writes 1e10, EEVEE's half float 65504) gets AO = 1 and never
- *   occludes anything.
+ * - Background: a depth that is not finite, <= 0, >= params.background_depth
+ *   (Cycles writes 1e10), or exactly HBAO_HALF_FLOAT_SKY (65504, the largest
+ *   half float: the sky of EEVEE's half-float Depth pass, whatever the
+ *   background_depth, so that one above it, from a camera's Clip End, leaves
+ *   geometry past 65504 to a float depth) gets AO = 1 and never occludes
+ *   anything.
  * - The output is always finite and in [0, 1].
  * - Scale: depths are used in single precision as given. Scaling every
  *   length of a view (depths, radius, thickness, background_depth,
@@ -193,6 +196,8 @@ typedef enum hbao_implementation {
 #define HBAO_DEFAULT_STRENGTH 1.0f
 /** EEVEE's half-float Depth pass stores background as 65504, Cycles as 1e10. */
 #define HBAO_DEFAULT_BACKGROUND_DEPTH 65504.0f
+/* Background at any background_depth (Conventions): EEVEE's half-float sky. */
+#define HBAO_HALF_FLOAT_SKY 65504.0f
 /** Infinitely thick occluders: on the benchmark scenes a finite thickness
  *  raised the error on three of four (docs/benchmark-layers.md). */
 #define HBAO_DEFAULT_THICKNESS 0.0f

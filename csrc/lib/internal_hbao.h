@@ -51,12 +51,12 @@ typedef struct hbao_settings {
 } hbao_settings;
 
 /* A depth value as the pipeline uses it: background (not finite, <= 0,
- * >= background_depth) as 0. z > 0 && z < background fails for NaN, -inf
- * and +inf (+inf < +inf is false where the background depth is infinite)
- * as for background, so no isfinite() is needed. Written as a select so
- * that the loops calling it vectorize. */
+ * >= background_depth, or exactly HBAO_HALF_FLOAT_SKY) as 0. z > 0 && z <
+ * background fails for NaN, -inf and +inf (+inf < +inf is false where the
+ * background depth is infinite) as for background, so no isfinite() is
+ * needed. Written as a select so that the loops calling it vectorize. */
 static inline float hbao_depth_value(float z, float background) {
-    return z > 0.0f && z < background ? z : 0.0f;
+    return z > 0.0f && z < background && z != HBAO_HALF_FLOAT_SKY ? z : 0.0f;
 }
 
 /* The image that horizons are searched on: the full image, or the

@@ -12,8 +12,7 @@ void camera_settings_init(camera_settings *settings) {
 
 float camera_background_depth(const camera_settings *settings, float background_depth) {
     if (!(settings->fields_set & CAMERA_FIELD_CLIP_END)) return background_depth;
-    const float at_clip_end = (float)((double)settings->clip_end * (1.0 - CAMERA_CLIP_END_MARGIN));
-    return at_clip_end < background_depth ? at_clip_end : background_depth;
+    return (float)((double)settings->clip_end * (1.0 - CAMERA_CLIP_END_MARGIN));
 }
 
 void camera_settings_apply(camera_settings *base, const camera_settings *override) {

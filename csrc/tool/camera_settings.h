@@ -41,8 +41,10 @@ typedef struct camera_settings {
     uint32_t fields_set;
 } camera_settings;
 
-/** `background_depth`, or less where the settings know the camera's clip
- *  end (CAMERA_CLIP_END_MARGIN). */
+/** `background_depth`, or, where the settings know the camera's clip end,
+ *  a hair short of it (CAMERA_CLIP_END_MARGIN): nothing is rendered past it,
+ *  and geometry up to it is geometry, past 65504 too (libhbao takes 65504
+ *  itself, EEVEE's half-float sky, for background at any background depth). */
 float camera_background_depth(const camera_settings *settings, float background_depth);
 
 /** No field set; the values are Blender's defaults. */

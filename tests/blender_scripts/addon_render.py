@@ -18,7 +18,8 @@ each through its own camera Camera_L, Camera_C, Camera_R; writes camera_<NNNN><v
 suffix>.json too), stereo_settings {convergence_mode, pivot, interocular_distance, ...: the
 camera's Stereoscopy settings; no view camera written then}, stereo_off_from_frame (Stereoscopy
 turned off from that frame on), output_views_format (the main output's views format), orthographic,
-clip_end (the camera's), camera_tilt (radians the camera turns up), camera_scale [x, y, z] (the
+clip_end (the camera's), scene_scale (every object's place and size and the camera's clip range
+times it), camera_tilt (radians the camera turns up), camera_scale [x, y, z] (the
 camera object's scale), camera_rig [x, y, z] (the camera parented to an empty of that scale, where
 it was), widen_camera (factor), dump_back_faces (writes <out>/back_<NNNN>.npy: the back faces
 render's Depth, top row first), border [min_x, max_x, min_y, max_y] (a border render cropped to it;
@@ -80,6 +81,14 @@ if spec.get("orthographic"):
     blender_scenes.make_orthographic(scene)
 if spec.get("clip_end"):  # the camera's Clip End
     scene.camera.data.clip_end = spec["clip_end"]
+if spec.get("scene_scale"):  # every length of the scene times it (not the lights')
+    for obj in scene.objects:
+        if obj.type != "LIGHT":
+            obj.location = obj.location * spec["scene_scale"]
+            if obj.type != "CAMERA":
+                obj.scale = obj.scale * spec["scene_scale"]
+    scene.camera.data.clip_start *= spec["scene_scale"]
+    scene.camera.data.clip_end *= spec["scene_scale"]
 if spec.get("camera_tilt"):  # the camera turned up (radians about its x axis)
     scene.camera.rotation_euler.x += spec["camera_tilt"]
 if spec.get("camera_rig"):  # the camera inside an empty of this scale, where it was
