@@ -574,6 +574,27 @@ def test_a_single_view_file_and_the_layers_listed(hbao_tool, tmp_path):
     assert '"C"' not in listed.stderr
 
 
+def test_a_compression_newer_than_openexr_31_is_named_not_called_truncated(hbao_tool, tmp_path):
+    """ZSTD (13) and HTJ2K (11, 12) came after OpenEXR 3.1, whose reader
+    reports the compression attribute invalid and reads on with another: the
+    tool said the file was cut short ("does not hold" its image, a corrupt
+    chunk leader), for --info too. It now names the compression as unknown
+    and says how to save the file (an exploratory run)."""
+    depth = np.full((8, 8), 5.0, np.float32)
+    plain = scanline_exr({"ViewLayer.Depth.Z": depth}, 8, 8)
+    marker = exr_attribute("compression", "compression", b"\0")
+    assert plain.count(marker) == 1
+    for code in (11, 13):
+        source = tmp_path / f"compression_{code}.exr"
+        newer = exr_attribute("compression", "compression", bytes([code]))
+        source.write_bytes(plain.replace(marker, newer))
+        for arguments in (("--info", source), (source, "-o", tmp_path / "ao.exr")):
+            assert_clean_error(run_tool(hbao_tool, *arguments), EXIT_RUNTIME,
+                               "a compression that this OpenEXR library does not know",
+                               f"Invalid value {code}", "save the EXR with ZIP")
+    assert not (tmp_path / "ao.exr").exists()
+
+
 def test_geometry_past_65504_is_geometry_under_the_cameras_clip_end(hbao_tool, tmp_path):
     """A scene modelled in centimetres, or at kilometres: the tool took the
     smaller of 65504 and the camera's clip end for the background, so every

@@ -354,6 +354,21 @@ int exr_input_open(exr_input *input, const char *path, tool_error *error) {
         goto fail;
     }
     for (int part = 0; part < input->part_count; ++part) {
+        /* A compression newer than this OpenEXR (ZSTD, HTJ2K of 3.4 and
+         * later): OpenEXRCore 3.1 reports the attribute's value invalid and
+         * reads on with another compression. Said so, not as a file cut
+         * short where its chunks do not parse. */
+        exr_compression_t compression = EXR_COMPRESSION_NONE;
+        CHECK_EXR(exr_get_compression(input->context, part, &compression), "no compression");
+        if ((int)compression < 0 || compression >= EXR_COMPRESSION_LAST_TYPE ||
+            strstr(last_error_message, "'compression'") != NULL) {
+            status = tool_fail(error, TOOL_EXIT_RUNTIME,
+                               "%s: a compression that this OpenEXR library does not know "
+                               "(a newer OpenEXR's, such as ZSTD or HTJ2K?): %s; save the EXR "
+                               "with ZIP, PIZ or no compression",
+                               path, last_error_message[0] ? last_error_message : "unknown");
+            goto fail;
+        }
         exr_storage_t storage;
         CHECK_EXR(exr_get_storage(input->context, part, &storage), "cannot read the storage type");
         if (storage != EXR_STORAGE_SCANLINE) {
