@@ -49,7 +49,15 @@ typedef struct finish_job {
     float spatial[MAX_BLUR_RADIUS + 1]; /* Gaussian weight by tap distance */
     float *out;
     int64_t out_row_stride;
-    atomic_int out_of_memory;
+    /* The bands' working rows (band_memory), one set per band that can run
+     * at once, taken before any band runs: a band cannot then fail for
+     * memory after others wrote their rows into the output (which may be
+     * the caller's depth, in place). A band takes a free set and gives it
+     * back. */
+    float *pool;
+    size_t pool_set_floats;
+    int pool_sets;
+    atomic_flag pool_taken[HBAO_MAX_THREADS];
 } finish_job;
 
 /* A row's guide normals, a row of each component (hbao_grid_normal_row). */
@@ -159,13 +167,21 @@ typedef struct band_memory {
     float *ring[2 * MAX_BLUR_RADIUS + 1];
 } band_memory;
 
-static int band_memory_make(band_memory *m, int width, int slots) {
-    const size_t row = (size_t)width;
-    m->block = malloc((1 + (size_t)slots) * row * sizeof(float));
-    if (m->block == NULL) return 0;
+/* A free set of the job's pool for one band, into *m; returns its index
+ * for band_memory_give. At most pool_sets bands run at once, so one is free;
+ * the loop only waits out another band's give. */
+static int band_memory_take(finish_job *job, band_memory *m, int slots) {
+    int set = 0;
+    while (atomic_flag_test_and_set(&job->pool_taken[set])) set = (set + 1) % job->pool_sets;
+    const size_t row = (size_t)job->width;
+    m->block = job->pool + (size_t)set * job->pool_set_floats;
     m->finished = m->block;
     for (int s = 0; s < slots; s++) m->ring[s] = m->finished + (1 + (size_t)s) * row;
-    return 1;
+    return set;
+}
+
+static void band_memory_give(finish_job *job, int set) {
+    atomic_flag_clear(&job->pool_taken[set]);
 }
 
 /* The taps and centres of row j's pass along the row (radius > 0): row j's
@@ -278,7 +294,6 @@ static hbao_result blur_grid(const hbao_settings *settings, const hbao_grid *gri
     job.strength = strength;
     job.out = out;
     job.out_row_stride = out_row_stride;
-    atomic_init(&job.out_of_memory, 0);
     const float sigma = 0.5f * (float)(job.radius + 1);
     for (int k = 0; k <= job.radius; k++)
         job.spatial[k] = expf(-(float)(k * k) / (2.0f * sigma * sigma));
@@ -289,6 +304,12 @@ static hbao_result blur_grid(const hbao_settings *settings, const hbao_grid *gri
     if (band_rows < MIN_BAND_ROWS) band_rows = MIN_BAND_ROWS;
     job.band_rows = band_rows;
     const int bands = (height + band_rows - 1) / band_rows;
+    job.pool_sets = bands < settings->threads ? bands : settings->threads;
+    if (job.pool_sets < 1) job.pool_sets = 1;
+    job.pool_set_floats = (2 + 2 * (size_t)job.radius) * (size_t)job.width;
+    job.pool = hbao_scratch_take((size_t)job.pool_sets * job.pool_set_floats * sizeof(float));
+    if (job.pool == NULL) return HBAO_ERROR_OUT_OF_MEMORY;
+    for (int set = 0; set < job.pool_sets; set++) atomic_flag_clear(&job.pool_taken[set]);
 
     hbao_row_job run = finish_band_portable;
 #ifdef HBAO_FINISH_X86
@@ -297,7 +318,8 @@ static hbao_result blur_grid(const hbao_settings *settings, const hbao_grid *gri
     if (implementation == HBAO_IMPLEMENTATION_AVX2) run = finish_band_avx2;
 #endif
     hbao_parallel_rows(settings->threads, bands, run, &job);
-    return atomic_load(&job.out_of_memory) ? HBAO_ERROR_OUT_OF_MEMORY : HBAO_SUCCESS;
+    hbao_scratch_give(job.pool);
+    return HBAO_SUCCESS;
 }
 
 /* The upsample of the (blurred) half-grid AO into the output, row by row. */

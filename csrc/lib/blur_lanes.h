@@ -165,10 +165,7 @@ BLUR_TARGET static void BLUR_NAME(finish_band)(void *context, int band) {
     const int first = band * job->band_rows;
     const int last = first + job->band_rows < height ? first + job->band_rows : height;
     band_memory m;
-    if (!band_memory_make(&m, width, slots)) {
-        atomic_store(&job->out_of_memory, 1);
-        return;
-    }
+    const int set = band_memory_take(job, &m, slots);
     tap_set taps;
     centre_row c;
     int next = first - radius > 0 ? first - radius : 0; /* the next row to make */
@@ -192,7 +189,7 @@ BLUR_TARGET static void BLUR_NAME(finish_band)(void *context, int band) {
         write_output(job->depth + (size_t)j * width, blurred, width, job->strength,
                      job->out + (int64_t)j * job->out_row_stride);
     }
-    free(m.block);
+    band_memory_give(job, set);
 }
 
 #undef VF

@@ -230,6 +230,11 @@ void hbao_parallel_rows(int threads, int rows, hbao_row_job job, void *context);
  * buffer is kept for the next call (hbao_release_memory frees them). */
 void *hbao_scratch_take(size_t bytes);
 void hbao_scratch_give(void *memory);
+/* Every allocation of the library is a scratch take, made before the stage
+ * that writes the caller's output starts (blur.c's band pool), so that a
+ * call that runs out of memory leaves the output as it was. For tests
+ * (csrc/tests/internal): where set, a take that it answers 1 for fails. */
+extern int (*hbao_scratch_fails)(size_t bytes);
 /* The threads "one per core" gives (threads = 0): the CPUs this process may
  * run on (hbao_cpus.h), at most HBAO_MAX_THREADS. */
 int hbao_available_cores(void);

@@ -53,8 +53,11 @@ static pthread_mutex_t scratch_lock = PTHREAD_MUTEX_INITIALIZER;
 static kept_block kept[SCRATCH_BLOCKS];
 static size_t kept_bytes;
 
+int (*hbao_scratch_fails)(size_t bytes) = NULL;
+
 void *hbao_scratch_take(size_t bytes) {
     if (bytes > SIZE_MAX - HEADER) return NULL;
+    if (hbao_scratch_fails != NULL && hbao_scratch_fails(bytes)) return NULL;
     unsigned char *start = NULL;
     pthread_mutex_lock(&scratch_lock);
     int best = -1;

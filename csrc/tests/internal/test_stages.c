@@ -731,6 +731,61 @@ TEST_CASE(given_normals_choose_how_to_face_the_viewer) {
     }
 }
 
+/* hbao_scratch_fails for the test below: the take numbered fail_at fails */
+static int takes_so_far, fail_at;
+static int fail_one_take(size_t bytes) {
+    (void)bytes;
+    return ++takes_so_far == fail_at;
+}
+
+/* A call that runs out of memory leaves its output as it was: it is computed
+ * over its own depth (in place) and the k-th allocation fails, for every k
+ * until the call succeeds (hbao_scratch_fails). Before, the blur's bands
+ * took their rows one band at a time: one that failed after others had
+ * written theirs returned "out of memory" with a part of the depth replaced
+ * by AO, and a retry computed AO from that (an exploratory run). Full and
+ * half resolution, with and without the blur, on 1 and 3 threads. */
+TEST_CASE(running_out_of_memory_leaves_the_output_as_it_was) {
+    enum { w = 96, h = 80 };
+    static float depth[w * h], work[w * h], expected[w * h];
+    for (int k = 0; k < w * h; k++)
+        depth[k] = 4.0f + 0.5f * sinf(0.21f * (float)(k % w)) * cosf(0.17f * (float)(k / w));
+    const hbao_camera camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
+    const hbao_channel channel = {work, 1, w};
+    for (int variant = 0; variant < 8; variant++) {
+        hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+        p.half_resolution = variant & 1;
+        p.blur_size = variant & 2 ? 0 : 7;
+        p.threads = variant & 4 ? 3 : 1;
+        memcpy(work, depth, sizeof work);
+        CHECK_RESULT(hbao_compute(&p, &camera, w, h, &channel, NULL, work, w), HBAO_SUCCESS);
+        memcpy(expected, work, sizeof work);
+        int failed = 0;
+        for (fail_at = 1;; fail_at++) {
+            hbao_release_memory();
+            memcpy(work, depth, sizeof work);
+            takes_so_far = 0;
+            hbao_scratch_fails = fail_one_take;
+            const hbao_result result = hbao_compute(&p, &camera, w, h, &channel, NULL, work, w);
+            hbao_scratch_fails = NULL;
+            /* an allocation that may fail (the call then does without it)
+             * succeeds with the AO; past the last allocation, nothing failed */
+            if (result == HBAO_SUCCESS) {
+                CHECK(memcmp(work, expected, sizeof work) == 0);
+                if (takes_so_far < fail_at) break;
+                continue;
+            }
+            CHECK_RESULT(result, HBAO_ERROR_OUT_OF_MEMORY);
+            if (memcmp(work, depth, sizeof work) != 0)
+                printf("  variant %d: allocation %d failed after the output was written\n", variant,
+                       fail_at);
+            CHECK(memcmp(work, depth, sizeof work) == 0);
+            failed++;
+        }
+        CHECK(failed >= 3); /* the call does allocate: depth, normals, AO at least */
+    }
+}
+
 /* threads = 0 is one thread per CPU the process may run on: with its
  * affinity narrowed to one CPU (as taskset, a container's cpuset or a farm
  * scheduler narrows it), one thread, not one per CPU online (on this
@@ -770,4 +825,5 @@ TEST_MAIN(TEST_ENTRY(blur_copies_agree_on_background_at_every_sharpness),
           TEST_ENTRY(given_normals_too_short_give_the_face_normal),
           TEST_ENTRY(given_normals_face_the_viewer_along_its_ray),
           TEST_ENTRY(given_normals_choose_how_to_face_the_viewer),
+          TEST_ENTRY(running_out_of_memory_leaves_the_output_as_it_was),
           TEST_ENTRY(default_threads_follow_the_cpus_the_process_may_use))
