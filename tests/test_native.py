@@ -320,3 +320,45 @@ def test_values_beyond_the_binary_fields_are_clamped_not_wrapped(native):
         "Steps 1e+12 is above the limit 64; using 64",
         "Directions -1e+12 is below the limit 1; using 1",
         "Strength 1e+300 is above the limit 16; using 16"])
+
+
+UPDATE_SCRIPT = r'''
+import os, shutil, sys
+sys.path.insert(0, sys.argv[1])
+source, folder = sys.argv[2], sys.argv[3]
+installed = os.path.join(folder, "libhbao.so")
+shutil.copy(source, installed)
+os.environ["HBAO_LIBRARY"] = installed
+from hbao import native
+print("FIRST", native.library_version())
+native.unload_library()  # enabled again, the same files: the loaded library again
+print("AGAIN", native.library_version())
+shutil.copy(source, installed + ".new")
+os.replace(installed + ".new", installed)  # an update while the process runs
+native.unload_library()
+try:
+    native.library_version()
+    print("LOADED THE OLD LIBRARY")
+except native.HBAOLibraryError as error:
+    print("REFUSED", error)
+'''
+
+
+def test_a_library_replaced_while_loaded_says_restart(tmp_path):
+    """An update of the add-on while Blender runs replaces lib/libhbao.so;
+    the dynamic loader hands back the library it loaded under that path
+    without looking at the file, so the new add-on ran the old library (an
+    exploratory run: the version stayed 0.3.0 after installing 0.3.2; a
+    changed struct would have been refused as from "different versions",
+    right after reinstalling both). The add-on now says to restart Blender.
+    The same file loaded again (the add-on disabled and enabled) loads."""
+    from conftest import LIBRARY
+    script = tmp_path / "update.py"
+    script.write_text(UPDATE_SCRIPT)
+    completed = subprocess.run(
+        [sys.executable, str(script), str(REPO / "addon"), str(LIBRARY.resolve()), str(tmp_path)],
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=120)
+    assert completed.returncode == 0, completed.stdout
+    assert "FIRST 0." in completed.stdout and "AGAIN 0." in completed.stdout, completed.stdout
+    assert "REFUSED" in completed.stdout and "restart Blender" in completed.stdout, \
+        completed.stdout

@@ -21,6 +21,29 @@ def library_file_name(stem, platform=None):
     return f"lib{stem}.so"
 
 
+def mapped_from_a_replaced_file(path, maps="/proc/self/maps"):
+    """Whether this process has `path` mapped from a file that has been
+    replaced since (its device and inode are no longer those of the file the
+    path names): an add-on updated while Blender runs. The dynamic loader
+    hands back a library already loaded under the same path without looking
+    at the file, so the old code would run with the new add-on. False where
+    `path` is not mapped, or where this system has no such list."""
+    try:
+        status = os.stat(path)
+        name = os.path.realpath(path)  # as the system lists it
+        with open(maps, encoding="utf-8", errors="replace") as lines:
+            for line in lines:
+                fields = line.rstrip("\n").split(maxsplit=5)
+                if len(fields) < 6 or fields[5].removesuffix(" (deleted)") != name:
+                    continue
+                major, minor = (int(number, 16) for number in fields[3].split(":"))
+                return (int(fields[4]), major, minor) != (
+                    status.st_ino, os.major(status.st_dev), os.minor(status.st_dev))
+    except (OSError, ValueError):
+        pass
+    return False
+
+
 class Handshake:
     """What a library must report to match its binding: `version_function()`
     must give a value whose `version_key(value)` is `expected`, and each
@@ -101,6 +124,11 @@ class NativeLibrary:
                 f"zip, which carries the library; from a source checkout, "
                 f"scripts/install_addon.sh builds and installs it (or build it with CMake and "
                 f"set {self.environment_variable} to build/{self.file_name}).")
+        if mapped_from_a_replaced_file(path):
+            raise self.error_class(
+                f"{name} at {path} was replaced since Blender loaded it (the add-on was updated "
+                f"while Blender runs), and Blender keeps the old library until it quits: restart "
+                f"Blender to finish the update.")
         try:
             library = ctypes.CDLL(str(path))
         except OSError as error:
