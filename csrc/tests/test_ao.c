@@ -1076,6 +1076,16 @@ static scene plate_slab_before_wall(double thickness) {
     return s;
 }
 
+/* Whether pixel k (12 or more pixels from the image's sides) of
+ * render_plate_before_wall's depth is the wall within 12 pixels of the
+ * plate's silhouette along its row. */
+static int wall_beside_the_plate(const float *depth, int k) {
+    if (depth[k] < 4.9f) return 0; /* the plate (depth ~4.7) */
+    for (int di = -12; di <= 12; di += 3)
+        if (depth[k + di] < 4.9f) return 1;
+    return 0;
+}
+
 static void render_plate_before_wall(scene_view *view, float **depth, float **normal) {
     const scene s = plate_before_wall();
     const double eye[3] = {0.3, -5.0, 0.2}, target[3] = {0, 0, 0};
@@ -1199,10 +1209,7 @@ TEST_CASE(back_face_layer_lets_light_pass_behind_a_thin_plate) {
             for (int j = 12; j < view.height - 12; j++) {
                 for (int i = 12; i < view.width - 12; i++) {
                     const int k = j * view.width + i;
-                    int near_plate = 0;
-                    for (int di = -12; di <= 12 && !near_plate; di += 3)
-                        near_plate = depth[k + di] < 4.9f;
-                    if (depth[k] < 4.9f || !near_plate) continue;
+                    if (!wall_beside_the_plate(depth, k)) continue;
                     double world[3];
                     scene_pixel_position(&view, i, j, depth[k], world);
                     const double wall_normal[3] = {0.0, -1.0, 0.0};
@@ -1273,10 +1280,7 @@ TEST_CASE(a_single_sided_plate_darkens_no_more_with_the_back_layer) {
         for (int j = 12; j < view.height - 12; j++) {
             for (int i = 12; i < view.width - 12; i++) {
                 const int k = j * view.width + i;
-                int near_plate = 0;
-                for (int di = -12; di <= 12 && !near_plate; di += 3)
-                    near_plate = depth[k + di] < 4.9f;
-                if (depth[k] < 4.9f || !near_plate) continue;
+                if (!wall_beside_the_plate(depth, k)) continue;
                 darker += fmax(0.0, plain[k] - layered[k]);
                 darkest_plain = fminf(darkest_plain, plain[k]);
                 darkest_layered = fminf(darkest_layered, layered[k]);
