@@ -83,6 +83,10 @@ void hbao_scratch_give(void *memory) {
     if (memory == NULL) return;
     unsigned char *start = (unsigned char *)memory - HEADER;
     const size_t capacity = *(size_t *)start;
+    if (capacity > SCRATCH_MAX_BYTES) { /* never kept: dropping the kept blocks makes no room */
+        free(start);
+        return;
+    }
     pthread_mutex_lock(&scratch_lock);
     int slot = -1;
     for (;;) {

@@ -786,6 +786,26 @@ TEST_CASE(running_out_of_memory_leaves_the_output_as_it_was) {
     }
 }
 
+/* A block larger than the whole kept memory (SCRATCH_MAX_BYTES, 512 MiB:
+ * an image above about 45 megapixels has such buffers) is freed when it is
+ * given back, and the blocks kept until then stay kept: before, making room
+ * for it freed every one of them first, so each call on such an image found
+ * none of its buffers kept (an exploratory run). The 513 MiB are reserved,
+ * never touched. */
+TEST_CASE(a_block_too_large_to_keep_leaves_the_kept_ones) {
+    hbao_release_memory();
+    void *small = hbao_scratch_take((size_t)1 << 20);
+    CHECK(small != NULL);
+    hbao_scratch_give(small);
+    void *huge = hbao_scratch_take(((size_t)513) << 20);
+    CHECK(huge != NULL);
+    hbao_scratch_give(huge);
+    void *again = hbao_scratch_take((size_t)1 << 20);
+    CHECK(again == small);
+    hbao_scratch_give(again);
+    hbao_release_memory();
+}
+
 /* threads = 0 is one thread per CPU the process may run on: with its
  * affinity narrowed to one CPU (as taskset, a container's cpuset or a farm
  * scheduler narrows it), one thread, not one per CPU online (on this
@@ -826,4 +846,5 @@ TEST_MAIN(TEST_ENTRY(blur_copies_agree_on_background_at_every_sharpness),
           TEST_ENTRY(given_normals_face_the_viewer_along_its_ray),
           TEST_ENTRY(given_normals_choose_how_to_face_the_viewer),
           TEST_ENTRY(running_out_of_memory_leaves_the_output_as_it_was),
+          TEST_ENTRY(a_block_too_large_to_keep_leaves_the_kept_ones),
           TEST_ENTRY(default_threads_follow_the_cpus_the_process_may_use))
