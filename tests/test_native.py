@@ -190,6 +190,32 @@ def test_layouts_need_no_copy_and_agree(native):
     assert np.abs(out - reference).max() <= EXACT
 
 
+def test_any_numpy_layout_gives_the_same_ao(native):
+    """Layouts the library cannot read as they are are copied first: a
+    Fortran-ordered or broadcast depth was refused as "a pixel or row stride
+    is too small" (an exploratory run), normals with every other float taken
+    (a stride between components) and a misaligned buffer were passed on."""
+    depth = _bumpy_depth()
+    normal = np.zeros((HEIGHT, WIDTH, 3), np.float32)
+    normal[..., 2] = 1.0
+    normal[::3, ::2, 0] = 0.3
+    reference = native.compute_ao(depth, normal)
+    spaced = np.zeros((HEIGHT, WIDTH, 6), np.float32)
+    spaced[..., ::2] = normal
+    raw = np.zeros(HEIGHT * WIDTH * 4 + 1, np.uint8)
+    misaligned = raw[1:].view(np.float32).reshape(HEIGHT, WIDTH)
+    misaligned[...] = depth
+    assert not misaligned.flags.aligned
+    for name, layout_depth, layout_normal in (
+            ("Fortran order", np.asfortranarray(depth), np.asfortranarray(normal)),
+            ("every other float", depth, spaced[..., ::2]),
+            ("misaligned", misaligned, normal)):
+        assert np.abs(native.compute_ao(layout_depth, layout_normal) - reference).max() <= EXACT, \
+            name
+    row = np.broadcast_to(depth[:1], depth.shape)
+    assert np.abs(native.compute_ao(row) - native.compute_ao(np.array(row))).max() <= EXACT
+
+
 # The view numbers are the library's doubles from float camera fields: exact
 # formulas evaluated in another order differ by a few double roundings.
 VIEW_TOLERANCE = 1e-12

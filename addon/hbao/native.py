@@ -86,14 +86,23 @@ def camera_crop(camera, full_width, full_height, x, y, width, height):
 
 
 def _as_float32(array):
-    """array as float32 without copying when it already is float32 with
-    float-aligned strides; a copy otherwise."""
+    """An (H, W) or (H, W, C) array as float32 without copying where the
+    library can read it as it is (an hbao_channel: aligned floats, a pixel's
+    components next to each other, pixels along a row and rows apart by
+    whole floats, a row's pixels before the next row's, rows in either
+    order); a copy otherwise (a Fortran-ordered or transposed array, a
+    broadcast one, every other float: the library refused some as "a stride
+    too small", and would have read others wrong)."""
     array = np.asarray(array)
     if array.dtype != np.float32:
         array = array.astype(np.float32)
-    if any(stride % _FLOAT_SIZE for stride in array.strides) or array.strides[-1] <= 0:
-        array = np.ascontiguousarray(array)
-    if array.ndim >= 2 and array.strides[1] <= 0:
+    channels = array.shape[2] if array.ndim == 3 else 1
+    row_extent = (array.shape[1] - 1) * array.strides[1] + channels * _FLOAT_SIZE \
+        if array.ndim >= 2 else 0
+    if (not array.flags.aligned or any(stride % _FLOAT_SIZE for stride in array.strides)
+            or (array.ndim == 3 and array.strides[2] != _FLOAT_SIZE)
+            or (array.ndim >= 2 and (array.strides[1] < channels * _FLOAT_SIZE
+                                     or abs(array.strides[0]) < row_extent))):
         array = np.ascontiguousarray(array)
     return array
 
