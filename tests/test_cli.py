@@ -133,10 +133,10 @@ def exr_attribute(name, kind, payload):
 
 
 def scanline_exr(channels, width, height, claimed_size=None, display_window=None,
-                 data_origin=(0, 0), half=()):
+                 data_origin=(0, 0), half=(), integers=()):
     """A single-part, uncompressed scanline EXR of float channels (name ->
     float32 array of shape (height, width); those named in `half` are stored
-    as half floats), written from the OpenEXR file
+    as half floats, those in `integers` as unsigned integers), written from the OpenEXR file
     layout so that tests can make inputs of any size, or a header whose
     claimed size (claimed_size=(w, h)) the file does not hold: then no chunk
     table and no chunks follow. The data window starts at `data_origin`
@@ -145,7 +145,8 @@ def scanline_exr(channels, width, height, claimed_size=None, display_window=None
     claimed_width, claimed_height = claimed_size or (width, height)
     names = sorted(channels)
     # chlist: name, pixel type (1 half, 2 float), pLinear, 3 reserved, x/y sampling.
-    chlist = b"".join(n.encode() + b"\0" + struct.pack("<iB3xii", 1 if n in half else 2, 0, 1, 1)
+    kinds = {n: 0 if n in integers else 1 if n in half else 2 for n in names}
+    chlist = b"".join(n.encode() + b"\0" + struct.pack("<iB3xii", kinds[n], 0, 1, 1)
                       for n in names) + b"\0"
     x0, y0 = data_origin
     box = struct.pack("<4i", x0, y0, x0 + claimed_width - 1, y0 + claimed_height - 1)
@@ -161,8 +162,8 @@ def scanline_exr(channels, width, height, claimed_size=None, display_window=None
               + exr_attribute("screenWindowWidth", "float", struct.pack("<f", 1.0)) + b"\0")
     if claimed_size is not None:
         return header
-    rows = [b"".join(np.ascontiguousarray(channels[n][y], dtype="<f2" if n in half else "<f4")
-                     .tobytes()
+    types = {0: "<u4", 1: "<f2", 2: "<f4"}
+    rows = [b"".join(np.ascontiguousarray(channels[n][y], dtype=types[kinds[n]]).tobytes()
                      for n in names) for y in range(height)]
     chunks = [struct.pack("<ii", y0 + y, len(row)) + row for y, row in enumerate(rows)]
     offsets, position = [], len(header) + 8 * height
@@ -572,6 +573,30 @@ def test_a_single_view_file_and_the_layers_listed(hbao_tool, tmp_path):
     listed = run_tool(hbao_tool, source, "-o", tmp_path / "x.exr", "--back-layer", "C")
     assert_clean_error(listed, EXIT_RUNTIME, 'several view layers', '"A", "B"')
     assert '"C"' not in listed.stderr
+
+
+def test_passes_stored_as_integers_are_refused(hbao_tool, tmp_path):
+    """A Depth or Normal channel of unsigned integers (an index or ID pass
+    under that name, from another program) was read as floats and gave AO
+    from whatever the integers were, with no word (an exploratory run). It
+    is refused, saying what it holds; integer normals can be left out."""
+    depth = np.full((16, 16), 5.0, np.float32)
+    depth[4:12, 4:12] = 4.0
+    normals = {f"ViewLayer.Normal.{axis}": np.full((16, 16), value, np.float32)
+               for axis, value in zip("XYZ", (0.0, 0.0, 1.0))}
+    camera = tmp_path / "camera.json"
+    camera.write_text(json.dumps({"lens": 20.0}))
+    for name in ("ViewLayer.Depth.Z", "ViewLayer.Normal.Y"):
+        source = tmp_path / f"{name}.exr"
+        source.write_bytes(scanline_exr({"ViewLayer.Depth.Z": depth, **normals}, 16, 16,
+                                        integers=(name,)))
+        output = tmp_path / f"{name}_ao.exr"
+        completed = run_tool(hbao_tool, source, "-o", output, "--camera", camera)
+        assert_clean_error(completed, EXIT_RUNTIME, f'"{name}" holds unsigned integers')
+        assert not output.exists()
+        if "Normal" in name:
+            assert "--no-normals" in completed.stderr
+            run_ok(hbao_tool, source, "-o", output, "--camera", camera, "--no-normals")
 
 
 def test_a_compression_newer_than_openexr_31_is_named_not_called_truncated(hbao_tool, tmp_path):

@@ -122,8 +122,29 @@ static exr_channel_request float_request(const char *name, float *data, int comp
     return request;
 }
 
+/* A pass stored as unsigned integers (an object or material index, a
+ * Cryptomatte hash written by another program) is no length or direction:
+ * read as floats it gave AO from whatever those integers were, silently. */
+static int refuse_integer_pass(const exr_input *input, const char *name, const char *what,
+                               tool_error *error) {
+    const int index = exr_input_find_channel(input, name);
+    if (index < 0 || input->channels->entries[index].pixel_type != EXR_PIXEL_UINT)
+        return TOOL_EXIT_SUCCESS;
+    return tool_fail(error, TOOL_EXIT_RUNTIME,
+                     "%s: \"%s\" holds unsigned integers, not %s (Blender writes half or "
+                     "float); check which channel holds them%s",
+                     input->path, name, what,
+                     strcmp(what, "normals") == 0 ? ", or leave them out with --no-normals" : "");
+}
+
 static int read_passes(exr_input *input, const blender_passes *passes, bool use_normals,
                        const blender_passes *back, ao_buffers *buffers, tool_error *error) {
+    int status = refuse_integer_pass(input, passes->depth, "depths", error);
+    for (int axis = 0; axis < 3 && use_normals && status == TOOL_EXIT_SUCCESS; ++axis)
+        status = refuse_integer_pass(input, passes->normal[axis], "normals", error);
+    if (status == TOOL_EXIT_SUCCESS && back != NULL)
+        status = refuse_integer_pass(input, back->depth, "depths", error);
+    if (status != TOOL_EXIT_SUCCESS) return status;
     const size_t pixel_count = (size_t)input->width * (size_t)input->height;
     buffers->depth = malloc(pixel_count * sizeof(float));
     buffers->ao = malloc(pixel_count * sizeof(float));
