@@ -526,6 +526,14 @@ def test_a_multi_view_render_in_one_file_says_to_save_each_view_alone(hbao_tool,
                        "Views Format: Individual", "export_cameras.py")
     assert "enable the Z/Depth pass" not in completed.stderr
     assert not (tmp_path / "ao.exr").exists()
+    # OpenEXR's own layout (exrmultiview) names the default view's channels
+    # without a view: it was read as that view, silently (an exploratory run).
+    source.write_bytes(scanline_exr({"ViewLayer.Depth.Z": depth,
+                                     "ViewLayer.Depth.right.Z": depth}, 8, 8))
+    completed = run_tool(hbao_tool, source, "-o", tmp_path / "ao.exr", "--no-normals")
+    assert_clean_error(completed, EXIT_RUNTIME, 'holds the views "(default)", "right"',
+                       "Views Format: Individual")
+    assert not (tmp_path / "ao.exr").exists()
 
 
 @pytest.mark.matrix
@@ -729,6 +737,17 @@ def test_a_file_output_nodes_depth_and_a_constant_depth(hbao_tool, tmp_path):
         assert ("every pixel's depth (Z) is 1: the AO is 1 everywhere" in completed.stderr) \
             == warned, (value, completed.stderr)
         assert exr_passes.read_channels(tmp_path / "flat_ao.exr", ["AO"])["AO"].min() == 1.0
+    # An empty shot whose sky lies at the camera file's Clip End (EEVEE 4.5,
+    # 5.0), or is EEVEE 3.x's 65504 under a farther one, is background: no
+    # warning (a review found both warned).
+    for value, clip_end in ((5.600006, 5.6), (65504.0, 1e6)):
+        source = tmp_path / "flat.exr"
+        source.write_bytes(scanline_exr({"Z": np.full((48, 64), value, np.float32)}, 64, 48))
+        camera = tmp_path / "flat.json"
+        camera.write_text(json.dumps({"lens": 20.0, "clip_end": clip_end}))
+        completed = run_ok(hbao_tool, source, "-o", tmp_path / "flat_ao.exr", "--camera", camera,
+                           *flags)
+        assert "every pixel's depth" not in completed.stderr, (value, completed.stderr)
 
 
 # --- camera ------------------------------------------------------------------

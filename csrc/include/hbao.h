@@ -33,7 +33,8 @@
  * - Scale: depths are used in single precision as given. Scaling every
  *   length of a view (depths, radius, thickness, background_depth,
  *   ortho_scale) by a power of two leaves the AO bit for bit the same
- *   while those lengths stay between about 1e-16 and 1e19 scene units
+ *   while those lengths stay between about 1e-16 and 1e19 scene units (and
+ *   no depth lands exactly on HBAO_HALF_FLOAT_SKY, which is background)
  *   (test_planes.c, ao_is_the_same_at_every_scale). Beyond 1e19 (only with
  *   a background_depth above it) squared distances overflow, and toward
  *   the denormals (below about 1e-17; below 1.2e-38 the depth weights no

@@ -304,7 +304,7 @@ static hbao_result blur_grid(const hbao_settings *settings, const hbao_grid *gri
     if (band_rows < MIN_BAND_ROWS) band_rows = MIN_BAND_ROWS;
     job.band_rows = band_rows;
     const int bands = (height + band_rows - 1) / band_rows;
-    job.pool_sets = bands < settings->threads ? bands : settings->threads;
+    job.pool_sets = hbao_parallel_threads(settings->threads, bands);
     if (job.pool_sets < 1) job.pool_sets = 1;
     job.pool_set_floats = (2 + 2 * (size_t)job.radius) * (size_t)job.width;
     job.pool = hbao_scratch_take((size_t)job.pool_sets * job.pool_set_floats * sizeof(float));

@@ -71,10 +71,11 @@ static void convert_depth_row(void *context, int j) {
 }
 
 /* The back layer's value for back depth b behind front depth `front`
- * (hbao_depth_value's): b where it is known (finite, behind the visible
- * surface, not background, and the pixel not background), else INFINITY. */
+ * (hbao_depth_value's): b where it is known (behind the visible surface,
+ * not background by hbao_depth_value's rule, EEVEE's half-float sky
+ * included, and the pixel not background), else INFINITY. */
 static inline float back_value(float front, float b, float background) {
-    const int known = front > 0.0f && isfinite(b) && b > front && b < background;
+    const int known = front > 0.0f && hbao_depth_value(b, background) > front;
     return known ? b : INFINITY;
 }
 

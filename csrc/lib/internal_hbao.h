@@ -225,6 +225,9 @@ static inline float hbao_sample_height(const hbao_grid *grid, const hbao_height_
  * started, the threads that did start do its rows. */
 typedef void (*hbao_row_job)(void *context, int row);
 void hbao_parallel_rows(int threads, int rows, hbao_row_job job, void *context);
+/* How many of `threads` hbao_parallel_rows runs `rows` on (the calling
+ * thread included): at most as many as there are grabs of rows. */
+int hbao_parallel_threads(int threads, int rows);
 
 /* Large working buffers (scratch.c): like malloc and free, but a given
  * buffer is kept for the next call (hbao_release_memory frees them). */

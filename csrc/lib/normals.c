@@ -187,24 +187,26 @@ static int reconstruct_normal(const hbao_grid *grid, int i, int j, const float c
 }
 
 /* The normal of a pixel without a usable given normal: the face normal
- * from depth, or V. */
-static void face_normal(const hbao_grid *grid, int i, int j, float n[3]) {
+ * from depth (returns 1), or V where depth gives none (returns 0). */
+static int face_normal(const hbao_grid *grid, int i, int j, float n[3]) {
     const float z = grid->depth[(size_t)j * grid->width + i];
     if (z <= 0.0f) {
         n[0] = 0.0f;
         n[1] = 0.0f;
         n[2] = 1.0f;
-        return;
+        return 0;
     }
     float p[3], v[3];
     hbao_grid_position(grid, i, j, z, p);
     view_vector(grid, p, v);
     if (!reconstruct_normal(grid, i, j, p, v, n)) {
         for (int c = 0; c < 3; c++) n[c] = v[c];
+        return 0;
     }
     if (n[0] * v[0] + n[1] * v[1] + n[2] * v[2] < 0.0f) {
         for (int c = 0; c < 3; c++) n[c] = -n[c];
     }
+    return 1;
 }
 
 /* ... into grid->normal */
@@ -224,8 +226,8 @@ static void fallback_normal(const normal_job *job, int i, int j) {
  * V, which faces the viewer as much as u faced away and keeps its tilt;
  * turned round, such a normal pointed into the surface, which then hid
  * itself (AO 0.03 where Cycles gives 0.63). The face normal from depth
- * tells the cases apart: the candidate nearer to it; on a tie (where depth
- * gives no face normal, which is then V), -u. A normal more than 30 degrees
+ * tells the cases apart: the candidate nearer to it; -u on a tie and where
+ * depth gives no face normal. A normal more than 30 degrees
  * past edge-on (dot(u, V) < -1/2) is no tilted shading normal: -u. */
 #define HBAO_MOST_TILT_PAST_EDGE_ON (-0.5f)
 static void turn_to_viewer(const normal_job *job, int i, int j) {
@@ -251,7 +253,10 @@ static void turn_to_viewer(const normal_job *job, int i, int j) {
         for (int c = 0; c < 3; c++) hbao_grid_normal_row(grid, j, c)[i] = -u[c];
         return;
     }
-    face_normal(grid, i, j, face);
+    if (!face_normal(grid, i, j, face)) { /* depth cannot tell: -u */
+        for (int c = 0; c < 3; c++) hbao_grid_normal_row(grid, j, c)[i] = -u[c];
+        return;
+    }
     float mirror[3];
     for (int c = 0; c < 3; c++) mirror[c] = u[c] - 2.0f * u_dot_v * v[c];
     const float mirror_agrees = mirror[0] * face[0] + mirror[1] * face[1] + mirror[2] * face[2];

@@ -39,6 +39,11 @@ int hbao_available_cores(void) {
     return cores > HBAO_MAX_THREADS ? HBAO_MAX_THREADS : cores;
 }
 
+int hbao_parallel_threads(int threads, int rows) {
+    const int useful = (rows + HBAO_ROWS_PER_GRAB - 1) / HBAO_ROWS_PER_GRAB;
+    return threads > useful ? useful : threads;
+}
+
 void hbao_parallel_rows(int threads, int rows, hbao_row_job job, void *context) {
     row_queue queue;
     atomic_init(&queue.next_row, 0);
@@ -46,8 +51,7 @@ void hbao_parallel_rows(int threads, int rows, hbao_row_job job, void *context) 
     queue.job = job;
     queue.context = context;
 
-    const int useful = (rows + HBAO_ROWS_PER_GRAB - 1) / HBAO_ROWS_PER_GRAB;
-    if (threads > useful) threads = useful;
+    threads = hbao_parallel_threads(threads, rows);
     pthread_t workers[HBAO_MAX_THREADS];
     int started = 0;
     for (int t = 1; t < threads; t++) {

@@ -1303,6 +1303,32 @@ TEST_CASE(a_single_sided_plate_darkens_no_more_with_the_back_layer) {
     free(normal);
 }
 
+TEST_CASE(a_back_layer_of_the_half_float_sky_is_no_back_layer) {
+    /* A back-face layer from a half-float render whose sky is 65504 (EEVEE
+     * 3.x), with a background depth above it (a camera's Clip End past
+     * 65504): those backs are background, as the front's 65504 is, so a
+     * layer of nothing else gives the AO without a layer, bit for bit. They
+     * were taken for backs far behind (a review: 8157 pixels of 32768 off,
+     * by up to 0.91). */
+    scene_view view;
+    float *depth, *normal;
+    render_plate_before_wall(&view, &depth, &normal);
+    const int pixels = view.width * view.height;
+    float *sky = malloc((size_t)pixels * sizeof(float));
+    for (int k = 0; k < pixels; k++) sky[k] = HBAO_HALF_FLOAT_SKY;
+    hbao_params p = exact_params(HBAO_INTEGRATION_COSINE);
+    p.radius = 0.4f;
+    p.background_depth = 1e6f;
+    float *plain = run(&p, &view, depth, normal);
+    float *layered = run_layers(&p, &view, depth, normal, sky);
+    CHECK(memcmp(plain, layered, (size_t)pixels * sizeof(float)) == 0);
+    free(plain);
+    free(layered);
+    free(sky);
+    free(depth);
+    free(normal);
+}
+
 /* --- known answers on cones ---------------------------------------------- */
 
 /* An orthographic camera looks down -z at a point P at depth CONE_DEPTH,
@@ -1761,6 +1787,7 @@ TEST_MAIN(TEST_ENTRY(plane_facing_camera_is_unoccluded), TEST_ENTRY(tilted_plane
           TEST_ENTRY(simd_paths_match_scalar_reference_bit_for_bit),
           TEST_ENTRY(a_post_at_the_lens_leaves_the_ao_of_its_blocks),
           TEST_ENTRY(a_single_sided_plate_darkens_no_more_with_the_back_layer),
+          TEST_ENTRY(a_back_layer_of_the_half_float_sky_is_no_back_layer),
           TEST_ENTRY(thin_occluders_do_not_darken_what_is_behind_them),
           TEST_ENTRY(back_face_layer_lets_light_pass_behind_a_thin_plate),
           TEST_ENTRY(thickness_skips_exactly_the_occluders_wholly_in_front),

@@ -339,8 +339,11 @@ static int write_outputs(const cli_options *options, const exr_input *input,
 static void warn_if_depth_is_constant(const exr_input *input, const char *channel,
                                       const float *depth, float background_depth) {
     const size_t count = (size_t)input->width * (size_t)input->height;
-    /* (a frame of background alone, an empty shot, says nothing) */
-    if (count < 2 || !(depth[0] > 0.0f) || !(depth[0] < background_depth)) return;
+    /* (a frame of background alone, an empty shot, says nothing: the
+     * library's rule, its half-float sky and the camera's clip end included) */
+    if (count < 2 || !(depth[0] > 0.0f) || !(depth[0] < background_depth) ||
+        depth[0] == HBAO_HALF_FLOAT_SKY)
+        return;
     for (size_t i = 1; i < count; ++i)
         if (depth[i] != depth[0]) return;
     tool_warn("%s: every pixel's depth (%s) is %g: the AO is 1 everywhere. A single-layer EXR "
@@ -403,15 +406,14 @@ int ao_compute_input(const cli_options *options, exr_input *input, ao_buffers *b
                   "--no-normals to reconstruct normals from depth",
                   passes.normal[0]);
 
-    if (strcmp(passes.depth, "Z") == 0) /* a single-layer EXR's */
-        warn_if_depth_is_constant(input, passes.depth, buffers->depth,
-                                  options->params.background_depth);
-    hbao_channel depth = {buffers->depth, 1, input->width};
-    hbao_channel normal = {buffers->normal, 3, (int64_t)input->width * 3};
-    hbao_channel back = {buffers->back, 1, input->width};
     /* a sky written at the camera's clip end (EEVEE in 4.5 and 5.0) is background */
     hbao_params params = options->params;
     params.background_depth = camera_background_depth(&camera, params.background_depth);
+    if (strcmp(passes.depth, "Z") == 0) /* a single-layer EXR's */
+        warn_if_depth_is_constant(input, passes.depth, buffers->depth, params.background_depth);
+    hbao_channel depth = {buffers->depth, 1, input->width};
+    hbao_channel normal = {buffers->normal, 3, (int64_t)input->width * 3};
+    hbao_channel back = {buffers->back, 1, input->width};
     hbao_result result = hbao_compute_layers(
         &params, &cropped, input->width, input->height, &depth, use_normals ? &normal : NULL,
         buffers->back != NULL ? &back : NULL, buffers->ao, input->width);

@@ -64,9 +64,10 @@ static bool view_depth_name(const char *name, const char **view, int *view_lengt
 
 /* A multi-view render saved as one file (Views Format: Multi-View): the
  * tool reads one view from one file, with that view's camera. */
-static int fail_on_views(const exr_input *input, tool_error *error) {
+static int fail_on_views(const exr_input *input, bool default_view, tool_error *error) {
     char views[300] = "";
     int count = 0;
+    if (default_view) snprintf(views, sizeof views, "%s", "\"(default)\"");
     for (int c = 0; c < input->channels->num_channels; ++c) {
         const char *view = NULL;
         int length = 0;
@@ -127,7 +128,7 @@ static bool is_layer(const char *name, int length, const char *layer) {
 
 static int fail_listing_layers(const exr_input *input, const char *problem, const char *excluded,
                                tool_error *error) {
-    const int views = fail_on_views(input, error);
+    const int views = fail_on_views(input, false, error);
     if (views != TOOL_EXIT_SUCCESS) return views;
     char list[600] = "";
     for (int c = 0; c < input->channels->num_channels; ++c) {
@@ -182,8 +183,14 @@ int blender_find_passes(const exr_input *input, const char *requested, const cha
                                    "the Depth pass is in several view layers; choose one with "
                                    "--layer NAME",
                                    excluded, error);
-    if (chosen != NULL)
+    if (chosen != NULL) {
+        /* OpenEXR's own multi-view layout names the default view's channels
+         * without a view ("ViewLayer.Depth.Z" beside "ViewLayer.Depth.right.Z"):
+         * refused as Blender's, not read as the default view, silently */
+        const int views = fail_on_views(input, true, error);
+        if (views != TOOL_EXIT_SUCCESS) return views;
         return fill_passes(input, chosen, chosen_length, chosen, true, passes, error);
+    }
     /* A File Output node's Depth input writes "Depth.V" beside "Normal.X" */
     static const char *const plain_depth[] = {"Depth.Z", "Depth.V", "Z"};
     for (int i = 0; i < 3; ++i)
