@@ -316,23 +316,32 @@ def test_a_camera_scaled_unevenly_gets_the_ao_of_the_unscaled_one(run_in_blender
     assert np.abs(node_outputs(scaled, 1)["ao"] - expected).max() <= 1e-5
 
 
-def test_the_sky_at_clip_end_is_background(run_in_blender, tmp_path, native):
+@pytest.mark.parametrize("clip_end, tilt", [(5.6, 0.2), (1e5, 0.35)])
+def test_the_sky_at_clip_end_is_background(run_in_blender, tmp_path, native, clip_end, tilt):
     """EEVEE in 4.5 and 5.0 writes the sky's Depth as the camera's Clip End
     (or a rounding of it) where 3.4 writes 65504 and 5.3 1e10: the sky was
     then a wall at Clip End, and took AO from what stood near it (0.52 off,
     the sky darkened: found by an exploratory run). A depth at Clip End is
     background: AO 1, and the rest is the library's AO with that
-    background."""
+    background. With a long clip range (Clip End 1e5, Clip Start 0.1) 4.5
+    and 5.0 write the sky a little short of Clip End (99864.38: the depth
+    buffer's precision), which is background too (camera.clip_end_margin;
+    a review found it a wall once 65504 no longer capped the background)."""
+    from hbao import camera as camera_model
     node = {"radius": 1.0, "blur_size": 0}
     out, log = render(run_in_blender, tmp_path, {
-        "engine": "BLENDER_EEVEE", "samples": 1, "clip_end": 5.6, "camera_tilt": 0.2,
+        "engine": "BLENDER_EEVEE", "samples": 1, "clip_end": clip_end, "camera_tilt": tilt,
         "nodes": [node]})
     assert "without AO" not in log, log[-3000:]
     depth, normal = frame_passes(out, 1)
     description = camera(out, 1)
-    assert description["clip_end"] == pytest.approx(5.6)
-    background = np.float32(5.6 * (1 - 1e-5))
-    sky = depth >= background
+    assert description["clip_end"] == pytest.approx(clip_end)
+    background = np.float32(camera_model.background_depth(description, 65504.0))
+    # what each Blender wrote for the sky past the scene (which lies within
+    # 20 units) is background by the node's rule, 3.4's 65504 by libhbao's
+    written_sky = (depth > 20.0) & (depth != 65504.0)
+    assert np.all(depth[written_sky] >= background), (depth[written_sky].min(), background)
+    sky = (depth >= background) | (depth == 65504.0)
     assert 50 < sky.sum() < depth.size - 50, sky.sum()  # sky and geometry both in view
     ao = node_outputs(out, 1)["ao"]
     assert ao.min() < 0.9 and np.all(ao[sky] == 1.0)
@@ -1385,4 +1394,5 @@ def test_a_file_with_the_old_group_keeps_its_keyframes_in_every_blender(run_in_b
                          if text.startswith("OLD DRIVER MODIFIERS ")).split()[-1])
     assert state["drivers"] == [["Thickness", "0.25 + 0.001 * frame + 0.0 * x", [
         ["frame", "SINGLE_PROP", "SCENE", "Scene", "frame_current", "LOC_X"],
-        ["x", "TRANSFORMS", "OBJECT", "Camera", "", "LOC_X"]], modifiers]], state
+        ["x", "TRANSFORMS", "OBJECT", "Camera", "", "LOC_X"]], modifiers,
+        [[0.0, 0.0], [2.0, 4.0]]]], state

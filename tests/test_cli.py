@@ -628,6 +628,34 @@ def test_a_compression_newer_than_openexr_31_is_named_not_called_truncated(hbao_
     assert not (tmp_path / "ao.exr").exists()
 
 
+def test_the_sky_of_a_long_clip_range_is_background(hbao_tool, tmp_path):
+    """EEVEE in 4.5 and 5.0 writes the sky from a depth buffer that holds the
+    far plane to about (clip end / clip start) x 2^-24 of it: 99864.38 for a
+    clip end of 1e5, 699050.7 for 1e6 (clip start 0.1; a review). With the
+    camera file's clip_start such a sky is background (the AO of a sky at
+    1e10, exactly); a camera file without clip_start keeps the earlier rule,
+    the lesser of 65504 and the clip end."""
+    depth = np.full((48, 64), 5.1, np.float32)
+    depth[16:30, 20:40] = 4.6
+    ao = {}
+    for name, sky, camera in (
+            ("far", 1e10, {"clip_start": 0.1, "clip_end": 1e5}),
+            ("1e5", 99864.38, {"clip_start": 0.1, "clip_end": 1e5}),
+            ("1e6", 699050.7, {"clip_start": 0.1, "clip_end": 1e6}),
+            ("old_file", 99864.38, {"clip_end": 1e5})):
+        image = depth.copy()
+        image[:16] = sky
+        (tmp_path / f"{name}.exr").write_bytes(scanline_exr({"ViewLayer.Depth.Z": image}, 64, 48))
+        (tmp_path / f"{name}.json").write_text(json.dumps(dict(camera, lens=20.0)))
+        run_ok(hbao_tool, tmp_path / f"{name}.exr", "-o", tmp_path / f"{name}_ao.exr",
+               "--camera", tmp_path / f"{name}.json", "--radius", "2", "--blur", "0")
+        from hbao import exr_passes
+        ao[name] = exr_passes.read_channels(tmp_path / f"{name}_ao.exr", ["AO"])["AO"]
+    assert ao["far"].min() < 0.9
+    for name in ("1e5", "1e6", "old_file"):
+        assert np.array_equal(ao[name], ao["far"]), name
+
+
 def test_geometry_past_65504_is_geometry_under_the_cameras_clip_end(hbao_tool, tmp_path):
     """A scene modelled in centimetres, or at kilometres: the tool took the
     smaller of 65504 and the camera's clip end for the background, so every
@@ -653,8 +681,9 @@ def test_geometry_past_65504_is_geometry_under_the_cameras_clip_end(hbao_tool, t
         elif name == "far_sky":
             image[36:40, 8:56] = 1e10
         (tmp_path / f"{name}.exr").write_bytes(scanline_exr({"ViewLayer.Depth.Z": image}, 64, 48))
-        (tmp_path / f"{name}.json").write_text(
-            json.dumps({"lens": 20.0, "clip_end": float(np.float32(5.6) * lengths)}))
+        (tmp_path / f"{name}.json").write_text(json.dumps(
+            {"lens": 20.0, "clip_start": float(np.float32(0.1) * lengths),
+             "clip_end": float(np.float32(5.6) * lengths)}))
         run_ok(hbao_tool, tmp_path / f"{name}.exr", "-o", tmp_path / f"{name}_ao.exr",
                "--camera", tmp_path / f"{name}.json", "--radius", repr(float(2.0 * lengths)),
                "--blur", "0")
@@ -676,6 +705,10 @@ def test_the_sky_at_the_cameras_clip_end_is_background(hbao_tool, tmp_path):
     header = (REPO / "csrc" / "tool" / "camera_settings.h").read_text()
     margin = float(re.search(r"#define CAMERA_CLIP_END_MARGIN (\S+)", header).group(1))
     assert margin == camera_model.CLIP_END_MARGIN
+    precision = re.search(r"#define CAMERA_CLIP_RANGE_PRECISION (\S+)", header).group(1)
+    assert float.fromhex(precision) == camera_model.CLIP_RANGE_PRECISION
+    most = float(re.search(r"#define CAMERA_MOST_CLIP_END_MARGIN (\S+)", header).group(1))
+    assert most == camera_model.MOST_CLIP_END_MARGIN
     depth = np.full((48, 64), 5.0, np.float32)
     depth[:16] = 5.600006  # the sky, above a box standing before the wall
     depth[16:30, 20:40] = 4.5
@@ -693,9 +726,10 @@ def test_the_sky_at_the_cameras_clip_end_is_background(hbao_tool, tmp_path):
     assert np.all(ao["with"][:16] == 1.0)
     assert ao["with"][16:].min() < 0.9  # the box and wall keep their AO
     bad = tmp_path / "bad.json"
-    bad.write_text(json.dumps({"clip_end": -1}))
-    refused = run_tool(hbao_tool, source, "-o", tmp_path / "bad.exr", "--camera", bad)
-    assert_clean_error(refused, EXIT_RUNTIME, '"clip_end" must be > 0')
+    for key in ("clip_end", "clip_start"):
+        bad.write_text(json.dumps({key: -1}))
+        refused = run_tool(hbao_tool, source, "-o", tmp_path / "bad.exr", "--camera", bad)
+        assert_clean_error(refused, EXIT_RUNTIME, f'"{key}" must be > 0')
 
 
 def test_a_file_output_nodes_depth_and_a_constant_depth(hbao_tool, tmp_path):

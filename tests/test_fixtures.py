@@ -62,9 +62,12 @@ def test_fixtures_hold_the_expected_layers_and_passes(run_blender, tmp_path):
 
 def check_camera_description(camera, name, written_now=False):
     """`camera` has CAMERA_KEYS and, written by today's scripts, the camera's
-    clip_end too (which fixtures written before it lack)."""
-    keys = dict(CAMERA_KEYS, clip_end=float) if written_now or "clip_end" in camera \
-        else CAMERA_KEYS
+    clip_start and clip_end too (which fixtures written before them lack)."""
+    keys = CAMERA_KEYS
+    if written_now or "clip_end" in camera:
+        keys = dict(keys, clip_end=float)
+    if written_now or "clip_start" in camera:
+        keys = dict(keys, clip_start=float)
     assert set(camera) == set(keys), name
     for key, kind in keys.items():
         assert isinstance(camera[key], kind), (name, key)

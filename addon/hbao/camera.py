@@ -41,6 +41,7 @@ def camera_from_blender(scene, camera_object=None):
         "pixel_aspect_x": float(render.pixel_aspect_x),
         "pixel_aspect_y": float(render.pixel_aspect_y),
         "world_to_camera": [[float(v) for v in row] for row in world_to_camera],
+        "clip_start": float(camera.clip_start),
         "clip_end": float(camera.clip_end),
     }
 
@@ -84,17 +85,35 @@ def shear(matrix):
 # Clip End and took AO from what stands near it (0.52 off: found by an
 # exploratory run).
 CLIP_END_MARGIN = 1e-5
+# ... and further below Clip End where the clip range is long: EEVEE's depth
+# buffer holds the far plane to about (Clip End / Clip Start) x 2^-24 of it,
+# so that sky came out at 0.999 Clip End with a range of 2e5 and at 0.7 with
+# 1e7 (a review). The margin: that fraction, twice over, at most a half.
+CLIP_RANGE_PRECISION = 2.0 ** -23
+MOST_CLIP_END_MARGIN = 0.5
+
+
+def clip_end_margin(clip_start, clip_end):
+    """The fraction of Clip End below it from which a depth is the sky."""
+    return max(CLIP_END_MARGIN,
+               min(MOST_CLIP_END_MARGIN, CLIP_RANGE_PRECISION * clip_end / clip_start))
 
 
 def background_depth(description, depth):
     """The background depth for a render through camera dict `description`:
-    a hair short of its Clip End (nothing is rendered past it, and geometry
-    up to it is geometry, past 65504 too: a scene modelled in centimetres
-    had AO 1 everywhere beyond 655 m), or `depth` (the parameter's) where
-    it has none. libhbao takes 65504 itself, EEVEE's half-float sky, for
-    background at any background depth."""
-    clip_end = description.get("clip_end")
-    return depth if clip_end is None else clip_end * (1.0 - CLIP_END_MARGIN)
+    short of its Clip End by clip_end_margin (nothing is rendered past it,
+    and geometry up to it is geometry, past 65504 too: a scene modelled in
+    centimetres had AO 1 everywhere beyond 655 m), or `depth` (the
+    parameter's) where it has none. A description without Clip Start (a
+    camera file written before it was) keeps the earlier rule: the lesser of
+    `depth` and Clip End less CLIP_END_MARGIN. libhbao takes 65504 itself,
+    EEVEE's half-float sky, for background at any background depth."""
+    clip_end, clip_start = description.get("clip_end"), description.get("clip_start")
+    if clip_end is None:
+        return depth
+    if not clip_start or clip_start <= 0.0:
+        return min(depth, clip_end * (1.0 - CLIP_END_MARGIN))
+    return clip_end * (1.0 - clip_end_margin(clip_start, clip_end))
 
 
 def full_size(render):

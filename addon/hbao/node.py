@@ -140,8 +140,10 @@ class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
             node_lines.draw(layout, node_place.GROUPED_SHORT, node_place.GROUPED_DETAILS, "ERROR")
         elif not self.inputs[DEPTH_INPUT].is_linked:
             # Render Layers shows no Depth output until the pass is ticked.
-            button = layout.operator("hbao.connect_passes", icon="LINKED")
-            button.node_name = self.name
+            # (the add-on disabled, its node type kept: no operator to offer)
+            if getattr(bpy.types, "HBAO_OT_connect_passes", None) is not None:
+                button = layout.operator("hbao.connect_passes", icon="LINKED")
+                button.node_name = self.name
         for name in ("falloff", "integration"):
             # A label of its own: the default split cuts "Integration" short.
             row = layout.split(factor=0.5)

@@ -20,6 +20,9 @@ def draw(layout, short, details, icon):
     text = short
     if len(text) > MAX_STATUS_CHARACTERS:
         text = text[:MAX_STATUS_CHARACTERS - 1] + "\u2026"
+    if not HBAO_OT_node_status.is_registered:  # the add-on disabled, its node type kept
+        layout.label(text=text, icon=icon)
+        return
     button = layout.operator(HBAO_OT_node_status.bl_idname, text=text, icon=icon, emboss=False)
     button.details = details or short
 

@@ -125,9 +125,15 @@ def _restore_modifier(fcurve, state):
 
 
 def _restore_curve(fcurve, state):
-    """An F-Curve's settings, keyframes (those it lacks inserted) and
+    """An F-Curve's settings, keyframes (those it lacks inserted, those it
+    has beyond them removed: 5.3's driver_add makes (0, 0) and (1, 1)) and
     modifiers (in place of any it has) as _curve_state() saved them."""
     _apply(fcurve, state.get("curve", {}))
+    saved_frames = {key["co"][0] for key in state.get("keys", [])}
+    for frame in [point.co[0] for point in fcurve.keyframe_points]:
+        if frame not in saved_frames:
+            point = next(point for point in fcurve.keyframe_points if point.co[0] == frame)
+            fcurve.keyframe_points.remove(point)
     frames = {point.co[0] for point in fcurve.keyframe_points}
     for key in state.get("keys", []):
         if key["co"][0] not in frames:

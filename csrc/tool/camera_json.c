@@ -35,15 +35,19 @@ typedef struct float_field {
     int must_be_positive;
 } float_field;
 
+/* offsets into camera_settings: the camera's fields and the clip range */
+#define CAMERA_OFFSET(name) (offsetof(camera_settings, camera) + offsetof(hbao_camera, name))
 static const float_field float_fields[] = {
-    {"lens", CAMERA_FIELD_LENS, offsetof(hbao_camera, lens), 1},
-    {"sensor_width", CAMERA_FIELD_SENSOR_WIDTH, offsetof(hbao_camera, sensor_width), 1},
-    {"sensor_height", CAMERA_FIELD_SENSOR_HEIGHT, offsetof(hbao_camera, sensor_height), 1},
-    {"shift_x", CAMERA_FIELD_SHIFT_X, offsetof(hbao_camera, shift_x), 0},
-    {"shift_y", CAMERA_FIELD_SHIFT_Y, offsetof(hbao_camera, shift_y), 0},
-    {"ortho_scale", CAMERA_FIELD_ORTHO_SCALE, offsetof(hbao_camera, ortho_scale), 1},
-    {"pixel_aspect_x", CAMERA_FIELD_PIXEL_ASPECT_X, offsetof(hbao_camera, pixel_aspect_x), 1},
-    {"pixel_aspect_y", CAMERA_FIELD_PIXEL_ASPECT_Y, offsetof(hbao_camera, pixel_aspect_y), 1},
+    {"lens", CAMERA_FIELD_LENS, CAMERA_OFFSET(lens), 1},
+    {"sensor_width", CAMERA_FIELD_SENSOR_WIDTH, CAMERA_OFFSET(sensor_width), 1},
+    {"sensor_height", CAMERA_FIELD_SENSOR_HEIGHT, CAMERA_OFFSET(sensor_height), 1},
+    {"shift_x", CAMERA_FIELD_SHIFT_X, CAMERA_OFFSET(shift_x), 0},
+    {"shift_y", CAMERA_FIELD_SHIFT_Y, CAMERA_OFFSET(shift_y), 0},
+    {"ortho_scale", CAMERA_FIELD_ORTHO_SCALE, CAMERA_OFFSET(ortho_scale), 1},
+    {"pixel_aspect_x", CAMERA_FIELD_PIXEL_ASPECT_X, CAMERA_OFFSET(pixel_aspect_x), 1},
+    {"pixel_aspect_y", CAMERA_FIELD_PIXEL_ASPECT_Y, CAMERA_OFFSET(pixel_aspect_y), 1},
+    {"clip_end", CAMERA_FIELD_CLIP_END, offsetof(camera_settings, clip_end), 1},
+    {"clip_start", CAMERA_FIELD_CLIP_START, offsetof(camera_settings, clip_start), 1},
 };
 
 #define COUNT_OF(array) (sizeof(array) / sizeof((array)[0]))
@@ -134,7 +138,7 @@ int camera_json_parse(const char *text, const char *source, camera_settings *set
         if (item == NULL) continue;
         char what[64];
         snprintf(what, sizeof what, "\"%s\"", field->key);
-        float *out = (float *)((char *)&settings->camera + field->offset);
+        float *out = (float *)((char *)settings + field->offset);
         status = read_number(item, what, source, out, error);
         if (status != TOOL_EXIT_SUCCESS) goto done;
         if (field->must_be_positive && !(*out > 0.0f)) {
@@ -142,16 +146,6 @@ int camera_json_parse(const char *text, const char *source, camera_settings *set
             goto done;
         }
         settings->fields_set |= field->field;
-    }
-    const cJSON *clip_end = cJSON_GetObjectItemCaseSensitive(root, "clip_end");
-    if (clip_end != NULL) {
-        status = read_number(clip_end, "\"clip_end\"", source, &settings->clip_end, error);
-        if (status != TOOL_EXIT_SUCCESS) goto done;
-        if (!(settings->clip_end > 0.0f)) {
-            status = tool_fail(error, TOOL_EXIT_RUNTIME, "%s: \"clip_end\" must be > 0", source);
-            goto done;
-        }
-        settings->fields_set |= CAMERA_FIELD_CLIP_END;
     }
     status = read_matrix(root, settings, source, error);
 done:

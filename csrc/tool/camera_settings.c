@@ -7,12 +7,21 @@ void camera_settings_init(camera_settings *settings) {
     hbao_camera defaults = HBAO_CAMERA_DEFAULT_INITIALIZER;
     settings->camera = defaults;
     settings->clip_end = 0.0f;
+    settings->clip_start = 0.0f;
     settings->fields_set = 0;
 }
 
 float camera_background_depth(const camera_settings *settings, float background_depth) {
     if (!(settings->fields_set & CAMERA_FIELD_CLIP_END)) return background_depth;
-    return (float)((double)settings->clip_end * (1.0 - CAMERA_CLIP_END_MARGIN));
+    const double clip_end = settings->clip_end;
+    if (!(settings->fields_set & CAMERA_FIELD_CLIP_START)) {
+        const float at_clip_end = (float)(clip_end * (1.0 - CAMERA_CLIP_END_MARGIN));
+        return at_clip_end < background_depth ? at_clip_end : background_depth;
+    }
+    double margin = CAMERA_CLIP_RANGE_PRECISION * clip_end / (double)settings->clip_start;
+    if (margin > CAMERA_MOST_CLIP_END_MARGIN) margin = CAMERA_MOST_CLIP_END_MARGIN;
+    if (margin < CAMERA_CLIP_END_MARGIN) margin = CAMERA_CLIP_END_MARGIN;
+    return (float)(clip_end * (1.0 - margin));
 }
 
 void camera_settings_apply(camera_settings *base, const camera_settings *override) {
@@ -32,6 +41,7 @@ void camera_settings_apply(camera_settings *base, const camera_settings *overrid
     if (set & CAMERA_FIELD_WORLD_TO_CAMERA)
         memcpy(to->world_to_camera, from->world_to_camera, sizeof to->world_to_camera);
     if (set & CAMERA_FIELD_CLIP_END) base->clip_end = override->clip_end;
+    if (set & CAMERA_FIELD_CLIP_START) base->clip_start = override->clip_start;
     base->fields_set |= set;
 }
 

@@ -39,6 +39,8 @@ static void append_camera(char *text, size_t *used, const camera_settings *setti
      * fields_set */
     if (settings->fields_set & CAMERA_FIELD_CLIP_END)
         append(text, used, " clip end %.9g", (double)settings->clip_end);
+    if (settings->fields_set & CAMERA_FIELD_CLIP_START)
+        append(text, used, " clip start %.9g", (double)settings->clip_start);
 }
 
 bool run_settings_text(const cli_options *options, const camera_settings *camera_file,

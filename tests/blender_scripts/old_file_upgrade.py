@@ -64,6 +64,6 @@ print("UPGRADE", json.dumps({
                  [[variable.name, variable.type, variable.targets[0].id_type,
                    getattr(variable.targets[0].id, "name", None), variable.targets[0].data_path,
                    variable.targets[0].transform_type] for variable in driver.driver.variables],
-                 len(driver.modifiers)]
+                 len(driver.modifiers), [list(key.co) for key in driver.keyframe_points]]
                 for driver in getattr(tree.animation_data, "drivers", ())],
 }), flush=True)
