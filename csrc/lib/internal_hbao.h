@@ -56,7 +56,10 @@ typedef struct hbao_settings {
  * background depth is infinite) as for background, so no isfinite() is
  * needed. Written as a select so that the loops calling it vectorize. */
 static inline float hbao_depth_value(float z, float background) {
-    return z > 0.0f && z < background && z != HBAO_HALF_FLOAT_SKY ? z : 0.0f;
+    /* & rather than &&: no branch, so the loops still vectorize (&& made
+     * the full-resolution depth conversion 1.3x slower, bench_ab) */
+    const int keep = (z > 0.0f) & (z < background) & (z != HBAO_HALF_FLOAT_SKY);
+    return keep ? z : 0.0f;
 }
 
 /* The image that horizons are searched on: the full image, or the
