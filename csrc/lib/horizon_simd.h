@@ -420,13 +420,12 @@ static inline VM SIMD_NAME(sample_far)(const SIMD_NAME(block) * b, const SIMD_NA
 }
 
 /* SIMD_NAME(sample_far) with the back layer: the lanes beyond the radius whose
- * occluder, of a known back, reaches into it (horizon.c's enter_the_ball)
- * join, at the point where their view ray enters the radius. */
+ * occluder reaches into it (horizon.c's enter_the_ball) join, at the point
+ * where their view ray enters the radius. */
 static inline VM SIMD_NAME(sample_layers)(const SIMD_NAME(block) * b, const SIMD_NAME(fetch) * f,
                                           VM live, VF delta[3], VF *dist2) {
     VM far;
     const VM ok = SIMD_NAME(sample_far)(b, f, live, delta, dist2, &far);
-    far = M_AND(far, V_LT(f->zb, V_SET(INFINITY))); /* a back unknown: ignored */
     if (!M_ANY(far)) return ok;
     const VF q[3] = {V_ADD(delta[0], b->p[0]), V_ADD(delta[1], b->p[1]), V_ADD(delta[2], b->p[2])};
     VF d[3] = {V_SET(0.0f), V_SET(0.0f), V_SET(-1.0f)};
@@ -441,7 +440,7 @@ static inline VM SIMD_NAME(sample_layers)(const SIMD_NAME(block) * b, const SIMD
     if (!M_ANY(enter)) return ok;
     const VF t = V_SUB(V_NEG(along), V_SQRT(V_MAX0(disc)));
     const VF entry_depth = V_NEG(V_ADD(q[2], V_MUL(t, d[2])));
-    enter = M_AND(enter, V_LE(entry_depth, f->zb));
+    enter = M_AND(enter, V_LE(entry_depth, f->zb)); /* INFINITY: unknown, any depth */
     VF entered[3];
     for (int c = 0; c < 3; c++) entered[c] = V_ADD(delta[c], V_MUL(t, d[c]));
     const VF entered2 =
