@@ -388,3 +388,16 @@ def test_a_library_replaced_while_loaded_says_restart(tmp_path):
     assert "FIRST 0." in completed.stdout and "AGAIN 0." in completed.stdout, completed.stdout
     assert "REFUSED" in completed.stdout and "restart Blender" in completed.stdout, \
         completed.stdout
+
+
+def test_integers_past_int32_are_refused_not_wrapped(native):
+    """ctypes turned 2^32 + 10 into 10 for the library's int32 arguments: a
+    crop at x = 2^32 + 10 gave the crop at x = 10, a view 2^32 + 64 wide the
+    view 64 wide (an exploratory run). They are refused now."""
+    crop = native.camera_crop({}, 1920, 1080, 10, 0, 100, 100)
+    assert crop == native.camera_crop({}, 1920, 1080, np.int64(10), 0, 100, 100)
+    for call in (lambda: native.camera_crop({}, 1920, 1080, 2 ** 32 + 10, 0, 100, 100),
+                 lambda: native.camera_view({}, 2 ** 32 + 64, 48),
+                 lambda: native.camera_view({}, 64.5, 48)):
+        with pytest.raises(ValueError, match="int32 range"):
+            call()

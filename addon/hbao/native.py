@@ -64,9 +64,23 @@ def _camera_struct(camera):
     return structure
 
 
+_INT32_RANGE = (-2 ** 31, 2 ** 31 - 1)
+
+
+def _int32s(**values):
+    """The values, each an int32 as the library's arguments are; ValueError
+    naming the first that is not (ctypes would wrap 2^32 + 10 to 10)."""
+    for name, value in values.items():
+        if not isinstance(value, (int, np.integer)) or not \
+                _INT32_RANGE[0] <= int(value) <= _INT32_RANGE[1]:
+            raise ValueError(f"{name} must be a whole number in the int32 range, not {value!r}")
+    return [int(value) for value in values.values()]
+
+
 def camera_view(camera, width, height):
     """The HBAOView of camera dict `camera` on a `width` x `height` image: libhbao's
     sensor fit (hbao_camera_view). Raises HBAOError, HBAOLibraryError, ValueError."""
+    width, height = _int32s(width=width, height=height)
     view = HBAOView()
     check(load_library().hbao_camera_view(ctypes.byref(_camera_struct(camera)), width, height,
                                           ctypes.byref(view)))
@@ -77,6 +91,8 @@ def camera_crop(camera, full_width, full_height, x, y, width, height):
     """The camera dict of the `width` x `height` rectangle at column `x`, row `y` (from the
     top) of the full image seen by camera dict `camera`, with the same view rays
     (hbao_camera_crop). Raises HBAOError, HBAOLibraryError, ValueError."""
+    full_width, full_height, x, y, width, height = _int32s(
+        full_width=full_width, full_height=full_height, x=x, y=y, width=width, height=height)
     structure = _camera_struct(camera)
     check(load_library().hbao_camera_crop(ctypes.byref(structure), full_width, full_height,
                                           x, y, width, height, ctypes.byref(structure)))
