@@ -185,6 +185,20 @@ def test_disabling_the_add_on_in_a_session_leaves_the_plain_render(run_in_blende
     assert (images["enabled"] < images["muted"] - 0.05).any()
 
 
+def test_disabling_after_a_reload_of_the_package_still_lets_go(run_in_blender, tmp_path):
+    """Reload Scripts re-runs the package of an add-on enabled for the
+    session (--addons): its list of registered modules was reset, so a later
+    disable (or quit) unregistered nothing: handlers stayed, the AO pass
+    stayed linked (a review). The list survives the reload now."""
+    completed = run_in_blender(SCRIPTS / "addon_reload_disable.py", tmp_path)
+    line = next((text for text in completed.stdout.splitlines()
+                 if text.startswith("RELOAD DISABLE ")), None)
+    assert line is not None, completed.stdout[-3000:]
+    state = json.loads(line[len("RELOAD DISABLE "):])
+    assert state == {"linked_before": True, "linked_after": False, "muted": True,
+                     "handlers_left": []}, state
+
+
 def test_node_thickness_reaches_the_library(run_in_blender, tmp_path, native):
     """The Thickness socket is the library's hbao_params.thickness: the node's
     AO equals the library's with it, and differs from infinitely thick."""

@@ -28,8 +28,11 @@ bl_info = {
     "support": "COMMUNITY",
 }
 
-# Modules registered in this order (unregistered in reverse); None until register().
-_registered = []
+# Modules registered in this order (unregistered in reverse). Kept across
+# importlib.reload (Reload Scripts of an add-on enabled for the session only,
+# `--addons`), which re-runs this file: reset, the modules it registered were
+# unknown to a later unregister, which then let go of nothing (a review).
+_registered = globals().get("_registered", [])
 
 
 def sync(scene=None):
