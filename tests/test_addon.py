@@ -339,7 +339,7 @@ def test_the_sky_at_clip_end_is_background(run_in_blender, tmp_path, native, cli
     background: AO 1, and the rest is the library's AO with that
     background. With a long clip range (Clip End 1e5, Clip Start 0.1) 4.5
     and 5.0 write the sky a little short of Clip End (99864.38: the depth
-    buffer's precision), which is background too (camera.clip_end_margin;
+    buffer's precision), which is background too (hbao_clip_background_depth;
     a review found it a wall once 65504 no longer capped the background)."""
     from hbao import camera as camera_model
     node = {"radius": 1.0, "blur_size": 0}

@@ -290,6 +290,8 @@ def test_incompatible_library_is_refused(monkeypatch, tmp_path):
         "int32_t hbao_compute(void) { return 0; }\n"
         "int32_t hbao_compute_layers(void) { return 0; }\n"
         "void hbao_release_memory(void) {}\n"
+        "float hbao_clip_background_depth(float s, float e, float d)"
+        " { (void)s; (void)e; return d; }\n"
         "size_t hbao_view_size(void) { return 40; }\n"
         "int32_t hbao_camera_view(void) { return 0; }\n"
         "int32_t hbao_camera_crop(void) { return 0; }\n"
@@ -401,3 +403,23 @@ def test_integers_past_int32_are_refused_not_wrapped(native):
                  lambda: native.camera_view({}, 64.5, 48)):
         with pytest.raises(ValueError, match="int32 range"):
             call()
+
+
+def test_the_background_below_clip_end_is_the_librarys_rule(native):
+    """The node's background depth (camera.background_depth) is libhbao's
+    hbao_clip_background_depth, the rule the CLI takes too (once in two
+    languages; csrc/tests/test_camera.c holds its values): the sky EEVEE 4.5
+    and 5.0 wrote short of a long clip range's Clip End is background,
+    geometry past 65504 is not, and a camera without a clip range keeps the
+    parameter's depth."""
+    from hbao import camera as camera_model
+    long_range = camera_model.background_depth({"clip_start": 0.1, "clip_end": 1e5}, 65504.0)
+    assert long_range == native.clip_background_depth(0.1, 1e5, 65504.0)
+    assert 65504.0 < long_range <= 99864.38
+    assert camera_model.background_depth({"clip_start": 0.1, "clip_end": 9.0}, 65504.0) == \
+        pytest.approx(9.0 * (1.0 - 2.0 ** -23 * 90.0), rel=1e-7)
+    # a camera file written before clip_start was: the lesser of the two
+    assert camera_model.background_depth({"clip_end": 1e6}, 65504.0) == 65504.0
+    assert camera_model.background_depth({"clip_end": 9.0}, 65504.0) == \
+        pytest.approx(9.0 * (1.0 - 1e-5), rel=1e-7)
+    assert camera_model.background_depth({}, 1234.5) == 1234.5

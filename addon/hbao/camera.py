@@ -78,42 +78,14 @@ def shear(matrix):
     return max(abs(axes[0].dot(axes[1])), abs(axes[0].dot(axes[2])), abs(axes[1].dot(axes[2])))
 
 
-# EEVEE in 4.5 and 5.0 writes the sky's Depth as the camera's Clip End, or a
-# rounding of it (8.99996 for 9, 5.600006 for 5.6), where 3.4 writes 65504
-# and 5.3 1e10: a depth within this fraction of Clip End, or past it, is
-# background (nothing is rendered there). Otherwise the sky was a wall at
-# Clip End and took AO from what stands near it (0.52 off: found by an
-# exploratory run).
-CLIP_END_MARGIN = 1e-5
-# ... and further below Clip End where the clip range is long: EEVEE's depth
-# buffer holds the far plane to about (Clip End / Clip Start) x 2^-24 of it,
-# so that sky came out at 0.999 Clip End with a range of 2e5 and at 0.7 with
-# 1e7 (a review). The margin: that fraction, twice over, at most a half.
-CLIP_RANGE_PRECISION = 2.0 ** -23
-MOST_CLIP_END_MARGIN = 0.5
-
-
-def clip_end_margin(clip_start, clip_end):
-    """The fraction of Clip End below it from which a depth is the sky."""
-    return max(CLIP_END_MARGIN,
-               min(MOST_CLIP_END_MARGIN, CLIP_RANGE_PRECISION * clip_end / clip_start))
-
-
 def background_depth(description, depth):
     """The background depth for a render through camera dict `description`:
-    short of its Clip End by clip_end_margin (nothing is rendered past it,
-    and geometry up to it is geometry, past 65504 too: a scene modelled in
-    centimetres had AO 1 everywhere beyond 655 m), or `depth` (the
-    parameter's) where it has none. A description without Clip Start (a
-    camera file written before it was) keeps the earlier rule: the lesser of
-    `depth` and Clip End less CLIP_END_MARGIN. libhbao takes 65504 itself,
-    EEVEE's half-float sky, for background at any background depth."""
-    clip_end, clip_start = description.get("clip_end"), description.get("clip_start")
-    if clip_end is None:
-        return depth
-    if not clip_start or clip_start <= 0.0:
-        return min(depth, clip_end * (1.0 - CLIP_END_MARGIN))
-    return clip_end * (1.0 - clip_end_margin(clip_start, clip_end))
+    libhbao's rule (hbao_clip_background_depth) for its Clip Start and End,
+    or `depth` (the parameter's) where it has none. EEVEE in 4.5 and 5.0
+    writes the sky's Depth as Clip End or a rounding of it, where 3.4 writes
+    65504 (background at any background depth) and 5.3 1e10."""
+    return native.clip_background_depth(description.get("clip_start"),
+                                        description.get("clip_end"), depth)
 
 
 def full_size(render):

@@ -101,6 +101,13 @@ def camera_crop(camera, full_width, full_height, x, y, width, height):
                 **{name: getattr(structure, name) for name in _CAMERA_FLOAT_NAMES})
 
 
+def clip_background_depth(clip_start, clip_end, depth):
+    """The background depth of a render through a camera with this clip
+    range (libhbao's hbao_clip_background_depth, the one rule the node and
+    the CLI share); None or 0 for an unknown Clip Start or End."""
+    return load_library().hbao_clip_background_depth(clip_start or 0.0, clip_end or 0.0, depth)
+
+
 def _as_float32(array):
     """An (H, W) or (H, W, C) array as float32 without copying where the
     library can read it as it is (an hbao_channel: aligned floats, a pixel's

@@ -53,6 +53,7 @@ _FUNCTIONS = {
                                       _CHANNEL_P, _CHANNEL_P, ctypes.POINTER(ctypes.c_float),
                                       ctypes.c_int64]),
     "hbao_release_memory": (None, []),
+    "hbao_clip_background_depth": (ctypes.c_float, [ctypes.c_float] * 3),
     "hbao_compute_layers": (ctypes.c_int32, [_PARAMS_P, _CAMERA_P, ctypes.c_int32, ctypes.c_int32,
                                              _CHANNEL_P, _CHANNEL_P, _CHANNEL_P,
                                              ctypes.POINTER(ctypes.c_float), ctypes.c_int64]),

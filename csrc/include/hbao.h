@@ -354,6 +354,27 @@ HBAO_EXPORT size_t hbao_camera_size(void);
 HBAO_EXPORT size_t hbao_view_size(void);
 
 /**
+ * The background depth (hbao_params.background_depth) of a render through a
+ * camera with this clip range, the rule every front end (the node, the CLI)
+ * takes from here. Nothing is rendered past Clip End, and EEVEE in Blender
+ * 4.5 and 5.0 writes the sky's depth as Clip End or a rounding of it
+ * (8.99996 for 9; 99864 for 1e5 with Clip Start 0.1: its depth buffer holds
+ * the far plane to about Clip End / Clip Start x 2^-24 of it). So depths
+ * within a margin of Clip End, or past it, are background:
+ * clip_end x (1 - margin), margin = max(1e-5, min(0.5, 2^-23 x clip_end /
+ * clip_start)). Geometry up to there is geometry, past 65504 too.
+ *
+ * @param clip_start  the camera's Clip Start; not finite or <= 0 means
+ *                    unknown (a camera file written before it was): then
+ *                    the lesser of `depth` and clip_end x (1 - 1e-5)
+ * @param clip_end    the camera's Clip End; not finite or <= 0 means
+ *                    unknown: then `depth`
+ * @param depth       the background depth without a camera (the
+ *                    parameter's, HBAO_DEFAULT_BACKGROUND_DEPTH by default)
+ */
+HBAO_EXPORT float hbao_clip_background_depth(float clip_start, float clip_end, float depth);
+
+/**
  * The view frame of `camera` on a width x height image: Blender's sensor fit
  * (BKE_camera_params_compute_viewplane), the one implementation of it that
  * hbao_compute() and every front end use.

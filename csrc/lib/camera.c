@@ -120,6 +120,25 @@ static int image_size_is_valid(int32_t width, int32_t height) {
            height <= HBAO_MAX_IMAGE_SIZE;
 }
 
+/* hbao_clip_background_depth's margins: below Clip End by at least
+ * CLIP_END_MARGIN (EEVEE's rounding of it), by twice the depth buffer's
+ * precision over a long clip range, by at most MOST_CLIP_END_MARGIN. */
+#define CLIP_END_MARGIN 1e-5
+#define CLIP_RANGE_PRECISION 0x1p-23
+#define MOST_CLIP_END_MARGIN 0.5
+
+float hbao_clip_background_depth(float clip_start, float clip_end, float depth) {
+    if (!finite_positive(clip_end)) return depth;
+    if (!finite_positive(clip_start)) {
+        const float at_clip_end = (float)((double)clip_end * (1.0 - CLIP_END_MARGIN));
+        return at_clip_end < depth ? at_clip_end : depth;
+    }
+    double margin = CLIP_RANGE_PRECISION * (double)clip_end / (double)clip_start;
+    if (margin > MOST_CLIP_END_MARGIN) margin = MOST_CLIP_END_MARGIN;
+    if (margin < CLIP_END_MARGIN) margin = CLIP_END_MARGIN;
+    return (float)((double)clip_end * (1.0 - margin));
+}
+
 hbao_result hbao_camera_view(const hbao_camera *camera, int32_t width, int32_t height,
                              hbao_view *view) {
     if (camera == NULL || view == NULL) return HBAO_ERROR_NULL_ARGUMENT;

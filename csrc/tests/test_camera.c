@@ -465,7 +465,47 @@ TEST_CASE(ao_with_a_guard_band_equals_the_larger_frame) {
     free(window_ao);
 }
 
-TEST_MAIN(TEST_ENTRY(view_equals_the_scene_model), TEST_ENTRY(cropped_camera_keeps_the_view_rays),
+/* hbao_clip_background_depth: the one rule the node and the CLI take the
+ * background below a camera's Clip End from. Depths EEVEE 4.5 and 5.0 wrote
+ * for the sky (measured: 8.99996 for Clip End 9, 5.600006 for 5.6, 99864.38
+ * for 0.1 .. 1e5, 699051 for 0.1 .. 1e6) are background; geometry a
+ * hundredth short of a short range's Clip End is not. */
+TEST_CASE(clip_range_background_depth) {
+    const struct {
+        float clip_start, clip_end, sky;
+    } skies[] = {{0.1f, 9.0f, 8.99996f},
+                 {0.1f, 5.6f, 5.600006f},
+                 {0.1f, 1e5f, 99864.38f},
+                 {0.1f, 1e6f, 699051.0f}};
+    for (size_t s = 0; s < sizeof skies / sizeof skies[0]; s++) {
+        const float background =
+            hbao_clip_background_depth(skies[s].clip_start, skies[s].clip_end, 65504.0f);
+        CHECK(skies[s].sky >= background);
+        CHECK(background < skies[s].clip_end);
+        CHECK(background >= 0.5f * skies[s].clip_end);
+    }
+    /* the margin: 1e-5 of Clip End at least, 2^-23 x Clip End / Clip Start,
+     * half of Clip End at most */
+    CHECK(hbao_clip_background_depth(1.0f, 9.0f, 65504.0f) == (float)(9.0 * (1.0 - 1e-5)));
+    CHECK(hbao_clip_background_depth(0.1f, 1e5f, 65504.0f) ==
+          (float)(1e5 * (1.0 - 0x1p-23 * 1e5 / (double)0.1f)));
+    CHECK(hbao_clip_background_depth(1e-3f, 1e6f, 65504.0f) == 5e5f);
+    CHECK(hbao_clip_background_depth(0.1f, 100.0f, 65504.0f) > 99.0f);
+    /* past 65504: a scene in centimetres keeps its geometry */
+    CHECK(hbao_clip_background_depth(1.0f, 2e6f, 65504.0f) > 1e6f);
+    /* Clip Start unknown (a camera file written before it was): the lesser
+     * of the depth and Clip End less 1e-5 */
+    CHECK(hbao_clip_background_depth(0.0f, 9.0f, 65504.0f) == (float)(9.0 * (1.0 - 1e-5)));
+    CHECK(hbao_clip_background_depth(-1.0f, 1e6f, 65504.0f) == 65504.0f);
+    CHECK(hbao_clip_background_depth(NAN, 1e6f, 1e10f) == (float)(1e6 * (1.0 - 1e-5)));
+    /* Clip End unknown: the depth as given */
+    const float unknown_ends[] = {0.0f, -5.0f, NAN, INFINITY};
+    for (size_t e = 0; e < sizeof unknown_ends / sizeof unknown_ends[0]; e++)
+        CHECK(hbao_clip_background_depth(0.1f, unknown_ends[e], 1234.5f) == 1234.5f);
+}
+
+TEST_MAIN(TEST_ENTRY(view_equals_the_scene_model), TEST_ENTRY(clip_range_background_depth),
+          TEST_ENTRY(cropped_camera_keeps_the_view_rays),
           TEST_ENTRY(crop_of_a_crop_equals_the_direct_crop),
           TEST_ENTRY(crop_of_the_whole_image_is_the_camera),
           TEST_ENTRY(crop_may_write_over_its_input), TEST_ENTRY(crop_rejects_bad_arguments),

@@ -12,16 +12,10 @@ void camera_settings_init(camera_settings *settings) {
 }
 
 float camera_background_depth(const camera_settings *settings, float background_depth) {
-    if (!(settings->fields_set & CAMERA_FIELD_CLIP_END)) return background_depth;
-    const double clip_end = settings->clip_end;
-    if (!(settings->fields_set & CAMERA_FIELD_CLIP_START)) {
-        const float at_clip_end = (float)(clip_end * (1.0 - CAMERA_CLIP_END_MARGIN));
-        return at_clip_end < background_depth ? at_clip_end : background_depth;
-    }
-    double margin = CAMERA_CLIP_RANGE_PRECISION * clip_end / (double)settings->clip_start;
-    if (margin > CAMERA_MOST_CLIP_END_MARGIN) margin = CAMERA_MOST_CLIP_END_MARGIN;
-    if (margin < CAMERA_CLIP_END_MARGIN) margin = CAMERA_CLIP_END_MARGIN;
-    return (float)(clip_end * (1.0 - margin));
+    const float clip_end = settings->fields_set & CAMERA_FIELD_CLIP_END ? settings->clip_end : 0.0f;
+    const float clip_start =
+        settings->fields_set & CAMERA_FIELD_CLIP_START ? settings->clip_start : 0.0f;
+    return hbao_clip_background_depth(clip_start, clip_end, background_depth);
 }
 
 void camera_settings_apply(camera_settings *base, const camera_settings *override) {

@@ -30,19 +30,6 @@ enum {
     CAMERA_FIELD_CLIP_START = 1u << 12 /**< clip_start, neither */
 };
 
-/** A depth within this fraction of the camera's clip end, or past it, is
- *  background: EEVEE in Blender 4.5 and 5.0 writes the sky's depth as the
- *  clip end, or a rounding of it (addon/hbao/camera.py's CLIP_END_MARGIN,
- *  held to this by tests/test_cli.py). */
-#define CAMERA_CLIP_END_MARGIN 1e-5
-/** ... and further below it where the clip range is long: EEVEE's depth
- *  buffer holds the far plane to about (clip end / clip start) x 2^-24 of
- *  it: the margin is that fraction twice over, at most
- *  CAMERA_MOST_CLIP_END_MARGIN (camera.py's clip_end_margin, held to this
- *  by tests/test_cli.py). */
-#define CAMERA_CLIP_RANGE_PRECISION 0x1p-23
-#define CAMERA_MOST_CLIP_END_MARGIN 0.5
-
 typedef struct camera_settings {
     hbao_camera camera; /**< only the fields named in fields_set are meaningful */
     float clip_end;     /**< Blender's camera clip_end (CAMERA_FIELD_CLIP_END) */
@@ -50,13 +37,10 @@ typedef struct camera_settings {
     uint32_t fields_set;
 } camera_settings;
 
-/** `background_depth`, or, where the settings know the camera's clip end
- *  and start, short of the clip end by the margin above: nothing is
- *  rendered past it, and geometry up to it is geometry, past 65504 too
- *  (libhbao takes 65504 itself, EEVEE's half-float sky, for background at
- *  any background depth). With a clip end alone (a camera file written
- *  before clip_start was), the lesser of `background_depth` and the clip
- *  end less CAMERA_CLIP_END_MARGIN, as before. */
+/** hbao_clip_background_depth() (the one rule, in libhbao) of the clip
+ *  range the settings know: `background_depth` without a clip end, the
+ *  older rule with a clip end alone (a camera file written before
+ *  clip_start was). */
 float camera_background_depth(const camera_settings *settings, float background_depth);
 
 /** No field set; the values are Blender's defaults. */
