@@ -11,7 +11,7 @@ import pytest
 from conftest import BLENDERS, REPO, _runner
 
 sys.path.insert(0, str(REPO / "addon"))
-from hbao.viewport import shader_sources  # noqa: E402
+from hbao.viewport import camera_sources, projection, shader_sources  # noqa: E402
 
 SCRIPTS = REPO / "tests" / "blender_scripts"
 ARTIFACTS = REPO / "out" / "test-artifacts"
@@ -60,7 +60,8 @@ EXPECTED_CASES = {"persp_cosine", "persp_hbao", "persp_cosine_no_falloff", "shif
                   "ortho_cosine", "persp_cosine_blur", "persp_hbao_blur_strength",
                   "ortho_cosine_blur", "persp_cosine_thickness", "persp_cosine_half",
                   "persp_hbao_half_blur", "ortho_cosine_half_odd", "persp_cosine_half_depth",
-                  "ortho_hbao_half_depth", "persp_cosine_near_posts"} | UNOCCLUDED_CASES
+                  "ortho_hbao_half_depth", "persp_cosine_near_posts",
+                  "far_scene_cosine_blur"} | UNOCCLUDED_CASES
 
 # The preview multiplies the view by AO <= 1: it may only darken. 8-bit
 # screenshots: one code value of slack for rounding.
@@ -126,6 +127,8 @@ _LIBRARY_CONSTANTS = [
      "internal_hbao.h", "HBAO_HALF_DEPTH_PRECISION"),
     ("HALF_DEPTH_FIT_REACH", shader_sources.NORMAL_DEFINES["HALF_DEPTH_FIT_REACH"],
      "normals.c", "HALF_DEPTH_FIT_REACH"),
+    ("HALF_FLOAT_SKY", camera_sources.HALF_FLOAT_SKY, "../include/hbao.h",
+     "HBAO_HALF_FLOAT_SKY"),
 ]
 
 
@@ -219,8 +222,12 @@ def test_use_node_settings_previews_the_nodes_values(run_in_blender):
     completed = run_in_blender(SCRIPTS / "viewport_node_settings.py")
     cases = {line.split(" ", 2)[1]: json.loads(line.split(" ", 2)[2])
              for line in completed.stdout.splitlines() if line.startswith("PARAMS ")}
-    own = {"radius": 2.5, "steps": 16, "thickness": 0.0, "falloff": "NONE"}
+    # the view's sky is 0 (its cleared depth buffer): every depth it holds
+    # is geometry, past 65504 too, as the render shades it
+    sky = {"background_depth": projection.BACKGROUND_DEPTH}
+    own = {"radius": 2.5, "steps": 16, "thickness": 0.0, "falloff": "NONE", **sky}
     assert cases["own"] == own, cases
     assert cases["node"] == pytest.approx(
-        {"radius": 0.9, "steps": 7, "thickness": 0.2, "falloff": "QUADRATIC"}, rel=1e-6), cases
+        {"radius": 0.9, "steps": 7, "thickness": 0.2, "falloff": "QUADRATIC", **sky},
+        rel=1e-6), cases
     assert cases["no_node"] == own, cases

@@ -94,7 +94,18 @@ CASES = [
     ("persp_cosine_half_depth", PERSPECTIVE_CAMERA, {"blur_size": 0}, {"half_depth": True}),
     ("ortho_hbao_half_depth", ORTHOGRAPHIC_CAMERA,
      {"integration": "HBAO", "blur_size": 0, "radius": 0.8}, {"half_depth": True}),
+    # The scene 7400 times larger (a scene in centimetres), seen as the
+    # preview sees it: its sky 0 (the cleared depth buffer), its background
+    # depth float's largest (projection.BACKGROUND_DEPTH), so that the wall,
+    # at 66600, is geometry; a band of sky at exactly 65504 just above the
+    # wall, within the radius before it, is background all the same
+    # (libhbao's HBAO_HALF_FLOAT_SKY), not a ledge that shades the wall's top.
+    ("far_scene_cosine_blur", PERSPECTIVE_CAMERA,
+     {"blur_size": 5, "radius": 7.4e3, "background_depth": projection.BACKGROUND_DEPTH},
+     {"scale": 7.4e3}),
 ]
+# The band of exactly 65504 of the scaled case: rows and columns of the sky.
+HALF_FLOAT_SKY_BAND = (slice(6, None), slice(40, 160))
 # The rounding of half floats relative to the value (csrc/lib/internal_hbao.h,
 # HBAO_HALF_DEPTH_PRECISION).
 HALF_DEPTH_PRECISION = 2.0 ** -10
@@ -217,6 +228,12 @@ def main():
         frame = projection.frame_from_camera(camera, width, height)
         viewport_frame = blender_frame(camera, width, height)
         depth = synthetic_depth(frame, scene.get("floor_y", FLOOR_Y))
+        if scene.get("scale"):
+            sky = depth >= 1e9
+            depth = np.where(sky, 0.0, depth * scene["scale"]).astype(np.float32)
+            band = np.zeros_like(sky)
+            band[HALF_FLOAT_SKY_BAND] = True
+            depth[sky & band] = 65504.0
         if scene.get("near_posts"):
             for first in NEAR_POSTS[1]:
                 depth[:, first:first + 4] = NEAR_POSTS[0]
@@ -237,7 +254,7 @@ def main():
             "reference_mean_ao": float(reference.mean()),
             "preview_mean_ao": float(preview.mean()),
             "occluded_fraction": float((reference < 0.9).mean()),
-            "background_fraction": float((depth >= 1e9).mean()),
+            "background_fraction": float(((depth >= 1e9) | (depth <= 0.0)).mean()),
             "finite": bool(np.isfinite(preview).all()),
         }
         print(name, report["cases"][name])

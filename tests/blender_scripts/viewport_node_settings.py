@@ -2,7 +2,9 @@
 """Run by tests/test_viewport.py in each Blender: a 3D view's preview
 settings with "Use Node Settings" on take the scene's HBAO node values at the
 current frame (keyframed Radius, Steps, Thickness, Falloff); off, or with no
-node in the scene, they are the view's own. Prints 'PARAMS <case> <json>'.
+node in the scene, they are the view's own. The background depth is the
+preview's own either way (viewport/projection.py: BACKGROUND_DEPTH). Prints
+'PARAMS <case> <json>'.
 
   blender -b --addons hbao --python viewport_node_settings.py
 """
@@ -33,8 +35,8 @@ view.radius = 2.5
 
 
 def show(case, params):
-    print("PARAMS", case, json.dumps({key: params[key] for key in
-                                      ("radius", "steps", "thickness", "falloff")}), flush=True)
+    keys = ("radius", "steps", "thickness", "falloff", "background_depth")
+    print("PARAMS", case, json.dumps({key: params[key] for key in keys}), flush=True)
 
 
 show("own", view.params(scene))

@@ -3,16 +3,23 @@
 the background test, a pixel's depth and camera-space position, the view
 vector, and how much a depth may be rounded. Plain strings, no bpy."""
 
-# Shared by every pass after linearize: the background test.
+# csrc/include/hbao.h, HBAO_HALF_FLOAT_SKY: background at any background
+# depth, EEVEE 3.x's half-float sky (tests/test_viewport.py compares them).
+HALF_FLOAT_SKY = 65504.0
+
+# Shared by every pass after linearize: the background test, libhbao's
+# (hbao_depth_value).
 COMMON = """
 #define PI 3.14159265358979323846
+#define HALF_FLOAT_SKY %r
 
-/* Not finite, <= 0 or >= background_depth: written so that NaN is background. */
+/* Not finite, <= 0, >= background_depth or exactly HALF_FLOAT_SKY: written
+ * so that NaN is background. */
 bool is_background(float z)
 {
-    return !(z > 0.0 && z < background_depth);
+    return !(z > 0.0 && z < background_depth && z != HALF_FLOAT_SKY);
 }
-"""
+""" % HALF_FLOAT_SKY
 
 # Shared by the normal and AO passes: depth and position of a pixel (i, j),
 # j from the top, through the camera model of docs/algorithm.md.

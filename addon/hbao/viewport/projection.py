@@ -91,6 +91,13 @@ def is_perspective_matrix(matrix):
     return abs(float(matrix[3][3])) < 0.5
 
 
+# The view's sky (its cleared depth buffer) linearises to 0, background;
+# every depth the buffer holds is geometry, at any distance. So the preview's
+# background depth is float's largest: the parameter's 65504 hid a scene past
+# 65504 units in the preview, though the render (camera's Clip End) shades it.
+BACKGROUND_DEPTH = 3.4028234663852886e38
+
+
 # An orthographic user view (not a camera's) clips from -clip_end / 2 to
 # +clip_end / 2 about its pivot (P23 = 0): depths measured from the pivot are
 # negative in front of it, and the AO takes a depth <= 0 for background (no AO

@@ -19,6 +19,7 @@ from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProp
                        IntProperty)
 
 from .. import compat, native, parameters, socket_values
+from . import projection
 from ..node import hbao_nodes
 from ..parameters import FALLOFF_ITEMS, INTEGRATION_ITEMS
 
@@ -106,11 +107,13 @@ class HBAOViewSettings(bpy.types.PropertyGroup):
         node = self.settings_node(scene) if self.use_node_settings else None
         if node is not None:
             scene = scene or bpy.context.scene
-            return socket_values.node_params(node, scene.frame_current, [])
-        values = {name: getattr(self, name) for name in parameters.DEFAULTS
-                  if name != "background_depth"}
-        values["half_resolution"] = int(self.half_resolution)
-        return native.resolve_params(values)
+            params = socket_values.node_params(node, scene.frame_current, [])
+        else:
+            values = {name: getattr(self, name) for name in parameters.DEFAULTS
+                      if name != "background_depth"}
+            values["half_resolution"] = int(self.half_resolution)
+            params = native.resolve_params(values)
+        return dict(params, background_depth=projection.BACKGROUND_DEPTH)
 
     @staticmethod
     def settings_node(scene=None):
