@@ -2190,6 +2190,31 @@ def test_info_json_is_valid_utf8_whatever_the_names_hold(hbao_tool, tmp_path):
     assert sorted(names) == sorted(["Depth.Z", "X\ufffd", "Y\ufffd", "\u00e9"])
 
 
+def test_names_from_a_file_reach_the_terminal_escaped(hbao_tool, tmp_path):
+    """EXR names are any bytes: a layer named with an escape sequence (clear
+    the screen, set the window title) or a newline drove the terminal, or
+    faked a line, when --info printed it and when an error or warning named
+    it. Control characters come out as \\xNN in the text, the messages and
+    the warnings; --json escapes them as JSON does."""
+    depth = np.full((16, 16), 2.0, np.float32)
+    depth[4:8, 4:8] = 1.5
+    # long enough (56 bytes) for the warning that Blender before 5.0 cut its Normal pass
+    layer = "Evil\x1b[2J\x1b]0;title\x07\nhbao: fake" + "L" * 32
+    source = tmp_path / "names.exr"
+    source.write_bytes(scanline_exr({f"{layer}.Depth.Z": depth}, 16, 16))
+    escaped = "Evil\\x1b[2J\\x1b]0;title\\x07\\x0ahbao: fake"
+    text = run_ok(hbao_tool, "--info", source).stdout
+    assert escaped in text and "\x1b" not in text and "\x07" not in text, text
+    assert not any(line.startswith("hbao: fake") for line in text.splitlines())
+    refused = run_tool(hbao_tool, source, "-o", tmp_path / "ao.exr", "--layer", "Other")
+    assert_clean_error(refused, EXIT_RUNTIME, escaped)
+    assert "\x1b" not in refused.stderr and len(refused.stderr.splitlines()) == 1
+    warned = run_ok(hbao_tool, source, "-o", tmp_path / "ao.exr", "--radius", "1")
+    assert escaped in warned.stderr and "\x1b" not in warned.stderr, warned.stderr
+    described = json.loads(run_ok(hbao_tool, "--info", "--json", source).stdout)
+    assert described["layers"] == [layer]
+
+
 def test_info_lists_layers_and_types(hbao_tool):
     description = info(hbao_tool, fixture_path("eevee_half"))
     assert description["layers"] == ["ViewLayer"]

@@ -28,7 +28,14 @@ typedef struct tool_error {
     char message[TOOL_ERROR_MESSAGE_SIZE];
 } tool_error;
 
-/** printf-style: set the message and return `status` (for `return tool_fail(...)`). */
+/** `text` into `out` (`size` bytes, NUL-terminated, cut before an escape
+ *  that does not fit) with its control characters as \xNN: a channel or
+ *  layer name from a file, or a path, with an escape sequence would drive
+ *  the terminal, with a newline fake a line of the output. */
+void tool_escape(const char *text, char *out, size_t size);
+
+/** printf-style: set the message and return `status` (for `return tool_fail(...)`).
+ *  Messages and warnings are escaped (tool_escape). */
 int tool_fail(tool_error *error, int status, const char *format, ...)
     __attribute__((format(printf, 3, 4)));
 

@@ -14,8 +14,9 @@
 #include "tool_error.h"
 
 #define BLENDER_CHANNEL_NAME_MAX 512
-/** Blender before 5.0 cuts EXR channel names to 63 bytes: a view layer named
- *  with this many bytes or more loses its Normal pass ("<layer>.Normal.X"). */
+/** Blender before 5.0 cuts EXR channel names past 64 bytes (EXR_TOT_MAXNAME;
+ *  addon/hbao/compat.py's EXR_CHANNEL_NAME_MAX): a view layer named with this
+ *  many bytes or more loses its Normal pass ("<layer>.Normal.X", 9 more). */
 #define BLENDER_NORMAL_LAYER_NAME_MAX 56
 
 typedef struct blender_passes {

@@ -42,7 +42,10 @@ static cJSON *rect_json(const pixel_rect *rect) {
 static void print_text(const exr_input *input, const channel_statistics *stats, const char **layers,
                        int layer_count) {
     const pixel_rect *data = &input->data_window, *display = &input->display_window;
-    printf("%s\n", input->path);
+    /* names from the file (and the path) with their control characters escaped */
+    char name[TOOL_ERROR_MESSAGE_SIZE];
+    tool_escape(input->path, name, sizeof name);
+    printf("%s\n", name);
     printf("  size (data window): %dx%d\n", input->width, input->height);
     printf("  data window: (%d, %d) - (%d, %d)\n", data->min_x, data->min_y, data->max_x,
            data->max_y);
@@ -54,15 +57,19 @@ static void print_text(const exr_input *input, const channel_statistics *stats, 
            input->has_pixel_aspect_ratio ? "" : " (not in header)");
     printf("  layers with a Depth pass:");
     for (int l = 0; l < layer_count; ++l) {
-        int length = (int)strlen(layers[l]) - (int)strlen(".Depth.Z");
-        printf("%s %.*s", l ? "," : "", length, layers[l]);
+        char layer[BLENDER_CHANNEL_NAME_MAX];
+        snprintf(layer, sizeof layer, "%.*s", (int)(strlen(layers[l]) - strlen(".Depth.Z")),
+                 layers[l]);
+        tool_escape(layer, name, sizeof name);
+        printf("%s %s", l ? "," : "", name);
     }
     printf("%s\n", layer_count ? "" : " none");
     printf("  channels: %d\n", input->channels->num_channels);
     for (int c = 0; c < input->channels->num_channels; ++c) {
         const exr_attr_chlist_entry_t *channel = &input->channels->entries[c];
         const channel_statistics *s = &stats[c];
-        printf("    %-28s %-5s", channel->name.str, exr_pixel_type_name(channel->pixel_type));
+        tool_escape(channel->name.str, name, sizeof name);
+        printf("    %-28s %-5s", name, exr_pixel_type_name(channel->pixel_type));
         if (s->finite_count > 0)
             printf("  min %-12.6g max %-12.6g mean %-12.6g", s->minimum, s->maximum, s->mean);
         else
