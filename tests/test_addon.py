@@ -185,6 +185,27 @@ def test_disabling_the_add_on_in_a_session_leaves_the_plain_render(run_in_blende
     assert (images["enabled"] < images["muted"] - 0.05).any()
 
 
+def test_a_scene_without_a_camera_composites_with_the_node(run_in_blender, tmp_path):
+    """A scene that only composites (another scene's render, or images in a
+    file without any camera) and has an HBAO node: Blender refused its
+    render, "Cannot render, no camera" (the add-on's helper scene copied the
+    scene's camera, none), and nothing was written (an exploratory run).
+    The helper borrows a camera now; the render goes on, and the node says
+    why its AO is off."""
+    completed = run_in_blender(SCRIPTS / "compositing_scene.py", tmp_path)
+    assert "COMPOSITING DONE" in completed.stdout, completed.stdout[-3000:]
+    cases = {line.split(" ", 2)[1]: json.loads(line.split(" ", 2)[2])
+             for line in completed.stdout.splitlines()
+             if line.startswith("COMPOSITING ") and line != "COMPOSITING DONE"}
+    assert set(cases) == {"other_scene", "no_camera_in_file"}, cases
+    for case, outcome in cases.items():
+        assert outcome["result"] == ["FINISHED"] and outcome["written"], (case, outcome)
+        assert (tmp_path / f"{case}.png").stat().st_size > 0
+    assert cases["other_scene"]["status"] == ["Depth: other scene, AO off"]
+    assert cases["no_camera_in_file"]["status"] == ["Depth not linked: AO off"]
+    assert "no camera" not in completed.stdout
+
+
 def test_disabling_after_a_reload_of_the_package_still_lets_go(run_in_blender, tmp_path):
     """Reload Scripts re-runs the package of an add-on enabled for the
     session (--addons): its list of registered modules was reset, so a later

@@ -124,12 +124,13 @@ def _configure_helper_scene(scene, helper, restructured):
     # depsgraph. Every scene sharing the tree brings its own, and those that
     # sequencer strips and stereo views show it through.
     cameras = view_cameras.render_cameras(scenes_served_by(helper))
+    if not cameras:  # scenes that only composite other scenes' renders
+        cameras = [view_cameras.stand_in_camera(compat.compositor_tree(scene))]
     for camera in cameras:
         if helper.collection.objects.get(camera.name) != camera:
             helper.collection.objects.link(camera)
             restructured = True
-    if owner.camera is not None:
-        set_if_different(helper, "camera", owner.camera)
+    set_if_different(helper, "camera", owner.camera or cameras[0])
     for obj in list(helper.collection.objects):
         if obj not in cameras:
             helper.collection.objects.unlink(obj)

@@ -8,6 +8,8 @@ camera_shift_x once the view is active; a view of Multi-View through the
 camera whose name has the view's camera suffix in place of another view's
 (Camera_L for "left" when the scene camera is Camera_C), or the scene camera
 where the scene has no such object."""
+import bpy
+
 from . import camera as camera_model
 from . import strip_cameras
 
@@ -65,6 +67,26 @@ def render_cameras(scenes):
         if camera is not None and camera not in unique:
             unique.append(camera)
     return unique
+
+
+# The camera a helper renders through where its main scene has none.
+STAND_IN_CAMERA_NAME = ".HBAO stand-in camera"
+
+
+def stand_in_camera(tree):
+    """A camera for the helper of a scene without one (a scene that only
+    composites other scenes' renders): Blender refuses to render a scene
+    without a camera ("Cannot render, no camera"), the helper too, and that
+    cancelled the whole render. That of a scene a Render Layers node of
+    `tree` shows, else any camera of the file, else one made for it (no
+    other user: it leaves the file with the helper). Main thread only."""
+    shown = [node.scene for node in tree.nodes
+             if node.bl_idname == "CompositorNodeRLayers" and node.scene is not None]
+    for camera in [scene.camera for scene in shown] + list(bpy.data.objects):
+        if camera is not None and camera.type == "CAMERA":
+            return camera
+    return bpy.data.objects.new(STAND_IN_CAMERA_NAME,
+                                bpy.data.cameras.new(STAND_IN_CAMERA_NAME))
 
 
 def camera_of_view(engine, scene, camera, view_name, evaluated=lambda obj: obj):

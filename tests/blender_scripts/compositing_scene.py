@@ -1,0 +1,67 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Run inside Blender by tests/test_addon.py: scenes without a camera that
+only composite, each with an HBAO node. "other_scene": scene Comp shows
+scene Shot's render (a Render Layers node of Shot) through the HBAO node;
+"no_camera_in_file": scene Plate, in a file without any camera, multiplies
+a generated image by the HBAO node (fed by no Render Layers node at all).
+Blender refused both renders ("Cannot render, no camera": the add-on's
+helper scene had no camera), cancelling them. Writes OUT/<case>.png and
+prints 'COMPOSITING <case> <json>' with the operator's result and the
+node's status.
+
+  blender -b --addons hbao --python compositing_scene.py -- OUT
+"""
+import json
+import os
+import sys
+
+import bpy
+
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(REPO, "scripts"))
+import blender_scenes  # noqa: E402
+
+out_dir = sys.argv[sys.argv.index("--") + 1]
+compat = sys.modules["hbao.compat"]
+SIZE = (64, 48)
+
+
+def render(scene, case):
+    scene.render.resolution_x, scene.render.resolution_y = SIZE
+    scene.render.resolution_percentage = 100
+    scene.render.filepath = os.path.join(out_dir, case)
+    scene.render.image_settings.file_format = "PNG"
+    result = bpy.ops.render.render(write_still=True, scene=scene.name)
+    nodes = [node for node in compat.compositor_tree(scene).nodes
+             if node.bl_idname == "CompositorNodeHBAO"]
+    print("COMPOSITING", case, json.dumps({
+        "result": sorted(result), "written": os.path.isfile(scene.render.filepath + ".png"),
+        "status": [node.status for node in nodes]}), flush=True)
+
+
+shot = blender_scenes.build_corner_scene(bpy.context.scene, SIZE, "CYCLES", 1)
+shot.name = "Shot"
+comp = blender_scenes.Compositor(bpy.data.scenes.new("Comp"))
+source = comp.render_layers()
+source.scene = shot
+hbao = comp.node("CompositorNodeHBAO", (300, 0))
+for name in ("Image", "Depth", "Normal"):
+    comp.link(source.outputs[name], hbao.inputs[name])
+comp.composite(hbao.outputs["Image"])
+render(comp.scene, "other_scene")
+
+for scene in [s for s in bpy.data.scenes if s.name != "Comp"]:
+    if not scene.name.startswith(".HBAO"):
+        bpy.data.scenes.remove(scene)
+for obj in [o for o in bpy.data.objects if o.type == "CAMERA"]:
+    bpy.data.objects.remove(obj)
+plate = blender_scenes.Compositor(bpy.data.scenes.new("Plate"))
+image = bpy.data.images.new("plate", *SIZE)
+image.generated_color = (0.5, 0.25, 0.125, 1.0)
+picture = plate.node("CompositorNodeImage", (-300, 0))
+picture.image = image
+hbao = plate.node("CompositorNodeHBAO", (300, 0))
+plate.link(picture.outputs["Image"], hbao.inputs["Image"])
+plate.composite(hbao.outputs["Image"])
+render(plate.scene, "no_camera_in_file")
+print("COMPOSITING DONE", flush=True)
