@@ -185,25 +185,38 @@ def test_disabling_the_add_on_in_a_session_leaves_the_plain_render(run_in_blende
     assert (images["enabled"] < images["muted"] - 0.05).any()
 
 
-def test_a_scene_without_a_camera_composites_with_the_node(run_in_blender, tmp_path):
-    """A scene that only composites (another scene's render, or images in a
-    file without any camera) and has an HBAO node: Blender refused its
-    render, "Cannot render, no camera" (the add-on's helper scene copied the
-    scene's camera, none), and nothing was written (an exploratory run).
-    The helper borrows a camera now; the render goes on, and the node says
-    why its AO is off."""
+def test_compositing_scenes_and_the_sources_a_node_refuses(run_in_blender, tmp_path):
+    """Found by an exploratory run, in every Blender:
+    - a scene that only composites (another scene's render, or images in a
+      file without any camera) with an HBAO node: Blender refused its render,
+      "Cannot render, no camera" (the add-on's helper scene copied the
+      scene's camera, none), and nothing was written. The helper borrows a
+      camera now; the render goes on, and the node says why its AO is off;
+    - the node, refusing another scene's passes, still turned them on in
+      that scene (a lasting change there), and its status line said "Depth
+      pass turned on", not why its AO was off;
+    - Connect Passes linked the tree's first Render Layers node even where
+      it showed another scene or was muted, which the node then refused: it
+      takes the first the node accepts, or makes one."""
     completed = run_in_blender(SCRIPTS / "compositing_scene.py", tmp_path)
-    assert "COMPOSITING DONE" in completed.stdout, completed.stdout[-3000:]
+    log = completed.stdout
+    assert "COMPOSITING DONE" in log, log[-3000:]
     cases = {line.split(" ", 2)[1]: json.loads(line.split(" ", 2)[2])
-             for line in completed.stdout.splitlines()
+             for line in log.splitlines()
              if line.startswith("COMPOSITING ") and line != "COMPOSITING DONE"}
-    assert set(cases) == {"other_scene", "no_camera_in_file"}, cases
+    assert set(cases) == {"other_scene", "connected", "no_camera_in_file"}, cases
     for case, outcome in cases.items():
         assert outcome["result"] == ["FINISHED"] and outcome["written"], (case, outcome)
         assert (tmp_path / f"{case}.png").stat().st_size > 0
+    assert "no camera" not in log
     assert cases["other_scene"]["status"] == ["Depth: other scene, AO off"]
+    assert "OTHER SCENE PASSES [false, false]" in log
+    connected = json.loads(next(line for line in log.splitlines()
+                                if line.startswith("CONNECTED "))[len("CONNECTED "):])
+    assert connected == {"result": ["FINISHED"], "scene": "Shot", "muted": False,
+                         "passes": [True, True], "elsewhere_passes": [False, False]}, connected
+    assert cases["connected"]["status"] == [""] and "1 AO pass(es)" in log
     assert cases["no_camera_in_file"]["status"] == ["Depth not linked: AO off"]
-    assert "no camera" not in completed.stdout
 
 
 def test_disabling_after_a_reload_of_the_package_still_lets_go(run_in_blender, tmp_path):

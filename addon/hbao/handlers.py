@@ -10,7 +10,7 @@ the only chance such a render has to build the hook."""
 import bpy
 
 from . import (compat, helper_lookup, helper_render_settings, helper_scene, node, node_place,
-               recomposite, strip_cameras, writes)
+               pass_sources, recomposite, strip_cameras, writes)
 from .report import NodeMessage, in_main_thread, log, post_node_messages, post_render_report
 
 _sync_scheduled = False
@@ -121,7 +121,7 @@ def _on_render_pre(scene, *_args):
         if in_main_thread():
             helper_scene.sync(scene)
         else:
-            helper_scene.enable_needed_passes(scene, tree)
+            pass_sources.enable_needed_passes(scene, tree)
         # The helper may serve several scenes (5.x): its engine computes for this one.
         helper_scene.record_rendering(scene)
     except Exception as error:

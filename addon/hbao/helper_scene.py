@@ -16,14 +16,13 @@ pointed at each scene's helper in turn would flip with every sync. The render
 handlers record the scene being rendered, which the engine reads."""
 import bpy
 
-from . import compat, extra_renders, helper_render_settings, view_cameras, writes
+from . import compat, extra_renders, helper_render_settings, pass_sources, view_cameras, writes
 from .data_edits import set_if_different
 from .helper_lookup import (ENGINE_IDNAME, HELPER_SCENE_PREFIX, MAIN_SCENE_KEY, MAIN_TREE_KEY,
                             MANAGED_NODE_KEY, helper_scene_of, is_helper, main_scene_of,
                             managed_node, scenes_pointing_at, scenes_served_by, serves)
-from .node import (AO_PASS_INPUT, DEPTH_INPUT, NORMAL_INPUT, hbao_nodes, next_pass_index,
-                   pass_name)
-from .report import NodeMessage, in_main_thread, log, note_change
+from .node import AO_PASS_INPUT, DEPTH_INPUT, hbao_nodes, next_pass_index, pass_name
+from .report import log
 from .socket_values import upstream
 
 MANAGED_NODE_NAME = "HBAO Passes"
@@ -139,42 +138,6 @@ def _configure_helper_scene(scene, helper, restructured):
         compat.settle_new_scene(helper)
 
 
-def enable_needed_passes(scene, tree):
-    """Turn on the Depth/Normal pass a linked HBAO node reads but the view
-    layer lacks. Plain settings only: allowed in the render job's thread."""
-    messages = []
-    for node in hbao_nodes(tree):
-        if node.mute:
-            continue
-        for input_name, attribute, label in ((DEPTH_INPUT, "use_pass_z", "Depth"),
-                                             (NORMAL_INPUT, "use_pass_normal", "Normal")):
-            socket = node.inputs.get(input_name)
-            if socket is None or not socket.is_linked:
-                continue
-            source = socket.links[0].from_node
-            while source.bl_idname == "NodeReroute" and source.inputs[0].is_linked:
-                source = source.inputs[0].links[0].from_node
-            if source.bl_idname != "CompositorNodeRLayers" or source.get(MANAGED_NODE_KEY):
-                continue
-            source_scene = source.scene or scene
-            view_layer = source_scene.view_layers.get(source.layer)
-            if view_layer is not None and not getattr(view_layer, attribute):
-                setattr(view_layer, attribute, True)
-                message = (f"enabled the {label} pass of view layer {view_layer.name!r} "
-                           f"for node {node.name!r}")
-                messages.append(message)
-                log(message)
-                # on the node and in the render's report, as the render's
-                # own messages are (which would otherwise replace it)
-                change = NodeMessage(
-                    node.name, f"the {label} pass of view layer {view_layer.name!r} was off; "
-                    f"the add-on turned it on (the node reads it)", f"{label} pass turned on")
-                note_change(scene.name, change)
-                if in_main_thread():  # outside a render: on the node now, as well
-                    node.status = change.short
-    return messages
-
-
 def _ensure_managed_node(tree, nodes, helper):
     rlayers = managed_node(tree)
     if rlayers is None:
@@ -234,7 +197,7 @@ def sync(scene):
             bpy.data.scenes.remove(helper)
         return []
 
-    messages = enable_needed_passes(scene, tree)
+    messages = pass_sources.enable_needed_passes(scene, tree)
     seen = set()
     for node in nodes:
         if node.pass_index == 0 or node.pass_index in seen:

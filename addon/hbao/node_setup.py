@@ -5,7 +5,7 @@ View Layer properties, so an artist who adds the node cannot link them. The
 node's "Connect Passes" button turns the passes on and links them."""
 import bpy
 
-from . import compat
+from . import compat, pass_sources
 from .helper_lookup import MANAGED_NODE_KEY
 from .node import hbao_nodes
 from .node_group import DEPTH_INPUT, IMAGE_INPUT, NORMAL_INPUT
@@ -23,17 +23,24 @@ def _user_render_layers(tree):
 
 def connect_passes(scene, node):
     """Turn on the Depth and Normal passes of the view layer of the scene's
-    first Render Layers node (made if there is none) and link its Image,
-    Depth and Normal to `node`'s unlinked inputs. Returns what it did, as a
-    sentence for the artist."""
+    first Render Layers node that the node takes passes from (not another
+    scene's, nor a muted one, nor of a layer that is not rendered: those it
+    refuses; made if there is none) and link its Image, Depth and Normal to
+    `node`'s unlinked inputs. Returns what it did, as a sentence for the
+    artist."""
     tree = node.id_data
-    sources = _user_render_layers(tree)
+    sources = [source for source in _user_render_layers(tree)
+               if pass_sources.render_layers_refusal(source, scene, "Depth") is None]
     if sources:
         source = sources[0]
     else:
         source = tree.nodes.new("CompositorNodeRLayers")
         source.location = (node.location.x - 300, node.location.y)
-    view_layer = (source.scene or scene).view_layers.get(source.layer)
+        source.scene = scene
+        rendered = [layer for layer in scene.view_layers if layer.use]
+        if rendered:
+            source.layer = rendered[0].name
+    view_layer = scene.view_layers.get(source.layer)
     turned_on = []
     for _input, label, attribute in _LINKS:
         if attribute and view_layer is not None and not getattr(view_layer, attribute):

@@ -2,11 +2,11 @@
 """Which AO computations a frame needs: one job per HBAO node whose output
 someone looks at, with the view layer its passes come from and its
 parameters at that frame."""
-from . import compat, handover, render_threads
-from .helper_lookup import MANAGED_NODE_KEY
+from . import compat, render_threads
 from .node import DEPTH_INPUT, NORMAL_INPUT, hbao_nodes, pass_name
+from .pass_sources import pass_source
 from .report import NodeMessage, post_node_messages, take_changes
-from .socket_values import node_params, upstream
+from .socket_values import node_params
 
 
 class Job:
@@ -22,40 +22,6 @@ class Job:
         # of the frame on each side, guard_geometry's
         self.guard_band = node.guard_band / 100.0
         self.back_faces = node.back_faces
-
-
-def pass_source(socket, scene, expected):
-    """(view layer name, error, short error) of the Render Layers pass feeding
-    `socket`; the short error fits the node's status line."""
-    source = upstream(socket)
-    if source is None:
-        return None, None, None
-    node = source.node
-    if node.bl_idname != "CompositorNodeRLayers" or node.get(MANAGED_NODE_KEY):
-        return (None, f"{socket.name} must come straight from a Render Layers node",
-                "wrong source")
-    if node.scene is not None and node.scene != scene:
-        return (None, f"{socket.name} comes from another scene ({node.scene.name})",
-                "other scene")
-    if source.identifier != expected and source.name != expected:
-        return (None, f"{socket.name} is linked to the {source.name} pass, not {expected}",
-                "wrong pass")
-    if node.mute:
-        return None, f"{socket.name} comes from a muted Render Layers node ({node.name})", "muted"
-    if not source.enabled:  # Blender 3.4 keeps the link to a pass the engine does not make
-        return (None, f"{socket.name} is linked to the {expected} pass, which the render engine "
-                "does not make", "no such pass")
-    view_layer = (node.scene or scene).view_layers.get(node.layer)
-    if view_layer is not None and not view_layer.use:
-        return (None, f"{socket.name} comes from view layer {node.layer!r}, which is not rendered "
-                "(its Use for Rendering is off)", "not rendered")
-    longest = handover.longest_layer_name(expected)
-    if longest is not None and len(node.layer.encode()) > longest:
-        return (None, f"{socket.name} comes from view layer {node.layer!r}, whose name is too "
-                f"long for this Blender's EXR files: its {expected} pass cannot be read back "
-                f"(Blender before 5.0 cuts channel names at {compat.EXR_CHANNEL_NAME_MAX} "
-                f"bytes; rename the layer to at most {longest})", "name too long")
-    return node.layer, None, None
 
 
 def plan_node(node, main, frame, warnings):
@@ -95,7 +61,7 @@ def plan(main, frame):
     """The AO computations `main` needs at `frame`: ([Job], [NodeMessage]).
     The messages are also posted for the nodes' status lines (each node of
     the tree gets its own, or none: a good frame clears an old status)."""
-    jobs, warnings = [], take_changes(main.name)
+    jobs, warnings = [], []
     nodes = hbao_nodes(compat.compositor_tree(main))
     for node in nodes:
         if node.mute:
@@ -105,6 +71,9 @@ def plan(main, frame):
         job = plan_node(node, main, frame, warnings)
         if job is not None:
             jobs.append(job)
+    # What the add-on changed (a pass turned on) after the problems, so that
+    # a node's status line leads with why its AO is off
+    warnings += take_changes(main.name)
     post_node_messages(main.name, node_names(main), warnings)
     return jobs, warnings
 

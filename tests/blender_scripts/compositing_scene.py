@@ -48,9 +48,38 @@ hbao = comp.node("CompositorNodeHBAO", (300, 0))
 for name in ("Image", "Depth", "Normal"):
     comp.link(source.outputs[name], hbao.inputs[name])
 comp.composite(hbao.outputs["Image"])
+# Shot's Depth and Normal passes off: the node refuses another scene's
+# passes, so turning them on there (a lasting change to that scene, for no
+# AO) is not its business
+shot_layer = shot.view_layers[0]
+shot_layer.use_pass_z = shot_layer.use_pass_normal = False
 render(comp.scene, "other_scene")
+print("OTHER SCENE PASSES", json.dumps([shot_layer.use_pass_z, shot_layer.use_pass_normal]),
+      flush=True)
 
-for scene in [s for s in bpy.data.scenes if s.name != "Comp"]:
+# Connect Passes in Shot's own compositor, whose first Render Layers nodes
+# show another scene and are muted: it links a Render Layers node of Shot
+# that the node takes passes from, and the render has AO.
+shot_tree = blender_scenes.Compositor(shot)
+elsewhere = bpy.data.scenes.new("Elsewhere")
+elsewhere.collection.objects.link(shot.camera)  # Blender renders the scenes shown
+elsewhere.camera = shot.camera
+shot_tree.render_layers(location=(-400, 300)).scene = elsewhere
+shot_tree.render_layers(location=(-400, 0)).mute = True
+hbao = shot_tree.node("CompositorNodeHBAO", (300, 0))
+hbao.inputs["Blur Size"].default_value = 0
+shot_tree.composite(hbao.outputs["Image"])
+connected = bpy.ops.hbao.connect_passes(node_name=hbao.name)
+source = hbao.inputs["Depth"].links[0].from_node
+print("CONNECTED", json.dumps({
+    "result": sorted(connected), "scene": source.scene.name, "muted": source.mute,
+    "passes": [shot_layer.use_pass_z, shot_layer.use_pass_normal],
+    "elsewhere_passes": [elsewhere.view_layers[0].use_pass_z,
+                         elsewhere.view_layers[0].use_pass_normal]}),
+      flush=True)
+render(shot, "connected")
+
+for scene in [s for s in bpy.data.scenes if s.name not in ("Comp", "Shot")]:
     if not scene.name.startswith(".HBAO"):
         bpy.data.scenes.remove(scene)
 for obj in [o for o in bpy.data.objects if o.type == "CAMERA"]:
