@@ -243,3 +243,23 @@ def test_the_glsl_constants_match_the_library():
     epsilon = library_pattern(r"np_length > ([\d.e-]+)f;",
                               "the normal-in-slice threshold (np_length > eps)")
     assert defines["NORMAL_IN_SLICE_EPSILON"] == float(epsilon.group(1))
+
+
+def test_one_version_everywhere():
+    """The release's version lives in CMakeLists.txt (the library's, its
+    soname's), hbao.h, the add-on's bl_info and its extension manifest (which
+    package_addon.sh names the zips by): they must agree, and so must the
+    oldest Blender in bl_info and in compat.py."""
+    cmake = re.search(r"project\(hbao VERSION (\d+)\.(\d+)\.(\d+)",
+                      (REPO / "CMakeLists.txt").read_text())
+    header = tuple(int(re.search(rf"#define HBAO_VERSION_{part} (\d+)", HEADER).group(1))
+                   for part in ("MAJOR", "MINOR", "PATCH"))
+    package = (REPO / "addon" / "hbao" / "__init__.py").read_text()
+    bl_version = re.search(r'"version": \((\d+), (\d+), (\d+)\)', package)
+    manifest = re.search(r'^version = "(\d+)\.(\d+)\.(\d+)"',
+                         (REPO / "addon" / "hbao" / "blender_manifest.toml").read_text(), re.M)
+    versions = [tuple(int(n) for n in match.groups()) for match in (cmake, bl_version, manifest)]
+    assert versions == [header] * 3, (header, versions)
+    oldest = re.search(r'"blender": \((\d+), (\d+), (\d+)\)', package).groups()
+    compat = (REPO / "addon" / "hbao" / "compat.py").read_text()
+    assert f"MIN_SUPPORTED_VERSION = ({', '.join(oldest)})" in compat

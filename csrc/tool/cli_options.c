@@ -579,6 +579,7 @@ int cli_parse(int argc, char **argv, cli_options *options, tool_error *error) {
 }
 
 void cli_print_help(FILE *stream) {
+    const hbao_camera camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
     fprintf(
         stream,
         "usage: hbao INPUT.exr -o OUTPUT.exr [options]\n"
@@ -673,9 +674,9 @@ void cli_print_help(FILE *stream) {
         "                          their defaults (world_to_camera has none where the\n"
         "                          Normal pass is used: an error); unknown keys are ignored.\n"
         "  --camera-type T         PERSP or ORTHO\n"
-        "  --lens MM               focal length (default 50)\n"
-        "  --sensor-width MM       (default 36)\n"
-        "  --sensor-height MM      (default 24)\n"
+        "  --lens MM               focal length (default %g)\n"
+        "  --sensor-width MM       (default %g)\n"
+        "  --sensor-height MM      (default %g)\n"
         "  --sensor-fit FIT        AUTO (default), HORIZONTAL or VERTICAL\n"
         "  --shift-x S, --shift-y S  lens shift in units of the fitted sensor side\n"
         "  --ortho-scale S         orthographic view size; implies --camera-type ORTHO\n"
@@ -701,7 +702,7 @@ void cli_print_help(FILE *stream) {
         "                          the frame number zero-padded to the run's length, as\n"
         "                          Blender names frames: hbao 'render_####.exr' -o\n"
         "                          'ao_####.exr'\n"
-        "                          --frames 1-250; up to 64 comma-separated ranges. An\n"
+        "                          --frames 1-250; up to %d comma-separated ranges. An\n"
         "                          output at least as new as its input (and --camera\n"
         "                          file), written with the same flags and camera file\n"
         "                          contents (its header's hbaoSettings), with a --preview\n"
@@ -742,6 +743,7 @@ void cli_print_help(FILE *stream) {
         (double)HBAO_DEFAULT_ANGLE_BIAS_DEGREES, HBAO_MAX_DIRECTIONS, HBAO_DEFAULT_DIRECTIONS,
         HBAO_MAX_STEPS, HBAO_DEFAULT_STEPS, HBAO_MAX_BLUR_SIZE, HBAO_DEFAULT_BLUR_SIZE,
         (double)HBAO_MAX_BLUR_SHARPNESS, (double)HBAO_DEFAULT_BLUR_SHARPNESS,
-        (double)HBAO_MAX_STRENGTH, (double)HBAO_DEFAULT_STRENGTH, HBAO_MAX_THREADS, FRAME_MAX,
-        CLI_MAX_JOBS);
+        (double)HBAO_MAX_STRENGTH, (double)HBAO_DEFAULT_STRENGTH, HBAO_MAX_THREADS,
+        (double)camera.lens, (double)camera.sensor_width, (double)camera.sensor_height, FRAME_MAX,
+        FRAME_RANGES_MAX, CLI_MAX_JOBS);
 }
