@@ -185,7 +185,7 @@ def test_disabling_the_add_on_in_a_session_leaves_the_plain_render(run_in_blende
     assert (images["enabled"] < images["muted"] - 0.05).any()
 
 
-def test_compositing_scenes_and_the_sources_a_node_refuses(run_in_blender, tmp_path):
+def test_compositing_scenes_and_the_sources_a_node_refuses(run_in_blender, blender, tmp_path):
     """Found by an exploratory run, in every Blender:
     - a scene that only composites (another scene's render, or images in a
       file without any camera) with an HBAO node: Blender refused its render,
@@ -197,7 +197,9 @@ def test_compositing_scenes_and_the_sources_a_node_refuses(run_in_blender, tmp_p
       pass turned on", not why its AO was off;
     - Connect Passes linked the tree's first Render Layers node even where
       it showed another scene or was muted, which the node then refused: it
-      takes the first the node accepts, or makes one."""
+      takes the first the node accepts, or makes one;
+    - a node fed by an Image node (a saved render) now points to the CLI,
+      and a muted link is called muted, not unlinked."""
     completed = run_in_blender(SCRIPTS / "compositing_scene.py", tmp_path)
     log = completed.stdout
     assert "COMPOSITING DONE" in log, log[-3000:]
@@ -216,7 +218,12 @@ def test_compositing_scenes_and_the_sources_a_node_refuses(run_in_blender, tmp_p
     assert connected == {"result": ["FINISHED"], "scene": "Shot", "muted": False,
                          "passes": [True, True], "elsewhere_passes": [False, False]}, connected
     assert cases["connected"]["status"] == [""] and "1 AO pass(es)" in log
-    assert cases["no_camera_in_file"]["status"] == ["Depth not linked: AO off"]
+    # (3.4 lists no muted link among a socket's links: unlinked there)
+    muted = "Depth: link muted," if blender.version_tuple >= (4, 0) else "Depth not linked:"
+    assert cases["no_camera_in_file"]["status"] == ["Depth: wrong source, AO off",
+                                                    f"{muted} AO off"]
+    assert ("Depth must come straight from a Render Layers node (for a saved render's EXR, use "
+            "the hbao command-line tool); AO off") in log
 
 
 def test_disabling_after_a_reload_of_the_package_still_lets_go(run_in_blender, tmp_path):

@@ -29,34 +29,40 @@ def render_layers_refusal(node, scene, label):
 
 
 def _feeding_output(socket):
-    """(output socket, whether its link is valid) that feeds `socket` through
-    reroutes, or (None, False): unlinked, or by a muted link. A link to a
-    pass that is off is invalid in 5.x, and still says where it comes from."""
+    """(output socket, whether its link is valid, whether a link is muted)
+    that feeds `socket` through reroutes; no output where it is unlinked or
+    a link is muted. A link to a pass that is off is invalid in 5.x, and
+    still says where it comes from."""
     valid = True
     for _reroute in range(MAX_REROUTES):
         if socket is None or not socket.is_linked:
-            return None, False
+            return None, False, False
         link = socket.links[0]
         if link.is_muted:
-            return None, False
+            return None, False, True
         valid = valid and link.is_valid
         if link.from_node.bl_idname != "NodeReroute":
-            return link.from_socket, valid
+            return link.from_socket, valid, False
         socket = link.from_node.inputs[0]
-    return None, False
+    return None, False, False
 
 
 def _render_layers_pass(socket, expected):
     """(output socket, its link valid, error, short error): the Render
-    Layers output that feeds `socket`; None for none, or for another kind of
-    source, with its error."""
-    source, valid = _feeding_output(socket)
+    Layers output that feeds `socket`; None for none (unlinked: no error),
+    or for another kind of source, with its error."""
+    source, valid, muted = _feeding_output(socket)
+    if muted:
+        return None, False, f"{socket.name}'s link is muted", "link muted"
     if source is None:
         return None, False, None, None
     node = source.node
     if node.bl_idname != "CompositorNodeRLayers" or node.get(MANAGED_NODE_KEY):
-        return (None, False, f"{socket.name} must come straight from a Render Layers node",
-                "wrong source")
+        # an Image node: a saved render, whose AO the CLI computes
+        hint = (" (for a saved render's EXR, use the hbao command-line tool)"
+                if node.bl_idname == "CompositorNodeImage" else "")
+        return (None, False, f"{socket.name} must come straight from a Render Layers node"
+                f"{hint}", "wrong source")
     if source.identifier != expected and source.name != expected:
         return (None, False, f"{socket.name} is linked to the {source.name} pass, not "
                 f"{expected}", "wrong pass")

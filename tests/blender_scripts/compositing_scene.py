@@ -3,7 +3,8 @@
 only composite, each with an HBAO node. "other_scene": scene Comp shows
 scene Shot's render (a Render Layers node of Shot) through the HBAO node;
 "no_camera_in_file": scene Plate, in a file without any camera, multiplies
-a generated image by the HBAO node (fed by no Render Layers node at all).
+a generated image by two HBAO nodes (fed by no Render Layers node at all:
+one's Depth from the Image node, the other's through a muted link).
 Blender refused both renders ("Cannot render, no camera": the add-on's
 helper scene had no camera), cancelling them. Writes OUT/<case>.png and
 prints 'COMPOSITING <case> <json>' with the operator's result and the
@@ -89,8 +90,15 @@ image = bpy.data.images.new("plate", *SIZE)
 image.generated_color = (0.5, 0.25, 0.125, 1.0)
 picture = plate.node("CompositorNodeImage", (-300, 0))
 picture.image = image
+# Depth from the Image node (a saved render, which the node refuses: the
+# CLI computes its AO), and from it through a muted link (AO off, as
+# unlinked, but said so)
 hbao = plate.node("CompositorNodeHBAO", (300, 0))
 plate.link(picture.outputs["Image"], hbao.inputs["Image"])
-plate.composite(hbao.outputs["Image"])
+plate.link(picture.outputs["Image"], hbao.inputs["Depth"])
+muted = plate.node("CompositorNodeHBAO", (600, 0))
+plate.link(hbao.outputs["Image"], muted.inputs["Image"])
+plate.link(picture.outputs["Image"], muted.inputs["Depth"]).is_muted = True
+plate.composite(muted.outputs["Image"])
 render(plate.scene, "no_camera_in_file")
 print("COMPOSITING DONE", flush=True)
