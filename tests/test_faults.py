@@ -350,6 +350,34 @@ def test_long_view_layer_names(run_in_blender, blender, tmp_path, native, no_lef
         assert np.all(ao == 1.0)
 
 
+def test_a_long_view_layer_name_in_a_render_with_one_view(run_in_blender, blender, tmp_path,
+                                                          native, no_leftovers):
+    """Blender 3.4 saves a render with one view on (Stereoscopy, the right
+    eye off) with the view in its channel names ("<layer>.Normal.left.X")
+    and cuts them past 63 bytes: a 50-byte layer (a mono render keeps 55)
+    lost its Normal pass, and the AO was off with a KeyError (an exploratory
+    run). The node now says so and reconstructs the normals; 4.5 and later
+    save the mono names, and the AO is exact."""
+    name = "L" * 50
+    out, log = render(run_in_blender, tmp_path, {
+        "layer_name": name, "stereo": "one_view", "nodes": [{"radius": 0.8, "blur_size": 0}]})
+    assert "KeyError" not in log, log[-3000:]
+    # with one view on, 3.4 writes the render without its file suffix
+    suffix = "_L" if (out / "frame_0001_L.exr").exists() else ""
+    with_normal = blender.version_tuple >= (4, 5)
+    if not with_normal:
+        assert "Normal comes from view layer" in log and "rename the layer to at most 49 bytes, " \
+            "or the view" in log, log[-3000:]
+    channels = [f"{name}.Depth.Z"] + [f"{name}.Normal.{axis}" for axis in "XYZ"]
+    passes = exr.read_channels(out / f"frame_0001{suffix}.exr", channels)
+    normal = np.stack([passes[c] for c in channels[1:]], axis=-1) if with_normal else None
+    description = json.loads((out / "camera_0001_L.json").read_text())
+    expected = native.compute_ao(passes[channels[0]], normal, camera=description,
+                                 params=node_params(radius=0.8, blur_size=0))
+    ao = node_outputs(out, 1, view="_L" if (out / "nodes_0001_L.exr").exists() else "")["ao"]
+    assert expected.min() < 0.9 and np.abs(ao - expected).max() <= EXACT
+
+
 def test_a_pass_the_render_engine_does_not_make_is_not_read(run_in_blender, tmp_path, native,
                                                             no_leftovers):
     """A scene switched to Workbench after its passes were linked: Workbench

@@ -8,7 +8,7 @@ from time import perf_counter as _clock
 
 import bpy
 
-from . import compat, exr_passes, render_threads, scratch_files, view_files
+from . import compat, exr_passes, render_threads, scratch_files, view_cameras, view_files
 from .report import log
 
 
@@ -28,9 +28,31 @@ def pass_channels(layer, pass_name):
     return [f"{layer}.{pass_name}.{axis}" for axis in PASS_AXES[pass_name]]
 
 
-def longest_layer_name(pass_name):
+# Blender 3.4 saves a render with a single view left on (Stereoscopy) as
+# one file whose channels carry the view's name ("<layer>.Depth.left.Z",
+# view_files.py), cut past 63 bytes: measured, a 49-byte layer's
+# "<layer>.Normal.left.X" reads back, a 50-byte one's does not (the AO was
+# off, with a KeyError). 4.5 and later save such a view with the mono names;
+# the versions between are untested, taken as 3.4.
+SINGLE_VIEW_CHANNEL_NAME_MAX = 63 if compat.VERSION < (4, 5, 0) else None
+
+
+def named_view(scene):
+    """The view whose name a save of `scene`'s Render Result puts in its
+    channel names (see above), or None."""
+    views = view_cameras.rendered_views(scene)
+    if SINGLE_VIEW_CHANNEL_NAME_MAX is None or views is None or len(views) != 1:
+        return None
+    return views[0][0]
+
+
+def longest_layer_name(pass_name, view=None):
     """The most bytes a view layer's name may have for its pass `pass_name`
-    to be read back (compat.EXR_CHANNEL_NAME_MAX), or None: any."""
+    to be read back (compat.EXR_CHANNEL_NAME_MAX; with the channels' `view`,
+    named_view, SINGLE_VIEW_CHANNEL_NAME_MAX), or None: any."""
+    if view is not None:
+        channel = f".{pass_name}.{view}.{PASS_AXES[pass_name][0]}"
+        return SINGLE_VIEW_CHANNEL_NAME_MAX - len(channel.encode())
     if compat.EXR_CHANNEL_NAME_MAX is None:
         return None
     return compat.EXR_CHANNEL_NAME_MAX - len(pass_channels("", pass_name)[0].encode())

@@ -83,13 +83,22 @@ def pass_source(socket, scene, expected):
     if not source.enabled or not valid:
         return (None, f"{socket.name} is linked to the {expected} pass, which the render engine "
                 "does not make", "no such pass")
-    longest = handover.longest_layer_name(expected)
-    if longest is not None and len(node.layer.encode()) > longest:
-        return (None, f"{socket.name} comes from view layer {node.layer!r}, whose name is too "
-                f"long for this Blender's EXR files: its {expected} pass cannot be read back "
-                f"(Blender before 5.0 cuts channel names at {compat.EXR_CHANNEL_NAME_MAX} "
-                f"bytes; rename the layer to at most {longest})", "name too long")
-    return node.layer, None, None
+    view = handover.named_view(scene)
+    longest = handover.longest_layer_name(expected, view)
+    if longest is None or len(node.layer.encode()) <= longest:
+        return node.layer, None, None
+    if view is None:
+        why = (f"Blender before 5.0 cuts channel names at {compat.EXR_CHANNEL_NAME_MAX} bytes; "
+               f"rename the layer to at most {longest}")
+    else:
+        rename = (f"the layer to at most {longest} bytes, or the view" if longest > 0 else
+                  "the view")
+        why = (f"Blender before 4.5 names the channels of a render with one view with that "
+               f"view, {view!r}, and cuts them past {handover.SINGLE_VIEW_CHANNEL_NAME_MAX} "
+               f"bytes; rename {rename}")
+    return (None, f"{socket.name} comes from view layer {node.layer!r}, whose name is too long "
+            f"for this Blender's EXR files: its {expected} pass cannot be read back ({why})",
+            "name too long")
 
 
 def enable_needed_passes(scene, tree):
