@@ -841,6 +841,10 @@ def test_a_camera_file_without_its_matrix_is_an_error_where_normals_are_used(
     ('{"world_to_camera": [[0, 0, 0, 0], [0, 0, 0, 0], [0, 0, 0, 0], [0, 0, 0, 1]]}',
      "world_to_camera\" is not a camera's matrix"),
     ('{"sensor_fit": 3}', "sensor_fit"),
+    # cJSON took the first of a repeated key, Python's json and jq the last
+    # (an exploratory run): the AO depended on the reader
+    ('{"lens": 32, "sensor_width": 36, "lens": 80}', '"lens" is given more than once'),
+    ('{"world_to_camera": null, "world_to_camera": null}', '"world_to_camera" is given more'),
 ])
 def test_bad_camera_file_is_an_error(hbao_tool, tmp_path, content, fragment):
     bad = tmp_path / "camera.json"

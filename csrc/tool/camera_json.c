@@ -115,6 +115,24 @@ static int read_matrix(const cJSON *root, camera_settings *settings, const char 
     return TOOL_EXIT_SUCCESS;
 }
 
+/* A key this tool reads given twice: cJSON takes the first value, Python's
+ * json and jq the last, so the AO depended on the reader; refused. */
+static int repeated_key(const cJSON *root, const char *source, tool_error *error) {
+    static const char *const other_keys[] = {"type", "sensor_fit", "world_to_camera"};
+    const size_t key_count = COUNT_OF(float_fields) + COUNT_OF(other_keys);
+    for (size_t k = 0; k < key_count; ++k) {
+        const char *key = k < COUNT_OF(float_fields) ? float_fields[k].key
+                                                     : other_keys[k - COUNT_OF(float_fields)];
+        int seen = 0;
+        for (const cJSON *item = root->child; item != NULL; item = item->next)
+            if (item->string != NULL && strcmp(item->string, key) == 0 && ++seen > 1)
+                return tool_fail(error, TOOL_EXIT_RUNTIME,
+                                 "%s: \"%s\" is given more than once; give each key once", source,
+                                 key);
+    }
+    return TOOL_EXIT_SUCCESS;
+}
+
 int camera_json_parse(const char *text, const char *source, camera_settings *settings,
                       tool_error *error) {
     cJSON *root = cJSON_Parse(text);
@@ -124,6 +142,8 @@ int camera_json_parse(const char *text, const char *source, camera_settings *set
         status = tool_fail(error, TOOL_EXIT_RUNTIME, "%s: expected a JSON object", source);
         goto done;
     }
+    status = repeated_key(root, source, error);
+    if (status != TOOL_EXIT_SUCCESS) goto done;
     status =
         read_enum(root, "type", projection_names, COUNT_OF(projection_names),
                   CAMERA_FIELD_PROJECTION, &settings->camera.projection, settings, source, error);
