@@ -536,6 +536,31 @@ def test_a_multi_view_render_in_one_file_says_to_save_each_view_alone(hbao_tool,
     assert not (tmp_path / "ao.exr").exists()
 
 
+def test_a_layer_named_like_a_pass_is_no_view(hbao_tool, tmp_path):
+    """A view layer whose name ends in ".Depth" ("BG.Depth": channels
+    "BG.Depth.Depth.Z", "BG.Depth.Normal.Z") was taken for a multi-view
+    render with views "Depth" and "Normal" and refused (an exploratory run):
+    it is read as any layer is, and the AO is that of --layer BG.Depth; beside
+    another layer, the tool asks for --layer, listing both."""
+    depth = np.full((16, 16), 3.0, np.float32)
+    depth[4:10, 4:10] = 2.5
+    normal = {f"BG.Depth.Normal.{axis}": np.full((16, 16), value, np.float32)
+              for axis, value in zip("XYZ", (0.0, 0.0, 1.0))}
+    source = tmp_path / "bg.exr"
+    source.write_bytes(scanline_exr({"BG.Depth.Depth.Z": depth, **normal}, 16, 16))
+    flags = ("--radius", "1", "--blur", "0", "--world-to-camera", "1 0 0 0 0 1 0 0 0 0 1 0 0 0 0 1")
+    run_ok(hbao_tool, source, "-o", tmp_path / "found.exr", *flags)
+    run_ok(hbao_tool, source, "-o", tmp_path / "named.exr", "--layer", "BG.Depth", *flags)
+    from hbao import exr_passes
+    found, named = (exr_passes.read_channels(tmp_path / f"{name}.exr", ["AO"])["AO"]
+                    for name in ("found", "named"))
+    assert found.min() < 0.95 and np.array_equal(found, named)
+    source.write_bytes(scanline_exr({"BG.Depth.Depth.Z": depth, "FG.Depth.Z": depth, **normal},
+                                    16, 16))
+    refused = run_tool(hbao_tool, source, "-o", tmp_path / "two.exr", *flags)
+    assert_clean_error(refused, EXIT_RUNTIME, "--layer NAME", '"BG.Depth", "FG"')
+
+
 @pytest.mark.matrix
 def test_a_multi_view_file_written_by_blender_says_to_save_each_view_alone(
         run_in_blender, blender, hbao_tool, tmp_path):

@@ -62,16 +62,49 @@ static bool view_depth_name(const char *name, const char **view, int *view_lengt
     return true;
 }
 
+/* Whether `name` is "<layer>.Depth.<view>.Z" for the first `layer_length`
+ * bytes of `layer`: a view of that layer (a view's name may hold dots). A
+ * layer whose own name ends in ".Depth" ("BG.Depth.Depth.Z") is no view. */
+static bool layer_view_depth_name(const char *name, const char *layer, int layer_length,
+                                  const char **view, int *view_length) {
+    static const char pass[] = ".Depth.";
+    const size_t length = strlen(name), prefix = (size_t)layer_length + strlen(pass);
+    if (length < prefix + strlen("x.Z") || strncmp(name, layer, (size_t)layer_length) != 0 ||
+        strncmp(name + layer_length, pass, strlen(pass)) != 0 ||
+        strcmp(name + length - 2, ".Z") != 0)
+        return false;
+    *view = name + prefix;
+    *view_length = (int)(length - 2 - prefix);
+    return true;
+}
+
+/* Whether the view's Depth `name` ("BG.Depth.Normal.Z") is rather a pass of
+ * a layer whose own name ends in ".Depth" (the file has "BG.Depth.Depth.Z",
+ * that layer's Depth pass): no view "Normal" (nor "Depth") of layer "BG". */
+static bool in_layer_named_depth(const exr_input *input, const char *name) {
+    char depth[BLENDER_CHANNEL_NAME_MAX];
+    const int layer_length = (int)(strstr(name, ".Depth.") - name) + (int)strlen(".Depth");
+    return set_name(depth, name, layer_length, depth_suffix) &&
+           exr_input_find_channel(input, depth) >= 0;
+}
+
 /* A multi-view render saved as one file (Views Format: Multi-View): the
- * tool reads one view from one file, with that view's camera. */
-static int fail_on_views(const exr_input *input, bool default_view, tool_error *error) {
+ * tool reads one view from one file, with that view's camera. With
+ * `default_layer` (its first `layer_length` bytes), the layer whose
+ * unnamed channels are a default view (OpenEXR's layout): only that
+ * layer's views count. */
+static int fail_on_views(const exr_input *input, const char *default_layer, int layer_length,
+                         tool_error *error) {
     char views[300] = "";
     int count = 0;
-    if (default_view) snprintf(views, sizeof views, "%s", "\"(default)\"");
+    if (default_layer != NULL) snprintf(views, sizeof views, "%s", "\"(default)\"");
     for (int c = 0; c < input->channels->num_channels; ++c) {
-        const char *view = NULL;
+        const char *view = NULL, *name = input->channels->entries[c].name.str;
         int length = 0;
-        if (!view_depth_name(input->channels->entries[c].name.str, &view, &length)) continue;
+        if (default_layer != NULL
+                ? !layer_view_depth_name(name, default_layer, layer_length, &view, &length)
+                : !view_depth_name(name, &view, &length) || in_layer_named_depth(input, name))
+            continue;
         const size_t used = strlen(views);
         snprintf(views + used, sizeof views - used, "%s\"%.*s\"", used ? ", " : "", length, view);
         ++count;
@@ -128,7 +161,7 @@ static bool is_layer(const char *name, int length, const char *layer) {
 
 static int fail_listing_layers(const exr_input *input, const char *problem, const char *excluded,
                                tool_error *error) {
-    const int views = fail_on_views(input, false, error);
+    const int views = fail_on_views(input, NULL, 0, error);
     if (views != TOOL_EXIT_SUCCESS) return views;
     char list[600] = "";
     for (int c = 0; c < input->channels->num_channels; ++c) {
@@ -187,7 +220,7 @@ int blender_find_passes(const exr_input *input, const char *requested, const cha
         /* OpenEXR's own multi-view layout names the default view's channels
          * without a view ("ViewLayer.Depth.Z" beside "ViewLayer.Depth.right.Z"):
          * refused as Blender's, not read as the default view, silently */
-        const int views = fail_on_views(input, true, error);
+        const int views = fail_on_views(input, chosen, chosen_length, error);
         if (views != TOOL_EXIT_SUCCESS) return views;
         return fill_passes(input, chosen, chosen_length, chosen, true, passes, error);
     }
