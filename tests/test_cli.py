@@ -1673,9 +1673,11 @@ def test_sequence_takes_each_frames_camera_from_a_pattern(hbao_tool, tmp_path):
 
 
 def test_a_camera_in_a_folder_with_a_hash_is_one_camera(hbao_tool, tmp_path):
-    """Only a '#' in the camera's file name makes it per frame: a camera in
-    a folder like 'shot#1' is read once, as before per-frame cameras (a
-    review found every frame failing on 'shot11/cam.json')."""
+    """A camera in a folder like 'shot#1' that exists is read once, as before
+    per-frame cameras (a review found every frame failing on
+    'shot11/cam.json'). Where no file has the path as written, a '#' run in
+    a folder is the frame, as in the input's and -o's folders: 'shot_#/cam.json'
+    was read literally and every frame failed (an exploratory run)."""
     folder = tmp_path / "shot#1"
     folder.mkdir()
     shutil.copyfile(camera_path("cycles_float_zip"), folder / "cam.json")
@@ -1686,6 +1688,21 @@ def test_a_camera_in_a_folder_with_a_hash_is_one_camera(hbao_tool, tmp_path):
     single = tmp_path / "single.exr"
     compute_ao(hbao_tool, "cycles_float_zip", single)
     assert (tmp_path / "ao_2.exr").read_bytes() == single.read_bytes()
+    name = "cycles_float_zip"
+    for frame, turn in ((1, 0), (2, 30)):
+        shot = tmp_path / f"shot_{frame}"
+        shot.mkdir()
+        shutil.copyfile(fixture_path(name), shot / "render.exr")
+        (shot / "cam.json").write_text(json.dumps(turned_camera(name, turn)))
+    run_ok(hbao_tool, tmp_path / "shot_#" / "render.exr", "-o", tmp_path / "shot_#" / "ao.exr",
+           "--frames", "1-2", "--camera", tmp_path / "shot_#" / "cam.json")
+    for frame in (1, 2):
+        single = tmp_path / f"single_{frame}.exr"
+        run_ok(hbao_tool, fixture_path(name), "-o", single, "--camera",
+               tmp_path / f"shot_{frame}" / "cam.json")
+        assert (tmp_path / f"shot_{frame}" / "ao.exr").read_bytes() == single.read_bytes()
+    assert (tmp_path / "shot_1" / "ao.exr").read_bytes() != \
+        (tmp_path / "shot_2" / "ao.exr").read_bytes()
 
 
 def test_sequence_refuses_an_output_that_is_another_frames_camera(hbao_tool, tmp_path):

@@ -113,8 +113,14 @@ static void report(sequence_run *run, const frame_outcome *outcome, const char *
  * scripts/export_cameras.py writes them); without one (a '#' in a folder's
  * name only, as before per-frame cameras), every frame has the same camera,
  * read once. */
+/* A camera file per frame (an animated camera): a '#' run in the camera
+ * file's name, or in a folder's where no file has the path as written
+ * ("shot_##/cam.json", as the input's and -o's folders are read; an existing
+ * "take #1/cam.json" is one camera for every frame). */
 static bool per_frame_camera(const cli_options *options) {
-    return options->camera_path != NULL && frame_pattern_has_frame_in_name(options->camera_path);
+    const char *path = options->camera_path;
+    if (path == NULL || !frame_pattern_has_frame(path)) return false;
+    return frame_pattern_has_frame_in_name(path) || access(path, F_OK) != 0;
 }
 
 static void run_frame(sequence_run *run, frame_outcome *outcome) {
