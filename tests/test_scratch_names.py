@@ -46,3 +46,12 @@ def test_view_files_stay_beside_the_scratch_file(tmp_path):
     assert files == {"left": path[:-4] + "_L.exr", "right": path[:-4] + "_R.exr"}
     with pytest.raises(ValueError, match="folder separator"):
         view_files.files(path, [("left", "_L"), ("right", "/../../home/artist/shot")])
+
+
+def test_a_scratch_folder_with_a_double_slash_is_absolute(monkeypatch):
+    """HBAO_TEMP_DIR=//tmp ("$ROOT/tmp" with ROOT=/) is /tmp; Blender's save
+    took "//" for a path relative to the .blend file and warned at every
+    frame (4.5 to 5.3; an exploratory run)."""
+    from hbao import scratch_files
+    monkeypatch.setenv(scratch_files.SCRATCH_FOLDER_VARIABLE, "//tmp:relative:///var/tmp")
+    assert scratch_files.folders() == ["/tmp", "relative", "/var/tmp"]
