@@ -41,8 +41,12 @@
  *   longer tell depths apart) they lose precision: the AO there is finite
  *   and in [0, 1] but not that of the geometry.
  * - Every call returns a result code; hbao_result_message() turns it into
- *   text. There is no global state: calls may run concurrently from several
- *   threads. The output is bit-identical whatever the number of threads.
+ *   text. Calls may run concurrently from several threads; the only state
+ *   kept between calls is the cache of working memory (hbao_release_memory),
+ *   which no result depends on. The output is bit-identical whatever the
+ *   number of threads (a worker thread that cannot start leaves its rows to
+ *   the others: HBAO_ERROR_THREAD, kept so that the codes keep their
+ *   numbers, is not returned).
  * - Outputs are allocated by the caller.
  */
 #ifndef HBAO_H
