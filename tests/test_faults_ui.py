@@ -98,3 +98,14 @@ def test_escape_while_the_add_on_computes_cancels_the_render(
     assert "F12: RENDERED" in log, log[-3000:]
     assert _settings(log, "AFTER") == _settings(log, "BEFORE")
     assert node_outputs(out, 1)["ao"].min() < 0.9
+
+
+def test_a_disabled_add_ons_nodes_still_draw(run_in_blender):
+    """The add-on disabled in a session keeps its node type registered while
+    a tree holds a node, so the rest of the compositing runs; drawing those
+    nodes raised AttributeError at every redraw (their status line's and
+    Connect Passes' operators were gone; a review). They draw plain labels
+    and no button now: the window redraws without a traceback."""
+    log = run_in_blender(SCRIPTS / "ui_disabled_node.py", ui=True).stdout
+    assert "DISABLED NODE: DONE" in log, log[-3000:]
+    assert "Traceback" not in log and "Error" not in log, log[-3000:]
