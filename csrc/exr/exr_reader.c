@@ -446,6 +446,16 @@ int exr_input_find_channel(const exr_input *input, const char *name) {
     return -1;
 }
 
+bool exr_input_channel_is_lossy(const exr_input *input, int channel) {
+    exr_compression_t compression = EXR_COMPRESSION_NONE;
+    if (channel < 0 || channel >= input->channels->num_channels ||
+        input->channels->entries[channel].pixel_type != EXR_PIXEL_HALF ||
+        exr_get_compression(input->context, input->channel_parts[channel], &compression) !=
+            EXR_ERR_SUCCESS)
+        return false;
+    return compression == EXR_COMPRESSION_B44 || compression == EXR_COMPRESSION_B44A;
+}
+
 static const exr_channel_request *find_request(const exr_channel_request *requests, int count,
                                                const char *name) {
     for (int r = 0; r < count; ++r)

@@ -87,6 +87,12 @@ int exr_usable_cores(void);
 /** Index of the channel called `name`, or -1. */
 int exr_input_find_channel(const exr_input *input, const char *name);
 
+/** Whether channel `channel` (an index of input->channels) is stored with
+ *  loss: half floats in a B44 or B44A part (whose 4x4 blocks keep about 6
+ *  bits of each value's difference from the block's largest; float and
+ *  uint channels it stores whole). DWAA and DWAB are refused on open. */
+bool exr_input_channel_is_lossy(const exr_input *input, int channel);
+
 void exr_input_close(exr_input *input);
 
 /** Bytes per pixel of a channel type (2 for half, 4 otherwise). */

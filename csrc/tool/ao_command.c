@@ -137,8 +137,26 @@ static int refuse_integer_pass(const exr_input *input, const char *name, const c
                      strcmp(what, "normals") == 0 ? ", or leave them out with --no-normals" : "");
 }
 
+/* A pass stored with loss (half floats with B44, as other programs write
+ * them; Blender writes Depth and Normal as float): the AO shows the codec's
+ * error in 4x4 blocks. Read all the same, with a warning per pass. */
+static void warn_lossy_pass(const exr_input *input, const char *const *names, int count) {
+    for (int c = 0; c < count; ++c)
+        if (exr_input_channel_is_lossy(input, exr_input_find_channel(input, names[c]))) {
+            tool_warn("%s: \"%s\" is stored as half floats with B44 compression, which loses "
+                      "detail in them: the AO may show 4x4 blocks; store the pass as float, or "
+                      "with a lossless compression (ZIP, PIZ)",
+                      input->path, names[c]);
+            return;
+        }
+}
+
 static int read_passes(exr_input *input, const blender_passes *passes, bool use_normals,
                        const blender_passes *back, ao_buffers *buffers, tool_error *error) {
+    const char *depth[1] = {passes->depth};
+    const char *normal[3] = {passes->normal[0], passes->normal[1], passes->normal[2]};
+    warn_lossy_pass(input, depth, 1);
+    if (use_normals) warn_lossy_pass(input, normal, 3);
     int status = refuse_integer_pass(input, passes->depth, "depths", error);
     for (int axis = 0; axis < 3 && use_normals && status == TOOL_EXIT_SUCCESS; ++axis)
         status = refuse_integer_pass(input, passes->normal[axis], "normals", error);
