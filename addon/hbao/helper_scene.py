@@ -134,6 +134,7 @@ def _configure_helper_scene(scene, helper, restructured):
         if obj not in cameras:
             helper.collection.objects.unlink(obj)
             restructured = True
+    view_cameras.drop_unused_stand_in()
     if restructured:
         compat.settle_new_scene(helper)
 
@@ -195,6 +196,7 @@ def sync(scene):
             log(f"removed the HBAO hook of {scene.name!r} (no HBAO node left)")
         if helper is not None:
             bpy.data.scenes.remove(helper)
+            view_cameras.drop_unused_stand_in()
         return []
 
     messages = pass_sources.enable_needed_passes(scene, tree)
@@ -257,6 +259,7 @@ def _sync_or_drop(scene):
     elif is_helper(scene):
         if not scenes_served_by(scene):
             bpy.data.scenes.remove(scene)
+            view_cameras.drop_unused_stand_in()
     else:
         tree = compat.compositor_tree(scene)
         if hbao_nodes(tree) or managed_node(tree) is not None:

@@ -12,6 +12,8 @@ import bpy
 
 from . import camera as camera_model
 from . import strip_cameras
+from .extra_renders import EXTRA_KEY
+from .helper_lookup import is_helper
 
 
 def rendered_views(scene):
@@ -77,16 +79,32 @@ def stand_in_camera(tree):
     """A camera for the helper of a scene without one (a scene that only
     composites other scenes' renders): Blender refuses to render a scene
     without a camera ("Cannot render, no camera"), the helper too, and that
-    cancelled the whole render. That of a scene a Render Layers node of
-    `tree` shows, else any camera of the file, else one made for it (no
-    other user: it leaves the file with the helper). Main thread only."""
-    shown = [node.scene for node in tree.nodes
-             if node.bl_idname == "CompositorNodeRLayers" and node.scene is not None]
-    for camera in [scene.camera for scene in shown] + list(bpy.data.objects):
-        if camera is not None and camera.type == "CAMERA":
-            return camera
-    return bpy.data.objects.new(STAND_IN_CAMERA_NAME,
-                                bpy.data.cameras.new(STAND_IN_CAMERA_NAME))
+    cancelled the whole render. That of an artist's scene a Render Layers
+    node of `tree` shows (not one of the add-on's scenes, whose cameras it
+    removes), else one made for it (drop_unused_stand_in removes it with
+    the helper). Main thread only."""
+    for node in tree.nodes:
+        scene = node.scene if node.bl_idname == "CompositorNodeRLayers" else None
+        if scene is not None and scene.camera is not None and not is_helper(scene) and \
+                EXTRA_KEY not in scene.keys():
+            return scene.camera
+    stand_in = bpy.data.objects.get(STAND_IN_CAMERA_NAME)
+    if stand_in is None or stand_in.type != "CAMERA":
+        stand_in = bpy.data.objects.new(STAND_IN_CAMERA_NAME,
+                                        bpy.data.cameras.new(STAND_IN_CAMERA_NAME))
+    return stand_in
+
+
+def drop_unused_stand_in():
+    """Remove the stand-in camera once no helper holds it, its camera data
+    too: an object nobody uses leaves the file, but its data stayed."""
+    stand_in = bpy.data.objects.get(STAND_IN_CAMERA_NAME)
+    if stand_in is None or stand_in.users != 0:
+        return
+    data = stand_in.data
+    bpy.data.objects.remove(stand_in)
+    if data is not None and data.users == 0:
+        bpy.data.cameras.remove(data)
 
 
 def camera_of_view(engine, scene, camera, view_name, evaluated=lambda obj: obj):

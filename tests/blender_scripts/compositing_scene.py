@@ -2,11 +2,14 @@
 """Run inside Blender by tests/test_addon.py: scenes without a camera that
 only composite, each with an HBAO node. "other_scene": scene Comp shows
 scene Shot's render (a Render Layers node of Shot) through the HBAO node;
-"no_camera_in_file": scene Plate, in a file without any camera, multiplies
-a generated image by two HBAO nodes (fed by no Render Layers node at all:
-one's Depth from the Image node, the other's through a muted link).
-Blender refused both renders ("Cannot render, no camera": the add-on's
-helper scene had no camera), cancelling them. Writes OUT/<case>.png and
+"connected": Connect Passes in Shot's own compositor;
+"image_only": scene Plate, without a camera, multiplies a generated image
+by two HBAO nodes (fed by no Render Layers node at all: one's Depth from
+the Image node, the other's through a muted link); its helper gets a camera
+made for it, not the add-on's own guard band camera of another scene, and
+that camera goes with the helper.
+Blender refused the renders of Comp and Plate ("Cannot render, no camera":
+the add-on's helper scene had no camera), cancelling them. Writes OUT/<case>.png and
 prints 'COMPOSITING <case> <json>' with the operator's result and the
 node's status.
 
@@ -24,6 +27,7 @@ import blender_scenes  # noqa: E402
 
 out_dir = sys.argv[sys.argv.index("--") + 1]
 compat = sys.modules["hbao.compat"]
+hbao_package = sys.modules["hbao"]
 SIZE = (64, 48)
 
 
@@ -80,11 +84,10 @@ print("CONNECTED", json.dumps({
       flush=True)
 render(shot, "connected")
 
-for scene in [s for s in bpy.data.scenes if s.name not in ("Comp", "Shot")]:
-    if not scene.name.startswith(".HBAO"):
-        bpy.data.scenes.remove(scene)
-for obj in [o for o in bpy.data.objects if o.type == "CAMERA"]:
-    bpy.data.objects.remove(obj)
+# Shot's node with a guard band: its hidden guard scene has a camera of the
+# add-on's own, which a helper must not borrow (it outlived the band)
+hbao.guard_band = 10.0
+hbao_package.sync()
 plate = blender_scenes.Compositor(bpy.data.scenes.new("Plate"))
 image = bpy.data.images.new("plate", *SIZE)
 image.generated_color = (0.5, 0.25, 0.125, 1.0)
@@ -100,5 +103,14 @@ muted = plate.node("CompositorNodeHBAO", (600, 0))
 plate.link(hbao.outputs["Image"], muted.inputs["Image"])
 plate.link(picture.outputs["Image"], muted.inputs["Depth"]).is_muted = True
 plate.composite(muted.outputs["Image"])
-render(plate.scene, "no_camera_in_file")
+render(plate.scene, "image_only")
+helper = next(s for s in bpy.data.scenes if s.get("hbao_main_scene") == "Plate")
+print("PLATE HELPER CAMERA", helper.camera.name, flush=True)
+# the HBAO nodes gone: the helper goes, and the camera made for it with it
+for node in [n for n in plate.tree.nodes if n.bl_idname == "CompositorNodeHBAO"]:
+    plate.tree.nodes.remove(node)
+hbao_package.sync()
+print("STAND-IN LEFT", json.dumps([item.name for item in list(bpy.data.objects)
+                                   + list(bpy.data.cameras)
+                                   if item.name.startswith(".HBAO stand-in")]), flush=True)
 print("COMPOSITING DONE", flush=True)
