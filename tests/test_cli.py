@@ -541,7 +541,9 @@ def test_a_layer_named_like_a_pass_is_no_view(hbao_tool, tmp_path):
     "BG.Depth.Depth.Z", "BG.Depth.Normal.Z") was taken for a multi-view
     render with views "Depth" and "Normal" and refused (an exploratory run):
     it is read as any layer is, and the AO is that of --layer BG.Depth; beside
-    another layer, the tool asks for --layer, listing both."""
+    another layer, the tool asks for --layer, listing both; so for names
+    with ".Depth." inside, and for Blender 3.4's single-view channels of
+    such a layer (a review)."""
     depth = np.full((16, 16), 3.0, np.float32)
     depth[4:10, 4:10] = 2.5
     normal = {f"BG.Depth.Normal.{axis}": np.full((16, 16), value, np.float32)
@@ -559,6 +561,31 @@ def test_a_layer_named_like_a_pass_is_no_view(hbao_tool, tmp_path):
                                     16, 16))
     refused = run_tool(hbao_tool, source, "-o", tmp_path / "two.exr", *flags)
     assert_clean_error(refused, EXIT_RUNTIME, "--layer NAME", '"BG.Depth", "FG"')
+    # ".Depth." inside a name: a review found "A.Depth.B" listed as views
+    inside = {f"A.Depth.B.{name[len('BG.Depth.'):]}": value for name, value in normal.items()}
+    source.write_bytes(scanline_exr({"A.Depth.B.Depth.Z": depth, "FG.Depth.Z": depth, **inside},
+                                    16, 16))
+    for extra in ((), ("--layer", "Nope")):
+        refused = run_tool(hbao_tool, source, "-o", tmp_path / "two.exr", *extra, *flags)
+        assert_clean_error(refused, EXIT_RUNTIME, '"A.Depth.B", "FG"')
+    # Blender 3.4's render with one view on ("<layer>.Depth.left.Z") of such
+    # a layer: that view of layer "BG.Depth", as of any layer
+    ao = {}
+    for layer in ("BG.Depth", "BG"):
+        view = {f"{layer}.Depth.left.Z": depth,
+                **{f"{layer}.Normal.left.{axis}": value[-1:].repeat(16, 0)
+                   for axis, value in zip("XYZ", normal.values())}}
+        source.write_bytes(scanline_exr(view, 16, 16))
+        run_ok(hbao_tool, source, "-o", tmp_path / f"view_{layer}.exr", *flags)
+        ao[layer] = exr_passes.read_channels(tmp_path / f"view_{layer}.exr", ["AO"])["AO"]
+    assert np.array_equal(ao["BG.Depth"], ao["BG"]) and np.array_equal(ao["BG"], found)
+    # OpenEXR's multi-view layout (the default view unnamed) is refused
+    # with --layer too, as without
+    source.write_bytes(scanline_exr({"ViewLayer.Depth.Z": depth,
+                                     "ViewLayer.Depth.right.Z": depth}, 16, 16))
+    refused = run_tool(hbao_tool, source, "-o", tmp_path / "views.exr", "--layer", "ViewLayer",
+                       "--no-normals")
+    assert_clean_error(refused, EXIT_RUNTIME, 'holds the views "(default)", "right"')
 
 
 @pytest.mark.matrix
@@ -1699,7 +1726,9 @@ def test_a_camera_in_a_folder_with_a_hash_is_one_camera(hbao_tool, tmp_path):
     per-frame cameras (a review found every frame failing on
     'shot11/cam.json'). Where no file has the path as written, a '#' run in
     a folder is the frame, as in the input's and -o's folders: 'shot_#/cam.json'
-    was read literally and every frame failed (an exploratory run)."""
+    was read literally and every frame failed (an exploratory run); not
+    where the path cannot be looked up (a review: 'Permission denied' became
+    a missing file of each frame)."""
     folder = tmp_path / "shot#1"
     folder.mkdir()
     shutil.copyfile(camera_path("cycles_float_zip"), folder / "cam.json")
@@ -1725,6 +1754,13 @@ def test_a_camera_in_a_folder_with_a_hash_is_one_camera(hbao_tool, tmp_path):
         assert (tmp_path / f"shot_{frame}" / "ao.exr").read_bytes() == single.read_bytes()
     assert (tmp_path / "shot_1" / "ao.exr").read_bytes() != \
         (tmp_path / "shot_2" / "ao.exr").read_bytes()
+    # a camera path that exists but cannot be looked up (here a folder that
+    # is a link to itself; for others an unreadable folder) is one camera,
+    # with the reason, not a frame pattern whose frames lack their files
+    (tmp_path / "take #1").symlink_to(tmp_path / "take #1")
+    refused = run_tool(hbao_tool, tmp_path / "in_#.exr", "-o", tmp_path / "loop_#.exr",
+                       "--frames", "1-2", "--camera", tmp_path / "take #1" / "cam.json")
+    assert_clean_error(refused, EXIT_RUNTIME, "take #1/cam.json: Too many levels of symbolic")
 
 
 def test_sequence_refuses_an_output_that_is_another_frames_camera(hbao_tool, tmp_path):
@@ -2281,6 +2317,18 @@ def test_names_from_a_file_reach_the_terminal_escaped(hbao_tool, tmp_path):
     assert escaped in warned.stderr and "\x1b" not in warned.stderr, warned.stderr
     described = json.loads(run_ok(hbao_tool, "--info", "--json", source).stdout)
     assert described["layers"] == [layer]
+    # C1 controls (U+009B, a terminal's CSI, in UTF-8) and bytes that are no
+    # UTF-8 (a raw 0x9b, CSI to an 8-bit terminal) passed (a review); a
+    # backslash is escaped too, so that no name reads as an escape; "é" stays
+    data = scanline_exr({"C1\u009b2J\\x1b\u00e9q.Depth.Z": depth}, 16, 16)
+    source.write_bytes(data.replace(b"q.Depth", b"\x9b.Depth"))
+    for arguments in (("--info", source), (source, "-o", tmp_path / "c1.exr", "--layer", "No")):
+        completed = subprocess.run([str(hbao_tool)] + [str(a) for a in arguments],
+                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                   timeout=TOOL_TIMEOUT_S)
+        output = completed.stdout + completed.stderr
+        assert b"C1\\xc2\\x9b2J\\x5cx1b\xc3\xa9\\x9b" in output, output
+        assert b"\xc2\x9b" not in output and b"\x9b." not in output, output
 
 
 def test_info_lists_layers_and_types(hbao_tool):

@@ -29,10 +29,15 @@ typedef struct tool_error {
 } tool_error;
 
 /** `text` into `out` (`size` bytes, NUL-terminated, cut before an escape
- *  that does not fit) with its control characters as \xNN: a channel or
- *  layer name from a file, or a path, with an escape sequence would drive
- *  the terminal, with a newline fake a line of the output. */
+ *  that does not fit) with its control characters (C0, DEL, C1), bytes that
+ *  are no UTF-8 and backslashes as \xNN: a channel or layer name from a
+ *  file, or a path, with an escape sequence would drive the terminal, with
+ *  a newline fake a line of the output. */
 void tool_escape(const char *text, char *out, size_t size);
+
+/** The length of the valid UTF-8 sequence at `text` (1 to 4 bytes; no
+ *  overlong forms or surrogates), or 0. */
+size_t tool_utf8_sequence(const unsigned char *text);
 
 /** printf-style: set the message and return `status` (for `return tool_fail(...)`).
  *  Messages and warnings are escaped (tool_escape). */

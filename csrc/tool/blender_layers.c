@@ -50,16 +50,40 @@ static int fill_passes(const exr_input *input, const char *layer, int layer_leng
 }
 
 /* Whether `name` is "<layer>.Depth.<view>.Z", a view's Depth pass as
- * Blender names it in a multi-view render saved as one file; the view's
- * name (its length) in *view. */
-static bool view_depth_name(const char *name, const char **view, int *view_length) {
-    const char *pass = strstr(name, ".Depth.");
-    if (pass == NULL) return false;
-    const char *start = pass + strlen(".Depth."), *end = strrchr(start, '.');
-    if (end == NULL || end == start || strcmp(end, ".Z") != 0) return false;
-    *view = start;
-    *view_length = (int)(end - start);
-    return true;
+ * Blender names it in a multi-view render saved as one file, with a view
+ * name without dots; the layer's length in *layer_length and the view's
+ * name (its length) in *view. The last such split: a layer's name may hold
+ * ".Depth." ("BG.Depth.Depth.left.Z" is view "left" of layer "BG.Depth"). */
+static bool view_depth_name(const char *name, int *layer_length, const char **view,
+                            int *view_length) {
+    static const char pass[] = ".Depth.";
+    const size_t length = strlen(name);
+    if (length < strlen(pass) + strlen("x.Z") || strcmp(name + length - 2, ".Z") != 0) return false;
+    for (const char *at = name + length - 2 - strlen(pass); at > name; --at) {
+        if (*at == '.' && at[1] != 'D') return false; /* the view would hold a dot */
+        if (strncmp(at, pass, strlen(pass)) != 0) continue;
+        const char *start = at + strlen(pass), *end = name + length - 2;
+        if (end == start || memchr(start, '.', (size_t)(end - start)) != NULL) return false;
+        *layer_length = (int)(at - name);
+        *view = start;
+        *view_length = (int)(end - start);
+        return true;
+    }
+    return false;
+}
+
+/* Whether `name` belongs to a layer that has a Depth pass of its own
+ * ("<prefix>.Depth.Z" exists for a prefix of `name` ending before a dot):
+ * "BG.Depth.Normal.Z" and "A.Depth.B.Normal.Z" are passes of layers
+ * "BG.Depth" and "A.Depth.B", not views of "BG" and "A". */
+static bool in_layer_with_depth(const exr_input *input, const char *name) {
+    for (const char *dot = strchr(name, '.'); dot != NULL; dot = strchr(dot + 1, '.')) {
+        char depth[BLENDER_CHANNEL_NAME_MAX];
+        if (set_name(depth, name, (int)(dot - name), depth_suffix) &&
+            exr_input_find_channel(input, depth) >= 0)
+            return true;
+    }
+    return false;
 }
 
 /* Whether `name` is "<layer>.Depth.<view>.Z" for the first `layer_length`
@@ -78,16 +102,6 @@ static bool layer_view_depth_name(const char *name, const char *layer, int layer
     return true;
 }
 
-/* Whether the view's Depth `name` ("BG.Depth.Normal.Z") is rather a pass of
- * a layer whose own name ends in ".Depth" (the file has "BG.Depth.Depth.Z",
- * that layer's Depth pass): no view "Normal" (nor "Depth") of layer "BG". */
-static bool in_layer_named_depth(const exr_input *input, const char *name) {
-    char depth[BLENDER_CHANNEL_NAME_MAX];
-    const int layer_length = (int)(strstr(name, ".Depth.") - name) + (int)strlen(".Depth");
-    return set_name(depth, name, layer_length, depth_suffix) &&
-           exr_input_find_channel(input, depth) >= 0;
-}
-
 /* A multi-view render saved as one file (Views Format: Multi-View): the
  * tool reads one view from one file, with that view's camera. With
  * `default_layer` (its first `layer_length` bytes), the layer whose
@@ -101,9 +115,11 @@ static int fail_on_views(const exr_input *input, const char *default_layer, int 
     for (int c = 0; c < input->channels->num_channels; ++c) {
         const char *view = NULL, *name = input->channels->entries[c].name.str;
         int length = 0;
+        int view_layer = 0;
         if (default_layer != NULL
                 ? !layer_view_depth_name(name, default_layer, layer_length, &view, &length)
-                : !view_depth_name(name, &view, &length) || in_layer_named_depth(input, name))
+                : !view_depth_name(name, &view_layer, &view, &length) ||
+                      in_layer_with_depth(input, name))
             continue;
         const size_t used = strlen(views);
         snprintf(views + used, sizeof views - used, "%s\"%.*s\"", used ? ", " : "", length, view);
@@ -124,17 +140,16 @@ static bool one_view_passes(const exr_input *input, blender_passes *passes) {
     const char *depth = NULL;
     for (int c = 0; c < input->channels->num_channels; ++c) {
         const char *view = NULL;
-        int length = 0;
+        int layer = 0, length = 0;
         const char *name = input->channels->entries[c].name.str;
-        if (!view_depth_name(name, &view, &length)) continue;
+        if (!view_depth_name(name, &layer, &view, &length)) continue;
         if (depth != NULL) return false;
         depth = name;
     }
     if (depth == NULL) return false;
     const char *view = NULL;
-    int view_length = 0;
-    view_depth_name(depth, &view, &view_length);
-    const int layer_length = (int)(strstr(depth, ".Depth.") - depth);
+    int layer_length = 0, view_length = 0;
+    view_depth_name(depth, &layer_length, &view, &view_length);
     memset(passes, 0, sizeof *passes);
     if (!set_name(passes->layer, depth, layer_length, "") ||
         !set_name(passes->depth, depth, (int)strlen(depth), ""))
@@ -194,6 +209,9 @@ int blender_find_passes(const exr_input *input, const char *requested, const cha
                      depth);
             return fail_listing_layers(input, problem, NULL, error);
         }
+        /* (OpenEXR's multi-view layout, below, named with --layer too) */
+        const int views = fail_on_views(input, requested, (int)strlen(requested), error);
+        if (views != TOOL_EXIT_SUCCESS) return views;
         return fill_passes(input, requested, (int)strlen(requested), depth, true, passes, error);
     }
     /* The one layer with a Depth pass (the back layer left out): with

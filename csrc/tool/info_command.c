@@ -78,29 +78,6 @@ static void print_text(const exr_input *input, const channel_statistics *stats, 
     }
 }
 
-/* The length of the valid UTF-8 sequence at text (1 to 4 bytes), or 0. */
-static size_t utf8_sequence(const unsigned char *text) {
-    const unsigned char lead = text[0];
-    size_t length;
-    unsigned lowest; /* the least code point of that length: no overlong forms */
-    if (lead < 0x80) return 1;
-    if (lead >= 0xC2 && lead <= 0xDF)
-        length = 2, lowest = 0x80;
-    else if (lead >= 0xE0 && lead <= 0xEF)
-        length = 3, lowest = 0x800;
-    else if (lead >= 0xF0 && lead <= 0xF4)
-        length = 4, lowest = 0x10000;
-    else
-        return 0;
-    unsigned code = lead & (0x7F >> length);
-    for (size_t k = 1; k < length; ++k) {
-        if ((text[k] & 0xC0) != 0x80) return 0; /* also stops at the terminating 0 */
-        code = (code << 6) | (text[k] & 0x3F);
-    }
-    if (code < lowest || code > 0x10FFFF || (code >= 0xD800 && code <= 0xDFFF)) return 0;
-    return length;
-}
-
 /* A JSON string of `raw` (a path or a name from the file, any bytes): JSON
  * text must be UTF-8, so each byte that is not part of a valid sequence
  * becomes U+FFFD, the replacement character. NULL when out of memory. */
@@ -110,7 +87,7 @@ static cJSON *json_string(const char *raw) {
     if (text == NULL) return NULL;
     size_t used = 0;
     while (*in != 0) {
-        const size_t length = utf8_sequence(in);
+        const size_t length = tool_utf8_sequence(in);
         if (length == 0) {
             memcpy(text + used, "\xEF\xBF\xBD", 3);
             used += 3;

@@ -2,6 +2,7 @@
 #define _DEFAULT_SOURCE /* realpath */
 #include "sequence_command.h"
 
+#include <errno.h>
 #include <limits.h>
 #include <pthread.h>
 #include <stdio.h>
@@ -28,8 +29,9 @@ typedef struct sequence_run {
     const cli_options *options;
     frame_outcome *outcomes;
     int64_t count;
-    int64_t next;     /* the next frame to start */
-    int64_t finished; /* for the progress count */
+    int64_t next;          /* the next frame to start */
+    int64_t finished;      /* for the progress count */
+    bool camera_per_frame; /* per_frame_camera */
     pthread_mutex_t lock;
 } sequence_run;
 
@@ -108,19 +110,18 @@ static void report(sequence_run *run, const frame_outcome *outcome, const char *
     pthread_mutex_unlock(&run->lock);
 }
 
-/* A --camera file name with a '#' run names each frame's own camera file,
- * as the input names its render (an animated camera:
- * scripts/export_cameras.py writes them); without one (a '#' in a folder's
- * name only, as before per-frame cameras), every frame has the same camera,
- * read once. */
-/* A camera file per frame (an animated camera): a '#' run in the camera
- * file's name, or in a folder's where no file has the path as written
- * ("shot_##/cam.json", as the input's and -o's folders are read; an existing
- * "take #1/cam.json" is one camera for every frame). */
+/* A camera file per frame (an animated camera: scripts/export_cameras.py
+ * writes them): a '#' run in the camera file's name, or in a folder's where
+ * no file has the path as written ("shot_##/cam.json", as the input's and
+ * -o's folders are read; an existing "take #1/cam.json", or one that cannot
+ * be looked up, is one camera for every frame, read once). Decided once,
+ * before any frame runs. */
 static bool per_frame_camera(const cli_options *options) {
     const char *path = options->camera_path;
     if (path == NULL || !frame_pattern_has_frame(path)) return false;
-    return frame_pattern_has_frame_in_name(path) || access(path, F_OK) != 0;
+    if (frame_pattern_has_frame_in_name(path)) return true;
+    struct stat status;
+    return stat(path, &status) != 0 && (errno == ENOENT || errno == ENOTDIR);
 }
 
 static void run_frame(sequence_run *run, frame_outcome *outcome) {
@@ -133,7 +134,7 @@ static void run_frame(sequence_run *run, frame_outcome *outcome) {
     frame.output_path = output;
     frame.preview_path = options->preview_path ? preview : NULL;
     /* a camera per frame (an animated camera): read by the frame itself */
-    const bool camera_per_frame = per_frame_camera(options);
+    const bool camera_per_frame = run->camera_per_frame;
     if (camera_per_frame) frame.camera_path = camera;
     const char *patterns[4] = {options->input_path, options->output_path, options->preview_path,
                                camera_per_frame ? options->camera_path : NULL};
@@ -315,12 +316,13 @@ static const frame_file *other_frames_file(const frame_file *files, size_t found
     return NULL;
 }
 
-static int refuse_other_frames_files(const cli_options *options, int64_t count, tool_error *error) {
+static int refuse_other_frames_files(const cli_options *options, int64_t count,
+                                     bool camera_per_frame, tool_error *error) {
     char canonical[4][PATH_MAX];
     /* the frames' input files: renders, and cameras where each has its own */
     const char *inputs[2] = {
         canonical_pattern(options->input_path, canonical[0]),
-        per_frame_camera(options) ? canonical_pattern(options->camera_path, canonical[3]) : NULL};
+        camera_per_frame ? canonical_pattern(options->camera_path, canonical[3]) : NULL};
     const char *input_names[2] = {"input", "--camera file"};
     const char *patterns[2] = {canonical_pattern(options->output_path, canonical[1]),
                                canonical_pattern(options->preview_path, canonical[2])};
@@ -376,10 +378,12 @@ done:
 }
 
 int sequence_command(const cli_options *options, tool_error *error) {
-    const int refused =
-        refuse_other_frames_files(options, frame_list_count(&options->frames), error);
+    const bool camera_per_frame = per_frame_camera(options);
+    const int refused = refuse_other_frames_files(options, frame_list_count(&options->frames),
+                                                  camera_per_frame, error);
     if (refused != TOOL_EXIT_SUCCESS) return refused;
     sequence_run run = {0};
+    run.camera_per_frame = camera_per_frame;
     run.count = frame_list_count(&options->frames);
     run.outcomes = calloc((size_t)run.count, sizeof *run.outcomes);
     if (run.outcomes == NULL) return tool_fail(error, TOOL_EXIT_RUNTIME, "out of memory");
@@ -388,7 +392,7 @@ int sequence_command(const cli_options *options, tool_error *error) {
 
     cli_options shared = *options;
     camera_settings camera_file;
-    if (options->camera_path != NULL && !per_frame_camera(options)) {
+    if (options->camera_path != NULL && !camera_per_frame) {
         camera_settings_init(&camera_file);
         const int status = camera_json_load(options->camera_path, &camera_file, error);
         if (status != TOOL_EXIT_SUCCESS) {
