@@ -32,10 +32,11 @@ def folders():
     Combined, Depth and Normal). A folder that failed (failed()) comes
     last, so later hand-overs do not fill it again first."""
     configured = os.environ.get(SCRATCH_FOLDER_VARIABLE, "")
-    # "//tmp" ("$ROOT/tmp" with ROOT=/) is /tmp, which Blender's save took
-    # for a path relative to the .blend file, with a warning every frame
-    listed = [os.sep + folder.lstrip(os.sep) if folder.startswith(os.sep) else folder
-              for folder in configured.split(os.pathsep) if folder]
+    # "//tmp" ("$ROOT/tmp" with ROOT=/) is /tmp on POSIX, which Blender's
+    # save took for a path relative to the .blend file, with a warning every
+    # frame (Windows' "\\server\share" is no such case)
+    listed = [("/" + folder.lstrip("/")) if os.name == "posix" and folder.startswith("/")
+              else folder for folder in configured.split(os.pathsep) if folder]
     if not listed:
         memory = [MEMORY_FOLDER] if os.path.isdir(MEMORY_FOLDER) and \
             os.access(MEMORY_FOLDER, os.W_OK) else []
