@@ -263,3 +263,24 @@ def test_one_version_everywhere():
     oldest = re.search(r'"blender": \((\d+), (\d+), (\d+)\)', package).groups()
     compat = (REPO / "addon" / "hbao" / "compat.py").read_text()
     assert f"MIN_SUPPORTED_VERSION = ({', '.join(oldest)})" in compat
+
+
+def test_the_camera_file_keys_are_the_ones_the_cli_reads():
+    """The add-on describes a camera (camera.camera_from_blender: the dict
+    the node computes with, and what scripts/export_cameras.py writes for
+    the CLI) with the keys csrc/tool/camera_json.c reads; the CLI ignores a
+    key it does not know, so a key renamed on one side only would leave the
+    CLI on its default, silently (an audit)."""
+    import ast
+    source = (REPO / "addon" / "hbao" / "camera.py").read_text()
+    function = next(node for node in ast.walk(ast.parse(source))
+                    if isinstance(node, ast.FunctionDef) and node.name == "camera_from_blender")
+    returned = [node.value for node in ast.walk(function)
+                if isinstance(node, ast.Return) and isinstance(node.value, ast.Dict)]
+    assert len(returned) == 1
+    written = {key.value for key in returned[0].keys}
+    reader = (REPO / "csrc" / "tool" / "camera_json.c").read_text()
+    read = set(re.findall(r'\{"(\w+)", CAMERA_FIELD_', reader))
+    read |= set(re.findall(r'read_enum\(root, "(\w+)"', reader))
+    read |= set(re.findall(r'const char \*key = "(\w+)";', reader))
+    assert written == read, (written - read, read - written)
