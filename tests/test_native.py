@@ -326,8 +326,13 @@ def test_clamping_happens_once_and_says_so(native):
 
 @pytest.mark.parametrize("params, message", [
     ({"radius": float("nan")}, "Radius is not a number"),
-    ({"steps": float("inf")}, "Steps is not a number"),
+    ({"steps": float("nan")}, "Steps is not a number"),
+    # (an infinite radius was "not a number", a negative thickness "not a
+    # valid value": an audit)
+    ({"radius": float("inf")}, "Radius is infinite"),
+    ({"steps": float("inf")}, "Steps is infinite"),
     ({"radius": -1.0}, "Radius -1 is negative"),
+    ({"thickness": -0.5}, "Thickness -0.5 is negative"),
     ({"falloff": "LINEAR"}, "falloff must be one of"),
     ({"raduis": 1.0}, "unknown HBAO parameter 'raduis'"),
 ])

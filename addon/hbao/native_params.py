@@ -26,8 +26,10 @@ def _int32(value):
     7.6), kept inside int32 so that ctypes cannot wrap it; the library's
     resolver then applies the field's limits."""
     value = float(value)
-    if value != value or value in (float("inf"), float("-inf")):
-        raise ValueError("not a number")
+    if value != value:
+        raise ValueError("is not a number")
+    if value in (float("inf"), float("-inf")):
+        raise ValueError("is infinite")  # as the library refuses it in a float field
     return int(min(max(round(value), _INT32_RANGE[0]), _INT32_RANGE[1]))
 
 
@@ -48,8 +50,8 @@ def params_struct(params):
         if dict(HBAOParams._fields_)[key] is ctypes.c_int32:
             try:
                 value = _int32(value)
-            except ValueError:
-                raise ValueError(f"{_label(key)} is not a number") from None
+            except ValueError as error:
+                raise ValueError(f"{_label(key)} {error}") from None
         else:
             # Beyond float32's range a finite value would become infinite, which
             # the library refuses: hand it the largest float instead, to clamp.
@@ -113,9 +115,11 @@ def resolve_params(params=None, warnings=None):
         problems = []
         for key in _field_names(fields.value):
             value = getattr(structure, key)
-            if value != value or value in (float("inf"), float("-inf")):
+            if value != value:
                 problems.append(f"{_label(key)} is not a number")
-            elif key == "radius":
+            elif value in (float("inf"), float("-inf")):
+                problems.append(f"{_label(key)} is infinite")
+            elif value < 0 and key in ("radius", "thickness"):
                 problems.append(f"{_label(key)} {_number(value)} is negative")
             elif key == "background_depth":
                 problems.append(f"{_label(key)} {_number(value)} is not above 0")
