@@ -109,7 +109,7 @@ def measure_scene(native, renders, scene, mode, overscans, thicknesses, backs):
     depth, normal, truth = reference["depth"], reference["normal"], reference["ao"]
     camera, radius = meta["camera"], meta["radius"]
     height, width = depth.shape
-    mask = np.isfinite(depth) & (depth > 0) & (depth < 1e9)
+    mask = metrics.foreground(depth)
     margin = int(round(width * sweep.BORDER_FRACTION))
     inner = np.zeros_like(mask)
     inner[margin:height - margin, margin:width - margin] = True

@@ -4,6 +4,13 @@ import math
 
 import numpy as np
 
+from config import SKY_DEPTH
+
+
+def foreground(depth):
+    """The pixels whose error counts: geometry, not the sky (SKY_DEPTH)."""
+    return np.isfinite(depth) & (depth > 0) & (depth < SKY_DEPTH)
+
 
 def error_stats(ao, reference, mask):
     """RMSE, mean absolute error, mean signed bias (ao - reference) and PSNR

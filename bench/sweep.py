@@ -100,7 +100,7 @@ class SceneData:
         self.depth = reference["depth"]
         self.normal = reference["normal"]
         self.truth = reference["ao"]
-        self.mask = np.isfinite(self.depth) & (self.depth > 0) & (self.depth < 1e9)
+        self.mask = metrics.foreground(self.depth)
         height, width = self.depth.shape
         margin = int(round(width * BORDER_FRACTION))
         self.inner = np.zeros_like(self.mask)
