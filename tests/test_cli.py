@@ -579,6 +579,15 @@ def test_a_layer_named_like_a_pass_is_no_view(hbao_tool, tmp_path):
         run_ok(hbao_tool, source, "-o", tmp_path / f"view_{layer}.exr", *flags)
         ao[layer] = exr_passes.read_channels(tmp_path / f"view_{layer}.exr", ["AO"])["AO"]
     assert np.array_equal(ao["BG.Depth"], ao["BG"]) and np.array_equal(ao["BG"], found)
+    # layers "BG" and "BG.Depth" side by side: "BG.Depth.Depth.Z" is no view
+    # "Depth" of BG (--layer BG was refused so; a review)
+    both = {"BG.Depth.Z": depth, "BG.Depth.Depth.Z": depth, **normal,
+            **{f"BG.Normal.{axis}": value for axis, value in zip("XYZ", normal.values())}}
+    source.write_bytes(scanline_exr(both, 16, 16))
+    for layer in ("BG", "BG.Depth"):
+        run_ok(hbao_tool, source, "-o", tmp_path / f"both_{layer}.exr", "--layer", layer, *flags)
+        assert np.array_equal(
+            exr_passes.read_channels(tmp_path / f"both_{layer}.exr", ["AO"])["AO"], found)
     # OpenEXR's multi-view layout (the default view unnamed) is refused
     # with --layer too, as without
     source.write_bytes(scanline_exr({"ViewLayer.Depth.Z": depth,

@@ -441,8 +441,19 @@ int exr_usable_cores(void) {
 }
 
 int exr_input_find_channel(const exr_input *input, const char *name) {
-    for (int c = 0; c < input->channels->num_channels; ++c)
-        if (strcmp(input->channels->entries[c].name.str, name) == 0) return c;
+    /* input->channels is sorted by strcmp, without duplicates
+     * (collect_channels): a file of 20000 channels took minutes where
+     * every view-like channel's layer was looked up (a review) */
+    int low = 0, high = input->channels->num_channels - 1;
+    while (low <= high) {
+        const int middle = low + (high - low) / 2;
+        const int order = strcmp(input->channels->entries[middle].name.str, name);
+        if (order == 0) return middle;
+        if (order < 0)
+            low = middle + 1;
+        else
+            high = middle - 1;
+    }
     return -1;
 }
 

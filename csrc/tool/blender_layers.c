@@ -72,14 +72,15 @@ static bool view_depth_name(const char *name, int *layer_length, const char **vi
     return false;
 }
 
-/* Whether `name` belongs to a layer that has a Depth pass of its own
- * ("<prefix>.Depth.Z" exists for a prefix of `name` ending before a dot):
- * "BG.Depth.Normal.Z" and "A.Depth.B.Normal.Z" are passes of layers
- * "BG.Depth" and "A.Depth.B", not views of "BG" and "A". */
-static bool in_layer_with_depth(const exr_input *input, const char *name) {
-    for (const char *dot = strchr(name, '.'); dot != NULL; dot = strchr(dot + 1, '.')) {
+/* Whether `name`, split as "<layer>.Depth.<rest>" with the layer's first
+ * `layer_length` bytes, is rather a pass of a longer layer that has a
+ * Depth pass of its own ("BG.Depth.Normal.Z" beside "BG.Depth.Depth.Z";
+ * "A.Depth.B.Depth.Z"): only prefixes from "<layer>.Depth" on. */
+static bool in_layer_with_depth(const exr_input *input, const char *name, int layer_length) {
+    for (const char *dot = name + layer_length + strlen(".Depth"); dot != NULL;
+         dot = strchr(dot + 1, '.')) {
         char depth[BLENDER_CHANNEL_NAME_MAX];
-        if (set_name(depth, name, (int)(dot - name), depth_suffix) &&
+        if (*dot == '.' && set_name(depth, name, (int)(dot - name), depth_suffix) &&
             exr_input_find_channel(input, depth) >= 0)
             return true;
     }
@@ -117,9 +118,10 @@ static int fail_on_views(const exr_input *input, const char *default_layer, int 
         int length = 0;
         int view_layer = 0;
         if (default_layer != NULL
-                ? !layer_view_depth_name(name, default_layer, layer_length, &view, &length)
+                ? !layer_view_depth_name(name, default_layer, layer_length, &view, &length) ||
+                      in_layer_with_depth(input, name, layer_length)
                 : !view_depth_name(name, &view_layer, &view, &length) ||
-                      in_layer_with_depth(input, name))
+                      in_layer_with_depth(input, name, view_layer))
             continue;
         const size_t used = strlen(views);
         snprintf(views + used, sizeof views - used, "%s\"%.*s\"", used ? ", " : "", length, view);
