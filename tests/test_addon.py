@@ -223,9 +223,10 @@ def test_compositing_scenes_and_the_sources_a_node_refuses(run_in_blender, blend
     muted = "Depth: link muted," if blender.version_tuple >= (4, 0) else "Depth not linked:"
     assert cases["image_only"]["status"] == ["Depth: wrong source, AO off", f"{muted} AO off"]
     # a camera made for the helper (not the add-on's guard band camera of
-    # Shot: it outlived the band; a review), gone with the helper
-    assert "PLATE HELPER CAMERA .HBAO stand-in camera" in log
-    assert "STAND-IN LEFT []" in log
+    # Shot: it outlived the band; nor an artist's object of its name, with a
+    # new camera at every sync: a review), gone with the helper
+    assert "PLATE HELPER CAMERA .HBAO stand-in camera.001 CAMERA" in log
+    assert "STAND-IN LEFT [\".HBAO stand-in camera\"]" in log  # the artist's
     assert ("Depth must come straight from a Render Layers node (for a saved render's EXR, use "
             "the hbao command-line tool); AO off") in log
 

@@ -331,6 +331,8 @@ def test_clamping_happens_once_and_says_so(native):
     # valid value": an audit)
     ({"radius": float("inf")}, "Radius is infinite"),
     ({"steps": float("inf")}, "Steps is infinite"),
+    ({"steps": "many"}, "Steps is not a number"),
+    ({"background_depth": float("-inf")}, "Background Depth -inf is not above 0"),
     ({"radius": -1.0}, "Radius -1 is negative"),
     ({"thickness": -0.5}, "Thickness -0.5 is negative"),
     ({"falloff": "LINEAR"}, "falloff must be one of"),

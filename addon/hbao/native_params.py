@@ -25,7 +25,10 @@ def _int32(value):
     """A whole-number field's value: the nearest integer (a Value node may feed
     7.6), kept inside int32 so that ctypes cannot wrap it; the library's
     resolver then applies the field's limits."""
-    value = float(value)
+    try:
+        value = float(value)
+    except (TypeError, ValueError):
+        raise ValueError("is not a number") from None
     if value != value:
         raise ValueError("is not a number")
     if value in (float("inf"), float("-inf")):
@@ -117,12 +120,12 @@ def resolve_params(params=None, warnings=None):
             value = getattr(structure, key)
             if value != value:
                 problems.append(f"{_label(key)} is not a number")
+            elif key == "background_depth":  # (+infinity is one: nothing is background)
+                problems.append(f"{_label(key)} {_number(value)} is not above 0")
             elif value in (float("inf"), float("-inf")):
                 problems.append(f"{_label(key)} is infinite")
             elif value < 0 and key in ("radius", "thickness"):
                 problems.append(f"{_label(key)} {_number(value)} is negative")
-            elif key == "background_depth":
-                problems.append(f"{_label(key)} {_number(value)} is not above 0")
             else:
                 problems.append(f"{_label(key)} {_number(value)} is not a valid value")
         if not problems:

@@ -71,8 +71,12 @@ def render_cameras(scenes):
     return unique
 
 
-# The camera a helper renders through where its main scene has none.
+# The camera a helper renders through where its main scene has none, and
+# the ID property that marks it as the add-on's (an artist's object may have
+# the name: then it was taken for the stand-in, and a new one made at every
+# sync; a review).
 STAND_IN_CAMERA_NAME = ".HBAO stand-in camera"
+STAND_IN_KEY = "hbao_stand_in"
 
 
 def stand_in_camera(tree):
@@ -88,17 +92,29 @@ def stand_in_camera(tree):
         if scene is not None and scene.camera is not None and not is_helper(scene) and \
                 EXTRA_KEY not in scene.keys():
             return scene.camera
-    stand_in = bpy.data.objects.get(STAND_IN_CAMERA_NAME)
-    if stand_in is None or stand_in.type != "CAMERA":
+    stand_in = _stand_in()
+    if stand_in is None:
         stand_in = bpy.data.objects.new(STAND_IN_CAMERA_NAME,
                                         bpy.data.cameras.new(STAND_IN_CAMERA_NAME))
+        stand_in[STAND_IN_KEY] = True
     return stand_in
+
+
+def _stand_in():
+    """The add-on's stand-in camera object of this file, or None."""
+    def ours(obj):
+        return obj is not None and obj.library is None and obj.type == "CAMERA" and \
+            bool(obj.get(STAND_IN_KEY))
+    named = bpy.data.objects.get(STAND_IN_CAMERA_NAME)
+    if ours(named) or named is None:
+        return named
+    return next((obj for obj in bpy.data.objects if ours(obj)), None)
 
 
 def drop_unused_stand_in():
     """Remove the stand-in camera once no helper holds it, its camera data
     too: an object nobody uses leaves the file, but its data stayed."""
-    stand_in = bpy.data.objects.get(STAND_IN_CAMERA_NAME)
+    stand_in = _stand_in()
     if stand_in is None or stand_in.users != 0:
         return
     data = stand_in.data
