@@ -20,9 +20,9 @@ from hbao.viewport import shader_sources  # noqa: E402
 HEADER = (REPO / "csrc" / "include" / "hbao.h").read_text()
 LIBRARY_SOURCES = {path.name: path.read_text()
                    for path in sorted((REPO / "csrc" / "lib").glob("*.c"))}
-# Header limits with no Python copy: the binding passes threads and image
-# sizes through, and the library checks them itself.
-UNMIRRORED_MAXIMA = {"THREADS", "IMAGE_SIZE"}
+# Header limits with no Python copy: the binding passes threads through, and
+# the library checks them itself.
+UNMIRRORED_MAXIMA = {"THREADS"}
 # Blender's names for the header's enumerators where they differ.
 BLENDER_ENUMERATOR_NAMES = {"PERSPECTIVE": "PERSP", "ORTHOGRAPHIC": "ORTHO"}
 PYTHON_ENUMS = {

@@ -14,6 +14,8 @@ import math
 
 import numpy as np
 
+from .parameters import MAX_IMAGE_SIZE
+
 # The widest band the node offers, as a fraction of the frame's width (and
 # height) on each side; the guard render then covers 1 + 2 x this.
 MAX_GUARD_BAND = 0.25
@@ -27,9 +29,15 @@ def guard_scale(fraction):
 
 def band_pixels(width, height, fraction):
     """(columns, rows) of the band on each side of a width x height frame;
-    whole pixels inside what the guard render covers."""
+    whole pixels inside what the guard render covers, and no more than keeps
+    the frame with its bands within the library's largest image (a frame
+    43692 pixels wide with a 25 % band lost its whole AO to the library's
+    size check; an exploratory run)."""
     fraction = min(max(float(fraction), 0.0), MAX_GUARD_BAND)
-    return int(math.floor(fraction * width)), int(math.floor(fraction * height))
+
+    def side(size):
+        return max(0, min(int(math.floor(fraction * size)), (MAX_IMAGE_SIZE - size) // 2))
+    return side(width), side(height)
 
 
 def widened_camera(values, scale):

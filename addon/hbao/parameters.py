@@ -31,6 +31,7 @@ MAX_BLUR_SIZE = 65
 MAX_BLUR_SHARPNESS = 1000.0
 MAX_ANGLE_BIAS_DEGREES = 60.0
 MAX_STRENGTH = 16.0
+MAX_IMAGE_SIZE = 65536
 
 # The header's enums by the names Blender uses for them: hbao_falloff,
 # hbao_integration, hbao_projection (Camera.type), hbao_sensor_fit
