@@ -20,21 +20,9 @@ sys.path.insert(0, os.path.join(REPO, "scripts"))
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import blender_scenes  # noqa: E402
 import timer_guard  # noqa: E402
+from ui_areas import node_editor, override  # noqa: E402
 
 state = {"tick": 0}
-
-
-def node_editor(window):
-    area = max(window.screen.areas, key=lambda a: a.width * a.height)
-    area.type = "NODE_EDITOR"
-    area.ui_type = "CompositorNodeTree"
-    return area
-
-
-def override(window, area):
-    region = [r for r in area.regions if r.type == "WINDOW"][-1]
-    return bpy.context.temp_override(window=window, screen=window.screen, area=area,
-                                     region=region)
 
 
 def tick():

@@ -26,6 +26,7 @@ import bpy
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import timer_guard  # noqa: E402
+from ui_areas import node_editor, override  # noqa: E402
 
 args = sys.argv[sys.argv.index("--") + 1:]
 OUT, SHOTS = Path(args[0]), Path(args[1])
@@ -73,19 +74,6 @@ def upgrade_report():
         "blur_at_11": socket_values.socket_value(tree, blur, 11.0, []),
         "blur_at_1": socket_values.socket_value(tree, blur, 1.0, []),
     }
-
-
-def node_editor(window):
-    area = max(window.screen.areas, key=lambda a: a.width * a.height)
-    area.type = "NODE_EDITOR"
-    area.ui_type = "CompositorNodeTree"
-    return area
-
-
-def override(window, area):
-    region = next(r for r in area.regions if r.type == "WINDOW")
-    return bpy.context.temp_override(window=window, screen=window.screen, area=area,
-                                     region=region)
 
 
 def menu_report(window, area):
