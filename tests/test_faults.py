@@ -254,6 +254,75 @@ def test_two_scenes_sharing_one_compositing_group(run_in_blender, tmp_path, nati
     assert np.abs(ao - expected).max() <= EXACT
 
 
+@pytest.mark.min_blender(5, 3)
+def test_another_compositor_effect_after_the_hbao_one(run_in_blender, tmp_path, native,
+                                                      no_leftovers):
+    """5.3 composites a stack of effects; Add Effect makes the new one active,
+    and the add-on, which served the active effect's group, left the HBAO
+    node unserved: a black frame (AO 0) with a wrong message. It serves the
+    effect that holds the HBAO node."""
+    node = {"radius": 0.8, "blur_size": 0}
+    out, log = render(run_in_blender, tmp_path, {"prepare": ["sync", "second_effect"],
+                                                 "nodes": [node]})
+    assert 'EFFECTS [["Scene Effect", false], ["Second", true]]' in log, log[-3000:]
+    assert "without AO" not in log and "renders nothing" not in log, log[-3000:]
+    expected = library_ao(native, out, 1, node_params(**node))
+    assert np.abs(node_outputs(out, 1)["ao"] - expected).max() <= EXACT
+
+
+@pytest.mark.min_blender(5, 3)
+def test_an_hbao_node_in_a_second_compositor_effect_says_why_it_gives_no_ao(
+        run_in_blender, tmp_path, native, no_leftovers):
+    node = {"radius": 0.8, "blur_size": 0}
+    out, log = render(run_in_blender, tmp_path, {
+        "prepare": ["sync", "second_effect_with_a_node"], "nodes": [node]})
+    said = ('HBAO: node "HBAO in the second effect" in compositor effect "Second": HBAO works '
+            'in one compositor effect of a scene, the first whose node group holds an HBAO node '
+            '("Scene Effect")')
+    assert log.count(said) == 1, log[-3000:]
+    expected = library_ao(native, out, 1, node_params(**node))
+    assert np.abs(node_outputs(out, 1)["ao"] - expected).max() <= EXACT
+
+
+@pytest.mark.min_blender(5, 3)
+def test_the_compositing_group_inside_another_group_passes_the_image_through(
+        run_in_blender, tmp_path, no_leftovers):
+    """5.3 renders the helper scene through the Render Layers node of a
+    nested group, which the hook does not serve: its passes read 0, the
+    frame came out black while the report said the AO was white. The
+    helper's engine writes 1 there."""
+    out, log = render(run_in_blender, tmp_path, {"prepare": ["sync", "wrap_compositing_group"],
+                                                 "nodes": [{"radius": 1.0}]})
+    assert 'in node group "Scene Compositing": HBAO works only at the top' in log, log[-3000:]
+    assert "HBAO: HBAO:" not in log
+    assert_no_ao_and_image_unchanged(out)
+
+
+@pytest.mark.min_blender(5, 3)
+def test_the_hbao_effect_off_for_renders_says_that_the_render_has_no_ao(
+        run_in_blender, tmp_path, no_leftovers):
+    out, log = render(run_in_blender, tmp_path, {"prepare": ["effect_off_for_render"],
+                                                 "nodes": [{"radius": 1.0}]})
+    assert log.count('HBAO: The compositor effect "Scene Effect" is off for renders') == 1, \
+        log[-3000:]
+    assert status_lines(log) == {"HBAO0": "Effect off for renders: no AO"}, log[-3000:]
+    assert (out / "frame_0001.exr").exists() and not (out / "nodes_0001.exr").exists()
+
+
+@pytest.mark.min_blender(4, 2)
+def test_the_add_on_scenes_set_to_the_gpu_compositor(run_in_blender, tmp_path, native,
+                                                     no_leftovers):
+    """4.5 and 5.0 crash (segmentation fault, Blender's own) rendering a
+    scene whose compositor renders another scene set to the GPU compositor,
+    as a script that sets every scene's device makes the add-on's: they are
+    kept on the CPU. With the guard band's and back faces' scenes too."""
+    node = {"radius": 0.8, "blur_size": 0, "guard_band": True, "back_faces": True}
+    out, log = render(run_in_blender, tmp_path, {"prepare": ["sync", "add_on_scenes_on_gpu"],
+                                                 "nodes": [node]})
+    assert "without AO" not in log, log[-3000:]
+    assert node_outputs(out, 1)["ao"].min() < 0.9
+
+
 @pytest.mark.parametrize("beside", [False, True], ids=["alone", "beside_a_top_level_node"])
 def test_hbao_node_inside_a_node_group_says_why_it_gives_no_ao(run_in_blender, tmp_path, native,
                                                                no_leftovers, beside):

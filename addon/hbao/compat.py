@@ -4,6 +4,8 @@ import sys
 
 import bpy
 
+from . import compositor_effects
+
 VERSION = bpy.app.version
 # The oldest Blender the add-on runs on (its bl_info says the same), and the
 # newest it has been tested with; a newer one is tried, with a warning.
@@ -140,30 +142,22 @@ def settle_new_scene(scene):
 
 
 def compositor_tree(scene):
-    """The scene's compositor node tree, or None."""
+    """The scene's compositor node tree the add-on serves, or None."""
     if HAS_COMPOSITING_NODE_GROUP:
-        return getattr(scene, "compositing_node_group", None)
+        return compositor_effects.served_group(scene)
     return scene.node_tree
 
 
 def ensure_compositor_tree(scene):
     """The scene's compositor tree, created (with compositing turned on) if needed."""
     if HAS_COMPOSITING_NODE_GROUP:
-        tree = scene.compositing_node_group
+        tree = compositor_tree(scene)
         if tree is None:
             tree = bpy.data.node_groups.new(f"{scene.name} Compositing", "CompositorNodeTree")
             scene.compositing_node_group = tree
         return tree
     scene.use_nodes = True
     return scene.node_tree
-
-
-def scene_of_tree(tree):
-    """The scene whose compositor tree is `tree`, or None."""
-    for scene in bpy.data.scenes:
-        if compositor_tree(scene) == tree:
-            return scene
-    return None
 
 
 def new_group_socket(tree, in_out, socket_type, name, subtype=None):

@@ -118,11 +118,11 @@ def _report_failure(engine, message):
 
 # What an artist who renders the helper scene itself (made it the active
 # scene) is told.
-HELPER_NOT_FOR_RENDERING = ("HBAO: \"{helper}\" is the HBAO add-on's helper scene and "
+HELPER_NOT_FOR_RENDERING = ("\"{helper}\" is the HBAO add-on's helper scene and "
                             "renders nothing by itself. Switch back to scene \"{main}\" and "
                             "render that.")
 # What an artist who picked this engine for a scene of their own is told.
-NOT_FOR_RENDERING = ("HBAO: \"{label}\" is the HBAO add-on's internal engine and renders "
+NOT_FOR_RENDERING = ("\"{label}\" is the HBAO add-on's internal engine and renders "
                      "nothing. Choose Cycles or EEVEE as the Render Engine (Render Properties), "
                      "and add the HBAO node in the Compositor.")
 
@@ -164,8 +164,16 @@ def render_helper(engine, depsgraph):
         message = (HELPER_NOT_FOR_RENDERING.format(helper=scene.name, main=main.name)
                    if main is not None
                    else NOT_FOR_RENDERING.format(label=HBAOPassEngine.bl_label))
-        log(message)
-        _report(engine, message)
+        _report_failure(engine, message)
+        # Its passes say "no AO" (1), not the zeros an unwritten result
+        # holds: a compositor that renders this scene through a Render Layers
+        # node the hook does not serve (5.3: in a nested group) multiplied
+        # its image by 0, a black frame.
+        result = engine.begin_result(0, 0, engine.resolution_x, engine.resolution_y)
+        try:
+            _fill_passes(result, {}, result.resolution_x, result.resolution_y)
+        finally:
+            engine.end_result(result)
         return
     start = time.perf_counter()
     engine.hbao_timings = {}

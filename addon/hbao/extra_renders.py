@@ -15,8 +15,8 @@ before the helper's: when the helper's engine runs, their Render Results
 hold this frame's passes (docs/blender-integration.md)."""
 import bpy
 
-from . import back_material, camera_time, compat, guard_camera, guard_geometry, strip_cameras, \
-    writes
+from . import back_material, camera_time, compat, guard_camera, guard_geometry, \
+    helper_render_settings, strip_cameras, writes
 from .camera import CameraError
 from .data_edits import set_if_different
 from .report import log
@@ -252,6 +252,7 @@ def record_rendering(main, helper):
         scene = scene_of(helper, kind)
         if scene is not None:
             set_if_different(scene.view_layers[0], "use", wanted)
+            helper_render_settings.keep_compositor_on_cpu(scene)
     guard = scene_of(helper, GUARD)
     if guard is not None:
         guard_camera.copy_settings(main, guard, guard.get(SCALE_KEY, 1.0))

@@ -86,14 +86,17 @@ def _on_render_init(scene, *_args):
     if not helper_lookup.is_helper(scene):
         tree = compat.compositor_tree(scene)
         # (the console's text, the report's: a node's reads "HBAO node ...")
-        messages = [(text, f"HBAO {text}") for text in (
+        messages = [(text, f"HBAO {text}") for text in [
             node_place.grouped_message(group, grouped)
-            for group, grouped in node_place.nodes_in_groups(tree, node.is_hbao_node))]
+            for group, grouped in node_place.nodes_in_groups(tree, node.is_hbao_node)]
+            + node_place.other_effect_messages(scene)]
         nodes = node.hbao_nodes(tree)
         settings = helper_render_settings
         off = None
         if nodes and not settings.compositor_runs(scene):
             off = (settings.COMPOSITING_OFF_DETAIL, settings.COMPOSITING_OFF_SHORT)
+        elif nodes and settings.effect_off_detail(scene) is not None:
+            off = (settings.effect_off_detail(scene), settings.EFFECT_OFF_SHORT)
         elif nodes and not settings.helper_renders(scene):
             off = (settings.SINGLE_LAYER_DETAIL, settings.SINGLE_LAYER_SHORT)
         if off is not None:

@@ -5,7 +5,7 @@ views. The compositor reads each view's AO pass from the helper, and the
 helper has a view's pass only where it has the view: with one view, a
 stereo render read 0 in both (a black frame); without Multi-View's own
 views (besides left and right), those views were black."""
-from . import compat
+from . import compat, compositor_effects
 from .data_edits import set_if_different
 
 SYNCED_RENDER_SETTINGS = (
@@ -35,6 +35,20 @@ COMPOSITING_OFF_DETAIL = ("Compositing is off (Output properties > Post Processi
 COMPOSITING_OFF_SHORT = "Compositing off: no AO"
 
 
+# 5.3: the compositor effect that holds the HBAO nodes switched off for
+# renders: Blender runs the others, not it.
+EFFECT_OFF_DETAIL = ("The compositor effect \"{effect}\" is off for renders (its Enable for "
+                     "Render): Blender runs no HBAO node of it and writes the render without AO. "
+                     "Turn it on for AO")
+EFFECT_OFF_SHORT = "Effect off for renders: no AO"
+
+
+def effect_off_detail(scene):
+    """EFFECT_OFF_DETAIL for `scene`'s effect where it is off, or None."""
+    effect = compositor_effects.off_for_renders(scene)
+    return EFFECT_OFF_DETAIL.format(effect=effect.name) if effect is not None else None
+
+
 def compositor_runs(scene):
     """Whether a render of `scene` runs its compositor."""
     return scene.render.use_compositing and (compat.HAS_COMPOSITING_NODE_GROUP
@@ -46,8 +60,19 @@ def helper_renders(scene):
     return not scene.render.use_single_layer
 
 
+def keep_compositor_on_cpu(own_scene):
+    """4.5 and 5.0 crash (segmentation fault, without the add-on too) rendering
+    a scene that a compositor's Render Layers node renders where that scene's
+    own compositor is set to the GPU (`compositor_device`, which a pipeline
+    script may set on every scene). The add-on's scenes composite nothing:
+    theirs stays on the CPU."""
+    if hasattr(own_scene.render, "compositor_device"):
+        set_if_different(own_scene.render, "compositor_device", "CPU")
+
+
 def copy(scene, helper):
     """Only plain values: allowed in the render job's thread too."""
+    keep_compositor_on_cpu(helper)
     for attribute in SYNCED_RENDER_SETTINGS:
         set_if_different(helper.render, attribute, getattr(scene.render, attribute))
     for view in scene.render.views:

@@ -11,12 +11,12 @@ import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 
 from . import compat, guard_geometry, node_lines, node_place, parameters, report, writes
+from .compositor_effects import NODE_IDNAME
 from .node_group import (AO_OUTPUT, AO_PASS_INPUT, DEPTH_INPUT, GROUP_TREE_NAME,  # noqa: F401
                          IMAGE_INPUT, IMAGE_OUTPUT, NORMAL_INPUT, VALUE_INPUTS,
                          adopt_group_copies, group_tree, upgrade_group_tree)
 from .parameters import FALLOFF_ITEMS, INTEGRATION_ITEMS
 
-NODE_IDNAME = "CompositorNodeHBAO"
 _D = parameters.DEFAULTS
 # Called with no arguments when an HBAO node is added, copied or deleted
 # (the hook's handlers subscribe: node callbacks must not edit the tree).
@@ -136,8 +136,9 @@ class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
         _announce_change()
 
     def draw_buttons(self, context, layout):
-        if not node_place.at_top_level(self):
-            node_lines.draw(layout, node_place.GROUPED_SHORT, node_place.GROUPED_DETAILS, "ERROR")
+        misplaced = node_place.misplaced(self)
+        if misplaced is not None:
+            node_lines.draw(layout, *misplaced, "ERROR")
         elif not self.inputs[DEPTH_INPUT].is_linked:
             # Render Layers shows no Depth output until the pass is ticked.
             # (the add-on disabled, its node type kept: no operator to offer)

@@ -44,8 +44,12 @@ disable_depth_pass, output_format (the main output's file format, default OPEN_E
 prepare [actions before rendering: sync, compositing_off, delete_helper, delete_extra_renders,
 rename_helper, pick_internal_engine, render_the_helper, rename_node, second_scene_shares_the_tree,
 group_last_node (the last HBAO node moved into a node group of the artist's), layer_not_rendered,
-mute_render_layers, switch_to_workbench], render_threads ({frame: the Performance panel's threads,
-0 for Auto}), layer_name (the first view layer's), single_layer (Render Single Layer on),
+mute_render_layers, switch_to_workbench; 5.3's compositor effects: second_effect (a pass-through
+effect added after the HBAO one, and so active), second_effect_with_a_node (one holding an HBAO
+node), wrap_compositing_group (the scene's group used through a Group node of a new group, the
+effect's now), effect_off_for_render; add_on_scenes_on_gpu (every scene's compositor_device GPU)],
+render_threads ({frame: the Performance panel's threads, 0 for Auto}), layer_name (the first view
+layer's), single_layer (Render Single Layer on),
 user_handlers (a pipeline's own render and frame change handlers, which print USER HANDLERS {json}:
 the scenes each list's handler saw, in order; render_stats leaves out repeats of the scene before).
 Prints OUTPUT SETTINGS {json} (the main output's settings after the renders), STATUS {json} (each
@@ -345,6 +349,36 @@ for action in spec.get("prepare", []):
     elif action == "mute_render_layers":
         for source in render_layers.values():
             source.mute = True
+    elif action in ("second_effect", "second_effect_with_a_node"):
+        # 5.3: Add Effect after the HBAO one, which makes the new one active:
+        # its group passes the image through, or holds an HBAO node of its own
+        compat = blender_scenes.compat
+        group = bpy.data.node_groups.new("Second Effect", "CompositorNodeTree")
+        compat.new_group_socket(group, "INPUT", "NodeSocketColor", "Image")
+        compat.new_group_socket(group, "OUTPUT", "NodeSocketColor", "Image")
+        group_in, group_out = group.nodes.new("NodeGroupInput"), group.nodes.new("NodeGroupOutput")
+        image = group_in.outputs["Image"]
+        if action == "second_effect_with_a_node":
+            inside = group.nodes.new("CompositorNodeHBAO")
+            inside.name = "HBAO in the second effect"
+            group.links.new(image, inside.inputs["Image"])
+            image = inside.outputs["Image"]
+        group.links.new(image, group_out.inputs["Image"])
+        scene.compositor_effects.new(name="Second").node_group = group
+        print("EFFECTS", json.dumps([[e.name, e.is_active] for e in scene.compositor_effects]),
+              flush=True)
+    elif action == "wrap_compositing_group":  # 5.3: the scene's group used through a Group node
+        wrapper = bpy.data.node_groups.new("Wrapper", "CompositorNodeTree")
+        blender_scenes.compat.new_group_socket(wrapper, "OUTPUT", "NodeSocketColor", "Image")
+        holder = wrapper.nodes.new("CompositorNodeGroup")
+        holder.node_tree = tree
+        wrapper.links.new(holder.outputs["Image"], wrapper.nodes.new("NodeGroupOutput").inputs[0])
+        scene.compositor_effects[0].node_group = wrapper
+    elif action == "effect_off_for_render":  # 5.3: the HBAO effect's Enable for Render off
+        scene.compositor_effects[0].enable_for_render = False
+    elif action == "add_on_scenes_on_gpu":  # a script that sets every scene's compositor device
+        for each in bpy.data.scenes:
+            each.render.compositor_device = "GPU"
     elif action == "second_scene_shares_the_tree":  # 5.0+: one node group, two scenes
         other = scene.copy()
         other.name = "Second"

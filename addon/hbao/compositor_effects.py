@@ -1,0 +1,57 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Which node group of a scene's compositor the add-on serves. Blender 5.3
+composites a stack of effects (`scene.compositor_effects`), each a node
+group run on the one before's image; `scene.compositing_node_group` is the
+active effect's group only (and deprecated). The add-on serves one group a
+scene: the first effect's whose group holds an HBAO node at its top level,
+else the active effect's (where a new node goes). Measured in bpy 5.3: with
+the active one served, adding a second effect after the HBAO one (Add
+Effect makes it active) left the HBAO node unserved and its render black.
+Reads only the scene given: no bpy import."""
+
+# The HBAO node's type name (node.py registers the node): here, below every
+# module that looks for HBAO nodes.
+NODE_IDNAME = "CompositorNodeHBAO"
+
+
+def holds_hbao_node(tree):
+    """Whether node tree `tree` (or None) has an HBAO node at its top level."""
+    return tree is not None and any(node.bl_idname == NODE_IDNAME for node in tree.nodes)
+
+
+def served_effect(scene):
+    """The effect of 5.3's stack whose group the add-on serves, or None:
+    none there, or a Blender without the stack."""
+    effects = getattr(scene, "compositor_effects", None)
+    if effects is None:
+        return None
+    for effect in effects:
+        if holds_hbao_node(effect.node_group):
+            return effect
+    return effects.active
+
+
+def served_group(scene):
+    """The compositing node group of `scene` (5.0 and later) that the add-on
+    serves, or None."""
+    if getattr(scene, "compositor_effects", None) is None:
+        return getattr(scene, "compositing_node_group", None)
+    effect = served_effect(scene)
+    return effect.node_group if effect is not None else None
+
+
+def other_effect_holding(scene, tree):
+    """The effect of `scene`'s stack whose group is `tree` where the add-on
+    serves another one, or None."""
+    served = served_group(scene)
+    for effect in getattr(scene, "compositor_effects", ()):
+        if effect.node_group == tree and tree != served:
+            return effect
+    return None
+
+
+def off_for_renders(scene):
+    """The served effect where it is switched off for renders (5.3's
+    Enable for Render), or None."""
+    effect = served_effect(scene)
+    return effect if effect is not None and not effect.enable_for_render else None
