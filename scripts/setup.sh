@@ -31,6 +31,7 @@ PACKAGES=(
     xdotool            # tests/test_faults_ui.py: a real Escape key press during F12
     time               # scripts/soak.sh: GNU time's peak memory of each run
     binutils           # readelf: tests/test_cli.py checks where the tool finds libhbao
+    locales            # localedef's sources: tests/test_faults.py makes an ISO-8859-1 locale
 )
 
 missing=()

@@ -2165,6 +2165,7 @@ def test_a_frame_pattern_without_frames_gets_a_hint(hbao_tool, tmp_path):
 
 @pytest.mark.parametrize("arguments, fragment", [
     (["--radius", "nan"], "--radius"),
+    (["--radius", "0,5"], '--radius: "0,5" is not a finite number (use a decimal point)'),
     (["--radius", "inf"], "--radius"),
     (["--radius", "1e999"], "--radius"),
     (["--radius", "-1"], "--radius"),

@@ -57,7 +57,7 @@ def register():
         if not compat.version_is_new_enough():
             return  # the message says why; a traceback would not
     from . import (engine, engine_guard, handlers, node, node_setup, recomposite,
-                   render_record, render_reports, writes)
+                   render_record, render_reports, report, writes)
     for module in (writes, node, node_setup, render_record, recomposite, engine, engine_guard,
                    render_reports, handlers):
         module.register()
@@ -67,14 +67,14 @@ def register():
         viewport.register()
         _registered.append(viewport)
     except Exception as error:  # the compositor node works without the preview
-        print(f"HBAO: the viewport preview could not be registered: {error}")
+        report.log(f"the viewport preview could not be registered: {error}")
     if not isinstance(bpy.data, bpy.types.BlendData):
         return  # add-on enabled at startup: load_post syncs once a file is open
     sync()
 
 
 def unregister():
-    from . import hook_release, preferences
+    from . import hook_release, preferences, report
     if _registered:  # enabled for this Blender: a hook to let go of
         hook_release.release_all()
     while _registered:
@@ -82,5 +82,5 @@ def unregister():
         try:
             module.unregister()
         except Exception as error:  # unregister the rest whatever one of them did
-            print(f"HBAO: {module.__name__} could not be unregistered: {error}")
+            report.log(f"{module.__name__} could not be unregistered: {error}")
     preferences.unregister()

@@ -78,7 +78,11 @@ def save_passes(scene, path, views=None):
         # a file per view (3.4 and 4.5 refuse a mono save as Stereo 3D side by side)
         settings.views_format = "INDIVIDUAL"
         try:  # the Render Result of the scene given, not only its settings
-            image.save_render(path, scene=scene)
+            # Blender writes a str path as UTF-8 (surrogates: as os.fsencode
+            # does); Python's os and libhbao_exr use os.fsencode: give
+            # Blender the str that names the same bytes.
+            image.save_render(os.fsencode(path).decode("utf-8", "surrogateescape"),
+                              scene=scene)
         except RuntimeError as error:  # Blender's message names neither folder nor cause,
             # and 3.4 to 5.3 say that a multi-view save failed after writing every view
             if view_files.saved(path, views):

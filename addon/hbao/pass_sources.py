@@ -89,7 +89,8 @@ def pass_source(socket, scene, expected):
         return node.layer, None, None
     if view is None:
         why = (f"Blender before 5.0 cuts channel names at {compat.EXR_CHANNEL_NAME_MAX} bytes; "
-               f"rename the layer to at most {longest}")
+               f"rename the layer to at most {longest} bytes (it has "
+               f"{len(node.layer.encode())})")
     else:
         rename = (f"the layer to at most {longest} bytes, or the view" if longest > 0 else
                   "the view")

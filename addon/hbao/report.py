@@ -3,6 +3,7 @@
 messages about a node that read well after Blender's "HBAO " report prefix
 and carry a short form for the node's status line, and whether the caller
 may change Blender data (only the main thread may)."""
+import sys
 import threading
 
 LOG_PREFIX = "HBAO:"
@@ -39,7 +40,20 @@ def take_render_reports():
 
 
 def log(message):
-    print(f"{LOG_PREFIX} {message}", flush=True)
+    """Print `message` to the console; never raises (a console that cannot
+    show a name's characters, as a non-UTF-8 locale's under bpy, or a
+    closed pipe, must not cost the render its AO)."""
+    text = f"{LOG_PREFIX} {message}"
+    try:
+        print(text, flush=True)
+    except UnicodeEncodeError:
+        encoding = getattr(sys.stdout, "encoding", None) or "ascii"
+        try:
+            print(text.encode(encoding, "backslashreplace").decode(encoding), flush=True)
+        except (OSError, ValueError):
+            pass
+    except (OSError, ValueError):  # a closed or broken stdout
+        pass
 
 
 def in_main_thread():

@@ -148,7 +148,8 @@ static int parse_float_flag(const char *flag, const char *text, float minimum, f
                             bool positive, float *out, tool_error *error) {
     float value;
     if (!parse_finite_float(text, &value))
-        return tool_fail(error, TOOL_EXIT_USAGE, "--%s: \"%s\" is not a finite number", flag, text);
+        return tool_fail(error, TOOL_EXIT_USAGE, "--%s: \"%s\" is not a finite number%s", flag,
+                         text, strchr(text, ',') != NULL ? " (use a decimal point)" : "");
     if (positive && !(value > 0.0f))
         return tool_fail(error, TOOL_EXIT_USAGE, "--%s: must be > 0 (got %s)", flag, text);
     if (value < minimum || value > maximum)

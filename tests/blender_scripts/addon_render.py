@@ -49,7 +49,7 @@ effect added after the HBAO one, and so active), second_effect_with_a_node (one 
 node), wrap_compositing_group (the scene's group used through a Group node of a new group, the
 effect's now), effect_off_for_render; add_on_scenes_on_gpu (every scene's compositor_device GPU)],
 render_threads ({frame: the Performance panel's threads, 0 for Auto}), layer_name (the first view
-layer's), single_layer (Render Single Layer on),
+layer's), scene_name, single_layer (Render Single Layer on),
 user_handlers (a pipeline's own render and frame change handlers, which print USER HANDLERS {json}:
 the scenes each list's handler saw, in order; render_stats leaves out repeats of the scene before).
 Prints OUTPUT SETTINGS {json} (the main output's settings after the renders), STATUS {json} (each
@@ -210,6 +210,8 @@ if spec.get("sequencer"):
 
 if spec.get("layer_name"):  # the first view layer renamed
     scene.view_layers[0].name = spec["layer_name"]
+if spec.get("scene_name"):
+    scene.name = spec["scene_name"]
 if spec.get("single_layer"):  # Render Single Layer (View Layer properties)
     scene.render.use_single_layer = True
 

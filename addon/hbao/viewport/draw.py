@@ -11,6 +11,7 @@ import bpy
 import gpu
 from bpy.app.handlers import persistent
 
+from ..report import log
 from . import pipeline, projection, settings
 
 SHADINGS = {"SOLID", "MATERIAL"}
@@ -96,7 +97,7 @@ def _draw():
                     region.tag_redraw()
         if message not in _reported_errors:
             _reported_errors.add(message)
-            print(f"HBAO viewport preview failed: {type(error).__name__}: {message}")
+            log(f"viewport preview failed: {type(error).__name__}: {message}")
 
 
 def _forget_closed_views(window_manager):
