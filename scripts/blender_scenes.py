@@ -71,10 +71,16 @@ def _collection(scene, name):
     return collection
 
 
+def _node_of_type(tree, idname):
+    """The first node of type `idname`: by name, Blender's Translate New Data
+    (a preference) would miss the default "Principled BSDF" and "Background"."""
+    return next(node for node in tree.nodes if node.bl_idname == idname)
+
+
 def _material(name, colour, roughness=0.6):
     material = bpy.data.materials.new(name)
     material.use_nodes = True
-    bsdf = material.node_tree.nodes.get("Principled BSDF")
+    bsdf = _node_of_type(material.node_tree, "ShaderNodeBsdfPrincipled")
     bsdf.inputs["Base Color"].default_value = (*colour, 1.0)
     bsdf.inputs["Roughness"].default_value = roughness
     material.diffuse_color = (*colour, 1.0)
@@ -118,7 +124,7 @@ def _world(scene):
     world = scene.world or bpy.data.worlds.new("World")
     scene.world = world
     world.use_nodes = True
-    background = world.node_tree.nodes.get("Background")
+    background = _node_of_type(world.node_tree, "ShaderNodeBackground")
     background.inputs["Color"].default_value = WORLD_COLOUR
     background.inputs["Strength"].default_value = WORLD_STRENGTH
     world.color = WORLD_COLOUR[:3]
