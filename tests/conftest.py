@@ -209,7 +209,7 @@ def run_command(command, user_scripts, env=None, check=True, timeout=BLENDER_TIM
     left Blender and Xvfb running), and the test fails with the output so far."""
     process = subprocess.Popen(
         command, env=blender_environment(user_scripts, env), start_new_session=True,
-        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="backslashreplace")
     try:
         stdout, _ = process.communicate(timeout=timeout)
     except subprocess.TimeoutExpired:

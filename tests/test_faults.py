@@ -285,6 +285,17 @@ def test_an_hbao_node_in_a_second_compositor_effect_says_why_it_gives_no_ao(
 
 
 @pytest.mark.min_blender(5, 3)
+def test_one_group_in_two_compositor_effects(run_in_blender, tmp_path, no_leftovers):
+    """The HBAO effect's group in a second effect too: both run, each
+    multiplying by the AO, and nothing says that one of them gives none.
+    (The group's File Output node writes its file twice: not read here.)"""
+    out, log = render(run_in_blender, tmp_path, {"prepare": ["sync", "same_group_twice"],
+                                                 "nodes": [{"radius": 0.8, "blur_size": 0}]})
+    assert "in compositor effect" not in log and "without AO" not in log, log[-3000:]
+    assert "renders nothing" not in log and (out / "frame_0001.exr").is_file()
+
+
+@pytest.mark.min_blender(5, 3)
 def test_the_compositing_group_inside_another_group_passes_the_image_through(
         run_in_blender, tmp_path, no_leftovers):
     """5.3 renders the helper scene through the Render Layers node of a
@@ -294,7 +305,7 @@ def test_the_compositing_group_inside_another_group_passes_the_image_through(
     out, log = render(run_in_blender, tmp_path, {"prepare": ["sync", "wrap_compositing_group"],
                                                  "nodes": [{"radius": 1.0}]})
     assert 'in node group "Scene Compositing": HBAO works only at the top' in log, log[-3000:]
-    assert "HBAO: HBAO:" not in log
+    assert "renders nothing" not in log and "HBAO: HBAO:" not in log, log[-3000:]
     assert_no_ao_and_image_unchanged(out)
 
 

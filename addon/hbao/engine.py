@@ -12,7 +12,7 @@ import numpy as np
 
 from . import camera as camera_model
 from . import (ao_cache, exr_passes, handover, job_inputs, layer_passes, native, recomposite,
-               render_record, scratch_files, timing_line)
+               render_record, scratch_files, strip_cameras, timing_line)
 from .helper_lookup import ENGINE_IDNAME, is_helper, pass_names_for_helper
 from .helper_scene import rendered_for_a_scene, scene_for_render
 from .planning import node_names, plan, tell_all_nodes
@@ -161,10 +161,14 @@ def render_helper(engine, depsgraph):
     request = recomposite.request_for(scene)
     main = scene_for_render(scene) if is_helper(scene) else None
     if request is None and (main is None or not rendered_for_a_scene(scene)):
-        message = (HELPER_NOT_FOR_RENDERING.format(helper=scene.name, main=main.name)
-                   if main is not None
-                   else NOT_FOR_RENDERING.format(label=HBAOPassEngine.bl_label))
-        _report_failure(engine, message)
+        if strip_cameras.in_a_job(scene):  # the artist rendered it
+            _report_failure(engine, HELPER_NOT_FOR_RENDERING.format(helper=scene.name,
+                                                                    main=main.name)
+                            if main is not None
+                            else NOT_FOR_RENDERING.format(label=HBAOPassEngine.bl_label))
+        else:  # the node's place says why (node_place)
+            log(f"{scene.name!r} rendered through a Render Layers node that the HBAO hook does "
+                f"not serve: its AO passes are 1")
         # Its passes say "no AO" (1), not the zeros an unwritten result
         # holds: a compositor that renders this scene through a Render Layers
         # node the hook does not serve (5.3: in a nested group) multiplied

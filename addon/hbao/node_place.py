@@ -21,8 +21,18 @@ OTHER_EFFECT_DETAILS = ("HBAO works in one compositor effect of a scene, the fir
 
 
 def at_top_level(node):
-    """Whether `node` lies in a scene's compositor tree itself."""
-    return any(compat.compositor_tree(scene) == node.id_data for scene in bpy.data.scenes)
+    """Whether `node` lies in a scene's compositor tree itself (the node
+    draws from it: only the scenes whose effects hold its tree are read)."""
+    tree = node.id_data
+    for scene in bpy.data.scenes:
+        effects = getattr(scene, "compositor_effects", None)
+        if effects is None:
+            if compat.compositor_tree(scene) == tree:
+                return True
+        elif any(effect.node_group == tree for effect in effects) and \
+                compositor_effects.served_group(scene) == tree:
+            return True
+    return False
 
 
 def misplaced(node):
@@ -44,7 +54,7 @@ def other_effect_messages(scene):
     return [f'node "{node.name}" in compositor effect "{effect.name}": '
             + OTHER_EFFECT_DETAILS.format(served=served.name)
             for effect in getattr(scene, "compositor_effects", ())
-            if effect != served and effect.node_group is not None
+            if effect.node_group is not None and effect.node_group != served.node_group
             for node in effect.node_group.nodes if node.bl_idname == compositor_effects.NODE_IDNAME]
 
 

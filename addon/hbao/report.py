@@ -50,7 +50,7 @@ def log(message):
         encoding = getattr(sys.stdout, "encoding", None) or "ascii"
         try:
             print(text.encode(encoding, "backslashreplace").decode(encoding), flush=True)
-        except (OSError, ValueError):
+        except (OSError, ValueError, LookupError):  # LookupError: an unknown encoding
             pass
     except (OSError, ValueError):  # a closed or broken stdout
         pass

@@ -53,6 +53,12 @@ def _innermost_job(scene):
     return len(names) - 1 - names[::-1].index(scene.name) if scene.name in names else None
 
 
+def in_a_job(scene):
+    """Whether a render job of `scene` runs now: a render the artist (or a
+    script) started, not one of a scene that a compositor renders."""
+    return _innermost_job(scene) is not None
+
+
 def job_ended(scene):
     """render_complete or render_cancel: `scene`'s job ends, and with it any
     job inside it."""

@@ -46,7 +46,8 @@ rename_helper, pick_internal_engine, render_the_helper, rename_node, second_scen
 group_last_node (the last HBAO node moved into a node group of the artist's), layer_not_rendered,
 mute_render_layers, switch_to_workbench; 5.3's compositor effects: second_effect (a pass-through
 effect added after the HBAO one, and so active), second_effect_with_a_node (one holding an HBAO
-node), wrap_compositing_group (the scene's group used through a Group node of a new group, the
+node), same_group_twice (a second effect with the HBAO effect's group), wrap_compositing_group
+(the scene's group used through a Group node of a new group, the
 effect's now), effect_off_for_render; add_on_scenes_on_gpu (every scene's compositor_device GPU)],
 render_threads ({frame: the Performance panel's threads, 0 for Auto}), layer_name (the first view
 layer's), scene_name, single_layer (Render Single Layer on),
@@ -369,6 +370,8 @@ for action in spec.get("prepare", []):
         scene.compositor_effects.new(name="Second").node_group = group
         print("EFFECTS", json.dumps([[e.name, e.is_active] for e in scene.compositor_effects]),
               flush=True)
+    elif action == "same_group_twice":  # 5.3: a second effect with the scene's own group
+        scene.compositor_effects.new(name="Again").node_group = tree
     elif action == "wrap_compositing_group":  # 5.3: the scene's group used through a Group node
         wrapper = bpy.data.node_groups.new("Wrapper", "CompositorNodeTree")
         blender_scenes.compat.new_group_socket(wrapper, "OUTPUT", "NodeSocketColor", "Image")
