@@ -310,6 +310,21 @@ def test_the_compositing_group_inside_another_group_passes_the_image_through(
 
 
 @pytest.mark.min_blender(5, 3)
+def test_the_hook_follows_the_hbao_nodes_to_another_effect(run_in_blender, tmp_path,
+                                                           no_leftovers):
+    """The HBAO nodes gone from the first effect, the hook serves the next
+    effect that holds one; the first keeps no managed Render Layers node (it
+    rendered the helper of the old group every frame, which refused)."""
+    out, log = render(run_in_blender, tmp_path, {
+        "prepare": ["sync", "second_effect_with_a_node", "hbao_nodes_leave_the_first_effect"],
+        "nodes": [{"radius": 0.8}]})
+    line = next(text for text in log.splitlines() if text.startswith("HOOKS "))
+    hooks = json.loads(line[len("HOOKS "):])
+    assert hooks == {"Scene Compositing": [], "Second Effect": ["HBAO Passes"]}, line
+    assert "rendered through a Render Layers node" not in log, log[-3000:]
+
+
+@pytest.mark.min_blender(5, 3)
 def test_the_hbao_effect_off_for_renders_says_that_the_render_has_no_ao(
         run_in_blender, tmp_path, no_leftovers):
     out, log = render(run_in_blender, tmp_path, {"prepare": ["effect_off_for_render"],

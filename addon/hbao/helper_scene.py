@@ -16,7 +16,8 @@ pointed at each scene's helper in turn would flip with every sync. The render
 handlers record the scene being rendered, which the engine reads."""
 import bpy
 
-from . import compat, extra_renders, helper_render_settings, pass_sources, view_cameras, writes
+from . import compat, extra_renders, helper_render_settings, hook_release, pass_sources, \
+    view_cameras, writes
 from .data_edits import set_if_different
 from .helper_lookup import (ENGINE_IDNAME, HELPER_SCENE_PREFIX, MAIN_SCENE_KEY, MAIN_TREE_KEY,
                             MANAGED_NODE_KEY, helper_scene_of, is_helper, main_scene_of,
@@ -101,7 +102,8 @@ def _configure_helper_scene(scene, helper, restructured):
     """Settings, camera and objects of `helper`, once the managed node of
     `scene`'s tree points at it. `restructured`: objects linked or unlinked,
     or a new scene: it must settle before a render."""
-    if compat.TREES_SHARED_BETWEEN_SCENES and helper.get(MAIN_TREE_KEY) is None:
+    if compat.TREES_SHARED_BETWEEN_SCENES and (restructured or helper.get(MAIN_TREE_KEY) is None):
+        # (a helper reused for its scene serves the scene's group now)
         helper[MAIN_TREE_KEY] = compat.compositor_tree(scene)
     # Between renders the helper follows one scene, the one it was made for,
     # so that syncing scenes that share its tree does not flip its settings
@@ -178,12 +180,28 @@ def _extra_view_layer(scene, nodes):
     return scene.view_layers[0] if len(scene.view_layers) else None
 
 
+def _unhook_other_effects(scene, served):
+    """5.3: the group a scene's hook serves follows its compositor effects
+    (compositor_effects.py). A group served before and by no scene now
+    keeps no managed Render Layers node (it rendered a helper that serves
+    another group), and its HBAO nodes pass Image through."""
+    for effect in getattr(scene, "compositor_effects", ()):
+        group = effect.node_group
+        if group is None or group == served or managed_node(group) is None or any(
+                compat.compositor_tree(other) == group for other in bpy.data.scenes):
+            continue
+        hook_release.unlink_ao_inputs(group)
+        group.nodes.remove(managed_node(group))
+        log(f"removed the HBAO hook of compositor effect {effect.name!r} of {scene.name!r}")
+
+
 def sync(scene):
     """Create, update or remove the hook of `scene` to match its HBAO nodes.
     Main thread only; returns a list of messages."""
     tree = compat.compositor_tree(scene)
     if tree is None or is_helper(scene):
         return []
+    _unhook_other_effects(scene, tree)
     nodes = hbao_nodes(tree)
     if not nodes:
         # found through the managed node: before it goes

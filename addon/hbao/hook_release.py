@@ -33,6 +33,13 @@ def _release(tree):
     rlayers = managed_node(tree)
     if rlayers is None:
         return
+    unlink_ao_inputs(tree)
+    set_if_different(rlayers, "mute", True)
+
+
+def unlink_ao_inputs(tree):
+    """The AO pass inputs of `tree`'s HBAO nodes unlinked and set to 1: the
+    nodes pass Image through."""
     for node in hbao_nodes(tree):
         target = node.inputs.get(AO_PASS_INPUT)
         if target is None:
@@ -40,4 +47,3 @@ def _release(tree):
         for link in list(target.links):
             tree.links.remove(link)
         set_if_different(target, "default_value", 1.0)
-    set_if_different(rlayers, "mute", True)

@@ -46,9 +46,11 @@ rename_helper, pick_internal_engine, render_the_helper, rename_node, second_scen
 group_last_node (the last HBAO node moved into a node group of the artist's), layer_not_rendered,
 mute_render_layers, switch_to_workbench; 5.3's compositor effects: second_effect (a pass-through
 effect added after the HBAO one, and so active), second_effect_with_a_node (one holding an HBAO
-node), same_group_twice (a second effect with the HBAO effect's group), wrap_compositing_group
-(the scene's group used through a Group node of a new group, the
-effect's now), effect_off_for_render; add_on_scenes_on_gpu (every scene's compositor_device GPU)],
+node), hbao_nodes_leave_the_first_effect (its HBAO nodes removed: the hook serves the second
+effect, and prints HOOKS {group: [its managed node]}), same_group_twice (a second effect with the
+HBAO effect's group), wrap_compositing_group (the scene's group used through a Group node of a new
+group, the effect's now), effect_off_for_render; add_on_scenes_on_gpu (every scene's
+compositor_device GPU)],
 render_threads ({frame: the Performance panel's threads, 0 for Auto}), layer_name (the first view
 layer's), scene_name, single_layer (Render Single Layer on),
 user_handlers (a pipeline's own render and frame change handlers, which print USER HANDLERS {json}:
@@ -370,6 +372,15 @@ for action in spec.get("prepare", []):
         scene.compositor_effects.new(name="Second").node_group = group
         print("EFFECTS", json.dumps([[e.name, e.is_active] for e in scene.compositor_effects]),
               flush=True)
+    elif action == "hbao_nodes_leave_the_first_effect":  # 5.3, after second_effect_with_a_node
+        import hbao
+        import hbao.helper_lookup
+        for node in [n for n in tree.nodes if n.bl_idname == "CompositorNodeHBAO"]:
+            tree.nodes.remove(node)
+        hbao.sync(scene)  # the hook serves the second effect's group now
+        print("HOOKS", json.dumps({e.node_group.name: [
+            n.name for n in e.node_group.nodes if n == hbao.helper_lookup.managed_node(
+                e.node_group)] for e in scene.compositor_effects}), flush=True)
     elif action == "same_group_twice":  # 5.3: a second effect with the scene's own group
         scene.compositor_effects.new(name="Again").node_group = tree
     elif action == "wrap_compositing_group":  # 5.3: the scene's group used through a Group node
