@@ -51,6 +51,8 @@ def other_effect_messages(scene):
     (5.3) whose group the add-on does not serve, as report.NodeMessage
     reads: after "HBAO " in Blender's reports."""
     served = compositor_effects.served_effect(scene)
+    if served is None:  # (no effect holds an HBAO node, and none is active)
+        return []
     return [f'node "{node.name}" in compositor effect "{effect.name}": '
             + OTHER_EFFECT_DETAILS.format(served=served.name)
             for effect in getattr(scene, "compositor_effects", ())
