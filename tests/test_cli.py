@@ -1353,6 +1353,30 @@ def test_size_claim_is_checked_against_the_file_before_allocating(hbao_tool, tmp
     assert not (tmp_path / "ao.exr").exists() and leftover_temporary_files(tmp_path) == []
 
 
+def test_out_of_memory_names_the_file_and_the_stage(hbao_tool, tmp_path):
+    """Short of memory for the passes (a 2000x1500 render's Depth and
+    Normal take 60 MB; the address space is limited to 50 MB, which the
+    tool alone fits in), the message names the file, what was being done
+    and how much it needed: a farm's log of many frames says which."""
+    render = tmp_path / "render.exr"
+    depth = np.full((1500, 2000), 5.0, np.float32)
+    normal = np.zeros_like(depth)
+    render.write_bytes(scanline_exr({"ViewLayer.Depth.Z": depth, "ViewLayer.Normal.X": normal,
+                                     "ViewLayer.Normal.Y": normal,
+                                     "ViewLayer.Normal.Z": normal + 1.0}, 2000, 1500))
+    address_space = 50 << 20
+
+    def limit_memory():
+        resource.setrlimit(resource.RLIMIT_AS, (address_space, address_space))
+
+    completed = subprocess.run([str(hbao_tool), str(render), "-o", str(tmp_path / "ao.exr")],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                               timeout=TOOL_TIMEOUT_S, preexec_fn=limit_memory)
+    assert_clean_error(completed, EXIT_RUNTIME, f"{render}: out of memory reading the passes of "
+                       "a 2000x1500 image (60 MB)")
+    assert not (tmp_path / "ao.exr").exists() and leftover_temporary_files(tmp_path) == []
+
+
 def test_unwritable_output_folder_is_an_error(hbao_tool, tmp_path):
     completed = run_tool(hbao_tool, fixture_path("cycles_float_zip"), "-o",
                          tmp_path / "no_such_folder" / "ao.exr")

@@ -170,8 +170,10 @@ static int read_passes(exr_input *input, const blender_passes *passes, bool use_
     if (back != NULL) buffers->back = malloc(pixel_count * sizeof(float));
     if (buffers->depth == NULL || buffers->ao == NULL || (use_normals && buffers->normal == NULL) ||
         (back != NULL && buffers->back == NULL))
-        return tool_fail(error, TOOL_EXIT_RUNTIME, "out of memory for a %dx%d image", input->width,
-                         input->height);
+        return tool_fail(error, TOOL_EXIT_RUNTIME,
+                         "%s: out of memory reading the passes of a %dx%d image (%.0f MB)",
+                         input->path, input->width, input->height,
+                         (double)pixel_count * (8 + (use_normals ? 12 : 0) + (back ? 4 : 0)) / 1e6);
     exr_channel_request requests[5];
     int count = 0;
     requests[count++] = float_request(passes->depth, buffers->depth, 1, input->width);
@@ -196,7 +198,9 @@ static int read_copies(exr_input *input, const char *ao_channel, ao_buffers *buf
     exr_channel_request *requests = calloc((size_t)channel_count, sizeof *requests);
     if (buffers->copies == NULL || requests == NULL) {
         free(requests);
-        return tool_fail(error, TOOL_EXIT_RUNTIME, "out of memory");
+        return tool_fail(error, TOOL_EXIT_RUNTIME,
+                         "%s: out of memory keeping the input's channels (--keep-input)",
+                         input->path);
     }
     int count = 0;
     for (int c = 0; c < channel_count; ++c) {
@@ -210,7 +214,9 @@ static int read_copies(exr_input *input, const char *ao_channel, ao_buffers *buf
         uint8_t *data = malloc(pixel_count * (size_t)size);
         if (data == NULL) {
             free(requests);
-            return tool_fail(error, TOOL_EXIT_RUNTIME, "out of memory");
+            return tool_fail(error, TOOL_EXIT_RUNTIME,
+                             "%s: out of memory keeping the input's channel \"%s\" (--keep-input)",
+                             input->path, channel->name.str);
         }
         buffers->copies[buffers->copy_count++] = data;
         exr_channel_request request = {channel->name.str, channel->pixel_type, data, size,
