@@ -277,8 +277,8 @@ def test_an_hbao_node_in_a_second_compositor_effect_says_why_it_gives_no_ao(
     out, log = render(run_in_blender, tmp_path, {
         "prepare": ["sync", "second_effect_with_a_node"], "nodes": [node]})
     said = ('HBAO: node "HBAO in the second effect" in compositor effect "Second": HBAO works '
-            'in one compositor effect of a scene, the first whose node group holds an HBAO node '
-            '("Scene Effect")')
+            'in one compositor effect of a scene, the first enabled for renders whose node group '
+            'holds an HBAO node ("Scene Effect")')
     assert log.count(said) == 1, log[-3000:]
     expected = library_ao(native, out, 1, node_params(**node))
     assert np.abs(node_outputs(out, 1)["ao"] - expected).max() <= EXACT
@@ -322,6 +322,21 @@ def test_the_hook_follows_the_hbao_nodes_to_another_effect(run_in_blender, tmp_p
     hooks = json.loads(line[len("HOOKS "):])
     assert hooks == {"Scene Compositing": [], "Second Effect": ["HBAO Passes"]}, line
     assert "rendered through a Render Layers node" not in log, log[-3000:]
+
+
+@pytest.mark.min_blender(5, 3)
+def test_the_first_hbao_effect_off_for_renders_serves_the_next(run_in_blender, tmp_path,
+                                                               no_leftovers):
+    """Two effects with HBAO nodes, the first off for renders: the hook
+    serves the second, which renders, and the first's node is told so."""
+    out, log = render(run_in_blender, tmp_path, {
+        "prepare": ["second_effect_with_a_node", "effect_off_for_render"],
+        "nodes": [{"radius": 1.0}]})
+    said = ('HBAO: node "HBAO0" in compositor effect "Scene Effect": HBAO works in one '
+            'compositor effect of a scene, the first enabled for renders whose node group holds '
+            'an HBAO node ("Second")')
+    assert log.count(said) == 1, log[-3000:]
+    assert "is off for renders" not in log, log[-3000:]
 
 
 @pytest.mark.min_blender(5, 3)

@@ -3,8 +3,9 @@
 composites a stack of effects (`scene.compositor_effects`), each a node
 group run on the one before's image; `scene.compositing_node_group` is the
 active effect's group only (and deprecated). The add-on serves one group a
-scene: the first effect's whose group holds an HBAO node at its top level,
-else the active effect's (where a new node goes). Measured in bpy 5.3: with
+scene: the first effect's, among those enabled for renders, whose group
+holds an HBAO node at its top level; else the first such effect's, enabled
+or not; else the active effect's (where a new node goes). Measured in bpy 5.3: with
 the active one served, adding a second effect after the HBAO one (Add
 Effect makes it active) left the HBAO node unserved and its render black.
 Reads only the scene given: no bpy import."""
@@ -25,10 +26,9 @@ def served_effect(scene):
     effects = getattr(scene, "compositor_effects", None)
     if effects is None:
         return None
-    for effect in effects:
-        if holds_hbao_node(effect.node_group):
-            return effect
-    return effects.active
+    holding = [effect for effect in effects if holds_hbao_node(effect.node_group)]
+    rendered = [effect for effect in holding if effect.enable_for_render]
+    return (rendered or holding or [effects.active])[0]
 
 
 def served_group(scene):

@@ -15,9 +15,10 @@ GROUPED_DETAILS = ("HBAO works only at the top level of a scene's compositor, no
                    "(Ctrl+Alt+G) or move it to the top level")
 # Blender 5.3's stack of compositor effects (compositor_effects.py)
 OTHER_EFFECT_SHORT = "In another effect: AO off"
-OTHER_EFFECT_DETAILS = ("HBAO works in one compositor effect of a scene, the first whose node "
-                        "group holds an HBAO node (\"{served}\"): this node passes Image through "
-                        "and its AO is white. Move it into that effect's group")
+OTHER_EFFECT_DETAILS = ("HBAO works in one compositor effect of a scene, the first enabled for "
+                        "renders whose node group holds an HBAO node (\"{served}\"): this node "
+                        "passes Image through and its AO is white. Move it into that effect's "
+                        "group")
 
 
 def at_top_level(node):
