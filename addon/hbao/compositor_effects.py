@@ -15,9 +15,13 @@ Reads only the scene given: no bpy import."""
 NODE_IDNAME = "CompositorNodeHBAO"
 
 
+def is_hbao_node(node):
+    return getattr(node, "bl_idname", "") == NODE_IDNAME
+
+
 def holds_hbao_node(tree):
     """Whether node tree `tree` (or None) has an HBAO node at its top level."""
-    return tree is not None and any(node.bl_idname == NODE_IDNAME for node in tree.nodes)
+    return tree is not None and any(is_hbao_node(node) for node in tree.nodes)
 
 
 def served_effect(scene):
@@ -26,9 +30,13 @@ def served_effect(scene):
     effects = getattr(scene, "compositor_effects", None)
     if effects is None:
         return None
-    holding = [effect for effect in effects if holds_hbao_node(effect.node_group)]
-    rendered = [effect for effect in holding if effect.enable_for_render]
-    return (rendered or holding or [effects.active])[0]
+    first_holding = None  # (read up to the first enabled one only: draws and handlers ask)
+    for effect in effects:
+        if holds_hbao_node(effect.node_group):
+            if effect.enable_for_render:
+                return effect
+            first_holding = first_holding or effect
+    return first_holding or effects.active
 
 
 def served_group(scene):

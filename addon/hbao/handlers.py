@@ -95,8 +95,8 @@ def _on_render_init(scene, *_args):
         off = None
         if nodes and not settings.compositor_runs(scene):
             off = (settings.COMPOSITING_OFF_DETAIL, settings.COMPOSITING_OFF_SHORT)
-        elif nodes and settings.effect_off_detail(scene) is not None:
-            off = (settings.effect_off_detail(scene), settings.EFFECT_OFF_SHORT)
+        elif nodes and (effect_off := settings.effect_off_detail(scene)) is not None:
+            off = (effect_off, settings.EFFECT_OFF_SHORT)
         elif nodes and not settings.helper_renders(scene):
             off = (settings.SINGLE_LAYER_DETAIL, settings.SINGLE_LAYER_SHORT)
         if off is not None:

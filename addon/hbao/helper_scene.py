@@ -187,11 +187,12 @@ def _unhook_other_effects(scene, served):
     another group), and its HBAO nodes pass Image through."""
     for effect in getattr(scene, "compositor_effects", ()):
         group = effect.node_group
-        if group is None or group == served or managed_node(group) is None or any(
-                compat.compositor_tree(other) == group for other in bpy.data.scenes):
+        rlayers = managed_node(group) if group is not None and group != served else None
+        if rlayers is None or any(compat.compositor_tree(other) == group
+                                  for other in bpy.data.scenes):
             continue
         hook_release.unlink_ao_inputs(group)
-        group.nodes.remove(managed_node(group))
+        group.nodes.remove(rlayers)
         log(f"removed the HBAO hook of compositor effect {effect.name!r} of {scene.name!r}")
 
 

@@ -11,7 +11,7 @@ import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 
 from . import compat, guard_geometry, node_lines, node_place, parameters, report, writes
-from .compositor_effects import NODE_IDNAME
+from .compositor_effects import NODE_IDNAME, is_hbao_node
 from .node_group import (AO_OUTPUT, AO_PASS_INPUT, DEPTH_INPUT, GROUP_TREE_NAME,  # noqa: F401
                          IMAGE_INPUT, IMAGE_OUTPUT, NORMAL_INPUT, VALUE_INPUTS,
                          adopt_group_copies, group_tree, upgrade_group_tree)
@@ -25,10 +25,6 @@ changed_callbacks = []
 # render runs, to bring the nodes' hint lines (hint, hint_details) up to
 # date; each returns whether it changed one (render_record.apply_hints).
 hint_refreshers = []
-
-
-def is_hbao_node(node):
-    return getattr(node, "bl_idname", "") == NODE_IDNAME
 
 
 def hbao_nodes(tree):

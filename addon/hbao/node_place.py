@@ -58,7 +58,7 @@ def other_effect_messages(scene):
             + OTHER_EFFECT_DETAILS.format(served=served.name)
             for effect in getattr(scene, "compositor_effects", ())
             if effect.node_group is not None and effect.node_group != served.node_group
-            for node in effect.node_group.nodes if node.bl_idname == compositor_effects.NODE_IDNAME]
+            for node in effect.node_group.nodes if compositor_effects.is_hbao_node(node)]
 
 
 def nodes_in_groups(tree, wanted):
