@@ -104,7 +104,7 @@ def configure_output(scene, job, scratch):
     for name in job["passes"]:
         output = compositor.file_output(str(scratch / name), name, file_format="OPEN_EXR")
         output.node.format.color_mode = "RGB"
-        output.add(name, blender_scenes.compat.pass_output(layers, PASS_SOCKETS[name]))
+        output.add(name, blender_scenes.compat_nodes.pass_output(layers, PASS_SOCKETS[name]))
     compositor.composite(layers.outputs["Image"])
 
 

@@ -22,7 +22,7 @@ try:
 except ImportError:
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "addon"))
 from hbao import camera as camera_model  # noqa: E402
-from hbao import compat  # noqa: E402
+from hbao import compat, compat_nodes  # noqa: E402
 
 import file_output  # noqa: E402  (beside this file: the File Output node's versions)
 import scene_parts  # noqa: E402  (beside this file: the parts every scene is built from)
@@ -301,14 +301,14 @@ class Compositor:
 
     def composite(self, socket, location=(900, 0)):
         """The final image: Composite (<5.0) or the group's output."""
-        node = compat.new_composite_output(self.tree)
+        node = compat_nodes.new_composite_output(self.tree)
         node.location = location
         self.link(socket, node.inputs[0])
         return node
 
     def value(self, value, location=(0, -300)):
         """A Value node (CompositorNodeValue <5.0, ShaderNodeValue 5.0+)."""
-        node = compat.new_value_node(self.tree)
+        node = compat_nodes.new_value_node(self.tree)
         node.location = location
         node.outputs[0].default_value = value
         return node

@@ -63,6 +63,30 @@ def native(built_library):
     return module
 
 
+class _NodeView:
+    """The library as the HBAO node outputs its AO: the helper's pass holds
+    1 - AO and the node's group turns it back (hbao.pass_encoding), so the
+    node's AO is the library's rounded once each way: its compute_ao
+    returns that, the rest is the library's."""
+
+    def __init__(self, library):
+        self._library = library
+
+    def __getattr__(self, name):
+        return getattr(self._library, name)
+
+    def compute_ao(self, *args, **kwargs):
+        from hbao import pass_encoding
+        ao = self._library.compute_ao(*args, **kwargs)
+        return pass_encoding.node_ao(pass_encoding.occlusion_pass(ao))
+
+
+@pytest.fixture(scope="session")
+def node_native(native):
+    """native, for the node's AO (_NodeView)."""
+    return _NodeView(native)
+
+
 @pytest.fixture(scope="session")
 def hbao_tool():
     if not TOOL.exists():

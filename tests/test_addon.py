@@ -37,6 +37,7 @@ pytestmark = pytest.mark.matrix
 
 from hbao import exr_passes as exr  # noqa: E402  (conftest puts addon/ on sys.path)
 from hbao import parameters as PARAMETERS  # noqa: E402
+from hbao import pass_encoding  # noqa: E402
 from hbao import timing_line  # noqa: E402
 
 
@@ -87,9 +88,9 @@ def camera(out, frame, view=""):
     return json.loads((out / f"camera_{frame:04d}{view}.json").read_text())
 
 
-def library_ao(native, out, frame, params, with_normal=True, layer="ViewLayer", view=""):
+def library_ao(node_native, out, frame, params, with_normal=True, layer="ViewLayer", view=""):
     depth, normal = frame_passes(out, frame, layer, with_normal, view)
-    return native.compute_ao(depth, normal, params=params, camera=camera(out, frame, view))
+    return node_native.compute_ao(depth, normal, params=params, camera=camera(out, frame, view))
 
 
 def node_params(**overrides):
@@ -104,7 +105,7 @@ def node_params(**overrides):
 
 
 def test_node_ao_matches_library_cycles_and_composites_image_times_ao(
-        run_in_blender, tmp_path, native):
+        run_in_blender, tmp_path, node_native):
     spec = {"samples": 64, "ao_reference": 1.0,
             "nodes": [{"radius": 1.0, "integration": "COSINE", "falloff": "NONE"}]}
     out, log = render(run_in_blender, tmp_path, spec)
@@ -114,7 +115,7 @@ def test_node_ao_matches_library_cycles_and_composites_image_times_ao(
     assert np.all(np.isfinite(ao)) and ao.min() >= 0.0 and ao.max() <= 1.0
     assert ao.min() < 0.6  # the corner and the contacts are occluded
 
-    expected = library_ao(native, out, 1, node_params(integration="COSINE", falloff="NONE"))
+    expected = library_ao(node_native, out, 1, node_params(integration="COSINE", falloff="NONE"))
     assert np.abs(ao - expected).max() <= EXACT
 
     product = outputs["render"] * ao[..., None]
@@ -245,20 +246,20 @@ def test_disabling_after_a_reload_of_the_package_still_lets_go(run_in_blender, t
                      "handlers_left": []}, state
 
 
-def test_node_thickness_reaches_the_library(run_in_blender, tmp_path, native):
+def test_node_thickness_reaches_the_library(run_in_blender, tmp_path, node_native):
     """The Thickness socket is the library's hbao_params.thickness: the node's
     AO equals the library's with it, and differs from infinitely thick."""
     spec = {"nodes": [{"radius": 0.7, "blur_size": 0, "thickness": 0.1}]}
     out, _ = render(run_in_blender, tmp_path, spec)
     ao = node_outputs(out, 1)["ao"]
-    expected = library_ao(native, out, 1, node_params(radius=0.7, blur_size=0, thickness=0.1))
+    expected = library_ao(node_native, out, 1, node_params(radius=0.7, blur_size=0, thickness=0.1))
     assert np.abs(ao - expected).max() <= EXACT
-    thick = library_ao(native, out, 1, node_params(radius=0.7, blur_size=0))
+    thick = library_ao(node_native, out, 1, node_params(radius=0.7, blur_size=0))
     assert np.abs(ao - thick).max() > 0.05  # the thickness changed the AO
 
 
 def test_connect_passes_button_turns_passes_on_and_links_them(
-        run_in_blender, tmp_path, native):
+        run_in_blender, tmp_path, node_native):
     """An artist adds the node to a view layer without Depth and Normal
     passes (Render Layers then has no such outputs to link): the node's
     Connect Passes button turns them on and links them, and the render has AO."""
@@ -269,12 +270,12 @@ def test_connect_passes_button_turns_passes_on_and_links_them(
     assert ("Turned on the Depth and Normal passes of view layer 'ViewLayer'; linked Image, "
             "Depth, Normal from 'Render Layers'") in log, log[-3000:]
     ao = node_outputs(out, 1)["ao"]
-    expected = library_ao(native, out, 1, node_params(radius=0.8, blur_size=0))
+    expected = library_ao(node_native, out, 1, node_params(radius=0.8, blur_size=0))
     assert ao.min() < 0.9 and np.abs(ao - expected).max() <= EXACT
 
 
 def test_time_remapped_animated_camera_gets_the_rendered_cameras_ao(
-        run_in_blender, tmp_path, native):
+        run_in_blender, tmp_path, node_native):
     """Time Remapping 100 -> 50: frame 2 shows the time of frame 1, and the
     camera moves. The node's AO is the library's with the camera Blender
     rendered (it took the camera at frame 2's own time: the helper scene did
@@ -282,13 +283,13 @@ def test_time_remapped_animated_camera_gets_the_rendered_cameras_ao(
     spec = {"frames": [2], "animate_camera": True, "time_remap": [100, 50],
             "nodes": [{"radius": 0.7, "blur_size": 0}]}
     out, _ = render(run_in_blender, tmp_path, spec)
-    expected = library_ao(native, out, 2, node_params(radius=0.7, blur_size=0))
+    expected = library_ao(node_native, out, 2, node_params(radius=0.7, blur_size=0))
     assert np.abs(node_outputs(out, 2)["ao"] - expected).max() <= EXACT
 
 
 @pytest.mark.parametrize("sequencer", ["override", "other_frame", "muted_meta", "nested",
                                        "covered"])
-def test_sequencer_strip_camera_override_gets_that_cameras_ao(run_in_blender, tmp_path, native,
+def test_sequencer_strip_camera_override_gets_that_cameras_ao(run_in_blender, tmp_path, node_native,
                                                               sequencer):
     """A Video Sequencer scene strip with a Camera override renders the
     scene through that camera: the node's AO in the sequencer's render is
@@ -307,7 +308,7 @@ def test_sequencer_strip_camera_override_gets_that_cameras_ao(run_in_blender, tm
                       {"radius": 0.7, "blur_size": 0, "back_faces": True, "guard_band": 10.0}]}
     out, log = render(run_in_blender, tmp_path, spec)
     params = node_params(radius=0.7, blur_size=0)
-    expected = library_ao(native, out, 1, params)
+    expected = library_ao(node_native, out, 1, params)
     through_strip = exr.read_channels(out / "strip_nodes_0001.exr", ["HBAO0_AO.V", "HBAO1_AO.V"])
     assert expected.min() < 0.9
     for node in ("HBAO0", "HBAO1"):
@@ -326,7 +327,7 @@ def test_sequencer_strip_camera_override_gets_that_cameras_ao(run_in_blender, tm
 
 
 def test_a_sequencer_animation_that_could_not_start_leaves_no_strip_camera(
-        run_in_blender, tmp_path, native):
+        run_in_blender, tmp_path, node_native):
     """An animation render of the sequencer's scene that cannot write its
     movie starts a render job that never ends (no render_complete nor
     render_cancel): the scene's own render after it still gets its own
@@ -334,7 +335,7 @@ def test_a_sequencer_animation_that_could_not_start_leaves_no_strip_camera(
     spec = {"sequencer": "failed_movie", "nodes": [{"radius": 0.7, "blur_size": 0}]}
     out, log = render(run_in_blender, tmp_path, spec)
     assert "MOVIE" in log
-    expected = library_ao(native, out, 1, node_params(radius=0.7, blur_size=0))
+    expected = library_ao(node_native, out, 1, node_params(radius=0.7, blur_size=0))
     assert np.abs(node_outputs(out, 1)["ao"] - expected).max() <= EXACT
     assert "rendered by a sequencer strip" not in log
 
@@ -377,7 +378,7 @@ def test_a_camera_scaled_unevenly_gets_the_ao_of_the_unscaled_one(run_in_blender
 
 
 @pytest.mark.parametrize("clip_end, tilt", [(5.6, 0.2), (1e5, 0.35)])
-def test_the_sky_at_clip_end_is_background(run_in_blender, tmp_path, native, clip_end, tilt):
+def test_the_sky_at_clip_end_is_background(run_in_blender, tmp_path, node_native, clip_end, tilt):
     """EEVEE in 4.5 and 5.0 writes the sky's Depth as the camera's Clip End
     (or a rounding of it) where 3.4 writes 65504 and 5.3 1e10: the sky was
     then a wall at Clip End, and took AO from what stood near it (0.52 off,
@@ -405,8 +406,8 @@ def test_the_sky_at_clip_end_is_background(run_in_blender, tmp_path, native, cli
     assert 50 < sky.sum() < depth.size - 50, sky.sum()  # sky and geometry both in view
     ao = node_outputs(out, 1)["ao"]
     assert ao.min() < 0.9 and np.all(ao[sky] == 1.0)
-    expected = native.compute_ao(depth, normal, camera=description,
-                                 params=dict(node_params(**node), background_depth=background))
+    expected = node_native.compute_ao(depth, normal, camera=description,
+                                      params=dict(node_params(**node), background_depth=background))
     assert np.abs(ao - expected).max() <= EXACT
 
 
@@ -427,7 +428,7 @@ def test_a_scene_past_65504_units_gets_its_ao(run_in_blender, tmp_path):
     assert difference.mean() <= SCALED_SCENE_MEAN_DIFFERENCE, difference.mean()
 
 
-def position_misfit(native, out, frame, description):
+def position_misfit(node_native, out, frame, description):
     """The median distance between where `description` (a camera dict)
     puts each foreground pixel's Depth and where Cycles' Position pass says
     its surface is: small for the camera the passes were rendered through
@@ -437,7 +438,7 @@ def position_misfit(native, out, frame, description):
     channels = exr.read_channels(out / f"frame_{frame:04d}.exr", names)
     depth = channels[names[0]]
     height, width = depth.shape
-    view = native.camera_view(description, width, height)
+    view = node_native.camera_view(description, width, height)
     columns = view.origin_x + (np.arange(width) + 0.5) * view.pixel_size_x
     rows = view.origin_y + (np.arange(height)[::-1] + 0.5) * view.pixel_size_y  # top row first
     x, y = np.meshgrid(columns, rows)
@@ -455,7 +456,7 @@ def position_misfit(native, out, frame, description):
                                    "samples": 1}],
                          ids=["subframe", "blur_start", "blur_end", "blur_center",
                               "eevee_blur_start"])
-def test_a_moving_camera_at_the_time_its_passes_show(run_in_blender, blender, tmp_path, native,
+def test_a_moving_camera_at_the_time_its_passes_show(run_in_blender, blender, tmp_path, node_native,
                                                      time):
     """A render at a subframe shows the camera there, and with camera motion
     blur the passes average about the camera at the middle of the shutter
@@ -473,7 +474,7 @@ def test_a_moving_camera_at_the_time_its_passes_show(run_in_blender, blender, tm
     out, log = render(run_in_blender, tmp_path, dict(time, frames=[2], animate_camera=True,
                                                      position_pass=True, nodes=nodes))
     assert "without AO" not in log, log[-3000:]
-    expected = library_ao(native, out, 2, node_params(**node))
+    expected = library_ao(node_native, out, 2, node_params(**node))
     assert expected.min() < 0.9
     assert np.abs(node_outputs(out, 2)["ao"] - expected).max() <= EXACT
     other_time = time.get("motion_blur") != "CENTER"
@@ -482,7 +483,7 @@ def test_a_moving_camera_at_the_time_its_passes_show(run_in_blender, blender, tm
     assert has_position or (time.get("engine") and blender.version_tuple < (4, 2))
     if other_time and has_position:  # that time's camera puts the Depth on the Position pass
         at_frame = json.loads((out / "camera_at_frame_0002.json").read_text())
-        fits = [position_misfit(native, out, 2, description)
+        fits = [position_misfit(node_native, out, 2, description)
                 for description in (camera(out, 2), at_frame)]
         assert fits[0] < 0.7 * fits[1], fits
     for kind in ("guard band", "back faces"):
@@ -535,29 +536,31 @@ def test_node_ao_matches_cli_with_the_written_camera(run_in_blender, tmp_path, h
          "--blur", "0", "--compression", "none"],
         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     assert completed.returncode == 0, completed.stdout
-    cli_ao = exr.read_channels(cli_out, ["AO"])["AO"]
+    # (the node's AO through the helper's pass: pass_encoding)
+    cli_ao = pass_encoding.node_ao(pass_encoding.occlusion_pass(
+        exr.read_channels(cli_out, ["AO"])["AO"]))
     node_ao = node_outputs(out, 1)["ao"]
     assert cli_ao.shape == node_ao.shape and node_ao.min() < 0.9
     assert np.abs(node_ao - cli_ao).max() <= EXACT
 
 
-def test_keyframed_radius_and_value_node(run_in_blender, tmp_path, native):
+def test_keyframed_radius_and_value_node(run_in_blender, tmp_path, node_native):
     spec = {"frames": [1, 2], "orthographic": True, "nodes": [
         {"name": "Keyed", "keyframes": [[1, 0.15], [2, 1.2]], "blur_size": 0},
         {"name": "Valued", "radius_from_value_node": 0.5, "normal": False}]}
     out, _ = render(run_in_blender, tmp_path, spec)
     ao = {frame: node_outputs(out, frame, "Keyed")["ao"] for frame in (1, 2)}
     for frame, radius in ((1, 0.15), (2, 1.2)):
-        expected = library_ao(native, out, frame, node_params(radius=radius, blur_size=0))
+        expected = library_ao(node_native, out, frame, node_params(radius=radius, blur_size=0))
         assert np.abs(ao[frame] - expected).max() <= EXACT
     # A larger radius sees more occluders: clearly darker on average.
     assert ao[2].mean() < ao[1].mean() - 0.02
     valued = node_outputs(out, 1, "Valued")["ao"]
-    expected = library_ao(native, out, 1, node_params(radius=0.5), with_normal=False)
+    expected = library_ao(node_native, out, 1, node_params(radius=0.5), with_normal=False)
     assert np.abs(valued - expected).max() <= EXACT
 
 
-def test_unchanged_frame_reuses_its_ao(run_in_blender, tmp_path, native):
+def test_unchanged_frame_reuses_its_ao(run_in_blender, tmp_path, node_native):
     """Frames 1 and 2 render the same passes with the same settings: frame 2
     reuses frame 1's AO (ao_cache.py; the console line says so) and it is
     still exactly the library's. Frame 3 changes one node's radius: that
@@ -579,14 +582,14 @@ def test_unchanged_frame_reuses_its_ao(run_in_blender, tmp_path, native):
     assert all(np.array_equal(a, b) for a, b in zip(passes[0], passes[1]))
     for frame, radius in ((1, 0.6), (2, 0.6), (3, 1.1)):
         keyed = node_outputs(out, frame, "Keyed")["ao"]
-        expected = library_ao(native, out, frame, node_params(radius=radius, blur_size=0))
+        expected = library_ao(node_native, out, frame, node_params(radius=radius, blur_size=0))
         assert np.abs(keyed - expected).max() <= EXACT
         fixed = node_outputs(out, frame, "Fixed")["ao"]
-        expected = library_ao(native, out, frame, node_params(radius=0.3, blur_size=0))
+        expected = library_ao(node_native, out, frame, node_params(radius=0.3, blur_size=0))
         assert np.abs(fixed - expected).max() <= EXACT
 
 
-def test_the_ao_uses_the_threads_blender_renders_with(run_in_blender, tmp_path, native):
+def test_the_ao_uses_the_threads_blender_renders_with(run_in_blender, tmp_path, node_native):
     """The AO (and the passes' read) runs on as many threads as Blender
     renders the scene with (RenderSettings.threads: `-t N`, else Fixed,
     else one per CPU), so a farm worker held to N threads stays there; the
@@ -606,7 +609,7 @@ def test_the_ao_uses_the_threads_blender_renders_with(run_in_blender, tmp_path, 
                if line.startswith("HBAO: 1 AO pass(es) ")]
     assert [f["threads"] for f in figures] == [1, 3, 1], log[-3000:]
     assert [f["reused"] for f in figures] == [0, 1, 1]
-    expected = library_ao(native, out, 1, node_params(radius=0.6, blur_size=0))
+    expected = library_ao(node_native, out, 1, node_params(radius=0.6, blur_size=0))
     assert np.abs(node_outputs(out, 1)["ao"] - expected).max() <= EXACT
 
 
@@ -649,7 +652,7 @@ def test_node_says_when_its_settings_changed_since_the_render(run_in_blender, tm
                      "blur size, muted": None}, log[-3000:]
 
 
-def test_new_node_settings_reach_the_ao_without_a_render(run_in_blender, tmp_path, native):
+def test_new_node_settings_reach_the_ao_without_a_render(run_in_blender, tmp_path, node_native):
     """After a render, a node whose AO parameters changed gets its AO from
     the passes that render handed over (recomposite.py: in a window the
     add-on's timer does this, the AO in a worker thread, then Blender
@@ -712,11 +715,11 @@ def test_new_node_settings_reach_the_ao_without_a_render(run_in_blender, tmp_pat
     assert (out / "frame_0001_again.exr").is_file(), log[-3000:]
     # The File Output of the second render (radius 1.1) replaced the first's.
     ao = node_outputs(out, 1, "Hinted")["ao"]
-    expected = library_ao(native, out, 1, node_params(radius=1.1, blur_size=0))
+    expected = library_ao(node_native, out, 1, node_params(radius=1.1, blur_size=0))
     assert np.abs(ao - expected).max() <= EXACT
 
 
-def test_a_render_stops_the_refresh_worker(run_in_blender, tmp_path, native):
+def test_a_render_stops_the_refresh_worker(run_in_blender, tmp_path, node_native):
     """Two nodes' radius changed after a render: the refresh's worker
     computes their AO one after the other (recomposite.py). A render of the
     scene that begins meanwhile makes it stop after the node it is
@@ -731,12 +734,12 @@ def test_a_render_stops_the_refresh_worker(run_in_blender, tmp_path, native):
     assert worker == {"jobs": 2, "computed": 1, "refreshed": False}, log[-3000:]
     assert printed_hints(log) == {"render": None}, log[-3000:]
     # The File Output of the render during the refresh replaced the first's.
-    expected = library_ao(native, out, 1, node_params(radius=0.9, blur_size=0))
+    expected = library_ao(node_native, out, 1, node_params(radius=0.9, blur_size=0))
     for name in ("First", "Second"):
         assert np.abs(node_outputs(out, 1, name)["ao"] - expected).max() <= EXACT, name
 
 
-def test_timer_waits_while_blender_refuses_writes(run_in_blender, tmp_path, native):
+def test_timer_waits_while_blender_refuses_writes(run_in_blender, tmp_path, node_native):
     """While another thread runs a read-only callback (a draw, Cycles'
     render), Blender refuses every write and operator from Python; a CI run
     once met that in the node timer's tick after an F12 render, which then
@@ -805,11 +808,11 @@ def test_timer_waits_while_blender_refuses_writes(run_in_blender, tmp_path, nati
     assert probes == ["False", "True"], log[-3000:]
     assert "Traceback" not in log and "could not bring the AO" not in log, log[-3000:]
     ao = node_outputs(out, 1, "Hinted")["ao"]
-    expected = library_ao(native, out, 1, node_params(radius=1.1, blur_size=0))
+    expected = library_ao(node_native, out, 1, node_params(radius=1.1, blur_size=0))
     assert np.abs(ao - expected).max() <= EXACT
 
 
-def test_two_nodes_two_view_layers_and_muted_node(run_in_blender, tmp_path, native):
+def test_two_nodes_two_view_layers_and_muted_node(run_in_blender, tmp_path, node_native):
     spec = {"scene": "two_layers", "nodes": [
         {"name": "Small", "layer": "Front", "radius": 0.2},
         {"name": "Large", "layer": "Back", "radius": 1.5},
@@ -818,14 +821,14 @@ def test_two_nodes_two_view_layers_and_muted_node(run_in_blender, tmp_path, nati
     small = node_outputs(out, 1, "Small")["ao"]
     large = node_outputs(out, 1, "Large")["ao"]
     assert np.abs(small - large).max() > 0.1
-    assert np.abs(small - library_ao(native, out, 1, node_params(radius=0.2),
+    assert np.abs(small - library_ao(node_native, out, 1, node_params(radius=0.2),
                                      layer="Front")).max() <= EXACT
-    assert np.abs(large - library_ao(native, out, 1, node_params(radius=1.5),
+    assert np.abs(large - library_ao(node_native, out, 1, node_params(radius=1.5),
                                      layer="Back")).max() <= EXACT
     assert "2 AO pass(es)" in log  # the muted node was not computed
 
 
-def test_missing_normal_pass_is_enabled_with_a_message(run_in_blender, tmp_path, native):
+def test_missing_normal_pass_is_enabled_with_a_message(run_in_blender, tmp_path, node_native):
     spec = {"disable_normal_pass": True, "nodes": [{"radius": 0.8}]}
     out, log = render(run_in_blender, tmp_path, spec)
     assert "enabled the Normal pass of view layer 'ViewLayer'" in log
@@ -833,7 +836,7 @@ def test_missing_normal_pass_is_enabled_with_a_message(run_in_blender, tmp_path,
     statuses = [json.loads(line[len("STATUS "):]) for line in log.splitlines()
                 if line.startswith("STATUS ")]
     assert statuses == [{"node": "HBAO0", "status": "Normal pass turned on"}], statuses
-    expected = library_ao(native, out, 1, node_params(radius=0.8))
+    expected = library_ao(node_native, out, 1, node_params(radius=0.8))
     assert np.abs(node_outputs(out, 1)["ao"] - expected).max() <= EXACT
 
 
@@ -866,7 +869,7 @@ def test_missing_exr_library_renders_without_ao_and_says_so(run_in_blender, tmp_
 
 
 def test_saved_file_renders_from_the_command_line(run_in_blender, blender,
-                                                  blender_user_scripts, tmp_path, native):
+                                                  blender_user_scripts, tmp_path, node_native):
     blend = tmp_path / "hbao.blend"
     out = tmp_path / "cli"
     render(run_in_blender, tmp_path, {"save_blend": str(blend),
@@ -883,14 +886,14 @@ def test_saved_file_renders_from_the_command_line(run_in_blender, blender,
             _camera_of(blender, blender_user_scripts, blend, tmp_path)))
     ao = node_outputs(setup, 1)["ao"]
     depth, normal = frame_passes(out, 1)
-    expected = native.compute_ao(depth, normal,
-                                 params=node_params(radius=0.6, integration="HBAO"),
-                                 camera=camera(setup, 1))
+    expected = node_native.compute_ao(depth, normal,
+                                      params=node_params(radius=0.6, integration="HBAO"),
+                                      camera=camera(setup, 1))
     assert np.abs(ao - expected).max() <= EXACT
 
 
 def test_animation_renders_every_frame_at_its_keyframed_radius(
-        run_in_blender, blender, blender_user_scripts, tmp_path, native):
+        run_in_blender, blender, blender_user_scripts, tmp_path, node_native):
     """`blender -b file.blend -s 1 -e 2 -a`: each frame's node AO is the
     library's AO of that frame's passes at that frame's keyframed radius."""
     blend = tmp_path / "animated.blend"
@@ -907,9 +910,9 @@ def test_animation_renders_every_frame_at_its_keyframed_radius(
             _camera_of(blender, blender_user_scripts, blend, tmp_path)))
         ao[frame] = node_outputs(setup, frame)["ao"]
         depth, normal = frame_passes(out, frame)
-        expected = native.compute_ao(depth, normal,
-                                     params=node_params(radius=radius, blur_size=0),
-                                     camera=camera(setup, frame))
+        expected = node_native.compute_ao(depth, normal,
+                                          params=node_params(radius=radius, blur_size=0),
+                                          camera=camera(setup, frame))
         assert np.abs(ao[frame] - expected).max() <= EXACT
     # The radius really changed between the frames of one animation render.
     assert ao[2].mean() < ao[1].mean() - 0.02
@@ -969,7 +972,7 @@ def test_border_edges_round_as_blender_rounds_them(run_in_blender, tmp_path, cro
                                            ("custom_view", ("_L", "_R", "_C"))],
                          ids=["stereo_3d", "one_view", "multi_view"])
 def test_stereo_and_multi_view_renders_get_each_views_ao(run_in_blender, tmp_path, monkeypatch,
-                                                         native, stereo, views):
+                                                         node_native, stereo, views):
     """Each view's AO is the library's from that view's passes and camera:
     Stereo 3D's eyes (the right one moved and, off-axis, shifted; the test
     works them out from the camera's Stereoscopy settings) and Multi-View's
@@ -991,8 +994,8 @@ def test_stereo_and_multi_view_renders_get_each_views_ao(run_in_blender, tmp_pat
     expected = {}
     for view in views:
         depth, normal = frame_passes(out, 1, view=suffix("frame", view))
-        expected[view] = native.compute_ao(depth, normal, camera=camera(out, 1, view),
-                                           params=node_params(radius=0.7, blur_size=0))
+        expected[view] = node_native.compute_ao(depth, normal, camera=camera(out, 1, view),
+                                                params=node_params(radius=0.7, blur_size=0))
     for view in views:
         outputs = node_outputs(out, 1, view=suffix("nodes", view))
         assert expected[view].min() < 0.9, view
@@ -1052,7 +1055,7 @@ def test_border_crop_render_matches_the_full_frame(run_in_blender, tmp_path):
     assert np.abs(inner_crop - inner_full).max() <= 1e-3
 
 
-def test_guard_band_sees_occluders_outside_the_frame(run_in_blender, tmp_path, native):
+def test_guard_band_sees_occluders_outside_the_frame(run_in_blender, tmp_path, node_native):
     """Two nodes, one with a guard band of 12.5 % (an extra 1-sample Cycles
     render through a camera 1.25 times as wide). The truth: the library on a
     real render 1.25 times as large through that wider camera (120x80, the
@@ -1071,7 +1074,7 @@ def test_guard_band_sees_occluders_outside_the_frame(run_in_blender, tmp_path, n
     wide_out, _ = render(run_in_blender, tmp_path,
                          {"resolution": [int(width * scale), int(height * scale)],
                           "widen_camera": scale, "nodes": [node]}, name="wide")
-    wide = library_ao(native, wide_out, 1, node_params(radius=1.0))
+    wide = library_ao(node_native, wide_out, 1, node_params(radius=1.0))
     truth = wide[rows:rows + height, columns:columns + width]
     without = node_outputs(out, 1, "HBAO0")["ao"]
     with_band = node_outputs(out, 1, "HBAO1")["ao"]
@@ -1088,7 +1091,7 @@ def test_guard_band_sees_occluders_outside_the_frame(run_in_blender, tmp_path, n
 
 
 @pytest.mark.parametrize("size, percentage", [((200, 100), 58), ((300, 200), 41)])
-def test_cropped_border_at_a_resolution_percentage(run_in_blender, tmp_path, native, size,
+def test_cropped_border_at_a_resolution_percentage(run_in_blender, tmp_path, node_native, size,
                                                    percentage):
     """Blender's image at a resolution percentage is (resolution x
     percentage) / 100 in integers: 116 x 58 for 200 x 100 at 58 %. The
@@ -1110,13 +1113,14 @@ def test_cropped_border_at_a_resolution_percentage(run_in_blender, tmp_path, nat
                       for f, n in zip(border, (width, width, height, height)))
     depth, normal = frame_passes(cropped, 1)
     assert depth.shape == (y1 - y0, x1 - x0)
-    crop = native.camera_crop(camera(full, 1), width, height, x0, height - y1, x1 - x0, y1 - y0)
-    expected = native.compute_ao(depth, normal, params=node_params(**node), camera=crop)
+    crop = node_native.camera_crop(camera(full, 1), width, height, x0, height - y1, x1 - x0,
+                                   y1 - y0)
+    expected = node_native.compute_ao(depth, normal, params=node_params(**node), camera=crop)
     assert expected.min() < 0.9
     assert np.abs(node_outputs(cropped, 1)["ao"] - expected).max() <= EXACT
 
 
-def test_border_render_gets_no_guard_band_and_says_so(run_in_blender, tmp_path, native):
+def test_border_render_gets_no_guard_band_and_says_so(run_in_blender, tmp_path, node_native):
     """A border render (cropped) with a guard band asked for: the extra
     render cannot be used; the AO is exactly the library's on the cropped
     render without a band, the render's report says why and the node shows
@@ -1133,11 +1137,12 @@ def test_border_render_gets_no_guard_band_and_says_so(run_in_blender, tmp_path, 
     # and 16-48 of 64, from the bottom: blender_scenes.camera_description).
     depth, normal = frame_passes(out, 1)
     assert depth.shape == (32, 48)
-    expected = native.compute_ao(depth, normal, params=node_params(**node), camera=camera(out, 1))
+    expected = node_native.compute_ao(depth, normal, params=node_params(**node),
+                                      camera=camera(out, 1))
     assert np.abs(node_outputs(out, 1)["ao"] - expected).max() <= EXACT
 
 
-def test_back_faces_give_each_occluder_its_thickness(run_in_blender, tmp_path, native):
+def test_back_faces_give_each_occluder_its_thickness(run_in_blender, tmp_path, node_native):
     """Two nodes, one with Back Faces (an extra 1-sample Cycles render whose
     front faces are transparent). The back render sees the far side of the
     cube and the sphere, behind their front (thickness > 0), and the floor
@@ -1157,8 +1162,8 @@ def test_back_faces_give_each_occluder_its_thickness(run_in_blender, tmp_path, n
     known = (back > depth) & (back < 1e4)
     assert known.mean() > 0.05  # the cube and the sphere have far sides
     assert np.all(back[known] - depth[known] < 1.5)  # within the props' size
-    expected = native.compute_ao(depth, normal, params=node_params(**node),
-                                 camera=camera(out, 1), back_depth=back)
+    expected = node_native.compute_ao(depth, normal, params=node_params(**node),
+                                      camera=camera(out, 1), back_depth=back)
     outputs = node_outputs(out, 1, "HBAO1")
     plain = node_outputs(out, 1, "HBAO0")["ao"]
     layered = outputs["ao"]
@@ -1173,7 +1178,7 @@ def test_back_faces_give_each_occluder_its_thickness(run_in_blender, tmp_path, n
 
 @pytest.mark.parametrize("how", ["append", "link"])
 def test_appended_or_linked_scene_renders_with_ao(run_in_blender, blender,
-                                                  blender_user_scripts, tmp_path, native, how):
+                                                  blender_user_scripts, tmp_path, node_native, how):
     """A scene with an HBAO node, appended or linked into another file, still
     renders its AO: the hook's helper scene comes along and is found again."""
     blend = tmp_path / "source.blend"
@@ -1191,9 +1196,9 @@ def test_appended_or_linked_scene_renders_with_ao(run_in_blender, blender,
         (setup / "camera_0001.json").write_text(json.dumps(
             _camera_of(blender, blender_user_scripts, blend, tmp_path)))
         depth, normal = frame_passes(out, 1)
-        expected = native.compute_ao(depth, normal,
-                                     params=node_params(radius=0.6, blur_size=0),
-                                     camera=camera(setup, 1))
+        expected = node_native.compute_ao(depth, normal,
+                                          params=node_params(radius=0.6, blur_size=0),
+                                          camera=camera(setup, 1))
         assert np.abs(ao - expected).max() <= EXACT
 
 
@@ -1222,7 +1227,7 @@ def _camera_of(blender, user_scripts, blend, tmp_path):
 
 @pytest.mark.ui
 @pytest.mark.parametrize("views", [[""], ["_L", "_R"]], ids=["mono", "stereo"])
-def test_f12_render_in_the_ui_job_thread(run_in_blender, tmp_path, native, views):
+def test_f12_render_in_the_ui_job_thread(run_in_blender, tmp_path, node_native, views):
     """F12 in a window renders in a job thread, the engine too (with Stereo
     3D, each eye from the engine's own camera calls there)."""
     out = tmp_path / "f12"
@@ -1233,18 +1238,18 @@ def test_f12_render_in_the_ui_job_thread(run_in_blender, tmp_path, native, views
     assert "Rendering without AO" not in completed.stdout, completed.stdout[-3000:]
     for view in views:
         ao = node_outputs(out, 1, view=view)["ao"]
-        expected = library_ao(native, out, 1, node_params(radius=0.9), view=view)
+        expected = library_ao(node_native, out, 1, node_params(radius=0.9), view=view)
         assert ao.min() < 0.9
         assert np.abs(ao - expected).max() <= EXACT, view
 
 
-def test_eevee_main_engine(run_in_blender, tmp_path, native):
+def test_eevee_main_engine(run_in_blender, tmp_path, node_native):
     spec = {"engine": "BLENDER_EEVEE", "resolution": [64, 48], "samples": 1,
             "nodes": [{"radius": 0.8}]}
     out, _ = render(run_in_blender, tmp_path, spec)
     ao = node_outputs(out, 1)["ao"]
     assert ao.min() < 0.9
-    expected = library_ao(native, out, 1, node_params(radius=0.8))
+    expected = library_ao(node_native, out, 1, node_params(radius=0.8))
     assert np.abs(ao - expected).max() <= EXACT
 
 
@@ -1414,7 +1419,8 @@ def test_a_group_rebuild_refused_midway_keeps_the_nodes_values(run_in_blender):
     assert state["refused"] and state["current"] and not state["pending"], state
     assert state["radius"] == 3.5 and state["directions"] == 7, state
     assert state["strength_from"] == ["Strength Value"] and state["depth_linked"], state
-    assert state["ao_pass_default"] == 1.0, state
+    # the pass input's value is the layout's (no occlusion), not the old 1
+    assert state["ao_pass_default"] == 0.0, state
 
 
 def test_a_file_with_the_old_group_keeps_its_keyframes_in_every_blender(run_in_blender, tmp_path):
@@ -1436,6 +1442,9 @@ def test_a_file_with_the_old_group_keeps_its_keyframes_in_every_blender(run_in_b
                                      for name in ("Directions", "Steps", "Blur Size")}, state
     assert state["directions"] == 8 and state["steps_source"] == ["Steps Value"], state
     assert state["blur"] == [3, 6, 9], state
+    # The hidden pass input held the AO before layout 5 (1 unlinked), the
+    # occlusion since: the old 1 is not kept (it would black the image).
+    assert state["ao_pass_value"] == 0.0, state
     # Everything set on a curve is kept, not its keys alone (5.3 deleted the
     # modifiers, easing and keyframe types with the curve).
     curve = state["radius_curve"]

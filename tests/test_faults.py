@@ -75,17 +75,17 @@ def test_users_png_output_is_restored_after_the_pass_hand_over(run_in_blender, t
 
 
 @pytest.mark.parametrize("edit", ["rename_node", "rename_helper"])
-def test_renamed_node_or_helper_scene_still_renders_ao(run_in_blender, tmp_path, native,
+def test_renamed_node_or_helper_scene_still_renders_ao(run_in_blender, tmp_path, node_native,
                                                        no_leftovers, edit):
     out, log = render(run_in_blender, tmp_path, {
         "prepare": ["sync", edit], "nodes": [{"radius": 0.8, "blur_size": 0}]})
     assert "without AO" not in log, log[-3000:]
     ao = node_outputs(out, 1)["ao"]
-    expected = library_ao(native, out, 1, node_params(radius=0.8, blur_size=0))
+    expected = library_ao(node_native, out, 1, node_params(radius=0.8, blur_size=0))
     assert np.abs(ao - expected).max() <= EXACT
 
 
-def test_deleted_helper_scene_is_rebuilt_or_explained(run_in_blender, tmp_path, native,
+def test_deleted_helper_scene_is_rebuilt_or_explained(run_in_blender, tmp_path, node_native,
                                                       no_leftovers):
     out, log = render(run_in_blender, tmp_path, {
         "prepare": ["sync", "delete_helper"], "nodes": [{"radius": 0.8, "blur_size": 0}]})
@@ -95,7 +95,7 @@ def test_deleted_helper_scene_is_rebuilt_or_explained(run_in_blender, tmp_path, 
         # artist is told what to do instead.
         assert "HBAO" in log and "helper" in log.lower(), log[-3000:]
     else:
-        expected = library_ao(native, out, 1, node_params(radius=0.8, blur_size=0))
+        expected = library_ao(node_native, out, 1, node_params(radius=0.8, blur_size=0))
         assert np.abs(ao - expected).max() <= EXACT
 
 
@@ -180,7 +180,7 @@ def test_full_disk_renders_without_ao_leaves_nothing_and_restores_settings(
 
 
 def test_passes_that_do_not_fit_in_the_first_scratch_folder_go_to_the_next(
-        run_in_blender, tmp_path, native, full_disk):
+        run_in_blender, tmp_path, node_native, full_disk):
     """HBAO_TEMP_DIR lists folders to try in turn (by default /dev/shm, then
     the system's temporary folder: a container's /dev/shm is 64 MB, less
     than a 1080p render's Combined, Depth and Normal, and every frame lost
@@ -200,7 +200,7 @@ def test_passes_that_do_not_fit_in_the_first_scratch_folder_go_to_the_next(
     assert log.count(f"cannot read back the passes saved in {full_disk}") == 1, log[-3000:]
     assert f"saving them in {second} instead" in log
     for frame in (1, 2):
-        expected = library_ao(native, out, frame, node_params(**node))
+        expected = library_ao(node_native, out, frame, node_params(**node))
         assert expected.min() < 0.9
         assert np.abs(node_outputs(out, frame)["ao"] - expected).max() <= EXACT
     assert list(full_disk.iterdir()) == [] and list(second.iterdir()) == []
@@ -214,7 +214,7 @@ def test_scratch_folder_that_cannot_be_written_says_which_and_how(run_in_blender
     assert "HBAO_TEMP_DIR names existing folders" in log
 
 
-def test_a_scratch_folder_that_does_not_exist_is_not_made(run_in_blender, tmp_path, native,
+def test_a_scratch_folder_that_does_not_exist_is_not_made(run_in_blender, tmp_path, node_native,
                                                           no_leftovers):
     """A mistyped HBAO_TEMP_DIR folder: Blender's save made it (parents too)
     and the passes went there, silently, the folder left behind (an
@@ -238,24 +238,24 @@ def test_a_scratch_folder_that_does_not_exist_is_not_made(run_in_blender, tmp_pa
     assert f"cannot save the passes for the AO in {read_only}" in log, log[-3000:]
     assert not (tmp_path / "missing").exists()
     assert "could not remove" not in log and "without AO" not in log, log[-3000:]
-    expected = library_ao(native, out, 1, node_params(**node))
+    expected = library_ao(node_native, out, 1, node_params(**node))
     assert np.abs(node_outputs(out, 1)["ao"] - expected).max() <= EXACT
 
 
 @pytest.mark.min_blender(5, 0)
-def test_two_scenes_sharing_one_compositing_group(run_in_blender, tmp_path, native,
+def test_two_scenes_sharing_one_compositing_group(run_in_blender, tmp_path, node_native,
                                                   no_leftovers):
     out, log = render(run_in_blender, tmp_path, {
         "prepare": ["sync", "second_scene_shares_the_tree"],
         "nodes": [{"radius": 0.8, "blur_size": 0}]})
     assert "without AO" not in log, log[-3000:]
     ao = node_outputs(out, 1)["ao"]
-    expected = library_ao(native, out, 1, node_params(radius=0.8, blur_size=0))
+    expected = library_ao(node_native, out, 1, node_params(radius=0.8, blur_size=0))
     assert np.abs(ao - expected).max() <= EXACT
 
 
 @pytest.mark.min_blender(5, 3)
-def test_another_compositor_effect_after_the_hbao_one(run_in_blender, tmp_path, native,
+def test_another_compositor_effect_after_the_hbao_one(run_in_blender, tmp_path, node_native,
                                                       no_leftovers):
     """5.3 composites a stack of effects; Add Effect makes the new one active,
     and the add-on, which served the active effect's group, left the HBAO
@@ -266,13 +266,13 @@ def test_another_compositor_effect_after_the_hbao_one(run_in_blender, tmp_path, 
                                                  "nodes": [node]})
     assert 'EFFECTS [["Scene Effect", false], ["Second", true]]' in log, log[-3000:]
     assert "without AO" not in log and "renders nothing" not in log, log[-3000:]
-    expected = library_ao(native, out, 1, node_params(**node))
+    expected = library_ao(node_native, out, 1, node_params(**node))
     assert np.abs(node_outputs(out, 1)["ao"] - expected).max() <= EXACT
 
 
 @pytest.mark.min_blender(5, 3)
 def test_an_hbao_node_in_a_second_compositor_effect_says_why_it_gives_no_ao(
-        run_in_blender, tmp_path, native, no_leftovers):
+        run_in_blender, tmp_path, node_native, no_leftovers):
     node = {"radius": 0.8, "blur_size": 0}
     out, log = render(run_in_blender, tmp_path, {
         "prepare": ["sync", "second_effect_with_a_node"], "nodes": [node]})
@@ -280,7 +280,7 @@ def test_an_hbao_node_in_a_second_compositor_effect_says_why_it_gives_no_ao(
             'in one compositor effect of a scene, the first enabled for renders whose node group '
             'holds an HBAO node ("Scene Effect")')
     assert log.count(said) == 1, log[-3000:]
-    expected = library_ao(native, out, 1, node_params(**node))
+    expected = library_ao(node_native, out, 1, node_params(**node))
     assert np.abs(node_outputs(out, 1)["ao"] - expected).max() <= EXACT
 
 
@@ -350,8 +350,31 @@ def test_the_hbao_effect_off_for_renders_says_that_the_render_has_no_ao(
     assert (out / "frame_0001.exr").exists() and not (out / "nodes_0001.exr").exists()
 
 
+# The control image of viewport_compositor.py: lit, far from black.
+VIEWPORT_CONTROL_MEAN_MIN = 0.3
+
+
+@pytest.mark.min_blender(5, 3)
+def test_the_viewport_compositor_shows_the_image_without_ao_not_black(run_in_blender):
+    """The Viewport Compositor (3D view, Material Preview, Compositor Always
+    or Camera) renders no other scene, so the helper's pass reads 0 there:
+    the node's Image was black (its pass held the AO). The pass holds the
+    occlusion since the group's layout 5, so 0 is no AO: the node's Image is
+    the image, its AO 1. bpy 5.3 draws headless (gpu.init); 4.5's and 5.0's
+    gpu module refuses to draw in background mode, and 3.4 has no Viewport
+    Compositor."""
+    completed = run_in_blender(SCRIPTS / "viewport_compositor.py")
+    line = next((text for text in completed.stdout.splitlines()
+                 if text.startswith("VIEWPORT COMPOSITOR ")), None)
+    assert line is not None, completed.stdout[-3000:]
+    for mode, drawn in json.loads(line[len("VIEWPORT COMPOSITOR "):]).items():
+        assert drawn["control_mean"] >= VIEWPORT_CONTROL_MEAN_MIN, (mode, drawn)
+        assert drawn["image_difference"] == EXACT, (mode, drawn)
+        assert drawn["ao_range"] == [1.0, 1.0], (mode, drawn)
+
+
 @pytest.mark.min_blender(4, 2)
-def test_the_add_on_scenes_set_to_the_gpu_compositor(run_in_blender, tmp_path, native,
+def test_the_add_on_scenes_set_to_the_gpu_compositor(run_in_blender, tmp_path, node_native,
                                                      no_leftovers):
     """4.5 and 5.0 crash (segmentation fault, Blender's own) rendering a
     scene whose compositor renders another scene set to the GPU compositor,
@@ -365,8 +388,8 @@ def test_the_add_on_scenes_set_to_the_gpu_compositor(run_in_blender, tmp_path, n
 
 
 @pytest.mark.parametrize("beside", [False, True], ids=["alone", "beside_a_top_level_node"])
-def test_hbao_node_inside_a_node_group_says_why_it_gives_no_ao(run_in_blender, tmp_path, native,
-                                                               no_leftovers, beside):
+def test_hbao_node_inside_a_node_group_says_why_it_gives_no_ao(run_in_blender, tmp_path,
+                                                               node_native, no_leftovers, beside):
     """An HBAO node that an artist put into a node group of their own passes
     Image through with a white AO, and the render's console (and, with a
     window, the Info editor) says why, once; the node itself says so too
@@ -383,7 +406,7 @@ def test_hbao_node_inside_a_node_group_says_why_it_gives_no_ao(run_in_blender, t
     assert_no_ao_and_image_unchanged(out, grouped_name)
     if beside:
         ao = node_outputs(out, 1)["ao"]
-        expected = library_ao(native, out, 1, node_params(radius=0.8, blur_size=0))
+        expected = library_ao(node_native, out, 1, node_params(radius=0.8, blur_size=0))
         assert np.abs(ao - expected).max() <= EXACT
 
 
@@ -448,8 +471,8 @@ def latin1_locale(tmp_path_factory):
 
 
 @pytest.mark.min_blender(4, 5)
-def test_a_console_and_folder_in_a_latin1_locale(run_in_blender, tmp_path, native, no_leftovers,
-                                                 latin1_locale):
+def test_a_console_and_folder_in_a_latin1_locale(run_in_blender, tmp_path, node_native,
+                                                 no_leftovers, latin1_locale):
     """bpy (not 3.4's Blender, whose Python is in UTF-8 mode) under a
     non-UTF-8 locale (LANG=de_DE gives ISO-8859-1) writes its console in
     that encoding, strictly, and names files in it. A console line naming a
@@ -472,12 +495,13 @@ def test_a_console_and_folder_in_a_latin1_locale(run_in_blender, tmp_path, nativ
     assert sorted(p.name for p in no_leftovers.iterdir()) == [folder.name]
     assert not any(folder.iterdir())
     folder.rmdir()
-    expected = library_ao(native, out, 1, node_params(radius=0.8))
+    expected = library_ao(node_native, out, 1, node_params(radius=0.8))
     assert np.abs(node_outputs(out, 1, "HBAO1")["ao"] - expected).max() <= EXACT
 
 
 @pytest.mark.parametrize("length", [56, 57])
-def test_long_view_layer_names(run_in_blender, blender, tmp_path, native, no_leftovers, length):
+def test_long_view_layer_names(run_in_blender, blender, tmp_path, node_native, no_leftovers,
+                               length):
     """Blender before 5.0 cuts EXR channel names at 64 bytes: a view layer
     of 56 bytes loses its Normal pass ("<layer>.Normal.X" is 65), one of 57
     its Depth too. The node then says so and reconstructs the normals, or
@@ -489,12 +513,12 @@ def test_long_view_layer_names(run_in_blender, blender, tmp_path, native, no_lef
     ao = node_outputs(out, 1)["ao"]
     params = node_params(radius=0.8, blur_size=0)
     if blender.version_tuple >= (5, 0):
-        expected = library_ao(native, out, 1, params, layer=name)
+        expected = library_ao(node_native, out, 1, params, layer=name)
         assert np.abs(ao - expected).max() <= EXACT
     elif length == 56:
         assert "Normal comes from view layer" in log, log[-3000:]
         assert "at most 55 bytes (it has 56)" in log, log[-3000:]
-        expected = library_ao(native, out, 1, params, with_normal=False, layer=name)
+        expected = library_ao(node_native, out, 1, params, with_normal=False, layer=name)
         assert np.abs(ao - expected).max() <= EXACT
     else:
         assert "Depth comes from view layer" in log, log[-3000:]
@@ -503,7 +527,7 @@ def test_long_view_layer_names(run_in_blender, blender, tmp_path, native, no_lef
 
 
 def test_a_long_view_layer_name_in_a_render_with_one_view(run_in_blender, blender, tmp_path,
-                                                          native, no_leftovers):
+                                                          node_native, no_leftovers):
     """Blender 3.4 saves a render with one view on (Stereoscopy, the right
     eye off) with the view in its channel names ("<layer>.Normal.left.X")
     and cuts them past 63 bytes: a 50-byte layer (a mono render keeps 55)
@@ -524,13 +548,13 @@ def test_a_long_view_layer_name_in_a_render_with_one_view(run_in_blender, blende
     passes = exr.read_channels(out / f"frame_0001{suffix}.exr", channels)
     normal = np.stack([passes[c] for c in channels[1:]], axis=-1) if with_normal else None
     description = json.loads((out / "camera_0001_L.json").read_text())
-    expected = native.compute_ao(passes[channels[0]], normal, camera=description,
-                                 params=node_params(radius=0.8, blur_size=0))
+    expected = node_native.compute_ao(passes[channels[0]], normal, camera=description,
+                                      params=node_params(radius=0.8, blur_size=0))
     ao = node_outputs(out, 1, view="_L" if (out / "nodes_0001_L.exr").exists() else "")["ao"]
     assert expected.min() < 0.9 and np.abs(ao - expected).max() <= EXACT
 
 
-def test_a_pass_the_render_engine_does_not_make_is_not_read(run_in_blender, tmp_path, native,
+def test_a_pass_the_render_engine_does_not_make_is_not_read(run_in_blender, tmp_path, node_native,
                                                             no_leftovers):
     """A scene switched to Workbench after its passes were linked: Workbench
     makes no Normal pass, and Blender 3.4 keeps the Normal link to the Render
@@ -540,7 +564,7 @@ def test_a_pass_the_render_engine_does_not_make_is_not_read(run_in_blender, tmp_
     out, log = render(run_in_blender, tmp_path, {"prepare": ["switch_to_workbench"],
                                                  "nodes": [{"radius": 0.8, "blur_size": 0}]})
     assert "KeyError" not in log and "Rendering without AO" not in log, log[-3000:]
-    expected = library_ao(native, out, 1, node_params(radius=0.8, blur_size=0),
+    expected = library_ao(node_native, out, 1, node_params(radius=0.8, blur_size=0),
                           with_normal=False)
     assert np.abs(node_outputs(out, 1)["ao"] - expected).max() <= EXACT
 
@@ -596,7 +620,7 @@ def test_internal_engine_picked_by_the_artist_explains_itself(run_in_blender, tm
 
 
 def test_helper_resized_after_the_sync_still_renders_exact_ao(run_in_blender, tmp_path,
-                                                              native, no_leftovers):
+                                                              node_native, no_leftovers):
     """The helper scene is set to half size after the hook synced it (a
     render_pre handler of the artist's), to make its pass smaller than the
     Render Result. Blender renders the helper at the Render Result's size
@@ -610,7 +634,7 @@ def test_helper_resized_after_the_sync_still_renders_exact_ao(run_in_blender, tm
     assert "FAULT resized" in log, log[-3000:]
     assert output_settings(log)["file_format"] == "OPEN_EXR_MULTILAYER"
     assert "without AO" not in log, log[-3000:]
-    expected = library_ao(native, out, 1, node_params(radius=1.0, blur_size=0))
+    expected = library_ao(node_native, out, 1, node_params(radius=1.0, blur_size=0))
     assert np.abs(node_outputs(out, 1)["ao"] - expected).max() <= EXACT
 
 

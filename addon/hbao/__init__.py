@@ -7,9 +7,9 @@ imported by register(), so that parameters, native, exr_passes, camera and
 viewport.projection/shader_sources work in plain Python (tests, benchmarks).
 
     bpy-free   parameters, library_loading, native, exr_passes, camera,
-               timing_line, scratch_names,
+               timing_line, scratch_names, pass_encoding,
                viewport.projection, viewport.shader_sources
-    Blender    compat (every version difference), writes, preferences, node,
+    Blender    compat (every version difference), compat_nodes, writes, preferences, node,
                helper_lookup, helper_scene, socket_values, planning, handover, engine,
                engine_guard, render_reports, handlers,
                viewport.*

@@ -105,6 +105,15 @@ def restore_image_settings(settings, saved):
             pass  # an enum value not valid for the restored format is re-derived
 
 
+def set_image_format(image_format, file_format):
+    """Set an ImageFormatSettings' file format. 5.0 filters the formats by
+    media_type, so the media type goes first."""
+    if hasattr(image_format, "media_type"):
+        image_format.media_type = ("MULTI_LAYER_IMAGE" if file_format == "OPEN_EXR_MULTILAYER"
+                                   else "IMAGE")
+    image_format.file_format = file_format
+
+
 def set_multilayer_exr(settings):
     """Make `settings` (ImageFormatSettings) save a single-part multilayer
     OpenEXR, the layout libhbao_exr reads, with no preview image beside it."""
@@ -192,35 +201,6 @@ def clear_group_interface(tree):
         tree.outputs.clear()
 
 
-def new_multiply_node(tree):
-    """A node that multiplies a colour by a factor-like value (Image x AO).
-    Returns (node, first colour input, second input, output)."""
-    try:
-        node = tree.nodes.new("CompositorNodeMixRGB")
-        node.blend_type = "MULTIPLY"
-        node.inputs[0].default_value = 1.0
-        return node, node.inputs[1], node.inputs[2], node.outputs[0]
-    except RuntimeError:
-        # 5.x compositor: the shared Mix node in RGBA mode.
-        node = tree.nodes.new("ShaderNodeMix")
-        node.data_type = "RGBA"
-        node.blend_type = "MULTIPLY"
-        node.inputs["Factor"].default_value = 1.0
-        colour_inputs = [s for s in node.inputs if s.type == "RGBA"]
-        colour_output = [s for s in node.outputs if s.type == "RGBA"][0]
-        return node, colour_inputs[0], colour_inputs[1], colour_output
-
-
-def new_composite_output(tree):
-    """The node that receives the final image: Composite (<5.0) or Group Output."""
-    if HAS_COMPOSITING_NODE_GROUP:
-        node = tree.nodes.new("NodeGroupOutput")
-        if "Image" not in group_socket_names(tree, "OUTPUT"):
-            new_group_socket(tree, "OUTPUT", "NodeSocketColor", "Image")
-        return node
-    return tree.nodes.new("CompositorNodeComposite")
-
-
 def find_fcurve(id_data, data_path, index=0):
     """The F-Curve animating `data_path` of `id_data`, or None (legacy and
     4.4+ layered actions)."""
@@ -245,38 +225,6 @@ def engine_identifier(engine):
     if engine == "BLENDER_EEVEE" and (4, 2, 0) <= VERSION < (5, 0, 0):
         return "BLENDER_EEVEE_NEXT"
     return engine
-
-
-# --- compositor nodes our scripts and tests build (5.0 renamed or reshaped them) ---
-
-def new_value_node(tree):
-    """A Value node: CompositorNodeValue before 5.0, ShaderNodeValue since."""
-    return tree.nodes.new("ShaderNodeValue" if HAS_COMPOSITING_NODE_GROUP
-                          else "CompositorNodeValue")
-
-
-# Render Layers outputs 5.0 renamed: old name -> new name.
-_RENAMED_PASS_OUTPUTS = {"AO": "Ambient Occlusion"}
-
-
-def pass_output(render_layers, name):
-    """A Render Layers node's output by its pre-5.0 name (AO is
-    "Ambient Occlusion" since 5.0)."""
-    output = render_layers.outputs.get(name)
-    if output is None and name in _RENAMED_PASS_OUTPUTS:
-        output = render_layers.outputs.get(_RENAMED_PASS_OUTPUTS[name])
-    if output is None:
-        raise KeyError(f"{render_layers.name} has no {name} output")
-    return output
-
-
-def set_image_format(image_format, file_format):
-    """Set an ImageFormatSettings' file format. 5.0 filters the formats by
-    media_type, so the media type goes first."""
-    if hasattr(image_format, "media_type"):
-        image_format.media_type = ("MULTI_LAYER_IMAGE" if file_format == "OPEN_EXR_MULTILAYER"
-                                   else "IMAGE")
-    image_format.file_format = file_format
 
 
 def motion_blur(scene):

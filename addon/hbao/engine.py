@@ -1,9 +1,10 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """The helper scene's render engine: renders nothing itself, but publishes
 one AO pass "HBAO <n>" per HBAO node of the tree it serves, computed by
-libhbao from the main Render Result's Depth and Normal passes.
+libhbao from the main Render Result's Depth and Normal passes; a pass holds
+the occlusion, 1 - AO (pass_encoding.py).
 
-Anything that goes wrong leaves the pass at 1 (no AO) with a message: the
+Anything that goes wrong leaves the pass at 0 (no AO) with a message: the
 render always completes."""
 import time
 
@@ -11,8 +12,9 @@ import bpy
 import numpy as np
 
 from . import camera as camera_model
-from . import (ao_cache, exr_passes, handover, job_inputs, layer_passes, native, recomposite,
-               render_record, scratch_files, strip_cameras, timing_line)
+from . import (ao_cache, exr_passes, handover, job_inputs, layer_passes, native,
+               pass_encoding, recomposite, render_record, scratch_files, strip_cameras,
+               timing_line)
 from .helper_lookup import ENGINE_IDNAME, is_helper, pass_names_for_helper
 from .helper_scene import rendered_for_a_scene, scene_for_render
 from .planning import node_names, plan, tell_all_nodes
@@ -142,7 +144,8 @@ INTERRUPTED = "stopped while the AO was computed: this frame renders without AO"
 
 
 def _fill_passes(result, results, width, height):
-    """Each registered AO pass of `result` gets its computed AO, or 1 (no AO)."""
+    """Each registered AO pass of `result` gets its computed AO's occlusion,
+    or 0 (no AO)."""
     stereo = any(view is not None for view, _name in results)
     for layer in result.layers:
         for render_pass in layer.passes:
@@ -151,12 +154,14 @@ def _fill_passes(result, results, width, height):
             view = result.views[render_pass.view_id].name if stereo else None
             ao = results.get((view, render_pass.name))
             if ao is None or ao.size != width * height:
-                ao = np.ones((height, width), np.float32)
-            render_pass.rect.foreach_set(ao.reshape(-1))
+                occlusion = np.full((height, width), pass_encoding.NO_OCCLUSION, np.float32)
+            else:
+                occlusion = pass_encoding.occlusion_pass(ao)
+            render_pass.rect.foreach_set(occlusion.reshape(-1))
 
 
 def render_helper(engine, depsgraph):
-    """HBAOPassEngine.render(): fill every registered AO pass, 1 where it failed."""
+    """HBAOPassEngine.render(): fill every registered AO pass, "no AO" where it failed."""
     scene = _original(depsgraph.scene)
     request = recomposite.request_for(scene)
     main = scene_for_render(scene) if is_helper(scene) else None
@@ -168,11 +173,10 @@ def render_helper(engine, depsgraph):
                             else NOT_FOR_RENDERING.format(label=HBAOPassEngine.bl_label))
         else:  # the node's place says why (node_place)
             log(f"{scene.name!r} rendered through a Render Layers node that the HBAO hook does "
-                f"not serve: its AO passes are 1")
-        # Its passes say "no AO" (1), not the zeros an unwritten result
-        # holds: a compositor that renders this scene through a Render Layers
-        # node the hook does not serve (5.3: in a nested group) multiplied
-        # its image by 0, a black frame.
+                f"not serve: its AO passes say no AO")
+        # Its passes say "no AO" (0): a compositor that renders this scene
+        # through a Render Layers node the hook does not serve (5.3: in a
+        # nested group) keeps its image as it is.
         result = engine.begin_result(0, 0, engine.resolution_x, engine.resolution_y)
         try:
             _fill_passes(result, {}, result.resolution_x, result.resolution_y)
@@ -214,7 +218,7 @@ def render_helper(engine, depsgraph):
         try:
             if not filled:
                 # Interrupted (bpy: Ctrl-C raises KeyboardInterrupt here):
-                # the passes say no AO, not the zeros that would black the image.
+                # the passes say no AO.
                 log(INTERRUPTED)
                 _fill_passes(result, {}, width, height)
         finally:

@@ -16,8 +16,8 @@ pointed at each scene's helper in turn would flip with every sync. The render
 handlers record the scene being rendered, which the engine reads."""
 import bpy
 
-from . import compat, extra_renders, helper_render_settings, hook_release, pass_sources, \
-    view_cameras, writes
+from . import compat, extra_renders, helper_render_settings, hook_release, pass_encoding, \
+    pass_sources, view_cameras, writes
 from .data_edits import set_if_different
 from .helper_lookup import (ENGINE_IDNAME, HELPER_SCENE_PREFIX, MAIN_SCENE_KEY, MAIN_TREE_KEY,
                             MANAGED_NODE_KEY, helper_scene_of, is_helper, main_scene_of,
@@ -244,7 +244,7 @@ def sync(scene):
         if not linked:  # AO 1: the node passes Image through
             for link in list(target.links):
                 tree.links.remove(link)
-            set_if_different(target, "default_value", 1.0)
+            set_if_different(target, "default_value", pass_encoding.NO_OCCLUSION)
             continue
         # Blender unhides linked sockets and refuses to hide them, so this one
         # link stays visible; the collapsed Render Layers node shows only it.

@@ -4,15 +4,16 @@ Reload Scripts, before a removal, as Blender quits).
 
 Each HBAO node's AO pass input is linked to the managed Render Layers node,
 whose helper scene only the add-on's engine renders. Disabled, Blender
-renders that scene with another engine, which writes no such pass: the node
-read 0 and the final image was black (Blender 3.4, which keeps the node's
-class, and bpy 5.3). So the pass input is unlinked (its value is then 1: the
+renders that scene with another engine, which writes no such pass (before
+the group's layout 5, whose pass holds the occlusion, the node then read 0
+and the final image was black: Blender 3.4, which keeps the node's class,
+and bpy 5.3). So the pass input is unlinked (its value is then "no AO": the
 node passes Image through) and the managed node muted, so that Blender does
 not render the helper scene at all. Enabled again, the add-on's sync links
 and unmutes them (helper_scene.py)."""
 import bpy
 
-from . import compat
+from . import compat, pass_encoding
 from .data_edits import set_if_different
 from .helper_lookup import managed_node
 from .node import AO_PASS_INPUT, hbao_nodes
@@ -38,12 +39,12 @@ def _release(tree):
 
 
 def unlink_ao_inputs(tree):
-    """The AO pass inputs of `tree`'s HBAO nodes unlinked and set to 1: the
-    nodes pass Image through."""
+    """The AO pass inputs of `tree`'s HBAO nodes unlinked and set to no AO:
+    the nodes pass Image through."""
     for node in hbao_nodes(tree):
         target = node.inputs.get(AO_PASS_INPUT)
         if target is None:
             continue
         for link in list(target.links):
             tree.links.remove(link)
-        set_if_different(target, "default_value", 1.0)
+        set_if_different(target, "default_value", pass_encoding.NO_OCCLUSION)

@@ -1,12 +1,12 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """The group tree every HBAO node shares: its sockets (which carry the
-artist's values), its contents (Image x AO pass), and its upgrade when a file
-saved with an older layout is opened."""
+artist's values), its contents (AO = 1 - the occlusion pass, Image x AO), and
+its upgrade when a file saved with an older layout is opened."""
 import json
 
 import bpy
 
-from . import compat, parameters, socket_keys
+from . import compat, compat_nodes, parameters, pass_encoding, socket_keys
 
 # One group tree shared by every HBAO node (the values live on each node's
 # own sockets). The leading dot hides it from data-block menus.
@@ -17,14 +17,19 @@ GROUP_TREE_NAME = ".HBAO"
 # 3: a Thickness socket after Strength.
 # 4: tooltips on every input, Radius and Thickness in scene units, no value
 #    fields on Depth, Normal and the hidden AO pass input.
-GROUP_TREE_VERSION = 4
+# 5: the hidden pass input carries the occlusion, 1 - AO, and defaults to 0:
+#    a pass nobody wrote reads 0 (the Viewport Compositor, which gives a
+#    compositor no other scene's passes; a machine without the add-on, whose
+#    helper scene renders no AO pass), which is now "no AO", not black.
+GROUP_TREE_VERSION = 5
 GROUP_VERSION_KEY = "hbao_group_version"
 
 IMAGE_INPUT = "Image"
 DEPTH_INPUT = "Depth"
 NORMAL_INPUT = "Normal"
-# The hidden input the hook links the computed AO pass to. Its default, 1,
-# is what the node outputs when the hook could not run: no AO, no harm.
+# The hidden input the hook links the computed pass to: the occlusion, 1 - AO
+# (engine.py writes it). Its default, 0, and the 0 of any pass left unwritten
+# are what the node outputs when the hook could not run: no AO, no harm.
 AO_PASS_INPUT = "HBAO Pass"
 IMAGE_OUTPUT = "Image"
 AO_OUTPUT = "AO"
@@ -91,7 +96,7 @@ def _build_group_tree(tree):
     for name, (key, default, minimum, maximum, socket_type, subtype) in VALUE_INPUTS.items():
         _new_input(tree, socket_type, name, default, minimum, maximum, subtype,
                    parameters.DESCRIPTIONS[key])
-    _new_input(tree, "NodeSocketFloat", AO_PASS_INPUT, 1.0, 0.0, 1.0,
+    _new_input(tree, "NodeSocketFloat", AO_PASS_INPUT, pass_encoding.NO_OCCLUSION, 0.0, 1.0,
                description=AO_PASS_TIP, hide_value=True)
     compat.new_group_socket(tree, "OUTPUT", "NodeSocketColor", IMAGE_OUTPUT)
     compat.new_group_socket(tree, "OUTPUT", "NodeSocketFloat", AO_OUTPUT)
@@ -100,12 +105,17 @@ def _build_group_tree(tree):
     group_input.location = (-300, 0)
     group_output = tree.nodes.new("NodeGroupOutput")
     group_output.location = (300, 0)
-    multiply, colour_a, colour_b, product = compat.new_multiply_node(tree)
+    one_minus, occlusion, ao = compat_nodes.new_one_minus_node(tree)
+    one_minus.name = one_minus.label = "AO = 1 - Pass"
+    one_minus.location = (-100, -150)
+    tree.links.new(group_input.outputs[AO_PASS_INPUT], occlusion)
+    multiply, colour_a, colour_b, product = compat_nodes.new_multiply_node(tree)
     multiply.name = multiply.label = "Image x AO"
+    multiply.location = (100, 0)
     tree.links.new(group_input.outputs[IMAGE_INPUT], colour_a)
-    tree.links.new(group_input.outputs[AO_PASS_INPUT], colour_b)
+    tree.links.new(ao, colour_b)
     tree.links.new(product, group_output.inputs[IMAGE_OUTPUT])
-    tree.links.new(group_input.outputs[AO_PASS_INPUT], group_output.inputs[AO_OUTPUT])
+    tree.links.new(ao, group_output.inputs[AO_OUTPUT])
     tree[GROUP_VERSION_KEY] = GROUP_TREE_VERSION
 
 
@@ -166,8 +176,11 @@ def _restore(node, states, targets):
         except (TypeError, ValueError, RuntimeError):
             pass  # keys of a socket whose kind changed: its value below
         try:
-            socket.default_value = (int(round(value)) if isinstance(socket.default_value, int)
-                                    else value)
+            # (the pass input's value is the layout's, not the artist's: a
+            # group of layout 4 held 1, which is now full occlusion)
+            if name != AO_PASS_INPUT:
+                socket.default_value = (int(round(value))
+                                        if isinstance(socket.default_value, int) else value)
         except (TypeError, ValueError):
             pass  # a socket whose kind changed beyond a number: keep its default
         for from_name, index in sources:

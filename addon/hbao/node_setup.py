@@ -5,7 +5,7 @@ View Layer properties, so an artist who adds the node cannot link them. The
 node's "Connect Passes" button turns the passes on and links them."""
 import bpy
 
-from . import compat, pass_sources
+from . import compat, compat_nodes, pass_sources
 from .helper_lookup import MANAGED_NODE_KEY
 from .node import hbao_nodes
 from .node_group import DEPTH_INPUT, IMAGE_INPUT, NORMAL_INPUT
@@ -51,7 +51,7 @@ def connect_passes(scene, node):
         target = node.inputs[input_name]
         if target.is_linked:
             continue
-        tree.links.new(compat.pass_output(source, output_name), target)
+        tree.links.new(compat_nodes.pass_output(source, output_name), target)
         linked.append(output_name)
     done = []
     if turned_on:

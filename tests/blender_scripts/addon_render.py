@@ -229,7 +229,8 @@ file_output = compositor.file_output(out_dir, "nodes_")
 first_layer = scene.view_layers[0].name
 file_output.add("Render", render_layers[first_layer].outputs["Image"])
 if spec.get("ao_reference"):
-    file_output.add("CyclesAO", blender_scenes.compat.pass_output(render_layers[first_layer], "AO"))
+    file_output.add("CyclesAO",
+                    blender_scenes.compat_nodes.pass_output(render_layers[first_layer], "AO"))
 
 connect_with_operator = []
 for index, node_spec in enumerate(spec.get("nodes", [{}])):

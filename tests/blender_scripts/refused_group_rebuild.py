@@ -31,6 +31,9 @@ value.name = "Strength Value"
 compositor.link(value.outputs[0], hbao.inputs["Strength"])
 tree = bpy.data.node_groups[node_group.GROUP_TREE_NAME]
 tree[node_group.GROUP_VERSION_KEY] = node_group.GROUP_TREE_VERSION - 1  # outdated
+# Layouts before 5 held the AO in the pass input, 1 where unlinked: kept, it
+# would now be full occlusion (a black image wherever the pass is unwritten).
+hbao.inputs[node_group.AO_PASS_INPUT].default_value = 1.0
 
 new_input = node_group._new_input
 calls = [0]

@@ -36,6 +36,9 @@ for name in ("Image", "Depth", "Normal"):
     compositor.link(layers.outputs[name], hbao.inputs[name])
 compositor.composite(hbao.outputs["Image"])
 hbao.inputs["Directions"].default_value = 8.0
+# The hidden pass input as layouts 1-4 left it unlinked: 1, the AO of no
+# occlusion then.
+hbao.inputs[node_group.AO_PASS_INPUT].default_value = 1.0
 value = compositor.value(7.0)
 value.name = "Steps Value"
 # Beside the node and below the Render Layers node, over neither: the UI
