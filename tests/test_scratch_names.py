@@ -4,6 +4,10 @@ cleanup and the soak's leftover check recognise exactly the names the
 hand-over gives its scratch files (tests/blender_scripts/scratch_removal.py
 removes real ones)."""
 import fnmatch
+import os
+import shutil
+import subprocess
+import sys
 
 import pytest
 
@@ -11,29 +15,58 @@ from conftest import REPO  # noqa: F401  (puts the add-on on sys.path)
 from hbao import scratch_names
 
 
-def test_a_name_gives_back_its_process():
-    name = scratch_names.name(4242, 139872, 7)
-    assert name == "hbao-passes-4242-139872-7.exr"
-    assert scratch_names.process_of(name) == 4242
+def test_a_name_gives_back_its_owner():
+    name = scratch_names.name(4242, 139872, 7, "0badcafe", "12345678")
+    assert name == "hbao-passes-4242-139872-7-0badcafe-12345678.exr"
+    assert scratch_names.owner_of(name) == (4242, "0badcafe", "12345678")
     assert fnmatch.fnmatchcase(name, scratch_names.glob_of(4242))
     assert not fnmatch.fnmatchcase(name, scratch_names.glob_of(424))
 
 
-def test_names_before_session_19_and_other_files():
-    assert scratch_names.process_of("hbao-passes-4242-139872.exr") == 4242
+def test_names_before_sessions_19_and_33_and_other_files():
+    assert scratch_names.owner_of("hbao-passes-4242-139872.exr") == (4242, None, None)
+    assert scratch_names.owner_of("hbao-passes-4242-139872-7.exr") == (4242, None, None)
     for other in ("hbao-passes-notes.exr", "hbao-passes-4242-1-2.exr.tmp",
                   "hbao-passes--1-2.exr", "render-4242-1-2.exr", "hbao-passes-4242.exr"):
-        assert scratch_names.process_of(other) is None, other
+        assert scratch_names.owner_of(other) is None, other
 
 
 def test_a_stereo_renders_view_files():
     """A stereo or multi-view save writes a file per view, its file suffix
     before the extension (view_files.view_path): recognised as the same
     process's, so that a killed Blender's view files are removed too."""
-    name = scratch_names.name(4242, 139872, 7)
+    name = scratch_names.name(4242, 139872, 7, "0badcafe", "12345678")
     for suffix in ("_L", "_R", "-center view"):
-        assert scratch_names.process_of(name[:-len(".exr")] + suffix + ".exr") == 4242, suffix
-    assert scratch_names.process_of("hbao-passes-4242-139872-7_L.exr.tmp") is None
+        owner = scratch_names.owner_of(name[:-len(".exr")] + suffix + ".exr")
+        assert owner == (4242, "0badcafe", "12345678"), suffix
+    assert scratch_names.owner_of(name[:-len(".exr")] + "_L.exr.tmp") is None
+
+
+SPACE_AND_RUN = ("from hbao import scratch_files; "
+                 "print(scratch_files._space, scratch_files._run)")
+
+
+def test_each_blender_names_its_files_apart_and_knows_its_space():
+    """Two processes of one machine and PID namespace share a space and
+    differ in their run, so no two Blenders make one name, even with the
+    same process and thread ids (two containers whose Blenders had the same
+    ids, with address space randomisation off, made one name: one frame got
+    another's AO, an exploratory run). A process of another PID namespace
+    (unshare) has another space."""
+    environment = dict(os.environ, PYTHONPATH=str(REPO / "addon"))
+    command = [sys.executable, "-c", SPACE_AND_RUN]
+    first, second = (subprocess.run(command, env=environment, check=True, text=True,
+                                    stdout=subprocess.PIPE).stdout.split() for _ in range(2))
+    assert first[0] == second[0] and first[1] != second[1], (first, second)
+    assert all(len(part) == 8 and int(part, 16) >= 0 for part in first + second)
+    if shutil.which("unshare") is None:
+        pytest.fail("unshare missing: Debian's util-linux has it")
+    namespaced = subprocess.run(["unshare", "--pid", "--fork", "--mount-proc"] + command,
+                                env=environment, text=True, stdout=subprocess.PIPE,
+                                stderr=subprocess.STDOUT)
+    # (needs root or user namespaces, which the project's machines allow)
+    assert namespaced.returncode == 0, namespaced.stdout
+    assert namespaced.stdout.split()[0] != first[0], namespaced.stdout
 
 
 def test_view_files_stay_beside_the_scratch_file(tmp_path):
@@ -41,7 +74,7 @@ def test_view_files_stay_beside_the_scratch_file(tmp_path):
     a suffix that would reach another folder (where the save would write and
     the removal then delete an artist's file) is refused before the save."""
     from hbao import view_files
-    path = str(tmp_path / scratch_names.name(4242, 1, 0))
+    path = str(tmp_path / scratch_names.name(4242, 1, 0, "0badcafe", "12345678"))
     files = view_files.files(path, [("left", "_L"), ("right", "_R")])
     assert files == {"left": path[:-4] + "_L.exr", "right": path[:-4] + "_R.exr"}
     with pytest.raises(ValueError, match="folder separator"):

@@ -4,8 +4,10 @@ Result there and reads it back) and how they are removed: in the
 background, after the AO; those of Blenders that have ended, at the first
 hand-over. bpy-free; their names are scratch_names.py's."""
 import contextlib
+import hashlib
 import itertools
 import os
+import socket
 import tempfile
 import threading
 import time
@@ -58,10 +60,37 @@ def failed(folder, paths):
 _scratch_numbers = itertools.count()
 
 
+def _read_text(path):
+    try:
+        with open(path, encoding="ascii", errors="replace") as file:
+            return file.read().strip()
+    except OSError:
+        return ""
+
+
+def process_space():
+    """8 hex digits naming where this process's id means something: the
+    machine's boot (Linux's boot_id, else the host name) and its PID
+    namespace (the inode of /proc/self/ns/pid, where there is one). Two
+    Blenders of one space see each other's process ids; of two spaces, not
+    (another machine, another container)."""
+    boot = _read_text("/proc/sys/kernel/random/boot_id") or socket.gethostname()
+    try:
+        namespace = os.stat("/proc/self/ns/pid").st_ino
+    except OSError:
+        namespace = 0
+    return hashlib.sha256(f"{boot}/{namespace}".encode()).hexdigest()[:8]
+
+
+# This process's: its space, and a random run (scratch_names.py).
+_space = process_space()
+_run = os.urandom(4).hex()
+
+
 def path_in(folder):
     """A new scratch file's path in `folder`."""
     return os.path.join(folder, scratch_names.name(
-        os.getpid(), threading.get_ident(), next(_scratch_numbers)))
+        os.getpid(), threading.get_ident(), next(_scratch_numbers), _space, _run))
 
 
 def _process_ended(pid):
@@ -74,18 +103,38 @@ def _process_ended(pid):
     return False
 
 
-# A scratch file lives for a second at most; one this old is left over.
+# How often a process looks for stale scratch files (remove_stale_now_and_then),
+# and how old a file of the names before session 33 must be to be stale.
 STALE_AGE_S = 600
+# How old a file of another space (scratch_names.py) must be to be stale: its
+# process cannot be asked about from here, and the clocks of the machines
+# that share a folder may differ (a file server's clock sets its time). A
+# scratch file lives for a second or so; an hour covers any clock a farm
+# keeps in step.
+OTHER_SPACE_STALE_AGE_S = 3600
+
+
+def _stale(owner, age_s):
+    """Whether a scratch file of `owner` (scratch_names.Owner), `age_s`
+    old by this machine's clock, is left over: this space's, of a process
+    that has ended (this process's id with another run: one that ended
+    before this process got its id); another space's, an hour old; one
+    named before session 33, of an ended process and STALE_AGE_S old."""
+    if owner.space == _space:
+        if owner.process == os.getpid():
+            return owner.run != _run
+        return _process_ended(owner.process)
+    if owner.space is not None:
+        return age_s >= OTHER_SPACE_STALE_AGE_S
+    return age_s >= STALE_AGE_S and _process_ended(owner.process)
 
 
 def remove_stale_scratch_files():
     """Remove the scratch files of Blender processes that have ended: one
     killed while it handed passes over, or a bpy script that ended by
-    os._exit before its removal thread was done. Only files older than
-    STALE_AGE_S: a process of another PID namespace that shares the folder
-    looks ended from here, but its files are never that old. A file of a
-    running process, or one this user may not remove, is left alone.
-    Returns the paths removed."""
+    os._exit before its removal thread was done (_stale says which). A
+    file of a running process, or one this user may not remove, is left
+    alone. Returns the paths removed."""
     removed = []
     for folder in folders():
         try:
@@ -94,12 +143,12 @@ def remove_stale_scratch_files():
             continue
         now = time.time()
         for name in names:
-            process = scratch_names.process_of(name)
-            if process is None or not _process_ended(process):
+            owner = scratch_names.owner_of(name)
+            if owner is None:
                 continue
             path = os.path.join(folder, name)
             try:
-                if now - os.stat(path).st_mtime < STALE_AGE_S:
+                if not _stale(owner, now - os.stat(path).st_mtime):
                     continue
                 os.remove(path)
                 removed.append(path)

@@ -6,7 +6,7 @@ fault set up first, by a render_pre handler registered after the add-on's
   blender -b --addons hbao --python fault_render.py -- '<json spec>' <out dir> <fault>
 
 Faults:
-  unreadable_save   the scratch path (HBAO_TEMP_DIR/hbao-passes-<pid>-<thread>-0.exr,
+  unreadable_save   the scratch path (HBAO_TEMP_DIR/hbao-passes-<pid>-<thread>-0-...,
                     known here: a -b render runs in this thread, and its first
                     hand-over saves the process's first scratch file) is a link
                     to /dev/null: the save "succeeds", the file read back is
@@ -38,8 +38,9 @@ def helper_scenes():
 if fault == "unreadable_save":
     # The add-on's own naming (scratch_files.path_in): the test checks the
     # link is gone afterwards, so a changed name fails it rather than passing.
-    link = os.path.join(os.environ["HBAO_TEMP_DIR"],
-                        f"hbao-passes-{os.getpid()}-{threading.get_ident()}-0.exr")
+    scratch_files = sys.modules["hbao.scratch_files"]
+    link = os.path.join(os.environ["HBAO_TEMP_DIR"], sys.modules["hbao.scratch_names"].name(
+        os.getpid(), threading.get_ident(), 0, scratch_files._space, scratch_files._run))
     os.symlink("/dev/null", link)
     print("FAULT link", link, flush=True)
 elif fault == "helper_resized":

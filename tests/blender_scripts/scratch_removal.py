@@ -115,27 +115,49 @@ assert not os.path.exists(inner_path), "the file was not removed after the outer
 
 
 # Files left by Blenders that ended (killed, or os._exit before the removal
-# thread was done) go at a process's first hand-over: only files older than
-# scratch_files.STALE_AGE_S, of processes that have ended.
+# thread was done) go at a process's first hand-over (scratch_files._stale):
+# this space's (this machine's boot and PID namespace) of processes that have
+# ended, at once; another space's (another machine or container, whose
+# process ids mean nothing here and whose clock may differ) once an hour old,
+# even where its process id is alive here (a container's Blender was process
+# 1); a name from before session 33, of an ended process, 10 minutes old.
 os.environ[scratch_files.SCRATCH_FOLDER_VARIABLE] = folder
 ended = subprocess.Popen(["true"])
 ended.wait()
+space, run = scratch_files._space, scratch_files._run
+other_space = "0badcafe" if space != "0badcafe" else "0badf00d"
+other_run = "12345678" if run != "12345678" else "87654321"
 old = time.time() - scratch_files.STALE_AGE_S - 60
-names = {"stale": (f"hbao-passes-{ended.pid}-1-7.exr", old),
-         "stale, before session 19's numbers": (f"hbao-passes-{ended.pid}-1.exr", old),
-         "fresh": (f"hbao-passes-{ended.pid}-1-8.exr", None),
-         "this process's": (f"hbao-passes-{os.getpid()}-1-9.exr", old),
-         "not a scratch file": ("hbao-passes-notes.exr", old),
-         "no process id": (f"hbao-passes-{2 ** 80}-1-1.exr", old)}
+older = time.time() - scratch_files.OTHER_SPACE_STALE_AGE_S - 60
+names = {
+    "stale": (f"hbao-passes-{ended.pid}-1-7-{space}-{other_run}.exr", old),
+    "this space's, ended, fresh": (f"hbao-passes-{ended.pid}-1-8-{space}-{other_run}.exr", None),
+    "this process id's earlier run": (
+        f"hbao-passes-{os.getpid()}-1-3-{space}-{other_run}.exr", None),
+    "another space's, an hour old, its id alive here": (
+        f"hbao-passes-1-1-4-{other_space}-{run}.exr", older),
+    "stale, before session 33": (f"hbao-passes-{ended.pid}-1-5.exr", old),
+    "stale, before session 19's numbers": (f"hbao-passes-{ended.pid}-1.exr", old),
+    "fresh, before session 33": (f"hbao-passes-{ended.pid}-1-8.exr", None),
+    "this process's": (f"hbao-passes-{os.getpid()}-1-9-{space}-{run}.exr", older),
+    "another space's, 11 minutes old, its id ended here": (
+        f"hbao-passes-{ended.pid}-1-6-{other_space}-{other_run}.exr", old),
+    "not a scratch file": ("hbao-passes-notes.exr", old),
+    "no process id": (f"hbao-passes-{2 ** 80}-1-1.exr", old)}
 for name, mtime in names.values():
     path = os.path.join(folder, name)
     open(path, "wb").close()
     if mtime is not None:
         os.utime(path, (mtime, mtime))
 removed = sorted(os.path.basename(path) for path in scratch_files.remove_stale_scratch_files())
-expected = sorted(names[kind][0] for kind in ("stale", "stale, before session 19's numbers"))
+expected = sorted(names[kind][0] for kind in (
+    "stale", "this space's, ended, fresh", "this process id's earlier run",
+    "another space's, an hour old, its id alive here", "stale, before session 33",
+    "stale, before session 19's numbers"))
 assert removed == expected, (removed, expected)
-for kind in ("fresh", "this process's", "not a scratch file", "no process id"):
+for kind in ("fresh, before session 33", "this process's",
+             "another space's, 11 minutes old, its id ended here", "not a scratch file",
+             "no process id"):
     path = os.path.join(folder, names[kind][0])
     assert os.path.exists(path), kind
     os.remove(path)
