@@ -1176,29 +1176,45 @@ def test_back_faces_give_each_occluder_its_thickness(run_in_blender, tmp_path, n
     assert errors[1] < errors[0]
 
 
+@pytest.mark.parametrize("layout", ["current", "older"])
 @pytest.mark.parametrize("how", ["append", "link"])
-def test_appended_or_linked_scene_renders_with_ao(run_in_blender, blender,
-                                                  blender_user_scripts, tmp_path, node_native, how):
+def test_appended_or_linked_scene_renders_with_ao(run_in_blender, blender, blender_user_scripts,
+                                                  tmp_path, native, node_native, how, layout):
     """A scene with an HBAO node, appended or linked into another file, still
-    renders its AO: the hook's helper scene comes along and is found again."""
+    renders its AO: the hook's helper scene comes along and is found again.
+    From a file saved before the group's layout 5 too ("older": its pass held
+    the AO): the add-on cannot rebuild a linked library's group, nor a group
+    appended by a script that renders at once, so the engine writes such a
+    node's pass as its group reads it (the AO was inverted: a review)."""
     blend = tmp_path / "source.blend"
     render(run_in_blender, tmp_path, {"save_blend": str(blend),
                                       "nodes": [{"radius": 0.6, "blur_size": 0}]}, name="setup")
+    setup = tmp_path / "setup"
+    # The file rendered as it is: its File Output writes the node's AO to
+    # setup/ (the render below writes over it)
+    run_command(blender.command(blend=blend, output=tmp_path / "plain" / "frame_####", frame=1),
+                blender_user_scripts)
+    first = node_outputs(setup, 1)["ao"]
+    if layout == "older":
+        made = run_in_blender(SCRIPTS / "older_layout_file.py", blend=blend, addon=False)
+        assert "OLDER LAYOUT 4" in made.stdout, made.stdout[-3000:]
     out = tmp_path / how
     out.mkdir()
     completed = run_in_blender(APPEND_SCRIPT, blend, how, out)
     assert "APPEND_RENDERED" in completed.stdout, completed.stdout[-3000:]
     assert "without AO" not in completed.stdout, completed.stdout[-3000:]
-    setup = tmp_path / "setup"
     ao = node_outputs(setup, 1)["ao"]
     assert np.isfinite(ao).all() and ao.min() < 0.8  # the corner is occluded
+    # the same scene rendered again (and, for layout 5, the pass's round trip)
+    assert np.abs(ao - first).max() <= SAME_RENDER_TOLERANCE
     if how == "append":
         (setup / "camera_0001.json").write_text(json.dumps(
             _camera_of(blender, blender_user_scripts, blend, tmp_path)))
         depth, normal = frame_passes(out, 1)
-        expected = node_native.compute_ao(depth, normal,
-                                          params=node_params(radius=0.6, blur_size=0),
-                                          camera=camera(setup, 1))
+        library = node_native if layout == "current" else native  # older: the AO itself
+        expected = library.compute_ao(depth, normal,
+                                      params=node_params(radius=0.6, blur_size=0),
+                                      camera=camera(setup, 1))
         assert np.abs(ao - expected).max() <= EXACT
 
 
@@ -1402,6 +1418,9 @@ def test_an_appended_scene_uses_the_add_ons_one_group_upgraded(run_in_blender, t
     assert report["directions"] == 8 and report["steps_source"] == ["Steps Value"], report
     assert report["depth_linked"], report
     assert report["blur_at_1"] == 3 and report["blur_at_11"] == 9, report
+    # the pass input's old 1 (Blender keeps a socket's value when a node
+    # moves to another group) is the new layout's no AO (a review)
+    assert report["ao_pass_value"] == 0.0, report
     assert "without AO" not in completed.stdout, completed.stdout[-3000:]
     assert (out / "frame.png").is_file(), completed.stdout[-3000:]
 
@@ -1445,6 +1464,8 @@ def test_a_file_with_the_old_group_keeps_its_keyframes_in_every_blender(run_in_b
     # The hidden pass input held the AO before layout 5 (1 unlinked), the
     # occlusion since: the old 1 is not kept (it would black the image).
     assert state["ao_pass_value"] == 0.0, state
+    # an HBAO node in an artist's node group keeps its values as well
+    assert state["grouped_directions"] == 7, state
     # Everything set on a curve is kept, not its keys alone (5.3 deleted the
     # modifiers, easing and keyframe types with the curve).
     curve = state["radius_curve"]

@@ -88,3 +88,27 @@ def test_a_scratch_folder_with_a_double_slash_is_absolute(monkeypatch):
     from hbao import scratch_files
     monkeypatch.setenv(scratch_files.SCRATCH_FOLDER_VARIABLE, "//tmp:relative:///var/tmp")
     assert scratch_files.folders() == ["/tmp", "relative", "/var/tmp"]
+
+
+def test_a_process_that_cannot_place_itself_takes_a_space_of_its_own(monkeypatch):
+    """Without the boot id or the PID namespace (no /proc, another system)
+    a process cannot tell which process ids are its neighbours': its space is
+    random, so every other process's files are another space's and wait an
+    hour (a host name alone let one container remove another's file in use;
+    a review)."""
+    from hbao import scratch_files
+    placed = scratch_files.process_space()
+    assert placed == scratch_files.process_space() == scratch_files._space
+    real_stat = os.stat
+
+    def no_namespace(path, *args, **kwargs):
+        if str(path) == "/proc/self/ns/pid":
+            raise FileNotFoundError(path)
+        return real_stat(path, *args, **kwargs)
+
+    monkeypatch.setattr(scratch_files.os, "stat", no_namespace)
+    unplaced = {scratch_files.process_space() for _ in range(4)}
+    monkeypatch.setattr(scratch_files.os, "stat", real_stat)
+    monkeypatch.setattr(scratch_files, "_read_text", lambda _path: "")
+    unplaced |= {scratch_files.process_space() for _ in range(4)}
+    assert len(unplaced) == 8 and placed not in unplaced, unplaced

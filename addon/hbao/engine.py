@@ -12,11 +12,13 @@ import bpy
 import numpy as np
 
 from . import camera as camera_model
-from . import (ao_cache, exr_passes, handover, job_inputs, layer_passes, native,
+from . import (ao_cache, compat, exr_passes, handover, job_inputs, layer_passes, native,
                pass_encoding, recomposite, render_record, scratch_files, strip_cameras,
                timing_line)
 from .helper_lookup import ENGINE_IDNAME, is_helper, pass_names_for_helper
 from .helper_scene import rendered_for_a_scene, scene_for_render
+from .node import hbao_nodes, pass_name
+from .node_group import GROUP_TREE_VERSION, layout_of
 from .planning import node_names, plan, tell_all_nodes
 from .report import log, post_render_report
 
@@ -58,7 +60,7 @@ def compute_passes(engine, depsgraph, width, height, request=None):
             engine, depsgraph, helper, main, jobs, warnings, lambda text: _report(engine, text))
 
     results = {}
-    # Esc: Blender asks through test_break(); the passes are left at 1 and
+    # Esc: Blender asks through test_break(); the passes say no AO and
     # the render ends as Blender decides (the scratch file goes as the
     # render_helper's removals_after block ends).
     if engine.test_break():
@@ -143,21 +145,35 @@ def main_of(helper, request):
 INTERRUPTED = "stopped while the AO was computed: this frame renders without AO"
 
 
-def _fill_passes(result, results, width, height):
-    """Each registered AO pass of `result` gets its computed AO's occlusion,
-    or 0 (no AO)."""
+def pass_layouts(main):
+    """{pass name: the layout of its node's group} for `main`'s HBAO nodes
+    (pass_encoding: the pass holds the occlusion, or for an older group, as
+    a scene linked from an older file has, the AO)."""
+    try:
+        nodes = hbao_nodes(compat.compositor_tree(main)) if main is not None else []
+        return {pass_name(node): layout_of(node) for node in nodes}
+    except Exception as error:  # the render must complete: the current layout's
+        log(f"could not read the HBAO nodes' group layouts: {error}")
+        return {}
+
+
+def _fill_passes(result, results, width, height, layouts):
+    """Each registered AO pass of `result` gets its computed AO, or no AO,
+    as its node's group reads it (layouts: pass_layouts)."""
     stereo = any(view is not None for view, _name in results)
     for layer in result.layers:
         for render_pass in layer.passes:
             if not render_pass.name.startswith(PASS_PREFIX):
                 continue
+            layout = layouts.get(render_pass.name, GROUP_TREE_VERSION)
             view = result.views[render_pass.view_id].name if stereo else None
             ao = results.get((view, render_pass.name))
             if ao is None or ao.size != width * height:
-                occlusion = np.full((height, width), pass_encoding.NO_OCCLUSION, np.float32)
+                values = np.full((height, width), pass_encoding.no_ao_for_layout(layout),
+                                 np.float32)
             else:
-                occlusion = pass_encoding.occlusion_pass(ao)
-            render_pass.rect.foreach_set(occlusion.reshape(-1))
+                values = pass_encoding.pass_for_layout(ao, layout)
+            render_pass.rect.foreach_set(values.reshape(-1))
 
 
 def render_helper(engine, depsgraph):
@@ -179,7 +195,8 @@ def render_helper(engine, depsgraph):
         # nested group) keeps its image as it is.
         result = engine.begin_result(0, 0, engine.resolution_x, engine.resolution_y)
         try:
-            _fill_passes(result, {}, result.resolution_x, result.resolution_y)
+            _fill_passes(result, {}, result.resolution_x, result.resolution_y,
+                         pass_layouts(main))
         finally:
             engine.end_result(result)
         return
@@ -190,7 +207,9 @@ def render_helper(engine, depsgraph):
     result = engine.begin_result(0, 0, engine.resolution_x, engine.resolution_y)
     width, height = result.resolution_x, result.resolution_y
     filled = False
+    layouts = {}
     try:
+        layouts = pass_layouts(main_of(scene, request))
         try:
             # The scratch files go once the AO is computed (scratch_files.removals_after).
             with scratch_files.removals_after():
@@ -205,14 +224,14 @@ def render_helper(engine, depsgraph):
             _report_failure(engine, f"{error}. Rendering without AO.")
             tell_all_nodes(main_of(scene, request), "Camera: AO off",
                            f"{error}. Rendering without AO.")
-        except Exception as error:  # the render must complete: AO = 1
+        except Exception as error:  # the render must complete: no AO
             results = {}
             _cache.clear()
             detail = f"{type(error).__name__}: {error}. Rendering without AO."
             _report_failure(engine, detail)
             tell_all_nodes(main_of(scene, request), "Error: AO off (see Info)", detail)
         write_start = time.perf_counter()
-        _fill_passes(result, results, width, height)
+        _fill_passes(result, results, width, height, layouts)
         filled = True
     finally:
         try:
@@ -220,7 +239,7 @@ def render_helper(engine, depsgraph):
                 # Interrupted (bpy: Ctrl-C raises KeyboardInterrupt here):
                 # the passes say no AO.
                 log(INTERRUPTED)
-                _fill_passes(result, {}, width, height)
+                _fill_passes(result, {}, width, height, layouts)
         finally:
             engine.end_result(result)
     timings = dict(engine.hbao_timings)

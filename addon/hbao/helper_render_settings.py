@@ -17,9 +17,9 @@ SYNCED_RENDER_SETTINGS = (
     "frame_map_old", "frame_map_new")
 VIEW_SETTINGS = ("use", "camera_suffix")
 # With Render Single Layer on, Blender renders no scene but the one asked
-# for, the helper neither: its AO pass would read 0, a black image. The hook
-# then unlinks the HBAO nodes from it (helper_scene.sync), and they pass
-# Image through.
+# for, the helper neither: its AO pass goes unwritten (no AO; before the
+# group's layout 5, a black image). The hook then unlinks the HBAO nodes from
+# it (helper_scene.sync), they pass Image through, and the node says why.
 SINGLE_LAYER_DETAIL = ("Render Single Layer is on (View Layer properties): Blender then renders "
                        "no other scene, HBAO's helper neither; AO off (the node passes Image "
                        "through). Turn it off for AO")

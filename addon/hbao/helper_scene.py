@@ -23,6 +23,7 @@ from .helper_lookup import (ENGINE_IDNAME, HELPER_SCENE_PREFIX, MAIN_SCENE_KEY, 
                             MANAGED_NODE_KEY, helper_scene_of, is_helper, main_scene_of,
                             managed_node, scenes_pointing_at, scenes_served_by, serves)
 from .node import AO_PASS_INPUT, DEPTH_INPUT, hbao_nodes, next_pass_index, pass_name
+from .node_group import layout_of
 from .report import log
 from .socket_values import upstream
 
@@ -244,7 +245,8 @@ def sync(scene):
         if not linked:  # AO 1: the node passes Image through
             for link in list(target.links):
                 tree.links.remove(link)
-            set_if_different(target, "default_value", pass_encoding.NO_OCCLUSION)
+            set_if_different(target, "default_value",
+                             pass_encoding.no_ao_for_layout(layout_of(node)))
             continue
         # Blender unhides linked sockets and refuses to hide them, so this one
         # link stays visible; the collapsed Render Layers node shows only it.

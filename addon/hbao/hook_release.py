@@ -17,6 +17,7 @@ from . import compat, pass_encoding
 from .data_edits import set_if_different
 from .helper_lookup import managed_node
 from .node import AO_PASS_INPUT, hbao_nodes
+from .node_group import layout_of
 from .report import log
 
 
@@ -47,4 +48,4 @@ def unlink_ao_inputs(tree):
             continue
         for link in list(target.links):
             tree.links.remove(link)
-        set_if_different(target, "default_value", pass_encoding.NO_OCCLUSION)
+        set_if_different(target, "default_value", pass_encoding.no_ao_for_layout(layout_of(node)))

@@ -34,8 +34,12 @@ def hbao_nodes(tree):
 
 def adopt_group_copies_of(scenes):
     """node_group.adopt_group_copies for the HBAO nodes of `scenes`'
-    compositor trees (5.x scenes may share one)."""
+    compositor trees (5.x scenes may share one) and of the compositor node
+    groups (an artist's group that holds one: appended with it)."""
     trees = {tree.as_pointer(): tree for tree in map(compat.compositor_tree, scenes) if tree}
+    trees.update((group.as_pointer(), group) for group in bpy.data.node_groups
+                 if group.bl_idname == "CompositorNodeTree"
+                 and not group.name.startswith(GROUP_TREE_NAME))
     return adopt_group_copies([node for tree in trees.values() for node in hbao_nodes(tree)])
 
 

@@ -18,9 +18,10 @@ GROUP_TREE_NAME = ".HBAO"
 # 4: tooltips on every input, Radius and Thickness in scene units, no value
 #    fields on Depth, Normal and the hidden AO pass input.
 # 5: the hidden pass input carries the occlusion, 1 - AO, and defaults to 0:
-#    a pass nobody wrote reads 0 (the Viewport Compositor, which gives a
-#    compositor no other scene's passes; a machine without the add-on, whose
-#    helper scene renders no AO pass), which is now "no AO", not black.
+#    a pass nobody wrote reads 0 (the Viewport Compositor gives a compositor
+#    no other scene's passes), which is now "no AO", not black
+#    (pass_encoding.py; the engine writes the old AO to a node whose group is
+#    older, as a scene linked from an older file has).
 GROUP_TREE_VERSION = 5
 GROUP_VERSION_KEY = "hbao_group_version"
 
@@ -119,14 +120,26 @@ def _build_group_tree(tree):
     tree[GROUP_VERSION_KEY] = GROUP_TREE_VERSION
 
 
+def layout_of(node):
+    """The layout (GROUP_TREE_VERSION) of an HBAO node's group: older in a
+    scene linked from an older file, until a sync in one appended."""
+    tree = node.node_tree
+    return tree.get(GROUP_VERSION_KEY, 1) if tree is not None else GROUP_TREE_VERSION
+
+
 def _is_current(tree):
     return tree is not None and tree.get(GROUP_VERSION_KEY) == GROUP_TREE_VERSION
 
 
 def _users(tree):
-    """The group nodes of the scenes' compositor trees that use `tree`."""
-    return [node for scene in bpy.data.scenes
-            for node in getattr(compat.compositor_tree(scene), "nodes", ())
+    """The group nodes that use `tree`: in the scenes' compositor trees and
+    in every other compositor node group (an artist's group holding an HBAO
+    node, 5.3's further effects), so that a rebuild keeps their values too."""
+    trees = {other.as_pointer(): other for other in bpy.data.node_groups
+             if other.bl_idname == "CompositorNodeTree" and other != tree}
+    trees.update((other.as_pointer(), other)
+                 for other in map(compat.compositor_tree, bpy.data.scenes) if other is not None)
+    return [node for other in trees.values() if other.library is None for node in other.nodes
             if getattr(node, "node_tree", None) == tree]
 
 
@@ -177,10 +190,11 @@ def _restore(node, states, targets):
             pass  # keys of a socket whose kind changed: its value below
         try:
             # (the pass input's value is the layout's, not the artist's: a
-            # group of layout 4 held 1, which is now full occlusion)
-            if name != AO_PASS_INPUT:
-                socket.default_value = (int(round(value))
-                                        if isinstance(socket.default_value, int) else value)
+            # group of layout 4 held 1, which is now full occlusion; Blender
+            # keeps it when an appended node moves to the shared group)
+            socket.default_value = (
+                pass_encoding.no_ao_for_layout(layout_of(node)) if name == AO_PASS_INPUT
+                else int(round(value)) if isinstance(socket.default_value, int) else value)
         except (TypeError, ValueError):
             pass  # a socket whose kind changed beyond a number: keep its default
         for from_name, index in sources:

@@ -7,7 +7,6 @@ import contextlib
 import hashlib
 import itertools
 import os
-import socket
 import tempfile
 import threading
 import time
@@ -70,15 +69,21 @@ def _read_text(path):
 
 def process_space():
     """8 hex digits naming where this process's id means something: the
-    machine's boot (Linux's boot_id, else the host name) and its PID
-    namespace (the inode of /proc/self/ns/pid, where there is one). Two
-    Blenders of one space see each other's process ids; of two spaces, not
-    (another machine, another container)."""
-    boot = _read_text("/proc/sys/kernel/random/boot_id") or socket.gethostname()
+    machine's boot (Linux's boot_id) and its PID namespace (the inode of
+    /proc/self/ns/pid). Two Blenders of one space see each other's process
+    ids; of two spaces, not (another machine, another container). Where
+    either cannot be read (no /proc, another system), the space is the
+    process's own, random: every other process's files are then another
+    space's, removed only when an hour old (a host name alone, or a
+    namespace taken for the same, let one container remove another's file
+    in use: a review)."""
+    boot = _read_text("/proc/sys/kernel/random/boot_id")
     try:
         namespace = os.stat("/proc/self/ns/pid").st_ino
     except OSError:
-        namespace = 0
+        namespace = None
+    if not boot or namespace is None:
+        return os.urandom(4).hex()
     return hashlib.sha256(f"{boot}/{namespace}".encode()).hexdigest()[:8]
 
 
@@ -103,9 +108,10 @@ def _process_ended(pid):
     return False
 
 
-# How often a process looks for stale scratch files (remove_stale_now_and_then),
-# and how old a file of the names before session 33 must be to be stale.
-STALE_AGE_S = 600
+# How often a process looks for stale scratch files (remove_stale_now_and_then).
+STALE_CHECK_INTERVAL_S = 600
+# How old a file named before session 33 (no space) must be to be stale.
+UNPLACED_STALE_AGE_S = 600
 # How old a file of another space (scratch_names.py) must be to be stale: its
 # process cannot be asked about from here, and the clocks of the machines
 # that share a folder may differ (a file server's clock sets its time). A
@@ -119,14 +125,14 @@ def _stale(owner, age_s):
     old by this machine's clock, is left over: this space's, of a process
     that has ended (this process's id with another run: one that ended
     before this process got its id); another space's, an hour old; one
-    named before session 33, of an ended process and STALE_AGE_S old."""
+    named before session 33, of an ended process and UNPLACED_STALE_AGE_S old."""
     if owner.space == _space:
         if owner.process == os.getpid():
             return owner.run != _run
         return _process_ended(owner.process)
     if owner.space is not None:
         return age_s >= OTHER_SPACE_STALE_AGE_S
-    return age_s >= STALE_AGE_S and _process_ended(owner.process)
+    return age_s >= UNPLACED_STALE_AGE_S and _process_ended(owner.process)
 
 
 def remove_stale_scratch_files():
@@ -162,14 +168,15 @@ _stale_files_checked_at = None  # time.monotonic() of the last look
 
 def remove_stale_now_and_then():
     """At a process's first hand-over, and again at the first after
-    STALE_AGE_S more: remove_stale_scratch_files() in the background (a
-    hand-over need not wait for it). A long animation started just after a
-    Blender was killed removes that Blender's file once it is old enough
-    (an 8K frame's is about a gigabyte of /dev/shm), not only the next
-    Blender to start ten minutes later."""
+    STALE_CHECK_INTERVAL_S more: remove_stale_scratch_files() in the
+    background (a hand-over need not wait for it). A long animation started
+    just after a Blender was killed removes that Blender's file once it is
+    stale (an 8K frame's is about a gigabyte of /dev/shm), not only the next
+    Blender to start."""
     global _stale_files_checked_at
     now = time.monotonic()
-    if _stale_files_checked_at is None or now - _stale_files_checked_at >= STALE_AGE_S:
+    last = _stale_files_checked_at
+    if last is None or now - last >= STALE_CHECK_INTERVAL_S:
         _stale_files_checked_at = now
         _in_background(_remove_stale_files)
 

@@ -59,6 +59,8 @@ print("UPGRADE", json.dumps({
     "steps_source": [link.from_node.name for link in node.inputs["Steps"].links],
     "blur": [socket_values.socket_value(tree, blur, float(frame), []) for frame in (1, 6, 11)],
     "ao_pass_value": node.inputs[node_group.AO_PASS_INPUT].default_value,
+    "grouped_directions": bpy.data.node_groups["Artist Group"].nodes[
+        "Grouped HBAO"].inputs["Directions"].default_value,
     "radius_curve": radius_curve(),
     "drivers": [[tree.path_resolve(driver.data_path.rsplit(".", 1)[0]).name,
                  driver.driver.expression,

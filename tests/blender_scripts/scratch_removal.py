@@ -127,7 +127,7 @@ ended.wait()
 space, run = scratch_files._space, scratch_files._run
 other_space = "0badcafe" if space != "0badcafe" else "0badf00d"
 other_run = "12345678" if run != "12345678" else "87654321"
-old = time.time() - scratch_files.STALE_AGE_S - 60
+old = time.time() - scratch_files.UNPLACED_STALE_AGE_S - 60
 older = time.time() - scratch_files.OTHER_SPACE_STALE_AGE_S - 60
 names = {
     "stale": (f"hbao-passes-{ended.pid}-1-7-{space}-{other_run}.exr", old),
@@ -195,7 +195,8 @@ for thread in list(scratch_files._removals):
 assert not os.path.exists(stale), "the first hand-over did not remove the stale file"
 
 # A file left meanwhile (a Blender killed while this one renders an animation):
-# the next hand-overs within STALE_AGE_S do not look again; the first after it does.
+# the next hand-overs within STALE_CHECK_INTERVAL_S do not look again; the
+# first after it does.
 open(stale, "wb").close()
 os.utime(stale, (old, old))
 
@@ -211,7 +212,8 @@ def hand_over():
 
 hand_over()
 assert os.path.exists(stale), "a hand-over looked for stale files again at once"
-scratch_files._stale_files_checked_at -= scratch_files.STALE_AGE_S
+scratch_files._stale_files_checked_at -= scratch_files.STALE_CHECK_INTERVAL_S
 hand_over()
-assert not os.path.exists(stale), "a hand-over STALE_AGE_S later did not remove the stale file"
+assert not os.path.exists(stale), \
+    "a hand-over STALE_CHECK_INTERVAL_S later did not remove the stale file"
 print("REMOVAL OK", flush=True)

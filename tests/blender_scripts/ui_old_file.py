@@ -89,6 +89,15 @@ while len(driven.keyframe_points):
     driven.keyframe_points.remove(driven.keyframe_points[0])
 for frame, value in ((0.0, 0.0), (2.0, 4.0)):
     driven.keyframe_points.insert(frame, value)
+# An HBAO node inside an artist's node group: the upgrade keeps its values
+# too (it reset Directions to 0 when it looked only at the top level).
+artist = bpy.data.node_groups.new("Artist Group", "CompositorNodeTree")
+grouped = artist.nodes.new("CompositorNodeHBAO")
+grouped.name = "Grouped HBAO"
+grouped.inputs["Directions"].default_value = 7.0
+holder = compositor.tree.nodes.new("CompositorNodeGroup")
+holder.node_tree = artist
+holder.location = (hbao.location.x - 600, hbao.location.y - 900)  # beside, off the screenshots
 print("OLD DRIVER MODIFIERS", len(driven.modifiers))
 print("OLD RADIUS", json.dumps({frame: curve.evaluate(frame) for frame in RADIUS_FRAMES}))
 print("OLD SOCKET", hbao.inputs["Directions"].bl_idname)
