@@ -109,3 +109,31 @@ def test_a_disabled_add_ons_nodes_still_draw(run_in_blender):
     log = run_in_blender(SCRIPTS / "ui_disabled_node.py", ui=True).stdout
     assert "DISABLED NODE: DONE" in log, log[-3000:]
     assert "Traceback" not in log and "Error" not in log, log[-3000:]
+
+
+def test_hbao_and_render_layers_nodes_pasted_into_another_file(run_in_blender, tmp_path):
+    """Shift+D of an HBAO node (Radius 2, Steps 9); Ctrl+C of it and its
+    Render Layers node, File > New, Ctrl+V (ui_paste_other_file.py): 3.4
+    crashed in the paste (the node's copy callback read the clipboard
+    node's group, a closed file's), and a node pasted alone came back with
+    default values (an exploratory run). Observed: the paste completes, the
+    node has the shared group, its sockets and its values, and renders AO
+    once linked again."""
+    out = tmp_path / "pasted"
+    completed = run_in_blender(SCRIPTS / "ui_paste_other_file.py", out, ui=True)
+    log = completed.stdout
+    # Shift+D first: the duplicate keeps the group and values, gets its own
+    # pass, starts unlinked, and no restore is left pending on it
+    assert _line(log, "DUPLICATED") == {"radius": 2.0, "steps": 9, "group": ".HBAO", "pass": 2,
+                                        "linked": False, "pending": False}
+    assert "PASTE {'FINISHED'}" in log, log[-3000:]
+    pasted = _line(log, "PASTED")
+    assert pasted == {"radius": 2.0, "steps": 9, "inputs": 11, "group": ".HBAO"}, pasted
+    rendered = _line(log, "RENDERED")
+    assert node_outputs(out, 1, rendered["node"])["ao"].min() < 0.9, rendered
+
+
+def _line(log, key):
+    line = next((text for text in log.splitlines() if text.startswith(f"{key} ")), None)
+    assert line is not None, log[-3000:]
+    return json.loads(line[len(key) + 1:])

@@ -14,7 +14,8 @@ from . import compat, guard_geometry, node_lines, node_place, parameters, report
 from .compositor_effects import NODE_IDNAME, is_hbao_node
 from .node_group import (AO_OUTPUT, AO_PASS_INPUT, DEPTH_INPUT, GROUP_TREE_NAME,  # noqa: F401
                          IMAGE_INPUT, IMAGE_OUTPUT, NORMAL_INPUT, VALUE_INPUTS,
-                         adopt_group_copies, group_tree, upgrade_group_tree)
+                         adopt_group_copies, group_tree, keep_copied_values,
+                         upgrade_group_tree)
 from .parameters import FALLOFF_ITEMS, INTEGRATION_ITEMS
 
 _D = parameters.DEFAULTS
@@ -126,7 +127,10 @@ class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
         _announce_change()
 
     def copy(self, node):
-        self.node_tree = node.node_tree
+        # Blender copies the group with the node. `node.node_tree` is not
+        # read: pasted into another file, `node` is the clipboard's, whose
+        # group may be a closed file's (3.4 crashed, an exploratory run).
+        keep_copied_values(self, node)
         self.pass_index = next_pass_index(self.id_data, exclude=self)
         _announce_change()
 
@@ -139,6 +143,11 @@ class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
         misplaced = node_place.misplaced(self)
         if misplaced is not None:
             node_lines.draw(layout, *misplaced, "ERROR")
+        elif self.node_tree is None or DEPTH_INPUT not in self.inputs:
+            # pasted from another file without its group: the add-on's next
+            # sync gives it the shared group and its values again
+            node_lines.draw(layout, "Setting up...", "Pasted without its node group: the add-on "
+                            "gives it the group and its values on its next update", "INFO")
         elif not self.inputs[DEPTH_INPUT].is_linked:
             # Render Layers shows no Depth output until the pass is ticked.
             # (the add-on disabled, its node type kept: no operator to offer)

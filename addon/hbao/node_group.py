@@ -17,20 +17,17 @@ GROUP_TREE_NAME = ".HBAO"
 # 3: a Thickness socket after Strength.
 # 4: tooltips on every input, Radius and Thickness in scene units, no value
 #    fields on Depth, Normal and the hidden AO pass input.
-# 5: the hidden pass input carries the occlusion, 1 - AO, and defaults to 0:
-#    a pass nobody wrote reads 0 (the Viewport Compositor gives a compositor
-#    no other scene's passes), which is now "no AO", not black
-#    (pass_encoding.py; the engine writes the old AO to a node whose group is
-#    older, as a scene linked from an older file has).
+# 5: the hidden pass input carries the occlusion, 1 - AO, default 0: an
+#    unwritten pass (the Viewport Compositor's) is no AO, not black
+#    (pass_encoding.py, which also says what older groups get).
 GROUP_TREE_VERSION = 5
 GROUP_VERSION_KEY = "hbao_group_version"
 
 IMAGE_INPUT = "Image"
 DEPTH_INPUT = "Depth"
 NORMAL_INPUT = "Normal"
-# The hidden input the hook links the computed pass to: the occlusion, 1 - AO
-# (engine.py writes it). Its default, 0, and the 0 of any pass left unwritten
-# are what the node outputs when the hook could not run: no AO, no harm.
+# The hidden input the hook links the computed pass to (pass_encoding.py);
+# its default, 0, is no AO: the node's output when the hook could not run.
 AO_PASS_INPUT = "HBAO Pass"
 IMAGE_OUTPUT = "Image"
 AO_OUTPUT = "AO"
@@ -121,8 +118,7 @@ def _build_group_tree(tree):
 
 
 def layout_of(node):
-    """The layout (GROUP_TREE_VERSION) of an HBAO node's group: older in a
-    scene linked from an older file, until a sync in one appended."""
+    """The layout (GROUP_TREE_VERSION) of an HBAO node's group."""
     tree = node.node_tree
     return tree.get(GROUP_VERSION_KEY, 1) if tree is not None else GROUP_TREE_VERSION
 
@@ -132,9 +128,8 @@ def _is_current(tree):
 
 
 def _users(tree):
-    """The group nodes that use `tree`: in the scenes' compositor trees and
-    in every other compositor node group (an artist's group holding an HBAO
-    node, 5.3's further effects), so that a rebuild keeps their values too."""
+    """The group nodes that use `tree`, in the scenes' compositor trees and
+    in every local compositor node group (an artist's; 5.3's effects)."""
     trees = {other.as_pointer(): other for other in bpy.data.node_groups
              if other.bl_idname == "CompositorNodeTree" and other != tree}
     trees.update((other.as_pointer(), other)
@@ -145,8 +140,7 @@ def _users(tree):
 
 def _socket_state(socket):
     """What rebuilding the group's interface would lose: the socket's value,
-    where its links come from, by node name and output index (sockets are new
-    objects after the rebuild), and its keyframes (socket_keys)."""
+    its links' sources (node name, output index), its keyframes (socket_keys)."""
     value = socket.default_value
     value = tuple(value) if hasattr(value, "__len__") else value
     sources = [(link.from_node.name, list(link.from_node.outputs).index(link.from_socket))
@@ -214,15 +208,31 @@ def _keep_state(node):
         node[PENDING_KEY] = json.dumps(_node_state(node))
 
 
+def keep_copied_values(node, original):
+    """A copy keeps the original's input values until it has the shared
+    group (adopt_group_copies): pasted into another file, a node comes
+    without its group, sockets and values. No links, no keyframes. Reads
+    only the original's sockets: the clipboard's node may point at a group
+    of a file since closed."""
+    if PENDING_KEY in node:  # (the original's unfinished restore came along)
+        return
+    states = {}
+    for socket in original.inputs:
+        value = getattr(socket, "default_value", None)
+        if value is not None:
+            states[socket.name] = (tuple(value) if hasattr(value, "__len__") else value, [], {})
+    node[PENDING_KEY] = json.dumps([states, []])
+
+
 def _finish_restores(nodes):
-    """The pending restores of `nodes` whose group is whole: not of a node
-    whose shared group is still outdated, or half rebuilt (a rebuild that
-    Blender refused midway: upgrade_group_tree finishes it first)."""
+    """The pending restores of `nodes` whose group is whole: not outdated or
+    half rebuilt (refused midway: upgrade_group_tree finishes it first), nor
+    missing (pasted from another file: adopt_group_copies gives one)."""
     for node in nodes:
         if PENDING_KEY not in node:
             continue
         tree = node.node_tree
-        if tree is not None and tree.name == GROUP_TREE_NAME and not _is_current(tree):
+        if tree is None or (tree.name == GROUP_TREE_NAME and not _is_current(tree)):
             continue
         try:
             states, targets = json.loads(node[PENDING_KEY])
