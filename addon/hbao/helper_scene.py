@@ -16,14 +16,13 @@ pointed at each scene's helper in turn would flip with every sync. The render
 handlers record the scene being rendered, which the engine reads."""
 import bpy
 
-from . import compat, extra_renders, helper_render_settings, hook_release, pass_encoding, \
-    pass_sources, view_cameras, writes
+from . import compat, extra_renders, helper_render_settings, hook_release, pass_sources, \
+    view_cameras, writes
 from .data_edits import set_if_different
 from .helper_lookup import (ENGINE_IDNAME, HELPER_SCENE_PREFIX, MAIN_SCENE_KEY, MAIN_TREE_KEY,
                             MANAGED_NODE_KEY, helper_scene_of, is_helper, main_scene_of,
                             managed_node, scenes_pointing_at, scenes_served_by, serves)
 from .node import AO_PASS_INPUT, DEPTH_INPUT, hbao_nodes, next_pass_index, pass_name
-from .node_group import layout_of
 from .report import log
 from .socket_values import upstream
 
@@ -243,10 +242,7 @@ def sync(scene):
             messages.append(f"node {node.name!r}: its AO pass socket is not available yet")
             continue
         if not linked:  # AO 1: the node passes Image through
-            for link in list(target.links):
-                tree.links.remove(link)
-            set_if_different(target, "default_value",
-                             pass_encoding.no_ao_for_layout(layout_of(node)))
+            hook_release.unlink_ao_input(tree, node)
             continue
         # Blender unhides linked sockets and refuses to hide them, so this one
         # link stays visible; the collapsed Render Layers node shows only it.

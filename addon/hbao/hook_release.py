@@ -13,11 +13,11 @@ not render the helper scene at all. Enabled again, the add-on's sync links
 and unmutes them (helper_scene.py)."""
 import bpy
 
-from . import compat, pass_encoding
+from . import compat
 from .data_edits import set_if_different
 from .helper_lookup import managed_node
 from .node import AO_PASS_INPUT, hbao_nodes
-from .node_group import layout_of
+from .node_group import no_ao_value
 from .report import log
 
 
@@ -43,9 +43,14 @@ def unlink_ao_inputs(tree):
     """The AO pass inputs of `tree`'s HBAO nodes unlinked and set to no AO:
     the nodes pass Image through."""
     for node in hbao_nodes(tree):
-        target = node.inputs.get(AO_PASS_INPUT)
-        if target is None:
-            continue
-        for link in list(target.links):
-            tree.links.remove(link)
-        set_if_different(target, "default_value", pass_encoding.no_ao_for_layout(layout_of(node)))
+        unlink_ao_input(tree, node)
+
+
+def unlink_ao_input(tree, node):
+    """`node`'s AO pass input unlinked and set to no AO (as its group reads it)."""
+    target = node.inputs.get(AO_PASS_INPUT)
+    if target is None:
+        return
+    for link in list(target.links):
+        tree.links.remove(link)
+    set_if_different(target, "default_value", no_ao_value(node))

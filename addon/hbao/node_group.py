@@ -9,7 +9,7 @@ import bpy
 from . import compat, compat_nodes, parameters, pass_encoding, socket_keys
 
 # One group tree shared by every HBAO node (the values live on each node's
-# own sockets). The leading dot hides it from data-block menus.
+# sockets); the leading dot hides it from data-block menus.
 GROUP_TREE_NAME = ".HBAO"
 # Bumped when the group's sockets or contents change; older trees are rebuilt
 # and the nodes using them keep their values and links (upgrade_group_tree).
@@ -40,10 +40,9 @@ _D = parameters.DEFAULTS
 
 
 def _value_input(key):
-    """(params key, default, socket min, socket max, socket type, subtype) of a
-    value socket: the library's limits (parameters.LIMITS); whole-number
-    parameters get integer sockets, so the node shows 4, not 4.000; lengths
-    show the scene's unit (1 m)."""
+    """(params key, default, min, max, socket type, subtype) of a value socket:
+    the library's limits; whole numbers as integer sockets (4, not 4.000);
+    lengths in the scene's unit."""
     if key in ("radius", "thickness"):
         return key, float(_D[key]), 0.0, MAX_LENGTH, "NodeSocketFloat", "DISTANCE"
     low, high, whole = parameters.LIMITS[key]
@@ -100,9 +99,8 @@ def _build_group_tree(tree):
     compat.new_group_socket(tree, "OUTPUT", "NodeSocketFloat", AO_OUTPUT)
 
     group_input = tree.nodes.new("NodeGroupInput")
-    group_input.location = (-300, 0)
     group_output = tree.nodes.new("NodeGroupOutput")
-    group_output.location = (300, 0)
+    group_input.location, group_output.location = (-300, 0), (300, 0)
     one_minus, occlusion, ao = compat_nodes.new_one_minus_node(tree)
     one_minus.name = one_minus.label = "AO = 1 - Pass"
     one_minus.location = (-100, -150)
@@ -121,6 +119,11 @@ def layout_of(node):
     """The layout (GROUP_TREE_VERSION) of an HBAO node's group."""
     tree = node.node_tree
     return tree.get(GROUP_VERSION_KEY, 1) if tree is not None else GROUP_TREE_VERSION
+
+
+def no_ao_value(node):
+    """The pass input value that means no AO to `node`'s group."""
+    return pass_encoding.no_ao_for_layout(layout_of(node))
 
 
 def _is_current(tree):
@@ -187,7 +190,7 @@ def _restore(node, states, targets):
             # group of layout 4 held 1, which is now full occlusion; Blender
             # keeps it when an appended node moves to the shared group)
             socket.default_value = (
-                pass_encoding.no_ao_for_layout(layout_of(node)) if name == AO_PASS_INPUT
+                no_ao_value(node) if name == AO_PASS_INPUT
                 else int(round(value)) if isinstance(socket.default_value, int) else value)
         except (TypeError, ValueError):
             pass  # a socket whose kind changed beyond a number: keep its default
@@ -197,9 +200,8 @@ def _restore(node, states, targets):
                 tree.links.new(source, socket)
 
 
-# A node's values and links, kept on the node itself (an ID property) while
-# its group changes: a restore that Blender refuses midway (writes.py) is
-# finished by the next sync instead of losing them.
+# A node's values and links, kept on the node (an ID property) while its group
+# changes: a restore Blender refuses midway (writes.py) ends at the next sync.
 PENDING_KEY = "hbao_pending_restore"
 
 
@@ -259,13 +261,12 @@ def upgrade_group_tree():
 
 
 def adopt_group_copies(nodes):
-    """Point each of `nodes` (HBAO nodes) that uses another local group than
-    the shared one at the shared, current group, keeping its values and
-    links: File > Append brings an appended scene's own copy (".HBAO.001"),
-    perhaps of an older layout, which upgrade_group_tree does not see. A copy
-    left without users is removed (one with a fake user, or an asset, is
-    kept). Nodes in linked or overridden trees are left alone. Returns how
-    many nodes moved."""
+    """Point each of `nodes` (HBAO nodes) that uses another local group, or
+    none (pasted from another file), at the shared current one, keeping its
+    values and links: File > Append brings its own copy (".HBAO.001"),
+    perhaps of an older layout. A copy left without users is removed (not
+    one with a fake user, or an asset). Nodes in linked or overridden trees
+    are left alone. Returns how many nodes moved."""
     nodes = [node for node in nodes if node.id_data.library is None and
              getattr(node.id_data, "override_library", None) is None]
     upgrade_group_tree()  # an outdated or half rebuilt shared group first
