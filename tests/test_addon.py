@@ -1447,7 +1447,7 @@ def test_a_file_with_the_old_group_keeps_its_keyframes_in_every_blender(run_in_b
     group is rebuilt and the node keeps its values, its Value node's link and
     its keyframes. bpy 5.3 deleted the keyframes with the interface sockets
     the rebuild removes (Blur Size then 9 at every frame, silently; an
-    exploratory run); they are put back (node_group._restore_keys)."""
+    exploratory run); they are put back (socket_keys.restore)."""
     old = tmp_path / "old.blend"
     saved = run_in_blender(SCRIPTS / "ui_old_file.py", old)
     assert "OLD SOCKET NodeSocketFloat" in saved.stdout, saved.stdout[-3000:]

@@ -18,7 +18,7 @@ from . import (ao_cache, compat, exr_passes, handover, job_inputs, layer_passes,
 from .helper_lookup import ENGINE_IDNAME, is_helper, pass_names_for_helper
 from .helper_scene import rendered_for_a_scene, scene_for_render
 from .node import hbao_nodes, pass_name
-from .node_group import GROUP_TREE_VERSION, layout_of
+from .group_layout import GROUP_TREE_VERSION, layout_of
 from .planning import node_names, plan, tell_all_nodes
 from .report import log, post_render_report
 

@@ -17,7 +17,7 @@ from . import compat
 from .data_edits import set_if_different
 from .helper_lookup import managed_node
 from .node import AO_PASS_INPUT, hbao_nodes
-from .node_group import no_ao_value
+from .group_layout import no_ao_value
 from .report import log
 
 

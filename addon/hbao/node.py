@@ -12,10 +12,9 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, St
 
 from . import compat, guard_geometry, node_lines, node_place, parameters, report, writes
 from .compositor_effects import NODE_IDNAME, is_hbao_node
-from .node_group import (AO_OUTPUT, AO_PASS_INPUT, DEPTH_INPUT, GROUP_TREE_NAME,  # noqa: F401
-                         IMAGE_INPUT, IMAGE_OUTPUT, NORMAL_INPUT, VALUE_INPUTS,
-                         adopt_group_copies, group_tree, keep_copied_values,
-                         upgrade_group_tree)
+from .group_layout import (AO_OUTPUT, AO_PASS_INPUT, DEPTH_INPUT, GROUP_TREE_NAME,  # noqa: F401
+                           IMAGE_INPUT, IMAGE_OUTPUT, NORMAL_INPUT, VALUE_INPUTS)
+from .node_group import adopt_group_copies, group_tree, keep_copied_values, upgrade_group_tree
 from .parameters import FALLOFF_ITEMS, INTEGRATION_ITEMS
 
 _D = parameters.DEFAULTS

@@ -8,7 +8,7 @@ import bpy
 from . import compat, compat_nodes, pass_sources
 from .helper_lookup import MANAGED_NODE_KEY
 from .node import hbao_nodes
-from .node_group import DEPTH_INPUT, IMAGE_INPUT, NORMAL_INPUT
+from .group_layout import DEPTH_INPUT, IMAGE_INPUT, NORMAL_INPUT
 
 # (HBAO input, Render Layers output, view layer setting; None: always there)
 _LINKS = ((IMAGE_INPUT, "Image", None), (DEPTH_INPUT, "Depth", "use_pass_z"),

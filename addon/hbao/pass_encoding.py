@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """What the helper scene's AO passes hold: the occlusion, 1 - AO, so that a
 pass nobody wrote (0) means no AO. The node's group turns it back (its Math
-node, node_group.py: AO = 1 - pass), as node_ao does here (the tests hold
+node, group_layout.py: AO = 1 - pass), as node_ao does here (the tests hold
 the two together: tests/conftest.py's node_native). Both are one float32
 subtraction: the node's AO is the library's exactly where the AO is 0.5 or
 more, and within 2^-25 below (a multiple of 2^-24 there).
@@ -12,7 +12,7 @@ add-on cannot rebuild a library's group), or appended by a script that
 renders before the add-on gave the node the current group. bpy-free."""
 import numpy as np
 
-# The first layout of the node's group (node_group.GROUP_TREE_VERSION) whose
+# The first layout of the node's group (group_layout.GROUP_TREE_VERSION) whose
 # pass holds the occlusion.
 FIRST_OCCLUSION_LAYOUT = 5
 # What every pass holds where no AO was computed for it (layout 5 on).

@@ -53,6 +53,6 @@ report = {
     "depth_linked": node.inputs["Depth"].is_linked,
     "blur_at_1": at(1, "Blur Size"), "blur_at_11": at(11, "Blur Size"),
     "status": node.status,
-    "ao_pass_value": node.inputs[sys.modules["hbao.node_group"].AO_PASS_INPUT].default_value,
+    "ao_pass_value": node.inputs[sys.modules["hbao.group_layout"].AO_PASS_INPUT].default_value,
 }
 print("GROUPS", json.dumps(report), flush=True)

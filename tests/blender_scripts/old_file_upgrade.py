@@ -14,7 +14,7 @@ import sys
 import bpy
 
 compat = sys.modules["hbao.compat"]
-node_group = sys.modules["hbao.node_group"]
+group_layout = sys.modules["hbao.group_layout"]
 socket_values = sys.modules["hbao.socket_values"]
 tree = compat.compositor_tree(bpy.context.scene)
 
@@ -51,14 +51,14 @@ def radius_curve():
 node = tree.nodes["HBAO"]
 blur = node.inputs["Blur Size"]
 print("UPGRADE", json.dumps({
-    "current": bpy.data.node_groups[node_group.GROUP_TREE_NAME].get(
-        node_group.GROUP_VERSION_KEY) == node_group.GROUP_TREE_VERSION,
+    "current": bpy.data.node_groups[group_layout.GROUP_TREE_NAME].get(
+        group_layout.GROUP_VERSION_KEY) == group_layout.GROUP_TREE_VERSION,
     "socket_types": {name: node.inputs[name].bl_idname
                      for name in ("Directions", "Steps", "Blur Size")},
     "directions": node.inputs["Directions"].default_value,
     "steps_source": [link.from_node.name for link in node.inputs["Steps"].links],
     "blur": [socket_values.socket_value(tree, blur, float(frame), []) for frame in (1, 6, 11)],
-    "ao_pass_value": node.inputs[node_group.AO_PASS_INPUT].default_value,
+    "ao_pass_value": node.inputs[group_layout.AO_PASS_INPUT].default_value,
     "grouped_directions": bpy.data.node_groups["Artist Group"].nodes[
         "Grouped HBAO"].inputs["Directions"].default_value,
     "radius_curve": radius_curve(),

@@ -9,7 +9,7 @@ OLDER LAYOUT <version>.
 """
 import bpy
 
-GROUP_TREE_NAME = ".HBAO"  # node_group.py's names (the add-on is not loaded)
+GROUP_TREE_NAME = ".HBAO"  # group_layout.py's names (the add-on is not loaded)
 VERSION_KEY = "hbao_group_version"
 PASS_INPUT = "HBAO Pass"
 ONE_MINUS_NODE = "AO = 1 - Pass"

@@ -17,15 +17,15 @@ REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 sys.path.insert(0, os.path.join(REPO, "scripts"))
 import blender_scenes  # noqa: E402
 
-node_group = sys.modules["hbao.node_group"]
+group_layout = sys.modules["hbao.group_layout"]
 # Frames at which the Radius curve is compared before and after an upgrade:
 # the keys, between them, the Cycles repeats past them, the Noise range.
 RADIUS_FRAMES = (1, 4, 11, 17, 33, 45, 55)
 # The version-1 layout: every value socket a float.
-node_group.GROUP_TREE_VERSION = 1
-for name, (key, default, low, high, _type, _subtype) in list(node_group.VALUE_INPUTS.items()):
-    node_group.VALUE_INPUTS[name] = (key, float(default), float(low), float(high),
-                                     "NodeSocketFloat", None)
+group_layout.GROUP_TREE_VERSION = 1
+for name, (key, default, low, high, _type, _subtype) in list(group_layout.VALUE_INPUTS.items()):
+    group_layout.VALUE_INPUTS[name] = (key, float(default), float(low), float(high),
+                                       "NodeSocketFloat", None)
 
 scene = blender_scenes.build_corner_scene(bpy.context.scene, (96, 64), "CYCLES", 4)
 compositor = blender_scenes.Compositor(scene)
@@ -38,7 +38,7 @@ compositor.composite(hbao.outputs["Image"])
 hbao.inputs["Directions"].default_value = 8.0
 # The hidden pass input as layouts 1-4 left it unlinked: 1, the AO of no
 # occlusion then.
-hbao.inputs[node_group.AO_PASS_INPUT].default_value = 1.0
+hbao.inputs[group_layout.AO_PASS_INPUT].default_value = 1.0
 value = compositor.value(7.0)
 value.name = "Steps Value"
 # Beside the node and below the Render Layers node, over neither: the UI
