@@ -868,12 +868,19 @@ def test_missing_exr_library_renders_without_ao_and_says_so(run_in_blender, tmp_
     assert np.abs(outputs["image"] - outputs["render"]).max() <= EXACT
 
 
-def test_saved_file_renders_from_the_command_line(run_in_blender, blender,
-                                                  blender_user_scripts, tmp_path, node_native):
+@pytest.mark.parametrize("shown", ["scene", "helper"])
+def test_saved_file_renders_from_the_command_line(run_in_blender, blender, blender_user_scripts,
+                                                  tmp_path, node_native, shown):
+    """`blender -b file.blend -f 1` renders the node's AO. Saved with the
+    window on the helper scene (Scene > Delete of the active scene showed it,
+    before window_scenes.py), the file rendered the helper: a frame without
+    the artist's image, exit code 0 (an exploratory run). The add-on moves
+    the window to the artist's scene when the file is loaded."""
     blend = tmp_path / "hbao.blend"
     out = tmp_path / "cli"
     render(run_in_blender, tmp_path, {"save_blend": str(blend),
-                                      "nodes": [{"radius": 0.6, "integration": "HBAO"}]},
+                                      "nodes": [{"radius": 0.6, "integration": "HBAO"}],
+                                      "prepare": ["show_the_helper"] if shown == "helper" else []},
            name="setup")
     # The file was saved before any render: the command line must render the
     # node as an artist's `blender -b file.blend -f 1` does, add-on enabled.

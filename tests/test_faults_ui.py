@@ -137,3 +137,28 @@ def _line(log, key):
     line = next((text for text in log.splitlines() if text.startswith(f"{key} ")), None)
     assert line is not None, log[-3000:]
     return json.loads(line[len(key) + 1:])
+
+
+@pytest.mark.parametrize("kind", ["NEW", "FULL_COPY"])
+def test_deleting_the_active_scene_never_shows_a_helper_scene(run_in_blender, tmp_path, kind):
+    """Scene > New (an empty scene, or a full copy that carries the node),
+    then Scene > Delete of the first scene while the window shows it
+    (ui_scene_delete.py). Blender shows the scene before the deleted one in
+    its list, and the add-on's helper scenes (".HBAO passes ...") come first:
+    the window showed the helper, which kept the deleted scene's helper in
+    the file and, saved so, is what `blender -b file -f 1` renders (an
+    exploratory run). Observed: the window shows the artist's scene, only
+    the helper of a scene that has a node is left, and the copy renders AO."""
+    out = tmp_path / "deleted"
+    completed = run_in_blender(SCRIPTS / "ui_scene_delete.py", kind, out, ui=True)
+    log = completed.stdout
+    assert "DELETE {'FINISHED'}" in log, log[-3000:]
+    state = _line(log, "SCENES")
+    if kind == "NEW":
+        assert state == {"window": "Scene.001", "scenes": {"Scene.001": False}, "managed": {}}
+        return
+    assert state == {"window": "Scene.001",
+                     "scenes": {".HBAO passes Scene.001": True, "Scene.001": False},
+                     "managed": {"Scene.001": ".HBAO passes Scene.001"}}, state
+    rendered = _line(log, "RENDERED")
+    assert node_outputs(out, 1, rendered["node"])["ao"].min() < 0.9, rendered

@@ -10,7 +10,7 @@ the only chance such a render has to build the hook."""
 import bpy
 
 from . import (compat, helper_lookup, helper_render_settings, helper_scene, node, node_place,
-               pass_sources, recomposite, strip_cameras, writes)
+               pass_sources, recomposite, strip_cameras, window_scenes, writes)
 from .report import NodeMessage, in_main_thread, log, post_node_messages, post_render_report
 
 _sync_scheduled = False
@@ -32,9 +32,22 @@ def _adopt_group_copies(scenes):
     return False
 
 
+def _leave_internal_scenes():
+    """window_scenes.leave_internal_scenes; whether Blender refused a write."""
+    try:
+        window_scenes.leave_internal_scenes()
+    except Exception as error:  # never break the user's session
+        if writes.writes_refused(error):
+            return True
+        log(f"could not move a window off the add-on's internal scene: {error}")
+    return False
+
+
 def _sync_everything():
-    """Every scene's nodes and hook; whether Blender refused a write."""
-    return _adopt_group_copies(bpy.data.scenes) or helper_scene.sync_all()
+    """Every scene's nodes and hook; whether Blender refused a write. The
+    windows first: a helper a window shows is not removed."""
+    return (_leave_internal_scenes() or _adopt_group_copies(bpy.data.scenes)
+            or helper_scene.sync_all())
 
 
 def _timer_sync():
@@ -162,7 +175,11 @@ def _on_render_end(scene, *_args):
 
 @bpy.app.handlers.persistent
 def _on_depsgraph_update_post(scene, *_args):
-    if helper_lookup.is_helper(scene) or not in_main_thread():
+    if not in_main_thread():
+        return
+    if window_scenes.is_internal(scene):
+        if window_scenes.shown_in_a_window(scene):  # (a scene was deleted)
+            schedule_sync()
         return
     tree = compat.compositor_tree(scene)
     # (a sequencer's strips may show an HBAO scene through a camera the

@@ -42,6 +42,7 @@ thickness, guard_band, back_faces, mute, connect_with_operator (left unlinked, t
 node's Connect Passes operator after the passes are disabled)}], disable_normal_pass,
 disable_depth_pass, output_format (the main output's file format, default OPEN_EXR_MULTILAYER),
 prepare [actions before rendering: sync, compositing_off, delete_helper, delete_extra_renders,
+show_the_helper (the window's scene: a file saved so renders it from the command line),
 rename_helper, pick_internal_engine, render_the_helper, rename_node, second_scene_shares_the_tree,
 group_last_node (the last HBAO node moved into a node group of the artist's), layer_not_rendered,
 mute_render_layers, switch_to_workbench; 5.3's compositor effects: second_effect (a pass-through
@@ -313,6 +314,10 @@ for action in spec.get("prepare", []):
         import hbao
         hbao.sync(scene)
         render_scene_name = helper_scenes()[0].name
+    elif action == "show_the_helper":  # the window on the helper (a scene was deleted)
+        import hbao
+        hbao.sync(scene)
+        bpy.context.window_manager.windows[0].scene = helper_scenes()[0]
     elif action == "pick_internal_engine":  # from the Render Engine menu
         import hbao.helper_lookup
         scene.render.engine = hbao.helper_lookup.ENGINE_IDNAME
