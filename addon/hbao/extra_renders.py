@@ -137,12 +137,16 @@ def _mirror_exclusions(source, target):
             _mirror_exclusions(child, mirror)
 
 
-def remove(helper, tree, kind):
+def remove(helper, tree, kind, keep_scene=False):
+    """Remove `helper`'s extra render of `kind`: its node, and its scene
+    unless `keep_scene` (a render is starting: bpy 5.3 crashed, in
+    render_init_depsgraph, rendering a frame whose render_init handler had
+    removed one; the next sync outside a render removes it)."""
     node = node_of(tree, kind)
     if node is not None:
         tree.nodes.remove(node)
     scene = scene_of(helper, kind)
-    if scene is None:
+    if scene is None or keep_scene:
         return
     camera = scene.camera if kind is GUARD else None
     del helper[kind.helper_key]
@@ -206,15 +210,16 @@ def _sync_kind(main, tree, nodes, helper, view_layer, kind):
     return node
 
 
-def sync(main, tree, nodes, helper, view_layer):
+def sync(main, tree, nodes, helper, view_layer, rendering=False):
     """Create, update or remove the extra renders of `helper` for `main`'s
     HBAO nodes; `view_layer` is the one whose collections they mirror. Main
-    thread only. Returns True when the helper's managed node must be made
-    again, after theirs (render order)."""
+    thread only; `rendering`: at a render's start (remove keeps the scenes).
+    Returns True when the helper's managed node must be made again, after
+    theirs (render order)."""
     extra_nodes = []
     for kind in KINDS:
         if main.camera is None or main.render.use_multiview or not _wanted(kind, nodes):
-            remove(helper, tree, kind)
+            remove(helper, tree, kind, keep_scene=rendering)
         else:
             extra_nodes.append(_sync_kind(main, tree, nodes, helper, view_layer, kind))
     order = list(tree.nodes)

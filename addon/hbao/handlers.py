@@ -135,7 +135,7 @@ def _on_render_pre(scene, *_args):
         return
     try:
         if in_main_thread():
-            helper_scene.sync(scene)
+            helper_scene.sync(scene, rendering=True)
         else:
             pass_sources.enable_needed_passes(scene, tree)
         # The helper may serve several scenes (5.x): its engine computes for this one.
@@ -169,8 +169,14 @@ def _unhook_before_render(scene):
 @bpy.app.handlers.persistent
 def _on_render_end(scene, *_args):
     strip_cameras.job_ended(scene)
-    if not helper_lookup.is_helper(scene):
-        helper_scene.record_render_end(scene)
+    if helper_lookup.is_helper(scene):
+        return
+    helper_scene.record_render_end(scene)
+    if in_main_thread():  # (`-b`, scripts) the extra scenes the render's start kept
+        try:
+            helper_scene.sync(scene)
+        except Exception as error:  # never break the user's session
+            log(f"could not update the HBAO hook of {scene.name!r}: {error}")
 
 
 @bpy.app.handlers.persistent

@@ -196,9 +196,11 @@ def _unhook_other_effects(scene, served):
         log(f"removed the HBAO hook of compositor effect {effect.name!r} of {scene.name!r}")
 
 
-def sync(scene):
+def sync(scene, rendering=False):
     """Create, update or remove the hook of `scene` to match its HBAO nodes.
-    Main thread only; returns a list of messages."""
+    Main thread only (`rendering`: in a render's start handlers, where the
+    extra renders' scenes stay until the render has ended); returns a list
+    of messages."""
     tree = compat.compositor_tree(scene)
     if tree is None or is_helper(scene):
         return []
@@ -226,7 +228,8 @@ def sync(scene):
         seen.add(node.pass_index)
 
     helper, new = _find_or_make_helper_scene(scene)
-    if extra_renders.sync(scene, tree, nodes, helper, _extra_view_layer(scene, nodes)):
+    if extra_renders.sync(scene, tree, nodes, helper, _extra_view_layer(scene, nodes),
+                          rendering):
         # made again below, after the guard's node: Blender renders in node order
         tree.nodes.remove(managed_node(tree))
     rlayers = _ensure_managed_node(tree, nodes, helper)

@@ -8,7 +8,9 @@ the scenes, and whether the second render's output named the helper.
 
 CASE: delete_last_node (the only HBAO node deleted between the renders, as a
 script does: no timer syncs in `-b`), panoramic_camera (the camera made
-panoramic: AO off, which the node must say).
+panoramic: AO off, which the node must say), guard_band_off and
+back_faces_off (the first render with a guard band of 10 %, or with back
+faces; the second without: the hook removes that render's scene).
 """
 import json
 import os
@@ -23,12 +25,20 @@ import blender_scenes  # noqa: E402
 case, out_dir = sys.argv[sys.argv.index("--") + 1:][:2]
 scene = blender_scenes.build_corner_scene(bpy.context.scene, (48, 32), "CYCLES", 1)
 node = blender_scenes.hbao_test_tree(scene, out_dir)
+if case == "guard_band_off":
+    node.guard_band = 10.0
+elif case == "back_faces_off":
+    node.back_faces = True
 bpy.ops.render.render(write_still=False)
 print("FIRST RENDER DONE", flush=True)
 if case == "delete_last_node":
     node.id_data.nodes.remove(node)
 elif case == "panoramic_camera":
     scene.camera.data.type = "PANO"
+elif case == "guard_band_off":
+    node.guard_band = 0.0
+elif case == "back_faces_off":
+    node.back_faces = False
 print("SECOND RENDER", flush=True)
 bpy.ops.render.render(write_still=False)
 node_module = sys.modules["hbao.node"]
