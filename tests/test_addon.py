@@ -899,30 +899,62 @@ def test_saved_file_renders_from_the_command_line(run_in_blender, blender, blend
     assert np.abs(ao - expected).max() <= EXACT
 
 
-def test_animation_renders_every_frame_at_its_keyframed_radius(
-        run_in_blender, blender, blender_user_scripts, tmp_path, node_native):
+@pytest.mark.parametrize("remap", [None, (2, 1)])
+def test_animation_renders_every_frame_at_its_keyframed_values(
+        run_in_blender, blender, blender_user_scripts, tmp_path, node_native, remap):
     """`blender -b file.blend -s 1 -e 2 -a`: each frame's node AO is the
-    library's AO of that frame's passes at that frame's keyframed radius."""
+    library's AO of that frame's passes at that frame's keyframed radius,
+    integration and half resolution (the node's menus and checkboxes were
+    read as saved: an exploratory run), and with Time Remapping (Old 2, New
+    1: frame 2 shows the animation's time 4) at the time Blender shows, as
+    for the camera (the keys were read at the frame number)."""
     blend = tmp_path / "animated.blend"
     out = tmp_path / "animation"
+    scale = remap[0] / remap[1] if remap else 1
+    keyed = {1: (0.15, "COSINE", False), 2: (1.2, "HBAO", True)}
     render(run_in_blender, tmp_path, {
-        "save_blend": str(blend), "frames": [1, 2],
-        "nodes": [{"keyframes": [[1, 0.15], [2, 1.2]], "blur_size": 0}]}, name="setup")
+        "save_blend": str(blend), "frames": [1, 2], "time_remap": remap,
+        "nodes": [{"keyframes": [[frame * scale, radius] for frame, (radius, *_) in keyed.items()],
+                   "property_keyframes": [
+                       [frame * scale, {"integration": integration, "half_resolution": half}]
+                       for frame, (_, integration, half) in keyed.items()],
+                   "blur_size": 0}]}, name="setup")
     command = blender.command(blend=blend, output=out / "frame_####", animation=(1, 2))
-    run_command(command, blender_user_scripts)
+    log = run_command(command, blender_user_scripts).stdout
+    assert "animated by" not in log, log[-3000:]
     setup = tmp_path / "setup"
     ao = {}
-    for frame, radius in ((1, 0.15), (2, 1.2)):
+    for frame, (radius, integration, half) in keyed.items():
         (setup / f"camera_{frame:04d}.json").write_text(json.dumps(
             _camera_of(blender, blender_user_scripts, blend, tmp_path)))
         ao[frame] = node_outputs(setup, frame)["ao"]
         depth, normal = frame_passes(out, frame)
-        expected = node_native.compute_ao(depth, normal,
-                                          params=node_params(radius=radius, blur_size=0),
+        params = node_params(radius=radius, blur_size=0, integration=integration,
+                             half_resolution=int(half))
+        expected = node_native.compute_ao(depth, normal, params=params,
                                           camera=camera(setup, frame))
-        assert np.abs(ao[frame] - expected).max() <= EXACT
+        assert np.abs(ao[frame] - expected).max() <= EXACT, (frame, remap)
     # The radius really changed between the frames of one animation render.
     assert ao[2].mean() < ao[1].mean() - 0.02
+
+
+@pytest.mark.parametrize("animation", ["driver", "NLA"])
+def test_a_value_animated_as_the_hook_cannot_follow_says_so(run_in_blender, tmp_path, animation):
+    """A driver on Radius, or its keyframes pushed down into an NLA strip:
+    a render's own depsgraph evaluates them but writes nothing back, so an
+    animation render used one value for every frame and said nothing (an
+    exploratory run). The node's status and the render's report now say so;
+    the AO is computed (at the value the socket holds)."""
+    node = {"radius_driver": "0.4 + 0.2"} if animation == "driver" else {
+        "keyframes": [[1, 0.3], [2, 1.0]], "keys_in_nla": True}
+    out, log = render(run_in_blender, tmp_path, {"nodes": [dict(node, blur_size=0)]})
+    long = {"driver": "a driver", "NLA": "NLA strips"}[animation]
+    assert f"Radius is animated by {long}, which the HBAO hook does not evaluate" in log, \
+        log[-3000:]
+    statuses = [json.loads(line[len("STATUS "):]) for line in log.splitlines()
+                if line.startswith("STATUS ")]
+    assert statuses == [{"node": "HBAO0", "status": f"Radius: fixed ({animation})"}], statuses
+    assert node_outputs(out, 1)["ao"].min() < 0.9
 
 
 def full_and_border_ao(run_in_blender, tmp_path, size, border, crop):

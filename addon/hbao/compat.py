@@ -202,10 +202,17 @@ def clear_group_interface(tree):
 
 
 def find_fcurve(id_data, data_path, index=0):
-    """The F-Curve animating `data_path` of `id_data`, or None (legacy and
-    4.4+ layered actions)."""
+    """The F-Curve animating `data_path` of `id_data` in its active action,
+    or None (legacy and 4.4+ layered actions)."""
     animation = getattr(id_data, "animation_data", None)
-    action = animation.action if animation else None
+    if animation is None:
+        return None
+    return action_fcurve(animation.action, getattr(animation, "action_slot", None), data_path,
+                         index)
+
+
+def action_fcurve(action, slot, data_path, index=0):
+    """The F-Curve of `action` (for `slot`, 4.4+) animating `data_path`, or None."""
     if action is None:
         return None
     fcurves = getattr(action, "fcurves", None)
@@ -213,7 +220,7 @@ def find_fcurve(id_data, data_path, index=0):
         return fcurves.find(data_path, index=index)
     try:
         from bpy_extras import anim_utils
-        channelbag = anim_utils.action_get_channelbag_for_slot(action, animation.action_slot)
+        channelbag = anim_utils.action_get_channelbag_for_slot(action, slot)
     except (ImportError, AttributeError):
         return None
     return channelbag.fcurves.find(data_path, index=index) if channelbag else None

@@ -90,12 +90,12 @@ class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
         description=parameters.DESCRIPTIONS["half_resolution"])
     guard_band: FloatProperty(
         name="Guard Band", default=0.0, min=0.0, max=100.0 * guard_geometry.MAX_GUARD_BAND,
-        subtype="PERCENTAGE", update=_extra_render_changed,
+        subtype="PERCENTAGE", update=_extra_render_changed, options=set(),
         description="Darkens image borders that come out too bright, by also looking this far "
                     "past each side (% of the frame); costs a quick extra render (Cycles, 1 "
                     "sample, Depth and Normal only). 0 = off")
     back_faces: BoolProperty(
-        name="Back Faces", default=False, update=_extra_render_changed,
+        name="Back Faces", default=False, update=_extra_render_changed, options=set(),
         description="Lets light pass between an object and the surface behind it, which "
                     "removes the dark halo around foreground objects; costs a quick extra "
                     "render of the back faces (Cycles, 1 sample, Depth only)")

@@ -39,7 +39,7 @@ def plan_node(node, main, frame, warnings):
         warnings.append(NodeMessage(node.name, f"{error}; reconstructing normals from depth",
                                     f"Normal: {short}, ignored"))
     try:
-        params = node_params(node, frame, warnings)
+        params = node_params(node, main, frame, warnings)
     except ValueError as value_error:
         warnings.append(NodeMessage(node.name, f"{value_error}; AO off",
                                     getattr(value_error, "short", "Invalid value: AO off")))

@@ -25,30 +25,85 @@ def upstream(socket):
     return None
 
 
-def _animated(id_data, owner, attribute, frame, fallback):
-    """owner.attribute at `frame` if an F-Curve animates it, else `fallback`.
-    The render may run in another thread than the depsgraph that evaluates
-    animation, so the F-Curve is evaluated here directly."""
+def animation_time(main, frame):
+    """The time at which Blender evaluates animation for `frame` (a float,
+    with its subframe) of `main`'s render: Time Remapping (Output > Frame
+    Range, Old and New) scales it, the camera's and the node's alike."""
+    return frame * main.render.frame_map_old / main.render.frame_map_new
+
+
+def _not_followed(id_data, path):
+    """What animates `path` that the hook does not evaluate, in long and
+    short form (("a driver", "driver"), ("NLA strips", "NLA")), or None."""
+    animation = getattr(id_data, "animation_data", None)
+    if animation is None:
+        return None
+    if animation.drivers.find(path) is not None:
+        return "a driver", "driver"
+    for track in animation.nla_tracks:
+        for strip in track.strips if not track.mute else ():
+            if not strip.mute and compat.action_fcurve(
+                    strip.action, getattr(strip, "action_slot", None), path) is not None:
+                return "NLA strips", "NLA"
+    return None
+
+
+def _animated(owner, attribute, time, node_name, label, notes):
+    """owner.attribute at `time` if the tree's active action animates it,
+    else None. The render may run in another thread than the depsgraph that
+    evaluates animation, and a render's own depsgraph writes nothing back to
+    the file's data: the F-Curve is evaluated here directly. A driver or NLA
+    strips on it add a NodeMessage to `notes`: every frame then uses the
+    stored value."""
+    id_data = owner.id_data
     try:
         path = owner.path_from_id(attribute)
     except ValueError:
-        return fallback
+        return None
+    other = _not_followed(id_data, path)
+    if other is not None:
+        other, short = other
+        notes.append(NodeMessage(
+            node_name, f"{label} is animated by {other}, which the HBAO hook does not "
+            "evaluate at each frame: an animation render uses the node tree's own keyframes, "
+            "else the value Blender shows now; key it in the tree's action or use a Value "
+            "node", f"{label}: fixed ({short})"))
     fcurve = compat.find_fcurve(id_data, path)
-    return fcurve.evaluate(frame) if fcurve is not None else fallback
+    return fcurve.evaluate(time) if fcurve is not None else None
 
 
-def socket_value(tree, socket, frame, warnings):
-    """The number `socket` carries at `frame`: its own (animated) value, or
-    that of the Value node linked to it."""
+def socket_value(socket, time, warnings, notes=None):
+    """The number `socket` carries at `time` (animation_time): its own
+    (animated) value, or that of the Value node linked to it. Problems go to
+    `warnings`, animation that is not followed to `notes` (or `warnings`)."""
+    notes = warnings if notes is None else notes
+    node_name = socket.node.name
     source = upstream(socket)
     if source is None:
-        return _animated(tree, socket, "default_value", frame, socket.default_value)
+        value = _animated(socket, "default_value", time, node_name, socket.name, notes)
+        return socket.default_value if value is None else value
     if source.node.bl_idname in compat.VALUE_NODE_IDNAMES:
-        return _animated(tree, source, "default_value", frame, source.default_value)
+        value = _animated(source, "default_value", time, node_name, socket.name, notes)
+        return source.default_value if value is None else value
     warnings.append(NodeMessage(
-        socket.node.name, f"{socket.name} comes from {source.node.name!r}; only a Value node "
+        node_name, f"{socket.name} comes from {source.node.name!r}; only a Value node "
         f"can drive it, using {socket.default_value:g}", f"{socket.name}: use a Value node"))
     return socket.default_value
+
+
+def property_value(node, attribute, time, notes):
+    """The node's property `attribute` at `time`, keyframed or not (menus
+    and checkboxes as Blender reads their F-Curves)."""
+    prop = node.bl_rna.properties[attribute]
+    value = _animated(node, attribute, time, node.name, prop.name, notes)
+    if value is None:
+        return getattr(node, attribute)
+    if prop.type == "ENUM":
+        return next((item.identifier for item in prop.enum_items
+                     if item.value == int(round(value))), getattr(node, attribute))
+    if prop.type == "BOOLEAN":
+        return value >= 0.5
+    return value
 
 
 def _label_of(message):
@@ -68,21 +123,23 @@ def _short_clamp(message):
     return f"{_label_of(message)} clamped to {message.rsplit('using ', 1)[-1]}"
 
 
-def node_params(node, frame, warnings):
-    """The params dict for native.compute_ao() from the node at `frame`,
-    resolved (completed and clamped) once, by the library (native.resolve_params); each
-    clamped value adds a NodeMessage. Raises ValueError when a value cannot
-    be used at all (not a number, negative), its `short` attribute the form
-    that fits the node's status line."""
-    tree = node.id_data
+def node_params(node, main, frame, warnings):
+    """The params dict for native.compute_ao() from the node at `frame` of
+    `main`'s render, resolved (completed and clamped) once, by the library
+    (native.resolve_params); each clamped value adds a NodeMessage. Raises
+    ValueError when a value cannot be used at all (not a number, negative),
+    its `short` attribute the form that fits the node's status line. Values
+    animated in ways an animation render does not follow are said last."""
+    time = animation_time(main, frame)
+    notes = []
     raw = {
-        "falloff": node.falloff,
-        "integration": node.integration,
-        "half_resolution": int(node.half_resolution),
-        "blur_sharpness": float(node.blur_sharpness),
+        "falloff": property_value(node, "falloff", time, notes),
+        "integration": property_value(node, "integration", time, notes),
+        "half_resolution": int(property_value(node, "half_resolution", time, notes)),
+        "blur_sharpness": float(property_value(node, "blur_sharpness", time, notes)),
     }
     for name, (key, *_socket) in VALUE_INPUTS.items():
-        raw[key] = float(socket_value(tree, node.inputs[name], frame, warnings))
+        raw[key] = float(socket_value(node.inputs[name], time, warnings, notes))
     clamped = []
     try:
         params = native.resolve_params(raw, clamped)
@@ -91,4 +148,5 @@ def node_params(node, frame, warnings):
         unusable.short = _short_error(str(error))
         raise unusable from error
     warnings += [NodeMessage(node.name, message, _short_clamp(message)) for message in clamped]
+    warnings += notes
     return params

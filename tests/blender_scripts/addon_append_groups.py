@@ -38,7 +38,7 @@ node = tree.nodes["HBAO"]
 
 
 def at(frame, name):
-    return socket_values.socket_value(tree, node.inputs[name], float(frame), [])
+    return socket_values.socket_value(node.inputs[name], float(frame), [])
 
 
 report = {

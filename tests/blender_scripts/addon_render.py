@@ -36,7 +36,9 @@ scene below it; each frame renders Edit (Outer) first, keeping the nodes' file a
 strip_nodes_<NNNN>.exr, then the scene through Strip Camera; "failed_movie": an animation render of
 Edit to a movie that cannot be written, then the scene's frames through its own camera),
 save_blend_after (path: the file saved after the renders), save_blend (path: saved after the setup,
-before rendering), nodes: [{name, layer, normal (bool), radius, keyframes [[frame, radius], ..],
+before rendering), time_remap ([old, new]: Time Remapping), nodes: [{name, layer, normal (bool),
+radius, keyframes [[frame, radius], ..], property_keyframes [[frame, {property: value}], ..],
+radius_driver (a driver's expression), keys_in_nla (the keyframes pushed down into an NLA strip),
 radius_from_value_node, falloff, integration, blur_size, angle_bias, directions, steps, strength,
 thickness, guard_band, back_faces, mute, connect_with_operator (left unlinked, then linked by the
 node's Connect Passes operator after the passes are disabled)}], disable_normal_pass,
@@ -218,6 +220,8 @@ if spec.get("scene_name"):
     scene.name = spec["scene_name"]
 if spec.get("single_layer"):  # Render Single Layer (View Layer properties)
     scene.render.use_single_layer = True
+if spec.get("time_remap"):  # Output > Frame Range > Time Stretching: Old, New
+    scene.render.frame_map_old, scene.render.frame_map_new = spec["time_remap"]
 
 compositor = blender_scenes.Compositor(scene)
 tree = compositor.tree
@@ -260,6 +264,17 @@ for index, node_spec in enumerate(spec.get("nodes", [{}])):
     for frame, radius in node_spec.get("keyframes", []):
         hbao.inputs["Radius"].default_value = radius
         hbao.inputs["Radius"].keyframe_insert("default_value", frame=frame)
+    for frame, values in node_spec.get("property_keyframes", []):
+        for key, value in values.items():
+            setattr(hbao, key, value)
+            hbao.keyframe_insert(key, frame=frame)
+    if node_spec.get("keys_in_nla"):  # the tree's action pushed down into an NLA strip
+        animation = hbao.id_data.animation_data
+        animation.nla_tracks.new().strips.new("Keys", 1, animation.action)
+        animation.action = None
+    if node_spec.get("radius_driver"):
+        driver = hbao.inputs["Radius"].driver_add("default_value").driver
+        driver.expression = node_spec["radius_driver"]
     hbao.mute = node_spec.get("mute", False)
     if index == 0:
         compositor.composite(hbao.outputs["Image"])

@@ -57,7 +57,7 @@ print("UPGRADE", json.dumps({
                      for name in ("Directions", "Steps", "Blur Size")},
     "directions": node.inputs["Directions"].default_value,
     "steps_source": [link.from_node.name for link in node.inputs["Steps"].links],
-    "blur": [socket_values.socket_value(tree, blur, float(frame), []) for frame in (1, 6, 11)],
+    "blur": [socket_values.socket_value(blur, float(frame), []) for frame in (1, 6, 11)],
     "ao_pass_value": node.inputs[group_layout.AO_PASS_INPUT].default_value,
     "grouped_directions": bpy.data.node_groups["Artist Group"].nodes[
         "Grouped HBAO"].inputs["Directions"].default_value,

@@ -71,8 +71,8 @@ def upgrade_report():
         "steps_source": steps.links[0].from_node.name if steps.is_linked else None,
         "depth_linked": hbao.inputs["Depth"].is_linked,
         "image_output_to": sorted(link.to_node.name for link in hbao.outputs["Image"].links),
-        "blur_at_11": socket_values.socket_value(tree, blur, 11.0, []),
-        "blur_at_1": socket_values.socket_value(tree, blur, 1.0, []),
+        "blur_at_11": socket_values.socket_value(blur, 11.0, []),
+        "blur_at_1": socket_values.socket_value(blur, 1.0, []),
     }
 
 
