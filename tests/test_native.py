@@ -290,6 +290,8 @@ def test_incompatible_library_is_refused(monkeypatch, tmp_path):
         "int32_t hbao_compute(void) { return 0; }\n"
         "int32_t hbao_compute_layers(void) { return 0; }\n"
         "void hbao_release_memory(void) {}\n"
+        "uint32_t hbao_last_notes(void) { return 0; }\n"
+        "const char *hbao_note_message(uint32_t n) { (void)n; return 0; }\n"
         "float hbao_clip_background_depth(float s, float e, float d)"
         " { (void)s; (void)e; return d; }\n"
         "size_t hbao_view_size(void) { return 40; }\n"
@@ -430,3 +432,16 @@ def test_the_background_below_clip_end_is_the_librarys_rule(native):
     assert camera_model.background_depth({"clip_end": 9.0}, 65504.0) == \
         pytest.approx(9.0 * (1.0 - 1e-5), rel=1e-7)
     assert camera_model.background_depth({}, 1234.5) == 1234.5
+
+
+def test_a_usual_compute_has_no_notes_and_each_note_has_words(native):
+    """native.last_notes() (hbao_last_notes): nothing after a usual call in
+    this thread; the one note there is, the reference search for want of
+    memory (csrc/tests/internal/test_stages.c provokes it), is worded by
+    the library for the CLI and the render's report alike."""
+    depth = np.full((32, 48), 4.0, dtype=np.float32)
+    native.compute_ao(depth, params={"radius": 0.5})
+    assert native.last_notes() == []
+    library = native_module.load_library()
+    assert b"the reference search computed the AO" in library.hbao_note_message(1)
+    assert library.hbao_note_message(2) == b"unknown note"

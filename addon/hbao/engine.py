@@ -91,6 +91,9 @@ def compute_passes(engine, depsgraph, width, height, request=None):
         ao = _cache.get(key, inputs)
         if ao is None:
             ao = layer_passes.compute(job, depth, normal, inputs.camera, extra)
+            for note in native.last_notes():  # (this thread's compute)
+                log(f"node {job.node_name!r}: {note}")
+                _report(engine, f"HBAO: node {job.node_name!r}: {note}")
         else:
             timings["cached"] = timings.get("cached", 0) + 1
         fresh[key] = (inputs, ao)

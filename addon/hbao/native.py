@@ -205,3 +205,12 @@ def compute_ao(depth, normal=None, *, params=None, camera=None, bottom_up=False,
         out_view.ctypes.data_as(ctypes.POINTER(ctypes.c_float)),
         out_view.strides[0] // _FLOAT_SIZE))
     return out
+
+
+def last_notes():
+    """What the calling thread's last compute_ao did other than usual, with
+    the same result (hbao_last_notes), as the library words each note."""
+    library = load_library()
+    notes = library.hbao_last_notes()
+    return [library.hbao_note_message(1 << bit).decode("utf-8", "replace")
+            for bit in range(32) if notes & (1 << bit)]

@@ -53,6 +53,8 @@ _FUNCTIONS = {
                                       _CHANNEL_P, _CHANNEL_P, ctypes.POINTER(ctypes.c_float),
                                       ctypes.c_int64]),
     "hbao_release_memory": (None, []),
+    "hbao_last_notes": (ctypes.c_uint32, []),
+    "hbao_note_message": (ctypes.c_char_p, [ctypes.c_uint32]),
     "hbao_clip_background_depth": (ctypes.c_float, [ctypes.c_float] * 3),
     "hbao_compute_layers": (ctypes.c_int32, [_PARAMS_P, _CAMERA_P, ctypes.c_int32, ctypes.c_int32,
                                              _CHANNEL_P, _CHANNEL_P, _CHANNEL_P,

@@ -465,6 +465,20 @@ HBAO_EXPORT hbao_result hbao_compute_layers(const hbao_params *params, const hba
                                             const hbao_channel *back_depth, float *ao,
                                             int64_t ao_row_stride);
 
+/** Bits of hbao_last_notes(). HBAO_NOTE_REFERENCE_SEARCH: no memory for the
+ *  SIMD search's copy of the depths (4 bytes a pixel of the grid, two with
+ *  the back layer), so the scalar reference searched: the same result,
+ *  several times slower (58.5 s against 6 for an 8K frame). */
+#define HBAO_NOTE_REFERENCE_SEARCH 1u
+
+/** What the calling thread's last hbao_compute or hbao_compute_layers did
+ *  other than usual (HBAO_NOTE_* bits; 0: nothing), for callers that tell
+ *  their users why a frame was slow. Set by every call, failed or not. */
+HBAO_EXPORT uint32_t hbao_last_notes(void);
+
+/** What one HBAO_NOTE_* bit means, for people ("unknown note" otherwise). */
+HBAO_EXPORT const char *hbao_note_message(uint32_t note);
+
 #ifdef __cplusplus
 }
 #endif

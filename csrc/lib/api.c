@@ -16,6 +16,13 @@ const char *hbao_result_message(hbao_result result) {
     return messages[result];
 }
 
+const char *hbao_note_message(uint32_t note) {
+    if (note == HBAO_NOTE_REFERENCE_SEARCH)
+        return "not enough memory for the fast search's copy of the depths; the reference "
+               "search computed the AO (the same result, several times slower)";
+    return "unknown note";
+}
+
 void hbao_params_default(hbao_params *params) {
     if (params == NULL) return;
     const hbao_params defaults = HBAO_PARAMS_DEFAULT_INITIALIZER;

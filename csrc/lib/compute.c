@@ -164,6 +164,13 @@ static void fill_ones(float *ao, int64_t row_stride, int width, int height) {
     }
 }
 
+/* The calling thread's last call's HBAO_NOTE_* bits (hbao_last_notes). */
+static _Thread_local uint32_t last_notes;
+
+uint32_t hbao_last_notes(void) {
+    return last_notes;
+}
+
 hbao_result hbao_compute(const hbao_params *params, const hbao_camera *camera, int32_t width,
                          int32_t height, const hbao_channel *depth, const hbao_channel *normal,
                          float *ao, int64_t ao_row_stride) {
@@ -175,6 +182,7 @@ hbao_result hbao_compute_layers(const hbao_params *params, const hbao_camera *ca
                                 int32_t height, const hbao_channel *depth,
                                 const hbao_channel *normal, const hbao_channel *back_depth,
                                 float *ao, int64_t ao_row_stride) {
+    last_notes = 0;
     if (params == NULL || camera == NULL || depth == NULL || depth->data == NULL || ao == NULL)
         return HBAO_ERROR_NULL_ARGUMENT;
     if (width < 1 || height < 1 || width > HBAO_MAX_IMAGE_SIZE || height > HBAO_MAX_IMAGE_SIZE)
@@ -249,7 +257,7 @@ hbao_result hbao_compute_layers(const hbao_params *params, const hbao_camera *ca
     if (grid.back != NULL && !any_finite(grid.back, grid_pixels)) grid.back = NULL;
     hbao_compute_normals(&s, camera, &grid, normal, scale);
 
-    hbao_compute_horizons(&s, &grid, grid_ao);
+    last_notes = hbao_compute_horizons(&s, &grid, grid_ao);
     result = hbao_finish(&s, &grid, grid_ao, &guide, width, height, ao, ao_row_stride);
 
 done:

@@ -721,7 +721,7 @@ int32_t hbao_best_implementation(void) {
     return HBAO_IMPLEMENTATION_SCALAR;
 }
 
-void hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *grid, float *ao) {
+uint32_t hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *grid, float *ao) {
     horizon_job job;
     job.settings = settings;
     job.grid = grid;
@@ -750,6 +750,7 @@ void hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *grid,
     tiled.tiles_across = (grid->width + TILE_COLUMNS - 1) / TILE_COLUMNS;
     tiled.tiles_down = (grid->height + TILE_ROWS - 1) / TILE_ROWS;
     tiled.simd = choose_kernel(settings->implementation);
+    uint32_t notes = 0;
     float *phase_depth = NULL, *phase_back = NULL;
     job.phase_depth = NULL;
     job.phase_back = NULL;
@@ -765,6 +766,7 @@ void hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *grid,
          * same result, only slower. */
         if (phase_depth == NULL || (grid->back != NULL && phase_back == NULL)) {
             tiled.simd = NULL;
+            notes |= HBAO_NOTE_REFERENCE_SEARCH;
             hbao_scratch_give(phase_depth);
             hbao_scratch_give(phase_back);
             phase_depth = phase_back = NULL;
@@ -780,4 +782,5 @@ void hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *grid,
                        &tiled);
     hbao_scratch_give(phase_depth);
     hbao_scratch_give(phase_back);
+    return notes;
 }

@@ -254,8 +254,9 @@ hbao_result hbao_settings_make(const hbao_params *params, hbao_settings *s);
 void hbao_compute_normals(const hbao_settings *settings, const hbao_camera *camera, hbao_grid *grid,
                           const hbao_channel *normal, int scale);
 
-/* horizon.c: raw AO on the grid (dense, grid->width wide). */
-void hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *grid, float *ao);
+/* horizon.c: raw AO on the grid (dense, grid->width wide). Returns the
+ * HBAO_NOTE_* bits of what it did other than usual. */
+uint32_t hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *grid, float *ao);
 
 /* What every horizon kernel needs: settings, grid and per-pattern-cell
  * tables (4x4 interleaved rotation and jitter, docs/algorithm.md). */

@@ -444,6 +444,9 @@ int ao_compute_input(const cli_options *options, exr_input *input, ao_buffers *b
     if (result != HBAO_SUCCESS)
         return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: cannot compute AO: %s", options->input_path,
                          hbao_result_message(result));
+    const uint32_t notes = hbao_last_notes();
+    for (uint32_t note = 1; note != 0; note <<= 1)
+        if (notes & note) tool_warn("%s: %s", options->input_path, hbao_note_message(note));
     return TOOL_EXIT_SUCCESS;
 }
 
