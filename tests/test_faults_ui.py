@@ -162,3 +162,35 @@ def test_deleting_the_active_scene_never_shows_a_helper_scene(run_in_blender, tm
                      "managed": {"Scene.001": ".HBAO passes Scene.001"}}, state
     rendered = _line(log, "RENDERED")
     assert node_outputs(out, 1, rendered["node"])["ao"].min() < 0.9, rendered
+
+
+def test_a_render_slot_shown_during_a_render_is_not_handed_over(run_in_blender, tmp_path):
+    """F12 into slot 2 while the artist shows slot 1 again (the Image
+    Editor's slot menu; ui_render_slots.py): Blender saves the slot it
+    shows, and the render got slot 1's AO, under "unchanged: reused" (an
+    exploratory run). Observed: that frame renders without AO and its report
+    says why, never with another render's AO."""
+    if shutil.which("xdotool") is None:
+        pytest.fail("xdotool missing: run scripts/setup.sh")
+    out = tmp_path / "slots"
+    log = run_in_blender(SCRIPTS / "ui_render_slots.py", "switch", out, ui=True).stdout
+    assert "SLOTS DONE" in log and "SWITCHED to slot 1" in log, log[-3000:]
+    assert "the Image Editor shows render slot 1 while this render writes slot 2" in log, \
+        log[-3000:]
+    first, second = (node_outputs(out / name, 1)["ao"] for name in ("first", "second"))
+    assert first.min() < 0.9  # the first render had AO
+    assert np.all(second == 1.0)  # none, rather than the first render's
+
+
+def test_a_cancelled_render_is_not_brought_up_to_date(run_in_blender, tmp_path):
+    """F12 completes; the cube moves; F12 cancelled with Escape; then the
+    Radius changes (ui_render_slots.py): the add-on's refresh composited the
+    cancelled render with the first render's AO at the new Radius (an
+    exploratory run). Observed: no refresh, and the node asks for a render."""
+    if shutil.which("xdotool") is None:
+        pytest.fail("xdotool missing: run scripts/setup.sh")
+    log = run_in_blender(SCRIPTS / "ui_render_slots.py", "cancel", tmp_path / "cancel",
+                         ui=True).stdout
+    assert "SLOTS DONE" in log and "ESCAPE sent" in log, log[-3000:]
+    assert "re-composited" not in log, log[-3000:]
+    assert _line(log, "HINT") == "Changed: render to update"

@@ -10,7 +10,7 @@ the only chance such a render has to build the hook."""
 import bpy
 
 from . import (compat, helper_lookup, helper_render_settings, helper_scene, node, node_place,
-               pass_sources, recomposite, strip_cameras, window_scenes, writes)
+               pass_sources, recomposite, render_slots, strip_cameras, window_scenes, writes)
 from .report import NodeMessage, in_main_thread, log, post_node_messages, post_render_report
 
 _sync_scheduled = False
@@ -97,6 +97,7 @@ def _on_render_init(scene, *_args):
     status lines too); then as every frame."""
     strip_cameras.job_started(scene)
     if not helper_lookup.is_helper(scene):
+        render_slots.started(scene)
         tree = compat.compositor_tree(scene)
         # (the console's text, the report's: a node's reads "HBAO node ...")
         messages = [(text, f"HBAO {text}") for text in [
@@ -167,10 +168,20 @@ def _unhook_before_render(scene):
 
 
 @bpy.app.handlers.persistent
-def _on_render_end(scene, *_args):
+def _on_render_complete(scene, *_args):
+    _on_render_end(scene, True)
+
+
+@bpy.app.handlers.persistent
+def _on_render_cancel(scene, *_args):
+    _on_render_end(scene, False)
+
+
+def _on_render_end(scene, completed):
     strip_cameras.job_ended(scene)
     if helper_lookup.is_helper(scene):
         return
+    render_slots.ended(scene, completed)
     helper_scene.record_render_end(scene)
     if in_main_thread():  # (`-b`, scripts) the extra scenes the render's start kept
         try:
@@ -200,8 +211,8 @@ _HANDLERS = (
     (bpy.app.handlers.save_pre, _on_save_pre),
     (bpy.app.handlers.render_init, _on_render_init),
     (bpy.app.handlers.render_pre, _on_frame_render_pre),
-    (bpy.app.handlers.render_complete, _on_render_end),
-    (bpy.app.handlers.render_cancel, _on_render_end),
+    (bpy.app.handlers.render_complete, _on_render_complete),
+    (bpy.app.handlers.render_cancel, _on_render_cancel),
     (bpy.app.handlers.depsgraph_update_post, _on_depsgraph_update_post),
 )
 

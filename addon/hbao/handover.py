@@ -6,17 +6,9 @@ straight into numpy arrays."""
 import os
 from time import perf_counter as _clock
 
-import bpy
-
-from . import compat, exr_passes, render_threads, scratch_files, view_cameras, view_files
+from . import (compat, exr_passes, render_slots, render_threads, scratch_files, view_cameras,
+               view_files)
 from .report import log
-
-
-def _render_result_image():
-    for image in bpy.data.images:
-        if image.type == "RENDER_RESULT":
-            return image
-    return None
 
 
 # The channels of each pass read back, as Blender names them in a saved
@@ -66,9 +58,14 @@ def save_passes(scene, path, views=None):
     """Write `scene`'s current Render Result to `path`, uncompressed 32-bit
     multilayer EXR, leaving the scene's output settings as they were; a
     stereo render's `views` [(view name, file suffix)] as view_files.py says."""
-    image = _render_result_image()
+    image = render_slots.render_result_image()
     if image is None:
         raise RuntimeError("Blender has no Render Result image to read the passes from")
+    other = render_slots.other_slot_shown(scene)
+    if other is not None:  # (Blender saves the slot shown)
+        raise RuntimeError(f"the Image Editor shows render slot {other[0]} while this render "
+                           f"writes slot {other[1]}, and Blender hands over the slot it shows; "
+                           f"keep slot {other[1]} shown while a render runs")
     settings = scene.render.image_settings
     saved = compat.saved_image_settings(settings)
     try:

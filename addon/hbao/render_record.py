@@ -12,7 +12,7 @@ writes the node's hint line, which the node only draws. The
 comparison is the render's own plan of the node (planning.plan_node), at the
 frame that was rendered, so a keyframed value that differs at another frame
 does not count as a change."""
-from . import compat, node
+from . import compat, node, render_slots
 from .planning import plan_node
 
 # (short, full): the node's line and its tooltip
@@ -57,8 +57,11 @@ def put_back(main_name, record):
 
 def last_render(main_name):
     """(frame, {node name: signature or None}, the scene's as_pointer()) of
-    `main_name`'s last render, or None."""
-    return _records.get(main_name)
+    `main_name`'s last render, or None; None too where the Render Result
+    no longer shows that render (a cancelled one since, or another slot:
+    render_slots), which a refresh must then leave alone. Main thread."""
+    record = _records.get(main_name)
+    return record if record is not None and render_slots.shows_last_render(main_name) else None
 
 
 def signature_of(job):

@@ -1,0 +1,52 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Whether the Render Result shows the render the add-on handed over.
+Blender keeps renders in the Render Result's slots (the Image Editor's slot
+menu, J), saves and composites the slot it shows, and keeps what a
+cancelled render (Esc) drew. So the hand-over (handover.py) must find the
+render's own slot shown, and a refresh (recomposite.py) may bring only a
+completed render up to date, and only while its slot is shown: an artist
+who looked at another slot while a render ran got that slot's AO."""
+import bpy
+
+# {main scene name: the slot its running or last render writes}, set at the
+# render's start, and {main scene name: whether that render completed}.
+_written = {}
+_completed = {}
+
+
+def render_result_image():
+    return next((image for image in bpy.data.images if image.type == "RENDER_RESULT"), None)
+
+
+def shown_slot():
+    """The Render Result's shown slot (0-based), or None."""
+    slots = getattr(render_result_image(), "render_slots", None)
+    return slots.active_index if slots is not None else None
+
+
+def started(scene):
+    """At a render's start (any thread): it writes the slot shown then."""
+    _written[scene.name] = shown_slot()
+    _completed[scene.name] = False
+
+
+def ended(scene, completed):
+    _completed[scene.name] = completed
+
+
+def other_slot_shown(scene):
+    """(shown, written), numbered as the slot menu numbers them, where the
+    Render Result shows another slot than `scene`'s render writes; else None."""
+    written, shown = _written.get(scene.name), shown_slot()
+    if written is None or shown is None or written == shown:
+        return None
+    return shown + 1, written + 1
+
+
+def shows_last_render(scene_name):
+    """Whether `scene_name`'s last render completed and its slot is shown
+    (True where no render started since the add-on loaded: -b, tests)."""
+    if scene_name not in _written:
+        return True
+    written, shown = _written[scene_name], shown_slot()
+    return _completed.get(scene_name, False) and (written is None or written == shown)
