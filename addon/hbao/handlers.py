@@ -96,8 +96,9 @@ def _on_render_init(scene, *_args):
     level), and that Render Single Layer turns the AO off (on the nodes'
     status lines too); then as every frame."""
     strip_cameras.job_started(scene)
-    if not helper_lookup.is_helper(scene):
+    if not window_scenes.is_internal(scene):
         render_slots.started(scene)
+    if not helper_lookup.is_helper(scene):
         tree = compat.compositor_tree(scene)
         # (the console's text, the report's: a node's reads "HBAO node ...")
         messages = [(text, f"HBAO {text}") for text in [

@@ -12,6 +12,9 @@ import bpy
 # render's start, and {main scene name: whether that render completed}.
 _written = {}
 _completed = {}
+# The scene of the render job running or last run: only its passes are the
+# Render Result's (a sequencer strip's scene renders inside another's job).
+_job_scene = None
 
 
 def render_result_image():
@@ -25,7 +28,9 @@ def shown_slot():
 
 
 def started(scene):
-    """At a render's start (any thread): it writes the slot shown then."""
+    """At a render job's start (any thread): it writes the slot shown then."""
+    global _job_scene
+    _job_scene = scene.name
     _written[scene.name] = shown_slot()
     _completed[scene.name] = False
 
@@ -36,7 +41,10 @@ def ended(scene, completed):
 
 def other_slot_shown(scene):
     """(shown, written), numbered as the slot menu numbers them, where the
-    Render Result shows another slot than `scene`'s render writes; else None."""
+    Render Result shows another slot than `scene`'s render job writes; else
+    None."""
+    if scene.name != _job_scene:
+        return None
     written, shown = _written.get(scene.name), shown_slot()
     if written is None or shown is None or written == shown:
         return None
