@@ -938,21 +938,39 @@ def test_animation_renders_every_frame_at_its_keyframed_values(
     assert ao[2].mean() < ao[1].mean() - 0.02
 
 
-@pytest.mark.parametrize("animation", ["driver", "NLA"])
+def test_the_nodes_menus_and_checkbox_read_their_curves_as_blender_does(run_in_blender):
+    """F-Curves without whole-number flags (made by scripts: fcurves.new),
+    linear, on Integration, Half Resolution and Falloff, and a muted one on
+    Blur Sharpness (property_curves.py): the hook rounded the menus where
+    Blender truncates, called a checkbox on from 0.5 where Blender needs 1,
+    and read muted curves (a review). Observed: the hook's value is
+    Blender's own at every frame and subframe tried."""
+    log = run_in_blender(SCRIPTS / "property_curves.py").stdout
+    line = next((text for text in log.splitlines() if text.startswith("CHECKED ")), None)
+    assert line is not None, log[-3000:]
+    assert json.loads(line[len("CHECKED "):]) == {"values": 28, "differed": 0}, log[-3000:]
+
+
+@pytest.mark.parametrize("animation", ["driver", "NLA", "NLA off"])
 def test_a_value_animated_as_the_hook_cannot_follow_says_so(run_in_blender, tmp_path, animation):
     """A driver on Radius, or its keyframes pushed down into an NLA strip:
     a render's own depsgraph evaluates them but writes nothing back, so an
     animation render used one value for every frame and said nothing (an
-    exploratory run). The node's status and the render's report now say so;
-    the AO is computed (at the value the socket holds)."""
+    exploratory run). The node's status and the render's report now say so
+    (not where the NLA is off: Blender ignores it then, a review); the AO is
+    computed (at the value the socket holds)."""
     node = {"radius_driver": "0.4 + 0.2"} if animation == "driver" else {
-        "keyframes": [[1, 0.3], [2, 1.0]], "keys_in_nla": True}
+        "keyframes": [[1, 0.3], [2, 1.0]], "keys_in_nla": "off" if animation == "NLA off" else True}
     out, log = render(run_in_blender, tmp_path, {"nodes": [dict(node, blur_size=0)]})
+    statuses = [json.loads(line[len("STATUS "):]) for line in log.splitlines()
+                if line.startswith("STATUS ")]
+    if animation == "NLA off":
+        assert "animated by" not in log, log[-3000:]
+        assert statuses == [{"node": "HBAO0", "status": ""}], statuses
+        return
     long = {"driver": "a driver", "NLA": "NLA strips"}[animation]
     assert f"Radius is animated by {long}, which the HBAO hook does not evaluate" in log, \
         log[-3000:]
-    statuses = [json.loads(line[len("STATUS "):]) for line in log.splitlines()
-                if line.startswith("STATUS ")]
     assert statuses == [{"node": "HBAO0", "status": f"Radius: fixed ({animation})"}], statuses
     assert node_outputs(out, 1)["ao"].min() < 0.9
 

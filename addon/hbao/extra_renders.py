@@ -141,7 +141,8 @@ def remove(helper, tree, kind, keep_scene=False):
     """Remove `helper`'s extra render of `kind`: its node, and its scene
     unless `keep_scene` (a render is starting: bpy 5.3 crashed, in
     render_init_depsgraph, rendering a frame whose render_init handler had
-    removed one; the next sync outside a render removes it)."""
+    removed one; the next sync after every render job has ended removes it:
+    handlers.py)."""
     node = node_of(tree, kind)
     if node is not None:
         tree.nodes.remove(node)

@@ -184,11 +184,11 @@ def _on_render_end(scene, completed):
         return
     render_slots.ended(scene, completed)
     helper_scene.record_render_end(scene)
-    if in_main_thread():  # (`-b`, scripts) the extra scenes the render's start kept
-        try:
-            helper_scene.sync(scene)
-        except Exception as error:  # never break the user's session
-            log(f"could not update the HBAO hook of {scene.name!r}: {error}")
+    # (`-b`, scripts) the extra scenes the render's start kept go, once the
+    # outermost job has ended: a sequencer strip's scene renders in a job of
+    # its own inside the sequencer scene's, whose next frame would crash
+    if in_main_thread() and not strip_cameras.jobs_running():
+        helper_scene.sync_all()
 
 
 @bpy.app.handlers.persistent

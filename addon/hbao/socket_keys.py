@@ -82,8 +82,9 @@ def _driver_state(fcurve):
     return state
 
 
-def _driver_fcurve(socket, path):
-    animation = getattr(socket.id_data, "animation_data", None)
+def driver_fcurve(id_data, path):
+    """The driver of `path` of `id_data`, or None."""
+    animation = getattr(id_data, "animation_data", None)
     return animation.drivers.find(path) if animation is not None else None
 
 
@@ -99,7 +100,7 @@ def saved(socket):
     fcurve = compat.find_fcurve(socket.id_data, path)
     if fcurve is not None:
         state["animation"] = _curve_state(fcurve)
-    driven = _driver_fcurve(socket, path)
+    driven = driver_fcurve(socket.id_data, path)
     if driven is not None:
         state["driver"] = _driver_state(driven)
     return state
@@ -195,5 +196,5 @@ def restore(socket, state):
         fcurve = compat.find_fcurve(socket.id_data, path)
         if fcurve is not None:
             _restore_curve(fcurve, animation)
-    if state.get("driver") and _driver_fcurve(socket, path) is None:
+    if state.get("driver") and driver_fcurve(socket.id_data, path) is None:
         _restore_driver(socket.driver_add("default_value"), state["driver"])

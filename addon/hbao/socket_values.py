@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """An HBAO node's settings at the frame being rendered: its sockets' values,
-keyframed or fed by a Value node, resolved into library parameters."""
-from . import compat, native, parameters
+keyframed or fed by a Value node, and its menus and checkboxes, keyframed,
+resolved into library parameters."""
+from . import compat, native, parameters, socket_keys
 from .node import VALUE_INPUTS
 from .report import NodeMessage
 
@@ -25,6 +26,10 @@ def upstream(socket):
     return None
 
 
+# C's FLT_EPSILON
+_FLOAT_EPSILON = 2.0 ** -23
+
+
 def animation_time(main, frame):
     """The time at which Blender evaluates animation for `frame` (a float,
     with its subframe) of `main`'s render: Time Remapping (Output > Frame
@@ -34,13 +39,18 @@ def animation_time(main, frame):
 
 def _not_followed(id_data, path):
     """What animates `path` that the hook does not evaluate, in long and
-    short form (("a driver", "driver"), ("NLA strips", "NLA")), or None."""
+    short form (("a driver", "driver"), ("NLA strips", "NLA")), or None:
+    a driver not muted; strips Blender evaluates (the NLA on, their track
+    the solo one where one is, neither muted; not inside meta strips)."""
     animation = getattr(id_data, "animation_data", None)
     if animation is None:
         return None
-    if animation.drivers.find(path) is not None:
+    driver = socket_keys.driver_fcurve(id_data, path)
+    if driver is not None and not driver.mute:
         return "a driver", "driver"
-    for track in animation.nla_tracks:
+    tracks = list(animation.nla_tracks) if animation.use_nla else []
+    solo = [track for track in tracks if track.is_solo]
+    for track in solo or tracks:
         for strip in track.strips if not track.mute else ():
             if not strip.mute and compat.action_fcurve(
                     strip.action, getattr(strip, "action_slot", None), path) is not None:
@@ -49,12 +59,12 @@ def _not_followed(id_data, path):
 
 
 def _animated(owner, attribute, time, node_name, label, notes):
-    """owner.attribute at `time` if the tree's active action animates it,
-    else None. The render may run in another thread than the depsgraph that
-    evaluates animation, and a render's own depsgraph writes nothing back to
-    the file's data: the F-Curve is evaluated here directly. A driver or NLA
-    strips on it add a NodeMessage to `notes`: every frame then uses the
-    stored value."""
+    """owner.attribute at `time` if the tree's active action animates it (an
+    F-Curve not muted), else None. The render may run in another thread than
+    the depsgraph that evaluates animation, and a render's own depsgraph
+    writes nothing back to the file's data: the F-Curve is evaluated here
+    directly. A driver or NLA strips on it add a NodeMessage to `notes`:
+    every frame then uses the F-Curve, or else the stored value."""
     id_data = owner.id_data
     try:
         path = owner.path_from_id(attribute)
@@ -69,7 +79,7 @@ def _animated(owner, attribute, time, node_name, label, notes):
             "else the value Blender shows now; key it in the tree's action or use a Value "
             "node", f"{label}: fixed ({short})"))
     fcurve = compat.find_fcurve(id_data, path)
-    return fcurve.evaluate(time) if fcurve is not None else None
+    return fcurve.evaluate(time) if fcurve is not None and not fcurve.mute else None
 
 
 def socket_value(socket, time, warnings, notes=None):
@@ -93,16 +103,18 @@ def socket_value(socket, time, warnings, notes=None):
 
 def property_value(node, attribute, time, notes):
     """The node's property `attribute` at `time`, keyframed or not (menus
-    and checkboxes as Blender reads their F-Curves)."""
+    and checkboxes as Blender writes an F-Curve's value into them: an enum
+    truncated, a boolean true above 1 - FLT_EPSILON; keyframe_insert's
+    curves hold whole numbers anyway)."""
     prop = node.bl_rna.properties[attribute]
     value = _animated(node, attribute, time, node.name, prop.name, notes)
     if value is None:
         return getattr(node, attribute)
     if prop.type == "ENUM":
         return next((item.identifier for item in prop.enum_items
-                     if item.value == int(round(value))), getattr(node, attribute))
+                     if item.value == int(value)), getattr(node, attribute))
     if prop.type == "BOOLEAN":
-        return value >= 0.5
+        return value > 1.0 - _FLOAT_EPSILON
     return value
 
 

@@ -67,6 +67,11 @@ def job_ended(scene):
         del _jobs[at:]
 
 
+def jobs_running():
+    """Whether any render job runs now (handlers.py: not while one does)."""
+    return bool(_jobs)
+
+
 def forget_jobs():
     """A file is loaded: no job of the old one runs."""
     del _jobs[:]

@@ -36,9 +36,9 @@ scene below it; each frame renders Edit (Outer) first, keeping the nodes' file a
 strip_nodes_<NNNN>.exr, then the scene through Strip Camera; "failed_movie": an animation render of
 Edit to a movie that cannot be written, then the scene's frames through its own camera),
 save_blend_after (path: the file saved after the renders), save_blend (path: saved after the setup,
-before rendering), time_remap ([old, new]: Time Remapping), nodes: [{name, layer, normal (bool),
-radius, keyframes [[frame, radius], ..], property_keyframes [[frame, {property: value}], ..],
-radius_driver (a driver's expression), keys_in_nla (the keyframes pushed down into an NLA strip),
+before rendering), nodes: [{name, layer, normal (bool), radius, keyframes [[frame, radius], ..],
+property_keyframes [[frame, {property: value}], ..], radius_driver (a driver's expression),
+keys_in_nla (the keyframes pushed down into an NLA strip; "off": the NLA then turned off),
 radius_from_value_node, falloff, integration, blur_size, angle_bias, directions, steps, strength,
 thickness, guard_band, back_faces, mute, connect_with_operator (left unlinked, then linked by the
 node's Connect Passes operator after the passes are disabled)}], disable_normal_pass,
@@ -163,7 +163,7 @@ if spec.get("animate_camera"):  # the camera turns and moves from frame 1 to fra
     moving.location.x += 0.8
     moving.keyframe_insert("rotation_euler", frame=5)
     moving.keyframe_insert("location", frame=5)
-if spec.get("time_remap"):  # Time Remapping [old, new]: frame f shows the time f * new / old
+if spec.get("time_remap"):  # Time Remapping [old, new]: frame f shows the time f * old / new
     scene.render.frame_map_old, scene.render.frame_map_new = spec["time_remap"]
 edit = None  # sequencer: the scene that shows `scene` in Video Sequencer strips
 if spec.get("sequencer"):
@@ -220,8 +220,6 @@ if spec.get("scene_name"):
     scene.name = spec["scene_name"]
 if spec.get("single_layer"):  # Render Single Layer (View Layer properties)
     scene.render.use_single_layer = True
-if spec.get("time_remap"):  # Output > Frame Range > Time Stretching: Old, New
-    scene.render.frame_map_old, scene.render.frame_map_new = spec["time_remap"]
 
 compositor = blender_scenes.Compositor(scene)
 tree = compositor.tree
@@ -272,6 +270,7 @@ for index, node_spec in enumerate(spec.get("nodes", [{}])):
         animation = hbao.id_data.animation_data
         animation.nla_tracks.new().strips.new("Keys", 1, animation.action)
         animation.action = None
+        animation.use_nla = node_spec["keys_in_nla"] != "off"  # (Blender then ignores them)
     if node_spec.get("radius_driver"):
         driver = hbao.inputs["Radius"].driver_add("default_value").driver
         driver.expression = node_spec["radius_driver"]

@@ -1,8 +1,8 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """Run by tests/test_faults_ui.py in Blender's window (Xvfb): a scene with an
-HBAO node, Scene > New of KIND (NEW, EMPTY, LINK_COPY, FULL_COPY: the copies
-carry the node), then Scene > Delete of the first scene while the window
-shows it. Blender shows the scene before the deleted one in its list: the
+HBAO node, Scene > New of KIND (NEW, EMPTY, LINK_COPY or FULL_COPY: the copies
+carry the node; the test runs NEW and FULL_COPY), then Scene > Delete of the
+first scene while the window shows it. Blender shows the scene before the deleted one in its list: the
 add-on's helper scenes, whose names start with a dot, come first. Prints
 SCENES {json} once the add-on's sync has run: the window's scene, the
 scenes left (name: internal?) and, for each artist scene, the helper its

@@ -107,7 +107,7 @@ class HBAOViewSettings(bpy.types.PropertyGroup):
         node = self.settings_node(scene) if self.use_node_settings else None
         if node is not None:
             scene = scene or bpy.context.scene
-            params = socket_values.node_params(node, scene.frame_current, [])
+            params = socket_values.node_params(node, scene, scene.frame_current, [])
         else:
             values = {name: getattr(self, name) for name in parameters.DEFAULTS
                       if name != "background_depth"}
