@@ -139,7 +139,7 @@ def _line(log, key):
     return json.loads(line[len(key) + 1:])
 
 
-@pytest.mark.parametrize("kind", ["NEW", "FULL_COPY"])
+@pytest.mark.parametrize("kind", ["NEW", "FULL_COPY", "NEW_SAVED"])
 def test_deleting_the_active_scene_never_shows_a_helper_scene(run_in_blender, tmp_path, kind):
     """Scene > New (an empty scene, or a full copy that carries the node),
     then Scene > Delete of the first scene while the window shows it
@@ -147,15 +147,20 @@ def test_deleting_the_active_scene_never_shows_a_helper_scene(run_in_blender, tm
     its list, and the add-on's helper scenes (".HBAO passes ...") come first:
     the window showed the helper, which kept the deleted scene's helper in
     the file and, saved so, is what `blender -b file -f 1` renders (an
-    exploratory run). Observed: the window shows the artist's scene, only
-    the helper of a scene that has a node is left, and the copy renders AO."""
+    exploratory run); a file saved right after the Delete kept the guard
+    band's and back faces' scenes (the deleted scene's objects inside them).
+    Observed: the window shows the artist's scene, only the helper of a
+    scene that has a node is left, in the session and in the saved file,
+    and the copy renders AO."""
     out = tmp_path / "deleted"
     completed = run_in_blender(SCRIPTS / "ui_scene_delete.py", kind, out, ui=True)
     log = completed.stdout
     assert "DELETE {'FINISHED'}" in log, log[-3000:]
     state = _line(log, "SCENES")
-    if kind == "NEW":
+    if kind.startswith("NEW"):
         assert state == {"window": "Scene.001", "scenes": {"Scene.001": False}, "managed": {}}
+        if kind == "NEW_SAVED":
+            assert _line(log, "SAVED") == ["Scene.001"]
         return
     assert state == {"window": "Scene.001",
                      "scenes": {".HBAO passes Scene.001": True, "Scene.001": False},
@@ -180,6 +185,23 @@ def test_a_render_slot_shown_during_a_render_is_not_handed_over(run_in_blender, 
     first, second = (node_outputs(out / name, 1)["ao"] for name in ("first", "second"))
     assert first.min() < 0.9  # the first render had AO
     assert np.all(second == 1.0)  # none, rather than the first render's
+
+
+@pytest.mark.parametrize("case", ["back", "keep_ui"])
+def test_a_render_slot_shown_again_or_kept_ui_is_not_refreshed(run_in_blender, tmp_path, case):
+    """back: F12 into slots 1 and 2, slot 1 shown and Radius changed (Blender
+    composites slot 1 with the helper's one render), slot 2 shown again and
+    Radius changed: a refresh composited slot 1's image into slot 2. keep_ui:
+    Display Mode "Keep User Interface", where Blender does not composite the
+    Render Result again, yet a refresh said it had, and the node no longer
+    asked for a render (exploratory runs). Observed: no refresh, and the
+    node says "Changed: render to update"."""
+    log = run_in_blender(SCRIPTS / "ui_render_slots.py", case, tmp_path / case,
+                         ui=True).stdout
+    assert "SLOTS DONE" in log, log[-3000:]
+    after = log[log.index("BACK TO SLOT 2"):] if case == "back" else log
+    assert "re-composited" not in after, log[-3000:]
+    assert _line(log, "HINT") == "Changed: render to update"
 
 
 def test_a_cancelled_render_is_not_brought_up_to_date(run_in_blender, tmp_path):

@@ -259,8 +259,9 @@ def sync(scene, rendering=False):
 def sync_all():
     """sync() every scene with HBAO nodes or a hook; drop helpers nobody uses.
     Returns whether Blender refused a write for the moment
-    (writes.writes_refused): a later call finishes the job."""
-    for scene in list(bpy.data.scenes):
+    (writes.writes_refused): a later call finishes the job. Helpers first:
+    the extra scenes of one dropped go in the same pass (a save then)."""
+    for scene in sorted(bpy.data.scenes, key=lambda scene: not is_helper(scene)):
         try:
             _sync_or_drop(scene)
         except Exception as error:  # never break the user's session

@@ -19,8 +19,9 @@ from .planning import plan_node
 HINT = ("Changed: render to update",
         "This node's settings changed since the last render. The AO in the compositor is "
         "still the last render's: render again (F12) to update it. (Changes to the AO "
-        "settings alone follow by themselves while the compositor is open; this one needs "
-        "passes the last render did not hand over.)")
+        "settings alone follow by themselves while the compositor is open and the Render "
+        "Result shows the last completed render, in its slot; other changes, another slot "
+        "shown, a cancelled render or Display Mode \"Keep User Interface\" need a render.)")
 
 # {main scene name: (frame, {node name: signature}, the scene's as_pointer())};
 # replaced whole per render, so the main thread never reads a half-written

@@ -51,10 +51,27 @@ def other_slot_shown(scene):
     return shown + 1, written + 1
 
 
+def _composited_again():
+    """Whether Blender composites the Render Result again when a node
+    changes: not with Render > Display Mode "Keep User Interface" (an
+    exploratory run: the Render Result kept its composite)."""
+    view = getattr(bpy.context.preferences, "view", None)
+    return getattr(view, "render_display_type", "WINDOW") != "NONE"
+
+
 def shows_last_render(scene_name):
-    """Whether `scene_name`'s last render completed and its slot is shown
-    (True where no render started since the add-on loaded: -b, tests)."""
+    """Whether `scene_name`'s last render completed, its slot is shown and
+    has been since (True where no render started since the add-on loaded:
+    -b, tests), and Blender composites it again on a change. A node changed
+    while another slot was shown made Blender composite that slot with the
+    helper's one render, which then showed through the render's slot (an
+    exploratory run): once seen shown, another slot ends the refreshes
+    until the next completed render."""
+    if not _composited_again():
+        return False
     if scene_name not in _written:
         return True
     written, shown = _written[scene_name], shown_slot()
-    return _completed.get(scene_name, False) and (written is None or written == shown)
+    if written is not None and shown is not None and written != shown:
+        _completed[scene_name] = False
+    return _completed.get(scene_name, False)

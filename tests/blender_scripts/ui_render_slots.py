@@ -13,6 +13,15 @@ samples, cancelled with Escape; then Radius 0.3, with the compositor shown.
 A refresh applied the first render's AO to the cancelled render. After a
 wait, prints HINT {json} (the node's hint line).
 
+CASE "back": F12 into slot 1; the cube moved, F12 into slot 2; slot 1
+shown and Radius 0.3 (Blender composites slot 1 with the helper's one
+render); slot 2 shown again (BACK TO SLOT 2), Radius 0.31. A refresh then
+composited slot 1's image into slot 2. After a wait, prints HINT {json}.
+
+CASE "keep_ui": Render > Display Mode "Keep User Interface"; F12, then
+Radius 0.3 with the compositor shown: Blender does not composite the Render
+Result again, yet a refresh said it had. After a wait, prints HINT {json}.
+
 Prints SLOTS DONE at the end.
 
   blender --addons hbao --python ui_render_slots.py -- CASE OUT_DIR
@@ -91,17 +100,34 @@ def tick():
             state.update(phase=state["after"], since=now)
     elif phase == "start":
         show_compositor()
+        if case == "keep_ui":
+            bpy.context.preferences.view.render_display_type = "NONE"
         render("first_done")
     elif phase == "first_done" and elapsed > 1.0:
         keep("first")
         bpy.data.objects["Cube"].location.x += 1.0
-        if case == "switch":
+        if case == "keep_ui":
+            node.inputs["Radius"].default_value = 0.3
+            state.update(phase="changed", since=now)
+        elif case == "back":
+            slots().active_index = 1
+            render("second_back")
+        elif case == "switch":
             scene.cycles.samples = 3000  # seconds: the switch comes first
             slots().active_index = 1
             render("second_done")
         else:
             scene.cycles.samples = 1000000
             render("cancelled")
+    elif phase == "second_back" and elapsed > 1.0:
+        slots().active_index = 0
+        node.inputs["Radius"].default_value = 0.3
+        state.update(phase="older_shown", since=now)
+    elif phase == "older_shown" and elapsed > SETTLE_S:
+        slots().active_index = 1
+        print("BACK TO SLOT 2", flush=True)
+        node.inputs["Radius"].default_value = 0.31
+        state.update(phase="changed", since=now)
     elif phase == "second_done" and elapsed > 1.0:
         keep("second")
         print("SLOTS DONE", flush=True)

@@ -2,12 +2,15 @@
 """Run by tests/test_faults_ui.py in Blender's window (Xvfb): a scene with an
 HBAO node, Scene > New of KIND (NEW, EMPTY, LINK_COPY or FULL_COPY: the copies
 carry the node; the test runs NEW and FULL_COPY), then Scene > Delete of the
-first scene while the window shows it. Blender shows the scene before the deleted one in its list: the
-add-on's helper scenes, whose names start with a dot, come first. Prints
+first scene while the window shows it. Blender shows the scene before the
+deleted one in its list: the add-on's helper scenes, whose names start with
+a dot, come first. Prints
 SCENES {json} once the add-on's sync has run: the window's scene, the
 scenes left (name: internal?) and, for each artist scene, the helper its
 managed node renders. With the copy still holding a node, renders it to
-OUT_DIR/nodes_0001.exr and prints RENDERED {json}.
+OUT_DIR/nodes_0001.exr and prints RENDERED {json}. KIND NEW_SAVED: NEW, the
+node with a guard band and back faces, and the file saved at once after the
+Delete, before any sync: prints SAVED {json}, the scenes in the file.
 
   blender --addons hbao --python ui_scene_delete.py -- KIND OUT_DIR
 """
@@ -15,6 +18,7 @@ import importlib
 import json
 import os
 import sys
+import traceback
 
 import bpy
 
@@ -44,17 +48,27 @@ def scenes():
 
 
 def step():
+    try:
+        return _step()
+    except Exception:  # a failure must end Blender, not leave it open
+        traceback.print_exc()
+        os._exit(1)
+
+
+def _step():
     window = bpy.context.window_manager.windows[0]
     index = next(steps)
     if index == 0:
         scene = blender_scenes.build_corner_scene(bpy.context.scene, (96, 64), "CYCLES", 4)
-        blender_scenes.hbao_test_tree(scene, out_dir, "HBAO")
+        hbao = blender_scenes.hbao_test_tree(scene, out_dir, "HBAO")
+        if kind == "NEW_SAVED":
+            hbao.guard_band, hbao.back_faces = 10.0, True
         scene.render.filepath = os.path.join(out_dir, "frame_")
         node_editor(window)
         return 1.0  # the add-on's sync makes the helper meanwhile
     if index == 1:
         with override(window, node_editor(window)):
-            print("NEW", bpy.ops.scene.new(type=kind), flush=True)
+            print("NEW", bpy.ops.scene.new(type=kind.replace("_SAVED", "")), flush=True)
         return 1.0
     if index == 2:
         window.scene = bpy.data.scenes["Scene"]
@@ -62,6 +76,12 @@ def step():
     if index == 3:
         with override(window, node_editor(window)):
             print("DELETE", bpy.ops.scene.delete(), flush=True)
+        if kind == "NEW_SAVED":
+            os.makedirs(out_dir, exist_ok=True)
+            path = os.path.join(out_dir, "saved.blend")
+            bpy.ops.wm.save_as_mainfile(filepath=path, copy=True)
+            with bpy.data.libraries.load(path) as (saved, _unused):
+                print("SAVED", json.dumps(sorted(saved.scenes)), flush=True)
         return 2.0
     try:  # (an exception here must not leave Blender open)
         state = scenes()
