@@ -18,35 +18,28 @@ _sync_scheduled = False
 _REFUSED_RETRY_S = 0.25
 
 
-def _adopt_group_copies(scenes):
-    """The HBAO nodes that came with a group of their own (File > Append) use
-    the shared one (node_group.adopt_group_copies). Returns whether Blender
-    refused the write for the moment. Not at a render's start: bpy 5.3
-    crashed when a node's group changed in render_pre."""
+def _refused(action, what):
+    """Run `action`; whether Blender refused a write for the moment
+    (writes.py). Any other error is logged as "could not `what`"."""
     try:
-        node.adopt_group_copies_of(scenes)
+        action()
     except Exception as error:  # never break the user's session
         if writes.writes_refused(error):
             return True
-        log(f"could not give the HBAO nodes the add-on's group: {error}")
-    return False
-
-
-def _leave_internal_scenes():
-    """window_scenes.leave_internal_scenes; whether Blender refused a write."""
-    try:
-        window_scenes.leave_internal_scenes()
-    except Exception as error:  # never break the user's session
-        if writes.writes_refused(error):
-            return True
-        log(f"could not move a window off the add-on's internal scene: {error}")
+        log(f"could not {what}: {error}")
     return False
 
 
 def _sync_everything():
     """Every scene's nodes and hook; whether Blender refused a write. The
-    windows first: a helper a window shows is not removed."""
-    return (_leave_internal_scenes() or _adopt_group_copies(bpy.data.scenes)
+    windows first (window_scenes): a helper a window shows is not removed.
+    Then the HBAO nodes that came with a group of their own (File > Append)
+    get the shared one; not at a render's start: bpy 5.3 crashed when a
+    node's group changed in render_pre."""
+    return (_refused(window_scenes.leave_internal_scenes,
+                     "move a window off the add-on's internal scene")
+            or _refused(lambda: node.adopt_group_copies_of(bpy.data.scenes),
+                        "give the HBAO nodes the add-on's group")
             or helper_scene.sync_all())
 
 

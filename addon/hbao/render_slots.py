@@ -18,6 +18,12 @@ _job_scene = None
 
 
 def render_result_image():
+    """Blender's Render Result image: by its usual name, else (renamed) the
+    first of its type. Asked at every refresh tick: no walk over a file's
+    images where the name finds it."""
+    image = bpy.data.images.get("Render Result")
+    if image is not None and image.type == "RENDER_RESULT":
+        return image
     return next((image for image in bpy.data.images if image.type == "RENDER_RESULT"), None)
 
 
