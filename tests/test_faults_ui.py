@@ -139,7 +139,7 @@ def _line(log, key):
     return json.loads(line[len(key) + 1:])
 
 
-@pytest.mark.parametrize("kind", ["NEW", "FULL_COPY", "NEW_SAVED"])
+@pytest.mark.parametrize("kind", ["NEW", "FULL_COPY", "NEW_SAVED", "SWITCH"])
 def test_deleting_the_active_scene_never_shows_a_helper_scene(run_in_blender, tmp_path, kind):
     """Scene > New (an empty scene, or a full copy that carries the node),
     then Scene > Delete of the first scene while the window shows it
@@ -151,12 +151,20 @@ def test_deleting_the_active_scene_never_shows_a_helper_scene(run_in_blender, tm
     band's and back faces' scenes (the deleted scene's objects inside them).
     Observed: the window shows the artist's scene, only the helper of a
     scene that has a node is left, in the session and in the saved file,
-    and the copy renders AO."""
+    and the copy renders AO. SWITCH: the scene selector's search finds the
+    helpers; a window switched to one stayed on it until the next edit.
+    Observed: the window goes back to the artist's scene at once."""
     out = tmp_path / "deleted"
     completed = run_in_blender(SCRIPTS / "ui_scene_delete.py", kind, out, ui=True)
     log = completed.stdout
-    assert "DELETE {'FINISHED'}" in log, log[-3000:]
     state = _line(log, "SCENES")
+    if kind == "SWITCH":
+        assert "SWITCHED .HBAO passes Scene" in log, log[-3000:]
+        assert state == {"window": "Scene",
+                         "scenes": {".HBAO passes Scene": True, "Scene": False},
+                         "managed": {"Scene": ".HBAO passes Scene"}}, state
+        return
+    assert "DELETE {'FINISHED'}" in log, log[-3000:]
     if kind.startswith("NEW"):
         assert state == {"window": "Scene.001", "scenes": {"Scene.001": False}, "managed": {}}
         if kind == "NEW_SAVED":

@@ -67,10 +67,17 @@ def schedule_sync():
         bpy.app.timers.register(_timer_sync, first_interval=0.0)
 
 
+def _on_window_scene(*_args):
+    """A window switched scenes: to an internal one, it goes back at once."""
+    if window_scenes.shows_an_internal_scene():
+        schedule_sync()
+
+
 @bpy.app.handlers.persistent
 def _on_load_post(*_args):
     global _sync_scheduled
     _sync_scheduled = False  # opening a file removed the timer, if it waited
+    window_scenes.watch(_on_window_scene)
     strip_cameras.forget_jobs()
     _sync_all_or_later()
 
@@ -217,6 +224,7 @@ def register():
             handlers.append(function)
     if schedule_sync not in node.changed_callbacks:
         node.changed_callbacks.append(schedule_sync)
+    window_scenes.watch(_on_window_scene)
 
 
 def unregister():
@@ -224,6 +232,7 @@ def unregister():
     if bpy.app.timers.is_registered(_timer_sync):
         bpy.app.timers.unregister(_timer_sync)
     _sync_scheduled = False
+    window_scenes.unwatch()
     if schedule_sync in node.changed_callbacks:
         node.changed_callbacks.remove(schedule_sync)
     for handlers, function in _HANDLERS:

@@ -6,12 +6,16 @@ dot, so they come first: deleting the active scene showed the artist a
 helper, which then kept the deleted scene's helper in the file (a window is
 a user) and, saved so, made `blender -b file -f 1` render the helper. A
 window found on one goes to the scene it serves, else the first of the
-artist's scenes (a new one where none is left)."""
+artist's scenes (a new one where none is left). The scene selector's search finds the
+internal scenes too: a switch to one (no handler fires for it) is watched on
+the message bus."""
 import bpy
 
 from . import extra_renders
 from .helper_lookup import is_helper, scenes_served_by
 from .report import log
+
+_OWNER = object()  # the message bus's key for watch()
 
 
 def is_internal(scene):
@@ -51,3 +55,21 @@ def leave_internal_scenes():
         window.scene = scene
         log(f"the window showed the add-on's internal scene {internal.name!r} "
             f"(a scene was deleted?); it shows {scene.name!r} now")
+
+
+def shows_an_internal_scene():
+    manager = bpy.context.window_manager
+    return manager is not None and any(
+        window.scene is not None and is_internal(window.scene) for window in manager.windows)
+
+
+def watch(notify):
+    """(Re)subscribe notify() to a window's scene switch: loading a file
+    clears the message bus."""
+    bpy.msgbus.clear_by_owner(_OWNER)
+    bpy.msgbus.subscribe_rna(key=(bpy.types.Window, "scene"), owner=_OWNER, args=(),
+                             notify=notify)
+
+
+def unwatch():
+    bpy.msgbus.clear_by_owner(_OWNER)

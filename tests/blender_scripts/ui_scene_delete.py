@@ -11,6 +11,8 @@ managed node renders. With the copy still holding a node, renders it to
 OUT_DIR/nodes_0001.exr and prints RENDERED {json}. KIND NEW_SAVED: NEW, the
 node with a guard band and back faces, and the file saved at once after the
 Delete, before any sync: prints SAVED {json}, the scenes in the file.
+KIND SWITCH: no new scene; the window is switched to the helper scene, as
+the scene selector's search (which finds ".HBAO ...") does, then SCENES.
 
   blender --addons hbao --python ui_scene_delete.py -- KIND OUT_DIR
 """
@@ -33,6 +35,7 @@ kind, out_dir = sys.argv[sys.argv.index("--") + 1:][:2]
 steps = iter(range(100))
 helper_lookup = sys.modules["hbao.helper_lookup"]
 window_scenes = importlib.import_module("hbao.window_scenes")
+switched = []
 
 
 def scenes():
@@ -55,6 +58,17 @@ def step():
         os._exit(1)
 
 
+def _switch_to_the_helper(window):
+    """SWITCH: once the sync has made the helper, the window shows it."""
+    managed = helper_lookup.managed_node(bpy.data.scenes["Scene"].node_tree)
+    if managed is None:
+        return 0.5  # the sync has not run yet
+    window.scene = managed.scene  # through RNA, as the scene selector sets it
+    print("SWITCHED", managed.scene.name, flush=True)
+    switched.append(managed.scene.name)
+    return 2.0
+
+
 def _step():
     window = bpy.context.window_manager.windows[0]
     index = next(steps)
@@ -66,14 +80,17 @@ def _step():
         scene.render.filepath = os.path.join(out_dir, "frame_")
         node_editor(window)
         return 1.0  # the add-on's sync makes the helper meanwhile
-    if index == 1:
+    if kind == "SWITCH":
+        if not switched and index < 20:
+            return _switch_to_the_helper(window)
+    elif index == 1:
         with override(window, node_editor(window)):
             print("NEW", bpy.ops.scene.new(type=kind.replace("_SAVED", "")), flush=True)
         return 1.0
-    if index == 2:
+    elif index == 2:
         window.scene = bpy.data.scenes["Scene"]
         return 1.0
-    if index == 3:
+    elif index == 3:
         with override(window, node_editor(window)):
             print("DELETE", bpy.ops.scene.delete(), flush=True)
         if kind == "NEW_SAVED":
