@@ -11,6 +11,7 @@ Blender has a user interface (Debian's, under Xvfb). Other tests get Debian's
 blender. The summary at the end counts the results per Blender."""
 import collections
 import contextlib
+import json
 import os
 import shutil
 import signal
@@ -224,6 +225,14 @@ def run_in_blender(blender, blender_user_scripts):
     """run_blender for the test's own Blender: a matrix test's `blender`
     parameter (the bpy builds too), else Debian's."""
     return _runner(blender, blender_user_scripts)
+
+
+def json_line(log, key):
+    """The JSON a Blender script printed after "KEY " (the first such line);
+    fails the test, showing the log's end, where there is none."""
+    line = next((text for text in log.splitlines() if text.startswith(f"{key} ")), None)
+    assert line is not None, log[-3000:]
+    return json.loads(line[len(key) + 1:])
 
 
 def run_command(command, user_scripts, env=None, check=True, timeout=BLENDER_TIMEOUT_S):

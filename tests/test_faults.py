@@ -11,7 +11,7 @@ import subprocess
 import numpy as np
 import pytest
 
-from conftest import EXR_LIBRARY, REPO, run_command, small_tmpfs
+from conftest import EXR_LIBRARY, REPO, json_line, run_command, small_tmpfs
 from test_addon import EXACT, exr, library_ao, node_outputs, node_params, render
 
 SCRIPTS = REPO / "tests" / "blender_scripts"
@@ -689,3 +689,59 @@ def test_a_panoramic_camera_says_so_on_the_node(run_in_blender, tmp_path):
     second, after = _render_twice(run_in_blender, tmp_path, "panoramic_camera")
     assert "is PANO" in second, second[-2000:]
     assert after["statuses"] == {"HBAO0": "Camera: AO off"}, after
+
+
+def test_an_edited_copy_of_the_nodes_group_is_kept(run_in_blender, tmp_path, node_native,
+                                                   no_leftovers):
+    """The HBAO node's group made single-user by a script (".HBAO.001") and
+    edited (a Power node squares the AO): the next sync took it for File >
+    Append's copy, pointed the node back at the shared group and deleted
+    the copy, edit and all, without a word (an exploratory run). Observed:
+    the copy is kept, and the node's AO is the library's squared."""
+    out = tmp_path / "copy"
+    log = run_in_blender(SCRIPTS / "node_places.py", "edited_copy", out).stdout
+    assert json_line(log, "GROUP") == {"node": ".HBAO.001", "groups": [".HBAO", ".HBAO.001"]}, \
+        log[-3000:]
+    assert "RENDERED {'FINISHED'}" in log, log[-3000:]
+    expected = library_ao(node_native, out, 1, node_params(radius=1.0, blur_size=0))
+    ao = node_outputs(out, 1)["ao"]
+    assert expected.min() < 0.9
+    assert np.abs(ao - expected * expected).max() <= 1e-6
+
+
+@pytest.mark.min_blender(5, 1)
+@pytest.mark.parametrize("case", ["strip_modifier", "compositor_strip"])
+def test_hbao_node_in_a_strips_compositor_says_why_it_gives_no_ao(run_in_blender, tmp_path,
+                                                                  no_leftovers, case):
+    """An HBAO node in the node group of a sequencer strip's Compositor
+    modifier, or of a Compositor strip (5.3): the node said "In a node group
+    ... Ungroup it", and the render said nothing (an exploratory run).
+    Observed: the node and, once, the render say that strips' compositors
+    get no AO."""
+    log = run_in_blender(SCRIPTS / "node_places.py", case, tmp_path / case).stdout
+    assert "RENDERED {'FINISHED'}" in log, log[-3000:]
+    assert json_line(log, "STATUS")["HBAO in strip"] == ["", "In a strip's compositor: AO off"]
+    strip = "Comp" if case == "compositor_strip" else "Shot"
+    said = (f'HBAO: node "HBAO in strip" in the compositor of strip "{strip}": HBAO works in '
+            f"a scene's compositor, not in a sequencer strip's")
+    assert log.count(said) == 1, log[-3000:]
+
+
+@pytest.mark.min_blender(5, 0)
+def test_hbao_node_in_a_linked_tree_says_why_it_gives_no_ao(run_in_blender, tmp_path,
+                                                            no_leftovers):
+    """A compositing node group with an HBAO node linked from another file
+    (File > Link) and made the scene's compositor: each sync logged "could
+    not update the HBAO hook ... Collection 'Scene Collection' is linked"
+    and the node said nothing (an exploratory run). Observed: the hook
+    leaves the linked tree alone, and the node and, once, the render say
+    to make it local."""
+    source = tmp_path / "source"
+    assert "SAVED" in run_in_blender(SCRIPTS / "node_places.py", "link_source", source).stdout
+    log = run_in_blender(SCRIPTS / "node_places.py", "linked_tree", tmp_path / "linked",
+                         source / "source.blend").stdout
+    assert "RENDERED {'FINISHED'}" in log, log[-3000:]
+    assert "could not" not in log, log[-3000:]
+    assert json_line(log, "STATUS")["HBAO0"] == ["", "In a linked tree: AO off"]
+    said = 'HBAO: node "HBAO0" in linked tree "Look": This compositor node tree comes from'
+    assert log.count(said) == 1, log[-3000:]

@@ -8,7 +8,7 @@ import shutil
 import numpy as np
 import pytest
 
-from conftest import REPO
+from conftest import REPO, json_line
 from test_addon import node_outputs
 from test_faults import no_leftovers  # noqa: F401  (the fixture)
 
@@ -124,19 +124,13 @@ def test_hbao_and_render_layers_nodes_pasted_into_another_file(run_in_blender, t
     log = completed.stdout
     # Shift+D first: the duplicate keeps the group and values, gets its own
     # pass, starts unlinked, and no restore is left pending on it
-    assert _line(log, "DUPLICATED") == {"radius": 2.0, "steps": 9, "group": ".HBAO", "pass": 2,
-                                        "linked": False, "pending": False}
+    assert json_line(log, "DUPLICATED") == {"radius": 2.0, "steps": 9, "group": ".HBAO",
+                                            "pass": 2, "linked": False, "pending": False}
     assert "PASTE {'FINISHED'}" in log, log[-3000:]
-    pasted = _line(log, "PASTED")
+    pasted = json_line(log, "PASTED")
     assert pasted == {"radius": 2.0, "steps": 9, "inputs": 11, "group": ".HBAO"}, pasted
-    rendered = _line(log, "RENDERED")
+    rendered = json_line(log, "RENDERED")
     assert node_outputs(out, 1, rendered["node"])["ao"].min() < 0.9, rendered
-
-
-def _line(log, key):
-    line = next((text for text in log.splitlines() if text.startswith(f"{key} ")), None)
-    assert line is not None, log[-3000:]
-    return json.loads(line[len(key) + 1:])
 
 
 @pytest.mark.parametrize("kind", ["NEW", "FULL_COPY", "NEW_SAVED", "SWITCH"])
@@ -157,7 +151,7 @@ def test_deleting_the_active_scene_never_shows_a_helper_scene(run_in_blender, tm
     out = tmp_path / "deleted"
     completed = run_in_blender(SCRIPTS / "ui_scene_delete.py", kind, out, ui=True)
     log = completed.stdout
-    state = _line(log, "SCENES")
+    state = json_line(log, "SCENES")
     if kind == "SWITCH":
         assert "SWITCHED .HBAO passes Scene" in log, log[-3000:]
         assert state == {"window": "Scene",
@@ -168,12 +162,12 @@ def test_deleting_the_active_scene_never_shows_a_helper_scene(run_in_blender, tm
     if kind.startswith("NEW"):
         assert state == {"window": "Scene.001", "scenes": {"Scene.001": False}, "managed": {}}
         if kind == "NEW_SAVED":
-            assert _line(log, "SAVED") == ["Scene.001"]
+            assert json_line(log, "SAVED") == ["Scene.001"]
         return
     assert state == {"window": "Scene.001",
                      "scenes": {".HBAO passes Scene.001": True, "Scene.001": False},
                      "managed": {"Scene.001": ".HBAO passes Scene.001"}}, state
-    rendered = _line(log, "RENDERED")
+    rendered = json_line(log, "RENDERED")
     assert node_outputs(out, 1, rendered["node"])["ao"].min() < 0.9, rendered
 
 
@@ -209,7 +203,7 @@ def test_a_render_slot_shown_again_or_kept_ui_is_not_refreshed(run_in_blender, t
     assert "SLOTS DONE" in log, log[-3000:]
     after = log[log.index("BACK TO SLOT 2"):] if case == "back" else log
     assert "re-composited" not in after, log[-3000:]
-    assert _line(log, "HINT") == "Changed: render to update"
+    assert json_line(log, "HINT") == "Changed: render to update"
 
 
 def test_a_cancelled_render_is_not_brought_up_to_date(run_in_blender, tmp_path):
@@ -223,4 +217,4 @@ def test_a_cancelled_render_is_not_brought_up_to_date(run_in_blender, tmp_path):
                          ui=True).stdout
     assert "SLOTS DONE" in log and "ESCAPE sent" in log, log[-3000:]
     assert "re-composited" not in log, log[-3000:]
-    assert _line(log, "HINT") == "Changed: render to update"
+    assert json_line(log, "HINT") == "Changed: render to update"

@@ -91,20 +91,17 @@ def _on_save_pre(*_args):
 
 @bpy.app.handlers.persistent
 def _on_render_init(scene, *_args):
-    """Once a render job, in the console and the Info editor: what the HBAO
-    nodes inside node groups mean (the hook computes only at the top
-    level), and that Render Single Layer turns the AO off (on the nodes'
-    status lines too); then as every frame."""
+    """Once a render job, in the console and the Info editor: why the HBAO
+    nodes that get no AO where they lie get none (node_place.py), and that
+    Render Single Layer turns the AO off (on the nodes' status lines too);
+    then as every frame."""
     strip_cameras.job_started(scene)
     if not window_scenes.is_internal(scene):
         render_slots.started(scene)
     if not helper_lookup.is_helper(scene):
         tree = compat.compositor_tree(scene)
         # (the console's text, the report's: a node's reads "HBAO node ...")
-        messages = [(text, f"HBAO {text}") for text in [
-            node_place.grouped_message(group, grouped)
-            for group, grouped in node_place.nodes_in_groups(tree, node.is_hbao_node)]
-            + node_place.other_effect_messages(scene)]
+        messages = [(text, f"HBAO {text}") for text in node_place.render_messages(scene)]
         nodes = node.hbao_nodes(tree)
         settings = helper_render_settings
         off = None

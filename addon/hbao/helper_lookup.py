@@ -75,8 +75,12 @@ def tree_of_helper(helper):
 
 
 def serves(helper, scene):
-    """Whether `helper` publishes the AO of `scene`'s compositor tree."""
-    if not is_helper(helper) or is_helper(scene):
+    """Whether `helper` publishes the AO of `scene`'s compositor tree. A
+    helper linked from another file serves that file's scenes only (a scene
+    of this file that composites with a linked tree gets no AO:
+    node_place.unhooked)."""
+    if not is_helper(helper) or is_helper(scene) or (helper.library is not None
+                                                     and scene.library is None):
         return False
     tree = compat.compositor_tree(scene)
     return tree is not None and tree_of_helper(helper) == tree

@@ -16,8 +16,8 @@ pointed at each scene's helper in turn would flip with every sync. The render
 handlers record the scene being rendered, which the engine reads."""
 import bpy
 
-from . import compat, extra_renders, helper_render_settings, hook_release, pass_sources, \
-    view_cameras, writes
+from . import (compat, extra_renders, helper_render_settings, hook_release, node_place,
+               pass_sources, view_cameras, writes)
 from .data_edits import set_if_different
 from .helper_lookup import (ENGINE_IDNAME, HELPER_SCENE_PREFIX, MAIN_SCENE_KEY, MAIN_TREE_KEY,
                             MANAGED_NODE_KEY, helper_scene_of, is_helper, main_scene_of,
@@ -202,8 +202,8 @@ def sync(scene, rendering=False):
     extra renders' scenes stay until the render has ended); returns a list
     of messages."""
     tree = compat.compositor_tree(scene)
-    if tree is None or is_helper(scene):
-        return []
+    if tree is None or is_helper(scene) or node_place.unhooked(scene, tree):
+        return []  # (the nodes of a linked tree say why they get no AO)
     _unhook_other_effects(scene, tree)
     nodes = hbao_nodes(tree)
     if not nodes:

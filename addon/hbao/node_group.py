@@ -145,9 +145,11 @@ def adopt_group_copies(nodes):
     """Point each of `nodes` (HBAO nodes) that uses another local group, or
     none (pasted from another file), at the shared current one, keeping its
     values and links: File > Append brings its own copy (".HBAO.001"),
-    perhaps of an older layout. A copy left without users is removed (not
-    one with a fake user, or an asset). Nodes in linked or overridden trees
-    are left alone. Returns how many nodes moved."""
+    perhaps of an older layout. A copy of the current layout whose contents
+    differ from the shared group's was made single-user and edited by the
+    artist: it is kept. A copy left without users is removed (not one with a
+    fake user, or an asset). Nodes in linked or overridden trees are left
+    alone. Returns how many nodes moved."""
     nodes = [node for node in nodes if node.id_data.library is None and
              getattr(node.id_data, "override_library", None) is None]
     upgrade_group_tree()  # an outdated or half rebuilt shared group first
@@ -157,6 +159,10 @@ def adopt_group_copies(nodes):
     if not strays:
         return 0
     shared = group_tree()
+    shared_contents = group_layout.contents(shared)
+    strays = [node for node in strays if node.node_tree is None
+              or not group_layout.is_current(node.node_tree)
+              or group_layout.contents(node.node_tree) == shared_contents]
     for node in strays:
         copy = node.node_tree
         _keep_state(node)

@@ -84,12 +84,12 @@ def _children(holder):
     return list(strips if strips is not None else getattr(holder, "sequences", []))
 
 
-def _every_strip(holder):
+def every_strip(holder):
     """The strips of `holder`, inside its meta strips too."""
     for strip in _children(holder):
         yield strip
         if strip.type == "META":
-            yield from _every_strip(strip)
+            yield from every_strip(strip)
 
 
 def _channel_muted(holder, number):
@@ -151,7 +151,7 @@ def strip_overrides(scenes):
     cameras = []
     for other in bpy.data.scenes:
         editor = getattr(other, "sequence_editor", None)
-        for strip in _every_strip(editor) if editor is not None else ():
+        for strip in every_strip(editor) if editor is not None else ():
             camera = getattr(strip, "scene_camera", None)
             if strip.type == "SCENE" and strip.scene in scenes and camera is not None:
                 cameras.append(camera)
