@@ -218,3 +218,27 @@ def test_a_cancelled_render_is_not_brought_up_to_date(run_in_blender, tmp_path):
     assert "SLOTS DONE" in log and "ESCAPE sent" in log, log[-3000:]
     assert "re-composited" not in log, log[-3000:]
     assert json_line(log, "HINT") == "Changed: render to update"
+
+
+@pytest.mark.parametrize("case", ["delete_undo", "delete_redo", "status_redo"])
+def test_undo_and_redo_keep_the_hook(run_in_blender, tmp_path, case):
+    """Undo and redo read the file back, and no depsgraph update follows
+    (ui_undo.py; an exploratory run): Scene > Delete then Ctrl+Z rendered
+    without AO (the engine, asked for the helper's passes during the undo,
+    found no main scene); then Ctrl+Shift+Z left the window on the helper
+    scene; a redo brought back a status line ("Compositing off") that the
+    last render had cleared. Observed: the render after the undo has the
+    AO of the one before, the window shows the artist's scene, and the
+    status is the last render's."""
+    out = tmp_path / case
+    log = run_in_blender(SCRIPTS / "ui_undo.py", case, out, ui=True).stdout
+    assert "UNDO DONE" in log and "UNDO {'FINISHED'}" in log, log[-3000:]
+    if case == "delete_undo":
+        first, after = (node_outputs(out / name, 1)["ao"] for name in ("first", "after"))
+        assert first.min() < 0.9
+        assert np.array_equal(after, first)
+    elif case == "delete_redo":
+        assert "REDO {'FINISHED'}" in log, log[-3000:]
+        assert json_line(log, "SCENES") == {"window": "Scene.001", "scenes": ["Scene.001"]}
+    else:
+        assert json_line(log, "STATUS") == ""

@@ -11,7 +11,8 @@ import bpy
 
 from . import (compat, helper_lookup, helper_render_settings, helper_scene, node, node_place,
                pass_sources, recomposite, render_slots, strip_cameras, window_scenes, writes)
-from .report import NodeMessage, in_main_thread, log, post_node_messages, post_render_report
+from .report import (NodeMessage, forget_node_messages, in_main_thread, log,
+                     post_last_node_messages, post_node_messages, post_render_report)
 
 _sync_scheduled = False
 # How soon a sync that Blender refused (writes.py) runs again.
@@ -74,9 +75,25 @@ def _on_window_scene(*_args):
 
 
 @bpy.app.handlers.persistent
+def _on_undo_or_redo(*_args):
+    """Undo and redo read the file back, and no depsgraph update follows:
+    3.4 showed a helper scene after Scene > Delete, Ctrl+Z, Ctrl+Shift+Z, and
+    rendered without AO after Scene > Delete, Ctrl+Z (the engine, asked
+    for the helper's passes while the undo read the scenes back, found no
+    main scene). The helpers' passes are asked for again, the nodes shown
+    what they were last told, and the hook synced."""
+    for helper in [scene for scene in bpy.data.scenes if helper_lookup.is_helper(scene)]:
+        for layer in helper.view_layers:
+            layer.update_render_passes()
+    post_last_node_messages()
+    schedule_sync()
+
+
+@bpy.app.handlers.persistent
 def _on_load_post(*_args):
     global _sync_scheduled
     _sync_scheduled = False  # opening a file removed the timer, if it waited
+    forget_node_messages()
     window_scenes.watch(_on_window_scene)
     strip_cameras.forget_jobs()
     _sync_all_or_later()
@@ -212,6 +229,8 @@ _HANDLERS = (
     (bpy.app.handlers.render_complete, _on_render_complete),
     (bpy.app.handlers.render_cancel, _on_render_cancel),
     (bpy.app.handlers.depsgraph_update_post, _on_depsgraph_update_post),
+    (bpy.app.handlers.undo_post, _on_undo_or_redo),
+    (bpy.app.handlers.redo_post, _on_undo_or_redo),
 )
 
 

@@ -13,6 +13,9 @@ LOG_PREFIX = "HBAO:"
 # the nodes (node.apply_node_messages). Written by the render thread: one
 # dict assignment, atomic under the GIL.
 _pending_node_messages = {}
+# The same, as last posted (not taken): an undo or redo brings back the
+# statuses saved with its step, which these then replace again.
+_last_node_messages = {}
 
 
 # What the engine reported during a render, waiting for the main thread to
@@ -84,6 +87,19 @@ def post_node_messages(scene_name, node_names, messages):
         if isinstance(message, NodeMessage):
             statuses.setdefault(message.node_name, []).append(message)
     _pending_node_messages[scene_name] = statuses
+    _last_node_messages[scene_name] = statuses
+
+
+def post_last_node_messages():
+    """Post again what each scene's nodes were last told: an undo or redo
+    restored older statuses."""
+    for scene_name, statuses in list(_last_node_messages.items()):
+        _pending_node_messages.setdefault(scene_name, statuses)
+
+
+def forget_node_messages():
+    """Another file is open: its scenes were told nothing yet."""
+    _last_node_messages.clear()
 
 
 def has_node_messages():

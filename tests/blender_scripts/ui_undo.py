@@ -1,0 +1,148 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Run in a real Blender window (xvfb) by tests/test_faults_ui.py: Edit >
+Undo and Redo, which read the file back without a depsgraph update.
+
+CASE "delete_undo": F12 (its File Output kept as OUT/first/nodes_0001.exr);
+Scene > New, the window back on "Scene", Scene > Delete of it, Ctrl+Z, F12
+(kept as OUT/after/nodes_0001.exr). That render had no AO.
+
+CASE "delete_redo": the same to Ctrl+Z, then Ctrl+Shift+Z; prints SCENES
+{json} (the window's scene, the scenes) a few seconds later. The window
+stayed on the helper scene.
+
+CASE "status_redo": Compositing off, F12 (the node says "Compositing off:
+no AO"), Compositing on, F12, Ctrl+Z, Ctrl+Shift+Z; prints STATUS {json}
+(the node's status line) a few seconds later. The old line came back.
+
+Prints UNDO DONE at the end.
+
+  blender --addons hbao --python ui_undo.py -- CASE OUT_DIR
+"""
+import json
+import os
+import shutil
+import sys
+import time
+
+import bpy
+
+case, out_dir = sys.argv[sys.argv.index("--") + 1:][:2]
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import f12_job  # noqa: E402
+import timer_guard  # noqa: E402
+from ui_areas import node_editor, override  # noqa: E402
+
+TIMEOUT_S = 240.0
+SETTLE_S = 3.0
+
+f12_job.corner_scene_with_node(out_dir)[1].inputs["Blur Size"].default_value = 0
+job = f12_job.F12Job()
+started = time.monotonic()
+
+
+def window():
+    return bpy.context.window_manager.windows[0]
+
+
+def operator(name, **kwargs):
+    """An operator in the node editor, as a key press runs it: in the
+    window, and a scene operator pushing its undo step."""
+    with override(window(), node_editor(window())):
+        if name in ("undo", "redo", "undo_push"):
+            done = getattr(bpy.ops.ed, name)(**kwargs)
+        else:
+            done = getattr(bpy.ops.scene, name)("EXEC_DEFAULT", True, **kwargs)
+        print(name.upper(), done, flush=True)
+
+
+def keep(name):
+    os.makedirs(os.path.join(out_dir, name), exist_ok=True)
+    shutil.copy(os.path.join(out_dir, "nodes_0001.exr"), os.path.join(out_dir, name))
+
+
+def render():
+    job.start()
+
+
+def rendered():
+    return "again" if not job.finished() else 1.0
+
+
+def compositing(on):
+    def step():
+        bpy.data.scenes["Scene"].render.use_compositing = on
+        operator("undo_push", message=f"compositing {on}")
+    return step
+
+
+def new_scene():
+    operator("new", type="NEW")
+
+
+def back_to_scene():
+    window().scene = bpy.data.scenes["Scene"]
+    operator("undo_push", message="back to Scene")
+
+
+def delete():
+    operator("delete")
+    return SETTLE_S
+
+
+def built():
+    operator("undo_push", message="built")  # (the scene and the hook the sync made)
+
+
+def undo():
+    operator("undo")
+    return SETTLE_S
+
+
+def redo():
+    operator("redo")
+    return SETTLE_S
+
+
+def report(key, value):
+    def step():
+        print(key, json.dumps(value()), flush=True)
+    return step
+
+
+def status():
+    return bpy.data.scenes["Scene"].node_tree.nodes["HBAO0"].status
+
+
+def scenes():
+    return {"window": window().scene.name, "scenes": sorted(s.name for s in bpy.data.scenes)}
+
+
+STEPS = [built] + {
+    "delete_undo": [render, rendered, lambda: keep("first"), new_scene, back_to_scene, delete,
+                    undo, render, rendered, lambda: keep("after")],
+    "delete_redo": [new_scene, back_to_scene, delete, undo, redo, report("SCENES", scenes)],
+    "status_redo": [compositing(False), render, rendered, compositing(True), render, rendered,
+                    undo, redo, report("STATUS", status)],
+}[case]
+steps = iter(STEPS)
+current = [None]
+
+
+def tick():
+    if time.monotonic() - started > TIMEOUT_S:
+        timer_guard.give_up("UNDO: TIMEOUT")
+    if current[0] is None:
+        current[0] = next(steps, None)
+        if current[0] is None:
+            print("UNDO DONE", flush=True)
+            timer_guard.quit_blender()
+            return None
+    wait = current[0]()
+    if wait == "again":
+        return 0.1
+    current[0] = None
+    return 1.0 if wait is None else wait
+
+
+node_editor(window())
+timer_guard.guarded_timer(tick, SETTLE_S)  # the add-on's sync makes the hook meanwhile
