@@ -223,7 +223,7 @@ def test_a_cancelled_render_is_not_brought_up_to_date(run_in_blender, tmp_path):
 @pytest.mark.parametrize("case", ["delete_undo", "delete_redo", "status_redo"])
 def test_undo_and_redo_keep_the_hook(run_in_blender, tmp_path, case):
     """Undo and redo read the file back, and no depsgraph update follows
-    (ui_undo.py; an exploratory run): Scene > Delete then Ctrl+Z rendered
+    (ui_session.py; an exploratory run): Scene > Delete then Ctrl+Z rendered
     without AO (the engine, asked for the helper's passes during the undo,
     found no main scene); then Ctrl+Shift+Z left the window on the helper
     scene; a redo brought back a status line ("Compositing off") that the
@@ -231,8 +231,8 @@ def test_undo_and_redo_keep_the_hook(run_in_blender, tmp_path, case):
     AO of the one before, the window shows the artist's scene, and the
     status is the last render's."""
     out = tmp_path / case
-    log = run_in_blender(SCRIPTS / "ui_undo.py", case, out, ui=True).stdout
-    assert "UNDO DONE" in log and "UNDO {'FINISHED'}" in log, log[-3000:]
+    log = run_in_blender(SCRIPTS / "ui_session.py", case, out, ui=True).stdout
+    assert "SESSION DONE" in log and "UNDO {'FINISHED'}" in log, log[-3000:]
     if case == "delete_undo":
         first, after = (node_outputs(out / name, 1)["ao"] for name in ("first", "after"))
         assert first.min() < 0.9
@@ -242,3 +242,22 @@ def test_undo_and_redo_keep_the_hook(run_in_blender, tmp_path, case):
         assert json_line(log, "SCENES") == {"window": "Scene.001", "scenes": ["Scene.001"]}
     else:
         assert json_line(log, "STATUS") == ""
+
+
+@pytest.mark.parametrize("case", ["reenable", "disable_during"])
+def test_the_add_on_disabled_and_enabled_in_a_session(run_in_blender, tmp_path, case):
+    """The add-on disabled and enabled again in Preferences, F12 at once
+    (ui_session.py; an exploratory run): the disable let go of the hook and
+    nothing made it again, so every F12 rendered without AO, silently, until
+    an edit; disabled while F12 ran, Blender 3.4 crashed (its own fault on
+    unregistering any add-on's render engine during a render). Observed: no
+    crash, and the F12 after enabling has the AO of the scene."""
+    out = tmp_path / case
+    log = run_in_blender(SCRIPTS / "ui_session.py", case, out, ui=True).stdout
+    assert "SESSION DONE" in log and "ADDON_ENABLE {'FINISHED'}" in log, log[-3000:]
+    after = node_outputs(out / "after", 1)["ao"]
+    if case == "disable_during":
+        assert "DISABLED DURING F12" in log, log[-3000:]
+        assert after.min() < 0.9
+    else:
+        assert np.array_equal(after, node_outputs(out / "first", 1)["ao"])

@@ -283,7 +283,8 @@ _HANDLERS = (bpy.app.handlers.render_complete, bpy.app.handlers.render_cancel)
 
 
 def register():
-    bpy.utils.register_class(HBAOPassEngine)
+    if "bl_rna" not in HBAOPassEngine.__dict__:  # kept by unregister, below
+        bpy.utils.register_class(HBAOPassEngine)
     for handlers in _HANDLERS:
         if _on_render_end not in handlers:
             handlers.append(_on_render_end)
@@ -295,4 +296,11 @@ def unregister():
             handlers.remove(_on_render_end)
     _cache.clear()
     native.release_memory()
-    bpy.utils.unregister_class(HBAOPassEngine)
+    # Blender 3.4 crashed (a null function call in the render thread) when
+    # an add-on's render engine was unregistered while a render ran: the
+    # add-on disabled in Preferences during F12. The engine then stays
+    # registered, and enabling the add-on again reuses it.
+    if bpy.app.is_job_running("RENDER"):
+        log("a render is running: the HBAO Passes engine stays registered until Blender quits")
+    else:
+        bpy.utils.unregister_class(HBAOPassEngine)

@@ -241,6 +241,11 @@ def register():
     if schedule_sync not in node.changed_callbacks:
         node.changed_callbacks.append(schedule_sync)
     window_scenes.watch(_on_window_scene)
+    # Enabled in a session (Preferences, after a disable, which let go of
+    # the hooks: hook_release.py): register() cannot read the file, and no
+    # depsgraph update need follow, so F12 rendered without AO until an
+    # edit. The hooks are made again at the first tick.
+    schedule_sync()
 
 
 def unregister():

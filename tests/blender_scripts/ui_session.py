@@ -1,6 +1,8 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
-"""Run in a real Blender window (xvfb) by tests/test_faults_ui.py: Edit >
-Undo and Redo, which read the file back without a depsgraph update.
+"""Run in a real Blender window (xvfb) by tests/test_faults_ui.py: what an
+artist does in a session, step by step. Edit > Undo and Redo read the file
+back without a depsgraph update; the add-on disabled and enabled in
+Preferences.
 
 CASE "delete_undo": F12 (its File Output kept as OUT/first/nodes_0001.exr);
 Scene > New, the window back on "Scene", Scene > Delete of it, Ctrl+Z, F12
@@ -14,9 +16,16 @@ CASE "status_redo": Compositing off, F12 (the node says "Compositing off:
 no AO"), Compositing on, F12, Ctrl+Z, Ctrl+Shift+Z; prints STATUS {json}
 (the node's status line) a few seconds later. The old line came back.
 
-Prints UNDO DONE at the end.
+CASE "reenable": F12 (kept as OUT/first), the add-on disabled and enabled
+in Preferences, F12 at once (kept as OUT/after). That render had no AO.
 
-  blender --addons hbao --python ui_undo.py -- CASE OUT_DIR
+CASE "disable_during": F12 of a render of some seconds, the add-on
+disabled in Preferences while it runs (Blender 3.4 crashed), enabled again
+once it has ended, F12 (kept as OUT/after).
+
+Prints SESSION DONE at the end.
+
+  blender --addons hbao --python ui_session.py -- CASE OUT_DIR
 """
 import json
 import os
@@ -35,7 +44,10 @@ from ui_areas import node_editor, override  # noqa: E402
 TIMEOUT_S = 240.0
 SETTLE_S = 3.0
 
-f12_job.corner_scene_with_node(out_dir)[1].inputs["Blur Size"].default_value = 0
+scene = f12_job.corner_scene_with_node(out_dir)[0]
+scene.node_tree.nodes["HBAO0"].inputs["Blur Size"].default_value = 0
+if case == "disable_during":
+    scene.cycles.samples = 4000  # some seconds
 job = f12_job.F12Job()
 started = time.monotonic()
 
@@ -103,6 +115,21 @@ def redo():
     return SETTLE_S
 
 
+def addon(enable):
+    def step():
+        name = "addon_enable" if enable else "addon_disable"
+        print(name.upper(), getattr(bpy.ops.preferences, name)(module="hbao"), flush=True)
+    return step
+
+
+def disable_while_rendering():
+    if not bpy.app.is_job_running("RENDER"):
+        return "again" if not job.finished() else None  # (ended before: the test says)
+    print("DISABLED DURING F12", flush=True)
+    addon(False)()
+    return 0.1
+
+
 def report(key, value):
     def step():
         print(key, json.dumps(value()), flush=True)
@@ -123,6 +150,10 @@ STEPS = [built] + {
     "delete_redo": [new_scene, back_to_scene, delete, undo, redo, report("SCENES", scenes)],
     "status_redo": [compositing(False), render, rendered, compositing(True), render, rendered,
                     undo, redo, report("STATUS", status)],
+    "reenable": [render, rendered, lambda: keep("first"), addon(False), addon(True), render,
+                 rendered, lambda: keep("after")],
+    "disable_during": [render, disable_while_rendering, rendered, addon(True), render, rendered,
+                       lambda: keep("after")],
 }[case]
 steps = iter(STEPS)
 current = [None]
@@ -130,11 +161,11 @@ current = [None]
 
 def tick():
     if time.monotonic() - started > TIMEOUT_S:
-        timer_guard.give_up("UNDO: TIMEOUT")
+        timer_guard.give_up("SESSION: TIMEOUT")
     if current[0] is None:
         current[0] = next(steps, None)
         if current[0] is None:
-            print("UNDO DONE", flush=True)
+            print("SESSION DONE", flush=True)
             timer_guard.quit_blender()
             return None
     wait = current[0]()
