@@ -709,6 +709,22 @@ def test_an_edited_copy_of_the_nodes_group_is_kept(run_in_blender, tmp_path, nod
     assert np.abs(ao - expected * expected).max() <= 1e-6
 
 
+def test_an_unedited_copy_gives_way_after_the_shared_group_was_edited(
+        run_in_blender, tmp_path, no_leftovers):
+    """File > Append of a scene whose node brings an unedited copy of the
+    group (".HBAO.001") after the artist edited the shared ".HBAO" in place:
+    a comparison of the two groups' contents took the copy for an edit (the
+    review; so did a copy built by 4.5 opened in 5.0, whose versioning
+    changes a setting). The copy is told by its own fingerprint, which
+    build() keeps: observed, it gives way to the shared group."""
+    source = tmp_path / "source"
+    assert "SAVED" in run_in_blender(SCRIPTS / "node_places.py", "link_source", source).stdout
+    log = run_in_blender(SCRIPTS / "node_places.py", "append_after_edit", tmp_path / "appended",
+                         source / "source.blend").stdout
+    assert json_line(log, "GROUP") == {"arrived": ".HBAO.001", "node": ".HBAO",
+                                       "groups": [".HBAO"]}, log[-3000:]
+
+
 @pytest.mark.min_blender(5, 1)
 @pytest.mark.parametrize("case", ["strip_modifier", "compositor_strip"])
 def test_hbao_node_in_a_strips_compositor_says_why_it_gives_no_ao(run_in_blender, tmp_path,

@@ -274,9 +274,7 @@ class HBAOPassEngine(bpy.types.RenderEngine):
 
 @bpy.app.handlers.persistent
 def _on_render_end(*_args):
-    # The library keeps its working memory from frame to frame of a render
-    # (a fifth of a frame's time); between renders it is given back.
-    native.release_memory()
+    native.release_memory()  # kept from frame to frame of a render (a fifth of a frame)
 
 
 _HANDLERS = (bpy.app.handlers.render_complete, bpy.app.handlers.render_cancel)
@@ -296,11 +294,5 @@ def unregister():
             handlers.remove(_on_render_end)
     _cache.clear()
     native.release_memory()
-    # Blender 3.4 crashed (a null function call in the render thread) when
-    # an add-on's render engine was unregistered while a render ran: the
-    # add-on disabled in Preferences during F12. The engine then stays
-    # registered, and enabling the add-on again reuses it.
-    if bpy.app.is_job_running("RENDER"):
-        log("a render is running: the HBAO Passes engine stays registered until Blender quits")
-    else:
+    if not bpy.app.is_job_running("RENDER"):  # (3.4 crashed: blender-integration.md)
         bpy.utils.unregister_class(HBAOPassEngine)

@@ -110,6 +110,7 @@ def build(tree):
     tree.links.new(product, group_output.inputs[IMAGE_OUTPUT])
     tree.links.new(ao, group_output.inputs[AO_OUTPUT])
     tree[GROUP_VERSION_KEY] = GROUP_TREE_VERSION
+    tree[BUILT_KEY] = fingerprint(tree)
 
 
 def layout_of(node):
@@ -127,38 +128,22 @@ def is_current(tree):
     return tree is not None and tree.get(GROUP_VERSION_KEY) == GROUP_TREE_VERSION
 
 
-# Node properties that change how a group looks, not what it computes.
-_COSMETIC = {"name", "label", "location", "location_absolute", "width", "height", "select",
-             "hide", "show_options", "show_preview", "show_texture", "use_custom_color",
-             "color", "parent", "color_tag", "warning_propagation"}
-_SETTING_TYPES = {"BOOLEAN", "INT", "FLOAT", "ENUM", "STRING"}
+# What build() made, kept in the group (copies carry it): a group whose
+# fingerprint differs from its own kept one was edited (node_group.py).
+BUILT_KEY = "hbao_group_built"
 
 
-def _plain(value):
-    """A property's value as a comparable Python value."""
-    if isinstance(value, (str, bool, int, float)) or value is None:
-        return value
-    try:
-        return tuple(_plain(item) for item in value)  # arrays, vectors, colours, enum sets
-    except TypeError:
-        return repr(value)
+def fingerprint(tree):
+    """The group's nodes (by name), its number of links and its sockets:
+    what an edit that adds, removes or rewires nodes changes, and what
+    Blender's versioning of an older file (a Mix node replaced by another
+    of the same name, a setting added) does not."""
+    sockets = [compat.group_socket_names(tree, in_out) for in_out in ("INPUT", "OUTPUT")]
+    return repr((sorted(node.name for node in tree.nodes), len(tree.links), sockets))
 
 
-def _node_contents(node):
-    settings = tuple((prop.identifier, _plain(getattr(node, prop.identifier, None)))
-                     for prop in node.bl_rna.properties
-                     if not prop.is_readonly and prop.type in _SETTING_TYPES
-                     and prop.identifier not in _COSMETIC)
-    values = tuple((socket.identifier, _plain(getattr(socket, "default_value", None)))
-                   for socket in node.inputs if not socket.is_linked)
-    return node.name, node.bl_idname, settings, values
-
-
-def contents(tree):
-    """What group `tree` computes: its nodes' types, settings and unlinked
-    input values, its links and its sockets; a copy whose contents differ
-    from the shared group's was edited (node_group.adopt_group_copies)."""
-    links = sorted((link.from_node.name, link.from_socket.identifier, link.to_node.name,
-                    link.to_socket.identifier) for link in tree.links)
-    return (sorted(_node_contents(node) for node in tree.nodes), links,
-            [compat.group_socket_names(tree, in_out) for in_out in ("INPUT", "OUTPUT")])
+def edited(tree):
+    """Whether group `tree`, made by build(), was edited since (not a group
+    made before build() kept its fingerprint)."""
+    built = tree.get(BUILT_KEY)
+    return built is not None and built != fingerprint(tree)

@@ -132,7 +132,11 @@ def upgrade_group_tree():
     order, so keyframes stay on their sockets), keeping each node's values and
     links. Called after a file is loaded, and before groups are adopted."""
     tree = bpy.data.node_groups.get(GROUP_TREE_NAME)
-    if tree is None or tree.library is not None or group_layout.is_current(tree):
+    if tree is None or tree.library is not None:
+        return
+    if group_layout.is_current(tree):
+        if group_layout.BUILT_KEY not in tree:  # built before the fingerprint was kept
+            tree[group_layout.BUILT_KEY] = group_layout.fingerprint(tree)
         return  # (a restore left pending on a whole group: adopt_group_copies, every sync)
     users = _users(tree)
     for node in users:
@@ -145,24 +149,23 @@ def adopt_group_copies(nodes):
     """Point each of `nodes` (HBAO nodes) that uses another local group, or
     none (pasted from another file), at the shared current one, keeping its
     values and links: File > Append brings its own copy (".HBAO.001"),
-    perhaps of an older layout. A copy of the current layout whose contents
-    differ from the shared group's was made single-user and edited by the
-    artist: it is kept. A copy left without users is removed (not one with a
-    fake user, or an asset). Nodes in linked or overridden trees are left
-    alone. Returns how many nodes moved."""
+    perhaps of an older layout. A copy of the current layout edited since
+    the add-on built it (nodes added, removed or rewired: group_layout.edited)
+    was made single-user by the artist: it is kept. A copy left without
+    users is removed (not one with a fake user, or an asset). Nodes in
+    linked or overridden trees are left alone. Returns how many nodes
+    moved."""
     nodes = [node for node in nodes if node.id_data.library is None and
              getattr(node.id_data, "override_library", None) is None]
     upgrade_group_tree()  # an outdated or half rebuilt shared group first
     _finish_restores(nodes)
     strays = [node for node in nodes if node.node_tree is None or (
-        node.node_tree.name != GROUP_TREE_NAME and node.node_tree.library is None)]
+        node.node_tree.name != GROUP_TREE_NAME and node.node_tree.library is None
+        and not (group_layout.is_current(node.node_tree)
+                 and group_layout.edited(node.node_tree)))]
     if not strays:
         return 0
     shared = group_tree()
-    shared_contents = group_layout.contents(shared)
-    strays = [node for node in strays if node.node_tree is None
-              or not group_layout.is_current(node.node_tree)
-              or group_layout.contents(node.node_tree) == shared_contents]
     for node in strays:
         copy = node.node_tree
         _keep_state(node)

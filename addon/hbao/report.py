@@ -87,6 +87,9 @@ def post_node_messages(scene_name, node_names, messages):
         if isinstance(message, NodeMessage):
             statuses.setdefault(message.node_name, []).append(message)
     _pending_node_messages[scene_name] = statuses
+    # (the latest last: scenes that share a tree, 5.x, post in turn, and the
+    # last render's messages must be shown last again)
+    _last_node_messages.pop(scene_name, None)
     _last_node_messages[scene_name] = statuses
 
 

@@ -6,9 +6,9 @@ dot, so they come first: deleting the active scene showed the artist a
 helper, which then kept the deleted scene's helper in the file (a window is
 a user) and, saved so, made `blender -b file -f 1` render the helper. A
 window found on one goes to the scene it serves, else the first of the
-artist's scenes (a new one where none is left). The scene selector's search finds the
-internal scenes too: a switch to one (no handler fires for it) is watched on
-the message bus."""
+artist's scenes (a new one where none is left). The scene selector's search
+finds the internal scenes too: a switch to one (no handler fires for it) is
+watched on the message bus."""
 import bpy
 
 from . import extra_renders

@@ -13,6 +13,10 @@ tried (node_place.py, node_group.py). CASE:
                     "Look" holds an HBAO node (a file to link from).
   linked_tree SOURCE  (5.x) "Look" linked from SOURCE (File > Link) and made
                     the scene's compositor; the UI's sync, then a render.
+  append_after_edit SOURCE  the shared group edited in place (the Power
+                    node), then scene "Shot" appended from SOURCE (its node
+                    with an unedited copy of the group); the UI's sync.
+                    Prints GROUP {json}: the appended node's group, the groups.
 
 Prints STATUS {json} (node: [status line, misplaced short or null]) before
 the render where one renders, and RENDERED.
@@ -116,9 +120,21 @@ def main():
     node.inputs["Blur Size"].default_value = 0
     sync()
     if case == "link_source":
-        compat.compositor_tree(scene).name = "Look"
+        if compat.HAS_COMPOSITING_NODE_GROUP:  # (3.4 and 4.5: the scene's own tree)
+            compat.compositor_tree(scene).name = "Look"
         bpy.ops.wm.save_as_mainfile(filepath=os.path.join(out_dir, "source.blend"))
         print("SAVED", flush=True)
+        return None
+    if case == "append_after_edit":
+        square_the_ao(node.node_tree)
+        with bpy.data.libraries.load(sys.argv[-1]) as (_unused, appended):
+            appended.scenes = ["Shot"]
+        copy = compat.compositor_tree(appended.scenes[0]).nodes["HBAO0"]
+        arrived = copy.node_tree.name
+        sync()
+        groups = sorted(g.name for g in bpy.data.node_groups if g.name.startswith(".HBAO"))
+        print("GROUP", json.dumps({"arrived": arrived, "node": copy.node_tree.name,
+                                   "groups": groups}), flush=True)
         return None
     if case == "edited_copy":
         node.node_tree = node.node_tree.copy()
