@@ -111,7 +111,8 @@ def render_messages(scene):
     messages += other_effect_messages(scene)
     return messages + [
         f'node "{node.name}" in the compositor of strip "{strip.name}": {STRIP_DETAILS}'
-        for strip, group in strip_groups.groups_of(scene) for within in _trees_within(group)
+        for strip, group in strip_groups.groups_of(scene, rendered=True)
+        for within in _trees_within(group)
         for node in within.nodes if is_hbao_node(node)]
 
 

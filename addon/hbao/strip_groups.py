@@ -6,12 +6,17 @@ AO (node_place.py says so)."""
 from .strip_cameras import every_strip
 
 
-def groups_of(scene):
-    """[(strip, node group)] of `scene`'s sequencer, meta strips' too."""
+def groups_of(scene, rendered=False):
+    """[(strip, node group)] of `scene`'s sequencer, meta strips' too;
+    `rendered`: only those a render of `scene` composites (the sequencer on
+    for renders, the strip and the modifier not muted)."""
     editor = getattr(scene, "sequence_editor", None)
+    if editor is None or (rendered and not scene.render.use_sequencer):
+        return []
     found = []
-    for strip in every_strip(editor) if editor is not None else ():
+    for strip in every_strip(editor):
         holders = [strip] + list(getattr(strip, "modifiers", ()))
         found += [(strip, holder.node_group) for holder in holders
-                  if getattr(holder, "node_group", None) is not None]
+                  if getattr(holder, "node_group", None) is not None
+                  and not (rendered and (strip.mute or getattr(holder, "mute", False)))]
     return found

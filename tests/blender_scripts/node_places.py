@@ -8,6 +8,7 @@ tried (node_place.py, node_group.py). CASE:
   strip_modifier    (5.x) scene "Edit" shows "Shot" (which has an HBAO node)
                     in a scene strip with a Compositor modifier whose group
                     holds an HBAO node; Edit is rendered.
+  muted_strip_modifier  (5.x) strip_modifier with the modifier muted.
   compositor_strip  (5.3) the same node group in a Compositor strip above.
   link_source       saves OUT_DIR/source.blend, whose compositing group
                     "Look" holds an HBAO node (a file to link from).
@@ -152,7 +153,9 @@ def main():
         strips.new_effect(name="Comp", type="COMPOSITOR", channel=2, frame_start=1, length=10,
                           input1=below).node_group = group
     else:
-        below.modifiers.new("Compositor", "COMPOSITOR").node_group = group
+        modifier = below.modifiers.new("Compositor", "COMPOSITOR")
+        modifier.node_group = group
+        modifier.mute = case == "muted_strip_modifier"
     sync()
     return render(edit)
 
