@@ -7,7 +7,7 @@ import json
 
 import bpy
 
-from . import compat, group_layout, socket_keys
+from . import compat, group_layout, node_place, socket_keys
 from .group_layout import AO_PASS_INPUT, GROUP_TREE_NAME
 
 
@@ -155,8 +155,7 @@ def adopt_group_copies(nodes):
     users is removed (not one with a fake user, or an asset). Nodes in
     linked or overridden trees are left alone. Returns how many nodes
     moved."""
-    nodes = [node for node in nodes if node.id_data.library is None and
-             getattr(node.id_data, "override_library", None) is None]
+    nodes = [node for node in nodes if not node_place.from_another_file(node.id_data)]
     upgrade_group_tree()  # an outdated or half rebuilt shared group first
     _finish_restores(nodes)
     strays = [node for node in nodes if node.node_tree is None or (
