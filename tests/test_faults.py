@@ -709,6 +709,25 @@ def test_an_edited_copy_of_the_nodes_group_is_kept(run_in_blender, tmp_path, nod
     assert np.abs(ao - expected * expected).max() <= 1e-6
 
 
+def test_an_error_in_a_render_handler_is_told_once_and_the_render_keeps_its_ao(
+        run_in_blender, node_native, tmp_path, no_leftovers):
+    """Blender prints a traceback for an error in an application handler,
+    at every call (a frame's, an edit's), and the rest of the handler is
+    lost. The function that gathers a render's messages made to raise
+    (node_places.py failing_messages: fault injection): observed, one line
+    says what could not be done, no traceback, and the node's AO is the
+    library's."""
+    out = tmp_path / "failing"
+    log = run_in_blender(SCRIPTS / "node_places.py", "failing_messages", out).stdout
+    assert "RENDERED {'FINISHED'}" in log, log[-3000:]
+    assert log.count("HBAO: could not prepare the render's HBAO messages: RuntimeError: "
+                     "injected") == 1, log[-3000:]
+    assert "Traceback" not in log, log[-3000:]
+    expected = library_ao(node_native, out, 1, node_params(radius=1.0, blur_size=0))
+    assert expected.min() < 0.9
+    assert np.abs(node_outputs(out, 1)["ao"] - expected).max() <= 1e-6
+
+
 def test_an_unedited_copy_gives_way_after_the_shared_group_was_edited(
         run_in_blender, tmp_path, no_leftovers):
     """File > Append of a scene whose node brings an unedited copy of the

@@ -15,6 +15,7 @@ from . import camera as camera_model
 from . import (ao_cache, compat, exr_passes, handover, job_inputs, layer_passes, native,
                pass_encoding, recomposite, render_record, scratch_files, strip_cameras,
                timing_line)
+from .callback_guard import never_raises
 from .helper_lookup import ENGINE_IDNAME, is_helper, pass_names_for_helper
 from .helper_scene import rendered_for_a_scene, scene_for_render
 from .node import hbao_nodes, pass_name
@@ -273,6 +274,7 @@ class HBAOPassEngine(bpy.types.RenderEngine):
 
 
 @bpy.app.handlers.persistent
+@never_raises("release the library's memory after the render")
 def _on_render_end(*_args):
     native.release_memory()  # kept from frame to frame of a render (a fifth of a frame)
 

@@ -11,6 +11,7 @@ which engine to choose (engine.py)."""
 import bpy
 
 from . import compat
+from .callback_guard import never_raises
 from .helper_lookup import ENGINE_IDNAME, is_helper
 from .report import log
 
@@ -73,11 +74,9 @@ def restore_engines():
     return messages
 
 
+@never_raises("check the scenes' render engines")
 def _on_engine_changed(*_args):
-    try:
-        restore_engines()
-    except Exception as error:  # never break the artist's session
-        log(f"could not check the scenes' render engines: {error}")
+    restore_engines()
 
 
 def subscribe():
@@ -90,6 +89,7 @@ def subscribe():
 
 
 @bpy.app.handlers.persistent
+@never_raises("check the scenes' render engines")
 def _on_load_post(*_args):
     _engines.clear()
     subscribe()

@@ -11,6 +11,7 @@ import bpy
 
 from . import (compat, helper_lookup, helper_render_settings, helper_scene, node, node_place,
                pass_sources, recomposite, render_slots, strip_cameras, window_scenes, writes)
+from .callback_guard import never_raises
 from .report import (NodeMessage, forget_node_messages, in_main_thread, log,
                      post_last_node_messages, post_node_messages, post_render_report)
 
@@ -46,10 +47,15 @@ def _sync_everything():
 
 def _timer_sync():
     global _sync_scheduled
-    if not writes.writes_allowed() or _sync_everything():
+    if _sync_refused():
         return _REFUSED_RETRY_S  # still scheduled
-    _sync_scheduled = False
+    _sync_scheduled = False  # (also after an error: the next change schedules again)
     return None  # run once
+
+
+@never_raises("update the HBAO hooks", result=False)
+def _sync_refused():
+    return not writes.writes_allowed() or _sync_everything()
 
 
 def _sync_all_or_later():
@@ -68,6 +74,7 @@ def schedule_sync():
         bpy.app.timers.register(_timer_sync, first_interval=0.0)
 
 
+@never_raises("move a window off the add-on's internal scene")
 def _on_window_scene(*_args):
     """A window switched scenes: to an internal one, it goes back at once."""
     if window_scenes.shows_an_internal_scene():
@@ -75,6 +82,7 @@ def _on_window_scene(*_args):
 
 
 @bpy.app.handlers.persistent
+@never_raises("restore the HBAO hook after an undo or redo")
 def _on_undo_or_redo(*_args):
     """Undo and redo read the file back, and no depsgraph update follows:
     3.4 showed a helper scene after Scene > Delete, Ctrl+Z, Ctrl+Shift+Z, and
@@ -90,6 +98,7 @@ def _on_undo_or_redo(*_args):
 
 
 @bpy.app.handlers.persistent
+@never_raises("update the HBAO hooks of the file opened")
 def _on_load_post(*_args):
     global _sync_scheduled
     _sync_scheduled = False  # opening a file removed the timer, if it waited
@@ -100,6 +109,7 @@ def _on_load_post(*_args):
 
 
 @bpy.app.handlers.persistent
+@never_raises("update the HBAO hooks before the save")
 def _on_save_pre(*_args):
     # Background scripts get no timer: the hook is built at the latest here, so
     # that `blender -b file.blend -f N` finds it in the file.
@@ -107,6 +117,7 @@ def _on_save_pre(*_args):
 
 
 @bpy.app.handlers.persistent
+@never_raises("prepare the render's HBAO messages")
 def _on_render_init(scene, *_args):
     """Once a render job, in the console and the Info editor: why the HBAO
     nodes that get no AO where they lie get none (node_place.py), and that
@@ -141,6 +152,7 @@ def _on_render_init(scene, *_args):
 
 
 @bpy.app.handlers.persistent
+@never_raises("prepare the HBAO hook for the render")
 def _on_render_pre(scene, *_args):
     if helper_lookup.is_helper(scene):
         return
@@ -161,6 +173,7 @@ def _on_render_pre(scene, *_args):
 
 
 @bpy.app.handlers.persistent
+@never_raises("prepare the HBAO hook for the frame")
 def _on_frame_render_pre(scene, *_args):
     strip_cameras.frame_started(scene)
     _on_render_pre(scene)
@@ -183,11 +196,13 @@ def _unhook_before_render(scene):
 
 
 @bpy.app.handlers.persistent
+@never_raises("close the render's HBAO records")
 def _on_render_complete(scene, *_args):
     _on_render_end(scene, True)
 
 
 @bpy.app.handlers.persistent
+@never_raises("close the render's HBAO records")
 def _on_render_cancel(scene, *_args):
     _on_render_end(scene, False)
 
@@ -206,6 +221,7 @@ def _on_render_end(scene, completed):
 
 
 @bpy.app.handlers.persistent
+@never_raises("follow an edit for the HBAO hook")
 def _on_depsgraph_update_post(scene, *_args):
     if not in_main_thread():
         return

@@ -11,6 +11,7 @@ import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 
 from . import compat, guard_geometry, node_lines, node_place, parameters, report, writes
+from .callback_guard import never_raises
 from .compositor_effects import NODE_IDNAME, is_hbao_node
 from .group_layout import (AO_OUTPUT, AO_PASS_INPUT, DEPTH_INPUT, GROUP_TREE_NAME,  # noqa: F401
                            IMAGE_INPUT, IMAGE_OUTPUT, NORMAL_INPUT, VALUE_INPUTS)
@@ -226,6 +227,7 @@ def _redraw_node_editors():
 _POLL_S = 0.25
 
 
+@never_raises("update the HBAO nodes' status lines", result=_POLL_S)
 def _poll_node_messages():
     if not bpy.app.is_job_running("RENDER"):
         if report.has_node_messages() and writes.writes_allowed():
@@ -236,11 +238,13 @@ def _poll_node_messages():
 
 
 @bpy.app.handlers.persistent
+@never_raises("update the HBAO nodes' status lines")
 def _on_render_done(*_args):
     apply_node_messages()  # `-b` and blocking renders: the main thread
 
 
 @bpy.app.handlers.persistent
+@never_raises("update the HBAO node group of the file opened")
 def _on_load_post(*_args):
     upgrade_group_tree()
 

@@ -9,6 +9,7 @@ it reports on its first timer event."""
 import bpy
 
 from . import report, writes
+from .callback_guard import never_raises
 
 _POLL_S = 0.25
 
@@ -33,6 +34,7 @@ class HBAO_OT_render_report(bpy.types.Operator):
         return {"FINISHED"}
 
 
+@never_raises("show the render's reports in the Info editor", result=_POLL_S)
 def _poll():
     if report.has_render_reports() and not bpy.app.is_job_running("RENDER"):
         windows = bpy.context.window_manager.windows

@@ -14,6 +14,9 @@ tried (node_place.py, node_group.py). CASE:
                     "Look" holds an HBAO node (a file to link from).
   linked_tree SOURCE  (5.x) "Look" linked from SOURCE (File > Link) and made
                     the scene's compositor; the UI's sync, then a render.
+  failing_messages  the add-on's function that gathers a render's messages
+                    (node_place.render_messages) made to raise (fault
+                    injection), then a render.
   append_after_edit SOURCE  the shared group edited in place (the Power
                     node), then scene "Shot" appended from SOURCE (its node
                     with an unedited copy of the group); the UI's sync.
@@ -143,6 +146,13 @@ def main():
         sync()
         groups = sorted(g.name for g in bpy.data.node_groups if g.name.startswith(".HBAO"))
         print("GROUP", json.dumps({"node": node.node_tree.name, "groups": groups}), flush=True)
+        return render(scene)
+    if case == "failing_messages":
+        from hbao import node_place
+
+        def render_messages(_scene):
+            raise RuntimeError("injected")
+        node_place.render_messages = render_messages
         return render(scene)
     edit = bpy.data.scenes.new("Edit")
     edit.render.resolution_x, edit.render.resolution_y = 96, 64

@@ -23,6 +23,12 @@ CASE "disable_during": F12 of a render of some seconds, the add-on
 disabled in Preferences while it runs (Blender 3.4 crashed), enabled again
 once it has ended, F12 (kept as OUT/after).
 
+CASE "failing_refresher": Compositing off, F12 (the node says
+"Compositing off: no AO"), a function of the add-on's status poll made to
+raise (fault injection: hbao.node.hint_refreshers), Compositing on, F12;
+prints STATUS {json} a few seconds later. Blender dropped the poll timer at
+its first error, and the line stayed.
+
 Prints SESSION DONE at the end.
 
   blender --addons hbao --python ui_session.py -- CASE OUT_DIR
@@ -130,6 +136,13 @@ def disable_while_rendering():
     return 0.1
 
 
+def failing_refresher():
+    def refresh():
+        raise RuntimeError("injected")
+    sys.modules["hbao"].node.hint_refreshers.append(refresh)
+    return SETTLE_S
+
+
 def report(key, value):
     def step():
         print(key, json.dumps(value()), flush=True)
@@ -150,6 +163,8 @@ STEPS = [built] + {
     "delete_redo": [new_scene, back_to_scene, delete, undo, redo, report("SCENES", scenes)],
     "status_redo": [compositing(False), render, rendered, compositing(True), render, rendered,
                     undo, redo, report("STATUS", status)],
+    "failing_refresher": [compositing(False), render, rendered, failing_refresher,
+                          compositing(True), render, rendered, report("STATUS", status)],
     "reenable": [render, rendered, lambda: keep("first"), addon(False), addon(True), render,
                  rendered, lambda: keep("after")],
     "disable_during": [render, disable_while_rendering, rendered, addon(True), render, rendered,

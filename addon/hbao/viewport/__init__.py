@@ -10,6 +10,8 @@ sidebar's "HBAO" tab. No native library needed: it runs on the GPU.
     draw.py                                           the draw handler (only while on)
     panel.py                                          sidebar panel and operator
 """
+from ..callback_guard import never_raises
+
 # bpy and the gpu modules are imported by register(), so that projection and
 # shader_sources (and this package) import in plain Python.
 _registered = False
@@ -40,6 +42,7 @@ def register():
         bpy.app.timers.register(_sync_later, first_interval=0.0)
 
 
+@never_raises("turn the viewport preview on for the views that had it")
 def _sync_later():
     from . import draw
     if _registered:

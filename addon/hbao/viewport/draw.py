@@ -11,6 +11,7 @@ import bpy
 import gpu
 from bpy.app.handlers import persistent
 
+from ..callback_guard import never_raises
 from ..report import log
 from . import pipeline, projection, settings
 
@@ -54,6 +55,7 @@ def sync_handler():
 
 
 @persistent
+@never_raises("turn the viewport preview on or off for the file opened")
 def sync_after_load(*_args):
     """load_post: a file saved with the preview on turns it on; one without turns it off."""
     sync_handler()
