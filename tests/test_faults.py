@@ -745,15 +745,16 @@ def test_an_unedited_copy_gives_way_after_the_shared_group_was_edited(
 
 
 @pytest.mark.min_blender(5, 1)
-@pytest.mark.parametrize("case", ["strip_modifier", "compositor_strip", "muted_strip_modifier"])
+@pytest.mark.parametrize("case", ["strip_modifier", "compositor_strip", "muted_strip_modifier",
+                                  "muted_meta"])
 def test_hbao_node_in_a_strips_compositor_says_why_it_gives_no_ao(run_in_blender, tmp_path,
                                                                   no_leftovers, case):
     """An HBAO node in the node group of a sequencer strip's Compositor
     modifier, or of a Compositor strip (5.3): the node said "In a node group
     ... Ungroup it", and the render said nothing (an exploratory run).
     Observed: the node and, once, the render say that strips' compositors
-    get no AO; a muted modifier's node, the render does not (it is not
-    composited)."""
+    get no AO; a muted modifier's node, or one in a muted meta strip, the
+    render does not (it is not composited)."""
     log = run_in_blender(SCRIPTS / "node_places.py", case, tmp_path / case).stdout
     assert "RENDERED {'FINISHED'}" in log, log[-3000:]
     assert json_line(log, "STATUS")["HBAO in strip"] == ["", "In a strip's compositor: AO off"]

@@ -84,12 +84,15 @@ def _children(holder):
     return list(strips if strips is not None else getattr(holder, "sequences", []))
 
 
-def every_strip(holder):
-    """The strips of `holder`, inside its meta strips too."""
+def every_strip(holder, unmuted=False):
+    """The strips of `holder`, inside its meta strips too; `unmuted`: only
+    those a render shows, neither muted nor in a muted channel or meta strip."""
     for strip in _children(holder):
+        if unmuted and (strip.mute or _channel_muted(holder, strip.channel)):
+            continue
         yield strip
         if strip.type == "META":
-            yield from every_strip(strip)
+            yield from every_strip(strip, unmuted)
 
 
 def _channel_muted(holder, number):

@@ -9,14 +9,15 @@ from .strip_cameras import every_strip
 def groups_of(scene, rendered=False):
     """[(strip, node group)] of `scene`'s sequencer, meta strips' too;
     `rendered`: only those a render of `scene` composites (the sequencer on
-    for renders, the strip and the modifier not muted)."""
+    for renders; the strip, its channel, a meta strip around it and the
+    modifier not muted)."""
     editor = getattr(scene, "sequence_editor", None)
     if editor is None or (rendered and not scene.render.use_sequencer):
         return []
     found = []
-    for strip in every_strip(editor):
+    for strip in every_strip(editor, unmuted=rendered):
         holders = [strip] + list(getattr(strip, "modifiers", ()))
         found += [(strip, holder.node_group) for holder in holders
                   if getattr(holder, "node_group", None) is not None
-                  and not (rendered and (strip.mute or getattr(holder, "mute", False)))]
+                  and not (rendered and getattr(holder, "mute", False))]
     return found

@@ -9,6 +9,8 @@ tried (node_place.py, node_group.py). CASE:
                     in a scene strip with a Compositor modifier whose group
                     holds an HBAO node; Edit is rendered.
   muted_strip_modifier  (5.x) strip_modifier with the modifier muted.
+  muted_meta        (5.x) strip_modifier with the strip inside a muted
+                    meta strip, and a Color strip above.
   compositor_strip  (5.3) the same node group in a Compositor strip above.
   link_source       saves OUT_DIR/source.blend, whose compositing group
                     "Look" holds an HBAO node (a file to link from).
@@ -166,6 +168,12 @@ def main():
         modifier = below.modifiers.new("Compositor", "COMPOSITOR")
         modifier.node_group = group
         modifier.mute = case == "muted_strip_modifier"
+        if case == "muted_meta":
+            meta = strips.new_meta("Meta", 2, 1)
+            below.move_to_meta(meta)
+            meta.mute = True
+            # (a strip that renders: a sequencer with none asks for a camera)
+            strips.new_effect(name="Fill", type="COLOR", channel=3, frame_start=1, length=10)
     sync()
     return render(edit)
 
