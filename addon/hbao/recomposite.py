@@ -96,12 +96,11 @@ _computing = {}
 
 
 def cancel_all():
-    """A render began (any thread): every refresh's worker stops after the
-    job it is computing rather than compete with the render for the cores.
-    A render of the worker's own scene brings its AO up to date, which
-    drops the refresh; otherwise (another scene, or the render cancelled)
-    the next tick's refresh goes on from what the worker computed (the
-    helper's engine computes the rest from the kept passes)."""
+    """A render began (any thread): every refresh's worker stops after the job it is
+    computing rather than compete with the render for the cores. A render of the worker's
+    own scene brings its AO up to date, which drops the refresh; otherwise (another scene,
+    or the render cancelled) the next tick's refresh goes on from what the worker computed
+    (the helper's engine computes the rest from the kept passes)."""
     for computation in list(_computing.values()):
         computation.cancelled = True
 
@@ -246,7 +245,8 @@ def refresh_changed(in_background=False):
     composite_trigger.retry_refused()
     rendered, helpers_rendered = False, set()
     for main in list(bpy.data.scenes):
-        helper = helper_scene.helper_scene_of(main)
+        has_record = render_record.last_render(main.name) is not None  # (else: nothing to do)
+        helper = helper_scene.helper_scene_of(main) if has_record else None
         due = _needs_refresh(main, helper) if helper is not None else None
         if due is None:
             computation = _computing.get(main.name)
