@@ -17,7 +17,7 @@ handlers record the scene being rendered, which the engine reads."""
 import bpy
 
 from . import (compat, extra_renders, helper_render_settings, hook_release, node_place,
-               pass_sources, view_cameras, writes)
+               pass_sources, strip_cameras, view_cameras, writes)
 from .data_edits import set_if_different
 from .helper_lookup import (ENGINE_IDNAME, HELPER_SCENE_PREFIX, MAIN_SCENE_KEY, MAIN_TREE_KEY,
                             MANAGED_NODE_KEY, MANAGED_NODE_NAME, helper_scene_of, is_helper,
@@ -261,13 +261,14 @@ def sync_all():
     Returns whether Blender refused a write for the moment
     (writes.writes_refused): a later call finishes the job. Helpers first:
     the extra scenes of one dropped go in the same pass (a save then)."""
-    for scene in sorted(bpy.data.scenes, key=lambda scene: not is_helper(scene)):
-        try:
-            _sync_or_drop(scene)
-        except Exception as error:  # never break the user's session
-            if writes.writes_refused(error):
-                return True  # the rest waits too
-            log(f"could not update the HBAO hook of {scene.name!r}: {error}")
+    with strip_cameras.walking_strips_once():
+        for scene in sorted(bpy.data.scenes, key=lambda scene: not is_helper(scene)):
+            try:
+                _sync_or_drop(scene)
+            except Exception as error:  # never break the user's session
+                if writes.writes_refused(error):
+                    return True  # the rest waits too
+                log(f"could not update the HBAO hook of {scene.name!r}: {error}")
     return False
 
 

@@ -3,8 +3,10 @@
 hook reads, against the file's size. For each count given, the scenes of
 bench/addon_sync.py (every other one with HBAO nodes), one sync to make the
 helpers, then a second sync with the add-on's lookup of a tree's managed
-node counted, and the node timer's refresh (no render done) likewise.
-Prints SCALING {json}: {count: [calls in the sync, calls in the refresh]}.
+node counted, and the node timer's refresh (no render done) likewise; and
+the walks of every sequencer strip for the strips' Camera overrides in that
+sync. Prints SCALING {json}: {count: [lookups in the sync, lookups in the
+refresh, walks of the strips in the sync]}.
 
   blender -b --addons hbao --python sync_scaling.py -- COUNT...
 """
@@ -19,22 +21,22 @@ spec = importlib.util.spec_from_file_location("addon_sync",
 addon_sync = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(addon_sync)
 
-from hbao import handlers, helper_lookup, recomposite  # noqa: E402
+from hbao import handlers, helper_lookup, recomposite, strip_cameras  # noqa: E402
 
 
-def counted(function):
-    """The calls of helper_lookup.managed_node that `function()` makes."""
+def counted(function, module=helper_lookup, name="managed_node"):
+    """The calls of module.name that `function()` makes."""
     calls = [0]
-    original = helper_lookup.managed_node
+    original = getattr(module, name)
 
-    def managed_node(tree):
+    def count(*args):
         calls[0] += 1
-        return original(tree)
-    helper_lookup.managed_node = managed_node
+        return original(*args)
+    setattr(module, name, count)
     try:
         function()
     finally:
-        helper_lookup.managed_node = original
+        setattr(module, name, original)
     return calls[0]
 
 
@@ -43,5 +45,6 @@ for count in [int(text) for text in sys.argv[sys.argv.index("--") + 1:]]:
     addon_sync.build(count)
     handlers._sync_everything()
     found[count] = [counted(handlers._sync_everything),
-                    counted(lambda: recomposite.refresh_changed(in_background=True))]
+                    counted(lambda: recomposite.refresh_changed(in_background=True)),
+                    counted(handlers._sync_everything, strip_cameras, "_overrides_by_scene")]
 print("SCALING", json.dumps(found), flush=True)
