@@ -25,6 +25,7 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "scripts"))
 sys.path.insert(0, str(REPO / "addon"))  # the add-on's bpy-free modules
 import blenders  # noqa: E402
+from hbao.callback_guard import FAILURE_MARK  # noqa: E402
 BUILD = Path(os.environ.get("HBAO_BUILD_DIR", REPO / "build"))
 LIBRARY = BUILD / "libhbao.so"
 # The add-on's EXR reader (csrc/exr): the add-on and the tests read EXRs with it.
@@ -195,13 +196,13 @@ def pytest_terminal_summary(terminalreporter):
 
 def _runner(blender, user_scripts):
     def run(script, *args, blend=None, ui=False, addon=True, env=None, check=True,
-            timeout=BLENDER_TIMEOUT_S, debug_memory=False):
+            timeout=BLENDER_TIMEOUT_S, debug_memory=False, addon_errors=False):
         command = blender.command(script, args, blend=blend, ui=ui,
                                   addons=("hbao",) if addon else ())
         if debug_memory and blender.kind == "app":  # bpy has no such option
             # Blender's allocator fills freed memory: reading it then crashes.
             command.insert(command.index(blender.executable) + 1, "--debug-memory")
-        return run_command(command, user_scripts, env, check, timeout)
+        return run_command(command, user_scripts, env, check, timeout, addon_errors)
     return run
 
 
@@ -235,11 +236,15 @@ def json_line(log, key):
     return json.loads(line[len(key) + 1:])
 
 
-def run_command(command, user_scripts, env=None, check=True, timeout=BLENDER_TIMEOUT_S):
+def run_command(command, user_scripts, env=None, check=True, timeout=BLENDER_TIMEOUT_S,
+                addon_errors=False):
     """Run a Blender command line with this checkout's add-on and libraries.
     It runs in a session of its own: past the timeout the whole process
     group is killed (xvfb-run, its Xvfb and Blender; killing xvfb-run alone
-    left Blender and Xvfb running), and the test fails with the output so far."""
+    left Blender and Xvfb running), and the test fails with the output so far.
+    An error the add-on's guarded callbacks logged (callback_guard.py, which
+    keeps Blender from printing a traceback) fails the test too, unless the
+    test injected it (`addon_errors`)."""
     process = subprocess.Popen(
         command, env=blender_environment(user_scripts, env), start_new_session=True,
         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="backslashreplace")
@@ -257,4 +262,6 @@ def run_command(command, user_scripts, env=None, check=True, timeout=BLENDER_TIM
     if check and completed.returncode != 0:
         pytest.fail(f"Blender exited with {completed.returncode}:\n"
                     f"{' '.join(command)}\n{completed.stdout[-6000:]}")
+    if not addon_errors and FAILURE_MARK in completed.stdout:
+        pytest.fail(f"an add-on callback failed:\n{' '.join(command)}\n{completed.stdout[-6000:]}")
     return completed

@@ -718,7 +718,8 @@ def test_an_error_in_a_render_handler_is_told_once_and_the_render_keeps_its_ao(
     says what could not be done, no traceback, and the node's AO is the
     library's."""
     out = tmp_path / "failing"
-    log = run_in_blender(SCRIPTS / "node_places.py", "failing_messages", out).stdout
+    log = run_in_blender(SCRIPTS / "node_places.py", "failing_messages", out,
+                         addon_errors=True).stdout
     assert "RENDERED {'FINISHED'}" in log, log[-3000:]
     assert log.count("HBAO: could not prepare the render's HBAO messages: RuntimeError: "
                      "injected") == 1, log[-3000:]

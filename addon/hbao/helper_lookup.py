@@ -19,30 +19,22 @@ HELPER_SCENE_PREFIX = ".HBAO passes "
 MAIN_SCENE_KEY = "hbao_main_scene"
 # ID property on the helper scene (5.0+): the compositing node group it serves.
 MAIN_TREE_KEY = "hbao_main_tree"
-# ID property on the Render Layers node the add-on manages, and the name it
-# gets (the artist may rename it).
+# ID property on the Render Layers node the add-on manages.
 MANAGED_NODE_KEY = "hbao_managed"
-MANAGED_NODE_NAME = "HBAO Passes"
 
 # Every lookup here runs for each scene at each sync (after every edit) and
-# at the nodes' timer, so each looks where the add-on put things first (the
-# managed node's name, the helper's main scene's name) and walks the file
-# only where that fails: walking every scene's tree for every pair of scenes
-# made a sync of a 40-scene file take 390 ms (bench/addon_sync.py).
-
-
-def _is_managed(node):
-    return node.bl_idname == "CompositorNodeRLayers" and bool(node.get(MANAGED_NODE_KEY))
+# at the nodes' timer, so a helper's scene is looked for by the name the
+# helper keeps first, and the file walked only where that fails: walking
+# every scene's tree for every pair of scenes made a sync of a 40-scene file
+# take 390 ms (bench/addon_sync.py).
 
 
 def managed_node(tree):
+    """The first Render Layers node of `tree` that the add-on manages."""
     if tree is None:
         return None
-    named = tree.nodes.get(MANAGED_NODE_NAME)
-    if named is not None and _is_managed(named):
-        return named
     for node in tree.nodes:
-        if _is_managed(node):
+        if node.bl_idname == "CompositorNodeRLayers" and node.get(MANAGED_NODE_KEY):
             return node
     return None
 

@@ -20,13 +20,13 @@ from . import (compat, extra_renders, helper_render_settings, hook_release, node
                pass_sources, strip_cameras, view_cameras, writes)
 from .data_edits import set_if_different
 from .helper_lookup import (ENGINE_IDNAME, HELPER_SCENE_PREFIX, MAIN_SCENE_KEY, MAIN_TREE_KEY,
-                            MANAGED_NODE_KEY, MANAGED_NODE_NAME, helper_scene_of, is_helper,
-                            main_scene_of, managed_node, scenes_pointing_at, scenes_served_by,
-                            serves)
+                            MANAGED_NODE_KEY, helper_scene_of, is_helper, main_scene_of,
+                            managed_node, scenes_pointing_at, scenes_served_by, serves)
 from .node import AO_PASS_INPUT, DEPTH_INPUT, hbao_nodes, next_pass_index, pass_name
 from .report import log
 from .socket_values import upstream
 
+MANAGED_NODE_NAME = "HBAO Passes"
 # How far below the first HBAO node the managed node goes (node editor units):
 # the HBAO node is about 555 units tall with its options and a hint line
 # (tests/test_ui.py measures it), a status line adds about 25.

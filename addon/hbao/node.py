@@ -185,6 +185,7 @@ def show_messages(node, messages):
     node.status_details = "\n".join(messages)
 
 
+@never_raises("update the HBAO nodes' status lines")
 def apply_node_messages():
     """Show what the hook last said about each node (main thread only: the
     render thread only posts it, report.post_node_messages). What Blender
@@ -232,9 +233,15 @@ def _poll_node_messages():
     if not bpy.app.is_job_running("RENDER"):
         if report.has_node_messages() and writes.writes_allowed():
             apply_node_messages()
-        if any([refresh() for refresh in hint_refreshers]):
+        # (each on its own: one that fails at every tick stops no other)
+        if any([_refresh(refresh) for refresh in hint_refreshers]):
             _redraw_node_editors()
     return _POLL_S
+
+
+@never_raises("update an HBAO node's hint line", result=False)
+def _refresh(refresh):
+    return refresh()
 
 
 @bpy.app.handlers.persistent

@@ -24,6 +24,7 @@ import bpy
 from . import (ao_cache, compat, composite_trigger, handler_hold, helper_scene, layer_passes,
                node, render_record, writes)
 from . import camera as camera_model
+from .callback_guard import never_raises
 from .planning import plan_node
 from .report import log
 
@@ -166,9 +167,8 @@ def _work(main, jobs):
 
 
 def _render_helper(main, helper, frame, ao_seconds):
-    """Whether the helper rendered every pass for `main` (Request.completed).
-    No render or frame change handler but the add-on's own runs for this
-    render (handler_hold.py)."""
+    """Whether the helper rendered every pass for `main` (Request.completed). No render or
+    frame change handler but the add-on's own runs for this render (handler_hold.py)."""
     global _request
     request = _request = Request(main.name, helper.name, frame, ao_seconds)
     try:
@@ -271,9 +271,9 @@ def refresh_changed(in_background=False):
 
 
 @bpy.app.handlers.persistent
+@never_raises("forget the last renders' passes")
 def _on_load_pre(*_args):
-    # What the last renders kept belongs to the file being closed: scenes
-    # of the next file may have the same names.
+    # What the last renders kept belongs to the file being closed (names recur).
     _computing.clear()
     _failed.clear()
     composite_trigger.forget()

@@ -159,11 +159,12 @@ _walk = None
 @contextlib.contextmanager
 def walking_strips_once():
     global _walk
-    _walk = [None]
+    outer = _walk  # (inside another: its walk serves)
+    _walk = outer if outer is not None else [None]
     try:
         yield
     finally:
-        _walk = None
+        _walk = outer
 
 
 def _overrides_by_scene():

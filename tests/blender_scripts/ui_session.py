@@ -25,9 +25,11 @@ once it has ended, F12 (kept as OUT/after).
 
 CASE "failing_refresher": Compositing off, F12 (the node says
 "Compositing off: no AO"), a function of the add-on's status poll made to
-raise (fault injection: hbao.node.hint_refreshers), Compositing on, F12;
-prints STATUS {json} a few seconds later. Blender dropped the poll timer at
-its first error, and the line stayed.
+raise (fault injection: first in hbao.node.hint_refreshers, and one that
+counts its calls last), Compositing on, F12; prints STATUS {json} and
+REFRESHED {json} (whether the last one ran) a few seconds later. Blender
+dropped the poll timer at its first error, and the line stayed; then the
+poll went on, but stopped at the failing function every tick.
 
 Prints SESSION DONE at the end.
 
@@ -136,10 +138,19 @@ def disable_while_rendering():
     return 0.1
 
 
+refreshed = [0]
+
+
 def failing_refresher():
     def refresh():
         raise RuntimeError("injected")
-    sys.modules["hbao"].node.hint_refreshers.append(refresh)
+
+    def counted():
+        refreshed[0] += 1
+        return False
+    refreshers = sys.modules["hbao"].node.hint_refreshers
+    refreshers.insert(0, refresh)
+    refreshers.append(counted)
     return SETTLE_S
 
 
@@ -164,7 +175,8 @@ STEPS = [built] + {
     "status_redo": [compositing(False), render, rendered, compositing(True), render, rendered,
                     undo, redo, report("STATUS", status)],
     "failing_refresher": [compositing(False), render, rendered, failing_refresher,
-                          compositing(True), render, rendered, report("STATUS", status)],
+                          compositing(True), render, rendered, report("STATUS", status),
+                          report("REFRESHED", lambda: refreshed[0] > 0)],
     "reenable": [render, rendered, lambda: keep("first"), addon(False), addon(True), render,
                  rendered, lambda: keep("after")],
     "disable_during": [render, disable_while_rendering, rendered, addon(True), render, rendered,

@@ -19,6 +19,7 @@ from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProp
                        IntProperty)
 
 from .. import compat, native, parameters, socket_values
+from ..callback_guard import never_raises
 from . import projection
 from ..node import hbao_nodes
 from ..parameters import FALLOFF_ITEMS, INTEGRATION_ITEMS
@@ -227,6 +228,7 @@ def any_enabled():
 
 
 @persistent
+@never_raises("note the viewport preview's views before the save")
 def _refresh_area_indices(*_args):
     """Before a save: write each entry's current area position, so the file maps
     entries to the right areas when it is opened again."""
@@ -241,6 +243,7 @@ def _refresh_area_indices(*_args):
 
 
 @persistent
+@never_raises("forget the viewport preview's views of the file closed")
 def _forget_areas(*_args):
     """After a load: areas are new objects; entries are found by position again."""
     _entry_by_area.clear()
