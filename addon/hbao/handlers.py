@@ -117,7 +117,7 @@ def _on_save_pre(*_args):
 
 
 @bpy.app.handlers.persistent
-@never_raises("prepare the render's HBAO messages")
+@never_raises("prepare the HBAO hook for the render job")
 def _on_render_init(scene, *_args):
     """Once a render job, in the console and the Info editor: why the HBAO
     nodes that get no AO where they lie get none (node_place.py), and that
@@ -128,8 +128,7 @@ def _on_render_init(scene, *_args):
         render_slots.started(scene)
     if not helper_lookup.is_helper(scene):
         tree = compat.compositor_tree(scene)
-        # (the console's text, the report's: a node's reads "HBAO node ...")
-        messages = [(text, f"HBAO {text}") for text in node_place.render_messages(scene)]
+        messages = list(_misplaced_messages(scene))
         nodes = node.hbao_nodes(tree)
         settings = helper_render_settings
         off = None
@@ -149,6 +148,14 @@ def _on_render_init(scene, *_args):
             if not bpy.app.background:  # `-b`: the console has it
                 post_render_report(report_text)
     _on_render_pre(scene)
+
+
+@never_raises("prepare the render's HBAO messages", result=())
+def _misplaced_messages(scene):
+    """(the console's text, the report's) of each HBAO node that gets no AO
+    where it lies: a node's report reads "HBAO node ...". Guarded on its
+    own: a failure here costs no status line of the render's."""
+    return [(text, f"HBAO {text}") for text in node_place.render_messages(scene)]
 
 
 @bpy.app.handlers.persistent
