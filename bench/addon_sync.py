@@ -18,7 +18,6 @@ nodes' draw asks). Prints one line per count, `sync-bench: {json}`, with
 the milliseconds."""
 import json
 import os
-import statistics
 import sys
 import time
 
@@ -27,19 +26,11 @@ import bpy
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
                                 "scripts"))
 import blender_scenes  # noqa: E402
+from bench_stats import median_ms  # noqa: E402
 from hbao import compat, handlers, node, node_place, recomposite  # noqa: E402
 
 NODES_PER_TREE = 4
 ROUNDS = 5
-
-
-def median_ms(function):
-    times = []
-    for _ in range(ROUNDS):
-        start = time.perf_counter()
-        function()
-        times.append((time.perf_counter() - start) * 1000.0)
-    return statistics.median(times)
 
 
 def fill_scene(scene, with_hbao):
@@ -87,15 +78,20 @@ def measure(count):
              for member in node.hbao_nodes(compat.compositor_tree(scene))]
     return {"blender": bpy.app.version_string, "scenes": count,
             "hbao_nodes": len(nodes), "first_sync_ms": round(first_sync, 1),
-            "sync_ms": round(median_ms(handlers._sync_everything), 1),
+            "sync_ms": round(median_ms(handlers._sync_everything, ROUNDS), 1),
             "timer_refresh_ms": round(median_ms(
-                lambda: recomposite.refresh_changed(in_background=True)), 2),
+                lambda: recomposite.refresh_changed(in_background=True), ROUNDS), 2),
             "misplaced_all_ms": round(median_ms(
-                lambda: [node_place.misplaced(member) for member in nodes]), 2)}
+                lambda: [node_place.misplaced(member) for member in nodes], ROUNDS), 2)}
 
 
 def main():
-    counts = [int(text) for text in sys.argv[sys.argv.index("--") + 1:]] or [10, 20, 40]
+    texts = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+    if not all(text.isdigit() and 1 <= int(text) <= 1000 for text in texts):
+        print("usage: ... --python bench/addon_sync.py -- [SCENES ...] (whole numbers, "
+              f"1-1000; default 10 20 40), not {' '.join(texts)!r}", file=sys.stderr, flush=True)
+        sys.exit(2)
+    counts = [int(text) for text in texts] or [10, 20, 40]
     for count in counts:
         print("sync-bench:", json.dumps(measure(count)), flush=True)
 

@@ -10,9 +10,7 @@ composite. One pixel is read back after each timed call, which waits for the
 GPU to finish (Python has no glFinish). Medians over repeated draws.
 """
 import json
-import statistics
 import sys
-import time
 from pathlib import Path
 
 import bpy
@@ -21,6 +19,7 @@ import gpu
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "scripts"))
 import blender_scenes  # noqa: E402
+from bench_stats import median_ms  # noqa: E402
 
 SIZES = ((1280, 720), (1920, 1080))
 
@@ -40,16 +39,6 @@ def _arguments():
 
 def _sync(offscreen_framebuffer):
     offscreen_framebuffer.read_color(0, 0, 1, 1, 4, 0, "FLOAT")
-
-
-def _median_ms(function, repeats):
-    function()  # warm-up: shader compilation, target allocation
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        function()
-        times.append((time.perf_counter() - start) * 1000.0)
-    return statistics.median(times)
 
 
 def run(options):
@@ -107,15 +96,15 @@ def run(options):
                 _sync(gpu.state.active_framebuffer_get())
 
         with bpy.context.temp_override(window=window, area=area, region=region):
-            scene_ms = _median_ms(draw_scene, options["repeats"])
+            scene_ms = median_ms(draw_scene, options["repeats"], warm_up=True)
             draw_scene()  # the offscreen holds the scene's depth for the preview
             state["background"] = background_fraction()
-            round_trip_ms = _median_ms(depth_round_trip, options["repeats"])
-            preview_ms = _median_ms(preview, options["repeats"])
+            round_trip_ms = median_ms(depth_round_trip, options["repeats"], warm_up=True)
+            preview_ms = median_ms(preview, options["repeats"], warm_up=True)
             state["params"] = dict(params, blur_size=0)
-            preview_no_blur_ms = _median_ms(preview, options["repeats"])
+            preview_no_blur_ms = median_ms(preview, options["repeats"], warm_up=True)
             state["params"] = dict(params, half_resolution=True)
-            preview_half_ms = _median_ms(preview, options["repeats"])
+            preview_half_ms = median_ms(preview, options["repeats"], warm_up=True)
         rows.append({"size": f"{width}x{height}", "scene_ms": scene_ms,
                      "depth_read_upload_ms": round_trip_ms, "preview_ms": preview_ms,
                      "preview_no_blur_ms": preview_no_blur_ms,

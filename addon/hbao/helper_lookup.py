@@ -90,16 +90,16 @@ def serves(helper, scene):
     helper linked from another file serves that file's scenes only (a scene
     of this file that composites with a linked tree gets no AO:
     node_place.unhooked)."""
-    return is_helper(helper) and _serves(helper, scene, lambda: tree_of_helper(helper))
-
-
-def _serves(helper, scene, helper_tree):
-    """serves() for a helper, its tree given by the function `helper_tree`
-    (called only where needed)."""
-    if is_helper(scene) or (helper.library is not None and scene.library is None):
+    if not is_helper(helper) or not _may_serve(helper, scene):
         return False
     tree = compat.compositor_tree(scene)
-    return tree is not None and helper_tree() == tree
+    return tree is not None and tree_of_helper(helper) == tree
+
+
+def _may_serve(helper, scene):
+    """serves() before the trees are compared: `scene` is the user's, and
+    of the helper's file where the helper is linked."""
+    return not is_helper(scene) and (helper.library is None or scene.library is not None)
 
 
 def helper_scene_of(scene):
@@ -115,8 +115,9 @@ def helper_scene_of(scene):
 def scenes_served_by(helper):
     if not is_helper(helper):
         return []
-    tree = tree_of_helper(helper)  # (once, not once a scene)
-    return [scene for scene in bpy.data.scenes if _serves(helper, scene, lambda: tree)]
+    helper_tree = tree_of_helper(helper)  # (once, not once a scene)
+    return [scene for scene in bpy.data.scenes if helper_tree is not None
+            and _may_serve(helper, scene) and compat.compositor_tree(scene) == helper_tree]
 
 
 def pass_names_for_helper(helper):
