@@ -67,8 +67,12 @@ noise.strength, noise.use_restricted_range = 0.02, True
 noise.frame_end, noise.frame_start = 50.0, 40.0
 envelope = curve.modifiers.new("ENVELOPE")
 envelope.use_restricted_range, envelope.frame_end, envelope.frame_start = True, 58.0, 52.0
-point = envelope.control_points.add(55.0)
-point.min, point.max = 0.4, 0.9
+envelope.control_points.add(55.0)
+# The bounds through foreach_set: a point's own min and max run Blender's
+# modifier update with the point as the modifier, which reads past it and
+# crashed bpy 5.3 now and then (socket_keys._restore_envelope).
+envelope.control_points.foreach_set("min", [0.4])
+envelope.control_points.foreach_set("max", [0.9])
 # A driver on Thickness: the add-on does not evaluate drivers, but an upgrade
 # must not delete the artist's.
 driven = hbao.inputs["Thickness"].driver_add("default_value")
