@@ -163,7 +163,7 @@ def ensure_compositor_tree(scene):
         tree = compositor_tree(scene)
         if tree is None:
             tree = bpy.data.node_groups.new(f"{scene.name} Compositing", "CompositorNodeTree")
-            scene.compositing_node_group = tree
+            compositor_effects.set_served_group(scene, tree)
         return tree
     scene.use_nodes = True
     return scene.node_tree

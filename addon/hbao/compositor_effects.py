@@ -48,6 +48,21 @@ def served_group(scene):
     return effect.node_group if effect is not None else None
 
 
+def set_served_group(scene, tree):
+    """Make node group `tree` the compositor of `scene` (5.0 and later): in
+    5.3 the active effect's group (a new effect where the stack is empty),
+    what the deprecated `scene.compositing_node_group` does when set; in 5.0
+    that property."""
+    effects = getattr(scene, "compositor_effects", None)
+    if effects is None:
+        scene.compositing_node_group = tree
+        return
+    effect = effects.active
+    if effect is None:
+        effect = effects.new(name=tree.name)
+    effect.node_group = tree
+
+
 def other_effect_holding(scene, tree):
     """The effect of `scene`'s stack whose group is `tree` where the add-on
     serves another one, or None."""

@@ -418,7 +418,7 @@ for action in spec.get("prepare", []):
     elif action == "second_scene_shares_the_tree":  # 5.0+: one node group, two scenes
         other = scene.copy()
         other.name = "Second"
-        other.compositing_node_group = tree
+        sys.modules["hbao.compositor_effects"].set_served_group(other, tree)
     else:
         raise ValueError(f"unknown prepare action {action!r}")
     print("PREPARED", action, flush=True)

@@ -116,7 +116,7 @@ def main():
         blender_scenes.build_corner_scene(scene, (96, 64), "CYCLES", 4)
         with bpy.data.libraries.load(sys.argv[-1], link=True) as (_unused, linked):
             linked.node_groups = ["Look"]
-        scene.compositing_node_group = linked.node_groups[0]
+        sys.modules["hbao.compositor_effects"].set_served_group(scene, linked.node_groups[0])
         sync()
         return render(scene)
     scene.name = "Shot"
