@@ -16,8 +16,8 @@ pointed at each scene's helper in turn would flip with every sync. The render
 handlers record the scene being rendered, which the engine reads."""
 import bpy
 
-from . import (compat, extra_renders, helper_render_settings, hook_release, node_place,
-               pass_sources, strip_cameras, view_cameras, writes)
+from . import (compat, compositor_effects, extra_renders, helper_render_settings, hook_release,
+               node_place, pass_sources, strip_cameras, view_cameras, writes)
 from .data_edits import set_if_different
 from .helper_lookup import (ENGINE_IDNAME, HELPER_SCENE_PREFIX, MAIN_SCENE_KEY, MAIN_TREE_KEY,
                             MANAGED_NODE_KEY, helper_scene_of, is_helper, main_scene_of,
@@ -261,7 +261,7 @@ def sync_all():
     Returns whether Blender refused a write for the moment
     (writes.writes_refused): a later call finishes the job. Helpers first:
     the extra scenes of one dropped go in the same pass (a save then)."""
-    with strip_cameras.walking_strips_once():
+    with strip_cameras.walking_strips_once(), compositor_effects.reading_each_scene_once():
         for scene in sorted(bpy.data.scenes, key=lambda scene: not is_helper(scene)):
             try:
                 _sync_or_drop(scene)

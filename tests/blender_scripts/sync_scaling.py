@@ -5,8 +5,10 @@ bench/addon_sync.py (every other one with HBAO nodes), one sync to make the
 helpers, then a second sync with the add-on's lookup of a tree's managed
 node counted, and the node timer's refresh (no render done) likewise; and
 the walks of every sequencer strip for the strips' Camera overrides in that
-sync. Prints SCALING {json}: {count: [lookups in the sync, lookups in the
-refresh, walks of the strips in the sync]}.
+sync, and the reads of a scene's stack of compositor effects (5.3; none
+before) in that sync. Prints SCALING {json}: {count: [lookups in the sync,
+lookups in the refresh, walks of the strips in the sync, reads of the
+effects in the sync]}.
 
   blender -b --addons hbao --python sync_scaling.py -- COUNT...
 """
@@ -21,7 +23,8 @@ spec = importlib.util.spec_from_file_location("addon_sync",
 addon_sync = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(addon_sync)
 
-from hbao import handlers, helper_lookup, recomposite, strip_cameras  # noqa: E402
+from hbao import (compositor_effects, handlers, helper_lookup, recomposite,  # noqa: E402
+                  strip_cameras)
 
 
 def counted(function, module=helper_lookup, name="managed_node"):
@@ -46,5 +49,6 @@ for count in [int(text) for text in sys.argv[sys.argv.index("--") + 1:]]:
     handlers._sync_everything()
     found[count] = [counted(handlers._sync_everything),
                     counted(lambda: recomposite.refresh_changed(in_background=True)),
-                    counted(handlers._sync_everything, strip_cameras, "_overrides_by_scene")]
+                    counted(handlers._sync_everything, strip_cameras, "_overrides_by_scene"),
+                    counted(handlers._sync_everything, compositor_effects, "served_effect")]
 print("SCALING", json.dumps(found), flush=True)
