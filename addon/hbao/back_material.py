@@ -4,7 +4,7 @@ where a ray meets a front face, opaque at a back face, so that the render's
 Depth is the nearest back face."""
 import bpy
 
-from . import writes
+from . import compat, writes
 
 NAME = ".HBAO back faces only"
 
@@ -16,7 +16,7 @@ def get_or_make():
         return material
     material = bpy.data.materials.new(NAME)
     with writes.whole_or_removed(lambda: bpy.data.materials.remove(material)):
-        material.use_nodes = True
+        compat.ensure_material_nodes(material)
         nodes = material.node_tree.nodes
         nodes.clear()
         geometry = nodes.new("ShaderNodeNewGeometry")

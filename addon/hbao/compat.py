@@ -247,3 +247,33 @@ def motion_blur(scene):
         return None
     holder = render if hasattr(render, "motion_blur_position") else scene.cycles
     return holder.motion_blur_position, render.motion_blur_shutter
+
+
+# 5.3 names a sequencer strip's frames anew (the old names are deprecated,
+# "expected to be removed in Blender 6.0"): frame_final_start/_end are
+# left_handle/right_handle, frame_start content_start, a scene strip's
+# animation_offset_start content_trim_start (the same values, measured).
+_STRIP_TYPE = getattr(bpy.types, "Strip", None) or getattr(bpy.types, "Sequence")
+HAS_STRIP_HANDLES = "left_handle" in _STRIP_TYPE.bl_rna.properties
+
+
+def strip_shown_frames(strip):
+    """(first, past the last) frame of the sequencer at which `strip` shows."""
+    if HAS_STRIP_HANDLES:
+        return strip.left_handle, strip.right_handle
+    return strip.frame_final_start, strip.frame_final_end
+
+
+def strip_content_start(strip):
+    """(the sequencer's frame where `strip`'s content begins, the frames of
+    the content trimmed at its start: 0 where the strip has no such trim)."""
+    if HAS_STRIP_HANDLES:
+        return strip.content_start, getattr(strip, "content_trim_start", 0)
+    return strip.frame_start, getattr(strip, "animation_offset_start", 0)
+
+
+def ensure_material_nodes(material):
+    """Give a new material its node tree: 4.5 and before make it on
+    use_nodes, which 5.0 deprecates (a new material has its tree there)."""
+    if material.node_tree is None:
+        material.use_nodes = True

@@ -24,6 +24,7 @@ import contextlib
 
 import bpy
 
+from . import compat
 from .camera import CameraError
 from .report import log
 
@@ -111,8 +112,8 @@ def _shown(holder, frame, covered):
     replaces what lies below it (Blender renders those below only as an
     effect strip's inputs)."""
     for strip in sorted(_children(holder), key=lambda strip: -strip.channel):
-        if strip.mute or _channel_muted(holder, strip.channel) \
-                or not strip.frame_final_start <= frame < strip.frame_final_end:
+        first, past_last = compat.strip_shown_frames(strip)
+        if strip.mute or _channel_muted(holder, strip.channel) or not first <= frame < past_last:
             continue
         if strip.type == "META":
             yield from _shown(strip, frame, covered)
@@ -126,8 +127,8 @@ def _shown(holder, frame, covered):
 def _scene_frame(strip, frame):
     """The frame of its scene that scene strip `strip` shows at its
     sequencer's `frame`, for a strip at its own speed."""
-    return (strip.scene.frame_start + frame - strip.frame_start
-            + getattr(strip, "animation_offset_start", 0))
+    content_start, trimmed = compat.strip_content_start(strip)
+    return strip.scene.frame_start + frame - content_start + trimmed
 
 
 def _showing(sequencer_scene, frame, scene, covered=False, depth=0):
