@@ -79,7 +79,7 @@ def _node_of_type(tree, idname):
 
 def _material(name, colour, roughness=0.6):
     material = bpy.data.materials.new(name)
-    material.use_nodes = True
+    compat.ensure_material_nodes(material)
     bsdf = _node_of_type(material.node_tree, "ShaderNodeBsdfPrincipled")
     bsdf.inputs["Base Color"].default_value = (*colour, 1.0)
     bsdf.inputs["Roughness"].default_value = roughness

@@ -10,7 +10,8 @@ the only chance such a render has to build the hook."""
 import bpy
 
 from . import (compat, helper_lookup, helper_render_settings, helper_scene, node, node_place,
-               pass_sources, recomposite, render_slots, strip_cameras, window_scenes, writes)
+               pass_sources, recomposite, render_slots, strip_cameras, unseen_occluders,
+               window_scenes, writes)
 from .callback_guard import never_raises
 from .report import (NodeMessage, forget_node_messages, in_main_thread, log,
                      post_last_node_messages, post_node_messages, post_render_report)
@@ -129,6 +130,8 @@ def _on_render_init(scene, *_args):
     if not helper_lookup.is_helper(scene):
         tree = compat.compositor_tree(scene)
         messages = list(_misplaced_messages(scene))
+        messages += [(text, f"HBAO {text}")
+                     for text in unseen_occluders.render_messages(scene, tree)]
         nodes = node.hbao_nodes(tree)
         settings = helper_render_settings
         off = None

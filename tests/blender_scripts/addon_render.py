@@ -371,6 +371,24 @@ for action in spec.get("prepare", []):
         scene.render.engine = "BLENDER_WORKBENCH"
     elif action == "layer_not_rendered":  # the last view layer's Use for Rendering off
         scene.view_layers[-1].use = False
+    elif action == "holdout_collection":  # View Layer > the Props collection's Holdout
+        scene.view_layers[0].layer_collection.children["Props"].holdout = True
+    elif action == "indirect_only_collection":  # ... its Indirect Only (Cycles)
+        scene.view_layers[0].layer_collection.children["Props"].indirect_only = True
+    elif action in ("holdout_objects", "objects_unseen_by_camera", "holdout_shader"):
+        for obj in bpy.data.collections["Props"].all_objects:
+            if action == "holdout_objects":  # Object > Visibility > Holdout
+                obj.is_holdout = True
+            elif action == "objects_unseen_by_camera":  # ... > Ray Visibility > Camera off
+                obj.visible_camera = False
+            else:  # a material whose surface is a Holdout shader
+                material = bpy.data.materials.new("Held out")
+                blender_scenes.compat.ensure_material_nodes(material)
+                nodes = material.node_tree.nodes
+                output = next(n for n in nodes if n.bl_idname == "ShaderNodeOutputMaterial")
+                material.node_tree.links.new(nodes.new("ShaderNodeHoldout").outputs[0],
+                                             output.inputs["Surface"])
+                obj.material_slots[0].material = material
     elif action == "mute_render_layers":
         for source in render_layers.values():
             source.mute = True
