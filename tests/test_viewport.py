@@ -216,6 +216,45 @@ def test_preview_comes_back_when_the_add_on_is_enabled_again(run_blender):
     assert handlers == ["HANDLER on True", "HANDLER enabled again True"], log[-3000:]
 
 
+@pytest.mark.parametrize("case", ["shift", "split", "saved"])
+def test_a_closed_views_preview_goes_with_it(run_blender, tmp_path, case):
+    """An exploratory run: a 3D view closed with the preview on left its
+    settings on the Screen, on, and the next view at its place in the
+    screen's areas (or at its address) took them over: another view
+    darkened that never had the preview (also after a save and reopen),
+    7 of 8 views split off afterwards started with it on, and the draw
+    handler stayed on with no view on. Now the closed view's settings are
+    found by no other view, turn the handler off, and are not saved."""
+    log = run_blender(SCRIPTS / "viewport_close.py", case, tmp_path, ui=True).stdout
+    assert "CLOSE: DONE" in log, log[-3000:]
+    seen = {line.split(" ", 1)[0] + " " + line.split(" ", 2)[1]: line.split(" ", 2)[2]
+            for line in log.splitlines() if line.startswith(("VIEWS ", "HANDLER ", "ENTRIES "))}
+    if case == "split":
+        assert [line for line in log.splitlines() if line.startswith("NEW VIEW ")] == \
+            ["NEW VIEW null"] * 8, log[-3000:]
+        assert seen["VIEWS split"] == "[null]" and seen["HANDLER split"] == "False", seen
+        return
+    big = "false" if case == "saved" else "null"  # (null: no settings)
+    assert seen["VIEWS before"] == f"[{big}, true]", seen
+    assert seen["VIEWS closed"] == f"[{big}]" and seen["HANDLER closed"] == "False", seen
+    if case == "saved":  # the closed view's settings were not saved
+        assert seen["VIEWS opened"] == "[false]" and seen["HANDLER opened"] == "False", seen
+        assert seen["ENTRIES opened"] == '["View 2"]', seen
+
+
+def test_x_ray_says_why_the_preview_draws_nothing(run_blender, tmp_path):
+    """Solid shading's X-ray below alpha 1 writes no depth: the preview drew
+    nothing and the panel said nothing (an exploratory run). The panel says
+    why (draw.not_drawn); at alpha 1 the preview darkens the view."""
+    log = run_blender(SCRIPTS / "viewport_xray.py", tmp_path, ui=True).stdout
+    assert "XRAY: DONE" in log, log[-3000:]
+    cases = {line.split(" ", 2)[1]: json.loads(line.split(" ", 2)[2])
+             for line in log.splitlines() if line.startswith("XRAY ") and "{" in line}
+    assert cases["1.0"]["not_drawn"] is None and cases["1.0"]["darkened"] > 0.01, cases
+    assert cases["0.5"]["not_drawn"].startswith("No AO through X-ray"), cases
+    assert cases["0.5"]["darkened"] == 0.0, cases
+
+
 def test_use_node_settings_previews_the_nodes_values(run_in_blender):
     """'Use Node Settings' previews the scene's HBAO node at the current frame
     (a keyframed Radius: 0.9 at frame 10), with no node the view's own."""

@@ -50,14 +50,15 @@ def refused_for_now(operation, label):
     return False
 
 
-def guarded_timer(step, first_interval):
+def guarded_timer(step, first_interval, persistent=False):
     """bpy.app.timers.register(step), except that an exception in step ends
     Blender (exit status 1, the traceback printed) instead of unregistering
     the timer silently and leaving Blender idle until the test's timeout.
     A step that Blender refused a write or an operator runs again
     REFUSED_RETRY_S later, up to REFUSED_RETRIES times in a row: a step
     changes its state only after its writes and operators, or makes them
-    once (f12_job.F12Job asks for its render again itself)."""
+    once (f12_job.F12Job asks for its render again itself). A `persistent`
+    timer goes on after a file is opened."""
     refusals = [0]
 
     def guarded():
@@ -72,7 +73,7 @@ def guarded_timer(step, first_interval):
                 return REFUSED_RETRY_S
             print("SCRIPT ERROR in the timer:", traceback.format_exc(), sep="\n", flush=True)
             os._exit(1)
-    bpy.app.timers.register(guarded, first_interval=first_interval)
+    bpy.app.timers.register(guarded, first_interval=first_interval, persistent=persistent)
 
 
 def end_now(status=0):

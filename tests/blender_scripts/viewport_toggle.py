@@ -70,7 +70,7 @@ def run():
     out_path, shot_path = arguments()
     viewport = sys.modules["hbao.viewport"]
     draw = sys.modules["hbao.viewport.draw"]
-    view_settings_module = sys.modules["hbao.viewport.settings"]
+    view_settings_module = sys.modules["hbao.viewport.view_entries"]
 
     window = bpy.context.window_manager.windows[0]
     blender_scenes.build_demo_scene(bpy.context.scene)
@@ -187,7 +187,7 @@ def turned_on_while_maximized(window, area, report):
     # a fresh 3D view: the timeline's area turned into one
     fresh = next(a for a in home.areas if a.type == "DOPESHEET_EDITOR")
     fresh.type = "VIEW_3D"
-    view_settings_module = sys.modules["hbao.viewport.settings"]
+    view_settings_module = sys.modules["hbao.viewport.view_entries"]
     report["fresh_view_had_settings"] = view_settings_module.find(home, fresh) is not None
     with override(window, fresh):
         bpy.ops.screen.screen_full_area(use_hide_panels=False)

@@ -7,6 +7,7 @@ sidebar's "HBAO" tab. No native library needed: it runs on the GPU.
     normal_sources.py, horizon_sources.py             no bpy (plain pytest)
     shaders.py, pipeline.py                           gpu passes
     settings.py                                       per-view settings on the Screen
+    view_entries.py                                   which settings are whose view
     draw.py                                           the draw handler (only while on)
     panel.py                                          sidebar panel and operator
 """
@@ -27,10 +28,10 @@ def register():
         return
     import bpy
 
-    from . import draw, panel, settings
+    from . import draw, panel, settings, view_entries
     settings.register()
     panel.register()
-    settings.enabled_change_callbacks.append(draw.sync_handler)
+    view_entries.enabled_change_callbacks.append(draw.sync_handler)
     bpy.app.handlers.load_post.append(draw.sync_after_load)
     _registered = True
     if isinstance(bpy.data, bpy.types.BlendData):
@@ -56,11 +57,11 @@ def unregister():
         return
     import bpy
 
-    from . import draw, panel, settings
+    from . import draw, panel, settings, view_entries
     while draw.sync_after_load in bpy.app.handlers.load_post:
         bpy.app.handlers.load_post.remove(draw.sync_after_load)
-    if draw.sync_handler in settings.enabled_change_callbacks:
-        settings.enabled_change_callbacks.remove(draw.sync_handler)
+    if draw.sync_handler in view_entries.enabled_change_callbacks:
+        view_entries.enabled_change_callbacks.remove(draw.sync_handler)
     draw.unregister()
     panel.unregister()
     settings.unregister()

@@ -13,7 +13,7 @@ from bpy.app.handlers import persistent
 
 from ..callback_guard import never_raises
 from ..report import log
-from . import pipeline, projection, settings
+from . import pipeline, projection, view_entries
 
 SHADINGS = {"SOLID", "MATERIAL"}
 
@@ -44,7 +44,7 @@ def handler_registered():
 def sync_handler():
     """Add the draw handler if any view has the preview on, remove it if none has."""
     global _handler
-    wanted = settings.any_enabled()
+    wanted = view_entries.any_enabled()
     if wanted and _handler is None:
         _handler = bpy.types.SpaceView3D.draw_handler_add(_draw, (), "WINDOW", "POST_VIEW")
     elif not wanted and _handler is not None:
@@ -69,14 +69,26 @@ def _redraw_3d_views():
                 area.tag_redraw()
 
 
+def not_drawn(space):
+    """Why the preview cannot draw in 3D view `space` (the panel says it),
+    or None. Solid shading's X-ray below alpha 1 writes no depth (the
+    preview drew nothing there, an exploratory run)."""
+    shading = space.shading
+    if shading.type not in SHADINGS:
+        return "Solid or Material Preview only"
+    if shading.type == "SOLID" and shading.show_xray and shading.xray_alpha < 1.0:
+        return "No AO through X-ray: turn X-ray off or its Alpha to 1"
+    return None
+
+
 def _draw():
     context = bpy.context
     space = context.space_data
     region_3d = context.region_data
-    if space is None or region_3d is None or space.shading.type not in SHADINGS:
+    if space is None or region_3d is None or not_drawn(space) is not None:
         _forget_error(context.area)  # not drawn: nothing failed
         return
-    view_settings = settings.find(context.screen, context.area)
+    view_settings = view_entries.find(context.screen, context.area)
     if view_settings is None or not view_settings.enabled:
         _forget_error(context.area)
         return

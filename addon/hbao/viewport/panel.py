@@ -4,7 +4,7 @@ preview on and off for one 3D view."""
 import bpy
 
 from .. import parameters, ui_text
-from . import draw, settings
+from . import draw, view_entries
 
 
 class HBAO_OT_viewport_preview_toggle(bpy.types.Operator):
@@ -18,7 +18,7 @@ class HBAO_OT_viewport_preview_toggle(bpy.types.Operator):
         return context.area is not None and context.area.type == "VIEW_3D"
 
     def execute(self, context):
-        view_settings = settings.ensure(context.screen, context.area)
+        view_settings = view_entries.ensure(context.screen, context.area)
         view_settings.enabled = not view_settings.enabled  # the update syncs the handler
         return {"FINISHED"}
 
@@ -71,20 +71,21 @@ class VIEW3D_PT_hbao_preview(bpy.types.Panel):
     bl_label = "HBAO Preview"
 
     def draw_header(self, context):
-        view_settings = settings.find(context.screen, context.area)
+        view_settings = view_entries.find(context.screen, context.area)
         if view_settings is not None:
             self.layout.prop(view_settings, "enabled", text="")
 
     def draw(self, context):
         layout = self.layout
-        view_settings = settings.find(context.screen, context.area)
+        view_settings = view_entries.find(context.screen, context.area)
         if view_settings is None:
             # Panels may not write the Screen; the operator creates the settings.
             layout.operator(HBAO_OT_viewport_preview_toggle.bl_idname,
                             text="Turn On", icon="SHADING_SOLID")
             return
-        if context.space_data.shading.type not in draw.SHADINGS:
-            layout.label(text="Solid or Material Preview only", icon="INFO")
+        why_not = draw.not_drawn(context.space_data)
+        if why_not is not None:
+            _wrapped_label(layout, context, why_not, "INFO")
         error = draw.view_error(context.area) if view_settings.enabled else None
         if error:
             _wrapped_label(layout.box(), context, f"No preview: {error}", "ERROR")

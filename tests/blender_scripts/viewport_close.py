@@ -1,0 +1,138 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Run in a Blender window (xvfb) by tests/test_viewport.py: a 3D view with
+the preview on is closed (an exploratory run found its settings taken over
+by other views). Each step in its own tick of the event loop, as an
+artist's clicks are:
+
+  shift   the Timeline made a 3D view (before the big 3D view in the
+          screen's areas) with the preview on; the small view closed: the
+          big view, which never had the preview, takes its place.
+  split   eight times: the big view split, the preview turned on in the
+          new view, the new view closed; a view split off next (which may
+          get the closed one's place or address) must start without it.
+  saved   "shift" with the big view's preview turned on and off before,
+          then the file saved and opened again.
+
+Prints 'VIEWS <when> {json}' (for each 3D view, big first: its settings'
+enabled, or null), 'HANDLER <when> <bool>' (the draw handler),
+'ENTRIES <when> [names]' (the window's screen's entries) and
+'CLOSE: DONE'.
+
+  blender --factory-startup --addons hbao --python viewport_close.py -- CASE OUT_DIR
+"""
+import json
+import os
+import sys
+
+import bpy
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import timer_guard  # noqa: E402
+
+case, out_dir = sys.argv[sys.argv.index("--") + 1:][:2]
+
+
+def window():
+    return bpy.context.window_manager.windows[0]
+
+
+def views_3d():
+    return sorted((a for a in window().screen.areas if a.type == "VIEW_3D"),
+                  key=lambda a: -a.width * a.height)
+
+
+def override(area):
+    region = [r for r in area.regions if r.type == "WINDOW"][-1]
+    return bpy.context.temp_override(window=window(), screen=window().screen, area=area,
+                                     region=region)
+
+
+def entries():
+    return sys.modules["hbao.viewport.view_entries"]
+
+
+def enabled(area):
+    found = entries().find(window().screen, area)
+    return None if found is None else found.enabled
+
+
+def toggle(area):
+    with override(area):
+        bpy.ops.hbao.viewport_preview_toggle()
+
+
+def report(when):
+    print(f"VIEWS {when} {json.dumps([enabled(area) for area in views_3d()])}", flush=True)
+    draw = sys.modules["hbao.viewport.draw"]
+    print(f"HANDLER {when} {draw.handler_registered()}", flush=True)
+    print(f"ENTRIES {when} {json.dumps([e.name for e in window().screen.hbao_viewport_views])}",
+          flush=True)
+
+
+def redrawn_report(when):
+    """report(when) after the big view drew (its preview looks its settings up)."""
+    with override(views_3d()[0]):
+        bpy.ops.wm.redraw_timer(type="DRAW_WIN_SWAP", iterations=2)
+    yield
+    report(when)
+
+
+def shift_steps(big_had_it=False):
+    timeline = next(a for a in window().screen.areas if a.type == "DOPESHEET_EDITOR")
+    timeline.type = "VIEW_3D"
+    yield
+    big, small = views_3d()
+    toggle(small)
+    if big_had_it:
+        toggle(big)
+        yield
+        toggle(views_3d()[0])  # the big view off again: its entry stays, off
+    yield
+    report("before")
+    with override(views_3d()[1]):
+        bpy.ops.screen.area_close()
+    yield
+    yield from redrawn_report("closed")
+
+
+def split_steps():
+    for _round in range(8):
+        before = {area.as_pointer() for area in window().screen.areas}
+        with override(views_3d()[0]):
+            bpy.ops.screen.area_split(direction="VERTICAL", factor=0.5)
+        yield
+        new = next(a for a in window().screen.areas if a.as_pointer() not in before)
+        print(f"NEW VIEW {json.dumps(enabled(new))}", flush=True)
+        toggle(new)
+        yield
+        new = next(a for a in window().screen.areas if a.as_pointer() not in before)
+        with override(new):
+            bpy.ops.screen.area_close()
+        yield
+    yield from redrawn_report("split")
+
+
+def saved_steps():
+    yield from shift_steps(big_had_it=True)
+    path = os.path.join(out_dir, "closed.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=path)
+    yield
+    bpy.ops.wm.open_mainfile(filepath=path)
+    yield
+    yield from redrawn_report("opened")
+
+
+steps = {"shift": shift_steps, "split": split_steps, "saved": saved_steps}[case]()
+
+
+def tick():
+    try:
+        next(steps)
+    except StopIteration:
+        print("CLOSE: DONE", flush=True)
+        timer_guard.quit_blender()
+        return None
+    return 0.3
+
+
+timer_guard.guarded_timer(tick, 0.5, persistent=True)
