@@ -48,4 +48,6 @@ def new_input(node, name, socket):
         node.inputs[0].name = name
         return node.inputs[0]
     node.file_slots.new(name)
-    return node.inputs[name]
+    # the new input is the last: by name, 4.5 would find the first (whose
+    # identifier stays "Image" when its name is another)
+    return node.inputs[-1]

@@ -1364,6 +1364,16 @@ def test_add_filter_menu_of_each_blender_lists_hbao(run_in_blender):
     assert menu["entries"] == [["node.add_node", "HBAO", "CompositorNodeHBAO"]], menu
 
 
+def test_the_test_scripts_file_output_inputs_keep_their_links(run_in_blender, tmp_path):
+    """scripts/file_output.py, which the tests' trees write their EXRs with:
+    in bpy 4.5 an input called "Image" added after another was looked up by
+    name and found the first input (whose identifier stays "Image"), so its
+    link replaced the first one's and its own layer was written black (an
+    exploratory run)."""
+    log = run_in_blender(SCRIPTS / "file_output_inputs.py", tmp_path).stdout
+    assert json_line(log, "INPUTS") == [["Render", "Image"], ["Image", "Depth"]], log[-3000:]
+
+
 def test_quitting_after_a_render_reads_no_freed_memory(run_blender, tmp_path):
     """Blender disables every add-on as it quits, before it frees its data:
     3.4 then freed the HBAO node type under the view layer's evaluated copy
