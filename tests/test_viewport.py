@@ -8,7 +8,7 @@ import sys
 
 import pytest
 
-from conftest import BLENDERS, REPO, _runner
+from conftest import BLENDERS, REPO, _runner, json_line
 
 sys.path.insert(0, str(REPO / "addon"))
 from hbao.viewport import camera_sources, projection, shader_sources  # noqa: E402
@@ -253,6 +253,22 @@ def test_x_ray_says_why_the_preview_draws_nothing(run_blender, tmp_path):
     assert cases["1.0"]["not_drawn"] is None and cases["1.0"]["darkened"] > 0.01, cases
     assert cases["0.5"]["not_drawn"].startswith("No AO through X-ray"), cases
     assert cases["0.5"]["darkened"] == 0.0, cases
+
+
+def test_the_preview_darkens_the_scene_under_the_overlays_not_them(run_blender, tmp_path):
+    """The preview multiplied everything in the view's overlay buffer by the
+    AO, so a selection outline across a crease turned near black (an
+    exploratory run). Now it darkens the scene under the overlays: where
+    the preview darkens the unselected view by more than 0.1, the outlines
+    drawn there lose less than 0.4 times as much (0.19 in Blender 3.4:
+    antialiased edges let some scene through); before, they lost more
+    than the scene (1.36 times: they are brighter)."""
+    log = run_blender(SCRIPTS / "viewport_overlays.py", tmp_path, ui=True).stdout
+    assert "OVERLAYS: DONE" in log, log[-3000:]
+    result = json_line(log, "OVERLAYS")
+    assert result["pixels"] >= 30, result
+    assert result["scene"] > 0.1, result
+    assert result["outline"] < 0.4 * result["scene"], result
 
 
 def test_use_node_settings_previews_the_nodes_values(run_in_blender):

@@ -169,8 +169,10 @@ def synthetic_depth(frame, floor_y=FLOOR_Y):
 
 def glsl_ao(depth, frame, params, depth_precision):
     """The preview pipeline's AO of `depth` (top row first): uploaded bottom-up as
-    OpenGL wants, AO + blur passes, then the composite pass multiplying a white
-    float target, read back and flipped to top-down."""
+    OpenGL wants, AO + blur passes, then the composite pass into a transparent
+    float target, as into the view's overlay buffer: Blender lays that over
+    the scene as out = colour + scene * (1 - alpha), so over a white scene
+    the AO is 1 - alpha; read back and flipped to top-down."""
     height, width = depth.shape
     upload = gpu.types.Buffer("FLOAT", width * height, depth[::-1].ravel().tolist())
     depth_texture = gpu.types.GPUTexture((width, height), format="R32F", data=upload)
@@ -180,11 +182,12 @@ def glsl_ao(depth, frame, params, depth_precision):
     result = gpu.types.GPUTexture((width, height), format="RGBA32F")
     framebuffer = gpu.types.GPUFrameBuffer(color_slots=result)
     with framebuffer.bind():
-        framebuffer.clear(color=(1.0, 1.0, 1.0, 1.0))
+        framebuffer.clear(color=(0.0, 0.0, 0.0, 0.0))
         pipeline.composite(ao_texture, params["strength"])
         pixels = framebuffer.read_color(0, 0, width, height, 4, 0, "FLOAT")
     pixels.dimensions = width * height * 4
-    return np.array(pixels, dtype=np.float32).reshape(height, width, 4)[::-1, :, 0]
+    colour_and_alpha = np.array(pixels, dtype=np.float32).reshape(height, width, 4)[::-1]
+    return colour_and_alpha[:, :, 0] + (1.0 - colour_and_alpha[:, :, 3])
 
 
 def blender_frame(camera, width, height):

@@ -13,42 +13,20 @@ import os
 import sys
 
 import bpy
-import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(
     os.path.abspath(__file__)))), "scripts"))
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import blender_scenes  # noqa: E402
 import timer_guard  # noqa: E402
+import view_shots  # noqa: E402
+from view_shots import override, view_3d  # noqa: E402
 
 out_dir = sys.argv[sys.argv.index("--") + 1]
 
 
-def view_3d():
-    window = bpy.context.window_manager.windows[0]
-    return window, max((a for a in window.screen.areas if a.type == "VIEW_3D"),
-                       key=lambda a: a.width * a.height)
-
-
-def override():
-    window, area = view_3d()
-    region = [r for r in area.regions if r.type == "WINDOW"][-1]
-    return bpy.context.temp_override(window=window, screen=window.screen, area=area,
-                                     region=region)
-
-
 def shot(name):
-    path = os.path.join(out_dir, f"{name}.png")
-    with override():
-        bpy.ops.wm.redraw_timer(type="DRAW_WIN_SWAP", iterations=2)
-    with override():
-        bpy.ops.screen.screenshot_area(filepath=path, check_existing=False)
-    image = bpy.data.images.load(path, check_existing=False)
-    pixels = np.empty(image.size[0] * image.size[1] * image.channels, dtype=np.float32)
-    image.pixels.foreach_get(pixels)
-    channels = image.channels
-    bpy.data.images.remove(image)
-    return pixels.reshape(-1, channels)[:, :3].mean(axis=1)
+    return view_shots.shot(os.path.join(out_dir, f"{name}.png"))
 
 
 def steps():

@@ -192,15 +192,18 @@ class AOPipeline:
 
 
 def composite(ao_texture, strength, pixel_offset=(0, 0)):
-    """Multiplies the bound framebuffer by ao^strength (see COMPOSITE_FRAGMENT)."""
+    """Multiplies the scene under the bound overlay framebuffer by
+    ao^strength, leaving the overlays' colours (see COMPOSITE_FRAGMENT)."""
     shader = shaders.get("composite")
     previous_blend = gpu.state.blend_get()
-    gpu.state.blend_set("ALPHA_PREMULT")
     try:
         shader.bind()
         shader.uniform_sampler("ao_texture", ao_texture)
         shader.uniform_int("pixel_offset", pixel_offset)
         shader.uniform_float("strength", strength)
-        _draw_quad("composite")
+        for alpha_step, blend in enumerate(("MULTIPLY", "ADDITIVE_PREMULT")):
+            gpu.state.blend_set(blend)
+            shader.uniform_int("alpha_step", alpha_step)
+            _draw_quad("composite")
     finally:
         gpu.state.blend_set(previous_blend)

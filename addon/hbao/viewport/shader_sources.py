@@ -192,11 +192,17 @@ void main()
 }
 """
 
-# Strength, then "multiply over the viewport": premultiplied black with alpha
-# 1 - ao leaves dst * ao. In POST_VIEW Blender draws into its overlay buffer,
-# which is composited premultiplied over the scene (out = overlay + scene *
-# (1 - alpha)); a MULTIPLY blend would only darken the (transparent) overlay
-# buffer, this darkens the scene and the overlays below it alike.
+# Strength, then "multiply the scene under the overlays". In POST_VIEW Blender
+# draws into its overlay buffer, which it composites premultiplied over the
+# scene: out = overlay + scene * (1 - alpha). The AO belongs to the scene
+# only, so the overlay's colour stays and its alpha becomes
+# alpha + (1 - alpha) * (1 - ao), in two draws (pipeline.composite): a
+# MULTIPLY blend with (1, 1, 1, ao) leaves the colour and makes the alpha
+# alpha * ao, then an ADDITIVE_PREMULT blend with (0, 0, 0, 1 - ao) adds
+# 1 - ao to it. Then out = overlay + scene * ao * (1 - alpha): the scene
+# darkens as before, and a selection outline or the grid over a crease
+# keeps its colour (one draw of premultiplied black with alpha 1 - ao
+# darkened them too).
 COMPOSITE_FRAGMENT = """
 void main()
 {
@@ -204,7 +210,7 @@ void main()
     /* pow(0, 0) is undefined in GLSL; strength 0 means no AO. */
     ao = strength > 0.0 ? pow(max(ao, 0.0), strength) : 1.0;
     ao = clamp(ao, 0.0, 1.0);
-    frag_output = vec4(0.0, 0.0, 0.0, 1.0 - ao);
+    frag_output = alpha_step == 0 ? vec4(1.0, 1.0, 1.0, ao) : vec4(0.0, 0.0, 0.0, 1.0 - ao);
 }
 """
 

@@ -65,7 +65,7 @@ _DEFINITIONS = {
         shader_sources.BLUR_DEFINES),
     "composite": lambda: _create_info(
         shader_sources.COMPOSITE_FRAGMENT,
-        [("IVEC2", "pixel_offset"), ("FLOAT", "strength")],
+        [("IVEC2", "pixel_offset"), ("FLOAT", "strength"), ("INT", "alpha_step")],
         ["ao_texture"]),
 }
 
