@@ -6,6 +6,7 @@ completes (exit 0, the image written), the console says why AO is missing
 left, and the user's output settings are as they were."""
 import json
 import os
+import re
 import subprocess
 
 import numpy as np
@@ -488,6 +489,23 @@ def test_objects_missing_from_cycles_depth_are_named(run_in_blender, tmp_path, n
     assert status_lines(log) == {"HBAO0": ""}, log[-3000:]
     ao = node_outputs(out, 1)["ao"]  # (4.5 and 5.0 hold the Floor out too: AO 1 there)
     assert np.all((ao >= 0.0) & (ao <= 1.0)) and (said is not None or ao.min() < 0.9)
+
+
+def test_a_render_too_low_for_the_radius_says_so(run_in_blender, tmp_path, no_leftovers):
+    """A render a few pixels high has every pixel near a border, so most
+    samples leave the image and the AO comes out nearly white (an
+    exploratory run: 4097x5, mean AO 0.9996 against Cycles' 0.65), and
+    nothing said why. The library notes it (HBAO_NOTE_RADIUS_BEYOND_IMAGE)
+    and the render's report says so, once for the node; the render goes on."""
+    out, log = render(run_in_blender, tmp_path, {"resolution": [512, 4],
+                                                 "nodes": [{"radius": 1.0}]})
+    # the report's line: "Warning: HBAO: ..." in 3.4, "WARNING HBAO: ..." in bpy
+    told = [line for line in log.splitlines()
+            if re.search(r"(Warning:|WARNING) HBAO: node 'HBAO0': at most pixels the radius "
+                         r"spans more pixels than the image's shorter side", line)]
+    assert len(told) == 1, log[-3000:]
+    ao = node_outputs(out, 1)["ao"]
+    assert np.all((ao >= 0.0) & (ao <= 1.0)), ao
 
 
 @pytest.fixture(scope="session")

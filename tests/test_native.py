@@ -444,4 +444,5 @@ def test_a_usual_compute_has_no_notes_and_each_note_has_words(native):
     assert native.last_notes() == []
     library = native_module.load_library()
     assert b"the reference search computed the AO" in library.hbao_note_message(1)
-    assert library.hbao_note_message(2) == b"unknown note"
+    assert b"lower the radius" in library.hbao_note_message(2)
+    assert library.hbao_note_message(4) == b"unknown note"

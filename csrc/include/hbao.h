@@ -470,6 +470,12 @@ HBAO_EXPORT hbao_result hbao_compute_layers(const hbao_params *params, const hba
  *  the back layer), so the scalar reference searched: the same result,
  *  several times slower (58.5 s against 6 for an 8K frame). */
 #define HBAO_NOTE_REFERENCE_SEARCH 1u
+/** HBAO_NOTE_RADIUS_BEYOND_IMAGE: at most of the image's foreground pixels
+ *  (a sample of about 4096 of them) the radius projects to more pixels than
+ *  the image's shorter side has (a render a few pixels high, or a camera
+ *  very close to the surfaces): most samples then fall outside the image,
+ *  so the AO comes out too light. The result is computed as usual. */
+#define HBAO_NOTE_RADIUS_BEYOND_IMAGE 2u
 
 /** What the calling thread's last hbao_compute or hbao_compute_layers did
  *  other than usual (HBAO_NOTE_* bits; 0: nothing), for callers that tell

@@ -20,6 +20,10 @@ const char *hbao_note_message(uint32_t note) {
     if (note == HBAO_NOTE_REFERENCE_SEARCH)
         return "not enough memory for the fast search's copy of the depths; the reference "
                "search computed the AO (the same result, several times slower)";
+    if (note == HBAO_NOTE_RADIUS_BEYOND_IMAGE)
+        return "at most pixels the radius spans more pixels than the image's shorter side, so "
+               "most samples fall outside the image and the AO comes out too light: lower the "
+               "radius, or render more pixels";
     return "unknown note";
 }
 

@@ -543,15 +543,36 @@ float hbao_horizon_pixel(const horizon_job *job, int i, int j, float step_px) {
     return ao < 1.0f ? ao : 1.0f;
 }
 
+/* The radius in grid pixels at depth z, as hbao_horizon_pixel and the SIMD
+ * kernels compute it per pixel. */
+static float projected_radius(const hbao_settings *s, const hbao_grid *g, float z) {
+    return g->orthographic ? s->radius / g->pixel_size : s->radius / (g->pixel_size * z);
+}
+
 float hbao_block_step_at(const hbao_settings *s, const hbao_grid *g, float nearest) {
-    /* The largest projected radius, as hbao_horizon_pixel and the SIMD
-     * kernels compute it per pixel, is the nearest pixel's: pixel_size * z
+    /* The largest projected radius is the nearest pixel's: pixel_size * z
      * and the division round monotonically, so radius / (pixel_size * z) is
      * largest, to the bit, where z is smallest. One division per block. */
     if (nearest == INFINITY) return HBAO_BLOCK_UNSAMPLED;
-    const float largest =
-        g->orthographic ? s->radius / g->pixel_size : s->radius / (g->pixel_size * nearest);
+    const float largest = projected_radius(s, g, nearest);
     return largest >= 1.0f ? (largest - 1.0f) / (float)s->steps : HBAO_BLOCK_UNSAMPLED;
+}
+
+/* HBAO_NOTE_RADIUS_BEYOND_IMAGE where, at more than half of a sample of the
+ * foreground pixels (every k-th of every k-th row, about 4096 pixels), the
+ * projected radius exceeds the grid's shorter side. */
+static uint32_t radius_note(const hbao_settings *s, const hbao_grid *g) {
+    const float shorter = (float)(g->width < g->height ? g->width : g->height);
+    const int step_i = g->width / 64 + 1, step_j = g->height / 64 + 1;
+    long foreground = 0, beyond = 0;
+    for (int j = step_j / 2; j < g->height; j += step_j)
+        for (int i = step_i / 2; i < g->width; i += step_i) {
+            const float z = g->depth[(size_t)j * g->width + i];
+            if (!(z > 0.0f)) continue; /* background */
+            foreground++;
+            beyond += projected_radius(s, g, z) > shorter;
+        }
+    return 2 * beyond > foreground ? HBAO_NOTE_RADIUS_BEYOND_IMAGE : 0u;
 }
 
 int hbao_block_classes(const hbao_settings *s, const hbao_grid *g, const float z[HBAO_BLOCK_PIXELS],
@@ -750,7 +771,7 @@ uint32_t hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *g
     tiled.tiles_across = (grid->width + TILE_COLUMNS - 1) / TILE_COLUMNS;
     tiled.tiles_down = (grid->height + TILE_ROWS - 1) / TILE_ROWS;
     tiled.simd = choose_kernel(settings->implementation);
-    uint32_t notes = 0;
+    uint32_t notes = radius_note(settings, grid);
     float *phase_depth = NULL, *phase_back = NULL;
     job.phase_depth = NULL;
     job.phase_back = NULL;
