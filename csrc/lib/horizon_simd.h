@@ -172,6 +172,14 @@ typedef struct SIMD_NAME(steps) {
      * of a bit test: bench_ab, 1080p, four file copies of each build, 0.973
      * on 1 thread, 0.979 on 2. */
     int plain_end;
+    /* Whether each step samples another pixel than the step before it and
+     * than the pixel itself: one coordinate of the step's offset moves by
+     * more than a pixel a step (1/16 of a pixel to spare for the floats'
+     * rounding up to offsets of 2^19 pixels; the steps move away from the
+     * pixel), and the first step is not on the pixel. fetch_step would
+     * then skip no plain step, and they take the lanes of `active` as
+     * candidates (*alive changes only on the side path). */
+    int distinct;
 } SIMD_NAME(steps);
 
 static inline VI SIMD_NAME(floor_to_int)(VF x) {
@@ -229,9 +237,11 @@ static inline void SIMD_NAME(plan_steps)(const SIMD_NAME(block) * b, float dc, f
         const unsigned outside = ~(unsigned)M_BITS(inside) & wanted;
         if (outside != 0) {
             t->count = first + __builtin_ctz(outside);
-            return;
+            break;
         }
     }
+    const float moves = fmaxf(fabsf(dc), fabsf(ds) * b->inv_ycor) * b->step_px;
+    t->distinct = moves >= 1.0625f && t->count > 0 && (t->ox[0] | t->oy[0]) != 0;
 }
 
 /* The plain steps' depths, asked of the memory as soon as the steps are
@@ -309,6 +319,18 @@ static int SIMD_NAME(fetch_at_side)(const SIMD_NAME(block) * b, int ox, int oy, 
     return 1;
 }
 
+/* Plain step `step` of plan t into *f, its samples candidates in the lanes
+ * of `candidate`. */
+static inline void SIMD_NAME(fetch_plain)(const SIMD_NAME(block) * b, const SIMD_NAME(steps) * t,
+                                          int step, VM candidate, SIMD_NAME(fetch) * f) {
+    const int index = t->index[step];
+    f->zs = V_ZERO_UNLESS(candidate, V_LOADU(b->job->phase_depth + index));
+    if (b->job->phase_back != NULL) f->zb = V_LOADU(b->job->phase_back + index);
+    f->row = t->row[step];
+    f->ox = t->ox_float[step];
+    f->candidate = candidate;
+}
+
 /* Step `step` of plan t into *f: 1, or 0 where it repeats the previous
  * step's pixel, or -1 where the direction's search ends because every lane
  * has left the image (*alive: the lanes still inside). Where the projected
@@ -321,13 +343,7 @@ static inline int SIMD_NAME(fetch_step)(const SIMD_NAME(block) * b, const SIMD_N
     const int ox = t->ox[step], oy = t->oy[step];
     if (step > 0 && ox == t->ox[step - 1] && oy == t->oy[step - 1]) return 0;
     if (step < t->plain_end) {
-        const VM candidate = (ox | oy) == 0 ? M_NONE() : *alive;
-        const int index = t->index[step];
-        f->zs = V_ZERO_UNLESS(candidate, V_LOADU(b->job->phase_depth + index));
-        if (b->job->phase_back != NULL) f->zb = V_LOADU(b->job->phase_back + index);
-        f->row = t->row[step];
-        f->ox = t->ox_float[step];
-        f->candidate = candidate;
+        SIMD_NAME(fetch_plain)(b, t, step, (ox | oy) == 0 ? M_NONE() : *alive, f);
         return 1;
     }
     return SIMD_NAME(fetch_at_side)(b, ox, oy, alive, f) ? 1 : -1;
@@ -475,24 +491,26 @@ static inline VM SIMD_NAME(above_tangent)(const SIMD_NAME(block) * b, VM ok, VF 
     return M_AND(ok, M_OR(V_GT(height, V_SET(0.0f)), b->view_below));
 }
 
-/* The one-layer search's sample: the lanes of sample_far's result, or no
- * lane where none of them lies above the tangent plane (above_tangent:
- * the step cannot change a horizon). The tangent test comes first, on
- * every lane, so such a step (about 9 in 10 in bench_speed's scene) skips
- * the usable-depth test and the squared length. */
-static inline VM SIMD_NAME(sample_rising)(const SIMD_NAME(block) * b, const SIMD_NAME(fetch) * f,
-                                          VM live, VF delta[3], VF *dist2, VF *height) {
+/* The one-layer search's sample: whether any lane of sample_far's result
+ * lies above the tangent plane (above_tangent: otherwise the step cannot
+ * change a horizon), with those lanes in *ok. The tangent test comes first,
+ * on every lane, so such a step (about 9 in 10 in bench_speed's scene)
+ * skips the usable-depth test and the squared length; always inlined, so
+ * that each test that fails leaves the caller's step at once. delta and
+ * dist2 are set only where it returns 1. */
+static inline __attribute__((always_inline)) int
+SIMD_NAME(sample_rising)(const SIMD_NAME(block) * b, const SIMD_NAME(fetch) * f, VM live,
+                         VF delta[3], VF *dist2, VF *height, VM *ok) {
     /* hbao_sample_height */
     *height = SIMD_NAME(height_at)(b, SIMD_NAME(height_across)(b, f), f->zs);
     const VM tangent = M_OR(V_GT(*height, V_SET(0.0f)), b->view_below);
-    const VM none = M_NONE(); /* delta and dist2 are left unset */
-    if (!M_ANY(tangent)) return none;
+    if (!M_ANY(tangent)) return 0;
     const VM valid = SIMD_NAME(sample_valid)(b, f, live);
-    if (!M_ANY(M_AND(valid, tangent))) return none;
+    if (!M_ANY(M_AND(valid, tangent))) return 0;
     SIMD_NAME(sample_delta)(b, f, delta);
     VM far;
-    const VM ok = SIMD_NAME(sample_reach)(b, valid, delta, dist2, &far);
-    return M_ANY(M_AND(ok, tangent)) ? ok : none; /* above_tangent(b, ok, height) */
+    *ok = SIMD_NAME(sample_reach)(b, valid, delta, dist2, &far);
+    return M_ANY(M_AND(*ok, tangent)); /* above_tangent(b, ok, height) */
 }
 
 static inline VF SIMD_NAME(cos_to_view)(const SIMD_NAME(block) * b, const VF delta[3],
@@ -517,10 +535,9 @@ static VF SIMD_NAME(direction_occlusion_hbao)(const hbao_settings *s, const SIMD
         const int got = SIMD_NAME(fetch_step)(b, t, step, &inside, &f);
         if (got < 0) break;
         if (got == 0) continue;
-        VF delta[3], dist2;
-        VF height;
-        const VM ok = SIMD_NAME(sample_rising)(b, &f, alive, delta, &dist2, &height);
-        if (!M_ANY(ok)) continue;
+        VF delta[3], dist2, height;
+        VM ok;
+        if (!SIMD_NAME(sample_rising)(b, &f, alive, delta, &dist2, &height, &ok)) continue;
         const VF inv_dist = V_DIV(V_SET(1.0f), V_SQRT(dist2));
         const VF sin_s = V_MUL(height, inv_dist);
         VM rest = ok;
@@ -600,67 +617,103 @@ static inline VF SIMD_NAME(visibility_start)(const hbao_settings *s, VF gamma,
                                             V_SET(s->bias_elevation_acos), gamma, sl);
 }
 
+/* The state of a direction's one-layer cosine search: its horizon so far,
+ * lane by lane, and what the search found (direction_occlusion_cosine). */
+typedef struct SIMD_NAME(cosine_search) {
+    VF elevation_max, cos_past_max, visibility_at_max, occlusion;
+    VM past_normal; /* lanes whose horizon passed the normal */
+    VM check_past_normal;
+    int any_check, quadratic, any_raised;
+} SIMD_NAME(cosine_search);
+
+/* One fetched step of the one-layer cosine search: its samples can raise
+ * the horizons of the lanes of `active`. */
+static inline __attribute__((always_inline)) void
+SIMD_NAME(cosine_step)(const SIMD_NAME(block) * b, const SIMD_NAME(slice) * sl,
+                       const SIMD_NAME(fetch) * f, VM active, SIMD_NAME(cosine_search) * c) {
+    VF delta[3], dist2, height;
+    VM ok;
+    if (!SIMD_NAME(sample_rising)(b, f, active, delta, &dist2, &height, &ok)) return;
+    const VF inv_dist = V_DIV(V_SET(1.0f), V_SQRT(dist2));
+    const VF sin_s = V_MUL(height, inv_dist);
+    VM raised = M_NONE(); /* no lane */
+    /* past_the_normal, its cheap half first (see above) */
+    const VM steep =
+        c->any_check ? M_AND(M_AND(ok, c->check_past_normal), V_GT(sin_s, b->n_dot_v)) : raised;
+    if (M_ANY(steep)) {
+        const VF cos_v = SIMD_NAME(cos_to_view)(b, delta, inv_dist);
+        const VM newly =
+            M_AND(M_AND(steep, V_GT(cos_v, sl->cos_gamma)), V_GT(cos_v, c->cos_past_max));
+        c->past_normal = M_OR(c->past_normal, newly);
+        c->cos_past_max = V_SELECT(newly, c->cos_past_max,
+                                   V_SELECT(V_GT(cos_v, V_SET(1.0f)), cos_v, V_SET(1.0f)));
+        raised = newly;
+    }
+    const VM elevation_candidates = M_ANDNOT(c->past_normal, M_ANDNOT(raised, ok));
+    const VF elevation = V_MUL(sin_s, sl->inv_np);
+    const VM rise = M_AND(elevation_candidates, V_GT(elevation, c->elevation_max));
+    c->elevation_max = V_SELECT(rise, c->elevation_max,
+                                V_SELECT(V_GT(elevation, V_SET(1.0f)), elevation, V_SET(1.0f)));
+    raised = M_OR(raised, rise);
+    c->any_raised |= M_ANY(raised);
+    if (c->quadratic && M_ANY(raised)) {
+        const VF visibility = SIMD_NAME(horizon_visibility)(c->past_normal, c->cos_past_max,
+                                                            c->elevation_max, sl->gamma, sl);
+        const VF weight = V_SUB(V_SET(1.0f), V_MUL(dist2, b->inv_radius2));
+        c->occlusion =
+            V_SELECT(raised, c->occlusion,
+                     V_ADD(c->occlusion, V_MUL(weight, V_SUB(c->visibility_at_max, visibility))));
+        c->visibility_at_max = V_SELECT(raised, c->visibility_at_max, visibility);
+    }
+}
+
 /* t: the direction's steps, planned (by the caller) before anything else:
  * the search does not wait on them; the open part is left to the end
  * (bench_ab, 1080p, four file copies of each build: 0.97 on 1 thread,
- * 0.98 on 2, against gamma and the open part first). */
+ * 0.98 on 2, against gamma and the open part first). Where the plan's
+ * plain steps each sample a pixel of their own (steps.distinct), they are
+ * searched first by a loop with none of fetch_step's tests, and a step
+ * leaves at its first failed test (cosine_step, sample_rising): on the
+ * Zen 2 VM of session 38, where a skipped step was some 54 instructions,
+ * 7 of them branches, and ran at 3.4 instructions a cycle, bit-identical,
+ * scripts/bench_ab_pairs.sh 1080p: defaults 0.948 on 1 thread, 0.949 on
+ * 2, half resolution 0.951, 8 x 6 + blur 15 0.986, back faces 0.991,
+ * radius 0.02 (steps on the same pixel: the loop with the tests) 1.006.
+ * The same for the HBAO integration measured 1.008: not kept there. */
 static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SIMD_NAME(block) * b,
                                                 VM active, const SIMD_NAME(steps) * t,
                                                 const SIMD_NAME(slice) * sl, VF *open_part) {
     const VF gamma = sl->gamma;
-    const VF inv_np = sl->inv_np;
-    const VM check_past_normal = V_GT(sl->sin_gamma, V_SET(0.0f));
-    const int any_check = M_ANY(M_AND(check_past_normal, active));
-    const int quadratic = s->falloff == HBAO_FALLOFF_QUADRATIC;
-
-    VF elevation_max = V_SET(s->sin_bias);
-    VM past_normal = M_NONE(); /* no lane */
-    VF cos_past_max = sl->cos_gamma;
-    VF visibility_at_max = quadratic ? SIMD_NAME(visibility_start)(s, gamma, sl) : V_SET(0.0f);
-    VF occlusion = V_SET(0.0f);
-    int any_raised = 0;
+    SIMD_NAME(cosine_search) c;
+    c.check_past_normal = V_GT(sl->sin_gamma, V_SET(0.0f));
+    c.any_check = M_ANY(M_AND(c.check_past_normal, active));
+    c.quadratic = s->falloff == HBAO_FALLOFF_QUADRATIC;
+    c.elevation_max = V_SET(s->sin_bias);
+    c.past_normal = M_NONE(); /* no lane */
+    c.cos_past_max = sl->cos_gamma;
+    c.visibility_at_max = c.quadratic ? SIMD_NAME(visibility_start)(s, gamma, sl) : V_SET(0.0f);
+    c.occlusion = V_SET(0.0f);
+    c.any_raised = 0;
+    int step = 0;
+    if (t->distinct) {
+        for (; step < t->plain_end; step++) {
+            SIMD_NAME(fetch) f;
+            SIMD_NAME(fetch_plain)(b, t, step, active, &f);
+            SIMD_NAME(cosine_step)(b, sl, &f, active, &c);
+        }
+    }
     VM inside = active;
-    for (int step = 0; step < t->count; step++) {
+    for (; step < t->count; step++) {
         SIMD_NAME(fetch) f;
         const int got = SIMD_NAME(fetch_step)(b, t, step, &inside, &f);
         if (got < 0) break;
         if (got == 0) continue;
-        VF delta[3], dist2;
-        VF height;
-        const VM ok = SIMD_NAME(sample_rising)(b, &f, active, delta, &dist2, &height);
-        if (!M_ANY(ok)) continue;
-        const VF inv_dist = V_DIV(V_SET(1.0f), V_SQRT(dist2));
-        const VF sin_s = V_MUL(height, inv_dist);
-        VM raised = M_NONE(); /* no lane */
-        /* past_the_normal, its cheap half first (see above) */
-        const VM steep =
-            any_check ? M_AND(M_AND(ok, check_past_normal), V_GT(sin_s, b->n_dot_v)) : raised;
-        if (M_ANY(steep)) {
-            const VF cos_v = SIMD_NAME(cos_to_view)(b, delta, inv_dist);
-            const VM newly =
-                M_AND(M_AND(steep, V_GT(cos_v, sl->cos_gamma)), V_GT(cos_v, cos_past_max));
-            past_normal = M_OR(past_normal, newly);
-            cos_past_max = V_SELECT(newly, cos_past_max,
-                                    V_SELECT(V_GT(cos_v, V_SET(1.0f)), cos_v, V_SET(1.0f)));
-            raised = newly;
-        }
-        const VM elevation_candidates = M_ANDNOT(past_normal, M_ANDNOT(raised, ok));
-        const VF elevation = V_MUL(sin_s, inv_np);
-        const VM rise = M_AND(elevation_candidates, V_GT(elevation, elevation_max));
-        elevation_max = V_SELECT(rise, elevation_max,
-                                 V_SELECT(V_GT(elevation, V_SET(1.0f)), elevation, V_SET(1.0f)));
-        raised = M_OR(raised, rise);
-        any_raised |= M_ANY(raised);
-        if (quadratic && M_ANY(raised)) {
-            const VF visibility =
-                SIMD_NAME(horizon_visibility)(past_normal, cos_past_max, elevation_max, gamma, sl);
-            const VF weight = V_SUB(V_SET(1.0f), V_MUL(dist2, b->inv_radius2));
-            occlusion =
-                V_SELECT(raised, occlusion,
-                         V_ADD(occlusion, V_MUL(weight, V_SUB(visibility_at_max, visibility))));
-            visibility_at_max = V_SELECT(raised, visibility_at_max, visibility);
-        }
+        SIMD_NAME(cosine_step)(b, sl, &f, active, &c);
     }
+    const int quadratic = c.quadratic, any_raised = c.any_raised;
+    const VM past_normal = c.past_normal;
+    const VF cos_past_max = c.cos_past_max, elevation_max = c.elevation_max;
+    VF occlusion = c.occlusion;
     /* Where no lane's horizon rose or passed the normal, the end is the
      * start, and start - start is 0 on every lane that counts (a finite
      * start; the others are left out by the caller): neither is computed. */
