@@ -1807,6 +1807,64 @@ def test_sequence_refuses_an_output_that_is_another_frames_camera(hbao_tool, tmp
     assert not list(tmp_path.glob("x_*"))
 
 
+def test_sequence_refuses_an_output_that_is_the_one_camera_file(hbao_tool, tmp_path):
+    """-o 'cam_#.json' --camera cam_3.json --frames 1-5 (one camera for every
+    frame): frame 3's output would replace the camera file after frames 1
+    and 2 read it. It was refused only when frame 3 came, with frames 1, 2,
+    4 and 5 written (an exploratory run); now before any frame runs, by
+    name and through a symbolic link."""
+    camera = camera_path("cycles_float_zip").read_text()
+    for frame in range(1, 6):
+        shutil.copyfile(fixture_path("cycles_float_zip"), tmp_path / f"render_{frame}.exr")
+    (tmp_path / "cam_3.json").write_text(camera)
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    completed = run_tool(hbao_tool, tmp_path / "render_#.exr", "-o", tmp_path / "cam_#.json",
+                         "--camera", tmp_path / "cam_3.json", "--frames", "1-5")
+    assert_clean_error(completed, EXIT_USAGE, "-o of frame 3",
+                       "is the --camera file that every frame reads")
+    (tmp_path / "ao_2.exr").symlink_to("cam_3.json")
+    linked = run_tool(hbao_tool, tmp_path / "render_#.exr", "-o", tmp_path / "ao_#.exr",
+                      "--camera", tmp_path / "cam_3.json", "--frames", "1-5")
+    assert_clean_error(linked, EXIT_USAGE, "-o of frame 2",
+                       "is the --camera file that every frame reads")
+    os.unlink(tmp_path / "ao_2.exr")
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+
+
+def test_sequence_refuses_an_output_that_links_to_another_frames_output(hbao_tool, tmp_path):
+    """a_2.exr a symbolic link to a_1.exr (held frames linked to save space,
+    then the shot rendered again): frame 2 wrote frame 1's output through
+    the link, frame 1 then found it up to date and skipped it, and the run
+    exited 0 with frame 2's AO as frame 1's (an exploratory run; with
+    --force two jobs raced into one file). Refused before any frame runs,
+    whether the target exists or not yet, and the same for a preview."""
+    shutil.copyfile(fixture_path("cycles_float_zip"), tmp_path / "r_1.exr")
+    shutil.copyfile(fixture_path("ortho_float"), tmp_path / "r_2.exr")
+
+    def run(*extra):
+        return run_tool(hbao_tool, tmp_path / "r_#.exr", "-o", tmp_path / "a_#.exr",
+                        "--frames", "2,1", "--no-normals", *extra)
+
+    (tmp_path / "a_2.exr").symlink_to("a_1.exr")  # not there yet: by the name it writes
+    assert_clean_error(run(), EXIT_USAGE, "-o of frame 2", "is the -o of frame 1")
+    assert not (tmp_path / "a_1.exr").exists()
+    run_ok(hbao_tool, tmp_path / "r_1.exr", "-o", tmp_path / "a_1.exr", "--no-normals")
+    first = (tmp_path / "a_1.exr").read_bytes()
+    for extra in ((), ("--force", "--jobs", "2")):  # there
+        assert_clean_error(run(*extra), EXIT_USAGE, "-o of frame 2", "is the -o of frame 1")
+        assert (tmp_path / "a_1.exr").read_bytes() == first
+    (tmp_path / "p_1.png").symlink_to("a_2.exr")  # a preview through a link to an output
+    os.unlink(tmp_path / "a_2.exr")
+    previews = run("--preview", tmp_path / "p_#.png")  # (frame 2 comes first)
+    assert_clean_error(previews, EXIT_USAGE, "-o of frame 2", "is the --preview of frame 1")
+    assert (tmp_path / "a_1.exr").read_bytes() == first and not (tmp_path / "a_2.exr").exists()
+    # each frame its own output: runs, and a rerun skips both
+    os.unlink(tmp_path / "p_1.png")
+    run_ok(hbao_tool, tmp_path / "r_#.exr", "-o", tmp_path / "a_#.exr", "--frames", "2,1",
+           "--no-normals")
+    assert (tmp_path / "a_2.exr").is_file() and not (tmp_path / "a_2.exr").is_symlink()
+
+
 EXPORT_CAMERAS = SCRIPTS / "export_cameras.py"
 SCRIPTS_IN_BLENDER = Path(__file__).resolve().parent / "blender_scripts"
 

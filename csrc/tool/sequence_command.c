@@ -201,9 +201,13 @@ static int summarize(const sequence_run *run, tool_error *error) {
  * is read (hbao 'f_#.exr' -o 'f_#0.exr'
  * --frames 1-10: frame 1 writes f_10.exr); one that is another frame's
  * preview or output, the two frames would replace each other's file
- * (-o 'o_#.exr' --preview 'o_#0.exr'). Each frame refuses its own input
- * and a preview that is its own output (ao_command); this refuses the
- * others' before any frame runs: by name, and by file (frame_file). */
+ * (-o 'o_#.exr' --preview 'o_#0.exr'), or, through a symbolic link, one
+ * frame would write the other's output and that frame then find it up to
+ * date (an exploratory run: a_0002.exr a link to a_0001.exr gave frame 1
+ * frame 2's AO, exit 0); one that is the --camera file every frame reads
+ * would replace it after the frames before it. Each frame refuses its own
+ * input and a preview that is its own output (ao_command); this refuses
+ * the others' before any frame runs: by name, and by file (frame_file). */
 /* `pattern` with its folder made canonical (canonical_path), so that names
  * of one file compare equal ("./o_#.exr" and "o_#.exr"); as given where the
  * folder holds the '#' run or cannot be resolved. */
@@ -223,7 +227,7 @@ typedef struct frame_file {
     dev_t device;
     ino_t inode;
     int32_t frame;
-    int kind;      /* 0: the render, 1: the frame's --camera file */
+    int kind;      /* 0: the render, 1: the frame's --camera file, 2: -o, 3: --preview */
     char *path;    /* as the frame names it (owned); for a dangling link, where it points */
     bool dangling; /* a symbolic link to a file not there yet (device, inode 0) */
 } frame_file;
@@ -252,19 +256,22 @@ static bool dangling_link_target(const char *path, char target[PATH_MAX]) {
     return lstat(path, &status) == 0 && S_ISLNK(status.st_mode) && final_path(path, target);
 }
 
-/* The listed frames' input files that exist, sorted by identity (NULL and
- * *found 0 where none, or no memory: the names' checks still run). */
-static frame_file *frames_input_files(const char *const inputs[2], const frame_list *frames,
-                                      int64_t count, size_t *found) {
+/* The listed frames' files (FRAME_FILE_KINDS patterns: inputs, outputs)
+ * that exist, sorted by identity (NULL and *found 0 where none, or no
+ * memory: the names' checks still run). */
+#define FRAME_FILE_KINDS 4
+static frame_file *frames_files(const char *const patterns[FRAME_FILE_KINDS],
+                                const frame_list *frames, int64_t count, size_t *found) {
     *found = 0;
-    frame_file *files = malloc((size_t)count * 2 * sizeof *files);
+    frame_file *files = malloc((size_t)count * FRAME_FILE_KINDS * sizeof *files);
     if (files == NULL) return NULL;
     char path[PATH_MAX];
     struct stat status;
     for (int64_t i = 0; i < count; ++i) {
         const int32_t frame = frame_list_at(frames, i);
-        for (int kind = 0; kind < 2; ++kind) {
-            if (inputs[kind] == NULL || !frame_pattern_path(inputs[kind], frame, path, sizeof path))
+        for (int kind = 0; kind < FRAME_FILE_KINDS; ++kind) {
+            if (patterns[kind] == NULL ||
+                !frame_pattern_path(patterns[kind], frame, path, sizeof path))
                 continue;
             char target[PATH_MAX];
             const bool exists = stat(path, &status) == 0;
@@ -316,20 +323,47 @@ static const frame_file *other_frames_file(const frame_file *files, size_t found
     return NULL;
 }
 
+/* What writing `path` would do to a file of another frame of `kind`
+ * (frame_file.kind), for the messages below. */
+static const char *clash_words(int kind) {
+    return kind < 2 ? "it would be replaced before it is read"
+                    : "each would replace the other, or one frame find the other's AO up to date";
+}
+
+/* The one --camera file that every frame reads (not one per frame), where
+ * writing `path` would replace it: by name, or as the same file. */
+static bool is_shared_camera(const char *camera, const struct stat *camera_status, const char *path,
+                             const char *written) {
+    struct stat status;
+    if (camera == NULL) return false;
+    if (strcmp(camera, path) == 0 || (written != NULL && strcmp(camera, written) == 0)) return true;
+    return camera_status != NULL && stat(path, &status) == 0 &&
+           status.st_dev == camera_status->st_dev && status.st_ino == camera_status->st_ino &&
+           (status.st_nlink == 1 || same_resolved_path(path, camera));
+}
+
 static int refuse_other_frames_files(const cli_options *options, int64_t count,
                                      bool camera_per_frame, tool_error *error) {
-    char canonical[4][PATH_MAX];
-    /* the frames' input files: renders, and cameras where each has its own */
-    const char *inputs[2] = {
+    char canonical[5][PATH_MAX];
+    /* the frames' files: renders, cameras where each has its own, outputs
+     * and previews (their indices in `files` are frame_file.kind) */
+    const char *files_patterns[FRAME_FILE_KINDS] = {
         canonical_pattern(options->input_path, canonical[0]),
-        camera_per_frame ? canonical_pattern(options->camera_path, canonical[3]) : NULL};
-    const char *input_names[2] = {"input", "--camera file"};
-    const char *patterns[2] = {canonical_pattern(options->output_path, canonical[1]),
-                               canonical_pattern(options->preview_path, canonical[2])};
-    const char *flags[2] = {"-o", "--preview"};
+        camera_per_frame ? canonical_pattern(options->camera_path, canonical[3]) : NULL,
+        canonical_pattern(options->output_path, canonical[1]),
+        canonical_pattern(options->preview_path, canonical[2])};
+    const char *names_of[FRAME_FILE_KINDS] = {"input", "--camera file", "-o", "--preview"};
+    const char *const *patterns = files_patterns + 2;
+    const char *const *flags = names_of + 2;
+    /* the camera file every frame reads */
+    const char *camera = !camera_per_frame && options->camera_path != NULL
+                             ? canonical_pattern(options->camera_path, canonical[4])
+                             : NULL;
+    struct stat camera_status;
+    const bool camera_exists = camera != NULL && stat(camera, &camera_status) == 0;
     char path[PATH_MAX];
     size_t found;
-    frame_file *files = frames_input_files(inputs, &options->frames, count, &found);
+    frame_file *files = frames_files(files_patterns, &options->frames, count, &found);
     int status = TOOL_EXIT_SUCCESS;
     for (int64_t i = 0; i < count; ++i) {
         const int32_t frame = frame_list_at(&options->frames, i);
@@ -337,37 +371,34 @@ static int refuse_other_frames_files(const cli_options *options, int64_t count,
             if (patterns[k] == NULL || !frame_pattern_path(patterns[k], frame, path, sizeof path))
                 continue;
             int32_t other;
-            /* the name, and where a link at it writes (an input not there yet) */
+            /* the name, and where a link at it writes (a file not there yet) */
             char written[PATH_MAX];
             const char *names[2] = {
                 path, final_path(path, written) && strcmp(written, path) != 0 ? written : NULL};
+            if (is_shared_camera(camera, camera_exists ? &camera_status : NULL, path, names[1])) {
+                status = tool_fail(error, TOOL_EXIT_USAGE,
+                                   "%s of frame %d (%s) is the --camera file that every frame "
+                                   "reads: it would be replaced",
+                                   flags[k], (int)frame, path);
+                goto done;
+            }
             for (int n = 0; n < 2; ++n)
-                for (int in = 0; in < 2; ++in)
-                    if (names[n] != NULL && inputs[in] != NULL &&
-                        frame_pattern_frame(inputs[in], names[n], &other) && other != frame &&
-                        frame_list_contains(&options->frames, other)) {
-                        status = tool_fail(error, TOOL_EXIT_USAGE,
-                                           "%s of frame %d (%s) is the %s of frame %d: it would "
-                                           "be replaced before it is read",
-                                           flags[k], (int)frame, path, input_names[in], (int)other);
+                for (int in = 0; in < FRAME_FILE_KINDS; ++in)
+                    if (names[n] != NULL && files_patterns[in] != NULL &&
+                        frame_pattern_frame(files_patterns[in], names[n], &other) &&
+                        other != frame && frame_list_contains(&options->frames, other)) {
+                        status = tool_fail(
+                            error, TOOL_EXIT_USAGE, "%s of frame %d (%s) is the %s of frame %d: %s",
+                            flags[k], (int)frame, path, names_of[in], (int)other, clash_words(in));
                         goto done;
                     }
             const frame_file *same = other_frames_file(files, found, path, frame);
             if (same != NULL) {
                 status = tool_fail(error, TOOL_EXIT_USAGE,
                                    "%s of frame %d (%s) is the %s of frame %d by another path (a "
-                                   "symbolic link): it would be written before it is read",
-                                   flags[k], (int)frame, path, input_names[same->kind],
-                                   (int)same->frame);
-                goto done;
-            }
-            const char *pattern = patterns[1 - k];
-            if (pattern != NULL && frame_pattern_frame(pattern, path, &other) && other != frame &&
-                frame_list_contains(&options->frames, other)) {
-                status = tool_fail(error, TOOL_EXIT_USAGE,
-                                   "%s of frame %d (%s) is the %s of frame %d: each would replace "
-                                   "the other",
-                                   flags[k], (int)frame, path, flags[1 - k], (int)other);
+                                   "symbolic link): %s",
+                                   flags[k], (int)frame, path, names_of[same->kind],
+                                   (int)same->frame, clash_words(same->kind));
                 goto done;
             }
         }
