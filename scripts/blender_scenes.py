@@ -329,10 +329,9 @@ class Compositor:
         return FileOutput(self, node)
 
 
-def hbao_test_tree(scene, out_dir, name="HBAO0"):
-    """Render Layers -> one HBAO node -> the final image, and a File Output
-    writing OUT_DIR/nodes_<frame>.exr with Render, <name>_AO and <name>_Image:
-    the tree the F12 and fault scripts render. Returns the HBAO node."""
+def hbao_node_tree(scene, name):
+    """Render Layers -> one HBAO node called `name` -> the final image.
+    Returns the Compositor, the Render Layers node and the HBAO node."""
     compositor = Compositor(scene)
     layers = compositor.render_layers()
     node = compositor.node("CompositorNodeHBAO")
@@ -340,6 +339,14 @@ def hbao_test_tree(scene, out_dir, name="HBAO0"):
     for socket in ("Image", "Depth", "Normal"):
         compositor.link(layers.outputs[socket], node.inputs[socket])
     compositor.composite(node.outputs["Image"])
+    return compositor, layers, node
+
+
+def hbao_test_tree(scene, out_dir, name="HBAO0"):
+    """hbao_node_tree, and a File Output writing OUT_DIR/nodes_<frame>.exr
+    with Render, <name>_AO and <name>_Image: the tree the F12 and fault
+    scripts render. Returns the HBAO node."""
+    compositor, layers, node = hbao_node_tree(scene, name)
     files = compositor.file_output(out_dir, "nodes_")
     for slot, socket in (("Render", layers.outputs["Image"]), (f"{name}_AO", node.outputs["AO"]),
                          (f"{name}_Image", node.outputs["Image"])):

@@ -9,7 +9,8 @@ import subprocess
 import numpy as np
 import pytest
 
-from conftest import BLENDER, REPO, blender_environment, json_line, run_command
+from conftest import (BLENDER, BLENDERS, REPO, _runner, blender_environment, json_line,
+                      run_command)
 
 SCRIPTS = REPO / "tests" / "blender_scripts"
 APPEND_SCRIPT = REPO / "tests" / "blender_scripts" / "addon_append.py"
@@ -162,6 +163,34 @@ def test_smooth_shaded_coarse_meshes_do_not_hide_themselves(run_in_blender, tmp_
         (cycles > SELF_HIDDEN_BRIGHT)
     print(f"self-hidden pixels: {int(hidden.sum())}")
     assert hidden.sum() <= SELF_HIDDEN_MOST, np.argwhere(hidden)[:20]
+
+
+@pytest.mark.matrix
+@pytest.mark.min_blender(5, 0)
+def test_a_file_saved_in_5_keeps_the_node_settings_in_4_5(run_in_blender, blender_user_scripts,
+                                                          tmp_path):
+    """Blender 5.0 keeps add-on properties apart from the custom properties
+    where 4.5 reads them: a file saved in 5.x gave 4.5 the node settings'
+    defaults, or, for a file made in 4.5 and edited in 5.x, the values 4.5
+    had saved (an exploratory run). The add-on copies them there before
+    each save in 5.x (older_blenders.py): 4.5 reads what 5.x saved, both
+    for a file made in 5.x and one made in 4.5; 5.x reads 4.5's."""
+    lts = next((b for b in BLENDERS if b.version_tuple[:2] == (4, 5)), None)
+    assert lts is not None, "the matrix has no Blender 4.5"
+    run_lts = _runner(lts, blender_user_scripts)
+    script = SCRIPTS / "older_blender_settings.py"
+    first = {"falloff": "QUADRATIC", "integration": "HBAO", "half_resolution": True,
+             "blur_sharpness": 12.0, "guard_band": 5.0, "back_faces": True}
+    second = {"falloff": "NONE", "integration": "COSINE", "half_resolution": False,
+              "blur_sharpness": 20.0, "guard_band": 0.0, "back_faces": False}
+    made_in_5, made_in_4_5, edited = (tmp_path / name for name in ("5.blend", "4.5.blend",
+                                                                   "edited.blend"))
+    run_in_blender(script, made_in_5, json.dumps(first))
+    assert json_line(run_lts(script, "-", "-", blend=made_in_5).stdout, "SETTINGS") == first
+    run_lts(script, made_in_4_5, json.dumps(first))
+    log = run_in_blender(script, edited, json.dumps(second), blend=made_in_4_5).stdout
+    assert json_line(log, "SETTINGS") == first
+    assert json_line(run_lts(script, "-", "-", blend=edited).stdout, "SETTINGS") == second
 
 
 def test_disabling_the_add_on_in_a_session_leaves_the_plain_render(run_in_blender, tmp_path):

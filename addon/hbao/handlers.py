@@ -10,8 +10,8 @@ the only chance such a render has to build the hook."""
 import bpy
 
 from . import (compat, helper_lookup, helper_render_settings, helper_scene, node, node_place,
-               pass_sources, recomposite, render_slots, strip_cameras, unseen_occluders,
-               window_scenes, writes)
+               older_blenders, pass_sources, recomposite, render_slots, strip_cameras,
+               unseen_occluders, window_scenes, writes)
 from .callback_guard import never_raises
 from .report import (NodeMessage, forget_node_messages, in_main_thread, log,
                      post_last_node_messages, post_node_messages, post_render_report)
@@ -115,6 +115,7 @@ def _on_save_pre(*_args):
     # Background scripts get no timer: the hook is built at the latest here, so
     # that `blender -b file.blend -f N` finds it in the file.
     _sync_all_or_later()
+    older_blenders.copy_node_settings()
 
 
 @bpy.app.handlers.persistent

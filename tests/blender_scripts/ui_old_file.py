@@ -28,13 +28,7 @@ for name, (key, default, low, high, _type, _subtype) in list(group_layout.VALUE_
                                        "NodeSocketFloat", None)
 
 scene = blender_scenes.build_corner_scene(bpy.context.scene, (96, 64), "CYCLES", 4)
-compositor = blender_scenes.Compositor(scene)
-layers = compositor.render_layers()
-hbao = compositor.node("CompositorNodeHBAO")
-hbao.name = "HBAO"
-for name in ("Image", "Depth", "Normal"):
-    compositor.link(layers.outputs[name], hbao.inputs[name])
-compositor.composite(hbao.outputs["Image"])
+compositor, _layers, hbao = blender_scenes.hbao_node_tree(scene, "HBAO")
 hbao.inputs["Directions"].default_value = 8.0
 # The hidden pass input as layouts 1-4 left it unlinked: 1, the AO of no
 # occlusion then.
