@@ -1266,6 +1266,34 @@ def open_temporary_files(pid, folder):
 TEMPORARY_KINDS = {"unnamed": None, "named": {"HBAO_TMPFILE": "0"}}
 
 
+def test_named_temporaries_a_killed_run_left_are_removed(hbao_tool, tmp_path):
+    """Where the file system has no O_TMPFILE (NFS before 4.2; HBAO_TMPFILE=0
+    here), SIGKILL leaves the run's named temporary in the output's folder,
+    up to a frame's size, and a farm rerunning the task piled them up (an
+    exploratory run). A run removes, before its first temporary there, those
+    of its user that nothing wrote for an hour, and says so; a fresh one (a
+    run still writing), another name and a symbolic link stay."""
+    out = tmp_path / "out"
+    out.mkdir()
+    stale = out / ".hbao-tmp-a1B2c3"
+    stale.write_bytes(b"\0" * 4096)
+    hour_ago = time.time() - 3700
+    os.utime(stale, (hour_ago, hour_ago))
+    kept = {name: out / name for name in (".hbao-tmp-z9Y8x7", ".hbao-tmp-long-name",
+                                          ".hbao-tmp-L1nk00")}
+    kept[".hbao-tmp-z9Y8x7"].write_bytes(b"fresh")
+    kept[".hbao-tmp-long-name"].write_bytes(b"other")
+    os.utime(kept[".hbao-tmp-long-name"], (hour_ago, hour_ago))
+    kept[".hbao-tmp-L1nk00"].symlink_to(kept[".hbao-tmp-long-name"])
+    os.utime(kept[".hbao-tmp-L1nk00"], (hour_ago, hour_ago), follow_symlinks=False)
+    completed = run_tool(hbao_tool, fixture_path("cycles_float_zip"), "-o", out / "ao.exr",
+                         env=dict(os.environ, HBAO_TMPFILE="0"))
+    assert completed.returncode == 0, completed.stderr
+    assert "removed 1 temporary file (.hbao-tmp-*) that a killed run left" in completed.stderr
+    assert not stale.exists() and all(os.path.lexists(path) for path in kept.values())
+    assert sorted(p.name for p in out.iterdir()) == sorted(["ao.exr", *kept])
+
+
 def signal_during_run(command, outputs, temporaries, signal_number, preexec_fn, env=None):
     """Starts the tool, waits until it holds its `temporaries` temporary
     files (so that the signal falls inside the run), sends the signal and

@@ -4,6 +4,7 @@
 #endif
 #include "atomic_file.h"
 
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <pthread.h>
@@ -13,9 +14,11 @@
 #include <stdint.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "canonical_path.h"
+#include "tool_error.h"
 
 /* Linux's limit on symbolic links followed in one lookup (MAXSYMLINKS). */
 #define SYMLINK_HOPS_MAX 40
@@ -176,6 +179,50 @@ static int open_unnamed_in_directory(const atomic_file *file) {
 
 static int name_unnamed(atomic_file *file);
 
+/* --- named temporaries left behind -----------------------------------------
+ * Where the file system has no O_TMPFILE (NFS before 4.2), a run that
+ * SIGKILL ends (a farm's hard timeout, the out-of-memory killer: no handler
+ * runs) leaves its named temporary in the output's folder, up to a frame's
+ * size, and a farm that reruns the task piles them up (an exploratory run).
+ * Before its first named temporary in a folder, a run removes those of its
+ * own user that nothing has written for STALE_TEMPORARY_S: a running one is
+ * written as its frame is, and a frame takes seconds. */
+#define STALE_TEMPORARY_S 3600
+#define TEMPORARY_PREFIX ".hbao-tmp-"
+
+/* Whether `name` is one mkstemp made from TEMPORARY_PREFIX "XXXXXX". */
+static bool is_temporary_name(const char *name) {
+    const size_t prefix = sizeof TEMPORARY_PREFIX - 1;
+    return strncmp(name, TEMPORARY_PREFIX, prefix) == 0 && strlen(name) == prefix + 6;
+}
+
+static void remove_stale_temporaries(const char *directory) {
+    static char swept[PATH_MAX]; /* the last folder swept (slots_lock) */
+    pthread_mutex_lock(&slots_lock);
+    const bool done = strcmp(swept, directory) == 0;
+    if (!done) snprintf(swept, sizeof swept, "%s", directory);
+    pthread_mutex_unlock(&slots_lock);
+    DIR *folder = done ? NULL : opendir(directory);
+    if (folder == NULL) return;
+    const time_t now = time(NULL);
+    int removed = 0;
+    for (const struct dirent *entry; (entry = readdir(folder)) != NULL;) {
+        struct stat status;
+        if (!is_temporary_name(entry->d_name) ||
+            fstatat(dirfd(folder), entry->d_name, &status, AT_SYMLINK_NOFOLLOW) != 0)
+            continue;
+        if (S_ISREG(status.st_mode) && status.st_uid == geteuid() &&
+            now - status.st_mtime >= STALE_TEMPORARY_S &&
+            unlinkat(dirfd(folder), entry->d_name, 0) == 0)
+            removed++;
+    }
+    closedir(folder);
+    if (removed > 0)
+        tool_warn("removed %d temporary file%s (" TEMPORARY_PREFIX
+                  "*) that a killed run left in %s",
+                  removed, removed == 1 ? "" : "s", directory);
+}
+
 /* A temporary file in the destination's directory, so that rename() stays
  * on one file system; the leading dot keeps it out of casual listings. The
  * name has a fixed length, whatever the destination's. */
@@ -183,7 +230,7 @@ static int create_named_temporary(atomic_file *file, tool_error *error) {
     const char *slash = strrchr(file->destination, '/');
     int directory_length = slash ? (int)(slash - file->destination + 1) : 0;
     int written = snprintf(file->temporary_path, sizeof file->temporary_path,
-                           "%.*s.hbao-tmp-XXXXXX", directory_length, file->destination);
+                           "%.*s" TEMPORARY_PREFIX "XXXXXX", directory_length, file->destination);
     if (written < 0 || (size_t)written >= sizeof file->temporary_path)
         return tool_fail(error, TOOL_EXIT_USAGE, "output path too long: %s", file->name);
     file->fd = open_unnamed_in_directory(file);
@@ -209,6 +256,8 @@ static int create_named_temporary(atomic_file *file, tool_error *error) {
         }
         close(file->fd);
     }
+    char directory[PATH_MAX];
+    if (destination_directory(file, directory)) remove_stale_temporaries(directory);
     sigset_t previous;
     block_cleanup_signals(&previous);
     file->fd = mkstemp(file->temporary_path);
@@ -227,7 +276,7 @@ static int create_unnamed_temporary(atomic_file *file, tool_error *error) {
     const char *folder = getenv("TMPDIR");
     if (folder == NULL || folder[0] == '\0') folder = "/tmp";
     char path[PATH_MAX];
-    int written = snprintf(path, sizeof path, "%s/.hbao-tmp-XXXXXX", folder);
+    int written = snprintf(path, sizeof path, "%s/" TEMPORARY_PREFIX "XXXXXX", folder);
     if (written < 0 || (size_t)written >= sizeof path)
         return tool_fail(error, TOOL_EXIT_RUNTIME, "TMPDIR too long: %s", folder);
     sigset_t previous;
