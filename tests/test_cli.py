@@ -2252,6 +2252,9 @@ def test_sequence_refuses_outputs_that_are_another_frames_or_its_own(hbao_tool, 
     (["in_#.exr", "-o", "ao_#.exr", "--frames", "1-2,"], "--frames"),
     (["in_#.exr", "-o", "ao_#.exr", "--frames", "1-5,5-7"], "no frame twice"),
     (["in_#.exr", "-o", "ao_#.exr", "--frames", "1-2", "--jobs", "0"], "--jobs"),
+    (["in_#.exr", "-o", "ao_#.exr", "--frames", "1-2", "-j0"], "--jobs"),  # as getopt reads it
+    (["in_#.exr", "-o", "ao_#.exr", "--frames", "1-40", "--frames", "3"],
+     "--frames is given twice"),
     (["in.exr", "-o", "ao.exr", "--jobs", "2"], "go with --frames"),
     (["in.exr", "-o", "ao.exr", "--force"], "go with --frames"),
     (["--info", "in_#.exr", "--frames", "1"], "drop --frames"),
@@ -2303,12 +2306,26 @@ def test_a_frame_pattern_without_frames_gets_a_hint(hbao_tool, tmp_path):
     (["--preview", ""], "empty"),
     (["--ao-channel", ""], "empty"),
     (["--ao-channel", "A" * 256], "EXR allows 255"),
+    # which one was meant is not known (an exploratory run: the last won)
+    (["-o", "second.exr"], "-o (--output) is given twice"),
+    (["--layer", "A", "--layer", "B"], "--layer is given twice"),
+    (["-hx"], "unknown option -hx"),
 ])
 def test_bad_flags_are_usage_errors(hbao_tool, tmp_path, arguments, fragment):
     completed = run_tool(hbao_tool, fixture_path("cycles_float_zip"), "-o", tmp_path / "o.exr",
                          *arguments)
     assert_clean_error(completed, EXIT_USAGE, fragment)
     assert not (tmp_path / "o.exr").exists()
+
+
+def test_short_options_take_their_value_attached(hbao_tool, tmp_path):
+    """-oOUT and -j2, as getopt reads them (an exploratory run: -j2 was an
+    unknown option while --jobs=2 worked)."""
+    for frame in (1, 2):
+        shutil.copyfile(fixture_path("cycles_float_zip"), tmp_path / f"in_{frame}.exr")
+    run_ok(hbao_tool, tmp_path / "in_#.exr", f"-o{tmp_path}/ao_#.exr", "--frames", "1-2", "-j2",
+           "--no-normals")
+    assert sorted(p.name for p in tmp_path.glob("ao_*")) == ["ao_1.exr", "ao_2.exr"]
 
 
 def test_out_of_range_parameters_are_clamped_with_a_warning(hbao_tool, tmp_path):

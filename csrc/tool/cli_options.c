@@ -450,7 +450,9 @@ static void options_init(cli_options *options) {
 }
 
 /* The option an argument that starts with '-' names (NULL: none), and in
- * *inline_value the value given with '=' (NULL: none). */
+ * *inline_value the value given with it (NULL: none): after '=' for a long
+ * option, right after the letter for a short one that takes a value (-j2,
+ * -oout.exr, as getopt reads them). */
 static const option_spec *option_of(const char *argument, const char **inline_value) {
     *inline_value = NULL;
     if (argument[1] == '-') {
@@ -459,7 +461,19 @@ static const option_spec *option_of(const char *argument, const char **inline_va
         if (equals != NULL) *inline_value = equals + 1;
         return find_long_option(name, equals ? (size_t)(equals - name) : strlen(name));
     }
-    return argument[2] == '\0' ? find_short_option(argument[1]) : NULL;
+    const option_spec *spec = find_short_option(argument[1]);
+    if (argument[2] == '\0' || spec == NULL) return spec;
+    if (!spec->takes_value) return NULL; /* -hx: no such option */
+    *inline_value = argument + 2;
+    return spec;
+}
+
+/* Options that name a file, a layer or the frames: given twice, which one
+ * was meant is not known (a farm's wrapper adding --frames to a user's),
+ * so that is refused; a number given twice takes the last, as usual. */
+static bool given_once(option_id id) {
+    return id == OPTION_OUTPUT || id == OPTION_PREVIEW || id == OPTION_CAMERA ||
+           id == OPTION_FRAMES || id == OPTION_LAYER || id == OPTION_BACK_LAYER;
 }
 
 /* --help (-h) or --version given as an option anywhere before "--": they
@@ -487,6 +501,7 @@ int cli_parse(int argc, char **argv, cli_options *options, tool_error *error) {
         return TOOL_EXIT_SUCCESS;
     }
     bool only_positionals = false;
+    bool given[OPTION_COUNT] = {false};
     for (int i = 1; i < argc; ++i) {
         const char *argument = argv[i];
         if (only_positionals || argument[0] != '-' || strcmp(argument, "-") == 0) {
@@ -506,6 +521,15 @@ int cli_parse(int argc, char **argv, cli_options *options, tool_error *error) {
         if (spec == NULL)
             return tool_fail(error, TOOL_EXIT_USAGE, "unknown option %s (see hbao --help)",
                              argument);
+        const size_t index = (size_t)(spec - option_specs);
+        if (given[index] && given_once(spec->id)) {
+            if (spec->short_name != 0)
+                return tool_fail(error, TOOL_EXIT_USAGE, "-%c (--%s) is given twice: give it once",
+                                 spec->short_name, spec->name);
+            return tool_fail(error, TOOL_EXIT_USAGE, "--%s is given twice: give it once",
+                             spec->name);
+        }
+        given[index] = true;
         const char *value = NULL;
         if (spec->takes_value) {
             if (inline_value != NULL) {
