@@ -1271,21 +1271,25 @@ def test_named_temporaries_a_killed_run_left_are_removed(hbao_tool, tmp_path):
     here), SIGKILL leaves the run's named temporary in the output's folder,
     up to a frame's size, and a farm rerunning the task piled them up (an
     exploratory run). A run removes, before its first temporary there, those
-    of its user that nothing wrote for an hour, and says so; a fresh one (a
-    run still writing), another name and a symbolic link stay."""
+    of its user that nothing wrote for a day, and says so; a fresh one (a run
+    still computing: its temporary is written after its frame is computed),
+    one 23 hours old (a task the farm suspended), another name and a
+    symbolic link stay."""
     out = tmp_path / "out"
     out.mkdir()
     stale = out / ".hbao-tmp-a1B2c3"
     stale.write_bytes(b"\0" * 4096)
-    hour_ago = time.time() - 3700
-    os.utime(stale, (hour_ago, hour_ago))
-    kept = {name: out / name for name in (".hbao-tmp-z9Y8x7", ".hbao-tmp-long-name",
-                                          ".hbao-tmp-L1nk00")}
+    day_ago, suspended = time.time() - 25 * 3600, time.time() - 23 * 3600
+    os.utime(stale, (day_ago, day_ago))
+    kept = {name: out / name for name in (".hbao-tmp-z9Y8x7", ".hbao-tmp-SuSp3d",
+                                          ".hbao-tmp-long-name", ".hbao-tmp-L1nk00")}
     kept[".hbao-tmp-z9Y8x7"].write_bytes(b"fresh")
+    kept[".hbao-tmp-SuSp3d"].write_bytes(b"suspended")
+    os.utime(kept[".hbao-tmp-SuSp3d"], (suspended, suspended))
     kept[".hbao-tmp-long-name"].write_bytes(b"other")
-    os.utime(kept[".hbao-tmp-long-name"], (hour_ago, hour_ago))
+    os.utime(kept[".hbao-tmp-long-name"], (day_ago, day_ago))
     kept[".hbao-tmp-L1nk00"].symlink_to(kept[".hbao-tmp-long-name"])
-    os.utime(kept[".hbao-tmp-L1nk00"], (hour_ago, hour_ago), follow_symlinks=False)
+    os.utime(kept[".hbao-tmp-L1nk00"], (day_ago, day_ago), follow_symlinks=False)
     completed = run_tool(hbao_tool, fixture_path("cycles_float_zip"), "-o", out / "ao.exr",
                          env=dict(os.environ, HBAO_TMPFILE="0"))
     assert completed.returncode == 0, completed.stderr
@@ -2310,6 +2314,8 @@ def test_a_frame_pattern_without_frames_gets_a_hint(hbao_tool, tmp_path):
     (["-o", "second.exr"], "-o (--output) is given twice"),
     (["--layer", "A", "--layer", "B"], "--layer is given twice"),
     (["-hx"], "unknown option -hx"),
+    (["-output=x.exr"], "did you mean --output?"),  # not -o with "utput=x.exr"
+    (["-radius", "2"], "did you mean --radius?"),
 ])
 def test_bad_flags_are_usage_errors(hbao_tool, tmp_path, arguments, fragment):
     completed = run_tool(hbao_tool, fixture_path("cycles_float_zip"), "-o", tmp_path / "o.exr",

@@ -11,7 +11,10 @@ an older Blender, and said nothing (an exploratory run; the sockets'
 values survive). Before each save in 5.x the settings are copied into
 custom properties of the same names, which an older Blender reads as its
 own; 5.x reads the values it keeps itself, and a file saved back by 4.5
-gives 5.x the values 4.5 saved (Blender moves them over on opening it)."""
+gives 5.x the values 4.5 saved (Blender moves them over on opening it).
+5.x's Custom Properties panel of the active node lists a custom property
+that has a property's name only with Developer Extras on
+(rna_prop_ui.draw), so artists do not see the copies."""
 import bpy
 
 from .compositor_effects import is_hbao_node

@@ -471,8 +471,8 @@ HBAO_EXPORT hbao_result hbao_compute_layers(const hbao_params *params, const hba
  *  several times slower (58.5 s against 6 for an 8K frame). */
 #define HBAO_NOTE_REFERENCE_SEARCH 1u
 /** HBAO_NOTE_RADIUS_BEYOND_IMAGE: at most of the image's foreground pixels
- *  (a sample of about 4096 of them) the radius projects to more pixels than
- *  the image's shorter side has (a render a few pixels high, or a camera
+ *  (judged on about 4096 pixels spread over the image) the radius spans
+ *  more than the image's shorter side (a render a few pixels high, or a camera
  *  very close to the surfaces): most samples then fall outside the image,
  *  so the AO comes out too light. The result is computed as usual. */
 #define HBAO_NOTE_RADIUS_BEYOND_IMAGE 2u

@@ -558,11 +558,12 @@ float hbao_block_step_at(const hbao_settings *s, const hbao_grid *g, float neare
     return largest >= 1.0f ? (largest - 1.0f) / (float)s->steps : HBAO_BLOCK_UNSAMPLED;
 }
 
-/* HBAO_NOTE_RADIUS_BEYOND_IMAGE where, at more than half of a sample of the
- * foreground pixels (every k-th of every k-th row, about 4096 pixels), the
- * projected radius exceeds the grid's shorter side. */
+/* HBAO_NOTE_RADIUS_BEYOND_IMAGE where, at more than half of the foreground
+ * pixels among about 4096 spread over the grid (every k-th of every k-th
+ * row), the projected radius exceeds the grid's shorter side. The radius is
+ * in pixels along a row; a column's pixels are ycor times as tall. */
 static uint32_t radius_note(const hbao_settings *s, const hbao_grid *g) {
-    const float shorter = (float)(g->width < g->height ? g->width : g->height);
+    const float shorter = fminf((float)g->width, (float)g->height * g->ycor);
     const int step_i = g->width / 64 + 1, step_j = g->height / 64 + 1;
     long foreground = 0, beyond = 0;
     for (int j = step_j / 2; j < g->height; j += step_j)

@@ -24,8 +24,8 @@
  * an instance for each, so that no step tests it (bench_ab, 1080p, four
  * file copies of each build: 0.970 on 1 thread, 0.958 on 2). */
 
-/* sample_rising leaves a sample's delta unset where it returns no lane,
- * and its callers read it only where a lane is returned; GCC cannot see
+/* sample_rising leaves a sample's delta unset where it returns 0, and
+ * its callers read it only where it returns 1; GCC cannot see
  * that through the masks, and zeroing it cost 4 instructions per step. */
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
@@ -174,13 +174,17 @@ typedef struct SIMD_NAME(steps) {
     int plain_end;
     /* Whether each step samples another pixel than the step before it and
      * than the pixel itself: one coordinate of the step's offset moves by
-     * more than a pixel a step (1/16 of a pixel to spare for the floats'
-     * rounding up to offsets of 2^19 pixels; the steps move away from the
-     * pixel), and the first step is not on the pixel. fetch_step would
-     * then skip no plain step, and they take the lanes of `active` as
+     * more than a pixel a step, and the first step is not on the pixel (the
+     * steps move away from the pixel). 1/16 of a pixel is to spare for the
+     * floats' rounding: a position is some five roundings, so two steps'
+     * positions differ from their exact difference by at most about 10
+     * 2^-24 |x|, 0.04 of a pixel at the largest plain offset, an image's
+     * size (HBAO_MAX_IMAGE_SIZE, asserted below). fetch_step would then
+     * skip no plain step, and they take the lanes of `active` as
      * candidates (*alive changes only on the side path). */
     int distinct;
 } SIMD_NAME(steps);
+_Static_assert(HBAO_MAX_IMAGE_SIZE <= 65536, "steps.distinct's margin holds to 2^16 pixels");
 
 static inline VI SIMD_NAME(floor_to_int)(VF x) {
     /* hbao_floor_in_range's result in range (its truncation and correction

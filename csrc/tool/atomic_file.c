@@ -185,10 +185,15 @@ static int name_unnamed(atomic_file *file);
  * runs) leaves its named temporary in the output's folder, up to a frame's
  * size, and a farm that reruns the task piles them up (an exploratory run).
  * Before its first named temporary in a folder, a run removes those of its
- * own user that nothing has written for STALE_TEMPORARY_S: a running one is
- * written as its frame is, and a frame takes seconds. */
-#define STALE_TEMPORARY_S 3600
+ * own user that nothing has written for STALE_TEMPORARY_S. A running one is
+ * created before its frame is read and computed and written after, which
+ * takes seconds to minutes; a day leaves room for a task a farm suspended
+ * (SIGSTOP) and for a node's clock ahead of the file server's. */
+#define STALE_TEMPORARY_S (24 * 3600)
 #define TEMPORARY_PREFIX ".hbao-tmp-"
+/* Folders this run swept (slots_lock): an output's and a preview's
+ * alternate frame by frame, and each is swept once. */
+#define SWEPT_FOLDERS 8
 
 /* Whether `name` is one mkstemp made from TEMPORARY_PREFIX "XXXXXX". */
 static bool is_temporary_name(const char *name) {
@@ -196,13 +201,23 @@ static bool is_temporary_name(const char *name) {
     return strncmp(name, TEMPORARY_PREFIX, prefix) == 0 && strlen(name) == prefix + 6;
 }
 
-static void remove_stale_temporaries(const char *directory) {
-    static char swept[PATH_MAX]; /* the last folder swept (slots_lock) */
+/* Whether this run has swept `directory` already; marks it swept. */
+static bool swept_before(const char *directory) {
+    static char swept[SWEPT_FOLDERS][PATH_MAX];
+    static int next;
     pthread_mutex_lock(&slots_lock);
-    const bool done = strcmp(swept, directory) == 0;
-    if (!done) snprintf(swept, sizeof swept, "%s", directory);
+    bool found = false;
+    for (int k = 0; k < SWEPT_FOLDERS && !found; ++k) found = strcmp(swept[k], directory) == 0;
+    if (!found) {
+        snprintf(swept[next], PATH_MAX, "%s", directory);
+        next = (next + 1) % SWEPT_FOLDERS;
+    }
     pthread_mutex_unlock(&slots_lock);
-    DIR *folder = done ? NULL : opendir(directory);
+    return found;
+}
+
+static void remove_stale_temporaries(const char *directory) {
+    DIR *folder = swept_before(directory) ? NULL : opendir(directory);
     if (folder == NULL) return;
     const time_t now = time(NULL);
     int removed = 0;

@@ -518,6 +518,15 @@ int cli_parse(int argc, char **argv, cli_options *options, tool_error *error) {
         }
         const char *inline_value;
         const option_spec *spec = option_of(argument, &inline_value);
+        /* -output=ao.exr would be -o with "utput=ao.exr" attached */
+        const char *name = argument + 1, *equals = strchr(name, '=');
+        const option_spec *meant =
+            argument[1] != '-'
+                ? find_long_option(name, equals ? (size_t)(equals - name) : strlen(name))
+                : NULL;
+        if (meant != NULL && argument[2] != '\0')
+            return tool_fail(error, TOOL_EXIT_USAGE, "unknown option %s (did you mean --%s?)",
+                             argument, meant->name);
         if (spec == NULL)
             return tool_fail(error, TOOL_EXIT_USAGE, "unknown option %s (see hbao --help)",
                              argument);
@@ -628,7 +637,7 @@ void cli_print_help(FILE *stream) {
         "                          refused (exit 2). Ctrl-C, SIGTERM and SIGHUP remove\n"
         "                          the temporary files; where one has a name (no\n"
         "                          O_TMPFILE: NFS before 4.2) and SIGKILL left it, the\n"
-        "                          next run there removes it after an hour. The same\n"
+        "                          next run there removes it after a day. The same\n"
         "                          holds for --preview.\n"
         "  --layer NAME            view layer to use (channels NAME.Depth.Z and, if\n"
         "                          present, NAME.Normal.X/Y/Z). Default: the one layer\n"
