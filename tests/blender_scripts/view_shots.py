@@ -1,10 +1,19 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
-"""Screenshots of the largest 3D view of a Blender window (xvfb), for the
-viewport scripts that compare what the preview draws: view_3d(),
-override() (a context for that view's operators) and shot(path) (the view
-redrawn, saved to path, returned as a row of per-pixel RGB means)."""
+"""What the viewport scripts that compare screenshots of the preview share
+(a Blender window under xvfb): the largest 3D view (view_3d, override: a
+context for its operators), the demo scene through its camera in Solid
+shading (demo_in_solid), the preview turned on strong enough to see
+(preview_on), screenshots as rows of per-pixel RGB means (shot), and the
+scripts' steps walked from a timer (walk_steps). The caller has put
+scripts/ and this folder on sys.path."""
+import os
+import sys
+
 import bpy
 import numpy as np
+
+import blender_scenes
+import timer_guard
 
 
 def view_3d():
@@ -20,7 +29,37 @@ def override():
                                      region=region)
 
 
-def shot(path):
+def demo_in_solid(show_overlays):
+    """The demo scene in the largest 3D view, through its camera, in Solid
+    shading. Returns the view's area and space."""
+    blender_scenes.build_demo_scene(bpy.context.scene)
+    _window, area = view_3d()
+    space = area.spaces.active
+    space.shading.type = "SOLID"
+    space.overlay.show_overlays = show_overlays
+    space.region_3d.view_perspective = "CAMERA"
+    with override():
+        bpy.ops.view3d.view_center_camera()
+    return area, space
+
+
+def toggle_preview():
+    with override():
+        bpy.ops.hbao.viewport_preview_toggle()
+
+
+def preview_on(area):
+    """Turns the preview on in `area`, strong enough to see in a screenshot
+    (as viewport_toggle.py)."""
+    toggle_preview()
+    view_settings = sys.modules["hbao.viewport.view_entries"].find(area.id_data, area)
+    view_settings.radius, view_settings.strength = 0.6, 1.5
+
+
+def shot(out_dir, name):
+    """The view redrawn, saved as OUT_DIR/NAME.png, as a row of per-pixel
+    RGB means."""
+    path = os.path.join(out_dir, f"{name}.png")
     # the redraw and the screenshot each need their own override block
     with override():
         bpy.ops.wm.redraw_timer(type="DRAW_WIN_SWAP", iterations=2)
@@ -32,3 +71,18 @@ def shot(path):
     channels = image.channels
     bpy.data.images.remove(image)
     return pixels.reshape(-1, channels)[:, :3].mean(axis=1)
+
+
+def walk_steps(steps, label):
+    """Runs the generator `steps` a step per timer tick (the window redraws
+    between them), then prints 'LABEL: DONE' and quits Blender."""
+    def tick():
+        try:
+            next(steps)
+        except StopIteration:
+            print(f"{label}: DONE", flush=True)
+            timer_guard.quit_blender()
+            return None
+        return 0.3
+
+    timer_guard.guarded_timer(tick, 0.5)

@@ -21,16 +21,9 @@ import numpy as np
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(
     os.path.abspath(__file__)))), "scripts"))
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import blender_scenes  # noqa: E402
-import timer_guard  # noqa: E402
 import view_shots  # noqa: E402
-from view_shots import override, view_3d  # noqa: E402
 
 out_dir = sys.argv[sys.argv.index("--") + 1]
-
-
-def shot(name):
-    return view_shots.shot(os.path.join(out_dir, f"{name}.png"))
 
 
 def select_all(selected):
@@ -39,25 +32,14 @@ def select_all(selected):
 
 
 def steps():
-    blender_scenes.build_demo_scene(bpy.context.scene)
-    _window, area = view_3d()
-    space = area.spaces.active
-    space.shading.type = "SOLID"
-    space.overlay.show_overlays = True
-    space.region_3d.view_perspective = "CAMERA"
-    with override():
-        bpy.ops.view3d.view_center_camera()
+    area, _space = view_shots.demo_in_solid(show_overlays=True)
     shots = {}
     for preview in ("off", "on"):
         if preview == "on":
-            with override():
-                bpy.ops.hbao.viewport_preview_toggle()
-            view_settings = sys.modules["hbao.viewport.view_entries"].find(area.id_data, area)
-            # strong enough to see in a screenshot (as viewport_toggle.py)
-            view_settings.radius, view_settings.strength = 0.6, 1.5
+            view_shots.preview_on(area)
         for selection in ("selected", "unselected"):
             select_all(selection == "selected")
-            shots[preview, selection] = shot(f"overlays_{preview}_{selection}")
+            shots[preview, selection] = view_shots.shot(out_dir, f"overlays_{preview}_{selection}")
             yield
     outline = np.abs(shots["off", "selected"] - shots["off", "unselected"]) > 0.08
     scene_darkening = shots["off", "unselected"] - shots["on", "unselected"]
@@ -72,17 +54,4 @@ def steps():
     yield
 
 
-walk = steps()
-
-
-def tick():
-    try:
-        next(walk)
-    except StopIteration:
-        print("OVERLAYS: DONE", flush=True)
-        timer_guard.quit_blender()
-        return None
-    return 0.3
-
-
-timer_guard.guarded_timer(tick, 0.5)
+view_shots.walk_steps(steps(), "OVERLAYS")
