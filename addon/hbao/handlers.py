@@ -10,8 +10,8 @@ the only chance such a render has to build the hook."""
 import bpy
 
 from . import (compat, helper_lookup, helper_render_settings, helper_scene, node, node_place,
-               older_blenders, pass_sources, recomposite, render_slots, strip_cameras,
-               unseen_occluders, window_scenes, writes)
+               older_blenders, pass_sources, recomposite, render_slots, saved_switch,
+               strip_cameras, unseen_occluders, window_scenes, writes)
 from .callback_guard import never_raises
 from .report import (NodeMessage, forget_node_messages, in_main_thread, log,
                      post_last_node_messages, post_node_messages, post_render_report)
@@ -116,6 +116,13 @@ def _on_save_pre(*_args):
     # that `blender -b file.blend -f N` finds it in the file.
     _sync_all_or_later()
     older_blenders.copy_node_settings()
+    saved_switch.before_save()
+
+
+@bpy.app.handlers.persistent
+@never_raises("switch the HBAO scenes on again after the save")
+def _on_save_post(*_args):
+    saved_switch.after_save()
 
 
 @bpy.app.handlers.persistent
@@ -251,6 +258,7 @@ def _on_depsgraph_update_post(scene, *_args):
 _HANDLERS = (
     (bpy.app.handlers.load_post, _on_load_post),
     (bpy.app.handlers.save_pre, _on_save_pre),
+    (bpy.app.handlers.save_post, _on_save_post),
     (bpy.app.handlers.render_init, _on_render_init),
     (bpy.app.handlers.render_pre, _on_frame_render_pre),
     (bpy.app.handlers.render_complete, _on_render_complete),
@@ -258,7 +266,8 @@ _HANDLERS = (
     (bpy.app.handlers.depsgraph_update_post, _on_depsgraph_update_post),
     (bpy.app.handlers.undo_post, _on_undo_or_redo),
     (bpy.app.handlers.redo_post, _on_undo_or_redo),
-)
+) + (((bpy.app.handlers.save_post_fail, _on_save_post),)
+     if hasattr(bpy.app.handlers, "save_post_fail") else ())  # (4.2+)
 
 
 def register():

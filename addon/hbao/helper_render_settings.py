@@ -73,6 +73,8 @@ def keep_compositor_on_cpu(own_scene):
 def copy(scene, helper):
     """Only plain values: allowed in the render job's thread too."""
     keep_compositor_on_cpu(helper)
+    for layer in helper.view_layers:  # saved off (saved_switch.py)
+        set_if_different(layer, "use", True)
     for attribute in SYNCED_RENDER_SETTINGS:
         set_if_different(helper.render, attribute, getattr(scene.render, attribute))
     for view in scene.render.views:
