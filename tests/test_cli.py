@@ -2408,7 +2408,7 @@ def test_help_and_version(hbao_tool):
                  "--keep-input", "--layer", "--preview", "--info", "identity"):
         assert flag in shown.stdout
     version = run_ok(hbao_tool, "--version").stdout
-    assert version.startswith("hbao 0.4.0") and "libhbao 0.4.0" in version
+    assert version.startswith("hbao 0.5.0") and "libhbao 0.5.0" in version
     # They win over everything else, a bad value of another flag too.
     for arguments in (["--help", "--radius", "abc"], ["--radius", "abc", "-h"],
                       ["x.exr", "--version", "--help"]):

@@ -10,7 +10,7 @@ import struct
 
 import pytest
 
-from conftest import REPO
+from conftest import REPO, json_line
 
 SCRIPTS = REPO / "tests" / "blender_scripts"
 ARTIFACTS = REPO / "out" / "test-artifacts"
@@ -196,3 +196,18 @@ def test_f12_with_guard_band_and_back_faces(run_blender, tmp_path):
     line = next(text for text in log.splitlines() if "AO pass(es)" in text)
     assert "guard band passes" in line and "back faces passes" in line, line
     assert "no guard band" not in log and "no back faces" not in log, log[-3000:]
+
+
+def test_a_save_during_f12_leaves_its_render_the_add_ons_scenes(run_blender, tmp_path):
+    """A slow save as F12 renders: the add-on switches its scenes off only
+    for a save outside renders (saved_switch.py). It switched them off during
+    the render, whose compositor then skipped them and composited the last
+    frame's AO (a review); a file saved then keeps them on."""
+    completed = run_blender(SCRIPTS / "ui_save_during_render.py", tmp_path / "f12", ui=True)
+    log = completed.stdout
+    assert "F12: DONE" in log, log[-3000:]
+    written = json_line(log, "WRITTEN")
+    assert len(written) == 3 and all(all(uses) for uses in written.values()), written
+    assert set(json_line(log, "RENDERED")) >= set(written) | {"Scene"}, log[-3000:]
+    line = next(text for text in log.splitlines() if "AO pass(es)" in text)
+    assert "guard band passes" in line and "back faces passes" in line, line

@@ -52,6 +52,11 @@ def record_render_end(scene):
     _in_progress.discard(getattr(helper_scene_of(scene), "name", None))
 
 
+def any_rendering():
+    """Whether a render job of a scene with a helper runs now."""
+    return bool(_in_progress)
+
+
 def rendered_for_a_scene(helper):
     """False when an artist renders the helper scene itself."""
     return helper.name in _in_progress

@@ -11,10 +11,16 @@ band, back faces) cost a Cycles render each for nothing. So a saved file
 holds the view layers of those scenes off (Blender skips a scene with none
 on), and the add-on switches them on again after the save and at every
 render's start (helper_render_settings.copy, extra_renders.record_rendering),
-any thread: a plain setting."""
+any thread: a plain setting.
+
+Not while a render runs: its compositor may reach the step where Blender
+renders these scenes during the save (F12's job runs beside the window),
+and would skip them, compositing the previous frame's AO (a review: a save
+as F12 rendered frame 3 gave it frame 1's AO, silently). A file saved then
+keeps them on, as files saved before this change."""
 import bpy
 
-from . import extra_renders
+from . import extra_renders, helper_scene
 from .helper_lookup import is_helper
 
 # (scene name, view layer name) of the layers switched off for the save
@@ -29,6 +35,8 @@ def _addon_scenes():
 def before_save():
     """Switch the add-on's scenes' view layers off, to be saved so."""
     after_save()  # (a save that failed where Blender has no handler for it)
+    if bpy.app.is_job_running("RENDER") or helper_scene.any_rendering():
+        return
     for scene in _addon_scenes():
         for layer in scene.view_layers:
             if layer.use:

@@ -62,7 +62,7 @@ extern "C" {
 #endif
 
 #define HBAO_VERSION_MAJOR 0
-#define HBAO_VERSION_MINOR 4
+#define HBAO_VERSION_MINOR 5
 #define HBAO_VERSION_PATCH 0
 /** Packed version: major * 10000 + minor * 100 + patch. */
 #define HBAO_VERSION (HBAO_VERSION_MAJOR * 10000 + HBAO_VERSION_MINOR * 100 + HBAO_VERSION_PATCH)
