@@ -1266,7 +1266,8 @@ def open_temporary_files(pid, folder):
 TEMPORARY_KINDS = {"unnamed": None, "named": {"HBAO_TMPFILE": "0"}}
 
 
-def test_named_temporaries_a_killed_run_left_are_removed(hbao_tool, tmp_path):
+@pytest.mark.parametrize("tmpfile", ["0", "1"])
+def test_named_temporaries_a_killed_run_left_are_removed(hbao_tool, tmp_path, tmpfile):
     """Where the file system has no O_TMPFILE (NFS before 4.2; HBAO_TMPFILE=0
     here), SIGKILL leaves the run's named temporary in the output's folder,
     up to a frame's size, and a farm rerunning the task piled them up (an
@@ -1274,7 +1275,9 @@ def test_named_temporaries_a_killed_run_left_are_removed(hbao_tool, tmp_path):
     of its user that nothing wrote for a day, and says so; a fresh one (a run
     still computing: its temporary is written after its frame is computed),
     one 23 hours old (a task the farm suspended), another name and a
-    symbolic link stay."""
+    symbolic link stay. A run whose own temporaries are unnamed (O_TMPFILE)
+    sweeps too: a farm's nodes may mount the folder by NFS versions with and
+    without it (a README audit found such a run left them)."""
     out = tmp_path / "out"
     out.mkdir()
     stale = out / ".hbao-tmp-a1B2c3"
@@ -1291,7 +1294,7 @@ def test_named_temporaries_a_killed_run_left_are_removed(hbao_tool, tmp_path):
     kept[".hbao-tmp-L1nk00"].symlink_to(kept[".hbao-tmp-long-name"])
     os.utime(kept[".hbao-tmp-L1nk00"], (day_ago, day_ago), follow_symlinks=False)
     completed = run_tool(hbao_tool, fixture_path("cycles_float_zip"), "-o", out / "ao.exr",
-                         env=dict(os.environ, HBAO_TMPFILE="0"))
+                         env=dict(os.environ, HBAO_TMPFILE=tmpfile))
     assert completed.returncode == 0, completed.stderr
     assert "removed 1 temporary file (.hbao-tmp-*) that a killed run left" in completed.stderr
     assert not stale.exists() and all(os.path.lexists(path) for path in kept.values())

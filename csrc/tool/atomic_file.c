@@ -184,8 +184,8 @@ static int name_unnamed(atomic_file *file);
  * SIGKILL ends (a farm's hard timeout, the out-of-memory killer: no handler
  * runs) leaves its named temporary in the output's folder, up to a frame's
  * size, and a farm that reruns the task piles them up (an exploratory run).
- * Before its first named temporary in a folder, a run removes those of its
- * own user that nothing has written for STALE_TEMPORARY_S. A running one is
+ * Before its first temporary in a folder, named or not, a run removes those
+ * of its own user that nothing has written for STALE_TEMPORARY_S. A running one is
  * created before its frame is read and computed and written after, which
  * takes seconds to minutes; a day leaves room for a task a farm suspended
  * (SIGSTOP) and for a node's clock ahead of the file server's. */
@@ -248,6 +248,10 @@ static int create_named_temporary(atomic_file *file, tool_error *error) {
                            "%.*s" TEMPORARY_PREFIX "XXXXXX", directory_length, file->destination);
     if (written < 0 || (size_t)written >= sizeof file->temporary_path)
         return tool_fail(error, TOOL_EXIT_USAGE, "output path too long: %s", file->name);
+    /* Whatever this run's own temporaries will be: a farm's nodes may
+     * mount the folder by NFS versions with and without O_TMPFILE. */
+    char directory[PATH_MAX];
+    if (destination_directory(file, directory)) remove_stale_temporaries(directory);
     file->fd = open_unnamed_in_directory(file);
     if (file->fd >= 0) {
         /* A second unnamed file, named and removed at once: so that naming
@@ -271,8 +275,6 @@ static int create_named_temporary(atomic_file *file, tool_error *error) {
         }
         close(file->fd);
     }
-    char directory[PATH_MAX];
-    if (destination_directory(file, directory)) remove_stale_temporaries(directory);
     sigset_t previous;
     block_cleanup_signals(&previous);
     file->fd = mkstemp(file->temporary_path);
