@@ -203,7 +203,8 @@ def test_a_save_during_f12_leaves_its_render_the_add_ons_scenes(run_blender, tmp
     for a save outside renders (saved_switch.py). It switched them off during
     the render, whose compositor then skipped them and composited the last
     frame's AO (a review); a file saved then keeps them on."""
-    completed = run_blender(SCRIPTS / "ui_save_during_render.py", tmp_path / "f12", ui=True)
+    completed = run_blender(SCRIPTS / "ui_f12_extra_renders.py", tmp_path / "f12", "save",
+                            ui=True)
     log = completed.stdout
     assert "F12: DONE" in log, log[-3000:]
     written = json_line(log, "WRITTEN")

@@ -185,10 +185,10 @@ static int name_unnamed(atomic_file *file);
  * runs) leaves its named temporary in the output's folder, up to a frame's
  * size, and a farm that reruns the task piles them up (an exploratory run).
  * Before its first temporary in a folder, named or not, a run removes those
- * of its own user that nothing has written for STALE_TEMPORARY_S. A running one is
- * created before its frame is read and computed and written after, which
- * takes seconds to minutes; a day leaves room for a task a farm suspended
- * (SIGSTOP) and for a node's clock ahead of the file server's. */
+ * of its own user that nothing has written for STALE_TEMPORARY_S. A running
+ * one is created before its frame is read and computed and written after,
+ * which takes seconds to minutes; a day leaves room for a task a farm
+ * suspended (SIGSTOP) and for a node's clock ahead of the file server's. */
 #define STALE_TEMPORARY_S (24 * 3600)
 #define TEMPORARY_PREFIX ".hbao-tmp-"
 /* Folders this run swept (slots_lock): an output's and a preview's
