@@ -1597,6 +1597,27 @@ def test_sequence_redoes_an_output_cut_short_or_damaged_since(hbao_tool, tmp_pat
         assert (folder / f"ao_{frame:04d}.exr").read_bytes() == expected[frame]
 
 
+def test_sequence_redoes_an_output_whose_middle_chunks_are_overwritten(hbao_tool, tmp_path):
+    """A skipped frame's output is checked by its structure (every chunk's
+    header in place) and its last chunk's pixels, not by decoding it all: a
+    stretch overwritten in its middle, longer than a chunk, breaks a chunk
+    header and is redone; the untouched frames are skipped."""
+    folder, sources = sequence_folder(tmp_path)
+    run_sequence(hbao_tool, folder)
+    expected = {frame: (folder / f"ao_{frame:04d}.exr").read_bytes() for frame in sources}
+    damaged = folder / "ao_0002.exr"
+    size = len(expected[2])
+    start, end = size * 2 // 5, size * 4 // 5
+    damaged.write_bytes(expected[2][:start] + bytes(end - start) + expected[2][end:])
+    os.utime(damaged.with_suffix(".png"), (damaged.stat().st_mtime + 1,) * 2)
+    rerun = run_sequence(hbao_tool, folder)
+    assert rerun.stderr.count("is up to date, skipped") == 2, rerun.stderr
+    assert "ao_0001.exr is up to date" in rerun.stderr
+    assert "ao_0004.exr is up to date" in rerun.stderr
+    for frame in sources:
+        assert (folder / f"ao_{frame:04d}.exr").read_bytes() == expected[frame]
+
+
 def test_sequence_redoes_frames_whose_camera_clip_end_changed(hbao_tool, tmp_path):
     """The camera file's clip_end decides which depths are background: a
     rerun with one that differs only there recomputes (it was taken as up
