@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 # Installs what building, testing and running the demo need on Debian 12 or 13
 # (Debian's Blender, the C toolchain, clang with its sanitizer and libFuzzer
-# runtime, OpenEXR, libpng, cJSON, numpy, pytest, Xvfb). PyPI's bpy builds come
+# runtime, OpenEXR, libpng, cJSON, libdeflate, numpy, pytest, Xvfb). PyPI's bpy builds come
 # from scripts/setup_bpy.sh. Idempotent: does nothing when everything is there.
 set -euo pipefail
 
@@ -25,6 +25,7 @@ PACKAGES=(
     openexr            # exrheader: the reference reader our written EXRs are checked with
     libpng-dev         # --preview PNGs
     libcjson-dev       # --camera FILE.json
+    libdeflate-dev     # the CLI's inflate of ZIP chunks (csrc/tool/zip_chunks.c)
     python3 python3-numpy python3-pytest python3-venv
     python3-pycodestyle  # the PEP 8 check of the test suite
     xvfb xauth         # F12 and viewport tests in a real window

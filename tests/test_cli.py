@@ -373,6 +373,38 @@ def test_keep_input_output_is_valid_for_the_reference_openexr(hbao_tool, tmp_pat
     assert "BlenderMultiChannel" in header
 
 
+@pytest.mark.parametrize("compression", ["zip", "zips"])
+def test_zip_chunks_read_to_the_bits_openexrcore_gives(hbao_tool, tmp_path, compression):
+    """The tool inflates ZIP and ZIPS chunks with libdeflate and undoes
+    OpenEXR's predictor and byte interleave itself (zip_chunks.c); the
+    add-on's libhbao_exr leaves them to OpenEXRCore (zlib). Files written
+    so (half and float channels, one frame whose last chunk has fewer
+    lines, two layers) come through the tool's --keep-input copy to the
+    same bits as OpenEXRCore reads them; a chunk damaged inside is a clean
+    error."""
+    from hbao import exr_passes
+    for name in ("eevee_half", "cycles_float_zip", "cycles_half_zip_tail", "two_layers"):
+        layer = ("--layer", "Front") if name == "two_layers" else ()
+        zipped = tmp_path / f"{name}.{compression}.exr"
+        run_ok(hbao_tool, fixture_path(name), "-o", zipped, "--keep-input",
+               "--compression", compression, *layer)
+        plain = tmp_path / f"{name}.none.exr"
+        run_ok(hbao_tool, zipped, "-o", plain, "--keep-input", "--compression", "none", *layer)
+        names = [n for n in exr_passes.channel_names(zipped) if n != "AO"]
+        assert len(names) >= 4, names
+        expected = exr_passes.read_channels(zipped, names)
+        copied = exr_passes.read_channels(plain, names)
+        for channel in names:
+            assert expected[channel].tobytes() == copied[channel].tobytes(), (name, channel)
+    data = bytearray(zipped.read_bytes())
+    middle = len(data) - 300  # inside the last chunk's deflate stream
+    data[middle:middle + 16] = bytes(16)
+    damaged = tmp_path / "damaged.exr"
+    damaged.write_bytes(bytes(data))
+    completed = run_tool(hbao_tool, damaged, "-o", tmp_path / "out.exr")
+    assert_clean_error(completed, EXIT_RUNTIME, "damaged.exr", "chunk")
+
+
 def zip_chunk_size(chunk, level):
     """The zlib size of one ZIP chunk as the OpenEXR file layout makes it: the
     bytes split into even and odd halves, then each byte stored as its

@@ -528,6 +528,27 @@ static exr_result_t copy_stored_chunk(exr_decode_pipeline_t *decode) {
     return EXR_ERR_SUCCESS;
 }
 
+static exr_zip_decompressor zip_decompressor;
+
+void exr_input_set_zip_decompressor(exr_zip_decompressor decompressor) {
+    zip_decompressor = decompressor;
+}
+
+bool exr_scratch_reserve(exr_scratch *scratch, size_t size) {
+    if (scratch->size >= size) return true;
+    uint8_t *grown = realloc(scratch->bytes, size);
+    if (grown == NULL) return false;
+    scratch->bytes = grown;
+    scratch->size = size;
+    return true;
+}
+
+/* A ZIP or ZIPS chunk through zip_decompressor, with the band's scratch
+ * (decoding_user_data). */
+static exr_result_t decompress_zip_chunk(exr_decode_pipeline_t *decode) {
+    return zip_decompressor(decode, decode->decoding_user_data);
+}
+
 /* Decode the requests that name channels of `part`, for the chunks that
  * start at rows first_y .. last_y of the file (a band; every chunk of the
  * part when the band is the whole data window); the other requests are left
@@ -553,7 +574,8 @@ static int read_band(exr_input *input, int part, const exr_channel_request *requ
     /* each decoder channel's request (NULL: none), looked up once: the
      * decoder keeps its channels in one order for every chunk */
     const exr_channel_request **channel_requests = NULL;
-    int *staged_channels = NULL; /* the decoder channels that go through staging */
+    int *staged_channels = NULL;         /* the decoder channels that go through staging */
+    exr_scratch zip_scratch = {NULL, 0}; /* zip_decompressor's */
 
     int32_t lines_per_chunk = 0;
     status = part_lines_per_chunk(input, part, &lines_per_chunk, error);
@@ -563,6 +585,9 @@ static int read_band(exr_input *input, int part, const exr_channel_request *requ
     const size_t scratch_size = (size_t)(scratch_line * lines_per_chunk);
     int staged_count = 0;
     const bool direct = part_reads_direct(input, part, requests, count, &staged_count);
+    exr_compression_t compression = EXR_COMPRESSION_LAST_TYPE;
+    CHECK_EXR(exr_get_compression(input->context, part, &compression), "no compression");
+    const bool zip = compression == EXR_COMPRESSION_ZIP || compression == EXR_COMPRESSION_ZIPS;
     scratch = malloc(scratch_size);
     if (staged_count > 0) {
         staging = malloc(scratch_size * (size_t)staged_count);
@@ -625,8 +650,12 @@ static int read_band(exr_input *input, int part, const exr_channel_request *requ
         }
         CHECK_EXR(exr_decoding_choose_default_routines(input->context, part, &decoder),
                   "cannot decode this channel layout");
-        if (decoder.decompress_fn != NULL && chunk.packed_size == chunk.unpacked_size)
+        if (decoder.decompress_fn != NULL && chunk.packed_size == chunk.unpacked_size) {
             decoder.decompress_fn = copy_stored_chunk;
+        } else if (decoder.decompress_fn != NULL && zip && zip_decompressor != NULL) {
+            decoder.decompress_fn = decompress_zip_chunk;
+            decoder.decoding_user_data = &zip_scratch;
+        }
         /* The stream skips and gathers reads only where OpenEXRCore chose
          * its direct read, which neither decompresses nor unpacks: its other
          * routines read their input back within exr_decoding_run. */
@@ -643,8 +672,6 @@ static int read_band(exr_input *input, int part, const exr_channel_request *requ
         }
         if (decoded == EXR_ERR_FEATURE_NOT_IMPLEMENTED) {
             /* OpenEXRCore 3.1 cannot decompress DWAA/DWAB. */
-            exr_compression_t compression = input->compression;
-            exr_get_compression(input->context, part, &compression);
             status = tool_fail(error, TOOL_EXIT_RUNTIME,
                                "%s: this OpenEXR library cannot decode %s compression; save "
                                "the EXR with ZIP, PIZ or no compression",
@@ -683,6 +710,7 @@ fail:
     free(staging);
     free(channel_requests);
     free(staged_channels);
+    free(zip_scratch.bytes);
     return status;
 }
 

@@ -80,6 +80,27 @@ int exr_input_read(exr_input *input, const exr_channel_request *requests, int co
 int exr_input_read_rows(exr_input *input, const exr_channel_request *requests, int count,
                         int32_t first_row, int32_t last_row, tool_error *error);
 
+/** A buffer a decoding thread keeps from chunk to chunk; grown with
+ *  realloc by whoever needs more, freed by the reader. */
+typedef struct exr_scratch {
+    uint8_t *bytes;
+    size_t size;
+} exr_scratch;
+
+/** Whether scratch holds at least size bytes, growing it where not. */
+bool exr_scratch_reserve(exr_scratch *scratch, size_t size);
+
+/** Decompresses one chunk of a ZIP or ZIPS part into decode->unpacked_buffer
+ *  (decode->chunk.unpacked_size bytes, as OpenEXRCore's own routine would
+ *  give them) from decode->packed_buffer; scratch is the thread's. Returns
+ *  EXR_ERR_SUCCESS, EXR_ERR_CORRUPT_CHUNK or EXR_ERR_OUT_OF_MEMORY. */
+typedef exr_result_t (*exr_zip_decompressor)(exr_decode_pipeline_t *decode, exr_scratch *scratch);
+
+/** The decompressor exr_input_read uses for ZIP and ZIPS chunks from now
+ *  on; NULL (the default): OpenEXRCore's. Set it before any read starts
+ *  (the tool sets it in main; libhbao_exr never does). */
+void exr_input_set_zip_decompressor(exr_zip_decompressor decompressor);
+
 /** What to do with a multi-view render saved in one file (the reader's
  *  part per view, the tool's view-named channels say it). */
 #define EXR_VIEWS_APART_ADVICE                                                                     \

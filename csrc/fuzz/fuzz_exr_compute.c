@@ -13,6 +13,7 @@
 #include "ao_command.h"
 #include "cli_options.h"
 #include "fuzz_input_file.h"
+#include "zip_chunks.h"
 
 /* Small settings keep an execution short; the size of the input picks one
  * of five variants so that each of the library's paths (half resolution,
@@ -38,6 +39,7 @@ static char *variants[VARIANTS][20] = {
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
+    exr_input_set_zip_decompressor(zip_chunks_decompress); /* as the tool reads */
     char **argv = variants[size % VARIANTS];
     int argc = 0;
     while (argv[argc] != NULL) ++argc;

@@ -14,6 +14,7 @@
 #include "ao_command.h"
 #include "cli_options.h"
 #include "fuzz_input_file.h"
+#include "zip_chunks.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -48,6 +49,7 @@ static void check_output(const char *path, int expected_channels) {
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
+    exr_input_set_zip_decompressor(zip_chunks_decompress); /* as the tool reads */
     const char *input_path = fuzz_input_file(data, size);
     static char output_path[4200], preview_path[4200];
     snprintf(output_path, sizeof output_path, "%s/out.exr", fuzz_scratch_folder());

@@ -15,6 +15,7 @@
 #include "info_command.h"
 #include "sequence_command.h"
 #include "tool_error.h"
+#include "zip_chunks.h"
 
 static void print_version(void) {
     int32_t version = hbao_version();
@@ -51,6 +52,7 @@ int main(int argc, char **argv) {
      * write fail with EPIPE, an error like any other (its message, exit 1,
      * the temporary files removed), instead of killing the tool mid-write. */
     signal(SIGPIPE, SIG_IGN);
+    exr_input_set_zip_decompressor(zip_chunks_decompress);
     cli_options options;
     tool_error error = {{0}};
     int status = cli_parse(argc, argv, &options, &error);
