@@ -461,15 +461,21 @@ def test_a_zip_chunk_that_does_not_shrink_is_stored(hbao_tool, tmp_path):
     assert first_chunk_size(tmp_path / "zip.exr") == 16 * 42 * 4
 
 
-def first_chunk_size(path):
-    """The data size of the first chunk of a single-part scanline EXR."""
+def first_chunk(path):
+    """(where its data starts, its data size) of the first chunk of a
+    single-part scanline EXR."""
     data = Path(path).read_bytes()
     at = 8
     while data[at] != 0:  # attributes: name, type, size, value
         at = data.index(b"\0", data.index(b"\0", at) + 1) + 1
         at += 4 + struct.unpack_from("<i", data, at)[0]
     offset = struct.unpack_from("<Q", data, at + 1)[0]
-    return struct.unpack_from("<i", data, offset + 4)[0]
+    return offset + 8, struct.unpack_from("<i", data, offset + 4)[0]  # after y and size
+
+
+def first_chunk_size(path):
+    """The data size of the first chunk of a single-part scanline EXR."""
+    return first_chunk(path)[1]
 
 
 @pytest.mark.parametrize("compression", ["zip", "piz", "zips", "rle", "none"])
@@ -1630,17 +1636,18 @@ def test_sequence_redoes_an_output_cut_short_or_damaged_since(hbao_tool, tmp_pat
 
 
 def test_sequence_redoes_an_output_whose_middle_chunks_are_overwritten(hbao_tool, tmp_path):
-    """A skipped frame's output is checked by its structure (every chunk's
-    header in place) and its last chunk's pixels, not by decoding it all: a
-    stretch overwritten in its middle, longer than a chunk, breaks a chunk
-    header and is redone; the untouched frames are skipped."""
+    """A stretch overwritten in an output's middle, longer than a chunk,
+    breaks a chunk header (the open's structure check); the untouched frames
+    are skipped."""
     folder, sources = sequence_folder(tmp_path)
     run_sequence(hbao_tool, folder)
     expected = {frame: (folder / f"ao_{frame:04d}.exr").read_bytes() for frame in sources}
     damaged = folder / "ao_0002.exr"
     size = len(expected[2])
     start, end = size * 2 // 5, size * 4 // 5
-    damaged.write_bytes(expected[2][:start] + bytes(end - start) + expected[2][end:])
+    with open(damaged, "r+b") as file:  # in place, as dd conv=notrunc: the seal stays
+        file.seek(start)
+        file.write(bytes(end - start))
     os.utime(damaged.with_suffix(".png"), (damaged.stat().st_mtime + 1,) * 2)
     rerun = run_sequence(hbao_tool, folder)
     assert rerun.stderr.count("is up to date, skipped") == 2, rerun.stderr
@@ -1648,6 +1655,59 @@ def test_sequence_redoes_an_output_whose_middle_chunks_are_overwritten(hbao_tool
     assert "ao_0004.exr is up to date" in rerun.stderr
     for frame in sources:
         assert (folder / f"ao_{frame:04d}.exr").read_bytes() == expected[frame]
+
+
+SEAL = "user.hbao.crc32"  # csrc/tool/output_seal.h
+
+
+def test_outputs_are_sealed_with_their_crc(hbao_tool, tmp_path):
+    """Each output carries the CRC-32 and size of its bytes in an extended
+    attribute (both temporary-file paths), which a sequence rerun checks
+    instead of decoding the output."""
+    for tmpfile in ("1", "0"):
+        output = tmp_path / f"ao_{tmpfile}.exr"
+        completed = run_tool(hbao_tool, fixture_path("eevee_half"), "-o", output, "--no-normals",
+                             env=dict(os.environ, HBAO_TMPFILE=tmpfile))
+        assert completed.returncode == 0, completed.stderr
+        data = output.read_bytes()
+        assert os.getxattr(output, SEAL) == \
+            f"crc32 {zlib.crc32(data):08x} size {len(data)}".encode()
+
+
+@pytest.mark.parametrize("sealed", [True, False])
+def test_sequence_redoes_an_output_with_a_block_overwritten_inside_a_chunk(
+        hbao_tool, tmp_path, sealed):
+    """A 4 KiB block zeroed inside one chunk of an output (a bad sector, a
+    hole punched, dd conv=notrunc) leaves every chunk header and the last
+    chunk whole: only the bytes tell. Sealed, the CRC differs; unsealed (a
+    copy that dropped extended attributes), the AO decodes whole and fails.
+    Either way the frame is redone (a review found it skipped when only the
+    structure and the last chunk were checked)."""
+    folder = tmp_path / "sequence"
+    folder.mkdir()
+    camera = camera_path("cycles_float_zip").read_text()
+    for frame in (1, 2):
+        shutil.copyfile(fixture_path("cycles_float_zip"), folder / f"render_{frame}.exr")
+    (folder / "cam.json").write_text(camera)
+    arguments = (folder / "render_#.exr", "-o", folder / "ao_#.exr", "--camera",
+                 folder / "cam.json", "--frames", "1-2")
+    run_ok(hbao_tool, *arguments)
+    damaged = folder / "ao_2.exr"
+    expected = damaged.read_bytes()
+    if not sealed:
+        os.removexattr(damaged, SEAL)
+    # inside the first of the three chunks' data: no header, not the last chunk
+    start, size = first_chunk(damaged)
+    assert size > 200
+    with open(damaged, "r+b") as file:
+        file.seek(start + size // 2)
+        file.write(bytes(64))
+    assert damaged.read_bytes() != expected
+    rerun = run_tool(hbao_tool, *arguments)
+    assert rerun.returncode == 0, rerun.stderr
+    assert rerun.stderr.count("is up to date, skipped") == 1, rerun.stderr
+    assert "ao_1.exr is up to date" in rerun.stderr
+    assert damaged.read_bytes() == expected
 
 
 def test_sequence_redoes_frames_whose_camera_clip_end_changed(hbao_tool, tmp_path):

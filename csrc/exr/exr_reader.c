@@ -734,37 +734,36 @@ static void *run_band(void *argument) {
     return NULL;
 }
 
-/* The part's chunks that hold rows first_row .. last_row of the data window
- * (0: its top), in input->threads bands of whole chunks (at most one band
- * per chunk), one thread each (OpenEXRCore reads one context from several
- * threads; each band has its own decoder). Every chunk is decoded into its
- * own rows, so the result does not depend on the number of threads. The
- * first band that fails, from the top, gives the message. */
+/* The part's chunks in input->threads bands of whole chunks (at most one
+ * band per chunk), one thread each (OpenEXRCore reads one context from several threads; each band has
+ * its own decoder). Every chunk is decoded into its own rows, so the result
+ * does not depend on the number of threads. The first band that fails, from
+ * the top, gives the message. */
 static int read_part(exr_input *input, int part, const exr_channel_request *requests, int count,
-                     int32_t first_row, int32_t last_row, tool_error *error) {
+                     tool_error *error) {
     int32_t lines_per_chunk = 0;
     int status = part_lines_per_chunk(input, part, &lines_per_chunk, error);
     if (status != TOOL_EXIT_SUCCESS) return status;
     const pixel_rect *window = &input->data_window;
-    const int64_t first_chunk = first_row / lines_per_chunk;
-    const int64_t chunks = last_row / lines_per_chunk + 1 - first_chunk;
+    const int64_t chunks = ((int64_t)input->height + lines_per_chunk - 1) / lines_per_chunk;
     int64_t threads = input->threads < 1 ? 1 : input->threads;
     if (threads > EXR_MAX_READ_THREADS) threads = EXR_MAX_READ_THREADS;
     if (threads > chunks) threads = chunks;
     atomic_bool stop;
     atomic_init(&stop, false);
+    if (threads <= 1)
+        return read_band(input, part, requests, count, window->min_y, window->max_y, &stop, error);
 
     band_job bands[EXR_MAX_READ_THREADS];
     pthread_t workers[EXR_MAX_READ_THREADS];
     bool started[EXR_MAX_READ_THREADS] = {false};
     for (int64_t b = 0; b < threads; ++b) {
-        const int64_t band_chunk = first_chunk + chunks * b / threads;
-        const int64_t end_chunk = first_chunk + chunks * (b + 1) / threads;
+        const int64_t first_chunk = chunks * b / threads, end_chunk = chunks * (b + 1) / threads;
         band_job job = {input,
                         part,
                         requests,
                         count,
-                        window->min_y + band_chunk * lines_per_chunk,
+                        window->min_y + first_chunk * lines_per_chunk,
                         window->min_y + end_chunk * lines_per_chunk - 1,
                         &stop,
                         TOOL_EXIT_SUCCESS,
@@ -772,9 +771,6 @@ static int read_part(exr_input *input, int part, const exr_channel_request *requ
         if (job.last_y > window->max_y) job.last_y = window->max_y;
         bands[b] = job;
     }
-    if (threads <= 1)
-        return read_band(input, part, requests, count, bands[0].first_y, bands[0].last_y, &stop,
-                         error);
     /* The calling thread decodes band 0; a band whose thread cannot start is
      * decoded here too, after it. */
     for (int64_t b = 1; b < threads; ++b)
@@ -797,15 +793,7 @@ static int read_part(exr_input *input, int part, const exr_channel_request *requ
 
 int exr_input_read(exr_input *input, const exr_channel_request *requests, int count,
                    tool_error *error) {
-    return exr_input_read_rows(input, requests, count, 0, input->height - 1, error);
-}
-
-int exr_input_read_rows(exr_input *input, const exr_channel_request *requests, int count,
-                        int32_t first_row, int32_t last_row, tool_error *error) {
     exr_clear_last_error();
-    if (first_row < 0 || last_row < first_row || last_row >= input->height)
-        return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: rows %d to %d are not in its %d rows",
-                         input->path, first_row, last_row, input->height);
     /* Only parts that hold a requested channel are decoded: reading Depth
      * from Blender 5's one-part-per-pass files skips Combined and the rest. */
     bool *wanted = calloc((size_t)input->part_count, sizeof *wanted);
@@ -821,8 +809,7 @@ int exr_input_read_rows(exr_input *input, const exr_channel_request *requests, i
     }
     int status = TOOL_EXIT_SUCCESS;
     for (int part = 0; part < input->part_count && status == TOOL_EXIT_SUCCESS; ++part)
-        if (wanted[part])
-            status = read_part(input, part, requests, count, first_row, last_row, error);
+        if (wanted[part]) status = read_part(input, part, requests, count, error);
     free(wanted);
     return status;
 }

@@ -73,13 +73,6 @@ int exr_input_open(exr_input *input, const char *path, tool_error *error);
 int exr_input_read(exr_input *input, const exr_channel_request *requests, int count,
                    tool_error *error);
 
-/** exr_input_read for rows first_row .. last_row of the data window only (0
- *  is its top; each request's data still points at the window's top-left
- *  pixel). The chunks that hold those rows are decoded whole, so the other
- *  rows of those chunks are written too; no other chunk is read. */
-int exr_input_read_rows(exr_input *input, const exr_channel_request *requests, int count,
-                        int32_t first_row, int32_t last_row, tool_error *error);
-
 /** A buffer a decoding thread keeps from chunk to chunk; grown with
  *  realloc by whoever needs more, freed by the reader. */
 typedef struct exr_scratch {

@@ -170,7 +170,9 @@ static int open_unnamed_in_directory(const atomic_file *file) {
     if (wanted != NULL && strcmp(wanted, "0") == 0) return -1;
     char directory[PATH_MAX];
     if (access("/proc/self/fd", X_OK) != 0 || !destination_directory(file, directory)) return -1;
-    return open(directory, O_TMPFILE | O_WRONLY | O_CLOEXEC, 0600);
+    /* read too: the finished file is read back for its seal (output_seal.h),
+     * as mkstemp's are */
+    return open(directory, O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
 #else
     (void)file;
     return -1;

@@ -17,6 +17,7 @@
 #include "canonical_path.h"
 #include "exr_reader.h"
 #include "frame_pattern.h"
+#include "output_seal.h"
 #include "run_settings.h"
 
 typedef struct frame_outcome {
@@ -40,33 +41,35 @@ static bool newer_or_equal(const struct stat *a, const struct stat *b) {
     return a->st_mtim.tv_nsec >= b->st_mtim.tv_nsec;
 }
 
-/* The output holds `settings` (its stamp) and is whole as far as its
- * structure shows: exr_input_open reads every chunk's header (each listed,
- * at its rows, inside the file) and the chunk that ends the file decodes
- * (ao_command writes rows top to bottom, so the bottom rows' chunk is the
- * last). An output cut short or overwritten at its end since the tool wrote
- * it (an interrupted copy, rsync --inplace) is redone, not skipped with its
- * header intact; a few bytes of pixels damaged inside an earlier chunk are
- * not looked for (decoding every chunk cost ~40 ms of CPU a 1080p frame,
- * most of a rerun's time; --force redoes every frame). */
+/* The output holds `settings` (its stamp), its structure is whole
+ * (exr_input_open reads every chunk's header: listed, at its rows, inside
+ * the file) and so are its bytes: a sealed output's bytes are the ones the
+ * tool sealed (output_seal.h, a read and a CRC), an unsealed one's AO
+ * channel decodes whole (every chunk inflating, ~40 ms of CPU a 1080p
+ * frame). An output cut short or damaged since the tool wrote it (an
+ * interrupted copy, rsync --inplace, a block overwritten or a hole punched
+ * in place) is redone, not skipped with its header intact. */
 static bool output_is_whole(const cli_options *frame, const char *settings) {
     exr_input output;
     tool_error ignored = {{0}};
     if (exr_input_open(&output, frame->output_path, &ignored) != TOOL_EXIT_SUCCESS) return false;
     bool whole = false;
-    /* the window's size, of which only the last chunk's rows are touched */
-    float *pixels = !run_settings_match(output.context, settings) ||
-                            exr_input_find_channel(&output, frame->ao_channel) < 0
-                        ? NULL
-                        : malloc((size_t)output.width * (size_t)output.height * sizeof *pixels);
-    if (pixels != NULL) {
-        const exr_channel_request request = {frame->ao_channel, EXR_PIXEL_FLOAT, (uint8_t *)pixels,
-                                             (int32_t)sizeof *pixels,
-                                             (int64_t)output.width * (int64_t)sizeof *pixels};
-        whole = exr_input_read_rows(&output, &request, 1, output.height - 1, output.height - 1,
-                                    &ignored) == TOOL_EXIT_SUCCESS;
+    if (run_settings_match(output.context, settings) &&
+        exr_input_find_channel(&output, frame->ao_channel) >= 0) {
+        const output_seal_state seal =
+            output.stream.open ? output_seal_check(output.stream.fd) : OUTPUT_SEAL_ABSENT;
+        if (seal == OUTPUT_SEAL_ABSENT) {
+            float *pixels = malloc((size_t)output.width * (size_t)output.height * sizeof *pixels);
+            const exr_channel_request request = {frame->ao_channel, EXR_PIXEL_FLOAT,
+                                                 (uint8_t *)pixels, (int32_t)sizeof *pixels,
+                                                 (int64_t)output.width * (int64_t)sizeof *pixels};
+            whole = pixels != NULL &&
+                    exr_input_read(&output, &request, 1, &ignored) == TOOL_EXIT_SUCCESS;
+            free(pixels);
+        } else {
+            whole = seal == OUTPUT_SEAL_MATCHES;
+        }
     }
-    free(pixels);
     exr_input_close(&output);
     return whole;
 }
