@@ -3,7 +3,7 @@
  * size, kept in the file's extended attribute OUTPUT_SEAL_ATTRIBUTE. A
  * sequence rerun (sequence_command.c) takes a sealed output whose bytes
  * still match as whole without decoding it (a read and a CRC, about a
- * millisecond a 1080p frame, against ~40 ms of inflate), and redoes one
+ * millisecond a 1080p frame, against ~17 ms of inflate), and redoes one
  * whose bytes changed since (a block overwritten in place, a hole punched,
  * an interrupted rsync --inplace). Where the file system keeps no user
  * extended attributes, or a copy dropped them (cp without -a, scp), there is

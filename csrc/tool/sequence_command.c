@@ -45,7 +45,7 @@ static bool newer_or_equal(const struct stat *a, const struct stat *b) {
  * (exr_input_open reads every chunk's header: listed, at its rows, inside
  * the file) and so are its bytes: a sealed output's bytes are the ones the
  * tool sealed (output_seal.h, a read and a CRC), an unsealed one's AO
- * channel decodes whole (every chunk inflating, ~40 ms of CPU a 1080p
+ * channel decodes whole (every chunk inflating, ~17 ms of CPU a 1080p
  * frame). An output cut short or damaged since the tool wrote it (an
  * interrupted copy, rsync --inplace, a block overwritten or a hole punched
  * in place) is redone, not skipped with its header intact. */
