@@ -247,8 +247,11 @@ static HBAO_ALWAYS_INLINE void write_output(const float *zc, const float *ao, in
  * side instead (BLUR_GROUPS 2, each in registers of its own) took 0.87 of
  * one's time (scripts/bench_blur_ab.sh), three no less than two. The
  * baseline copy keeps 16 lanes (four SSE2 registers), which its loop runs
- * faster than 8, and one group (two were slower). The AVX-512 copy keeps
- * one group until a machine with AVX-512 measures two. The x86 copies take
+ * faster than 8, and one group (two were slower). The AVX-512 copy takes
+ * two groups as well: on a Zen 5 (AMD EPYC, AVX-512, session 41),
+ * bench_blur_ab.sh on 1 thread, blur 3 0.916, 5 0.998-1.055 (three runs),
+ * 7 1.026, 9 0.954, 11 0.932, 15 0.900; three and four groups 0.937 and
+ * 0.964 at 15 and 1.29 and 1.16 at 5. The x86 copies take
  * their minimum and maximum from the instruction set (BLUR_MIN, BLUR_MAX:
  * a < b ? a : b and a > b ? a : b, NaN giving b, as the scalar code's
  * selects), one instruction where GCC's vector selects take two. */
@@ -270,7 +273,7 @@ static HBAO_ALWAYS_INLINE void write_output(const float *zc, const float *ao, in
 #include "blur_lanes.h"
 
 #define BLUR_LANES 16
-#define BLUR_GROUPS 1
+#define BLUR_GROUPS 2
 #define BLUR_SKIPS_CHECK 1
 #define BLUR_MIN _mm512_min_ps
 #define BLUR_MAX _mm512_max_ps
