@@ -1635,6 +1635,32 @@ def test_sequence_redoes_an_output_cut_short_or_damaged_since(hbao_tool, tmp_pat
         assert (folder / f"ao_{frame:04d}.exr").read_bytes() == expected[frame]
 
 
+def test_sequence_redoes_a_frame_whose_preview_is_cut_short_or_damaged(hbao_tool, tmp_path):
+    """A --preview PNG newer than its EXR is up to date only where it is whole
+    (its chunks' CRCs, up to IEND at its end): an emptied one and one with a
+    byte changed inside its image data were skipped, left broken."""
+    folder, sources = sequence_folder(tmp_path)
+    run_sequence(hbao_tool, folder)
+    previews = {frame: (folder / f"ao_{frame:04d}.png").read_bytes() for frame in sources}
+    exrs = {frame: (folder / f"ao_{frame:04d}.exr").read_bytes() for frame in sources}
+    (folder / "ao_0001.png").write_bytes(b"")
+    damaged = bytearray(previews[2])
+    image_data = damaged.index(b"IDAT") + 4
+    damaged[image_data + 10] ^= 0x40
+    (folder / "ao_0002.png").write_bytes(bytes(damaged))
+    for frame in (1, 2):  # newer than their EXRs: only the content is wrong
+        exr_time = (folder / f"ao_{frame:04d}.exr").stat().st_mtime
+        os.utime(folder / f"ao_{frame:04d}.png", (exr_time + 1,) * 2)
+    rerun = run_sequence(hbao_tool, folder)
+    assert rerun.stderr.count("is up to date, skipped") == 1, rerun.stderr
+    assert "ao_0004.exr is up to date" in rerun.stderr
+    for frame in sources:
+        assert (folder / f"ao_{frame:04d}.png").read_bytes() == previews[frame]
+        assert (folder / f"ao_{frame:04d}.exr").read_bytes() == exrs[frame]
+    again = run_sequence(hbao_tool, folder)
+    assert again.stderr.count("is up to date, skipped") == 3, again.stderr
+
+
 def test_sequence_redoes_an_output_whose_middle_chunks_are_overwritten(hbao_tool, tmp_path):
     """A stretch overwritten in an output's middle, longer than a chunk,
     breaks a chunk header (the open's structure check); the untouched frames
