@@ -1687,17 +1687,20 @@ SEAL = "user.hbao.crc32"  # csrc/tool/output_seal.h
 
 
 def test_outputs_are_sealed_with_their_crc(hbao_tool, tmp_path):
-    """Each output carries the CRC-32 and size of its bytes in an extended
-    attribute (both temporary-file paths), which a sequence rerun checks
-    instead of decoding the output."""
+    """Each output carries the CRC-32 and size of its bytes, and its input's
+    size and time, in an extended attribute (both temporary-file paths),
+    which a sequence rerun checks instead of decoding the output."""
     for tmpfile in ("1", "0"):
         output = tmp_path / f"ao_{tmpfile}.exr"
         completed = run_tool(hbao_tool, fixture_path("eevee_half"), "-o", output, "--no-normals",
                              env=dict(os.environ, HBAO_TMPFILE=tmpfile))
         assert completed.returncode == 0, completed.stderr
         data = output.read_bytes()
-        assert os.getxattr(output, SEAL) == \
-            f"crc32 {zlib.crc32(data):08x} size {len(data)}".encode()
+        source = os.stat(fixture_path("eevee_half"))
+        seconds, nanoseconds = divmod(source.st_mtime_ns, 10**9)
+        assert os.getxattr(output, SEAL) == (
+            f"crc32 {zlib.crc32(data):08x} size {len(data)} "
+            f"input {source.st_size} {seconds}.{nanoseconds:09d}").encode()
 
 
 @pytest.mark.parametrize("sealed", [True, False])
@@ -1734,6 +1737,59 @@ def test_sequence_redoes_an_output_with_a_block_overwritten_inside_a_chunk(
     assert rerun.stderr.count("is up to date, skipped") == 1, rerun.stderr
     assert "ao_1.exr is up to date" in rerun.stderr
     assert damaged.read_bytes() == expected
+
+
+def test_sequence_redoes_a_sealed_frame_whose_input_is_another_file(hbao_tool, tmp_path):
+    """A sealed output names the input it was computed from (size and
+    time): a rerun redoes a frame whose input was replaced by an older file
+    (another render copied over it with its time kept, cp -p) and one into
+    whose place another frame's output was copied with its attributes
+    (cp -a). Both were skipped: each output was newer than its input, with
+    the same settings and its own bytes."""
+    folder, sources = sequence_folder(tmp_path)
+    run_sequence(hbao_tool, folder)
+    expected_4 = (folder / "ao_0004.exr").read_bytes()
+    replaced = folder / "render_0001.exr"
+    old_time = replaced.stat().st_mtime
+    shutil.copyfile(fixture_path(sources[2]), replaced)
+    os.utime(replaced, (old_time - 100,) * 2)  # older than its output
+    for suffix in ("exr", "png"):
+        shutil.copy2(folder / f"ao_0002.{suffix}", folder / f"ao_0004.{suffix}")
+    assert os.getxattr(folder / "ao_0004.exr", SEAL) == os.getxattr(folder / "ao_0002.exr", SEAL)
+    rerun = run_sequence(hbao_tool, folder)
+    assert rerun.stderr.count("is up to date, skipped") == 1, rerun.stderr
+    assert "ao_0002.exr is up to date" in rerun.stderr
+    single = tmp_path / "single.exr"
+    run_ok(hbao_tool, fixture_path(sources[2]), "-o", single, "--no-normals")
+    assert (folder / "ao_0001.exr").read_bytes() == single.read_bytes()
+    assert (folder / "ao_0004.exr").read_bytes() == expected_4
+    again = run_sequence(hbao_tool, folder)
+    assert again.stderr.count("is up to date, skipped") == 3, again.stderr
+
+
+def test_sequence_reads_an_earlier_versions_seal_as_none(hbao_tool, tmp_path):
+    """Session 40's seal ("crc32 ... size ...", no input) is no seal to this
+    version: the output's AO is decoded instead, so a whole one is skipped
+    (a farm's outputs are not all recomputed after an upgrade) and one with
+    a chunk damaged is redone."""
+    folder, sources = sequence_folder(tmp_path)
+    run_sequence(hbao_tool, folder)
+    expected = {frame: (folder / f"ao_{frame:04d}.exr").read_bytes() for frame in sources}
+    for frame in sources:
+        output = folder / f"ao_{frame:04d}.exr"
+        data = output.read_bytes()
+        os.setxattr(output, SEAL, f"crc32 {zlib.crc32(data):08x} size {len(data)}".encode())
+    damaged = folder / "ao_0002.exr"
+    start, size = first_chunk(damaged)
+    with open(damaged, "r+b") as file:
+        file.seek(start + size // 2)
+        file.write(bytes(64))
+    os.utime(folder / "ao_0002.png", (damaged.stat().st_mtime + 1,) * 2)
+    rerun = run_sequence(hbao_tool, folder)
+    assert rerun.stderr.count("is up to date, skipped") == 2, rerun.stderr
+    assert "frame 2: " in rerun.stderr and "ao_0002.exr is up to date" not in rerun.stderr
+    for frame in sources:
+        assert (folder / f"ao_{frame:04d}.exr").read_bytes() == expected[frame]
 
 
 def test_sequence_redoes_frames_whose_camera_clip_end_changed(hbao_tool, tmp_path):

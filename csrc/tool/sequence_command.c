@@ -45,12 +45,15 @@ static bool newer_or_equal(const struct stat *a, const struct stat *b) {
 /* The output holds `settings` (its stamp), its structure is whole
  * (exr_input_open reads every chunk's header: listed, at its rows, inside
  * the file) and so are its bytes: a sealed output's bytes are the ones the
- * tool sealed (output_seal.h, a read and a CRC), an unsealed one's AO
- * channel decodes whole (every chunk inflating, ~17 ms of CPU a 1080p
- * frame). An output cut short or damaged since the tool wrote it (an
- * interrupted copy, rsync --inplace, a block overwritten or a hole punched
- * in place) is redone, not skipped with its header intact. */
-static bool output_is_whole(const cli_options *frame, const char *settings) {
+ * tool sealed from this input (output_seal.h, a read and a CRC; `input`:
+ * the input's status now), an unsealed one's AO channel decodes whole
+ * (every chunk inflating, ~17 ms of CPU a 1080p frame). An output cut short
+ * or damaged since the tool wrote it (an interrupted copy, rsync --inplace,
+ * a block overwritten or a hole punched in place) is redone, not skipped
+ * with its header intact, and so is a sealed one computed from another
+ * input than the file there now. */
+static bool output_is_whole(const cli_options *frame, const struct stat *input,
+                            const char *settings) {
     exr_input output;
     tool_error ignored = {{0}};
     if (exr_input_open(&output, frame->output_path, &ignored) != TOOL_EXIT_SUCCESS) return false;
@@ -58,7 +61,7 @@ static bool output_is_whole(const cli_options *frame, const char *settings) {
     if (run_settings_match(output.context, settings) &&
         exr_input_find_channel(&output, frame->ao_channel) >= 0) {
         const output_seal_state seal =
-            output.stream.open ? output_seal_check(output.stream.fd) : OUTPUT_SEAL_ABSENT;
+            output.stream.open ? output_seal_check(output.stream.fd, input) : OUTPUT_SEAL_ABSENT;
         if (seal == OUTPUT_SEAL_ABSENT) {
             float *pixels = malloc((size_t)output.width * (size_t)output.height * sizeof *pixels);
             const exr_channel_request request = {frame->ao_channel, EXR_PIXEL_FLOAT,
@@ -103,7 +106,7 @@ static bool up_to_date(const cli_options *frame) {
         return false;
     char settings[RUN_SETTINGS_MAX];
     return run_settings_text(frame, frame->camera_file, settings) &&
-           output_is_whole(frame, settings);
+           output_is_whole(frame, &input, settings);
 }
 
 static void report(sequence_run *run, const frame_outcome *outcome, const char *output,
