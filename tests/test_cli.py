@@ -1661,6 +1661,29 @@ def test_sequence_redoes_a_frame_whose_preview_is_cut_short_or_damaged(hbao_tool
     assert again.stderr.count("is up to date, skipped") == 3, again.stderr
 
 
+def test_sequence_with_a_fifo_for_a_preview_does_not_wait_on_it(hbao_tool, tmp_path):
+    """A FIFO in a preview's place, newer than its EXR, is not a PNG to
+    check: the check must not open it for reading and wait for a writer
+    that never comes (the run hung). The frame is redone, and its preview
+    written into the FIFO for its reader, as a first run writes it."""
+    folder, _ = sequence_folder(tmp_path)
+    run_sequence(hbao_tool, folder)
+    expected = (folder / "ao_0002.png").read_bytes()
+    preview = folder / "ao_0002.png"
+    preview.unlink()
+    os.mkfifo(preview)
+    received = []
+    reader = threading.Thread(target=lambda: received.append(preview.read_bytes()), daemon=True)
+    reader.start()
+    rerun = run_tool(hbao_tool, folder / "render_####.exr", "-o", folder / "ao_####.exr",
+                     "--preview", folder / "ao_####.png", "--frames", "1-2", "--no-normals")
+    reader.join(timeout=30)
+    assert rerun.returncode == 0, rerun.stderr
+    assert "ao_0001.exr is up to date" in rerun.stderr, rerun.stderr
+    assert "ao_0002.exr is up to date" not in rerun.stderr, rerun.stderr
+    assert received == [expected]
+
+
 def test_sequence_redoes_an_output_whose_middle_chunks_are_overwritten(hbao_tool, tmp_path):
     """A stretch overwritten in an output's middle, longer than a chunk,
     breaks a chunk header (the open's structure check); the untouched frames
@@ -1688,8 +1711,8 @@ SEAL = "user.hbao.crc32"  # csrc/tool/output_seal.h
 
 def test_outputs_are_sealed_with_their_crc(hbao_tool, tmp_path):
     """Each output carries the CRC-32 and size of its bytes, and its input's
-    size and time, in an extended attribute (both temporary-file paths),
-    which a sequence rerun checks instead of decoding the output."""
+    size, time and file name, in an extended attribute (both temporary-file
+    paths), which a sequence rerun checks instead of decoding the output."""
     for tmpfile in ("1", "0"):
         output = tmp_path / f"ao_{tmpfile}.exr"
         completed = run_tool(hbao_tool, fixture_path("eevee_half"), "-o", output, "--no-normals",
@@ -1700,7 +1723,8 @@ def test_outputs_are_sealed_with_their_crc(hbao_tool, tmp_path):
         seconds, nanoseconds = divmod(source.st_mtime_ns, 10**9)
         assert os.getxattr(output, SEAL) == (
             f"crc32 {zlib.crc32(data):08x} size {len(data)} "
-            f"input {source.st_size} {seconds}.{nanoseconds:09d}").encode()
+            f"input {source.st_size} {seconds}.{nanoseconds:09d} "
+            f"{fixture_path('eevee_half').name}").encode()
 
 
 @pytest.mark.parametrize("sealed", [True, False])
@@ -1765,6 +1789,34 @@ def test_sequence_redoes_a_sealed_frame_whose_input_is_another_file(hbao_tool, t
     assert (folder / "ao_0004.exr").read_bytes() == expected_4
     again = run_sequence(hbao_tool, folder)
     assert again.stderr.count("is up to date, skipped") == 3, again.stderr
+
+
+def test_sequence_tells_inputs_apart_by_name_and_forgives_a_rounded_time(hbao_tool, tmp_path):
+    """Two frames rendered alike (one size, one time, even one content) are
+    still two inputs: another frame's output copied into a frame's place
+    with its attributes is redone. An input whose time a copy rounded down
+    to a coarser file system's resolution (seconds, microseconds) is the
+    same input; a time changed otherwise, by a nanosecond, is not."""
+    folder = tmp_path / "sequence"
+    folder.mkdir()
+    same_time = 1_700_000_000_123_456_789
+    for frame in (1, 2, 3, 4):
+        render = folder / f"render_{frame:04d}.exr"
+        shutil.copyfile(fixture_path("cycles_float_zip"), render)
+        os.utime(render, ns=(same_time, same_time))
+    arguments = (folder / "render_####.exr", "-o", folder / "ao_####.exr", "--frames", "1-4",
+                 "--no-normals")
+    run_ok(hbao_tool, *arguments)
+    shutil.copy2(folder / "ao_0002.exr", folder / "ao_0001.exr")
+    rounded = {2: same_time // 10**9 * 10**9, 3: same_time // 1000 * 1000, 4: same_time + 1}
+    for frame, time in rounded.items():
+        os.utime(folder / f"render_{frame:04d}.exr", ns=(time, time))
+    rerun = run_ok(hbao_tool, *arguments)
+    assert rerun.stderr.count("is up to date, skipped") == 2, rerun.stderr
+    assert "ao_0002.exr is up to date" in rerun.stderr
+    assert "ao_0003.exr is up to date" in rerun.stderr
+    again = run_ok(hbao_tool, *arguments)
+    assert again.stderr.count("is up to date, skipped") == 4, again.stderr
 
 
 def test_sequence_reads_an_earlier_versions_seal_as_none(hbao_tool, tmp_path):

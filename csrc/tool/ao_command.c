@@ -344,7 +344,8 @@ static int write_outputs(const cli_options *options, const exr_input *input,
     }
     status = exr_write_image(files->exr.fd, options->output_path, &layout, channels, channel_count,
                              error);
-    if (status == TOOL_EXIT_SUCCESS) output_seal_attach(files->exr.fd, &input->file_status);
+    if (status == TOOL_EXIT_SUCCESS)
+        output_seal_attach(files->exr.fd, input->path, &input->file_status);
     if (status == TOOL_EXIT_SUCCESS && options->preview_path != NULL)
         status =
             png_write_gray(files->png.fd, options->preview_path, ao + rows * input->width + columns,

@@ -3,6 +3,7 @@
 
 #include <errno.h>
 #include <inttypes.h>
+#include <limits.h>
 #include <libdeflate.h>
 #include <stdbool.h>
 #include <stdint.h>
@@ -13,10 +14,11 @@
 #include <sys/xattr.h>
 #include <unistd.h>
 
-/* "crc32 <8 hex digits> size <bytes> input <bytes> <seconds>.<nanoseconds>":
- * readable with getfattr. (Session 40's "crc32 ... size ..." without the
- * input is read as no seal: the rerun decodes that output instead.) */
-#define SEAL_TEXT_MAX 128
+/* "crc32 <8 hex digits> size <bytes> input <bytes> <seconds>.<nanoseconds>
+ * <input's file name>": readable with getfattr. (An earlier version's
+ * "crc32 ... size ..." names no input: it is read as no seal, and the rerun
+ * decodes that output instead.) */
+#define SEAL_TEXT_MAX (128 + NAME_MAX)
 #define READ_BLOCK (1u << 20)
 
 /* The CRC-32 and size of the regular file open as fd, read from its start. */
@@ -47,38 +49,90 @@ static bool file_crc(int fd, uint32_t *crc, int64_t *size) {
     return ok;
 }
 
-void output_seal_attach(int fd, const struct stat *input) {
-    uint32_t crc = 0;
-    int64_t size = 0;
-    if (!file_crc(fd, &crc, &size)) return;
-    char text[SEAL_TEXT_MAX];
-    const int length = snprintf(
-        text, sizeof text,
-        "crc32 %08" PRIx32 " size %" PRId64 " input %" PRId64 " %" PRId64 ".%09ld", crc, size,
-        (int64_t)input->st_size, (int64_t)input->st_mtim.tv_sec, (long)input->st_mtim.tv_nsec);
-    if (length > 0 && length < (int)sizeof text)
-        (void)fsetxattr(fd, OUTPUT_SEAL_ATTRIBUTE, text, (size_t)length, 0);
+/* What a seal holds. */
+typedef struct seal {
+    uint32_t crc;
+    int64_t size, input_size, input_seconds;
+    long input_nanoseconds;
+    const char *input_name; /* the file's own name, no folder */
+} seal;
+
+/* The file's own name in `path`: after its last '/'. */
+static const char *file_name(const char *path) {
+    const char *slash = strrchr(path, '/');
+    return slash != NULL ? slash + 1 : path;
 }
 
-output_seal_state output_seal_check(int fd, const struct stat *input) {
+/* The seal's text into text[SEAL_TEXT_MAX]: its length, or -1 where it does
+ * not fit. The one spelling: a seal is read back by parsing it and comparing
+ * this text of what was parsed with the stored one. */
+static int seal_text(const seal *v, char text[SEAL_TEXT_MAX]) {
+    const int length = snprintf(
+        text, SEAL_TEXT_MAX,
+        "crc32 %08" PRIx32 " size %" PRId64 " input %" PRId64 " %" PRId64 ".%09ld %s", v->crc,
+        v->size, v->input_size, v->input_seconds, v->input_nanoseconds, v->input_name);
+    return length > 0 && length < SEAL_TEXT_MAX ? length : -1;
+}
+
+/* Parses a stored seal (NUL-terminated text of `length` bytes) into *v;
+ * false where it is not the text seal_text writes. */
+static bool seal_parse(const char *text, ssize_t length, seal *v) {
+    int consumed = 0;
+    if (sscanf(text, "crc32 %8" SCNx32 " size %" SCNd64 " input %" SCNd64 " %" SCNd64 ".%9ld%n",
+               &v->crc, &v->size, &v->input_size, &v->input_seconds, &v->input_nanoseconds,
+               &consumed) != 5 ||
+        consumed <= 0 || consumed + 1 >= length || text[consumed] != ' ')
+        return false;
+    v->input_name = text + consumed + 1; /* the rest, spaces included */
+    char canonical[SEAL_TEXT_MAX];
+    const int canonical_length = seal_text(v, canonical);
+    return canonical_length == length && memcmp(canonical, text, (size_t)length) == 0;
+}
+
+/* Whether a modification time read now (now_*) is the sealed one, or the
+ * sealed one rounded down to a coarser file system's resolution (a copy
+ * that kept times onto ext4 with small inodes, SMB, FAT): a shot copied
+ * with its attributes is not recomputed for it. */
+static bool same_time(int64_t sealed_seconds, long sealed_nanoseconds, int64_t now_seconds,
+                      long now_nanoseconds) {
+    if (sealed_seconds == now_seconds && sealed_nanoseconds == now_nanoseconds) return true;
+    static const long resolutions[] = {100, 1000, 1000000, 10000000, 1000000000};
+    for (size_t k = 0; k < sizeof resolutions / sizeof resolutions[0]; k++)
+        if (now_seconds == sealed_seconds &&
+            now_nanoseconds == sealed_nanoseconds / resolutions[k] * resolutions[k])
+            return true;
+    /* FAT's two seconds */
+    const int64_t even = sealed_seconds - (sealed_seconds % 2 + 2) % 2;
+    return now_nanoseconds == 0 && now_seconds == even;
+}
+
+void output_seal_attach(int fd, const char *input_path, const struct stat *input) {
+    seal v = {0,
+              0,
+              (int64_t)input->st_size,
+              (int64_t)input->st_mtim.tv_sec,
+              (long)input->st_mtim.tv_nsec,
+              file_name(input_path)};
+    if (!file_crc(fd, &v.crc, &v.size)) return;
+    char text[SEAL_TEXT_MAX];
+    const int length = seal_text(&v, text);
+    if (length > 0) (void)fsetxattr(fd, OUTPUT_SEAL_ATTRIBUTE, text, (size_t)length, 0);
+}
+
+output_seal_state output_seal_check(int fd, const char *input_path, const struct stat *input) {
     char text[SEAL_TEXT_MAX];
     const ssize_t length = fgetxattr(fd, OUTPUT_SEAL_ATTRIBUTE, text, sizeof text - 1);
     if (length <= 0) return OUTPUT_SEAL_ABSENT;
     text[length] = '\0';
-    uint32_t sealed_crc = 0;
-    int64_t sealed_size = 0, input_size = 0, input_seconds = 0;
-    long input_nanoseconds = 0;
-    int consumed = 0;
-    if (sscanf(text, "crc32 %8" SCNx32 " size %" SCNd64 " input %" SCNd64 " %" SCNd64 ".%9ld%n",
-               &sealed_crc, &sealed_size, &input_size, &input_seconds, &input_nanoseconds,
-               &consumed) != 5 ||
-        consumed != length)
-        return OUTPUT_SEAL_ABSENT;
-    if (input_size != (int64_t)input->st_size || input_seconds != (int64_t)input->st_mtim.tv_sec ||
-        input_nanoseconds != (long)input->st_mtim.tv_nsec)
+    seal sealed;
+    if (!seal_parse(text, length, &sealed)) return OUTPUT_SEAL_ABSENT;
+    if (sealed.input_size != (int64_t)input->st_size ||
+        strcmp(sealed.input_name, file_name(input_path)) != 0 ||
+        !same_time(sealed.input_seconds, sealed.input_nanoseconds, (int64_t)input->st_mtim.tv_sec,
+                   (long)input->st_mtim.tv_nsec))
         return OUTPUT_SEAL_DIFFERS; /* computed from another file */
     uint32_t crc = 0;
     int64_t size = 0;
     if (!file_crc(fd, &crc, &size)) return OUTPUT_SEAL_DIFFERS;
-    return crc == sealed_crc && size == sealed_size ? OUTPUT_SEAL_MATCHES : OUTPUT_SEAL_DIFFERS;
+    return crc == sealed.crc && size == sealed.size ? OUTPUT_SEAL_MATCHES : OUTPUT_SEAL_DIFFERS;
 }

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
 /* A seal on each EXR the tool writes: the CRC-32 of the file's bytes and its
- * size, and the size and modification time of the input it was computed
- * from, kept in the file's extended attribute OUTPUT_SEAL_ATTRIBUTE. A
+ * size, and the file name, size and modification time of the input it was
+ * computed from, kept in the file's extended attribute OUTPUT_SEAL_ATTRIBUTE. A
  * sequence rerun (sequence_command.c) takes a sealed output whose bytes
  * still match, and whose input is still the file it was computed from, as
  * up to date without decoding it (a read and a CRC, about a millisecond a
@@ -9,9 +9,11 @@
  * since (a block overwritten in place, a hole punched, an interrupted rsync
  * --inplace), and one whose input is another file now though not a newer
  * one (another render copied over it with its time kept, cp -p or rsync -a;
- * another frame's output moved into its place). The input is named by size
- * and time, not by content, and not in the EXR itself: the same input and
- * flags still write the same bytes. Where the file system keeps no user
+ * another frame's output moved into its place). The input is named by name,
+ * size and time (a time rounded down by a coarser file system's copy is the
+ * same), not by content: two files of one name, size and time pass for one.
+ * Not in the EXR itself: the same input and flags still write the same
+ * bytes. Where the file system keeps no user
  * extended attributes, or a copy dropped them (cp without -a, scp), there is
  * no seal, and the rerun decodes the output whole instead. */
 #ifndef HBAO_OUTPUT_SEAL_H
@@ -28,13 +30,13 @@ typedef enum output_seal_state {
 } output_seal_state;
 
 /** Seals the complete file open as fd (the output's temporary, before it is
- *  renamed into place), computed from the input whose status (stat) was
- *  `input` when it was read. Best effort: where the file system refuses the
+ *  renamed into place), computed from the input at input_path whose status
+ *  (stat) was `input` when it was read. Best effort: where the file system refuses the
  *  attribute, the file stays unsealed. */
-void output_seal_attach(int fd, const struct stat *input);
+void output_seal_attach(int fd, const char *input_path, const struct stat *input);
 
-/** The seal of the file open as fd against its bytes now and the status of
- *  its input now. */
-output_seal_state output_seal_check(int fd, const struct stat *input);
+/** The seal of the file open as fd against its bytes now and its input
+ *  now: its path (by the file's own name) and status. */
+output_seal_state output_seal_check(int fd, const char *input_path, const struct stat *input);
 
 #endif /* HBAO_OUTPUT_SEAL_H */

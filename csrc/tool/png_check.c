@@ -1,10 +1,13 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
 #include "png_check.h"
 
+#include <fcntl.h>
 #include <libdeflate.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #define READ_BLOCK 16384u
 /* PNG's limit on a chunk's length (2^31 - 1) */
@@ -50,8 +53,15 @@ static bool chunks_are_whole(FILE *file) {
 }
 
 bool png_file_is_whole(const char *path) {
-    FILE *file = fopen(path, "rb");
-    if (file == NULL) return false;
+    /* without blocking: a FIFO of that name would wait for a writer */
+    const int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) return false;
+    struct stat status;
+    FILE *file = fstat(fd, &status) == 0 && S_ISREG(status.st_mode) ? fdopen(fd, "rb") : NULL;
+    if (file == NULL) {
+        close(fd);
+        return false;
+    }
     const bool whole = chunks_are_whole(file);
     fclose(file);
     return whole;

@@ -12,8 +12,9 @@
 
 #include <stdbool.h>
 
-/** True where `path` is a PNG file whose every chunk's CRC matches, up to
- *  IEND at its end; false for anything else, an unreadable file included. */
+/** True where `path` is a regular PNG file whose every chunk's CRC matches,
+ *  up to IEND at its end; false for anything else, an unreadable file and
+ *  a FIFO (not waited on) included. */
 bool png_file_is_whole(const char *path);
 
 #endif /* HBAO_PNG_CHECK_H */

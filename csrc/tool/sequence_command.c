@@ -61,7 +61,8 @@ static bool output_is_whole(const cli_options *frame, const struct stat *input,
     if (run_settings_match(output.context, settings) &&
         exr_input_find_channel(&output, frame->ao_channel) >= 0) {
         const output_seal_state seal =
-            output.stream.open ? output_seal_check(output.stream.fd, input) : OUTPUT_SEAL_ABSENT;
+            output.stream.open ? output_seal_check(output.stream.fd, frame->input_path, input)
+                               : OUTPUT_SEAL_ABSENT;
         if (seal == OUTPUT_SEAL_ABSENT) {
             float *pixels = malloc((size_t)output.width * (size_t)output.height * sizeof *pixels);
             const exr_channel_request request = {frame->ao_channel, EXR_PIXEL_FLOAT,
@@ -101,8 +102,8 @@ static bool up_to_date(const cli_options *frame) {
          (S_ISREG(other.st_mode) && !newer_or_equal(&output, &other))))
         return false;
     if (frame->preview_path != NULL &&
-        (stat(frame->preview_path, &other) != 0 || !newer_or_equal(&other, &output) ||
-         !png_file_is_whole(frame->preview_path)))
+        (stat(frame->preview_path, &other) != 0 || !S_ISREG(other.st_mode) ||
+         !newer_or_equal(&other, &output) || !png_file_is_whole(frame->preview_path)))
         return false;
     char settings[RUN_SETTINGS_MAX];
     return run_settings_text(frame, frame->camera_file, settings) &&
