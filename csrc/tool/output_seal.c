@@ -90,18 +90,15 @@ static bool seal_parse(const char *text, ssize_t length, seal *v) {
 }
 
 /* Whether a modification time read now (now_*) is the sealed one, or the
- * sealed one rounded down to a coarser file system's resolution (a copy
- * that kept times onto ext4 with small inodes, SMB, FAT): a shot copied
- * with its attributes is not recomputed for it. */
+ * sealed one rounded down to a coarser file system's resolution, a power of
+ * ten of nanoseconds up to a second, or FAT's two seconds (a copy that kept
+ * times onto ext4 with small inodes, SMB, FAT): a shot copied with its
+ * attributes is not recomputed for it. */
 static bool same_time(int64_t sealed_seconds, long sealed_nanoseconds, int64_t now_seconds,
                       long now_nanoseconds) {
-    if (sealed_seconds == now_seconds && sealed_nanoseconds == now_nanoseconds) return true;
-    static const long resolutions[] = {100, 1000, 1000000, 10000000, 1000000000};
-    for (size_t k = 0; k < sizeof resolutions / sizeof resolutions[0]; k++)
-        if (now_seconds == sealed_seconds &&
-            now_nanoseconds == sealed_nanoseconds / resolutions[k] * resolutions[k])
-            return true;
-    /* FAT's two seconds */
+    if (now_seconds == sealed_seconds)
+        for (long resolution = 1; resolution <= 1000000000L; resolution *= 10)
+            if (now_nanoseconds == sealed_nanoseconds / resolution * resolution) return true;
     const int64_t even = sealed_seconds - (sealed_seconds % 2 + 2) % 2;
     return now_nanoseconds == 0 && now_seconds == even;
 }

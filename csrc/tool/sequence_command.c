@@ -82,8 +82,9 @@ static bool output_is_whole(const cli_options *frame, const struct stat *input,
 /* Up to date, as make decides, and computed with the same flags: every
  * output exists and is at least as new as the input and the camera file, the
  * preview at least as new as the EXR (ao_command writes it after the EXR, so
- * a preview left from before the EXR was last computed is stale) and whole
- * (png_check.h: its chunks' CRCs, up to IEND at its end), and the
+ * a preview left from before the EXR was last computed is stale) and a whole
+ * PNG file (png_check.h: a regular file, its chunks' CRCs up to IEND at its
+ * end; a FIFO is not opened to wait on), and the
  * EXR's header holds the settings this run would write (run_settings.h)
  * and it is whole (output_is_whole).
  * (An input re-rendered while its frame was computed gets no output:
@@ -102,8 +103,8 @@ static bool up_to_date(const cli_options *frame) {
          (S_ISREG(other.st_mode) && !newer_or_equal(&output, &other))))
         return false;
     if (frame->preview_path != NULL &&
-        (stat(frame->preview_path, &other) != 0 || !S_ISREG(other.st_mode) ||
-         !newer_or_equal(&other, &output) || !png_file_is_whole(frame->preview_path)))
+        (stat(frame->preview_path, &other) != 0 || !newer_or_equal(&other, &output) ||
+         !png_file_is_whole(frame->preview_path)))
         return false;
     char settings[RUN_SETTINGS_MAX];
     return run_settings_text(frame, frame->camera_file, settings) &&
