@@ -19,7 +19,7 @@ esac
 PACKAGES=(
     blender            # the add-on's UI tests (3.4.1 on Debian 12, 4.3 on 13)
     cmake gcc make pkg-config
-    clang "libclang-rt-$LLVM-dev"  # fuzz targets (libFuzzer, ASan, UBSan); clang is LLVM $LLVM
+    clang "libclang-rt-$LLVM-dev"  # the SIMD kernels; fuzz targets (libFuzzer, ASan, UBSan); LLVM $LLVM
     clang-format                 # the C style check (.clang-format)
     libopenexr-dev     # OpenEXRCore, the EXR reader/writer of the CLI
     openexr            # exrheader: the reference reader our written EXRs are checked with

@@ -155,14 +155,15 @@ int main(int argc, char **argv) {
     printf(
         "Cosine integration; 'defaults' = %d directions x %d steps, blur %d. Best implementation "
         "on "
-        "this CPU: %s. The scalar column is the portable reference code (horizon search and blur) "
+        "this CPU: %s (SIMD kernels compiled by %s). The scalar column is the portable reference "
+        "code (horizon search and blur) "
         "on "
         "1 thread. A round times every column once (and the last one without blur). Cells: median "
         "wall-clock ms (median process CPU ms, all threads together). Speed-up and blur share "
         "((time - time without blur) / time, on the last column: wall, with the least and the "
         "greatest round's; CPU; the blur's own CPU ms) are medians of the per-round values.\n",
         HBAO_DEFAULT_DIRECTIONS, HBAO_DEFAULT_STEPS, HBAO_DEFAULT_BLUR_SIZE,
-        bench_implementation_label(best));
+        bench_implementation_label(best), HBAO_KERNELS_BUILT_BY);
     print_load("before");
     printf("\n| settings | size |");
     int last_column = -1, scalar_column = -1;
