@@ -1635,15 +1635,22 @@ def test_sequence_redoes_an_output_cut_short_or_damaged_since(hbao_tool, tmp_pat
         assert (folder / f"ao_{frame:04d}.exr").read_bytes() == expected[frame]
 
 
-def test_sequence_redoes_a_frame_whose_preview_is_cut_short_or_damaged(hbao_tool, tmp_path):
-    """A --preview PNG newer than its EXR is up to date only where it is whole
-    (its chunks' CRCs, up to IEND at its end): an emptied one and one with a
-    byte changed inside its image data were skipped, left broken."""
+@pytest.mark.parametrize("sealed", [True, False])
+def test_sequence_redoes_a_frame_whose_preview_is_cut_short_or_damaged(
+        hbao_tool, tmp_path, sealed):
+    """A --preview PNG newer than its EXR is up to date only where it is whole:
+    an emptied one and one with a byte changed inside its image data were
+    skipped, left broken. Sealed, its seal tells (output_seal.h); unsealed (a
+    copy that dropped extended attributes), its chunks' CRCs up to IEND at
+    its end (png_check.h)."""
     folder, sources = sequence_folder(tmp_path)
     run_sequence(hbao_tool, folder)
     previews = {frame: (folder / f"ao_{frame:04d}.png").read_bytes() for frame in sources}
     exrs = {frame: (folder / f"ao_{frame:04d}.exr").read_bytes() for frame in sources}
-    (folder / "ao_0001.png").write_bytes(b"")
+    if not sealed:
+        for frame in sources:
+            os.removexattr(folder / f"ao_{frame:04d}.png", SEAL)
+    (folder / "ao_0001.png").write_bytes(b"")  # in place: a seal stays
     damaged = bytearray(previews[2])
     image_data = damaged.index(b"IDAT") + 4
     damaged[image_data + 10] ^= 0x40
@@ -1659,6 +1666,33 @@ def test_sequence_redoes_a_frame_whose_preview_is_cut_short_or_damaged(hbao_tool
         assert (folder / f"ao_{frame:04d}.exr").read_bytes() == exrs[frame]
     again = run_sequence(hbao_tool, folder)
     assert again.stderr.count("is up to date, skipped") == 3, again.stderr
+
+
+def test_sequence_redoes_a_frame_whose_preview_is_another_frames(hbao_tool, tmp_path):
+    """Another frame's preview, whole, copied into a frame's place with its
+    attributes (cp -a, rsync -aX) and newer than the frame's EXR: its PNG
+    chunks are whole, and it was skipped. Its seal names the other frame's
+    input: the frame is redone. A copy without the attributes has no seal
+    to tell by, and is skipped (README)."""
+    folder, sources = sequence_folder(tmp_path)
+    run_sequence(hbao_tool, folder)
+    previews = {frame: (folder / f"ao_{frame:04d}.png").read_bytes() for frame in sources}
+    assert previews[1] != previews[2]
+    swapped = folder / "ao_0001.png"
+    shutil.copy2(folder / "ao_0002.png", swapped)  # with its extended attributes
+    assert os.getxattr(swapped, SEAL) == os.getxattr(folder / "ao_0002.png", SEAL)
+    exr_time = (folder / "ao_0001.exr").stat().st_mtime
+    os.utime(swapped, (exr_time + 1,) * 2)  # not stale by its time
+    rerun = run_sequence(hbao_tool, folder)
+    assert rerun.stderr.count("is up to date, skipped") == 2, rerun.stderr
+    assert "ao_0001.exr is up to date" not in rerun.stderr
+    assert swapped.read_bytes() == previews[1]
+    swapped.unlink()  # (a copy over it would keep its own seal, which tells)
+    shutil.copyfile(folder / "ao_0002.png", swapped)  # no attributes: no seal
+    os.utime(swapped, (exr_time + 1,) * 2)
+    unsealed = run_sequence(hbao_tool, folder)
+    assert unsealed.stderr.count("is up to date, skipped") == 3, unsealed.stderr
+    assert swapped.read_bytes() == previews[2]
 
 
 def test_sequence_with_a_fifo_for_a_preview_does_not_wait_on_it(hbao_tool, tmp_path):
@@ -1710,21 +1744,24 @@ SEAL = "user.hbao.crc32"  # csrc/tool/output_seal.h
 
 
 def test_outputs_are_sealed_with_their_crc(hbao_tool, tmp_path):
-    """Each output carries the CRC-32 and size of its bytes, and its input's
-    size, time and file name, in an extended attribute (both temporary-file
-    paths), which a sequence rerun checks instead of decoding the output."""
+    """Each output, and its preview, carries the CRC-32 and size of its
+    bytes, and its input's size, time and file name, in an extended
+    attribute (both temporary-file paths), which a sequence rerun checks
+    instead of decoding the output."""
     for tmpfile in ("1", "0"):
         output = tmp_path / f"ao_{tmpfile}.exr"
+        preview = output.with_suffix(".png")
         completed = run_tool(hbao_tool, fixture_path("eevee_half"), "-o", output, "--no-normals",
-                             env=dict(os.environ, HBAO_TMPFILE=tmpfile))
+                             "--preview", preview, env=dict(os.environ, HBAO_TMPFILE=tmpfile))
         assert completed.returncode == 0, completed.stderr
-        data = output.read_bytes()
         source = os.stat(fixture_path("eevee_half"))
         seconds, nanoseconds = divmod(source.st_mtime_ns, 10**9)
-        assert os.getxattr(output, SEAL) == (
-            f"crc32 {zlib.crc32(data):08x} size {len(data)} "
-            f"input {source.st_size} {seconds}.{nanoseconds:09d} "
-            f"{fixture_path('eevee_half').name}").encode()
+        for sealed in (output, preview):
+            data = sealed.read_bytes()
+            assert os.getxattr(sealed, SEAL) == (
+                f"crc32 {zlib.crc32(data):08x} size {len(data)} "
+                f"input {source.st_size} {seconds}.{nanoseconds:09d} "
+                f"{fixture_path('eevee_half').name}").encode()
 
 
 @pytest.mark.parametrize("sealed", [True, False])

@@ -346,11 +346,14 @@ static int write_outputs(const cli_options *options, const exr_input *input,
                              error);
     if (status == TOOL_EXIT_SUCCESS)
         output_seal_attach(files->exr.fd, input->path, &input->file_status);
-    if (status == TOOL_EXIT_SUCCESS && options->preview_path != NULL)
+    if (status == TOOL_EXIT_SUCCESS && options->preview_path != NULL) {
         status =
             png_write_gray(files->png.fd, options->preview_path, ao + rows * input->width + columns,
                            window->max_x - window->min_x + 1, window->max_y - window->min_y + 1,
                            input->width, error);
+        if (status == TOOL_EXIT_SUCCESS)
+            output_seal_attach(files->png.fd, input->path, &input->file_status);
+    }
     /* Both files are complete: only now replace the destinations, unless the
      * input changed while it was read. */
     if (status == TOOL_EXIT_SUCCESS) status = refuse_changed_input(input, error);

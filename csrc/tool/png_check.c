@@ -1,7 +1,6 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
 #include "png_check.h"
 
-#include <fcntl.h>
 #include <libdeflate.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -52,17 +51,18 @@ static bool chunks_are_whole(FILE *file) {
     }
 }
 
-bool png_file_is_whole(const char *path) {
-    /* without blocking: a FIFO of that name would wait for a writer */
-    const int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-    if (fd < 0) return false;
+bool png_fd_is_whole(int fd) {
     struct stat status;
-    FILE *file = fstat(fd, &status) == 0 && S_ISREG(status.st_mode) ? fdopen(fd, "rb") : NULL;
+    if (fstat(fd, &status) != 0 || !S_ISREG(status.st_mode)) return false;
+    /* a descriptor of its own for the stream: fd stays open, and is read
+     * from the file's start */
+    const int own = dup(fd);
+    FILE *file = own >= 0 ? fdopen(own, "rb") : NULL;
     if (file == NULL) {
-        close(fd);
+        if (own >= 0) close(own);
         return false;
     }
-    const bool whole = chunks_are_whole(file);
+    const bool whole = fseeko(file, 0, SEEK_SET) == 0 && chunks_are_whole(file);
     fclose(file);
     return whole;
 }

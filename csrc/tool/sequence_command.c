@@ -3,6 +3,7 @@
 #include "sequence_command.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <limits.h>
 #include <pthread.h>
 #include <stdio.h>
@@ -79,12 +80,29 @@ static bool output_is_whole(const cli_options *frame, const struct stat *input,
     return whole;
 }
 
+/* The preview whole and this frame's: a sealed one by its seal (output_seal.h:
+ * its bytes, and the input it was computed from, so that another frame's
+ * whole preview copied into its place with its attributes is redone), an
+ * unsealed one by its chunks' CRCs (png_check.h). Opened without blocking
+ * (a FIFO of that name would wait for a writer), a regular file only. */
+static bool preview_is_whole(const cli_options *frame, const struct stat *input) {
+    const int fd = open(frame->preview_path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) return false;
+    struct stat status;
+    bool whole = false;
+    if (fstat(fd, &status) == 0 && S_ISREG(status.st_mode)) {
+        const output_seal_state seal = output_seal_check(fd, frame->input_path, input);
+        whole = seal == OUTPUT_SEAL_ABSENT ? png_fd_is_whole(fd) : seal == OUTPUT_SEAL_MATCHES;
+    }
+    close(fd);
+    return whole;
+}
+
 /* Up to date, as make decides, and computed with the same flags: every
  * output exists and is at least as new as the input and the camera file, the
  * preview at least as new as the EXR (ao_command writes it after the EXR, so
- * a preview left from before the EXR was last computed is stale) and a whole
- * PNG file (png_check.h: a regular file, its chunks' CRCs up to IEND at its
- * end; a FIFO is not opened to wait on), and the
+ * a preview left from before the EXR was last computed is stale) and whole
+ * (preview_is_whole), and the
  * EXR's header holds the settings this run would write (run_settings.h)
  * and it is whole (output_is_whole).
  * (An input re-rendered while its frame was computed gets no output:
@@ -104,7 +122,7 @@ static bool up_to_date(const cli_options *frame) {
         return false;
     if (frame->preview_path != NULL &&
         (stat(frame->preview_path, &other) != 0 || !newer_or_equal(&other, &output) ||
-         !png_file_is_whole(frame->preview_path)))
+         !preview_is_whole(frame, &input)))
         return false;
     char settings[RUN_SETTINGS_MAX];
     return run_settings_text(frame, frame->camera_file, settings) &&
