@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
 #include "png_check.h"
 
+#include <fcntl.h>
 #include <libdeflate.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -54,9 +55,9 @@ static bool chunks_are_whole(FILE *file) {
 bool png_fd_is_whole(int fd) {
     struct stat status;
     if (fstat(fd, &status) != 0 || !S_ISREG(status.st_mode)) return false;
-    /* a descriptor of its own for the stream: fd stays open, and is read
-     * from the file's start */
-    const int own = dup(fd);
+    /* a descriptor of its own for the stream, so that fd stays open (it
+     * shares fd's offset: read from the file's start) */
+    const int own = fcntl(fd, F_DUPFD_CLOEXEC, 0);
     FILE *file = own >= 0 ? fdopen(own, "rb") : NULL;
     if (file == NULL) {
         if (own >= 0) close(own);

@@ -15,9 +15,9 @@
 
 /** True where fd is open on a regular PNG file whose every chunk's CRC
  *  matches, up to IEND at its end; false for anything else, an unreadable
- *  file included. Reads from the file's start; fd stays open. (The caller
- *  opens it without blocking: a FIFO of that name would wait for a
- *  writer.) */
+ *  file included. Reads from the file's start (moving fd's offset); fd
+ *  stays open. (The caller opens it without blocking: a FIFO of that name
+ *  would wait for a writer.) */
 bool png_fd_is_whole(int fd);
 
 #endif /* HBAO_PNG_CHECK_H */
