@@ -9,16 +9,24 @@
 # second finds every output up to date and skips it. Prints each run's wall
 # time and frames per second. Exits 1 when a run fails, when an output is
 # missing after the first run, or when the second run rewrites any output.
-#   scripts/bench_cli_sequence.sh [--frames N] [--jobs J]   (BLENDER=/path/to/blender renders)
+# --preview: each frame also writes its PNG preview (--preview 'ao_####.png'),
+# which the second run checks too.
+#   scripts/bench_cli_sequence.sh [--frames N] [--jobs J] [--preview]
+#   (BLENDER=/path/to/blender renders)
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 FRAMES=250
 JOBS=2
-usage() { echo "usage: $0 [--frames N] [--jobs J]   (N in [1, 9999], J in [1, 32])" >&2; exit 2; }
+PREVIEW=()
+usage() {
+    echo "usage: $0 [--frames N] [--jobs J] [--preview]   (N in [1, 9999], J in [1, 32])" >&2
+    exit 2
+}
 while [ $# -gt 0 ]; do
     case "$1" in
         --frames) [ $# -ge 2 ] || usage; FRAMES="$2"; shift 2 ;;
         --jobs) [ $# -ge 2 ] || usage; JOBS="$2"; shift 2 ;;
+        --preview) PREVIEW=(--preview 'ao_####.png'); shift ;;
         *) usage ;;
     esac
 done
@@ -42,23 +50,25 @@ run() {  # prints the run's wall seconds; returns hbao's exit status
     local start end status=0
     start=$(date +%s.%N)
     (cd "$WORK" && "$HBAO" 'render_####.exr' -o 'ao_####.exr' --camera "$RENDER.camera.json" \
-        --frames "1-$FRAMES" -j "$JOBS" 2>"$WORK/log.txt") || status=$?
+        --frames "1-$FRAMES" -j "$JOBS" "${PREVIEW[@]}" 2>"$WORK/log.txt") || status=$?
     end=$(date +%s.%N)
     echo "$start $end" | awk '{printf "%.3f", $2 - $1}'
     return "$status"
 }
 
 echo "hbao on $FRAMES frames of $(basename "$RENDER").exr ($(du -Lh "$RENDER.exr" | cut -f1)" \
-     "each), -j $JOBS, $(nproc) cores"
+     "each), -j $JOBS${PREVIEW:+, with previews}, $(nproc) cores"
 first=$(run) || { echo "first run failed:" >&2; tail -n 20 "$WORK/log.txt" >&2; exit 1; }
 computed=$(ls "$WORK" | grep -c '^ao_[0-9]*\.exr$' || true)
-if [ "$computed" -ne "$FRAMES" ]; then
-    echo "first run wrote $computed of $FRAMES outputs" >&2
+previews=$(ls "$WORK" | grep -c '^ao_[0-9]*\.png$' || true)
+if [ "$computed" -ne "$FRAMES" ] || { [ ${#PREVIEW[@]} -gt 0 ] && [ "$previews" -ne "$FRAMES" ]; }; then
+    echo "first run wrote $computed of $FRAMES outputs ($previews previews)" >&2
     exit 1
 fi
-before=$(cd "$WORK" && stat -c '%n %Y.%y' ao_*.exr | md5sum)
+outputs() { (cd "$WORK" && stat -c '%n %Y.%y' ao_* | md5sum); }
+before=$(outputs)
 second=$(run) || { echo "second run failed:" >&2; tail -n 20 "$WORK/log.txt" >&2; exit 1; }
-after=$(cd "$WORK" && stat -c '%n %Y.%y' ao_*.exr | md5sum)
+after=$(outputs)
 skipped=$(grep -c 'is up to date, skipped' "$WORK/log.txt" || true)
 if [ "$before" != "$after" ] || [ "$skipped" -ne "$FRAMES" ]; then
     echo "second run rewrote outputs (skipped $skipped of $FRAMES)" >&2
