@@ -1695,6 +1695,31 @@ def test_sequence_redoes_a_frame_whose_preview_is_another_frames(hbao_tool, tmp_
     assert swapped.read_bytes() == previews[2]
 
 
+def test_sequence_redoes_a_preview_made_with_an_earlier_exr(hbao_tool, tmp_path):
+    """A run with other settings and no --preview computes the EXRs again
+    and leaves the previews as they were; touched (newer than the new EXRs)
+    or restored with their times, those previews were skipped by the next
+    run with --preview, though they show the earlier settings' AO. A
+    preview's seal names the EXR it was made with: they are redone."""
+    folder, sources = sequence_folder(tmp_path)
+    run_sequence(hbao_tool, folder, "--radius", "0.5")
+    run_tool(hbao_tool, folder / "render_####.exr", "-o", folder / "ao_####.exr",
+             "--frames", "1-5", "--no-normals", "--radius", "2")
+    for frame in sources:
+        exr_time = (folder / f"ao_{frame:04d}.exr").stat().st_mtime
+        os.utime(folder / f"ao_{frame:04d}.png", (exr_time + 1,) * 2)
+    rerun = run_sequence(hbao_tool, folder, "--radius", "2")
+    assert "is up to date" not in rerun.stderr, rerun.stderr
+    for frame in sources:
+        single = tmp_path / f"single_{frame}.exr"
+        run_ok(hbao_tool, fixture_path(sources[frame]), "-o", single, "--no-normals",
+               "--radius", "2", "--preview", single.with_suffix(".png"))
+        assert ((folder / f"ao_{frame:04d}.png").read_bytes()
+                == single.with_suffix(".png").read_bytes())
+    again = run_sequence(hbao_tool, folder, "--radius", "2")
+    assert again.stderr.count("is up to date, skipped") == 3, again.stderr
+
+
 def test_sequence_with_a_fifo_for_a_preview_does_not_wait_on_it(hbao_tool, tmp_path):
     """A FIFO in a preview's place, newer than its EXR, is not a PNG to
     check: the check must not open it for reading and wait for a writer
@@ -1744,24 +1769,24 @@ SEAL = "user.hbao.crc32"  # csrc/tool/output_seal.h
 
 
 def test_outputs_are_sealed_with_their_crc(hbao_tool, tmp_path):
-    """Each output, and its preview, carries the CRC-32 and size of its
-    bytes, and its input's size, time and file name, in an extended
-    attribute (both temporary-file paths), which a sequence rerun checks
-    instead of decoding the output."""
+    """Each output carries the CRC-32 and size of its bytes, and its input's
+    size, time and file name, in an extended attribute (both temporary-file
+    paths), which a sequence rerun checks instead of decoding the output;
+    its preview the same, with the EXR for its input."""
     for tmpfile in ("1", "0"):
         output = tmp_path / f"ao_{tmpfile}.exr"
         preview = output.with_suffix(".png")
         completed = run_tool(hbao_tool, fixture_path("eevee_half"), "-o", output, "--no-normals",
                              "--preview", preview, env=dict(os.environ, HBAO_TMPFILE=tmpfile))
         assert completed.returncode == 0, completed.stderr
-        source = os.stat(fixture_path("eevee_half"))
-        seconds, nanoseconds = divmod(source.st_mtime_ns, 10**9)
-        for sealed in (output, preview):
+        # the EXR names its input, the preview its EXR
+        for sealed, source in ((output, fixture_path("eevee_half")), (preview, output)):
             data = sealed.read_bytes()
+            seconds, nanoseconds = divmod(source.stat().st_mtime_ns, 10**9)
             assert os.getxattr(sealed, SEAL) == (
                 f"crc32 {zlib.crc32(data):08x} size {len(data)} "
-                f"input {source.st_size} {seconds}.{nanoseconds:09d} "
-                f"{fixture_path('eevee_half').name}").encode()
+                f"input {source.stat().st_size} {seconds}.{nanoseconds:09d} "
+                f"{source.name}").encode()
 
 
 @pytest.mark.parametrize("sealed", [True, False])

@@ -351,8 +351,10 @@ static int write_outputs(const cli_options *options, const exr_input *input,
             png_write_gray(files->png.fd, options->preview_path, ao + rows * input->width + columns,
                            window->max_x - window->min_x + 1, window->max_y - window->min_y + 1,
                            input->width, error);
-        if (status == TOOL_EXIT_SUCCESS)
-            output_seal_attach(files->png.fd, input->path, &input->file_status);
+        /* sealed as computed from the EXR, whose own seal names the input */
+        struct stat exr_status;
+        if (status == TOOL_EXIT_SUCCESS && fstat(files->exr.fd, &exr_status) == 0)
+            output_seal_attach(files->png.fd, options->output_path, &exr_status);
     }
     /* Both files are complete: only now replace the destinations, unless the
      * input changed while it was read. */

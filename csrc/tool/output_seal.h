@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
 /* A seal on each EXR the tool writes, and on its --preview PNG: the CRC-32 of
- * the file's bytes and its
- * size, and the file name, size and modification time of the input it was
- * computed from, kept in the file's extended attribute OUTPUT_SEAL_ATTRIBUTE. A
+ * the file's bytes and its size, and the file name, size and modification
+ * time of the input it was computed from, kept in the file's extended
+ * attribute OUTPUT_SEAL_ATTRIBUTE. A
  * sequence rerun (sequence_command.c) takes a sealed output whose bytes
  * still match, and whose input is still the file it was computed from, as
  * up to date without decoding it (a read and a CRC, about a millisecond a
@@ -13,8 +13,10 @@
  * another frame's output moved into its place). The input is named by name,
  * size and time (a time rounded down by a coarser file system's copy is the
  * same), not by content: two files of one name, size and time pass for one.
- * A preview is held to its seal the same way (another frame's whole preview
- * copied into its place with its attributes is redone). Not in the file
+ * A --preview PNG is sealed the same way, as computed from its EXR (the
+ * EXR's name, size and time, where the EXR's seal names the render): another
+ * frame's whole preview copied into its place with its attributes, or one
+ * left from before its EXR was computed again, is redone. Not in the file
  * itself: the same input and flags still write the same bytes. Where the
  * file system keeps no user extended attributes, or a copy dropped them (cp
  * without -a, scp), there is no seal, and the rerun decodes the output whole

@@ -81,17 +81,18 @@ static bool output_is_whole(const cli_options *frame, const struct stat *input,
 }
 
 /* The preview whole and this frame's: a sealed one by its seal (output_seal.h:
- * its bytes, and the input it was computed from, so that another frame's
- * whole preview copied into its place with its attributes is redone), an
+ * its bytes, and the EXR it was made with, `output` its status now; so that
+ * another frame's whole preview copied into its place with its attributes,
+ * or one left from before its EXR was computed again, is redone), an
  * unsealed one by its chunks' CRCs (png_check.h). Opened without blocking
  * (a FIFO of that name would wait for a writer), a regular file only. */
-static bool preview_is_whole(const cli_options *frame, const struct stat *input) {
+static bool preview_is_whole(const cli_options *frame, const struct stat *output) {
     const int fd = open(frame->preview_path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
     if (fd < 0) return false;
     struct stat status;
     bool whole = false;
     if (fstat(fd, &status) == 0 && S_ISREG(status.st_mode)) {
-        const output_seal_state seal = output_seal_check(fd, frame->input_path, input);
+        const output_seal_state seal = output_seal_check(fd, frame->output_path, output);
         whole = seal == OUTPUT_SEAL_ABSENT ? png_fd_is_whole(fd) : seal == OUTPUT_SEAL_MATCHES;
     }
     close(fd);
@@ -122,7 +123,7 @@ static bool up_to_date(const cli_options *frame) {
         return false;
     if (frame->preview_path != NULL &&
         (stat(frame->preview_path, &other) != 0 || !newer_or_equal(&other, &output) ||
-         !preview_is_whole(frame, &input)))
+         !preview_is_whole(frame, &output)))
         return false;
     char settings[RUN_SETTINGS_MAX];
     return run_settings_text(frame, frame->camera_file, settings) &&
