@@ -154,11 +154,9 @@ int main(int argc, char **argv) {
            radius, runs);
     printf(
         "Cosine integration; 'defaults' = %d directions x %d steps, blur %d. Best implementation "
-        "on "
-        "this CPU: %s (SIMD kernels compiled by %s). The scalar column is the portable reference "
-        "code (horizon search and blur) "
-        "on "
-        "1 thread. A round times every column once (and the last one without blur). Cells: median "
+        "on this CPU: %s (SIMD kernels compiled by %s). The scalar column is the portable "
+        "reference code (horizon search and blur) on 1 thread. A round times every column once "
+        "(and the last one without blur). Cells: median "
         "wall-clock ms (median process CPU ms, all threads together). Speed-up and blur share "
         "((time - time without blur) / time, on the last column: wall, with the least and the "
         "greatest round's; CPU; the blur's own CPU ms) are medians of the per-round values.\n",

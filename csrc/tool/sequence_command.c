@@ -80,32 +80,33 @@ static bool output_is_whole(const cli_options *frame, const struct stat *input,
     return whole;
 }
 
-/* The preview whole and this frame's: a sealed one by its seal (output_seal.h:
- * its bytes, and the EXR it was made with, `output` its status now; so that
- * another frame's whole preview copied into its place with its attributes,
- * or one left from before its EXR was computed again, is redone), an
- * unsealed one by its chunks' CRCs (png_check.h). Opened without blocking
- * (a FIFO of that name would wait for a writer), a regular file only. */
-static bool preview_is_whole(const cli_options *frame, const struct stat *output) {
+/* The preview up to date: at least as new as its EXR (`output`: the EXR's
+ * status now; ao_command writes the preview after the EXR, so one left from
+ * before the EXR was last computed is stale), and whole and this frame's: a
+ * sealed one by its seal (output_seal.h: its bytes, and the EXR it was made
+ * with; so that another frame's whole preview copied into its place with its
+ * attributes, or one left from before its EXR was computed again, is
+ * redone), an unsealed one by its chunks' CRCs (png_check.h; a regular file
+ * only, as the seal's CRC). One open, without blocking: a FIFO of that name
+ * would wait for a writer. */
+static bool preview_is_current(const cli_options *frame, const struct stat *output) {
     const int fd = open(frame->preview_path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
     if (fd < 0) return false;
     struct stat status;
-    bool whole = false;
-    if (fstat(fd, &status) == 0 && S_ISREG(status.st_mode)) {
+    bool current = false;
+    if (fstat(fd, &status) == 0 && newer_or_equal(&status, output)) {
         const output_seal_state seal = output_seal_check(fd, frame->output_path, output);
-        whole = seal == OUTPUT_SEAL_ABSENT ? png_fd_is_whole(fd) : seal == OUTPUT_SEAL_MATCHES;
+        current = seal == OUTPUT_SEAL_ABSENT ? png_fd_is_whole(fd) : seal == OUTPUT_SEAL_MATCHES;
     }
     close(fd);
-    return whole;
+    return current;
 }
 
 /* Up to date, as make decides, and computed with the same flags: every
  * output exists and is at least as new as the input and the camera file, the
- * preview at least as new as the EXR (ao_command writes it after the EXR, so
- * a preview left from before the EXR was last computed is stale) and whole
- * (preview_is_whole), and the
- * EXR's header holds the settings this run would write (run_settings.h)
- * and it is whole (output_is_whole).
+ * preview is current (preview_is_current), and the EXR's header holds the
+ * settings this run would write (run_settings.h) and it is whole
+ * (output_is_whole).
  * (An input re-rendered while its frame was computed gets no output:
  * ao_command's refuse_changed_input.) */
 static bool up_to_date(const cli_options *frame) {
@@ -121,10 +122,7 @@ static bool up_to_date(const cli_options *frame) {
         (stat(frame->camera_path, &other) != 0 ||
          (S_ISREG(other.st_mode) && !newer_or_equal(&output, &other))))
         return false;
-    if (frame->preview_path != NULL &&
-        (stat(frame->preview_path, &other) != 0 || !newer_or_equal(&other, &output) ||
-         !preview_is_whole(frame, &output)))
-        return false;
+    if (frame->preview_path != NULL && !preview_is_current(frame, &output)) return false;
     char settings[RUN_SETTINGS_MAX];
     return run_settings_text(frame, frame->camera_file, settings) &&
            output_is_whole(frame, &input, settings);
