@@ -2,13 +2,16 @@
 """The add-on's pass hand-over against the passes a render has: the same
 1920x1080 interior render (Cycles, 1 sample, the HBAO node at the library's
 defaults) with only Combined, Depth and Normal, then with a compositing
-artist's usual passes as well (blender_scenes.PRODUCTION_PASSES).
-The hand-over saves the whole Render Result (handover.py), so it grows with
-them. Prints, for each, the helper scene's whole render (the engine's part
-of the frame), the AO and the hand-over (save, read, write) of the renders
-that computed the AO, as the add-on's console lines give them.
+artist's usual passes as well (blender_scenes.PRODUCTION_PASSES); each
+with the passes taken from Cycles' memory (pass_capture.py, the default
+from Blender 4.5) and through the file round trip (handover.py:
+HBAO_PASSES_FROM_MEMORY=0), which saves the whole Render Result and so
+grows with the passes. Prints, for each, the helper scene's whole render
+(the engine's part of the frame), the AO and the hand-over (from memory,
+or save and read; write) of the renders that computed the AO, as the
+add-on's console lines give them.
 
-  python3 scripts/bench_handover_passes.py [--blender bpy-5] [--repeats 4]
+  python3 scripts/bench_handover_passes.py [--blender bpy-5] [--repeats 4] [--size WxH]
 
 Needs the build (build/libhbao.so, build/libhbao_exr.so, or the libraries
 that HBAO_LIBRARY and HBAO_EXR_LIBRARY name, to time another build) and the
@@ -28,14 +31,16 @@ REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO / "addon"))  # the add-on's bpy-free timing_line
 from hbao import timing_line  # noqa: E402
 
-FIELDS = ("total_ms", "ao_ms", "handover_ms", "save_ms", "read_ms", "write_ms")
+FIELDS = ("total_ms", "ao_ms", "handover_ms", "capture_ms", "save_ms", "read_ms", "write_ms")
+ROUTES = {"memory": "1", "file": "0"}  # HBAO_PASSES_FROM_MEMORY
 
 
-def run(blender, passes, repeats, user_scripts):
-    spec = {"scene": "interior", "width": 1920, "height": 1080, "samples": 1,
+def run(blender, passes, route, repeats, user_scripts, size):
+    spec = {"scene": "interior", "width": size[0], "height": size[1], "samples": 1,
             "repeats": repeats, "threads": 2, "passes": passes,
             "node": {"directions": 4, "steps": 16, "blur_size": 5}}
-    env = dict(os.environ, BLENDER_USER_SCRIPTS=str(user_scripts), PYTHONUNBUFFERED="1")
+    env = dict(os.environ, BLENDER_USER_SCRIPTS=str(user_scripts), PYTHONUNBUFFERED="1",
+               HBAO_PASSES_FROM_MEMORY=ROUTES[route])
     env.setdefault("HBAO_LIBRARY", str(REPO / "build/libhbao.so"))
     env.setdefault("HBAO_EXR_LIBRARY", str(REPO / "build/libhbao_exr.so"))
     command = blender.command(REPO / "bench" / "addon_timing.py", [json.dumps(spec)])
@@ -56,7 +61,10 @@ def main():
     parser.add_argument("--blender", default="bpy-5",
                         help="a name or prefix from scripts/blenders.py (default bpy-5)")
     parser.add_argument("--repeats", type=int, default=4)
+    parser.add_argument("--size", default="1920x1080",
+                        help="WxH (default 1920x1080; 3840x2160: Cycles renders it in tiles)")
     args = parser.parse_args()
+    size = tuple(int(part) for part in args.size.lower().split("x"))
     found = [b for b in blenders.all_blenders() if b.name.startswith(args.blender)]
     if not found:
         raise SystemExit(f"bench_handover_passes: no Blender named {args.blender}* here")
@@ -65,20 +73,22 @@ def main():
         user_scripts = Path(folder)
         (user_scripts / "addons").mkdir()
         (user_scripts / "addons" / "hbao").symlink_to(REPO / "addon" / "hbao")
-        print(f"bench_handover_passes: {blender.name}, interior 1920x1080, 1 Cycles sample, "
+        print(f"bench_handover_passes: {blender.name}, interior {size[0]}x{size[1]}, "
+              f"1 Cycles sample, "
               f"defaults; ms per render that computed the AO (median, least-greatest)")
-        print("| passes | the helper's render | AO | hand-over | save | read | write | "
-              "hand-over / AO |")
-        print("|---|---|---|---|---|---|---|---|")
-        for passes in ("plain", "production"):
-            rows = run(blender, passes, args.repeats, user_scripts)
+        print("| passes | hand-over | the helper's render | AO | hand-over | from memory | save | "
+              "read | write | hand-over / AO |")
+        print("|---|---|---|---|---|---|---|---|---|---|")
+        for passes, route in ((passes, route) for passes in ("plain", "production")
+                              for route in ROUTES):
+            rows = run(blender, passes, route, args.repeats, user_scripts, size)
             cells = []
             for index in range(len(FIELDS)):
                 values = [row[index] for row in rows]
                 cells.append(f"{statistics.median(values):.0f} ({min(values)}-{max(values)})")
             ratios = [row[2] / row[1] for row in rows]
             name = "Combined, Depth, Normal" if passes == "plain" else "production (81 channels)"
-            print(f"| {name} | " + " | ".join(cells) +
+            print(f"| {name} | {route} | " + " | ".join(cells) +
                   f" | {statistics.median(ratios):.2f} ({min(ratios):.2f}-{max(ratios):.2f}) |")
 
 

@@ -153,7 +153,13 @@ def blender_environment(user_scripts, extra=None):
     return env
 
 
+# The add-on's switch to the file round trip (pass_capture.py): the tests
+# choose the route themselves (file_route), never the shell they run in.
+PASSES_FROM_MEMORY = "HBAO_PASSES_FROM_MEMORY"
+
+
 def pytest_configure(config):
+    os.environ.pop(PASSES_FROM_MEMORY, None)
     config.addinivalue_line("markers", "matrix: runs once in every Blender of the matrix")
     config.addinivalue_line("markers", "ui: needs Blender's user interface (Xvfb)")
     config.addinivalue_line("markers", "extension: needs Blender 4.2+ (extensions)")
@@ -239,6 +245,15 @@ def run_blender(blender_user_scripts):
     if DEBIAN_BLENDER is None:
         pytest.fail("blender not found: run scripts/setup.sh")
     return _runner(DEBIAN_BLENDER, blender_user_scripts)
+
+
+@pytest.fixture
+def file_route(monkeypatch):
+    """The main passes handed over through the file round trip
+    (handover.py), for the tests of that route's faults: Blender 3.4,
+    EEVEE and tiled or border renders take it, while 4.5 and later take
+    Cycles' passes from memory (pass_capture.py)."""
+    monkeypatch.setenv(PASSES_FROM_MEMORY, "0")
 
 
 @pytest.fixture

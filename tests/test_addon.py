@@ -193,7 +193,8 @@ def test_a_file_saved_in_5_keeps_the_node_settings_in_4_5(run_in_blender, blende
     assert json_line(run_lts(script, "-", "-", blend=edited).stdout, "SETTINGS") == second
 
 
-def test_disabling_the_add_on_in_a_session_leaves_the_plain_render(run_in_blender, tmp_path):
+def test_disabling_the_add_on_in_a_session_leaves_the_plain_render(run_in_blender, blender,
+                                                                   tmp_path):
     """The add-on disabled in a session (Preferences, or before removing it),
     then a render: Blender 3.4 (which keeps the node's class) and bpy 5.3
     composited the node with its AO pass from a helper scene that no engine
@@ -206,11 +207,20 @@ def test_disabling_the_add_on_in_a_session_leaves_the_plain_render(run_in_blende
     completed = run_in_blender(SCRIPTS / "addon_disable_in_session.py", out)
     assert "DISABLED IN SESSION DONE" in completed.stdout, completed.stdout[-3000:]
     images = {}
-    for step in ("enabled", "muted", "disabled", "enabled_again"):
+    for step in ("enabled", "muted", "disabled", "enabled_again", "disabled_under_another"):
         channels = exr.read_channels(out / f"{step}.exr", ["R", "G", "B"])
         images[step] = np.stack([channels[c] for c in "RGB"], axis=-1)
     assert np.abs(images["disabled"] - images["muted"]).max() <= SAME_RENDER_TOLERANCE
     assert np.abs(images["enabled_again"] - images["enabled"]).max() <= SAME_RENDER_TOLERANCE
+    assert np.abs(images["disabled_under_another"] - images["muted"]).max() \
+        <= SAME_RENDER_TOLERANCE
+    # Cycles' own render() back once the add-on is disabled, wrapped once
+    # again when it is enabled (pass_capture.py; 3.4 is never wrapped); a
+    # later wrapper of another add-on's kept.
+    wrapped = "wrapped" if blender.version_tuple >= (4, 5) else "own"
+    assert json_line(completed.stdout, "ENGINE RENDER") == {
+        "enabled": wrapped, "disabled": "own", "enabled_again": wrapped,
+        "disabled_under_another": "another's"}
     # the AO is real: the corner darker than in the plain render
     assert (images["enabled"] < images["muted"] - 0.05).any()
 
@@ -1123,6 +1133,86 @@ def test_stereo_and_multi_view_renders_get_each_views_ao(run_in_blender, tmp_pat
     assert list(scratch.iterdir()) == []
 
 
+# Each render the memory route is tried on (pass_capture.py): its spec;
+# {(view layer, view file suffix): (node, radius)} of the AO held to the
+# library's; whether the passes can be taken from memory (4.5 and later).
+MEMORY_ROUTE_CASES = {
+    "one_layer": ({"nodes": [{"radius": 0.7, "blur_size": 0}]},
+                  {("ViewLayer", ""): ("HBAO0", 0.7)}, True),
+    "two_layers": ({"scene": "two_layers", "nodes": [
+        {"name": "Small", "layer": "Front", "radius": 0.2, "blur_size": 0},
+        {"name": "Large", "layer": "Back", "radius": 1.5, "blur_size": 0}]},
+        {("Front", ""): ("Small", 0.2), ("Back", ""): ("Large", 1.5)}, True),
+    "stereo": ({"stereo": True, "nodes": [{"radius": 0.7, "blur_size": 0}]},
+               {("ViewLayer", "_L"): ("HBAO0", 0.7), ("ViewLayer", "_R"): ("HBAO0", 0.7)},
+               True),
+    # Cycles writes a tiled render's pixels in its render_frame_finish()
+    "tiles": ({"tile_size": 32, "nodes": [{"radius": 0.7, "blur_size": 0}]},
+              {("ViewLayer", ""): ("HBAO0", 0.7)}, True),
+    # the guard band's and back faces' renders taken too (test_back_faces_
+    # give_each_occluder_its_thickness holds that AO to the library's)
+    "extra_renders": ({"nodes": [{"radius": 0.7, "blur_size": 0},
+                                 {"name": "HBAO1", "radius": 0.7, "blur_size": 0,
+                                  "guard_band": 10.0, "back_faces": True}]},
+                      {("ViewLayer", ""): ("HBAO0", 0.7)}, True),
+    # the result is the border's region until Blender places it (the border
+    # tests below hold its AO)
+    "border": ({"border": [0.25, 0.75, 0.25, 0.75], "crop": False,
+                "nodes": [{"radius": 0.7, "blur_size": 0}]}, {}, False),
+}
+
+
+@pytest.mark.parametrize("case", list(MEMORY_ROUTE_CASES))
+def test_cycles_passes_from_memory_give_the_ao_of_the_written_passes(run_in_blender, blender,
+                                                                     tmp_path, node_native, case):
+    """From 4.5, Cycles' Depth and Normal reach the AO from its own Render
+    Result in memory, with no scratch file (pass_capture.py); the timing
+    line says "from memory". The AO is exactly the library's from the
+    passes Blender wrote to the output, view by view and layer by layer (a
+    wrong pass, view, layer or row order misses by far more than 0); a
+    tiled render's too (before, its passes read as zeros). Border renders,
+    and every render in 3.4, take the file round trip."""
+    spec, held, from_memory = MEMORY_ROUTE_CASES[case]
+    assert_hand_over_route(run_in_blender, tmp_path, node_native, spec, held,
+                           from_memory and blender.version_tuple >= (4, 5))
+
+
+@pytest.mark.min_blender(4, 5)
+def test_grease_pencil_strokes_keep_the_file_route(run_in_blender, tmp_path, node_native):
+    """Blender draws Grease Pencil strokes into the Depth pass after Cycles'
+    render(): taken there, the passes missed the stroke before the camera
+    (an exploratory run). A scene with Grease Pencil objects hands its
+    passes over through the file, and its AO is the written passes'."""
+    assert_hand_over_route(run_in_blender, tmp_path, node_native,
+                           {"grease_pencil": True, "nodes": [{"radius": 0.7, "blur_size": 0}]},
+                           {("ViewLayer", ""): ("HBAO0", 0.7)}, False)
+
+
+def assert_hand_over_route(run_in_blender, tmp_path, node_native, spec, held, from_memory):
+    """Render `spec`; every timing line says whether the passes came
+    `from_memory`; the AO of `held` as MEMORY_ROUTE_CASES says."""
+    out, log = render(run_in_blender, tmp_path, spec)
+    lines = [line for line in log.splitlines() if timing_line.parse(line) is not None]
+    assert lines, log[-3000:]
+    for line in lines:
+        figures = timing_line.parse(line)
+        assert ("(from memory " in line) == from_memory, log[-3000:]
+        assert (figures["save_ms"] + figures["read_ms"] == 0) or not from_memory, line
+        for kind in figures["extras_ms"]:
+            assert (f"{kind} passes {figures['extras_ms'][kind]} ms from memory" in line) \
+                == from_memory, line
+    if "guard_band" in str(spec):
+        assert "guard band passes" in log and "back faces passes" in log, log[-3000:]
+    assert "Rendering without AO" not in log and "could not take the passes" not in log
+    for (layer, view), (node, radius) in held.items():
+        depth, normal = frame_passes(out, 1, layer, view=view)
+        expected = node_native.compute_ao(depth, normal, camera=camera(out, 1, view),
+                                          params=node_params(radius=radius, blur_size=0))
+        assert expected.min() < 0.9, (layer, view)
+        ao = node_outputs(out, 1, node=node, view=view)["ao"]
+        assert np.abs(ao - expected).max() <= EXACT, (layer, view)
+
+
 def test_a_mono_render_after_a_stereo_one_gets_its_ao(run_in_blender, tmp_path):
     """Stereoscopy turned off after a stereo render whose output is one side
     by side image: the hand-over's save of the mono frame failed in 3.4 and
@@ -1479,7 +1569,8 @@ def test_package_and_install(tmp_path):
     assert "ENABLED True 0." in check.stdout, check.stdout[-2000:]
 
 
-def test_scratch_files_are_removed_beside_the_render_two_at_most(run_in_blender, tmp_path):
+def test_scratch_files_are_removed_beside_the_render_two_at_most(run_in_blender, tmp_path,
+                                                                 file_route):
     """handover.py removes each scratch file in a thread of its own; a save
     waits for every removal but the latest (so at most two files at a time,
     outside the engine's removals_after block, where a frame's files go
@@ -1490,7 +1581,8 @@ def test_scratch_files_are_removed_beside_the_render_two_at_most(run_in_blender,
     assert list(tmp_path.iterdir()) == []
 
 
-def test_scratch_file_stays_until_the_ao_is_computed(run_in_blender, tmp_path, monkeypatch):
+def test_scratch_file_stays_until_the_ao_is_computed(run_in_blender, tmp_path, monkeypatch,
+                                                     file_route):
     """The removal of a frame's scratch file, the kernel freeing its pages,
     waits until the frame's AO is computed (scratch_files.removals_after), so
     that it does not compete with the AO's threads; then it goes. Two frames,

@@ -67,3 +67,23 @@ def test_passes_are_compared_bit_for_bit():
     assert cache.get("node", inputs(signed)) is None
     assert cache.get("node", inputs(depth.astype(np.float64))) is None
     assert cache.get("node", inputs(depth.copy())) is not None
+
+
+def test_passes_handed_over_from_memory_compare_in_either_order():
+    # pass_capture.py hands over top-down views of Blender's bottom-up rows;
+    # the file route contiguous top-down arrays. Equal pictures are equal
+    # either way, and a change in any row tells them apart.
+    bottom_up = np.arange(4 * 6 * 3, dtype=np.float32).reshape(4, 6, 3)
+    top_down_view = bottom_up[::-1]
+    cache = AOCache()
+    cache.keep_only({"node": (inputs(top_down_view[..., 0], top_down_view), bottom_up)})
+    again = bottom_up.copy()
+    assert cache.get("node", inputs(again[::-1][..., 0], again[::-1])) is bottom_up
+    assert cache.get("node", inputs(np.ascontiguousarray(top_down_view[..., 0]),
+                                    np.ascontiguousarray(top_down_view))) is bottom_up
+    for row in range(4):
+        changed = bottom_up.copy()
+        changed[row, 5, 2] += 1.0
+        assert cache.get("node", inputs(changed[::-1][..., 0], changed[::-1])) is None
+        assert cache.get("node", inputs(bottom_up[::-1][..., 0],
+                                        np.ascontiguousarray(changed[::-1]))) is None

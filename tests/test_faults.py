@@ -196,7 +196,7 @@ def render_with_scratch_folder(run_in_blender, tmp_path, folder):
 
 
 def test_full_disk_renders_without_ao_leaves_nothing_and_restores_settings(
-        run_in_blender, tmp_path, full_disk):
+        run_in_blender, tmp_path, full_disk, file_route):
     log = render_with_scratch_folder(run_in_blender, tmp_path, full_disk)
     # The reason names the folder and how to choose another.
     assert f"cannot read back the passes saved in {full_disk}" in log, log[-3000:]
@@ -205,7 +205,7 @@ def test_full_disk_renders_without_ao_leaves_nothing_and_restores_settings(
 
 
 def test_passes_that_do_not_fit_in_the_first_scratch_folder_go_to_the_next(
-        run_in_blender, tmp_path, node_native, full_disk):
+        run_in_blender, tmp_path, node_native, full_disk, file_route):
     """HBAO_TEMP_DIR lists folders to try in turn (by default /dev/shm, then
     the system's temporary folder: a container's /dev/shm is 64 MB, less
     than a 1080p render's Combined, Depth and Normal, and every frame lost
@@ -231,7 +231,8 @@ def test_passes_that_do_not_fit_in_the_first_scratch_folder_go_to_the_next(
     assert list(full_disk.iterdir()) == [] and list(second.iterdir()) == []
 
 
-def test_scratch_folder_that_cannot_be_written_says_which_and_how(run_in_blender, tmp_path):
+def test_scratch_folder_that_cannot_be_written_says_which_and_how(run_in_blender, tmp_path,
+                                                                  file_route):
     blocked = tmp_path / "a file, not a folder"
     blocked.write_text("")
     log = render_with_scratch_folder(run_in_blender, tmp_path, blocked)
@@ -240,7 +241,7 @@ def test_scratch_folder_that_cannot_be_written_says_which_and_how(run_in_blender
 
 
 def test_a_scratch_folder_that_does_not_exist_is_not_made(run_in_blender, tmp_path, node_native,
-                                                          no_leftovers):
+                                                          no_leftovers, file_route):
     """A mistyped HBAO_TEMP_DIR folder: Blender's save made it (parents too)
     and the passes went there, silently, the folder left behind (an
     exploratory run). It is skipped with a message naming it; the next
@@ -653,7 +654,7 @@ def render_with_fault(run_in_blender, tmp_path, spec, fault):
 
 
 def test_an_interrupted_hand_over_renders_the_image_without_ao(run_in_blender, tmp_path,
-                                                               no_leftovers):
+                                                               no_leftovers, file_route):
     """Ctrl-C in a bpy render while the add-on's Python runs raises
     KeyboardInterrupt there, which the engine's `except Exception` let
     through: the AO passes stayed unfilled (0) and the frame was saved
@@ -666,7 +667,8 @@ def test_an_interrupted_hand_over_renders_the_image_without_ao(run_in_blender, t
     assert_no_ao_and_image_unchanged(out)
 
 
-def test_unreadable_saved_passes_render_without_ao(run_in_blender, tmp_path, no_leftovers):
+def test_unreadable_saved_passes_render_without_ao(run_in_blender, tmp_path, no_leftovers,
+                                                   file_route):
     """The saved Render Result cannot be read back: the scratch path is a
     link to /dev/null, so Blender's save succeeds and the read finds an
     empty file. Observed: the render completes, AO = 1, the console says

@@ -18,7 +18,7 @@ def test_a_computed_frame():
     assert timing_line.parse("HBAO: " + line) == {
         "passes": 2, "width": 1920, "height": 1080, "total_ms": 192, "ao_ms": 122,
         "threads": 0, "reused": 0, "handover_ms": 70, "save_ms": 50, "read_ms": 14,
-        "write_ms": 6, "recomposited": False, "extras_ms": {}}
+        "capture_ms": 0, "write_ms": 6, "recomposited": False, "extras_ms": {}}
 
 
 @pytest.mark.parametrize("extra, expected", [
@@ -45,3 +45,14 @@ def test_other_lines_are_not_timing_lines():
                  "HBAO: 1 AO pass(es) 640x360 in 12 ms: AO 5 ms",
                  "bench-addon: {\"ao\": 1}", ""):
         assert timing_line.parse(text) is None, text
+
+
+def test_passes_taken_from_memory():
+    timings = {"capture": 0.0052, "write": 0.0031, "ao": 0.0424, "threads": 2}
+    line = timing_line.format_line(1, 1920, 1080, 0.0511, timings)
+    assert line == ("1 AO pass(es) 1920x1080 in 51 ms: AO 42 ms on 2 threads, pass hand-over "
+                    "8 ms (from memory 5, write 3)")
+    figures = timing_line.parse(line)
+    assert {key: figures[key] for key in ("handover_ms", "capture_ms", "save_ms", "read_ms",
+                                          "write_ms")} == {
+        "handover_ms": 8, "capture_ms": 5, "save_ms": 0, "read_ms": 0, "write_ms": 3}, line

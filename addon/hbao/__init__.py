@@ -56,10 +56,10 @@ def register():
         preferences.show(message)
         if not compat.version_is_new_enough():
             return  # the message says why; a traceback would not
-    from . import (engine, engine_guard, handlers, node, node_setup, recomposite,
+    from . import (engine, engine_guard, handlers, node, node_setup, pass_capture, recomposite,
                    render_record, render_reports, report, writes)
     for module in (writes, node, node_setup, render_record, recomposite, engine, engine_guard,
-                   render_reports, handlers):
+                   render_reports, pass_capture, handlers):
         module.register()
         _registered.append(module)
     try:

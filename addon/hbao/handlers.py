@@ -10,8 +10,8 @@ the only chance such a render has to build the hook."""
 import bpy
 
 from . import (compat, helper_lookup, helper_render_settings, helper_scene, node, node_place,
-               older_blenders, pass_sources, recomposite, render_slots, saved_switch,
-               strip_cameras, unseen_occluders, window_scenes, writes)
+               older_blenders, pass_capture, pass_sources, planning, recomposite, render_slots,
+               saved_switch, strip_cameras, unseen_occluders, window_scenes, writes)
 from .callback_guard import never_raises
 from .report import (NodeMessage, forget_node_messages, in_main_thread, log,
                      post_last_node_messages, post_node_messages, post_render_report)
@@ -188,6 +188,7 @@ def _on_render_pre(scene, *_args):
         helper_scene.record_rendering(scene)
     except Exception as error:
         log(f"could not prepare the HBAO hook of {scene.name!r}: {error}")
+    planning.watch_passes(scene)
 
 
 @bpy.app.handlers.persistent
@@ -229,6 +230,7 @@ def _on_render_end(scene, completed):
     strip_cameras.job_ended(scene)
     if helper_lookup.is_helper(scene):
         return
+    pass_capture.forget(scene)
     render_slots.ended(scene, completed)
     helper_scene.record_render_end(scene)
     # (`-b`, scripts) the extra scenes the render's start kept go, once the

@@ -1,13 +1,14 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
-"""Handing the main Render Result's passes to Python: Blender gives a
-Python engine no access to another scene's Render Result pixels, but it can
-save the Render Result as a multilayer EXR, which libhbao_exr decodes
-straight into numpy arrays."""
+"""Handing the main Render Result's passes to Python: taken from the main
+engine's memory where pass_capture.py can; else, as Blender gives a Python
+engine no access to another scene's Render Result pixels, by saving the
+Render Result as a multilayer EXR, which libhbao_exr decodes straight into
+numpy arrays."""
 import os
 from time import perf_counter as _clock
 
-from . import (compat, exr_passes, render_slots, render_threads, scratch_files, view_cameras,
-               view_files)
+from . import (compat, exr_passes, pass_capture, render_slots, render_threads, scratch_files,
+               view_cameras, view_files)
 from .report import log
 
 
@@ -100,7 +101,13 @@ def read_passes(scene, layers, views=None, threads=0):
     whether its normal is wanted}; with `views` [(view name, file suffix)]
     of a stereo or multi-view render, {view name: those} instead; and the
     seconds the save and the read (by `threads`, 0: one per core) took.
-    Saved in the first of scratch_files.folders() that takes the file."""
+    Taken from the engine's memory where pass_capture.py could ({"capture":
+    seconds}), else saved in the first of scratch_files.folders() that
+    takes the file."""
+    taken = pass_capture.take(scene, layers, views)
+    if taken is not None:
+        channels, seconds = taken
+        return channels, {"capture": seconds}
     scratch_files.remove_stale_now_and_then()
     scratch_files.wait_for_older_removals()
     folders = scratch_files.folders()

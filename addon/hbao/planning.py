@@ -2,7 +2,9 @@
 """Which AO computations a frame needs: one job per HBAO node whose output
 someone looks at, with the view layer its passes come from and its
 parameters at that frame."""
-from . import compat, render_threads
+from . import (compat, extra_renders, helper_lookup, helper_render_settings, pass_capture,
+               render_threads)
+from .callback_guard import never_raises
 from .node import DEPTH_INPUT, NORMAL_INPUT, hbao_nodes, pass_name
 from .pass_sources import pass_source
 from .report import NodeMessage, post_node_messages, take_changes
@@ -57,17 +59,53 @@ def node_names(main):
     return [node.name for node in hbao_nodes(compat.compositor_tree(main))]
 
 
+def _computing_nodes(main):
+    """The HBAO nodes of `main` that compute: not muted, and someone looks
+    at an output (a node nobody looks at costs nothing)."""
+    return [node for node in hbao_nodes(compat.compositor_tree(main))
+            if not node.mute and any(output.is_linked for output in node.outputs)]
+
+
+def passes_read(main):
+    """{view layer name: whether its Normal is read} of the passes that
+    `main`'s computing HBAO nodes read, as their jobs would (plan_node)."""
+    layers = {}
+    for node in _computing_nodes(main):
+        depth_layer = pass_source(node.inputs[DEPTH_INPUT], main, "Depth")[0]
+        if depth_layer is None:
+            continue
+        normal_layer = pass_source(node.inputs[NORMAL_INPUT], main, "Normal")[0]
+        layers[depth_layer] = layers.get(depth_layer, False) or normal_layer == depth_layer
+    return layers
+
+
+@never_raises("take the render's passes from memory (they are saved instead)")
+def watch_passes(main):
+    """Before a frame of `main`: pass_capture takes the passes its helper
+    will read, those of its extra renders too (nothing where no helper
+    renders)."""
+    pass_capture.watch(main, *_passes_to_take(main))
+
+
+def _passes_to_take(main):
+    if not (helper_render_settings.compositor_runs(main)
+            and helper_render_settings.helper_renders(main)):
+        return {}, []
+    helper = helper_lookup.helper_scene_of(main)
+    extras = []
+    for kind in extra_renders.KINDS if helper is not None else ():
+        extra = extra_renders.for_render(main, helper, kind)[0]
+        if extra is not None:
+            extras.append((extra, {extra.view_layers[0].name: kind.wants_normal}))
+    return passes_read(main), extras
+
+
 def plan(main, frame):
     """The AO computations `main` needs at `frame`: ([Job], [NodeMessage]).
     The messages are also posted for the nodes' status lines (each node of
     the tree gets its own, or none: a good frame clears an old status)."""
     jobs, warnings = [], []
-    nodes = hbao_nodes(compat.compositor_tree(main))
-    for node in nodes:
-        if node.mute:
-            continue
-        if not any(output.is_linked for output in node.outputs):
-            continue  # nobody looks at it: costs nothing
+    for node in _computing_nodes(main):
         job = plan_node(node, main, frame, warnings)
         if job is not None:
             jobs.append(job)

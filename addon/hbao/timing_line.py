@@ -5,7 +5,8 @@ read it with. bpy-free.
 
     2 AO pass(es) 1920x1080 in 190 ms: AO 120 ms on 8 threads (1 of 2 unchanged: reused),
     pass hand-over 70 ms (save 50, read 14, write 6)[, re-composited ...]
-    [, guard band passes 80 ms][, back faces passes 75 ms]
+    [...] pass hand-over 8 ms (from memory 5, write 3) [...]   (pass_capture.py)
+    [, guard band passes 80 ms][, back faces passes 75 ms][ from memory]
 """
 import re
 
@@ -14,33 +15,41 @@ _LINE = re.compile(
     r"AO (?P<ao_ms>\d+) ms(?: on (?P<threads>\d+) threads?)?"
     r"(?: \((?P<reused>\d+) of \d+ unchanged: reused\))?, "
     r"pass hand-over (?P<handover_ms>\d+) ms "
-    r"\(save (?P<save_ms>\d+), read (?P<read_ms>\d+), write (?P<write_ms>\d+)\)"
+    r"\((?:save (?P<save_ms>\d+), read (?P<read_ms>\d+)|from memory (?P<capture_ms>\d+)), "
+    r"write (?P<write_ms>\d+)\)"
     r"(?P<recomposited>, re-composited)?")
 _EXTRA = re.compile(r", (?P<kind>[a-z ]+) passes (?P<ms>\d+) ms")
 
 
 def format_line(count, width, height, total, timings):
     """The line for a helper render of `count` AO passes: `total` and the
-    values of `timings` in seconds (save, read, write, ao, kept, and
-    "<kind> save" and "<kind> read" for each extra render's passes,
-    layer_passes.py), `timings["cached"]` the passes reused and
-    `timings["threads"]` the AO's threads."""
-    milliseconds = {name: timings.get(name, 0.0) * 1000 for name in ("save", "read", "write",
-                                                                     "ao")}
-    handover_ms = milliseconds["save"] + milliseconds["read"] + milliseconds["write"]
+    values of `timings` in seconds (save and read, or capture: the passes
+    taken from memory; write, ao, kept, and "<kind> save" and "<kind>
+    read" for each extra render's passes, layer_passes.py),
+    `timings["cached"]` the passes reused and `timings["threads"]` the
+    AO's threads."""
+    milliseconds = {name: timings.get(name, 0.0) * 1000
+                    for name in ("save", "read", "capture", "write", "ao")}
+    handover_ms = sum(milliseconds[name] for name in ("save", "read", "capture", "write"))
     cached = f" ({timings['cached']} of {count} unchanged: reused)" if "cached" in timings else ""
     threads = timings.get("threads")
     on = "" if threads is None else f" on {threads} thread{'' if threads == 1 else 's'}"
+    if "capture" in timings:
+        passes = f"from memory {milliseconds['capture']:.0f}"
+    else:
+        passes = f"save {milliseconds['save']:.0f}, read {milliseconds['read']:.0f}"
     line = (f"{count} AO pass(es) {width}x{height} in {total * 1000:.0f} ms: AO "
             f"{milliseconds['ao']:.0f} ms{on}{cached}, pass hand-over {handover_ms:.0f} ms "
-            f"(save {milliseconds['save']:.0f}, read {milliseconds['read']:.0f}, write "
-            f"{milliseconds['write']:.0f})")
+            f"({passes}, write {milliseconds['write']:.0f})")
     if "kept" in timings:
         line += (f", re-composited with new settings from the last render's passes (their AO "
                  f"computed beforehand in {timings['kept'] * 1000:.0f} ms)")
-    for kind in (key[:-len(" save")] for key in timings if key.endswith(" save")):
-        seconds = timings[f"{kind} save"] + timings.get(f"{kind} read", 0.0)
-        line += f", {kind} passes {seconds * 1000:.0f} ms"
+    kinds = dict.fromkeys(key.rsplit(" ", 1)[0] for key in timings
+                          if key.endswith((" save", " capture")))
+    for kind in kinds:
+        seconds = sum(timings.get(f"{kind} {name}", 0.0) for name in ("save", "read", "capture"))
+        memory = " from memory" if f"{kind} capture" in timings else ""
+        line += f", {kind} passes {seconds * 1000:.0f} ms{memory}"
     return line
 
 
@@ -48,9 +57,10 @@ def parse(text):
     """The figures of the timing line found in `text` (a log line, with or
     without the "HBAO: " prefix), or None: passes, width, height and the
     milliseconds as ints (total_ms, ao_ms, handover_ms, save_ms, read_ms,
-    write_ms), threads (the AO's, 0 where the line has none), reused (passes
-    whose AO was reused, 0 if none), recomposited (bool) and extras_ms
-    ({kind: ms} for the extra renders' passes)."""
+    capture_ms: the passes taken from memory, write_ms; 0 where absent),
+    threads (the AO's, 0 where the line has none), reused (passes whose AO
+    was reused, 0 if none), recomposited (bool) and extras_ms ({kind: ms}
+    for the extra renders' passes)."""
     match = _LINE.search(text)
     if match is None:
         return None

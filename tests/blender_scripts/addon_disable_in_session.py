@@ -4,15 +4,20 @@ again in one session, a render after each step. The corner scene with an
 HBAO node whose Image feeds the final image (blender_scenes.hbao_test_tree);
 each render's final image is written to OUT/<step>.exr (32-bit float):
 enabled, muted (the node muted: the plain render), disabled (the add-on
-disabled in the session), enabled_again. Prints DISABLED IN SESSION DONE.
+disabled in the session), enabled_again, disabled_under_another (disabled
+again after another add-on wrapped Cycles' render over the add-on's
+wrapper, pass_capture.py). Prints ENGINE RENDER {json} (what Cycles'
+render() was after each step) and DISABLED IN SESSION DONE.
 
   blender -b --addons hbao --python addon_disable_in_session.py -- OUT
 """
+import json
 import os
 import sys
 
 import addon_utils
 import bpy
+import cycles
 
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(REPO, "scripts"))
@@ -32,12 +37,40 @@ def render(step):
     bpy.ops.render.render(write_still=True)
 
 
+own_render = cycles.CyclesRender.__dict__["render"]
+seen = {}
+
+
+def note(step):
+    """How Cycles' render() stands: its own, the add-on's wrapper of it,
+    another's, or a wrapper of a wrapper."""
+    render_function = cycles.CyclesRender.__dict__["render"]
+    inner = getattr(render_function, "hbao_wraps", None)
+    seen[step] = ("own" if render_function is own_render else
+                  "wrapped" if inner is own_render else
+                  "another's" if render_function is another_render else
+                  "wrapped twice" if inner is not None else "unknown")
+
+
+def another_render(self, depsgraph):  # another add-on's wrapper
+    return wrapped_by_another(self, depsgraph)
+
+
 render("enabled")
+note("enabled")
 node.mute = True
 render("muted")
 node.mute = False
 addon_utils.disable("hbao", default_set=True)
+note("disabled")
 render("disabled")
 addon_utils.enable("hbao", default_set=True)
 render("enabled_again")
+note("enabled_again")
+wrapped_by_another = cycles.CyclesRender.__dict__["render"]
+cycles.CyclesRender.render = another_render
+addon_utils.disable("hbao", default_set=True)
+note("disabled_under_another")
+render("disabled_under_another")
+print("ENGINE RENDER " + json.dumps(seen), flush=True)
 print("DISABLED IN SESSION DONE", flush=True)

@@ -55,7 +55,8 @@ HBAO effect's group), wrap_compositing_group (the scene's group used through a G
 group, the effect's now), effect_off_for_render; add_on_scenes_on_gpu (every scene's
 compositor_device GPU)],
 render_threads ({frame: the Performance panel's threads, 0 for Auto}), layer_name (the first view
-layer's), scene_name, single_layer (Render Single Layer on),
+layer's), scene_name, single_layer (Render Single Layer on), tile_size (Cycles renders in tiles
+of that many pixels), grease_pencil (a stroke object before the camera; 4.5+),
 user_handlers (a pipeline's own render and frame change handlers, which print USER HANDLERS {json}:
 the scenes each list's handler saw, in order; render_stats leaves out repeats of the scene before).
 Prints OUTPUT SETTINGS {json} (the main output's settings after the renders), STATUS {json} (each
@@ -136,6 +137,13 @@ for key, value in spec.get("stereo_settings", {}).items():  # the camera's Stere
 if spec.get("position_pass"):  # Cycles' Position pass: where each pixel's surface is
     for view_layer in scene.view_layers:
         view_layer.use_pass_position = True
+if spec.get("grease_pencil"):  # a Grease Pencil stroke 2 units before the camera (4.5+)
+    from mathutils import Vector
+    bpy.ops.object.grease_pencil_add(type="STROKE",
+                                     location=scene.camera.matrix_world @ Vector((0, 0, -2)))
+if spec.get("tile_size"):
+    scene.cycles.use_auto_tile = True
+    scene.cycles.tile_size = spec["tile_size"]
 if spec.get("motion_blur"):  # camera motion blur, this shutter Position, 1 frame long
     scene.render.use_motion_blur = True
     scene.render.motion_blur_shutter = 1.0

@@ -1,0 +1,289 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The main render's Depth and Normal, and those of its extra renders (guard
+band, back faces), taken from Blender's memory, without the file round trip
+of handover.py, where its engine is written in Python (Cycles).
+
+Python reads a Render Result's pixels only through a RenderEngine's own
+`get_result()`, and only the engine that rendered it holds one: so the
+render() of the main scene's engine class is wrapped, and once the engine
+has rendered a view layer, that layer's passes are copied out of its
+result (`RenderPass.rect`). A tiled render's pixels are not there yet
+(Blender allocates the passes only when the engine writes the whole
+frame, and reads them as zeros before): Cycles writes them in its
+render_frame_finish(), which is wrapped too, and they are taken after it.
+The helper's render, which follows, takes them (take()) instead of saving
+and reading the whole Render Result.
+
+Anything else keeps the file round trip:
+- Blender before 4.5: 3.4 reads a pass without pixels from a null pointer
+  and crashes (a tiled render, found by an exploratory run), where 4.5 to
+  5.3 read zeros;
+- a border render, whose result is the border's region until Blender puts
+  it in the frame;
+- a scene with Grease Pencil objects, whose strokes Blender draws into the
+  Depth pass after the engine's render();
+- engines written in C (EEVEE, Workbench): there is no render() to wrap;
+- HBAO_PASSES_FROM_MEMORY=0.
+A capture that is missing, all zeros or not of the result's size is not
+taken, and the helper falls back to the file: the same arrays either way.
+
+The wrappers only copy: they call the engine's own method first and return
+what it returns; a failure of the copy is logged and costs the render
+nothing. unregister() puts the engine's own methods back, or, where another
+add-on wrapped them since, leaves wrappers that only pass through.
+"""
+import os
+from time import perf_counter as _clock
+
+import bpy
+import numpy as np
+
+from . import compat
+from .report import log
+
+# Where a render's own pixels can be read after its engine's render()
+# (see above).
+SUPPORTED = compat.VERSION >= (4, 5, 0)
+# Set to 0, the passes always take the file round trip (to compare, or
+# where an engine's wrapper misbehaves).
+SWITCH_VARIABLE = "HBAO_PASSES_FROM_MEMORY"
+
+# The channels of each pass taken, as handover.py reads them from the file.
+_CHANNELS = {"Depth": 1, "Normal": 3}
+_GREASE_PENCIL_DATA = ("grease_pencils", "grease_pencils_v3")
+_GREASE_PENCIL_TYPES = ("GREASEPENCIL", "GPENCIL")
+
+# Engine classes wrapped: {class: ({method name: its own function}, the
+# wrappers' state)}.
+_wrapped = {}
+# The scenes whose renders are taken: {scene pointer: {view layer name:
+# whether its Normal is wanted}}, set by watch() before each frame.
+_watched = {}
+# What the engines left: {(scene pointer, view layer name): {"views": {view
+# name: {"depth": array, "normal": array or None}}, "seconds": float}}.
+_taken = {}
+# The extra renders' scenes watched with a main scene: {main scene pointer:
+# [scene pointer]}.
+_extras = {}
+# The layers whose pixels an engine writes in its render_frame_finish():
+# {engine pointer: [(scene pointer, view layer name)]}.
+_later = {}
+
+
+def _engine_class(engine_name):
+    """The Python class of the render engine `engine_name`, or None (an
+    engine written in C, or the add-on's own)."""
+    for engine_class in bpy.types.RenderEngine.__subclasses__():
+        if getattr(engine_class, "bl_idname", None) == engine_name:
+            module = engine_class.__module__
+            if module == __package__ or module.startswith(__package__ + "."):
+                return None
+            return engine_class if "render" in engine_class.__dict__ else None
+    return None
+
+
+def _guarded(step, *args):
+    try:
+        step(*args)
+    except Exception as error:  # the render goes on; the file route stays
+        log(f"could not take the passes from the render in memory "
+            f"({type(error).__name__}: {error}); saving them instead")
+
+
+def _wrap(engine_class):
+    """Wrap the engine's render() and, where it has one, its
+    render_frame_finish(), in which Cycles writes a tiled render's pixels."""
+    own = {name: engine_class.__dict__[name] for name in ("render", "render_frame_finish")
+           if name in engine_class.__dict__}
+    state = {"active": True}
+
+    def render(self, depsgraph):
+        result = own["render"](self, depsgraph)
+        if state["active"] and _watched and not self.is_preview:
+            _guarded(_after_layer, self, depsgraph, "render_frame_finish" in own)
+        return result
+
+    def render_frame_finish(self):
+        result = own["render_frame_finish"](self)
+        if state["active"] and _later:
+            _guarded(_after_frame, self)
+        return result
+
+    for name, function in (("render", render), ("render_frame_finish", render_frame_finish)):
+        if name in own:
+            function.hbao_wraps = own[name]
+            setattr(engine_class, name, function)
+    _wrapped[engine_class] = (own, state)
+
+
+def _has_grease_pencil(scene):
+    """Whether `scene` shows Grease Pencil objects, whose strokes Blender
+    draws into the Depth pass after the engine's render() (an exploratory
+    run: 12446 of 24000 depths differed from the saved file's)."""
+    if not any(len(getattr(bpy.data, name, ())) for name in _GREASE_PENCIL_DATA):
+        return False  # (no need to look through a large scene's objects)
+    return any(obj.type in _GREASE_PENCIL_TYPES for obj in scene.objects)
+
+
+def watch(scene, layers, extras=()):
+    """Take the passes of `scene`'s coming frame from its engine, for
+    `layers` {view layer name: whether its Normal is wanted}, and those of
+    the `extras` [(scene, layers)] that its render renders as well
+    (extra_renders.py); what a previous frame left is dropped."""
+    forget(scene)
+    if not _watch_one(scene, layers):
+        return
+    for extra, extra_layers in extras:
+        _forget_pointer(extra.as_pointer())
+        if _watch_one(extra, extra_layers):
+            _extras.setdefault(scene.as_pointer(), []).append(extra.as_pointer())
+
+
+def _watch_one(scene, layers):
+    if not SUPPORTED or not layers or scene.render.use_border \
+            or os.environ.get(SWITCH_VARIABLE, "1").strip() == "0" or _has_grease_pencil(scene):
+        return False
+    engine_class = _engine_class(scene.render.engine)
+    if engine_class is None:
+        return False
+    if engine_class not in _wrapped:  # (a class registered again is a new class)
+        _wrap(engine_class)
+    _watched[scene.as_pointer()] = dict(layers)
+    return True
+
+
+def forget(scene):
+    """Drop what was taken of `scene`'s render and of its extra renders,
+    and stop watching them."""
+    pointer = scene.as_pointer()
+    for extra in _extras.pop(pointer, []):
+        _forget_pointer(extra)
+    _forget_pointer(pointer)
+
+
+def _forget_pointer(pointer):
+    _watched.pop(pointer, None)
+    for key in [key for key in _taken if key[0] == pointer]:
+        _taken.pop(key, None)
+    for engine, layers in list(_later.items()):
+        _later[engine] = [entry for entry in layers if entry[0] != pointer]
+
+
+def _pass_array(render_pass, width, height):
+    channels = _CHANNELS[render_pass.name]
+    if render_pass.channels != channels or len(render_pass.rect) != width * height:
+        return None
+    pixels = np.empty(width * height * channels, np.float32)  # (foreach_get: flat)
+    render_pass.rect.foreach_get(pixels)
+    array = pixels.reshape((height, width) if channels == 1 else (height, width, channels))
+    # Blender's rows run from the bottom: a top-down view of them, no copy
+    # (native.py and ao_cache.py read such views in place).
+    return array[::-1]
+
+
+def _after_layer(engine, depsgraph, finishes):
+    """Take the layer `engine` has just rendered, or, where its pixels are
+    not there yet and the engine `finishes` the frame, after that."""
+    pointer = depsgraph.scene.as_pointer()
+    layer_name = depsgraph.view_layer.name
+    if layer_name not in _watched.get(pointer, ()):
+        return
+    if _take(engine, pointer, layer_name) is None and finishes:
+        _later.setdefault(engine.as_pointer(), []).append((pointer, layer_name))
+
+
+def _after_frame(engine):
+    for pointer, layer_name in _later.pop(engine.as_pointer(), []):
+        if layer_name in _watched.get(pointer, ()):
+            _take(engine, pointer, layer_name)
+
+
+def _take(engine, pointer, layer_name):
+    """Copy view layer `layer_name`'s passes out of `engine`'s result: True
+    when taken, None when its pixels are not there (yet), False when they
+    will not do."""
+    with_normal = _watched[pointer][layer_name]
+    start = _clock()
+    result = engine.get_result()
+    if result is None:
+        return False
+    width, height = result.resolution_x, result.resolution_y
+    layer = next((layer for layer in result.layers if layer.name == layer_name), None)
+    if layer is None:
+        return False
+    view_names = [view.name for view in result.views] or [""]
+    views = {name: {"depth": None, "normal": None} for name in view_names}
+    for render_pass in layer.passes:
+        wanted = render_pass.name == "Depth" or (render_pass.name == "Normal" and with_normal)
+        if not wanted or not 0 <= render_pass.view_id < len(view_names):
+            continue
+        array = _pass_array(render_pass, width, height)
+        if array is None:
+            return False
+        views[view_names[render_pass.view_id]][render_pass.name.lower()] = array
+    for arrays in views.values():
+        if arrays["depth"] is None or (with_normal and arrays["normal"] is None):
+            return False
+        if not arrays["depth"].any():  # no pixels behind the pass (see above)
+            return None
+    _taken[(pointer, layer_name)] = {"views": views, "seconds": _clock() - start}
+    return True
+
+
+def take(scene, layers, views=None):
+    """(channels, seconds) as handover.read_passes gives them, from what
+    `scene`'s engine left of its render that has just ended, for `layers`
+    {view layer name: whether its normal is wanted} and `views` [(view
+    name, file suffix)] (None: a mono render); or None where any of it was
+    not taken. What is taken is dropped here."""
+    pointer = scene.as_pointer()
+    if not layers:
+        return None
+    found = {}
+    for layer in layers:
+        entry = _taken.get((pointer, layer))
+        if entry is None:
+            return None
+        found[layer] = entry
+    names = [None] if views is None else [name for name, _suffix in views]
+    channels = {}
+    for name in names:
+        view_channels = {}
+        for layer, with_normal in layers.items():
+            taken_views = found[layer]["views"]
+            if name is None:
+                if len(taken_views) != 1:
+                    return None
+                arrays = next(iter(taken_views.values()))
+            elif name in taken_views:
+                arrays = taken_views[name]
+            else:
+                return None
+            if with_normal and arrays["normal"] is None:
+                return None
+            view_channels[("depth", layer)] = arrays["depth"]
+            if with_normal:
+                view_channels[("normal", layer)] = arrays["normal"]
+        channels[name] = view_channels
+    for layer in layers:
+        _taken.pop((pointer, layer), None)
+    seconds = sum(entry["seconds"] for entry in found.values())
+    return (channels[None] if views is None else channels), seconds
+
+
+def register():
+    pass  # the engines are wrapped at their first watched render
+
+
+def unregister():
+    _watched.clear()
+    _taken.clear()
+    _later.clear()
+    _extras.clear()
+    for engine_class, (own, state) in list(_wrapped.items()):
+        state["active"] = False
+        for name, function in own.items():
+            if getattr(engine_class.__dict__.get(name), "hbao_wraps", None) is function:
+                setattr(engine_class, name, function)
+            # else wrapped again by someone else since: the chain stays, ours passes through
+    _wrapped.clear()
