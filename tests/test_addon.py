@@ -1178,13 +1178,17 @@ def test_cycles_passes_from_memory_give_the_ao_of_the_written_passes(run_in_blen
 
 
 @pytest.mark.min_blender(4, 5)
-def test_grease_pencil_strokes_keep_the_file_route(run_in_blender, tmp_path, node_native):
+@pytest.mark.parametrize("grease_pencil", [True, "instanced"])
+def test_grease_pencil_strokes_keep_the_file_route(run_in_blender, tmp_path, node_native,
+                                                   grease_pencil):
     """Blender draws Grease Pencil strokes into the Depth pass after Cycles'
     render(): taken there, the passes missed the stroke before the camera
-    (an exploratory run). A scene with Grease Pencil objects hands its
-    passes over through the file, and its AO is the written passes'."""
+    (an exploratory run), also one shown through a collection instance (a
+    review). While Grease Pencil objects are in use the passes go through
+    the file, and the AO is the written passes'."""
     assert_hand_over_route(run_in_blender, tmp_path, node_native,
-                           {"grease_pencil": True, "nodes": [{"radius": 0.7, "blur_size": 0}]},
+                           {"grease_pencil": grease_pencil,
+                            "nodes": [{"radius": 0.7, "blur_size": 0}]},
                            {("ViewLayer", ""): ("HBAO0", 0.7)}, False)
 
 

@@ -20,8 +20,8 @@ Anything else keeps the file round trip:
   5.3 read zeros;
 - a border render, whose result is the border's region until Blender puts
   it in the frame;
-- a scene with Grease Pencil objects, whose strokes Blender draws into the
-  Depth pass after the engine's render();
+- while Grease Pencil objects are in use, whose strokes Blender draws into
+  the Depth pass after the engine's render();
 - engines written in C (EEVEE, Workbench): there is no render() to wrap;
 - HBAO_PASSES_FROM_MEMORY=0.
 A capture that is missing, all zeros or not of the result's size is not
@@ -50,11 +50,9 @@ SWITCH_VARIABLE = "HBAO_PASSES_FROM_MEMORY"
 
 # The channels of each pass taken, as handover.py reads them from the file.
 _CHANNELS = {"Depth": 1, "Normal": 3}
-_GREASE_PENCIL_DATA = ("grease_pencils", "grease_pencils_v3")
-_GREASE_PENCIL_TYPES = ("GREASEPENCIL", "GPENCIL")
 
 # Engine classes wrapped: {class: ({method name: its own function}, the
-# wrappers' state)}.
+# wrappers' state, {method name: the wrapper})}.
 _wrapped = {}
 # The scenes whose renders are taken: {scene pointer: {view layer name:
 # whether its Normal is wanted}}, set by watch() before each frame.
@@ -71,15 +69,21 @@ _later = {}
 
 
 def _engine_class(engine_name):
-    """The Python class of the render engine `engine_name`, or None (an
-    engine written in C, or the add-on's own)."""
+    """The registered Python class of the render engine `engine_name`, or
+    None (an engine written in C, or the add-on's own). A class replaced by
+    a new registration (Cycles reloaded) stays among the subclasses while
+    anything holds it: the last registered one is Blender's."""
+    found = None
     for engine_class in bpy.types.RenderEngine.__subclasses__():
-        if getattr(engine_class, "bl_idname", None) == engine_name:
-            module = engine_class.__module__
-            if module == __package__ or module.startswith(__package__ + "."):
-                return None
-            return engine_class if "render" in engine_class.__dict__ else None
-    return None
+        if getattr(engine_class, "bl_idname", None) == engine_name \
+                and getattr(engine_class, "is_registered", True):
+            found = engine_class
+    if found is None:
+        return None
+    module = found.__module__
+    if module == __package__ or module.startswith(__package__ + "."):
+        return None
+    return found if "render" in found.__dict__ else None
 
 
 def _guarded(step, *args):
@@ -109,20 +113,38 @@ def _wrap(engine_class):
             _guarded(_after_frame, self)
         return result
 
-    for name, function in (("render", render), ("render_frame_finish", render_frame_finish)):
-        if name in own:
-            function.hbao_wraps = own[name]
-            setattr(engine_class, name, function)
-    _wrapped[engine_class] = (own, state)
+    wrappers = {"render": render, "render_frame_finish": render_frame_finish}
+    wrappers = {name: wrappers[name] for name in own}
+    for name, function in wrappers.items():
+        setattr(engine_class, name, function)
+    _wrapped[engine_class] = (own, state, wrappers)
 
 
-def _has_grease_pencil(scene):
-    """Whether `scene` shows Grease Pencil objects, whose strokes Blender
-    draws into the Depth pass after the engine's render() (an exploratory
-    run: 12446 of 24000 depths differed from the saved file's)."""
-    if not any(len(getattr(bpy.data, name, ())) for name in _GREASE_PENCIL_DATA):
-        return False  # (no need to look through a large scene's objects)
-    return any(obj.type in _GREASE_PENCIL_TYPES for obj in scene.objects)
+def _needs_wrapping(engine_class):
+    """Not wrapped yet, or its own render() put back since (by another
+    add-on that had wrapped it before this one); a wrapper of another
+    add-on's over this one's keeps this one inside."""
+    entry = _wrapped.get(engine_class)
+    if entry is None:
+        return True
+    own, state, _wrappers = entry
+    if engine_class.__dict__.get("render") is own["render"]:
+        state["active"] = False
+        return True
+    return False
+
+
+def _grease_pencil_in_use():
+    """Whether any Grease Pencil object may be rendered, whose strokes
+    Blender draws into the Depth pass after the engine's render() (an
+    exploratory run: 12446 of 24000 depths differed from the saved file's).
+    Not only the scene's own objects: a collection instance or a background
+    set draws its strokes too (a review), so any Grease Pencil data in use
+    counts (4.5: grease_pencils_v3; 5.x: grease_pencils, annotations apart)."""
+    data = getattr(bpy.data, "grease_pencils_v3", None)
+    if data is None:
+        data = bpy.data.grease_pencils
+    return any(grease_pencil.users for grease_pencil in data)
 
 
 def watch(scene, layers, extras=()):
@@ -141,12 +163,14 @@ def watch(scene, layers, extras=()):
 
 def _watch_one(scene, layers):
     if not SUPPORTED or not layers or scene.render.use_border \
-            or os.environ.get(SWITCH_VARIABLE, "1").strip() == "0" or _has_grease_pencil(scene):
+            or os.environ.get(SWITCH_VARIABLE, "1").strip() == "0" or _grease_pencil_in_use():
         return False
     engine_class = _engine_class(scene.render.engine)
     if engine_class is None:
         return False
-    if engine_class not in _wrapped:  # (a class registered again is a new class)
+    for stale in [cls for cls in _wrapped if not getattr(cls, "is_registered", True)]:
+        _wrapped.pop(stale)[1]["active"] = False  # (let go of a replaced class)
+    if _needs_wrapping(engine_class):
         _wrap(engine_class)
     _watched[scene.as_pointer()] = dict(layers)
     return True
@@ -280,10 +304,10 @@ def unregister():
     _taken.clear()
     _later.clear()
     _extras.clear()
-    for engine_class, (own, state) in list(_wrapped.items()):
+    for engine_class, (own, state, wrappers) in list(_wrapped.items()):
         state["active"] = False
         for name, function in own.items():
-            if getattr(engine_class.__dict__.get(name), "hbao_wraps", None) is function:
+            if engine_class.__dict__.get(name) is wrappers[name]:
                 setattr(engine_class, name, function)
             # else wrapped again by someone else since: the chain stays, ours passes through
     _wrapped.clear()

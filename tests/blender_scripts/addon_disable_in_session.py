@@ -11,6 +11,7 @@ render() was after each step) and DISABLED IN SESSION DONE.
 
   blender -b --addons hbao --python addon_disable_in_session.py -- OUT
 """
+import functools
 import json
 import os
 import sys
@@ -45,15 +46,14 @@ def note(step):
     """How Cycles' render() stands: its own, the add-on's wrapper of it,
     another's, or a wrapper of a wrapper."""
     render_function = cycles.CyclesRender.__dict__["render"]
-    inner = getattr(render_function, "hbao_wraps", None)
     seen[step] = ("own" if render_function is own_render else
-                  "wrapped" if inner is own_render else
                   "another's" if render_function is another_render else
-                  "wrapped twice" if inner is not None else "unknown")
+                  "wrapped" if render_function.__module__.endswith(".pass_capture") else
+                  "unknown")
 
 
-def another_render(self, depsgraph):  # another add-on's wrapper
-    return wrapped_by_another(self, depsgraph)
+def another_render(self, depsgraph):  # another add-on's wrapper (which
+    return wrapped_by_another(self, depsgraph)  # copies the wrapped's attributes)
 
 
 render("enabled")
@@ -68,6 +68,7 @@ addon_utils.enable("hbao", default_set=True)
 render("enabled_again")
 note("enabled_again")
 wrapped_by_another = cycles.CyclesRender.__dict__["render"]
+another_render = functools.wraps(wrapped_by_another)(another_render)
 cycles.CyclesRender.render = another_render
 addon_utils.disable("hbao", default_set=True)
 note("disabled_under_another")

@@ -56,7 +56,8 @@ group, the effect's now), effect_off_for_render; add_on_scenes_on_gpu (every sce
 compositor_device GPU)],
 render_threads ({frame: the Performance panel's threads, 0 for Auto}), layer_name (the first view
 layer's), scene_name, single_layer (Render Single Layer on), tile_size (Cycles renders in tiles
-of that many pixels), grease_pencil (a stroke object before the camera; 4.5+),
+of that many pixels), grease_pencil (a stroke object before the camera; "instanced": in a collection
+shown through an instance; 4.5+),
 user_handlers (a pipeline's own render and frame change handlers, which print USER HANDLERS {json}:
 the scenes each list's handler saw, in order; render_stats leaves out repeats of the scene before).
 Prints OUTPUT SETTINGS {json} (the main output's settings after the renders), STATUS {json} (each
@@ -141,6 +142,15 @@ if spec.get("grease_pencil"):  # a Grease Pencil stroke 2 units before the camer
     from mathutils import Vector
     bpy.ops.object.grease_pencil_add(type="STROKE",
                                      location=scene.camera.matrix_world @ Vector((0, 0, -2)))
+    if spec["grease_pencil"] == "instanced":  # shown only through a collection instance
+        stroke = bpy.context.active_object
+        asset = bpy.data.collections.new("Stroke asset")
+        for collection in list(stroke.users_collection):
+            collection.objects.unlink(stroke)
+        asset.objects.link(stroke)
+        instance = bpy.data.objects.new("Stroke instance", None)
+        instance.instance_type, instance.instance_collection = "COLLECTION", asset
+        scene.collection.objects.link(instance)
 if spec.get("tile_size"):
     scene.cycles.use_auto_tile = True
     scene.cycles.tile_size = spec["tile_size"]
