@@ -14,18 +14,11 @@ render_frame_finish(), which is wrapped too, and they are taken after it.
 The helper's render, which follows, takes them (take()) instead of saving
 and reading the whole Render Result.
 
-Anything else keeps the file round trip:
-- Blender before 4.5: 3.4 reads a pass without pixels from a null pointer
-  and crashes (a tiled render, found by an exploratory run), where 4.5 to
-  5.3 read zeros;
-- a border render, whose result is the border's region until Blender puts
-  it in the frame;
-- while Grease Pencil objects are in use, whose strokes Blender draws into
-  the Depth pass after the engine's render();
-- engines written in C (EEVEE, Workbench): there is no render() to wrap;
-- HBAO_PASSES_FROM_MEMORY=0.
-A capture that is missing, all zeros or not of the result's size is not
-taken, and the helper falls back to the file: the same arrays either way.
+Anything else keeps the file round trip, which gives the same arrays (the
+exclusions and why: docs/blender-integration.md, hook step 3): Blender
+before 4.5, border renders, Grease Pencil in use, engines written in C, and
+HBAO_PASSES_FROM_MEMORY=0; so does a capture that is missing, all zeros or
+not of the result's size.
 
 The wrappers only copy: they call the engine's own method first and return
 what it returns; a failure of the copy is logged and costs the render
@@ -41,9 +34,7 @@ import numpy as np
 from . import compat
 from .report import log
 
-# Where a render's own pixels can be read after its engine's render()
-# (see above).
-SUPPORTED = compat.VERSION >= (4, 5, 0)
+SUPPORTED = compat.VERSION >= (4, 5, 0)  # (3.4 crashes reading a pass without pixels)
 # Set to 0, the passes always take the file round trip (to compare, or
 # where an engine's wrapper misbehaves).
 SWITCH_VARIABLE = "HBAO_PASSES_FROM_MEMORY"
@@ -60,9 +51,7 @@ _watched = {}
 # What the engines left: {(scene pointer, view layer name): {"views": {view
 # name: {"depth": array, "normal": array or None}}, "seconds": float}}.
 _taken = {}
-# The extra renders' scenes watched with a main scene: {main scene pointer:
-# [scene pointer]}.
-_extras = {}
+_extras = {}  # {main scene pointer: [its extra renders' scene pointers]}
 # The layers whose pixels an engine writes in its render_frame_finish():
 # {engine pointer: [(scene pointer, view layer name)]}.
 _later = {}
@@ -113,8 +102,8 @@ def _wrap(engine_class):
             _guarded(_after_frame, self)
         return result
 
-    wrappers = {"render": render, "render_frame_finish": render_frame_finish}
-    wrappers = {name: wrappers[name] for name in own}
+    wrappers = {name: function for name, function in (
+        ("render", render), ("render_frame_finish", render_frame_finish)) if name in own}
     for name, function in wrappers.items():
         setattr(engine_class, name, function)
     _wrapped[engine_class] = (own, state, wrappers)
@@ -135,12 +124,9 @@ def _needs_wrapping(engine_class):
 
 
 def _grease_pencil_in_use():
-    """Whether any Grease Pencil object may be rendered, whose strokes
-    Blender draws into the Depth pass after the engine's render() (an
-    exploratory run: 12446 of 24000 depths differed from the saved file's).
-    Not only the scene's own objects: a collection instance or a background
-    set draws its strokes too (a review), so any Grease Pencil data in use
-    counts (4.5: grease_pencils_v3; 5.x: grease_pencils, annotations apart)."""
+    """Whether Grease Pencil data is in use (4.5: grease_pencils_v3; 5.x:
+    grease_pencils, annotations apart): a scene's own, an instanced or a
+    background set's strokes all go into Depth after render()."""
     data = getattr(bpy.data, "grease_pencils_v3", None)
     if data is None:
         data = bpy.data.grease_pencils
