@@ -56,15 +56,25 @@ def run(blender, passes, route, repeats, user_scripts, size):
     return rows[1:]
 
 
+def _size(text):
+    try:
+        width, height = (int(part) for part in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not WxH, e.g. 1920x1080") from None
+    if not (16 <= width <= 16384 and 16 <= height <= 16384):
+        raise argparse.ArgumentTypeError(f"{text!r}: each side 16 to 16384 pixels")
+    return width, height
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--blender", default="bpy-5",
                         help="a name or prefix from scripts/blenders.py (default bpy-5)")
     parser.add_argument("--repeats", type=int, default=4)
-    parser.add_argument("--size", default="1920x1080",
+    parser.add_argument("--size", default="1920x1080", type=_size,
                         help="WxH (default 1920x1080; 3840x2160: Cycles renders it in tiles)")
     args = parser.parse_args()
-    size = tuple(int(part) for part in args.size.lower().split("x"))
+    size = args.size
     found = [b for b in blenders.all_blenders() if b.name.startswith(args.blender)]
     if not found:
         raise SystemExit(f"bench_handover_passes: no Blender named {args.blender}* here")
