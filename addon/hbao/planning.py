@@ -67,14 +67,15 @@ def _computing_nodes(main):
 
 
 def passes_read(main):
-    """{view layer name: whether its Normal is read} of the passes that the
-    jobs of `main`'s current frame read (plan_node's rule, its messages
-    left out)."""
+    """{view layer name: whether its Normal is read} of the passes that
+    `main`'s computing HBAO nodes read, as their jobs would (plan_node)."""
     layers = {}
     for node in _computing_nodes(main):
-        job = plan_node(node, main, main.frame_current, [])
-        if job is not None:
-            layers[job.layer] = layers.get(job.layer, False) or job.with_normal
+        depth_layer = pass_source(node.inputs[DEPTH_INPUT], main, "Depth")[0]
+        if depth_layer is None:
+            continue
+        normal_layer = pass_source(node.inputs[NORMAL_INPUT], main, "Normal")[0]
+        layers[depth_layer] = layers.get(depth_layer, False) or normal_layer == depth_layer
     return layers
 
 
