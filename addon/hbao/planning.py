@@ -26,9 +26,23 @@ class Job:
         self.back_faces = node.back_faces
 
 
+def _sources(node, main):
+    """Where `node`'s Depth and Normal come from: two pass_source answers,
+    (view layer or None, error, short). Read without the library, so that
+    render_pre can choose the passes to take where the library is broken."""
+    return (pass_source(node.inputs[DEPTH_INPUT], main, "Depth"),
+            pass_source(node.inputs[NORMAL_INPUT], main, "Normal"))
+
+
+def _reads_normal(depth_layer, normal_layer):
+    """Whether a job uses its Normal pass: only from Depth's own layer."""
+    return normal_layer is not None and normal_layer == depth_layer
+
+
 def plan_node(node, main, frame, warnings):
     """The Job of one HBAO node, or None when it computes nothing."""
-    depth_layer, error, short = pass_source(node.inputs[DEPTH_INPUT], main, "Depth")
+    depth, normal = _sources(node, main)
+    depth_layer, error, short = depth
     if depth_layer is None:
         if error is None:
             warnings.append(NodeMessage(node.name, "Depth is not linked; AO off (the node "
@@ -36,7 +50,7 @@ def plan_node(node, main, frame, warnings):
         else:
             warnings.append(NodeMessage(node.name, f"{error}; AO off", f"Depth: {short}, AO off"))
         return None
-    normal_layer, error, short = pass_source(node.inputs[NORMAL_INPUT], main, "Normal")
+    normal_layer, error, short = normal
     if error:
         warnings.append(NodeMessage(node.name, f"{error}; reconstructing normals from depth",
                                     f"Normal: {short}, ignored"))
@@ -50,7 +64,7 @@ def plan_node(node, main, frame, warnings):
         warnings.append(NodeMessage(node.name, "Normal comes from another view layer than "
                                     "Depth; reconstructing normals from depth",
                                     "Normal: other layer, ignored"))
-    return Job(node, depth_layer, normal_layer == depth_layer, params,
+    return Job(node, depth_layer, _reads_normal(depth_layer, normal_layer), params,
                render_threads.count(main))
 
 
@@ -68,14 +82,14 @@ def _computing_nodes(main):
 
 def passes_read(main):
     """{view layer name: whether its Normal is read} of the passes that
-    `main`'s computing HBAO nodes read, as their jobs would (plan_node)."""
+    `main`'s computing HBAO nodes read, as their jobs would (plan_node's
+    _sources and _reads_normal, without its parameters and the library)."""
     layers = {}
     for node in _computing_nodes(main):
-        depth_layer = pass_source(node.inputs[DEPTH_INPUT], main, "Depth")[0]
-        if depth_layer is None:
-            continue
-        normal_layer = pass_source(node.inputs[NORMAL_INPUT], main, "Normal")[0]
-        layers[depth_layer] = layers.get(depth_layer, False) or normal_layer == depth_layer
+        (depth_layer, _, _), (normal_layer, _, _) = _sources(node, main)
+        if depth_layer is not None:
+            layers[depth_layer] = (layers.get(depth_layer, False)
+                                   or _reads_normal(depth_layer, normal_layer))
     return layers
 
 
