@@ -1155,6 +1155,10 @@ MEMORY_ROUTE_CASES = {
                                  {"name": "HBAO1", "radius": 0.7, "blur_size": 0,
                                   "guard_band": 10.0, "back_faces": True}]},
                       {("ViewLayer", ""): ("HBAO0", 0.7)}, True),
+    # an engine written in Python that is not Cycles (raycast_engine.py),
+    # which writes its passes in bands, each its own begin_result()
+    "python_engine": ({"python_engine": True, "nodes": [{"radius": 0.7, "blur_size": 0}]},
+                      {("ViewLayer", ""): ("HBAO0", 0.7)}, True),
     # the result is the border's region until Blender places it (the border
     # tests below hold its AO)
     "border": ({"border": [0.25, 0.75, 0.25, 0.75], "crop": False,
@@ -1163,15 +1167,17 @@ MEMORY_ROUTE_CASES = {
 
 
 @pytest.mark.parametrize("case", list(MEMORY_ROUTE_CASES))
-def test_cycles_passes_from_memory_give_the_ao_of_the_written_passes(run_in_blender, blender,
-                                                                     tmp_path, node_native, case):
+def test_passes_from_memory_give_the_ao_of_the_written_passes(run_in_blender, blender, tmp_path,
+                                                              node_native, case):
     """From 4.5, Cycles' Depth and Normal reach the AO from its own Render
     Result in memory, with no scratch file (pass_capture.py); the timing
     line says "from memory". The AO is exactly the library's from the
     passes Blender wrote to the output, view by view and layer by layer (a
     wrong pass, view, layer or row order misses by far more than 0); a
-    tiled render's too (before, its passes read as zeros). Border renders,
-    and every render in 3.4, take the file round trip."""
+    tiled render's too (before, its passes read as zeros), and that of an
+    engine written in Python other than Cycles, which writes its passes in
+    bands. Border renders, and every render in 3.4, take the file round
+    trip."""
     spec, held, from_memory = MEMORY_ROUTE_CASES[case]
     assert_hand_over_route(run_in_blender, tmp_path, node_native, spec, held,
                            from_memory and blender.version_tuple >= (4, 5))

@@ -57,7 +57,8 @@ compositor_device GPU)],
 render_threads ({frame: the Performance panel's threads, 0 for Auto}), layer_name (the first view
 layer's), scene_name, single_layer (Render Single Layer on), tile_size (Cycles renders in tiles
 of that many pixels), grease_pencil (a stroke object before the camera; "instanced": in a collection
-shown through an instance; 4.5+),
+shown through an instance; 4.5+), python_engine (rendered by raycast_engine.py, a third-party
+engine's stand-in),
 user_handlers (a pipeline's own render and frame change handlers, which print USER HANDLERS {json}:
 the scenes each list's handler saw, in order; render_stats leaves out repeats of the scene before).
 Prints OUTPUT SETTINGS {json} (the main output's settings after the renders), STATUS {json} (each
@@ -151,6 +152,10 @@ if spec.get("grease_pencil"):  # a Grease Pencil stroke 2 units before the camer
         instance = bpy.data.objects.new("Stroke instance", None)
         instance.instance_type, instance.instance_collection = "COLLECTION", asset
         scene.collection.objects.link(instance)
+if spec.get("python_engine"):  # rendered by raycast_engine.py, an engine written in Python
+    import raycast_engine
+    raycast_engine.register()
+    scene.render.engine = raycast_engine.IDNAME
 if spec.get("tile_size"):
     scene.cycles.use_auto_tile = True
     scene.cycles.tile_size = spec["tile_size"]
