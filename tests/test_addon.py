@@ -1184,14 +1184,17 @@ def test_passes_from_memory_give_the_ao_of_the_written_passes(run_in_blender, bl
 
 
 @pytest.mark.min_blender(4, 5)
-@pytest.mark.parametrize("grease_pencil", [True, "instanced"])
+@pytest.mark.parametrize("grease_pencil", [True, "instanced", "geometry_nodes"])
 def test_grease_pencil_strokes_keep_the_file_route(run_in_blender, tmp_path, node_native,
                                                    grease_pencil):
     """Blender draws Grease Pencil strokes into the Depth pass after Cycles'
     render(): taken there, the passes missed the stroke before the camera
     (an exploratory run), also one shown through a collection instance (a
-    review). While Grease Pencil objects are in use the passes go through
-    the file, and the AO is the written passes'."""
+    review). Strokes that geometry nodes make (Curves to Grease Pencil) are
+    drawn as a Grease Pencil object's are. While Grease Pencil objects or
+    such node groups are in use the passes go through the file, and the AO
+    is the written passes'. (The bpy builds here draw no strokes without
+    OpenGL, so this holds the route, and the AO only to the passes.)"""
     assert_hand_over_route(run_in_blender, tmp_path, node_native,
                            {"grease_pencil": grease_pencil,
                             "nodes": [{"radius": 0.7, "blur_size": 0}]},

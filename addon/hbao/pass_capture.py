@@ -14,16 +14,12 @@ render_frame_finish(), which is wrapped too, and they are taken after it.
 The helper's render, which follows, takes them (take()) instead of saving
 and reading the whole Render Result.
 
-Anything else keeps the file round trip, which gives the same arrays (the
-exclusions and why: docs/blender-integration.md, hook step 3): Blender
-before 4.5, border renders, Grease Pencil in use, engines written in C, and
-HBAO_PASSES_FROM_MEMORY=0; so does a capture that is missing, all zeros or
-not of the result's size.
-
-The wrappers only copy: they call the engine's own method first and return
-what it returns; a failure of the copy is logged and costs the render
-nothing. unregister() puts the engine's own methods back, or, where another
-add-on wrapped them since, leaves wrappers that only pass through.
+Anything else keeps the file round trip, which gives the same arrays
+(docs/blender-integration.md, hook step 3: what and why), as does a capture
+that is missing, all zeros or not of the result's size. The wrappers call
+the engine's own method first and return what it returns; a failed copy is
+logged and costs the render nothing. unregister() puts the engine's own
+methods back, or leaves wrappers that only pass through.
 """
 import os
 from time import perf_counter as _clock
@@ -35,25 +31,22 @@ from . import compat
 from .report import log
 
 SUPPORTED = compat.VERSION >= (4, 5, 0)  # (3.4 crashes reading a pass without pixels)
-# Set to 0, the passes always take the file round trip (to compare, or
-# where an engine's wrapper misbehaves).
+# Set to 0: always the file round trip (to compare, or where a wrapper misbehaves).
 SWITCH_VARIABLE = "HBAO_PASSES_FROM_MEMORY"
 
-# The channels of each pass taken, as handover.py reads them from the file.
+# The channels of each pass taken, as handover.py reads them.
 _CHANNELS = {"Depth": 1, "Normal": 3}
 
 # Engine classes wrapped: {class: ({method name: its own function}, the
 # wrappers' state, {method name: the wrapper})}.
 _wrapped = {}
-# The scenes whose renders are taken: {scene pointer: {view layer name:
-# whether its Normal is wanted}}, set by watch() before each frame.
+# The scenes whose renders are taken (watch()): {scene pointer: {layer: with Normal}}.
 _watched = {}
 # What the engines left: {(scene pointer, view layer name): {"views": {view
 # name: {"depth": array, "normal": array or None}}, "seconds": float}}.
 _taken = {}
 _extras = {}  # {main scene pointer: [its extra renders' scene pointers]}
-# The layers whose pixels an engine writes in its render_frame_finish():
-# {engine pointer: [(scene pointer, view layer name)]}.
+# Layers an engine writes in render_frame_finish(): {engine pointer: [(scene, layer)]}.
 _later = {}
 
 
@@ -123,14 +116,22 @@ def _needs_wrapping(engine_class):
     return False
 
 
+# The geometry node that makes strokes, with no Grease Pencil data behind them
+_STROKE_MAKER = "GeometryNodeCurvesToGreasePencil"
+
+
 def _grease_pencil_in_use():
     """Whether Grease Pencil data is in use (4.5: grease_pencils_v3; 5.x:
     grease_pencils, annotations apart): a scene's own, an instanced or a
-    background set's strokes all go into Depth after render()."""
+    background set's strokes all go into Depth after render(); or a node
+    group in use that makes strokes (Blender draws those as it draws a
+    Grease Pencil object's)."""
     data = getattr(bpy.data, "grease_pencils_v3", None)
     if data is None:
         data = bpy.data.grease_pencils
-    return any(grease_pencil.users for grease_pencil in data)
+    return any(grease_pencil.users for grease_pencil in data) or any(
+        node.bl_idname == _STROKE_MAKER for group in bpy.data.node_groups
+        if group.users and group.bl_idname == "GeometryNodeTree" for node in group.nodes)
 
 
 def watch(scene, layers, extras=()):

@@ -57,8 +57,8 @@ compositor_device GPU)],
 render_threads ({frame: the Performance panel's threads, 0 for Auto}), layer_name (the first view
 layer's), scene_name, single_layer (Render Single Layer on), tile_size (Cycles renders in tiles
 of that many pixels), grease_pencil (a stroke object before the camera; "instanced": in a collection
-shown through an instance; 4.5+), python_engine (rendered by raycast_engine.py, a third-party
-engine's stand-in),
+shown through an instance; "geometry_nodes": a stroke made by a Curves to Grease Pencil node;
+4.5+), python_engine (rendered by raycast_engine.py, a third-party engine's stand-in),
 user_handlers (a pipeline's own render and frame change handlers, which print USER HANDLERS {json}:
 the scenes each list's handler saw, in order; render_stats leaves out repeats of the scene before).
 Prints OUTPUT SETTINGS {json} (the main output's settings after the renders), STATUS {json} (each
@@ -139,7 +139,25 @@ for key, value in spec.get("stereo_settings", {}).items():  # the camera's Stere
 if spec.get("position_pass"):  # Cycles' Position pass: where each pixel's surface is
     for view_layer in scene.view_layers:
         view_layer.use_pass_position = True
-if spec.get("grease_pencil"):  # a Grease Pencil stroke 2 units before the camera (4.5+)
+if spec.get("grease_pencil") == "geometry_nodes":  # strokes made by geometry nodes (4.5+)
+    from mathutils import Vector
+    maker = bpy.data.objects.new("Stroke maker", bpy.data.meshes.new("Stroke maker"))
+    maker.matrix_world = scene.camera.matrix_world
+    scene.collection.objects.link(maker)
+    group = bpy.data.node_groups.new("Strokes", "GeometryNodeTree")
+    group.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+    line = group.nodes.new("GeometryNodeCurvePrimitiveLine")
+    line.inputs["Start"].default_value = (-1.0, -0.5, -2.0)  # 2 units before the camera
+    line.inputs["End"].default_value = (1.0, 0.5, -2.0)
+    radius = group.nodes.new("GeometryNodeSetCurveRadius")
+    radius.inputs["Radius"].default_value = 0.1
+    strokes = group.nodes.new("GeometryNodeCurvesToGreasePencil")
+    output = group.nodes.new("NodeGroupOutput")
+    group.links.new(line.outputs[0], radius.inputs["Curve"])
+    group.links.new(radius.outputs[0], strokes.inputs[0])
+    group.links.new(strokes.outputs[0], output.inputs[0])
+    maker.modifiers.new("Strokes", "NODES").node_group = group
+elif spec.get("grease_pencil"):  # a Grease Pencil stroke 2 units before the camera (4.5+)
     from mathutils import Vector
     bpy.ops.object.grease_pencil_add(type="STROKE",
                                      location=scene.camera.matrix_world @ Vector((0, 0, -2)))
