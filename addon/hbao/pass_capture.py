@@ -140,8 +140,8 @@ def watch(scene, layers, extras=()):
     the `extras` [(scene, layers)] that its render renders as well
     (extra_renders.py); what a previous frame left is dropped."""
     forget(scene)
-    if not _watch_one(scene, layers):
-        return
+    if not _watch_one(scene, layers) or _grease_pencil_in_use():  # (one scan a frame)
+        return forget(scene)
     for extra, extra_layers in extras:
         _forget_pointer(extra.as_pointer())
         if _watch_one(extra, extra_layers):
@@ -150,7 +150,7 @@ def watch(scene, layers, extras=()):
 
 def _watch_one(scene, layers):
     if not SUPPORTED or not layers or scene.render.use_border \
-            or os.environ.get(SWITCH_VARIABLE, "1").strip() == "0" or _grease_pencil_in_use():
+            or os.environ.get(SWITCH_VARIABLE, "1").strip() == "0":
         return False
     engine_class = _engine_class(scene.render.engine)
     if engine_class is None:
