@@ -152,11 +152,14 @@ if spec.get("grease_pencil") == "geometry_nodes":  # strokes made by geometry no
     radius = group.nodes.new("GeometryNodeSetCurveRadius")
     radius.inputs["Radius"].default_value = 0.1
     strokes = group.nodes.new("GeometryNodeCurvesToGreasePencil")
+    strokes.inputs["Instances as Layers"].default_value = False  # (on, plain curves make none)
     output = group.nodes.new("NodeGroupOutput")
     group.links.new(line.outputs[0], radius.inputs["Curve"])
     group.links.new(radius.outputs[0], strokes.inputs[0])
     group.links.new(strokes.outputs[0], output.inputs[0])
     maker.modifiers.new("Strokes", "NODES").node_group = group
+    print("STROKE INSTANCES", sum(instance.object.type == "GREASEPENCIL" for instance
+                                  in bpy.context.evaluated_depsgraph_get().object_instances))
 elif spec.get("grease_pencil"):  # a Grease Pencil stroke 2 units before the camera (4.5+)
     from mathutils import Vector
     bpy.ops.object.grease_pencil_add(type="STROKE",
