@@ -46,8 +46,7 @@ _watched = {}
 # name: {"depth": array, "normal": array or None}}, "seconds": float}}.
 _taken = {}
 _extras = {}  # {main scene pointer: [its extra renders' scene pointers]}
-# Layers an engine writes in render_frame_finish(): {engine pointer: [(scene, layer)]}.
-_later = {}
+_later = {}  # layers written in render_frame_finish(): {engine pointer: [(scene, layer)]}
 
 
 def _engine_class(engine_name):
@@ -140,7 +139,8 @@ def watch(scene, layers, extras=()):
     the `extras` [(scene, layers)] that its render renders as well
     (extra_renders.py); what a previous frame left is dropped."""
     forget(scene)
-    if not _watch_one(scene, layers) or _grease_pencil_in_use():  # (one scan a frame)
+    # the scan once a frame, and only where a capture would be taken; then
+    if not _watch_one(scene, layers) or _grease_pencil_in_use():  # undo _watch_one
         return forget(scene)
     for extra, extra_layers in extras:
         _forget_pointer(extra.as_pointer())

@@ -140,7 +140,6 @@ if spec.get("position_pass"):  # Cycles' Position pass: where each pixel's surfa
     for view_layer in scene.view_layers:
         view_layer.use_pass_position = True
 if spec.get("grease_pencil") == "geometry_nodes":  # strokes made by geometry nodes (4.5+)
-    from mathutils import Vector
     maker = bpy.data.objects.new("Stroke maker", bpy.data.meshes.new("Stroke maker"))
     maker.matrix_world = scene.camera.matrix_world
     scene.collection.objects.link(maker)

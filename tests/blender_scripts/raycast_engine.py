@@ -15,7 +15,9 @@ BACKGROUND_DEPTH = 1e10  # Blender's depth where nothing was hit
 
 
 def _rays(scene, camera, width, height):
-    """Each pixel's ray direction in camera space, rows from the bottom."""
+    """The pixel centres' x (columns) and y (rows, from the bottom) on the
+    camera's view plane, and that plane's z: each pixel's ray in camera
+    space is (x, y, z)."""
     corners = camera.data.view_frame(scene=scene)  # top right, bottom right, bottom left, top left
     right, bottom, left, top = corners[0].x, corners[1].y, corners[2].x, corners[0].y
     depth = corners[0].z
