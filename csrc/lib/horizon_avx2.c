@@ -107,6 +107,14 @@ static inline int pair_any(pair_f m) {
 static inline pair_f pair_select(pair_f m, pair_f a, pair_f b) {
     return (pair_f){_mm256_blendv_ps(a.lo, b.lo, m.lo), _mm256_blendv_ps(a.hi, b.hi, m.hi)};
 }
+/* the least lane (no NaN lane) */
+static inline float pair_least(pair_f a) {
+    __m256 m = _mm256_min_ps(a.lo, a.hi);
+    m = _mm256_min_ps(m, _mm256_permute2f128_ps(m, m, 1));
+    m = _mm256_min_ps(m, _mm256_shuffle_ps(m, m, _MM_SHUFFLE(1, 0, 3, 2)));
+    m = _mm256_min_ps(m, _mm256_shuffle_ps(m, m, _MM_SHUFFLE(2, 3, 0, 1)));
+    return _mm256_cvtss_f32(m);
+}
 static inline pair_i pair_lanes(void) {
     return (pair_i){_mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7),
                     _mm256_setr_epi32(8, 9, 10, 11, 12, 13, 14, 15)};
@@ -159,6 +167,7 @@ static inline pair_f pair_load_lanes(pair_f m, const float *p, pair_f fill) {
 #define I_STOREU(p, v) pair_istoreu((int *)(p), (v))
 #define M_BITS pair_bits
 #define V_MIN pair_min
+#define V_LEAST pair_least
 #define V_CEIL pair_ceil
 #define V_FLOOR pair_floor
 #define I_SUB pair_isub

@@ -47,6 +47,7 @@
 #define M_BITS(m) ((int)(m))
 
 #define V_MIN _mm512_min_ps
+#define V_LEAST _mm512_reduce_min_ps /* the least lane (no NaN lane) */
 #define V_CEIL(a) _mm512_roundscale_ps((a), _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC)
 #define V_FLOOR(a) _mm512_roundscale_ps((a), _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC)
 #define I_SUB _mm512_sub_epi32
