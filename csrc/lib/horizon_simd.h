@@ -40,14 +40,10 @@ static inline VF SIMD_NAME(dot3)(VF a0, VF a1, VF a2, VF b0, VF b1, VF b2) {
 static inline VF SIMD_NAME(acos_of_magnitude)(VF x) {
     const VM negative = V_LT(x, V_SET(0.0f));
     const VF ax = V_SELECT(negative, x, V_NEG(x));
-    VF p = V_SET(-0.0012624911f);
-    p = V_ADD(V_MUL(p, ax), V_SET(0.0066700901f));
-    p = V_SUB(V_MUL(p, ax), V_SET(0.0170881256f));
-    p = V_ADD(V_MUL(p, ax), V_SET(0.0308918810f));
-    p = V_SUB(V_MUL(p, ax), V_SET(0.0501743046f));
-    p = V_ADD(V_MUL(p, ax), V_SET(0.0889789874f));
-    p = V_SUB(V_MUL(p, ax), V_SET(0.2145988016f));
-    p = V_ADD(V_MUL(p, ax), V_SET(1.5707963050f));
+    VF p = V_SET(HBAO_ACOS_A3);
+    p = V_ADD(V_MUL(p, ax), V_SET(HBAO_ACOS_A2));
+    p = V_ADD(V_MUL(p, ax), V_SET(HBAO_ACOS_A1));
+    p = V_ADD(V_MUL(p, ax), V_SET(HBAO_ACOS_A0));
     const VF one_minus = V_SUB(V_SET(1.0f), ax);
     const VF root = V_ZERO_UNLESS(V_GT(one_minus, V_SET(0.0f)), V_SQRT(one_minus));
     return V_MUL(root, p);
