@@ -115,6 +115,17 @@ static inline float pair_least(pair_f a) {
     m = _mm256_min_ps(m, _mm256_shuffle_ps(m, m, _MM_SHUFFLE(2, 3, 0, 1)));
     return _mm256_cvtss_f32(m);
 }
+static inline pair_f pair_set_halves(float a, float b) {
+    return (pair_f){_mm256_set1_ps(a), _mm256_set1_ps(b)};
+}
+static inline void pair_store_halves(float *p, float *q, pair_f a) {
+    _mm256_storeu_ps(p, a.lo);
+    _mm256_storeu_ps(q, a.hi);
+}
+static inline void pair_istore_halves(int *p, int *q, pair_i a) {
+    _mm256_storeu_si256((__m256i *)p, a.lo);
+    _mm256_storeu_si256((__m256i *)q, a.hi);
+}
 static inline pair_i pair_lanes(void) {
     return (pair_i){_mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7),
                     _mm256_setr_epi32(8, 9, 10, 11, 12, 13, 14, 15)};
@@ -168,6 +179,9 @@ static inline pair_f pair_load_lanes(pair_f m, const float *p, pair_f fill) {
 #define M_BITS pair_bits
 #define V_MIN pair_min
 #define V_LEAST pair_least
+#define V_SET_HALVES pair_set_halves
+#define V_STORE_HALVES pair_store_halves
+#define I_STORE_HALVES pair_istore_halves
 #define V_CEIL pair_ceil
 #define V_FLOOR pair_floor
 #define I_SUB pair_isub

@@ -47,6 +47,18 @@
 #define M_BITS(m) ((int)(m))
 
 #define V_MIN _mm512_min_ps
+/* lanes 0-7 a, lanes 8-15 b; the low and the high 8 lanes stored to p and q */
+#define V_SET_HALVES(a, b) _mm512_mask_blend_ps(0xff00, _mm512_set1_ps(a), _mm512_set1_ps(b))
+static inline void store_halves_avx512(float *p, float *q, __m512 v) {
+    _mm256_storeu_ps(p, _mm512_castps512_ps256(v));
+    _mm256_storeu_ps(q, _mm256_castpd_ps(_mm512_extractf64x4_pd(_mm512_castps_pd(v), 1)));
+}
+static inline void istore_halves_avx512(int *p, int *q, __m512i v) {
+    _mm256_storeu_si256((__m256i *)p, _mm512_castsi512_si256(v));
+    _mm256_storeu_si256((__m256i *)q, _mm512_extracti64x4_epi64(v, 1));
+}
+#define V_STORE_HALVES store_halves_avx512
+#define I_STORE_HALVES istore_halves_avx512
 #define V_LEAST _mm512_reduce_min_ps /* the least lane (no NaN lane) */
 #define V_CEIL(a) _mm512_roundscale_ps((a), _MM_FROUND_TO_POS_INF | _MM_FROUND_NO_EXC)
 #define V_FLOOR(a) _mm512_roundscale_ps((a), _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC)

@@ -13,7 +13,9 @@
  * M_ANDNOT(a, b) = ~a & b, M_ANY, M_NONE() (no lane); V_SELECT(m, a, b) = m ? b : a;
  * V_ZERO_UNLESS(m, v); I_SET I_ADD I_MULLO I_LANES (0, 1, ...) I_TO_F; V_CVTT
  * (truncating float -> int32); V_FLOOR; I_STOREU; M_BITS(m) (lane k -> bit k);
- * V_LEAST(v): the least lane, where no lane is NaN;
+ * V_LEAST(v): the least lane, where no lane is NaN; V_SET_HALVES(a, b) (a in
+ * the low half of the lanes, b in the high), V_STORE_HALVES(p, q, v) and
+ * I_STORE_HALVES (the low half of the lanes to p, the high to q);
  * for the back layer's sector masks: V_MIN V_CEIL, I_SUB I_AND I_OR
  * I_ANDNOT(a, b) = ~a & b, I_SLLV (per-lane shift, 0 from 32 on) I_SRLI,
  * I_ZERO_UNLESS(m, v); I_SRAI (arithmetic shift) for the steps' indices;
@@ -189,60 +191,153 @@ static inline VI SIMD_NAME(floor_to_int)(VF x) {
     return V_CVTT(V_FLOOR(x));
 }
 
+/* One vector of steps of plan_steps: each lane one step of direction (dc,
+ * ds) (lane by lane: plan_two plans two directions in one vector), step
+ * index `step`: hbao_step_offset with the same float operations, and what
+ * a plain step's fetch needs. */
+typedef struct SIMD_NAME(step_lanes) {
+    VF x, y;     /* the offsets, as floats */
+    VI ox, oy;   /* and as whole pixels */
+    VI index;    /* the lanes' depths in phase_depth (for plain steps) */
+    VF row;      /* the samples' grid row (hbao_grid_y) */
+    VF ox_float; /* ox, as floats (exact) */
+    VM row_inside;
+} SIMD_NAME(step_lanes);
+
+static inline void SIMD_NAME(step_lanes_of)(const SIMD_NAME(block) * b, VF step, VF dc, VF ds,
+                                            SIMD_NAME(step_lanes) * v) {
+    const hbao_grid *g = b->grid;
+    const VF along = V_ADD(V_SET(1.0f), V_MUL(V_ADD(step, V_SET(b->jitter)), V_SET(b->step_px)));
+    v->x = V_ADD(V_SET(0.5f), V_MUL(dc, along));
+    v->y = V_SUB(V_SET(0.5f), V_MUL(V_MUL(ds, along), V_SET(b->inv_ycor)));
+    v->ox = SIMD_NAME(floor_to_int)(v->x);
+    v->oy = SIMD_NAME(floor_to_int)(v->y);
+    const VI sj = I_ADD(I_SET(b->j), v->oy);
+    const VF sj_float = I_TO_F(sj);
+    v->ox_float = I_TO_F(v->ox);
+    v->row_inside = M_AND(V_GE(sj_float, V_SET(0.0f)), V_LT(sj_float, V_SET((float)g->height)));
+    /* lane k samples column first_i + 4 k + ox: phase (phase + ox) mod
+     * 4, index first_x + k + floor((phase + ox) / 4) of that phase's row */
+    const VI moved = I_ADD(I_SET(b->phase), v->ox);
+    const VI row_index = I_ADD(I_MULLO(I_AND(moved, I_SET(3)), I_SET(g->height)), sj);
+    v->index = I_ADD(I_MULLO(row_index, I_SET(b->job->phase_width)),
+                     I_ADD(I_SET(b->first_x), I_SRAI(moved, 2)));
+    v->row = V_MUL(V_ADD(sj_float, V_SET(g->y_offset)), V_SET(g->y_step));
+}
+
+/* The lanes whose step is plain: the sample row inside, and lane 0's and
+ * the last lane's columns (exact small integers as floats). */
+static inline unsigned SIMD_NAME(plain_bits)(const SIMD_NAME(block) * b,
+                                             const SIMD_NAME(step_lanes) * v) {
+    const VF column0 = V_ADD(V_SET((float)b->first_i), v->ox_float);
+    const VM plain =
+        M_AND(v->row_inside, M_AND(V_GE(column0, V_SET(0.0f)),
+                                   V_LT(V_ADD(column0, V_SET((float)(4 * (SIMD_LANES - 1)))),
+                                        V_SET((float)b->grid->width))));
+    return (unsigned)M_BITS(plain);
+}
+
+/* The lanes whose step lies less than an image away. A plain step does:
+ * 0 <= first_i + ox and first_i + ox + 4 (SIMD_LANES - 1) < width give
+ * 1 - width <= -first_i <= ox <= x < ox + 1 <= width, and 0 <= j + oy <
+ * height the same of y; so where every step is plain the test is left out
+ * (bench_ab_pairs.sh, 1080p, Zen 5, 1 thread, against testing every plan:
+ * 0.986 at the defaults, 0.987 at 8 x 6 + blur 15; session 45). */
+static inline unsigned SIMD_NAME(inside_bits)(const hbao_grid *g, const SIMD_NAME(step_lanes) * v) {
+    const VM inside = M_AND(
+        M_AND(V_GE(v->x, V_SET((float)(1 - g->width))), V_LT(v->x, V_SET((float)g->width))),
+        M_AND(V_GE(v->y, V_SET((float)(1 - g->height))), V_LT(v->y, V_SET((float)g->height))));
+    return (unsigned)M_BITS(inside);
+}
+
+/* t's count and plain_end from the first `count` lanes' bits (plain:
+ * plain_bits, or 0 where indices may overflow; inside: inside_bits, or
+ * all where every lane is plain), for steps first .. first + count - 1;
+ * returns 1 where the plan goes on. */
+static inline int SIMD_NAME(plan_counts)(SIMD_NAME(steps) * t, int first, int count, unsigned plain,
+                                         unsigned inside) {
+    const unsigned wanted = (count == 32 ? 0u : 1u << count) - 1u;
+    if (t->plain_end == first) {
+        const unsigned run = ~plain & wanted;
+        t->plain_end = first + (run == 0 ? count : __builtin_ctz(run));
+    }
+    const unsigned outside = ~inside & wanted;
+    if (outside == 0) return 1;
+    t->count = first + __builtin_ctz(outside);
+    return 0;
+}
+
+/* Whether each step of t samples another pixel than the one before
+ * (steps.distinct), for direction (dc, ds) of block b. */
+static inline void SIMD_NAME(plan_distinct)(const SIMD_NAME(block) * b, float dc, float ds,
+                                            SIMD_NAME(steps) * t) {
+    const float moves = fmaxf(fabsf(dc), fabsf(ds) * b->inv_ycor) * b->step_px;
+    t->distinct = moves >= 1.0625f && t->count > 0 && (t->ox[0] | t->oy[0]) != 0;
+}
+
 /* hbao_step_offset for SIMD_LANES steps at once, each lane one step, with
  * the same float operations, and the plain steps' fetch data, for block b. */
 static inline void SIMD_NAME(plan_steps)(const SIMD_NAME(block) * b, float dc, float ds, int steps,
                                          SIMD_NAME(steps) * t) {
-    const hbao_grid *g = b->grid;
-    const int phase_width = b->job->phase_width;
     t->count = steps;
     t->plain_end = 0;
     for (int first = 0; first < steps; first += SIMD_LANES) {
-        const VF step = I_TO_F(I_ADD(I_SET(first), I_LANES));
-        const VF along =
-            V_ADD(V_SET(1.0f), V_MUL(V_ADD(step, V_SET(b->jitter)), V_SET(b->step_px)));
-        const VF x = V_ADD(V_SET(0.5f), V_MUL(V_SET(dc), along));
-        const VF y = V_SUB(V_SET(0.5f), V_MUL(V_MUL(V_SET(ds), along), V_SET(b->inv_ycor)));
-        const VM inside =
-            M_AND(M_AND(V_GE(x, V_SET((float)(1 - g->width))), V_LT(x, V_SET((float)g->width))),
-                  M_AND(V_GE(y, V_SET((float)(1 - g->height))), V_LT(y, V_SET((float)g->height))));
-        const VI ox = SIMD_NAME(floor_to_int)(x), oy = SIMD_NAME(floor_to_int)(y);
-        I_STOREU(t->ox + first, ox);
-        I_STOREU(t->oy + first, oy);
-        const VI sj = I_ADD(I_SET(b->j), oy);
-        const VF sj_float = I_TO_F(sj);
-        const VF ox_float = I_TO_F(ox);
-        const VM row_inside =
-            M_AND(V_GE(sj_float, V_SET(0.0f)), V_LT(sj_float, V_SET((float)g->height)));
-        /* lane k samples column first_i + 4 k + ox: phase (phase + ox) mod
-         * 4, index first_x + k + floor((phase + ox) / 4) of that phase's row */
-        const VI moved = I_ADD(I_SET(b->phase), ox);
-        const VI row_index = I_ADD(I_MULLO(I_AND(moved, I_SET(3)), I_SET(g->height)), sj);
-        I_STOREU(t->index + first, I_ADD(I_MULLO(row_index, I_SET(phase_width)),
-                                         I_ADD(I_SET(b->first_x), I_SRAI(moved, 2))));
-        V_STOREU(t->row + first, V_MUL(V_ADD(sj_float, V_SET(g->y_offset)), V_SET(g->y_step)));
-        V_STOREU(t->ox_float + first, ox_float);
+        SIMD_NAME(step_lanes) v;
+        SIMD_NAME(step_lanes_of)
+        (b, I_TO_F(I_ADD(I_SET(first), I_LANES)), V_SET(dc), V_SET(ds), &v);
+        I_STOREU(t->ox + first, v.ox);
+        I_STOREU(t->oy + first, v.oy);
+        I_STOREU(t->index + first, v.index);
+        V_STOREU(t->row + first, v.row);
+        V_STOREU(t->ox_float + first, v.ox_float);
         const int count = steps - first < SIMD_LANES ? steps - first : SIMD_LANES;
         const unsigned wanted = (count == 32 ? 0u : 1u << count) - 1u;
+        int every_lane_plain = 0;
         if (t->plain_end == first && b->job->int_indices) {
-            /* plain: the sample row inside, and lane 0's and the last
-             * lane's columns (exact small integers as floats) */
-            const VF column0 = V_ADD(V_SET((float)b->first_i), ox_float);
-            const VM plain =
-                M_AND(row_inside, M_AND(V_GE(column0, V_SET(0.0f)),
-                                        V_LT(V_ADD(column0, V_SET((float)(4 * (SIMD_LANES - 1)))),
-                                             V_SET((float)g->width))));
-            const unsigned run = ~(unsigned)M_BITS(plain) & wanted;
+            const unsigned run = ~SIMD_NAME(plain_bits)(b, &v) & wanted;
             t->plain_end = first + (run == 0 ? count : __builtin_ctz(run));
+            every_lane_plain = run == 0;
         }
-        const unsigned outside = ~(unsigned)M_BITS(inside) & wanted;
+        if (every_lane_plain) continue; /* inside_bits: a plain step lies inside */
+        const unsigned outside = ~SIMD_NAME(inside_bits)(b->grid, &v) & wanted;
         if (outside != 0) {
             t->count = first + __builtin_ctz(outside);
             break;
         }
     }
-    const float moves = fmaxf(fabsf(dc), fabsf(ds) * b->inv_ycor) * b->step_px;
-    t->distinct = moves >= 1.0625f && t->count > 0 && (t->ox[0] | t->oy[0]) != 0;
+    SIMD_NAME(plan_distinct)(b, dc, ds, t);
+}
+
+/* plan_steps for two directions at once, (dc0, ds0) into *t0 and (dc1,
+ * ds1) into *t1, where their steps fit in half a vector (steps <=
+ * SIMD_LANES / 2): the lanes of each half are one direction's, with the
+ * same float operations, so each plan is plan_steps', exactly. A plan was
+ * a tenth of the frame at 8 x 6, whose 6 steps left 10 of 16 lanes idle.
+ * With block_ao's copies for one and two layers (below), against a plan
+ * each (bench_ab_pairs.sh, 1080p, Zen 5), 8 x 6 + blur 15: 0.938 on 1
+ * thread, 0.947 on 2, AVX2 0.895; session 45. */
+static inline void SIMD_NAME(plan_two)(const SIMD_NAME(block) * b, float dc0, float ds0, float dc1,
+                                       float ds1, int steps, SIMD_NAME(steps) * t0,
+                                       SIMD_NAME(steps) * t1) {
+    enum { half = SIMD_LANES / 2 };
+    SIMD_NAME(step_lanes) v;
+    SIMD_NAME(step_lanes_of)
+    (b, I_TO_F(I_AND(I_LANES, I_SET(half - 1))), V_SET_HALVES(dc0, dc1), V_SET_HALVES(ds0, ds1),
+     &v);
+    I_STORE_HALVES(t0->ox, t1->ox, v.ox);
+    I_STORE_HALVES(t0->oy, t1->oy, v.oy);
+    I_STORE_HALVES(t0->index, t1->index, v.index);
+    V_STORE_HALVES(t0->row, t1->row, v.row);
+    V_STORE_HALVES(t0->ox_float, t1->ox_float, v.ox_float);
+    const unsigned wanted = (1u << steps) - 1u, both = wanted | wanted << half;
+    const unsigned plain = b->job->int_indices ? SIMD_NAME(plain_bits)(b, &v) : 0u;
+    const unsigned inside = (~plain & both) == 0 ? both : SIMD_NAME(inside_bits)(b->grid, &v);
+    t0->count = t1->count = steps;
+    t0->plain_end = t1->plain_end = 0;
+    SIMD_NAME(plan_counts)(t0, 0, steps, plain, inside);
+    SIMD_NAME(plan_counts)(t1, 0, steps, plain >> half, inside >> half);
+    SIMD_NAME(plan_distinct)(b, dc0, ds0, t0);
+    SIMD_NAME(plan_distinct)(b, dc1, ds1, t1);
 }
 
 /* The plain steps' depths, asked of the memory as soon as the steps are
@@ -951,6 +1046,27 @@ static VF SIMD_NAME(direction_occlusion_hbao_layers)(const hbao_settings *s,
  * 1.013, 8 x 6 + blur 15 0.970 and 0.974. 8 ahead instead of 4: 16
  * directions 0.988, 4 and 8 directions 1.003-1.013. */
 #define SIMD_PLAN_AHEAD 4
+_Static_assert(SIMD_PLAN_AHEAD % 2 == 0, "plan_two's two plans are neighbours in the ring");
+
+/* Plans direction k of a group (its cosines and sines) into
+ * plans[k % SIMD_PLAN_AHEAD] and prefetches its steps' depths; where
+ * `left` (the directions from k on) is at least 2 and steps fit in half a
+ * vector, direction k + 1 too (plan_two). */
+static inline __attribute__((always_inline)) void
+SIMD_NAME(plan_ahead)(const SIMD_NAME(block) * b, const float *group_cos, const float *group_sin,
+                      int k, int left, int steps, SIMD_NAME(steps) * plans) {
+    SIMD_NAME(steps) *t = &plans[k % SIMD_PLAN_AHEAD];
+    if (left >= 2 && steps <= SIMD_LANES / 2) {
+        SIMD_NAME(plan_two)
+        (b, group_cos[k], group_sin[k], group_cos[k + 1], group_sin[k + 1], steps, t, t + 1);
+        SIMD_NAME(prefetch_steps)(b, t);
+        SIMD_NAME(prefetch_steps)(b, t + 1);
+    } else {
+        SIMD_NAME(plan_steps)(b, group_cos[k], group_sin[k], steps, t);
+        SIMD_NAME(prefetch_steps)(b, t);
+    }
+}
+
 #if SIMD_PAIRED_DIRECTIONS > SIMD_DIRECTION_GROUP
 #define SIMD_SLICE_ROOM SIMD_PAIRED_DIRECTIONS
 #else
@@ -1045,16 +1161,17 @@ static inline VM SIMD_NAME(lane_mask)(unsigned lanes) {
 /* The AO of the lanes `lanes` (a class: hbao_block_classes; bit k: lane k)
  * of the block of phase a at x0 in row j (its pixels before x1), with the
  * class's step step_px: each direction's steps are planned, then searched.
- * Writes those lanes' pixels only. */
-static void SIMD_NAME(block_ao)(const hbao_horizon_job *job, int x0, int x1, int j, int a,
-                                float step_px, unsigned lanes_wanted) {
+ * Writes those lanes' pixels only. layers: whether the job has a back
+ * layer (job->phase_back), a constant in each of block_ao's copies. */
+static inline __attribute__((always_inline)) void
+SIMD_NAME(block_ao_copy)(const hbao_horizon_job *job, int x0, int x1, int j, int a, float step_px,
+                         unsigned lanes_wanted, const int layers) {
     const hbao_settings *s = job->settings;
     SIMD_NAME(block) b;
     VM active = SIMD_NAME(block_setup)(job, x0, j, a, step_px, &b);
     if (lanes_wanted != SIMD_ALL_LANES) active = M_AND(active, SIMD_NAME(lane_mask)(lanes_wanted));
     const int live = M_ANY(active);
     const int cosine = s->integration == HBAO_INTEGRATION_COSINE;
-    const int layers = job->phase_back != NULL;
     VF occlusion_sum = V_SET(0.0f), visible_sum = V_SET(0.0f), open_sum = V_SET(0.0f);
     const int cell = a + 4 * (j & 3);
     const float *direction_cos = job->direction_cos[cell];
@@ -1083,21 +1200,24 @@ static void SIMD_NAME(block_ao)(const hbao_horizon_job *job, int x0, int x1, int
             }
         }
         SIMD_NAME(steps) plans[SIMD_PLAN_AHEAD];
-        for (int k = 0; k < count && k < SIMD_PLAN_AHEAD; k++) {
-            SIMD_NAME(plan_steps)
-            (&b, direction_cos[first + k], direction_sin[first + k], s->steps, &plans[k]);
-            SIMD_NAME(prefetch_steps)(&b, &plans[k]);
+        const float *group_cos = direction_cos + first, *group_sin = direction_sin + first;
+        const int by_two = s->steps <= SIMD_LANES / 2; /* two directions a plan_two */
+        for (int k = 0; k < count && k < SIMD_PLAN_AHEAD; k += by_two ? 2 : 1) {
+            SIMD_NAME(plan_ahead)
+            (&b, group_cos, group_sin, k, by_two ? count - k : 1, s->steps, plans);
         }
         for (int k = 0; k < count; k++) {
             const SIMD_NAME(slice) *sl = &slices[k];
             const VM lanes = cosine ? M_AND(active, sl->usable) : active;
             SIMD_NAME(steps) *t = &plans[k % SIMD_PLAN_AHEAD];
-            const int next = k + SIMD_PLAN_AHEAD - 1; /* into the plan of direction k - 1 */
-            if (k > 0 && next < count) {
-                SIMD_NAME(steps) *later = &plans[next % SIMD_PLAN_AHEAD];
-                SIMD_NAME(plan_steps)
-                (&b, direction_cos[first + next], direction_sin[first + next], s->steps, later);
-                SIMD_NAME(prefetch_steps)(&b, later);
+            if (by_two) { /* at an even k, k + 2 and k + 3 into the plans of k - 2 and k - 1 */
+                if (k >= 2 && k % 2 == 0 && k + 2 < count) {
+                    SIMD_NAME(plan_ahead)
+                    (&b, group_cos, group_sin, k + 2, count - (k + 2), s->steps, plans);
+                }
+            } else if (k > 0 && k + SIMD_PLAN_AHEAD - 1 < count) { /* into the plan of k - 1 */
+                SIMD_NAME(plan_ahead)
+                (&b, group_cos, group_sin, k + SIMD_PLAN_AHEAD - 1, 1, s->steps, plans);
             }
             if (!M_ANY(lanes)) continue;
             if (cosine) {
@@ -1139,6 +1259,37 @@ static void SIMD_NAME(block_ao)(const hbao_horizon_job *job, int x0, int x1, int
         if (i < x1 && (lanes_wanted == SIMD_ALL_LANES || (lanes_wanted >> k & 1u)))
             out[i] = result[k];
     }
+}
+
+/* block_ao's two copies, for one depth layer and for two, each with
+ * everything inlined and the block's state in registers. Since plan_two
+ * (which only a plan of up to half a vector of steps takes) the choices
+ * made as the block is searched had made one function's code slower at
+ * the defaults, and one copy for each way of planning 1.10 of the time
+ * with back faces. Against block_ao as one function before plan_two
+ * (bench_ab_pairs.sh, 1080p, Zen 5, plan_two included): the defaults
+ * 0.970 on 1 thread and 0.980 on 2, half resolution 0.972, back faces
+ * 1.017 (AVX2 0.946). */
+static __attribute__((noinline)) void SIMD_NAME(block_ao_one_layer)(const hbao_horizon_job *job,
+                                                                    int x0, int x1, int j, int a,
+                                                                    float step_px,
+                                                                    unsigned lanes_wanted) {
+    SIMD_NAME(block_ao_copy)(job, x0, x1, j, a, step_px, lanes_wanted, 0);
+}
+
+static __attribute__((noinline)) void SIMD_NAME(block_ao_two_layers)(const hbao_horizon_job *job,
+                                                                     int x0, int x1, int j, int a,
+                                                                     float step_px,
+                                                                     unsigned lanes_wanted) {
+    SIMD_NAME(block_ao_copy)(job, x0, x1, j, a, step_px, lanes_wanted, 1);
+}
+
+static inline void SIMD_NAME(block_ao)(const hbao_horizon_job *job, int x0, int x1, int j, int a,
+                                       float step_px, unsigned lanes_wanted) {
+    if (job->phase_back != NULL)
+        SIMD_NAME(block_ao_two_layers)(job, x0, x1, j, a, step_px, lanes_wanted);
+    else
+        SIMD_NAME(block_ao_one_layer)(job, x0, x1, j, a, step_px, lanes_wanted);
 }
 
 /* The block's row of phase_depth (its depths, padded with background
