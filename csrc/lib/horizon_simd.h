@@ -238,9 +238,12 @@ static inline unsigned SIMD_NAME(plain_bits)(const SIMD_NAME(block) * b,
 }
 
 /* The lanes whose step lies less than an image away. A plain step does:
- * 0 <= first_i + ox and first_i + ox + 4 (SIMD_LANES - 1) < width give
- * 1 - width <= -first_i <= ox <= x < ox + 1 <= width, and 0 <= j + oy <
- * height the same of y; so where every step is plain the test is left out
+ * lane 0 of a searched block lies inside the image (0 <= first_i < width,
+ * 0 <= j < height: its block has a foreground lane, and phase_depth's
+ * padding is background), so 0 <= first_i + ox and first_i + ox +
+ * 4 (SIMD_LANES - 1) < width give 1 - width <= -first_i <= ox <= x < ox +
+ * 1 <= width, and 0 <= j + oy < height the same of y; so where every step
+ * is plain the test is left out
  * (bench_ab_pairs.sh, 1080p, Zen 5, 1 thread, against testing every plan:
  * 0.986 at the defaults, 0.987 at 8 x 6 + blur 15; session 45). */
 static inline unsigned SIMD_NAME(inside_bits)(const hbao_grid *g, const SIMD_NAME(step_lanes) * v) {
@@ -250,21 +253,16 @@ static inline unsigned SIMD_NAME(inside_bits)(const hbao_grid *g, const SIMD_NAM
     return (unsigned)M_BITS(inside);
 }
 
-/* t's count and plain_end from the first `count` lanes' bits (plain:
- * plain_bits, or 0 where indices may overflow; inside: inside_bits, or
- * all where every lane is plain), for steps first .. first + count - 1;
- * returns 1 where the plan goes on. */
-static inline int SIMD_NAME(plan_counts)(SIMD_NAME(steps) * t, int first, int count, unsigned plain,
-                                         unsigned inside) {
-    const unsigned wanted = (count == 32 ? 0u : 1u << count) - 1u;
-    if (t->plain_end == first) {
-        const unsigned run = ~plain & wanted;
-        t->plain_end = first + (run == 0 ? count : __builtin_ctz(run));
-    }
-    const unsigned outside = ~inside & wanted;
-    if (outside == 0) return 1;
-    t->count = first + __builtin_ctz(outside);
-    return 0;
+/* plan_two's t: its count and plain_end from the bits of its `steps`
+ * lanes (steps <= SIMD_LANES / 2; plain: plain_bits, or 0 where indices
+ * may overflow; inside: inside_bits, or all where every lane is plain),
+ * as plan_steps sets them. */
+static inline void SIMD_NAME(plan_counts)(SIMD_NAME(steps) * t, int steps, unsigned plain,
+                                          unsigned inside) {
+    const unsigned wanted = (1u << steps) - 1u;
+    const unsigned run = ~plain & wanted, outside = ~inside & wanted;
+    t->plain_end = run == 0 ? steps : __builtin_ctz(run);
+    t->count = outside == 0 ? steps : __builtin_ctz(outside);
 }
 
 /* Whether each step of t samples another pixel than the one before
@@ -332,10 +330,8 @@ static inline void SIMD_NAME(plan_two)(const SIMD_NAME(block) * b, float dc0, fl
     const unsigned wanted = (1u << steps) - 1u, both = wanted | wanted << half;
     const unsigned plain = b->job->int_indices ? SIMD_NAME(plain_bits)(b, &v) : 0u;
     const unsigned inside = (~plain & both) == 0 ? both : SIMD_NAME(inside_bits)(b->grid, &v);
-    t0->count = t1->count = steps;
-    t0->plain_end = t1->plain_end = 0;
-    SIMD_NAME(plan_counts)(t0, 0, steps, plain, inside);
-    SIMD_NAME(plan_counts)(t1, 0, steps, plain >> half, inside >> half);
+    SIMD_NAME(plan_counts)(t0, steps, plain, inside);
+    SIMD_NAME(plan_counts)(t1, steps, plain >> half, inside >> half);
     SIMD_NAME(plan_distinct)(b, dc0, ds0, t0);
     SIMD_NAME(plan_distinct)(b, dc1, ds1, t1);
 }
@@ -1044,7 +1040,10 @@ static VF SIMD_NAME(direction_occlusion_hbao_layers)(const hbao_settings *s,
  * 0.921; back faces 0.975 and 0.984; half resolution 1.020 and 0.997; 4K
  * 0.929 and 0.926; AVX2 on the same machine: defaults 1.008 and
  * 1.013, 8 x 6 + blur 15 0.970 and 0.974. 8 ahead instead of 4: 16
- * directions 0.988, 4 and 8 directions 1.003-1.013. */
+ * directions 0.988, 4 and 8 directions 1.003-1.013. Where plan_two plans
+ * two directions at once (up to 8 steps), the first four are planned
+ * before any search, then, as an even direction k >= 2 is searched, k + 2
+ * and k + 3 into the plans of k - 2 and k - 1 (plan_ahead). */
 #define SIMD_PLAN_AHEAD 4
 _Static_assert(SIMD_PLAN_AHEAD % 2 == 0, "plan_two's two plans are neighbours in the ring");
 
@@ -1158,7 +1157,7 @@ static inline VM SIMD_NAME(lane_mask)(unsigned lanes) {
 /* Every lane of a block (HBAO_BLOCK_PIXELS bits) */
 #define SIMD_ALL_LANES ((1u << HBAO_BLOCK_PIXELS) - 1u)
 
-/* The AO of the lanes `lanes` (a class: hbao_block_classes; bit k: lane k)
+/* The AO of the lanes `lanes_wanted` (a class: hbao_block_classes; bit k: lane k)
  * of the block of phase a at x0 in row j (its pixels before x1), with the
  * class's step step_px: each direction's steps are planned, then searched.
  * Writes those lanes' pixels only. layers: whether the job has a back

@@ -367,14 +367,16 @@ static inline float hbao_sine_from_cosine(float c) {
     return sqrtf(fmaxf(0.0f, 1.0f - c * c));
 }
 
-/* acos(x) for x in [-1, 1] to 6.7e-5 absolute (Abramowitz & Stegun
- * 4.4.45): the cosine integration needs an angle for every direction's
- * horizon and every slice. A&S 4.4.46 (to 2e-8, eight terms instead of
- * four) until session 45: its arc cosines were 8 % of a 1080p frame at the
- * defaults and 11 % at 8 x 6 (perf); this one moves no AO by more than
- * 2.3e-5 there (a twentieth of a half float's step near 1) and measured,
- * after / before (scripts/bench_ab_pairs.sh, Zen 5, 1 thread), 0.993 at
- * the defaults and 0.970 at 8 x 6 + blur 15. */
+/* acos(x) for x in [-1, 1] to 6.8e-5 absolute in floats (Abramowitz &
+ * Stegun 4.4.45: 6.7e-5; the largest error lies at 0, so that a slice
+ * whose projected normal points along V gets a gamma of 6.8e-5, not 0):
+ * the cosine integration needs an angle for every direction's horizon and
+ * every slice. A&S 4.4.46 (to 2e-8, eight terms instead of four) until
+ * session 45: its arc cosines were 8 % of a 1080p frame at the defaults
+ * and 11 % at 8 x 6 (perf); this one moves no AO by more than 2.3e-5 there
+ * (a twentieth of a half float's step near 1) and measured, after / before
+ * (scripts/bench_ab_pairs.sh, Zen 5, 1 thread), 0.993 at the defaults and
+ * 0.970 at 8 x 6 + blur 15. */
 #define HBAO_ACOS_A3 (-0.0187293f) /* the coefficients, x^3 first: horizon_simd.h's too */
 #define HBAO_ACOS_A2 0.0742610f
 #define HBAO_ACOS_A1 (-0.2121144f)

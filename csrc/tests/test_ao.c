@@ -975,6 +975,60 @@ TEST_CASE(simd_paths_match_scalar_reference_bit_for_bit) {
     free(normal);
 }
 
+/* The SIMD kernels plan a direction's steps a vector at a time, and two
+ * directions in one vector where the steps fit in half of it (up to 8); a
+ * group's plans are made ahead, two at a time or one (horizon_simd.h,
+ * plan_two and plan_ahead). Every step count around those halves and
+ * wholes, and direction counts below, at and above the plans kept ahead
+ * and the paired groups, against the scalar reference: perspective and
+ * orthographic, with and without a back layer, both integrations. */
+TEST_CASE(every_step_and_direction_count_matches_the_scalar_reference) {
+    scene_view view;
+    float *depth, *normal;
+    render_standard_view(boxes_scene(), 141, 97, &view, &depth, &normal);
+    const int pixels = view.width * view.height;
+    for (int k = 0; k < 60; k++) depth[(k * 7919) % pixels] = 1e10f; /* holes */
+    for (int k = 0; k < 60; k++) depth[(k * 6007) % pixels] *= 0.1f; /* specks */
+    const size_t bytes = (size_t)pixels * sizeof(float);
+    float *back = malloc(bytes);
+    for (int k = 0; k < pixels; k++)
+        back[k] = k % 3 == 0 ? 0.0f : depth[k] + 0.05f + 0.1f * (float)(k % 5);
+    const int step_counts[] = {1, 3, 7, 8, 9, 16, 17};
+    const int direction_counts[] = {1, 2, 3, 5, 8, 17};
+    const int kernels[] = {HBAO_IMPLEMENTATION_AVX2, HBAO_IMPLEMENTATION_AVX512};
+    int differing_runs = 0;
+    for (int a = 0; a < 7; a++)
+        for (int d = 0; d < 6; d++)
+            for (int variant = 0; variant < 8; variant++) {
+                hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+                p.steps = step_counts[a];
+                p.directions = direction_counts[d];
+                p.integration = variant & 1;
+                p.half_resolution = (a + d) & 1;
+                p.radius = (a + d + variant) & 2 ? 0.3f : 0.9f;
+                const float *layer = variant & 2 ? back : NULL;
+                view.camera.projection =
+                    variant & 4 ? HBAO_PROJECTION_ORTHOGRAPHIC : HBAO_PROJECTION_PERSPECTIVE;
+                p.implementation = HBAO_IMPLEMENTATION_SCALAR;
+                float *scalar = run_layers(&p, &view, depth, normal, layer);
+                for (int k = 0; k < 2; k++) {
+                    p.implementation = kernels[k];
+                    float *fast = run_layers(&p, &view, depth, normal, layer);
+                    if (memcmp(scalar, fast, bytes) != 0) {
+                        differing_runs++;
+                        printf("  %d steps, %d directions, variant %d, kernel %d differ\n", p.steps,
+                               p.directions, variant, kernels[k]);
+                    }
+                    free(fast);
+                }
+                free(scalar);
+            }
+    CHECK(differing_runs == 0);
+    free(back);
+    free(depth);
+    free(normal);
+}
+
 /* A post at the lens (depth 0.25, four columns wide, every row) in front of
  * the corner (depths 4 to 7): the pixels of the corner that share a block
  * with it and lie beyond its reach keep their AO. With one step length for
@@ -1734,6 +1788,7 @@ TEST_MAIN(TEST_ENTRY(plane_facing_camera_is_unoccluded), TEST_ENTRY(tilted_plane
           TEST_ENTRY(strength_is_a_power), TEST_ENTRY(background_never_occludes),
           TEST_ENTRY(tiny_projected_radius_gives_one),
           TEST_ENTRY(simd_paths_match_scalar_reference_bit_for_bit),
+          TEST_ENTRY(every_step_and_direction_count_matches_the_scalar_reference),
           TEST_ENTRY(a_post_at_the_lens_leaves_the_ao_of_its_blocks),
           TEST_ENTRY(a_back_layer_of_the_half_float_sky_is_no_back_layer),
           TEST_ENTRY(thin_occluders_do_not_darken_what_is_behind_them),
