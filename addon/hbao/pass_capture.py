@@ -139,8 +139,8 @@ def watch(scene, layers, extras=()):
     the `extras` [(scene, layers)] that its render renders as well
     (extra_renders.py); what a previous frame left is dropped."""
     forget(scene)
-    # the scan once a frame, and only where a capture would be taken; then
-    if not _watch_one(scene, layers) or _grease_pencil_in_use():  # undo _watch_one
+    # the Grease Pencil scan only where a capture would be taken; forget() undoes _watch_one
+    if not _watch_one(scene, layers) or _grease_pencil_in_use():
         return forget(scene)
     for extra, extra_layers in extras:
         _forget_pointer(extra.as_pointer())
