@@ -11,7 +11,10 @@
  * The blur's stages are fused per band of rows: a thread walks down its
  * band, makes each row (blurred along the row) into a ring of the last 2r+1
  * rows, and as soon as the rows a column tap needs are there, blurs down the
- * column and writes the finished row. Each row of the grid is thus read from
+ * column and writes the finished row. The AVX-512 copy blurs two rows down
+ * their columns at once (2r+2 rows in the ring), loading each row of taps
+ * once for both: the loads, not the arithmetic, bound the blur (session
+ * 46: 0.94 of one row at a time for the 15-pixel blur, docs/speed.md). Each row of the grid is thus read from
  * memory once. A band recomputes the r rows above and below it that its
  * neighbours also make; every row's values depend only on the input, so the
  * result is the same for any number of threads and any band height. */
@@ -87,6 +90,19 @@ typedef struct tap_set {
     float spatial[2 * MAX_BLUR_RADIUS + 1];
 } tap_set;
 
+/* The taps of two rows' passes down the columns, a = row j and b = row
+ * j + 1 (blur_two, blur_lanes.h): the rows j - r .. j + 1 + r inside the
+ * image in order, each with its steps from row a's (as tap_set's), its AO
+ * row in the ring, and whether it is a tap of a and of b with its spatial
+ * weight for each. */
+typedef struct tap_pair_set {
+    int count;
+    int depth_step[2 * MAX_BLUR_RADIUS + 2], normal_step[2 * MAX_BLUR_RADIUS + 2];
+    const float *ao[2 * MAX_BLUR_RADIUS + 2];
+    float spatial_a[2 * MAX_BLUR_RADIUS + 2], spatial_b[2 * MAX_BLUR_RADIUS + 2];
+    unsigned char of_a[2 * MAX_BLUR_RADIUS + 2], of_b[2 * MAX_BLUR_RADIUS + 2];
+} tap_pair_set;
+
 /* The centre row of a pass: its depth, AO and guide normals. */
 typedef struct centre_row {
     const float *z, *ao, *nx, *ny, *nz;
@@ -159,12 +175,15 @@ static int background_needs_check(const float *z, int width, float sharpness) {
     return outside;
 }
 
-/* Scratch of one band: the finished row and the ring of rows blurred
- * along themselves, width floats each. */
+/* Scratch of one band: the two finished rows and the ring of rows blurred
+ * along themselves (the rows r above a centre to r below: 2 r + 1 slots,
+ * or 2 r + 2 where two rows of centres are blurred down their columns at
+ * once; a copy that does not uses 2 r + 1, which measured 0.98 of 2 r + 2
+ * with AVX2), width floats each. */
 typedef struct band_memory {
     float *block;
-    float *finished;
-    float *ring[2 * MAX_BLUR_RADIUS + 1];
+    float *finished, *finished_b;
+    float *ring[2 * MAX_BLUR_RADIUS + 2];
 } band_memory;
 
 /* A free set of the job's pool for one band, into *m; returns its index
@@ -176,7 +195,8 @@ static int band_memory_take(finish_job *job, band_memory *m, int slots) {
     const size_t row = (size_t)job->width;
     m->block = job->pool + (size_t)set * job->pool_set_floats;
     m->finished = m->block;
-    for (int s = 0; s < slots; s++) m->ring[s] = m->finished + (1 + (size_t)s) * row;
+    m->finished_b = m->block + row;
+    for (int s = 0; s < slots; s++) m->ring[s] = m->finished + (2 + (size_t)s) * row;
     return set;
 }
 
@@ -207,9 +227,9 @@ static HBAO_ALWAYS_INLINE void row_pass(const finish_job *job, int j, tap_set *t
 
 /* The taps and centres of row j's pass down the column (radius > 0): rows
  * j - r .. j + r of the ring. */
-static HBAO_ALWAYS_INLINE void column_pass(const finish_job *job, const band_memory *m, int j,
-                                           tap_set *taps, centre_row *c) {
-    const int width = job->width, radius = job->radius, slots = 2 * radius + 1;
+static HBAO_ALWAYS_INLINE void column_pass(const finish_job *job, const band_memory *m, int slots,
+                                           int j, tap_set *taps, centre_row *c) {
+    const int width = job->width, radius = job->radius;
     taps->count = 0;
     taps->along_row = 0;
     const normal_row n = normals_of_row(job->grid, j);
@@ -222,6 +242,26 @@ static HBAO_ALWAYS_INLINE void column_pass(const finish_job *job, const band_mem
         taps->count++;
     }
     *c = (centre_row){job->depth + (size_t)j * width, m->ring[j % slots], n.nx, n.ny, n.nz};
+}
+
+/* The taps of rows j and j + 1's passes down the columns (radius > 0,
+ * j + 1 < height): tap_pair_set. */
+static HBAO_ALWAYS_INLINE void column_pair_pass(const finish_job *job, const band_memory *m,
+                                                int slots, int j, tap_pair_set *pairs) {
+    const int width = job->width, radius = job->radius;
+    const normal_row n = normals_of_row(job->grid, j);
+    pairs->count = 0;
+    for (int k = -radius; k <= radius + 1; k++) {
+        if (j + k < 0 || j + k >= job->height) continue;
+        const int t = pairs->count++;
+        pairs->depth_step[t] = k * width;
+        pairs->normal_step[t] = (int)(normals_of_row(job->grid, j + k).nx - n.nx);
+        pairs->ao[t] = m->ring[(j + k) % slots];
+        pairs->of_a[t] = k != 0 && k <= radius;
+        pairs->of_b[t] = k != 1 && k >= 1 - radius;
+        pairs->spatial_a[t] = job->spatial[k < 0 ? -k : k > radius ? 0 : k];
+        pairs->spatial_b[t] = job->spatial[k - 1 < 0 ? 1 - k > radius ? 0 : 1 - k : k - 1];
+    }
 }
 
 /* A finished row of AO (1 on background, where zc <= 0) to the output:
@@ -258,6 +298,7 @@ static HBAO_ALWAYS_INLINE void write_output(const float *zc, const float *ao, in
 #define BLUR_LANES 16
 #define BLUR_GROUPS 1
 #define BLUR_SKIPS_CHECK 0
+#define BLUR_TWO_ROWS 0
 #define BLUR_NAME(name) name##_portable
 #define BLUR_TARGET
 #include "blur_lanes.h"
@@ -266,6 +307,7 @@ static HBAO_ALWAYS_INLINE void write_output(const float *zc, const float *ao, in
 #define BLUR_LANES 8
 #define BLUR_GROUPS 2
 #define BLUR_SKIPS_CHECK 1
+#define BLUR_TWO_ROWS 0
 #define BLUR_MIN _mm256_min_ps
 #define BLUR_MAX _mm256_max_ps
 #define BLUR_NAME(name) name##_avx2
@@ -275,6 +317,7 @@ static HBAO_ALWAYS_INLINE void write_output(const float *zc, const float *ao, in
 #define BLUR_LANES 16
 #define BLUR_GROUPS 2
 #define BLUR_SKIPS_CHECK 1
+#define BLUR_TWO_ROWS 1
 #define BLUR_MIN _mm512_min_ps
 #define BLUR_MAX _mm512_max_ps
 #define BLUR_NAME(name) name##_avx512
@@ -309,7 +352,7 @@ static hbao_result blur_grid(const hbao_settings *settings, const hbao_grid *gri
     const int bands = (height + band_rows - 1) / band_rows;
     job.pool_sets = hbao_parallel_threads(settings->threads, bands);
     if (job.pool_sets < 1) job.pool_sets = 1;
-    job.pool_set_floats = (2 + 2 * (size_t)job.radius) * (size_t)job.width;
+    job.pool_set_floats = (4 + 2 * (size_t)job.radius) * (size_t)job.width;
     job.pool = hbao_scratch_take((size_t)job.pool_sets * job.pool_set_floats * sizeof(float));
     if (job.pool == NULL) return HBAO_ERROR_OUT_OF_MEMORY;
     for (int set = 0; set < job.pool_sets; set++) atomic_flag_clear(&job.pool_taken[set]);

@@ -6,7 +6,9 @@
  * vectors a step of the loop takes side by side), BLUR_SKIPS_CHECK (1: a
  * row whose background taps weigh 0 by themselves skips the test for them,
  * blur.c's background_needs_check; 0: every row tests, as the scalar
- * reference, which the tests hold the others to), BLUR_NAME(x) (the copy's
+ * reference, which the tests hold the others to), BLUR_TWO_ROWS (1: the
+ * passes down the columns run two rows of centres at once, lanes_two; 0:
+ * one, lanes), BLUR_NAME(x) (the copy's
  * names), BLUR_TARGET (its instruction set's function attribute, or
  * nothing) and, optionally, BLUR_MIN and BLUR_MAX (the instruction set's
  * minimum and maximum of two vectors of BLUR_LANES floats: a < b ? a : b
@@ -64,6 +66,51 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE VF BLUR_NAME(power)(VF base) {
     return power * power;
 }
 
+/* A centre's state: its depth, depth factor and scaled normal, and its
+ * sums (blur_pixel). */
+typedef struct BLUR_NAME(centre) {
+    VF zc, factor, cx, cy, cz, sum, weight_sum;
+} BLUR_NAME(centre);
+
+BLUR_TARGET static HBAO_ALWAYS_INLINE BLUR_NAME(centre)
+    BLUR_NAME(centre_at)(const centre_row *c, float sharpness, int at) {
+    const VF zero = {0.0f};
+    BLUR_NAME(centre) s;
+    s.zc = BLUR_NAME(load)(c->z + at);
+    const VF scaled = BLUR_NAME(select)(s.zc > 0.0f, sharpness / s.zc, zero);
+    s.factor = BLUR_NAME(select)(scaled < FLT_MAX, scaled, zero + FLT_MAX) * HBAO_BLUR_DEPTH_WEIGHT;
+    s.cx = BLUR_NAME(load)(c->nx + at) * HBAO_BLUR_NORMAL_WEIGHT;
+    s.cy = BLUR_NAME(load)(c->ny + at) * HBAO_BLUR_NORMAL_WEIGHT;
+    s.cz = BLUR_NAME(load)(c->nz + at) * HBAO_BLUR_NORMAL_WEIGHT;
+    s.sum = BLUR_NAME(load)(c->ao + at);
+    s.weight_sum = zero + 1.0f;
+    return s;
+}
+
+/* blur_pixel's tap of depth z, normal (nx, ny, nz) and AO ao */
+BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(add_tap)(BLUR_NAME(centre) * s, VF z, VF nx,
+                                                              VF ny, VF nz, VF ao, float spatial,
+                                                              int check) {
+    const VF zero = {0.0f};
+    const VF difference = (z - s->zc) * s->factor;
+    const VF facing = nx * s->cx + ny * s->cy + nz * s->cz;
+    const VF capped = BLUR_NAME(min)(facing, zero + HBAO_BLUR_NORMAL_WEIGHT);
+    const VF base = (1.0f - HBAO_BLUR_NORMAL_WEIGHT + capped) - difference * difference;
+    /* blur_pixel's "* valid": the product is finite, so times 1 is itself */
+    const VF unchecked = spatial * BLUR_NAME(power)(base);
+    const VF weight = check ? BLUR_NAME(zero_unless)(z > 0.0f, unchecked) : unchecked;
+    s->sum += weight * ao;
+    s->weight_sum += weight;
+}
+
+/* The centre's blurred value into target */
+BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(centre_done)(const BLUR_NAME(centre) * s,
+                                                                  float *target) {
+    const VF zero = {0.0f};
+    const VF blurred = BLUR_NAME(select)(s->zc > 0.0f, s->sum / s->weight_sum, zero + 1.0f);
+    memcpy(target, &blurred, sizeof blurred);
+}
+
 /* blur_pixel for pixels i .. i + groups * BLUR_LANES - 1, all of whose
  * taps lie inside the row, as `groups` vectors side by side. along_row is
  * taps->along_row as a constant, so that each pass loads only the steps it
@@ -80,44 +127,45 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(lanes)(const tap_set *taps,
                                                             const centre_row *c, float sharpness,
                                                             int i, float *target, int along_row,
                                                             int check, int groups) {
-    const VF zero = {0.0f}, one = zero + 1.0f;
-    VF zc[BLUR_GROUPS], factor[BLUR_GROUPS], cx[BLUR_GROUPS], cy[BLUR_GROUPS], cz[BLUR_GROUPS];
-    VF sum[BLUR_GROUPS], weight_sum[BLUR_GROUPS];
-    for (int g = 0; g < groups; g++) {
-        const int at = i + g * BLUR_LANES;
-        zc[g] = BLUR_NAME(load)(c->z + at);
-        const VF scaled = BLUR_NAME(select)(zc[g] > 0.0f, sharpness / zc[g], zero);
-        factor[g] =
-            BLUR_NAME(select)(scaled < FLT_MAX, scaled, zero + FLT_MAX) * HBAO_BLUR_DEPTH_WEIGHT;
-        cx[g] = BLUR_NAME(load)(c->nx + at) * HBAO_BLUR_NORMAL_WEIGHT;
-        cy[g] = BLUR_NAME(load)(c->ny + at) * HBAO_BLUR_NORMAL_WEIGHT;
-        cz[g] = BLUR_NAME(load)(c->nz + at) * HBAO_BLUR_NORMAL_WEIGHT;
-        sum[g] = BLUR_NAME(load)(c->ao + at);
-        weight_sum[g] = one;
-    }
+    BLUR_NAME(centre) centre[BLUR_GROUPS];
+    for (int g = 0; g < groups; g++)
+        centre[g] = BLUR_NAME(centre_at)(c, sharpness, i + g * BLUR_LANES);
     for (int t = 0; t < taps->count; t++) {
         for (int g = 0; g < groups; g++) {
-            const int centre = i + g * BLUR_LANES;
-            const int at = centre + taps->depth_step[t];
-            const int normal_at = along_row ? at : centre + taps->normal_step[t];
-            const VF z = BLUR_NAME(load)(c->z + at);
-            const VF difference = (z - zc[g]) * factor[g];
-            const VF facing = BLUR_NAME(load)(c->nx + normal_at) * cx[g] +
-                              BLUR_NAME(load)(c->ny + normal_at) * cy[g] +
-                              BLUR_NAME(load)(c->nz + normal_at) * cz[g];
-            const VF capped = BLUR_NAME(min)(facing, zero + HBAO_BLUR_NORMAL_WEIGHT);
-            const VF base = (1.0f - HBAO_BLUR_NORMAL_WEIGHT + capped) - difference * difference;
-            /* blur_pixel's "* valid": the product is finite, so times 1 is itself */
-            const VF unchecked = taps->spatial[t] * BLUR_NAME(power)(base);
-            const VF weight = check ? BLUR_NAME(zero_unless)(z > 0.0f, unchecked) : unchecked;
-            sum[g] += weight * BLUR_NAME(load)(along_row ? c->ao + at : taps->ao[t] + centre);
-            weight_sum[g] += weight;
+            const int at = i + g * BLUR_LANES + taps->depth_step[t];
+            const int normal_at = along_row ? at : i + g * BLUR_LANES + taps->normal_step[t];
+            BLUR_NAME(add_tap)
+            (&centre[g], BLUR_NAME(load)(c->z + at), BLUR_NAME(load)(c->nx + normal_at),
+             BLUR_NAME(load)(c->ny + normal_at), BLUR_NAME(load)(c->nz + normal_at),
+             BLUR_NAME(load)(along_row ? c->ao + at : taps->ao[t] + i + g * BLUR_LANES),
+             taps->spatial[t], check);
         }
     }
-    for (int g = 0; g < groups; g++) {
-        const VF blurred = BLUR_NAME(select)(zc[g] > 0.0f, sum[g] / weight_sum[g], one);
-        memcpy(target + i + g * BLUR_LANES, &blurred, sizeof blurred);
+    for (int g = 0; g < groups; g++)
+        BLUR_NAME(centre_done)(&centre[g], target + i + g * BLUR_LANES);
+}
+
+/* The column passes of two rows of centres at once, a below b (a single
+ * vector of lanes each): pairs->count rows of taps, each loaded once and
+ * added to whichever of the two centres it is a tap of, in the order of
+ * their rows, as each row's own pass (lanes) adds them. Rows j - r + 1 ..
+ * j + r are taps of both; one vector each keeps both centres' state in
+ * registers. */
+BLUR_TARGET static HBAO_ALWAYS_INLINE void
+BLUR_NAME(lanes_two)(const tap_pair_set *pairs, const centre_row *a, const centre_row *b,
+                     float sharpness, int i, float *target_a, float *target_b, int check) {
+    BLUR_NAME(centre) ca = BLUR_NAME(centre_at)(a, sharpness, i);
+    BLUR_NAME(centre) cb = BLUR_NAME(centre_at)(b, sharpness, i);
+    for (int t = 0; t < pairs->count; t++) {
+        const int at = i + pairs->depth_step[t], normal_at = i + pairs->normal_step[t];
+        const VF z = BLUR_NAME(load)(a->z + at), nx = BLUR_NAME(load)(a->nx + normal_at),
+                 ny = BLUR_NAME(load)(a->ny + normal_at), nz = BLUR_NAME(load)(a->nz + normal_at),
+                 ao = BLUR_NAME(load)(pairs->ao[t] + i);
+        if (pairs->of_a[t]) BLUR_NAME(add_tap)(&ca, z, nx, ny, nz, ao, pairs->spatial_a[t], check);
+        if (pairs->of_b[t]) BLUR_NAME(add_tap)(&cb, z, nx, ny, nz, ao, pairs->spatial_b[t], check);
     }
+    BLUR_NAME(centre_done)(&ca, target_a + i);
+    BLUR_NAME(centre_done)(&cb, target_b + i);
 }
 
 /* The vector loop of a pass over pixels i .. last - 1, as far as whole
@@ -155,22 +203,50 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(blur_pass)(const tap_set *t
     for (; i < width; i++) target[i] = blur_pixel(taps, c, sharpness, width, i);
 }
 
+/* The column passes of rows a and b = a + 1 (column_pair_pass) into
+ * target_a and target_b: lanes_two over whole vectors, each row's
+ * blur_pixel for the rest. A row's check is the single pass's
+ * (blur_pass); testing where one row needs it and the other not gives the
+ * same floats (background_needs_check). */
+BLUR_TARGET static HBAO_ALWAYS_INLINE void
+BLUR_NAME(blur_two)(const tap_pair_set *pairs, const tap_set *taps_a, const centre_row *a,
+                    const tap_set *taps_b, const centre_row *b, float sharpness, int width,
+                    float *target_a, float *target_b) {
+    const int check = !BLUR_SKIPS_CHECK || background_needs_check(a->z, width, sharpness) ||
+                      background_needs_check(b->z, width, sharpness);
+    int i = 0;
+    if (check)
+        for (; i + BLUR_LANES <= width; i += BLUR_LANES)
+            BLUR_NAME(lanes_two)(pairs, a, b, sharpness, i, target_a, target_b, 1);
+    else
+        for (; i + BLUR_LANES <= width; i += BLUR_LANES)
+            BLUR_NAME(lanes_two)(pairs, a, b, sharpness, i, target_a, target_b, 0);
+    for (; i < width; i++) {
+        target_a[i] = blur_pixel(taps_a, a, sharpness, width, i);
+        target_b[i] = blur_pixel(taps_b, b, sharpness, width, i);
+    }
+}
+
 /* The copy's job for one band of output rows: each row is made (blurred
  * along itself into the ring) once a column pass needs it, then the band's
  * rows are blurred down their columns and written out. */
 BLUR_TARGET static void BLUR_NAME(finish_band)(void *context, int band) {
     finish_job *job = context;
     const int width = job->width, radius = job->radius, height = job->height;
-    const int slots = 2 * radius + 1;
+    const int slots = 2 * radius + 1 + BLUR_TWO_ROWS;
     const int first = band * job->band_rows;
     const int last = first + job->band_rows < height ? first + job->band_rows : height;
     band_memory m;
     const int set = band_memory_take(job, &m, slots);
-    tap_set taps;
-    centre_row c;
+    tap_set taps, taps_b;
+    tap_pair_set pairs;
+    centre_row c, c_b;
     int next = first - radius > 0 ? first - radius : 0; /* the next row to make */
-    for (int j = first; j < last; j++) {
-        const int needed = j + radius < height ? j + radius : height - 1;
+    /* rows two at a time down their columns where the copy does
+     * (BLUR_TWO_ROWS) and the band has two left */
+    for (int j = first; j < last; j += BLUR_TWO_ROWS && radius > 0 && j + 1 < last ? 2 : 1) {
+        const int two = BLUR_TWO_ROWS && radius > 0 && j + 1 < last;
+        const int needed = j + two + radius < height ? j + two + radius : height - 1;
         for (; next <= needed; next++) {
             float *slot = m.ring[next % slots];
             if (radius == 0) {
@@ -180,14 +256,23 @@ BLUR_TARGET static void BLUR_NAME(finish_band)(void *context, int band) {
             row_pass(job, next, &taps, &c);
             BLUR_NAME(blur_pass)(&taps, &c, job->sharpness, width, radius, slot);
         }
-        const float *blurred = m.ring[j % slots];
-        if (radius > 0) {
-            column_pass(job, &m, j, &taps, &c);
-            BLUR_NAME(blur_pass)(&taps, &c, job->sharpness, width, radius, m.finished);
-            blurred = m.finished;
+        if (radius == 0) {
+            write_output(job->depth + (size_t)j * width, m.ring[j % slots], width, job->strength,
+                         job->out + (int64_t)j * job->out_row_stride);
+            continue;
         }
-        write_output(job->depth + (size_t)j * width, blurred, width, job->strength,
-                     job->out + (int64_t)j * job->out_row_stride);
+        column_pass(job, &m, slots, j, &taps, &c);
+        if (!two) {
+            BLUR_NAME(blur_pass)(&taps, &c, job->sharpness, width, radius, m.finished);
+        } else {
+            column_pass(job, &m, slots, j + 1, &taps_b, &c_b);
+            column_pair_pass(job, &m, slots, j, &pairs);
+            BLUR_NAME(blur_two)
+            (&pairs, &taps, &c, &taps_b, &c_b, job->sharpness, width, m.finished, m.finished_b);
+        }
+        for (int row = 0; row <= two; row++)
+            write_output(job->depth + (size_t)(j + row) * width, row ? m.finished_b : m.finished,
+                         width, job->strength, job->out + (int64_t)(j + row) * job->out_row_stride);
     }
     band_memory_give(job, set);
 }
@@ -197,6 +282,7 @@ BLUR_TARGET static void BLUR_NAME(finish_band)(void *context, int band) {
 #undef BLUR_LANES
 #undef BLUR_GROUPS
 #undef BLUR_SKIPS_CHECK
+#undef BLUR_TWO_ROWS
 #undef BLUR_NAME
 #undef BLUR_TARGET
 #undef BLUR_MIN
