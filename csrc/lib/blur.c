@@ -11,10 +11,10 @@
  * The blur's stages are fused per band of rows: a thread walks down its
  * band, makes each row (blurred along the row) into a ring of the last 2r+1
  * rows, and as soon as the rows a column tap needs are there, blurs down the
- * column and writes the finished row. The AVX-512 copy blurs two rows down
- * their columns at once (2r+2 rows in the ring), loading each row of taps
- * once for both: the loads, not the arithmetic, bound the blur (session
- * 46: 0.94 of one row at a time for the 15-pixel blur, docs/speed.md). Each row of the grid is thus read from
+ * column and writes the finished row. The AVX-512 copy blurs several rows
+ * down their columns at once (BLUR_COLUMN_ROWS), loading each row of taps
+ * once for all of them: the loads, not the arithmetic, bound the column
+ * pass (session 46, docs/speed.md). Each row of the grid is thus read from
  * memory once. A band recomputes the r rows above and below it that its
  * neighbours also make; every row's values depend only on the input, so the
  * result is the same for any number of threads and any band height. */
@@ -90,18 +90,23 @@ typedef struct tap_set {
     float spatial[2 * MAX_BLUR_RADIUS + 1];
 } tap_set;
 
-/* The taps of two rows' passes down the columns, a = row j and b = row
- * j + 1 (blur_two, blur_lanes.h): the rows j - r .. j + 1 + r inside the
- * image in order, each with its steps from row a's (as tap_set's), its AO
- * row in the ring, and whether it is a tap of a and of b with its spatial
- * weight for each. */
-typedef struct tap_pair_set {
-    int count;
-    int depth_step[2 * MAX_BLUR_RADIUS + 2], normal_step[2 * MAX_BLUR_RADIUS + 2];
-    const float *ao[2 * MAX_BLUR_RADIUS + 2];
-    float spatial_a[2 * MAX_BLUR_RADIUS + 2], spatial_b[2 * MAX_BLUR_RADIUS + 2];
-    unsigned char of_a[2 * MAX_BLUR_RADIUS + 2], of_b[2 * MAX_BLUR_RADIUS + 2];
-} tap_pair_set;
+/* The most rows of centres a copy blurs down their columns at once
+ * (BLUR_COLUMN_ROWS, blur_lanes.h). */
+#define MAX_COLUMN_ROWS 4
+
+/* The taps of `rows` rows' passes down the columns, rows j .. j + rows - 1
+ * (blur_rows, blur_lanes.h): the rows j - r .. j + rows - 1 + r inside the
+ * image in order, each with its steps from row j's (as tap_set's), its AO
+ * row in the ring, and for each centre row c whether it is one of c's taps
+ * (of[c]) and its spatial weight for c. */
+typedef struct column_taps {
+    int count, rows;
+    int depth_step[2 * MAX_BLUR_RADIUS + MAX_COLUMN_ROWS],
+        normal_step[2 * MAX_BLUR_RADIUS + MAX_COLUMN_ROWS];
+    const float *ao[2 * MAX_BLUR_RADIUS + MAX_COLUMN_ROWS];
+    float spatial[MAX_COLUMN_ROWS][2 * MAX_BLUR_RADIUS + MAX_COLUMN_ROWS];
+    unsigned char of[MAX_COLUMN_ROWS][2 * MAX_BLUR_RADIUS + MAX_COLUMN_ROWS];
+} column_taps;
 
 /* The centre row of a pass: its depth, AO and guide normals. */
 typedef struct centre_row {
@@ -175,15 +180,16 @@ static int background_needs_check(const float *z, int width, float sharpness) {
     return outside;
 }
 
-/* Scratch of one band: the two finished rows and the ring of rows blurred
- * along themselves (the rows r above a centre to r below: 2 r + 1 slots,
- * or 2 r + 2 where two rows of centres are blurred down their columns at
- * once; a copy that does not uses 2 r + 1, which measured 0.98 of 2 r + 2
- * with AVX2), width floats each. */
+/* Scratch of one band: the finished rows (one for each row of centres
+ * blurred at once) and the ring of rows blurred along themselves (the rows
+ * r above the first centre to r below the last: 2 r + rows slots; a copy
+ * that blurs one row at a time keeps 2 r + 1, which measured 0.98 of
+ * 2 r + 2 with AVX2), width floats each. */
+#define BAND_ROWS(radius) (2 * (radius) + 2 * MAX_COLUMN_ROWS)
 typedef struct band_memory {
     float *block;
-    float *finished, *finished_b;
-    float *ring[2 * MAX_BLUR_RADIUS + 2];
+    float *finished[MAX_COLUMN_ROWS];
+    float *ring[2 * MAX_BLUR_RADIUS + MAX_COLUMN_ROWS];
 } band_memory;
 
 /* A free set of the job's pool for one band, into *m; returns its index
@@ -194,9 +200,8 @@ static int band_memory_take(finish_job *job, band_memory *m, int slots) {
     while (atomic_flag_test_and_set(&job->pool_taken[set])) set = (set + 1) % job->pool_sets;
     const size_t row = (size_t)job->width;
     m->block = job->pool + (size_t)set * job->pool_set_floats;
-    m->finished = m->block;
-    m->finished_b = m->block + row;
-    for (int s = 0; s < slots; s++) m->ring[s] = m->finished + (2 + (size_t)s) * row;
+    for (int r = 0; r < MAX_COLUMN_ROWS; r++) m->finished[r] = m->block + (size_t)r * row;
+    for (int s = 0; s < slots; s++) m->ring[s] = m->block + (MAX_COLUMN_ROWS + (size_t)s) * row;
     return set;
 }
 
@@ -244,23 +249,25 @@ static HBAO_ALWAYS_INLINE void column_pass(const finish_job *job, const band_mem
     *c = (centre_row){job->depth + (size_t)j * width, m->ring[j % slots], n.nx, n.ny, n.nz};
 }
 
-/* The taps of rows j and j + 1's passes down the columns (radius > 0,
- * j + 1 < height): tap_pair_set. */
-static HBAO_ALWAYS_INLINE void column_pair_pass(const finish_job *job, const band_memory *m,
-                                                int slots, int j, tap_pair_set *pairs) {
+/* The taps of rows j .. j + rows - 1's passes down the columns (radius >
+ * 0, j + rows <= height): column_taps. */
+static HBAO_ALWAYS_INLINE void column_rows_pass(const finish_job *job, const band_memory *m,
+                                                int slots, int j, int rows, column_taps *taps) {
     const int width = job->width, radius = job->radius;
     const normal_row n = normals_of_row(job->grid, j);
-    pairs->count = 0;
-    for (int k = -radius; k <= radius + 1; k++) {
+    taps->count = 0;
+    taps->rows = rows;
+    for (int k = -radius; k <= radius + rows - 1; k++) {
         if (j + k < 0 || j + k >= job->height) continue;
-        const int t = pairs->count++;
-        pairs->depth_step[t] = k * width;
-        pairs->normal_step[t] = (int)(normals_of_row(job->grid, j + k).nx - n.nx);
-        pairs->ao[t] = m->ring[(j + k) % slots];
-        pairs->of_a[t] = k != 0 && k <= radius;
-        pairs->of_b[t] = k != 1 && k >= 1 - radius;
-        pairs->spatial_a[t] = job->spatial[k < 0 ? -k : k > radius ? 0 : k];
-        pairs->spatial_b[t] = job->spatial[k - 1 < 0 ? 1 - k > radius ? 0 : 1 - k : k - 1];
+        const int t = taps->count++;
+        taps->depth_step[t] = k * width;
+        taps->normal_step[t] = (int)(normals_of_row(job->grid, j + k).nx - n.nx);
+        taps->ao[t] = m->ring[(j + k) % slots];
+        for (int c = 0; c < rows; c++) {
+            const int offset = k - c < 0 ? c - k : k - c; /* from centre row j + c */
+            taps->of[c][t] = offset != 0 && offset <= radius;
+            taps->spatial[c][t] = job->spatial[offset <= radius ? offset : 0];
+        }
     }
 }
 
@@ -291,14 +298,21 @@ static HBAO_ALWAYS_INLINE void write_output(const float *zc, const float *ao, in
  * two groups as well: on a Zen 5 (AMD EPYC, AVX-512, session 41),
  * bench_blur_ab.sh on 1 thread, blur 3 0.916, 5 0.998-1.055 (three runs),
  * 7 1.026, 9 0.954, 11 0.932, 15 0.900; three and four groups 0.937 and
- * 0.964 at 15 and 1.29 and 1.16 at 5. The x86 copies take
+ * 0.964 at 15 and 1.29 and 1.16 at 5. Down the columns the AVX-512 copy
+ * blurs four rows of centres at once (BLUR_COLUMN_ROWS; each row of taps
+ * is read from the second-level cache, and now once for four rows), which
+ * its 32 registers hold: bench_blur_ab.sh on 1 thread (session 46), two
+ * rows against one 0.940 at blur 15 and 0.985 at 5; three against two
+ * 0.974 and 0.948; four against three 0.981 and 0.986; six against four
+ * 1.013 and 1.044. AVX2's two rows (16 registers) took 1.034 of one. The
+ * x86 copies take
  * their minimum and maximum from the instruction set (BLUR_MIN, BLUR_MAX:
  * a < b ? a : b and a > b ? a : b, NaN giving b, as the scalar code's
  * selects), one instruction where GCC's vector selects take two. */
 #define BLUR_LANES 16
 #define BLUR_GROUPS 1
 #define BLUR_SKIPS_CHECK 0
-#define BLUR_TWO_ROWS 0
+#define BLUR_COLUMN_ROWS 1
 #define BLUR_NAME(name) name##_portable
 #define BLUR_TARGET
 #include "blur_lanes.h"
@@ -307,7 +321,7 @@ static HBAO_ALWAYS_INLINE void write_output(const float *zc, const float *ao, in
 #define BLUR_LANES 8
 #define BLUR_GROUPS 2
 #define BLUR_SKIPS_CHECK 1
-#define BLUR_TWO_ROWS 0
+#define BLUR_COLUMN_ROWS 1
 #define BLUR_MIN _mm256_min_ps
 #define BLUR_MAX _mm256_max_ps
 #define BLUR_NAME(name) name##_avx2
@@ -317,7 +331,7 @@ static HBAO_ALWAYS_INLINE void write_output(const float *zc, const float *ao, in
 #define BLUR_LANES 16
 #define BLUR_GROUPS 2
 #define BLUR_SKIPS_CHECK 1
-#define BLUR_TWO_ROWS 1
+#define BLUR_COLUMN_ROWS 4
 #define BLUR_MIN _mm512_min_ps
 #define BLUR_MAX _mm512_max_ps
 #define BLUR_NAME(name) name##_avx512
@@ -352,7 +366,7 @@ static hbao_result blur_grid(const hbao_settings *settings, const hbao_grid *gri
     const int bands = (height + band_rows - 1) / band_rows;
     job.pool_sets = hbao_parallel_threads(settings->threads, bands);
     if (job.pool_sets < 1) job.pool_sets = 1;
-    job.pool_set_floats = (4 + 2 * (size_t)job.radius) * (size_t)job.width;
+    job.pool_set_floats = (size_t)BAND_ROWS(job.radius) * (size_t)job.width;
     job.pool = hbao_scratch_take((size_t)job.pool_sets * job.pool_set_floats * sizeof(float));
     if (job.pool == NULL) return HBAO_ERROR_OUT_OF_MEMORY;
     for (int set = 0; set < job.pool_sets; set++) atomic_flag_clear(&job.pool_taken[set]);

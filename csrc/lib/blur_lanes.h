@@ -6,9 +6,9 @@
  * vectors a step of the loop takes side by side), BLUR_SKIPS_CHECK (1: a
  * row whose background taps weigh 0 by themselves skips the test for them,
  * blur.c's background_needs_check; 0: every row tests, as the scalar
- * reference, which the tests hold the others to), BLUR_TWO_ROWS (1: the
- * passes down the columns run two rows of centres at once, lanes_two; 0:
- * one, lanes), BLUR_NAME(x) (the copy's
+ * reference, which the tests hold the others to), BLUR_COLUMN_ROWS (the
+ * rows of centres whose passes down the columns run at once, lanes_rows,
+ * up to MAX_COLUMN_ROWS; 1: one at a time, lanes), BLUR_NAME(x) (the copy's
  * names), BLUR_TARGET (its instruction set's function attribute, or
  * nothing) and, optionally, BLUR_MIN and BLUR_MAX (the instruction set's
  * minimum and maximum of two vectors of BLUR_LANES floats: a < b ? a : b
@@ -145,27 +145,26 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(lanes)(const tap_set *taps,
         BLUR_NAME(centre_done)(&centre[g], target + i + g * BLUR_LANES);
 }
 
-/* The column passes of two rows of centres at once, a below b (a single
- * vector of lanes each): pairs->count rows of taps, each loaded once and
- * added to whichever of the two centres it is a tap of, in the order of
- * their rows, as each row's own pass (lanes) adds them. Rows j - r + 1 ..
- * j + r are taps of both; one vector each keeps both centres' state in
- * registers. */
+/* The column passes of taps->rows rows of centres at once (a single
+ * vector of lanes each): taps->count rows of taps, each loaded once and
+ * added to each centre it is a tap of, in the order of their rows, as each
+ * row's own pass (lanes) adds them. c[0] is the first row's centres, the
+ * others follow it; rows is a constant. */
 BLUR_TARGET static HBAO_ALWAYS_INLINE void
-BLUR_NAME(lanes_two)(const tap_pair_set *pairs, const centre_row *a, const centre_row *b,
-                     float sharpness, int i, float *target_a, float *target_b, int check) {
-    BLUR_NAME(centre) ca = BLUR_NAME(centre_at)(a, sharpness, i);
-    BLUR_NAME(centre) cb = BLUR_NAME(centre_at)(b, sharpness, i);
-    for (int t = 0; t < pairs->count; t++) {
-        const int at = i + pairs->depth_step[t], normal_at = i + pairs->normal_step[t];
-        const VF z = BLUR_NAME(load)(a->z + at), nx = BLUR_NAME(load)(a->nx + normal_at),
-                 ny = BLUR_NAME(load)(a->ny + normal_at), nz = BLUR_NAME(load)(a->nz + normal_at),
-                 ao = BLUR_NAME(load)(pairs->ao[t] + i);
-        if (pairs->of_a[t]) BLUR_NAME(add_tap)(&ca, z, nx, ny, nz, ao, pairs->spatial_a[t], check);
-        if (pairs->of_b[t]) BLUR_NAME(add_tap)(&cb, z, nx, ny, nz, ao, pairs->spatial_b[t], check);
+BLUR_NAME(lanes_rows)(const column_taps *taps, const centre_row *c, float sharpness, int i,
+                      float *const *targets, int check, int rows) {
+    BLUR_NAME(centre) centre[MAX_COLUMN_ROWS];
+    for (int r = 0; r < rows; r++) centre[r] = BLUR_NAME(centre_at)(&c[r], sharpness, i);
+    for (int t = 0; t < taps->count; t++) {
+        const int at = i + taps->depth_step[t], normal_at = i + taps->normal_step[t];
+        const VF z = BLUR_NAME(load)(c->z + at), nx = BLUR_NAME(load)(c->nx + normal_at),
+                 ny = BLUR_NAME(load)(c->ny + normal_at), nz = BLUR_NAME(load)(c->nz + normal_at),
+                 ao = BLUR_NAME(load)(taps->ao[t] + i);
+        for (int r = 0; r < rows; r++)
+            if (taps->of[r][t])
+                BLUR_NAME(add_tap)(&centre[r], z, nx, ny, nz, ao, taps->spatial[r][t], check);
     }
-    BLUR_NAME(centre_done)(&ca, target_a + i);
-    BLUR_NAME(centre_done)(&cb, target_b + i);
+    for (int r = 0; r < rows; r++) BLUR_NAME(centre_done)(&centre[r], targets[r] + i);
 }
 
 /* The vector loop of a pass over pixels i .. last - 1, as far as whole
@@ -203,28 +202,27 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(blur_pass)(const tap_set *t
     for (; i < width; i++) target[i] = blur_pixel(taps, c, sharpness, width, i);
 }
 
-/* The column passes of rows a and b = a + 1 (column_pair_pass) into
- * target_a and target_b: lanes_two over whole vectors, each row's
- * blur_pixel for the rest. A row's check is the single pass's
- * (blur_pass); testing where one row needs it and the other not gives the
- * same floats (background_needs_check). */
+/* The column passes of taps->rows rows (column_rows_pass), centres c[0]
+ * .., into targets: lanes_rows over whole vectors, each row's blur_pixel
+ * (single) for the rest. A row's check is the single pass's (blur_pass);
+ * testing where one row needs it and another not gives the same floats
+ * (background_needs_check). */
 BLUR_TARGET static HBAO_ALWAYS_INLINE void
-BLUR_NAME(blur_two)(const tap_pair_set *pairs, const tap_set *taps_a, const centre_row *a,
-                    const tap_set *taps_b, const centre_row *b, float sharpness, int width,
-                    float *target_a, float *target_b) {
-    const int check = !BLUR_SKIPS_CHECK || background_needs_check(a->z, width, sharpness) ||
-                      background_needs_check(b->z, width, sharpness);
+BLUR_NAME(blur_rows)(const column_taps *taps, const tap_set *single, const centre_row *c,
+                     float sharpness, int width, float *const *targets, int rows) {
+    int check = !BLUR_SKIPS_CHECK;
+    for (int r = 0; r < rows && !check; r++)
+        check = background_needs_check(c[r].z, width, sharpness);
     int i = 0;
     if (check)
         for (; i + BLUR_LANES <= width; i += BLUR_LANES)
-            BLUR_NAME(lanes_two)(pairs, a, b, sharpness, i, target_a, target_b, 1);
+            BLUR_NAME(lanes_rows)(taps, c, sharpness, i, targets, 1, rows);
     else
         for (; i + BLUR_LANES <= width; i += BLUR_LANES)
-            BLUR_NAME(lanes_two)(pairs, a, b, sharpness, i, target_a, target_b, 0);
-    for (; i < width; i++) {
-        target_a[i] = blur_pixel(taps_a, a, sharpness, width, i);
-        target_b[i] = blur_pixel(taps_b, b, sharpness, width, i);
-    }
+            BLUR_NAME(lanes_rows)(taps, c, sharpness, i, targets, 0, rows);
+    for (; i < width; i++)
+        for (int r = 0; r < rows; r++)
+            targets[r][i] = blur_pixel(&single[r], &c[r], sharpness, width, i);
 }
 
 /* The copy's job for one band of output rows: each row is made (blurred
@@ -233,20 +231,20 @@ BLUR_NAME(blur_two)(const tap_pair_set *pairs, const tap_set *taps_a, const cent
 BLUR_TARGET static void BLUR_NAME(finish_band)(void *context, int band) {
     finish_job *job = context;
     const int width = job->width, radius = job->radius, height = job->height;
-    const int slots = 2 * radius + 1 + BLUR_TWO_ROWS;
+    const int slots = 2 * radius + BLUR_COLUMN_ROWS;
     const int first = band * job->band_rows;
     const int last = first + job->band_rows < height ? first + job->band_rows : height;
     band_memory m;
     const int set = band_memory_take(job, &m, slots);
-    tap_set taps, taps_b;
-    tap_pair_set pairs;
-    centre_row c, c_b;
+    tap_set taps, single[BLUR_COLUMN_ROWS];
+    column_taps rows_taps;
+    centre_row c, centres[BLUR_COLUMN_ROWS];
     int next = first - radius > 0 ? first - radius : 0; /* the next row to make */
-    /* rows two at a time down their columns where the copy does
-     * (BLUR_TWO_ROWS) and the band has two left */
-    for (int j = first; j < last; j += BLUR_TWO_ROWS && radius > 0 && j + 1 < last ? 2 : 1) {
-        const int two = BLUR_TWO_ROWS && radius > 0 && j + 1 < last;
-        const int needed = j + two + radius < height ? j + two + radius : height - 1;
+    /* BLUR_COLUMN_ROWS rows at a time down their columns while the band has
+     * as many left, then one */
+    for (int j = first; j < last;) {
+        const int rows = radius > 0 && j + BLUR_COLUMN_ROWS <= last ? BLUR_COLUMN_ROWS : 1;
+        const int needed = j + rows - 1 + radius < height ? j + rows - 1 + radius : height - 1;
         for (; next <= needed; next++) {
             float *slot = m.ring[next % slots];
             if (radius == 0) {
@@ -259,20 +257,23 @@ BLUR_TARGET static void BLUR_NAME(finish_band)(void *context, int band) {
         if (radius == 0) {
             write_output(job->depth + (size_t)j * width, m.ring[j % slots], width, job->strength,
                          job->out + (int64_t)j * job->out_row_stride);
+            j++;
             continue;
         }
-        column_pass(job, &m, slots, j, &taps, &c);
-        if (!two) {
-            BLUR_NAME(blur_pass)(&taps, &c, job->sharpness, width, radius, m.finished);
+        if (rows == 1) {
+            column_pass(job, &m, slots, j, &taps, &c);
+            BLUR_NAME(blur_pass)(&taps, &c, job->sharpness, width, radius, m.finished[0]);
         } else {
-            column_pass(job, &m, slots, j + 1, &taps_b, &c_b);
-            column_pair_pass(job, &m, slots, j, &pairs);
-            BLUR_NAME(blur_two)
-            (&pairs, &taps, &c, &taps_b, &c_b, job->sharpness, width, m.finished, m.finished_b);
+            for (int r = 0; r < rows; r++)
+                column_pass(job, &m, slots, j + r, &single[r], &centres[r]);
+            column_rows_pass(job, &m, slots, j, rows, &rows_taps);
+            BLUR_NAME(blur_rows)
+            (&rows_taps, single, centres, job->sharpness, width, m.finished, rows);
         }
-        for (int row = 0; row <= two; row++)
-            write_output(job->depth + (size_t)(j + row) * width, row ? m.finished_b : m.finished,
-                         width, job->strength, job->out + (int64_t)(j + row) * job->out_row_stride);
+        for (int r = 0; r < rows; r++)
+            write_output(job->depth + (size_t)(j + r) * width, m.finished[r], width, job->strength,
+                         job->out + (int64_t)(j + r) * job->out_row_stride);
+        j += rows;
     }
     band_memory_give(job, set);
 }
@@ -282,7 +283,7 @@ BLUR_TARGET static void BLUR_NAME(finish_band)(void *context, int band) {
 #undef BLUR_LANES
 #undef BLUR_GROUPS
 #undef BLUR_SKIPS_CHECK
-#undef BLUR_TWO_ROWS
+#undef BLUR_COLUMN_ROWS
 #undef BLUR_NAME
 #undef BLUR_TARGET
 #undef BLUR_MIN
