@@ -183,22 +183,59 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE int BLUR_NAME(vectors)(const tap_set *taps
 
 /* One pass over a row of centres into target: the vector loop where every
  * tap lies inside the row, blur_pixel (blur.c) at the ends. */
+/* Pixels [from, to) of a pass along the row (near its ends, where some
+ * taps fall outside it) through the vector loop, on a copy of the row's
+ * pixels from - radius on in which those outside the row are background
+ * (depth, normal and AO 0). A tap there weighs +0 (the background test, or
+ * where the copy leaves it out background_needs_check's proof), so that
+ * adding it changes no sum: the floats are blur_pixel's, which leaves such
+ * taps out. to - from is at most radius + BLUR_GROUPS * BLUR_LANES. */
+BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(row_ends)(const tap_set *taps,
+                                                               const centre_row *c, float sharpness,
+                                                               int width, int radius, int from,
+                                                               int to, float *target, int check) {
+    enum { SPAN = 4 * MAX_BLUR_RADIUS + 4 * BLUR_GROUPS * BLUR_LANES };
+    float z[SPAN], nx[SPAN], ny[SPAN], nz[SPAN], ao[SPAN], out[SPAN];
+    const int count = to - from;
+    const int lanes = (count + BLUR_LANES - 1) / BLUR_LANES * BLUR_LANES;
+    for (int x = 0; x < lanes + 2 * radius; x++) {
+        const int p = from - radius + x;
+        const int inside = p >= 0 && p < width;
+        z[x] = inside ? c->z[p] : 0.0f;
+        nx[x] = inside ? c->nx[p] : 0.0f;
+        ny[x] = inside ? c->ny[p] : 0.0f;
+        nz[x] = inside ? c->nz[p] : 0.0f;
+        ao[x] = inside ? c->ao[p] : 0.0f;
+    }
+    const centre_row local = {z + radius, ao + radius, nx + radius, ny + radius, nz + radius};
+    for (int i = 0; i < lanes; i += BLUR_LANES)
+        BLUR_NAME(lanes)(taps, &local, sharpness, i, out, 1, check, 1);
+    memcpy(target + from, out, (size_t)count * sizeof(float));
+}
+
+/* One pass over a row of centres into target: the vector loop where every
+ * tap lies inside the row; near a row's ends row_ends; at a column pass's
+ * end (under a vector) blur_pixel (blur.c). */
 BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(blur_pass)(const tap_set *taps,
                                                                 const centre_row *c,
                                                                 float sharpness, int width,
                                                                 int radius, float *target) {
-    const int first = taps->along_row ? radius : 0;
-    const int last = taps->along_row ? width - radius : width; /* vector lanes in [first, last) */
-    int i = 0;
-    for (; i < first && i < width; i++) target[i] = blur_pixel(taps, c, sharpness, width, i);
     /* a constant 1 where the copy never skips: no scan of the row then */
     const int check = !BLUR_SKIPS_CHECK || background_needs_check(c->z, width, sharpness);
-    if (taps->along_row)
-        i = check ? BLUR_NAME(vectors)(taps, c, sharpness, i, last, target, 1, 1)
-                  : BLUR_NAME(vectors)(taps, c, sharpness, i, last, target, 1, 0);
-    else
-        i = check ? BLUR_NAME(vectors)(taps, c, sharpness, i, last, target, 0, 1)
-                  : BLUR_NAME(vectors)(taps, c, sharpness, i, last, target, 0, 0);
+    if (taps->along_row) {
+        const int first = radius < width ? radius : width, last = width - radius;
+        if (first > 0)
+            BLUR_NAME(row_ends)(taps, c, sharpness, width, radius, 0, first, target, check);
+        int i = first;
+        if (first < last)
+            i = check ? BLUR_NAME(vectors)(taps, c, sharpness, first, last, target, 1, 1)
+                      : BLUR_NAME(vectors)(taps, c, sharpness, first, last, target, 1, 0);
+        if (i < width)
+            BLUR_NAME(row_ends)(taps, c, sharpness, width, radius, i, width, target, check);
+        return;
+    }
+    int i = check ? BLUR_NAME(vectors)(taps, c, sharpness, 0, width, target, 0, 1)
+                  : BLUR_NAME(vectors)(taps, c, sharpness, 0, width, target, 0, 0);
     for (; i < width; i++) target[i] = blur_pixel(taps, c, sharpness, width, i);
 }
 

@@ -184,14 +184,16 @@ TEST_CASE(identical_output_for_any_band_height) {
     }
 }
 
-/* A row's pixels go through blur_pixel (blur.c) near its ends and through
- * the vector loop (blur_lanes.h) elsewhere, which must give the same bits.
+/* A row's pixels go through row_ends (blur_lanes.h: the vector loop on a
+ * copy of the row padded with background) near its ends, blur_pixel
+ * (blur.c) at a column pass's last partial vector, and the vector loop
+ * elsewhere, which must give the same bits.
  * The same picture is computed twice: alone, and with PAD background columns
  * on each side. With the sensor fitted vertically a pixel's ray depends on
  * its column's distance from the image's centre only, and PAD keeps the
  * search's 4 x 4 pattern and blocks in step, so the picture's pixels get the
  * same raw AO in both; a tap on background weighs 0 as a tap outside the
- * image adds nothing. The ends of the picture (blur_pixel alone) lie inside
+ * image adds nothing. The ends of the picture (row_ends alone) lie inside
  * the padded image's vector loop, and its column pass's last partial vector
  * too, for every copy whatever its lanes. */
 TEST_CASE(blur_pixel_and_the_vector_loop_agree) {
