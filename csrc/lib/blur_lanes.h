@@ -183,6 +183,25 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE int BLUR_NAME(vectors)(const tap_set *taps
 
 /* One pass over a row of centres into target: the vector loop where every
  * tap lies inside the row, blur_pixel (blur.c) at the ends. */
+/* Whether a pass over the centres of a row (depth z) must test its taps for
+ * background (blur.c, before outside_self_masking); always where the copy
+ * never skips the test. */
+BLUR_TARGET static HBAO_ALWAYS_INLINE int
+BLUR_NAME(background_needs_check)(const float *z, int width, float sharpness) {
+    float low, high;
+    if (!BLUR_SKIPS_CHECK || !self_masking_bounds(sharpness, &low, &high)) return 1;
+    VI outside = {0};
+    int i = 0;
+    for (; i + BLUR_LANES <= width; i += BLUR_LANES) {
+        const VF depth = BLUR_NAME(load)(z + i);
+        outside |= (depth != 0.0f) & ((depth < low) | (depth > high));
+    }
+    int any = 0;
+    for (int l = 0; l < BLUR_LANES; l++) any |= outside[l] != 0;
+    for (; i < width; i++) any |= outside_self_masking(z[i], low, high);
+    return any;
+}
+
 /* Pixels [from, to) of a pass along the row (near its ends, where some
  * taps fall outside it) through the vector loop, on a copy of the row's
  * pixels from - radius on in which those outside the row are background
@@ -216,12 +235,9 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(row_ends)(const tap_set *ta
 /* One pass over a row of centres into target: the vector loop where every
  * tap lies inside the row; near a row's ends row_ends; at a column pass's
  * end (under a vector) blur_pixel (blur.c). */
-BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(blur_pass)(const tap_set *taps,
-                                                                const centre_row *c,
-                                                                float sharpness, int width,
-                                                                int radius, float *target) {
-    /* a constant 1 where the copy never skips: no scan of the row then */
-    const int check = !BLUR_SKIPS_CHECK || background_needs_check(c->z, width, sharpness);
+BLUR_TARGET static HBAO_ALWAYS_INLINE void
+BLUR_NAME(blur_pass)(const tap_set *taps, const centre_row *c, float sharpness, int width,
+                     int radius, float *target, int check) {
     if (taps->along_row) {
         const int first = radius < width ? radius : width, last = width - radius;
         if (first > 0)
@@ -246,10 +262,10 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(blur_pass)(const tap_set *t
  * (background_needs_check). */
 BLUR_TARGET static HBAO_ALWAYS_INLINE void
 BLUR_NAME(blur_rows)(const column_taps *taps, const tap_set *single, const centre_row *c,
-                     float sharpness, int width, float *const *targets, int rows) {
-    int check = !BLUR_SKIPS_CHECK;
-    for (int r = 0; r < rows && !check; r++)
-        check = background_needs_check(c[r].z, width, sharpness);
+                     const int *checks, float sharpness, int width, float *const *targets,
+                     int rows) {
+    int check = 0;
+    for (int r = 0; r < rows; r++) check |= checks[r];
     int i = 0;
     if (check)
         for (; i + BLUR_LANES <= width; i += BLUR_LANES)
@@ -274,6 +290,7 @@ BLUR_TARGET static void BLUR_NAME(finish_band)(void *context, int band) {
     band_memory m;
     const int set = band_memory_take(job, &m, slots);
     tap_set taps, single[BLUR_COLUMN_ROWS];
+    int checks[2 * MAX_BLUR_RADIUS + MAX_COLUMN_ROWS]; /* of the ring's rows */
     column_taps rows_taps;
     centre_row c, centres[BLUR_COLUMN_ROWS];
     int next = first - radius > 0 ? first - radius : 0; /* the next row to make */
@@ -289,7 +306,9 @@ BLUR_TARGET static void BLUR_NAME(finish_band)(void *context, int band) {
                 continue;
             }
             row_pass(job, next, &taps, &c);
-            BLUR_NAME(blur_pass)(&taps, &c, job->sharpness, width, radius, slot);
+            checks[next % slots] = BLUR_NAME(background_needs_check)(c.z, width, job->sharpness);
+            BLUR_NAME(blur_pass)
+            (&taps, &c, job->sharpness, width, radius, slot, checks[next % slots]);
         }
         if (radius == 0) {
             write_output(job->depth + (size_t)j * width, m.ring[j % slots], width, job->strength,
@@ -299,13 +318,16 @@ BLUR_TARGET static void BLUR_NAME(finish_band)(void *context, int band) {
         }
         if (rows == 1) {
             column_pass(job, &m, slots, j, &taps, &c);
-            BLUR_NAME(blur_pass)(&taps, &c, job->sharpness, width, radius, m.finished[0]);
+            BLUR_NAME(blur_pass)
+            (&taps, &c, job->sharpness, width, radius, m.finished[0], checks[j % slots]);
         } else {
             for (int r = 0; r < rows; r++)
                 column_pass(job, &m, slots, j + r, &single[r], &centres[r]);
             column_rows_pass(job, &m, slots, j, rows, &rows_taps);
+            int row_checks[BLUR_COLUMN_ROWS];
+            for (int r = 0; r < rows; r++) row_checks[r] = checks[(j + r) % slots];
             BLUR_NAME(blur_rows)
-            (&rows_taps, single, centres, job->sharpness, width, m.finished, rows);
+            (&rows_taps, single, centres, row_checks, job->sharpness, width, m.finished, rows);
         }
         for (int r = 0; r < rows; r++)
             write_output(job->depth + (size_t)(j + r) * width, m.finished[r], width, job->strength,
