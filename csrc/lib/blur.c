@@ -9,9 +9,9 @@
  * guided by the full-resolution depth, then keeps edges sharp.
  *
  * The blur's stages are fused per band of rows: a thread walks down its
- * band, makes each row (blurred along the row) into a ring of the last 2r+1
- * rows, and as soon as the rows a column tap needs are there, blurs down the
- * column and writes the finished row. The AVX-512 copy blurs several rows
+ * band, makes each row (blurred along the row) into a ring of the last
+ * 2r + BLUR_COLUMN_ROWS rows, and as soon as the rows a column tap needs
+ * are there, blurs down the column and writes the finished row. The AVX-512 copy blurs several rows
  * down their columns at once (BLUR_COLUMN_ROWS), loading each row of taps
  * once for all of them: the loads, not the arithmetic, bound the column
  * pass (session 46, docs/speed.md). Each row of the grid is thus read from

@@ -149,7 +149,7 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(lanes)(const tap_set *taps,
  * vector of lanes each): taps->count rows of taps, each loaded once and
  * added to each centre it is a tap of, in the order of their rows, as each
  * row's own pass (lanes) adds them. c[0] is the first row's centres, the
- * others follow it; rows is a constant. */
+ * others follow it; rows is a constant (BLUR_COLUMN_ROWS). */
 BLUR_TARGET static HBAO_ALWAYS_INLINE void
 BLUR_NAME(lanes_rows)(const column_taps *taps, const centre_row *c, float sharpness, int i,
                       float *const *targets, int check, int rows) {
@@ -181,8 +181,6 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE int BLUR_NAME(vectors)(const tap_set *taps
     return i;
 }
 
-/* One pass over a row of centres into target: the vector loop where every
- * tap lies inside the row, blur_pixel (blur.c) at the ends. */
 /* Whether a pass over the centres of a row (depth z) must test its taps for
  * background (blur.c, before outside_self_masking); always where the copy
  * never skips the test. */
@@ -205,15 +203,17 @@ BLUR_NAME(background_needs_check)(const float *z, int width, float sharpness) {
 /* Pixels [from, to) of a pass along the row (near its ends, where some
  * taps fall outside it) through the vector loop, on a copy of the row's
  * pixels from - radius on in which those outside the row are background
- * (depth, normal and AO 0). A tap there weighs +0 (the background test, or
- * where the copy leaves it out background_needs_check's proof), so that
- * adding it changes no sum: the floats are blur_pixel's, which leaves such
- * taps out. to - from is at most radius + BLUR_GROUPS * BLUR_LANES. */
+ * (depth and normal 0, AO -0). A tap there weighs +0 (the background
+ * test, or where the copy leaves it out background_needs_check's proof),
+ * and +0 * -0 = -0 added to any sum leaves it as it is, -0 included: the
+ * floats are blur_pixel's, which leaves such taps out. to - from is at
+ * most radius at the left end and below radius + BLUR_LANES at the right
+ * (blur_pass), so the copy spans under 3 radius + 2 BLUR_LANES pixels. */
 BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(row_ends)(const tap_set *taps,
                                                                const centre_row *c, float sharpness,
                                                                int width, int radius, int from,
                                                                int to, float *target, int check) {
-    enum { SPAN = 4 * MAX_BLUR_RADIUS + 4 * BLUR_GROUPS * BLUR_LANES };
+    enum { SPAN = 3 * MAX_BLUR_RADIUS + 2 * BLUR_LANES };
     float z[SPAN], nx[SPAN], ny[SPAN], nz[SPAN], ao[SPAN], out[SPAN];
     const int count = to - from;
     const int lanes = (count + BLUR_LANES - 1) / BLUR_LANES * BLUR_LANES;
@@ -224,7 +224,7 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(row_ends)(const tap_set *ta
         nx[x] = inside ? c->nx[p] : 0.0f;
         ny[x] = inside ? c->ny[p] : 0.0f;
         nz[x] = inside ? c->nz[p] : 0.0f;
-        ao[x] = inside ? c->ao[p] : 0.0f;
+        ao[x] = inside ? c->ao[p] : -0.0f;
     }
     const centre_row local = {z + radius, ao + radius, nx + radius, ny + radius, nz + radius};
     for (int i = 0; i < lanes; i += BLUR_LANES)
@@ -327,7 +327,8 @@ BLUR_TARGET static void BLUR_NAME(finish_band)(void *context, int band) {
             int row_checks[BLUR_COLUMN_ROWS];
             for (int r = 0; r < rows; r++) row_checks[r] = checks[(j + r) % slots];
             BLUR_NAME(blur_rows)
-            (&rows_taps, single, centres, row_checks, job->sharpness, width, m.finished, rows);
+            (&rows_taps, single, centres, row_checks, job->sharpness, width, m.finished,
+             BLUR_COLUMN_ROWS);
         }
         for (int r = 0; r < rows; r++)
             write_output(job->depth + (size_t)(j + r) * width, m.finished[r], width, job->strength,
