@@ -85,6 +85,10 @@ static HBAO_ALWAYS_INLINE normal_row normals_of_row(const hbao_grid *grid, int j
 typedef struct tap_set {
     int count;
     int along_row; /* 1: steps shift along the row, so edge pixels lose taps */
+    /* Along a row: floats from the row's depth and AO to the next row's
+     * (its normals' lie three times as far), which the pass prefetches as
+     * it goes; 0: no next row. */
+    int next_row;
     int depth_step[2 * MAX_BLUR_RADIUS + 1], normal_step[2 * MAX_BLUR_RADIUS + 1];
     const float *ao[2 * MAX_BLUR_RADIUS + 1];
     float spatial[2 * MAX_BLUR_RADIUS + 1];
@@ -229,6 +233,7 @@ static HBAO_ALWAYS_INLINE void row_pass(const finish_job *job, int j, tap_set *t
     const float *z = job->depth + (size_t)j * width;
     taps->count = 0;
     taps->along_row = 1;
+    taps->next_row = j + 1 < job->height ? width : 0;
     for (int k = -radius; k <= radius; k++) {
         if (k == 0) continue;
         taps->depth_step[taps->count] = k;
@@ -247,6 +252,7 @@ static HBAO_ALWAYS_INLINE void column_pass(const finish_job *job, const band_mem
     const int width = job->width, radius = job->radius;
     taps->count = 0;
     taps->along_row = 0;
+    taps->next_row = 0;
     const normal_row n = normals_of_row(job->grid, j);
     for (int k = -radius; k <= radius; k++) {
         if (k == 0 || j + k < 0 || j + k >= job->height) continue;
