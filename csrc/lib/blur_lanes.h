@@ -277,15 +277,12 @@ BLUR_NAME(blur_pass)(const tap_set *taps, const centre_row *c, float sharpness, 
 
 /* The column passes of taps->rows rows (column_rows_pass), centres c[0]
  * .., into targets: lanes_rows over whole vectors, each row's blur_pixel
- * (single) for the rest. A row's check is the single pass's (blur_pass);
- * testing where one row needs it and another not gives the same floats
- * (background_needs_check). */
+ * (single) for the rest. check: whether any of the rows needs the test
+ * (background_needs_check); testing where one row needs it and another
+ * not gives the same floats. */
 BLUR_TARGET static HBAO_ALWAYS_INLINE void
-BLUR_NAME(blur_rows)(const column_taps *taps, const tap_set *single, const centre_row *c,
-                     const int *checks, float sharpness, int width, float *const *targets,
-                     int rows) {
-    int check = 0;
-    for (int r = 0; r < rows; r++) check |= checks[r];
+BLUR_NAME(blur_rows)(const column_taps *taps, const tap_set *single, const centre_row *c, int check,
+                     float sharpness, int width, float *const *targets, int rows) {
     int i = 0;
     if (check)
         for (; i + BLUR_LANES <= width; i += BLUR_LANES)
@@ -344,10 +341,10 @@ BLUR_TARGET static void BLUR_NAME(finish_band)(void *context, int band) {
             for (int r = 0; r < rows; r++)
                 column_pass(job, &m, slots, j + r, &single[r], &centres[r]);
             column_rows_pass(job, &m, slots, j, rows, &rows_taps);
-            int row_checks[BLUR_COLUMN_ROWS];
-            for (int r = 0; r < rows; r++) row_checks[r] = checks[(j + r) % slots];
+            int check = 0; /* any row's */
+            for (int r = 0; r < rows; r++) check |= checks[(j + r) % slots];
             BLUR_NAME(blur_rows)
-            (&rows_taps, single, centres, row_checks, job->sharpness, width, m.finished,
+            (&rows_taps, single, centres, check, job->sharpness, width, m.finished,
              BLUR_COLUMN_ROWS);
         }
         for (int r = 0; r < rows; r++)
