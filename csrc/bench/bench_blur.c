@@ -9,8 +9,11 @@
  * builds of it against each other.
  *   bench_blur [--calls N] [--blur B] [--sharpness S] [--size WxH]
  *              [--threads T] [--implementation scalar|avx2|avx512]
+ *              [--background P]
  * Prints one line: the fastest and the median CPU ms of N calls, and a
- * hash of the output's bits (the same for every build that blurs alike). */
+ * hash of the output's bits (the same for every build that blurs alike).
+ * --background P: the upper P per cent of the rows are background (depth
+ * and normal 0), as a sky above a horizon. */
 #include <stdint.h>
 
 #include "bench_common.h"
@@ -20,7 +23,8 @@
 static void usage(const char *program) {
     fprintf(stderr,
             "usage: %s [--calls N] [--blur B] [--sharpness S] [--size WxH] [--threads T]\n"
-            "  [--implementation scalar|avx2|avx512] (default: the best this CPU has)\n",
+            "  [--implementation scalar|avx2|avx512] (default: the best this CPU has)\n"
+            "  [--background P] (the upper P per cent of the rows background; default 0)\n",
             program);
 }
 
@@ -32,7 +36,7 @@ static long whole_number(const char *text, long low, long high) {
 }
 
 int main(int argc, char **argv) {
-    long calls = 10, blur = 15, width = 1920, height = 1080, threads = 1;
+    long calls = 10, blur = 15, width = 1920, height = 1080, threads = 1, background = 0;
     int implementation = HBAO_IMPLEMENTATION_AUTO;
     float sharpness = HBAO_DEFAULT_BLUR_SHARPNESS;
     int bad = 0;
@@ -50,6 +54,8 @@ int main(int argc, char **argv) {
             sharpness = strtof(value, &end);
             bad = end == value || *end != '\0' ||
                   !(sharpness >= 0.0f && sharpness <= HBAO_MAX_BLUR_SHARPNESS);
+        } else if (!strcmp(argv[a], "--background")) {
+            bad = (background = whole_number(value, 0, 100)) < 0;
         } else if (!strcmp(argv[a], "--threads")) {
             bad = (threads = whole_number(value, 1, 64)) < 1;
         } else if (!strcmp(argv[a], "--size")) {
@@ -72,7 +78,7 @@ int main(int argc, char **argv) {
         fprintf(stderr,
                 "bench_blur: --calls 1-1000, --blur an odd size 1-%d, --sharpness 0-%g, "
                 "--size WxH with each 16-16384, --threads 1-64, --implementation "
-                "scalar|avx2|avx512\n",
+                "scalar|avx2|avx512, --background 0-100\n",
                 HBAO_MAX_BLUR_SIZE, (double)HBAO_MAX_BLUR_SHARPNESS);
         return 2;
     }
@@ -95,12 +101,15 @@ int main(int argc, char **argv) {
         return 1;
     }
     memcpy(grid.depth, b.depth, pixels * sizeof(float));
+    const size_t sky = (size_t)(height * background / 100) * width; /* background pixels */
+    memset(grid.depth, 0, sky * sizeof(float));
     memset(grid.normal + 3 * pixels, 0, HBAO_NORMAL_PADDING * sizeof(float));
     uint32_t state = 12345u;
     for (int j = 0; j < height; j++) {
         for (int i = 0; i < width; i++) {
             const size_t k = (size_t)j * width + i;
-            for (int c = 0; c < 3; c++) hbao_grid_normal_row(&grid, j, c)[i] = b.normal[3 * k + c];
+            for (int c = 0; c < 3; c++)
+                hbao_grid_normal_row(&grid, j, c)[i] = k < sky ? 0.0f : b.normal[3 * k + c];
             raw[k] = (float)(test_random(&state) >> 8) / 16777216.0f;
         }
     }
@@ -128,9 +137,9 @@ int main(int argc, char **argv) {
     double fastest = times[0];
     for (int call = 1; call < calls; call++)
         fastest = times[call] < fastest ? times[call] : fastest;
-    printf("bench_blur %ldx%ld, blur %ld, sharpness %g, %ld thread(s), %s: fastest %.2f, median "
-           "%.2f CPU ms over %ld calls; output hash %016llx\n",
-           width, height, blur, (double)sharpness, threads,
+    printf("bench_blur %ldx%ld, blur %ld, sharpness %g, %ld thread(s), %ld %% background, %s: "
+           "fastest %.2f, median %.2f CPU ms over %ld calls; output hash %016llx\n",
+           width, height, blur, (double)sharpness, threads, background,
            bench_implementation_label(hbao_finish_implementation(implementation)), fastest,
            median_of(times, (int)calls), calls, (unsigned long long)hash);
     free(times);

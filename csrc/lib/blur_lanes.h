@@ -3,21 +3,25 @@
  * GCC vector types, and the band job that runs it: written once for every
  * instruction set, blur.c includes this header once per copy, after
  * defining BLUR_LANES (the lanes of a vector), BLUR_GROUPS (how many
- * vectors a step of the loop takes side by side), BLUR_SKIPS_CHECK (1: a
- * row whose background taps weigh 0 by themselves skips the test for them,
- * blur.c's background_needs_check; 0: every row tests, as the scalar
+ * vectors a step of the loop takes side by side), BLUR_SKIPS (1: the copy
+ * skips work whose floats it knows: a row whose background taps weigh 0 by
+ * themselves skips the test for them, blur.c's background_needs_check, and
+ * a vector of centres that are all background skips its taps, its value
+ * being 1 (background_only); 0: the copy does all of it, as the scalar
  * reference, which the tests hold the others to), BLUR_COLUMN_ROWS (the
  * rows of centres whose passes down the columns run at once, lanes_rows,
  * up to MAX_COLUMN_ROWS; 1: one at a time, lanes), BLUR_NAME(x) (the copy's
  * names), BLUR_TARGET (its instruction set's function attribute, or
- * nothing) and, optionally, BLUR_MIN and BLUR_MAX (the instruction set's
- * minimum and maximum of two vectors of BLUR_LANES floats: a < b ? a : b
- * and a > b ? a : b, b where either is NaN). Every operation is
- * blur_pixel's (blur.c), lane by lane and never contracted into an FMA
- * (the background test, where it is skipped, changes no float), so every
- * copy gives the same floats as the scalar reference. test_blur.c
- * compares the copies with each other, and each copy's blur_pixel with its
- * vector loop (blur_pixel_and_the_vector_loop_agree). */
+ * nothing), where BLUR_SKIPS is 1 BLUR_ANY(mask) (whether any lane of a
+ * VI compare's result is set) and, optionally, BLUR_MIN and BLUR_MAX (the
+ * instruction set's minimum and maximum of two vectors of BLUR_LANES
+ * floats: a < b ? a : b and a > b ? a : b, b where either is NaN). Every
+ * operation is blur_pixel's (blur.c), lane by lane and never contracted
+ * into an FMA (what the copy skips changes no float), so every copy gives
+ * the same floats as the scalar reference. test_blur.c compares the copies
+ * with each other (background_runs_blur_as_the_reference among them), and
+ * each copy's blur_pixel with its vector loop
+ * (blur_pixel_and_the_vector_loop_agree). */
 
 /* GCC and clang warn that passing these vectors by value differs between
  * instruction sets; the helpers are always inlined, so no call passes one. */
@@ -111,6 +115,29 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(centre_done)(const BLUR_NAM
     memcpy(target, &blurred, sizeof blurred);
 }
 
+/* Whether the centres at z[i .. i + count * BLUR_LANES - 1] are all
+ * background (not above 0: blur_pixel gives each of them 1 whatever its
+ * taps); never where the copy skips nothing (BLUR_SKIPS). */
+BLUR_TARGET static HBAO_ALWAYS_INLINE int BLUR_NAME(background_only)(const float *z, int i,
+                                                                     int count) {
+#if BLUR_SKIPS
+    VI above = {0};
+    for (int g = 0; g < count; g++) above |= BLUR_NAME(load)(z + i + g * BLUR_LANES) > 0.0f;
+    return !BLUR_ANY(above);
+#else
+    (void)z;
+    (void)i;
+    (void)count;
+    return 0;
+#endif
+}
+
+/* value into target[0 .. count * BLUR_LANES - 1] */
+BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(fill)(float *target, int count, float value) {
+    const VF v = (VF){0.0f} + value;
+    for (int g = 0; g < count; g++) memcpy(target + g * BLUR_LANES, &v, sizeof v);
+}
+
 /* blur_pixel for pixels i .. i + groups * BLUR_LANES - 1, all of whose
  * taps lie inside the row, as `groups` vectors side by side. along_row is
  * taps->along_row as a constant, so that each pass loads only the steps it
@@ -127,6 +154,10 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(lanes)(const tap_set *taps,
                                                             const centre_row *c, float sharpness,
                                                             int i, float *target, int along_row,
                                                             int check, int groups) {
+    if (BLUR_NAME(background_only)(c->z, i, groups)) {
+        BLUR_NAME(fill)(target + i, groups, 1.0f);
+        return;
+    }
     BLUR_NAME(centre) centre[BLUR_GROUPS];
     for (int g = 0; g < groups; g++)
         centre[g] = BLUR_NAME(centre_at)(c, sharpness, i + g * BLUR_LANES);
@@ -153,6 +184,12 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(lanes)(const tap_set *taps,
 BLUR_TARGET static HBAO_ALWAYS_INLINE void
 BLUR_NAME(lanes_rows)(const column_taps *taps, const centre_row *c, float sharpness, int i,
                       float *const *targets, int check, int rows) {
+    int background = 1;
+    for (int r = 0; r < rows; r++) background &= BLUR_NAME(background_only)(c[r].z, i, 1);
+    if (background) {
+        for (int r = 0; r < rows; r++) BLUR_NAME(fill)(targets[r] + i, 1, 1.0f);
+        return;
+    }
     BLUR_NAME(centre) centre[MAX_COLUMN_ROWS];
     for (int r = 0; r < rows; r++) centre[r] = BLUR_NAME(centre_at)(&c[r], sharpness, i);
     for (int t = 0; t < taps->count; t++) {
@@ -207,7 +244,7 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE int BLUR_NAME(vectors)(const tap_set *taps
 BLUR_TARGET static HBAO_ALWAYS_INLINE int
 BLUR_NAME(background_needs_check)(const float *z, int width, float sharpness) {
     float low, high;
-    if (!BLUR_SKIPS_CHECK || !self_masking_bounds(sharpness, &low, &high)) return 1;
+    if (!BLUR_SKIPS || !self_masking_bounds(sharpness, &low, &high)) return 1;
     VI outside = {0};
     int i = 0;
     for (; i + BLUR_LANES <= width; i += BLUR_LANES) {
@@ -359,9 +396,10 @@ BLUR_TARGET static void BLUR_NAME(finish_band)(void *context, int band) {
 #undef VI
 #undef BLUR_LANES
 #undef BLUR_GROUPS
-#undef BLUR_SKIPS_CHECK
+#undef BLUR_SKIPS
 #undef BLUR_COLUMN_ROWS
 #undef BLUR_NAME
 #undef BLUR_TARGET
 #undef BLUR_MIN
 #undef BLUR_MAX
+#undef BLUR_ANY

@@ -147,6 +147,21 @@ static void stepped_floor(int w, int h, int hole_period, float hole_depth, float
     }
 }
 
+/* The settings of variant 0 .. BLUR_VARIANTS - 1 of the comparisons
+ * between copies: blur 5, 15 and 65 (wider than a band), at full and half
+ * resolution, on 1 thread of the scalar reference. */
+#define BLUR_VARIANTS 6
+static hbao_params blur_variant(int variant) {
+    const int sizes[] = {5, 15, 65};
+    hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+    p.radius = 0.3f;
+    p.blur_size = sizes[variant % 3];
+    p.half_resolution = variant / 3;
+    p.threads = 1;
+    p.implementation = HBAO_IMPLEMENTATION_SCALAR;
+    return p;
+}
+
 /* The blur runs per band of rows whose height follows the thread count
  * (blur.c), each band remaking the r rows above and below it. A tall image
  * makes 1, 2 and 5 threads cut it into bands of 38, 19 and 16 rows; blur
@@ -159,14 +174,8 @@ TEST_CASE(identical_output_for_any_band_height) {
     hbao_camera camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
     hbao_channel d = {depth, 1, w};
     hbao_channel n = {normal, 3, 3 * (int64_t)w};
-    const int sizes[] = {5, 15, 65};
-    for (int variant = 0; variant < 6; variant++) {
-        hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
-        p.radius = 0.3f;
-        p.blur_size = sizes[variant % 3];
-        p.half_resolution = variant / 3;
-        p.threads = 1;
-        p.implementation = HBAO_IMPLEMENTATION_SCALAR;
+    for (int variant = 0; variant < BLUR_VARIANTS; variant++) {
+        hbao_params p = blur_variant(variant);
         CHECK_RESULT(hbao_compute(&p, &camera, w, h, &d, &n, one, w), HBAO_SUCCESS);
         const int threads[] = {2, 5};
         for (int t = 0; t < 2; t++) {
@@ -239,6 +248,56 @@ TEST_CASE(blur_pixel_and_the_vector_loop_agree) {
             CHECK(occluded > w * h / 10); /* something to blur */
         }
     }
+}
+
+/* The x86 copies skip the taps of a vector of centres that are all
+ * background (blur_lanes.h: background_only; their value is 1 whatever the
+ * taps), down the columns only where all the rows the AVX-512 copy blurs at
+ * once are (lanes_rows); the portable copy, the reference, skips nothing.
+ * Runs of 40 background pixels along the rows, moved every 3 rows and
+ * shifted every 4, give vectors that are all background, all geometry and
+ * mixed, and groups of rows that differ in them: every copy must give the
+ * reference's bits, at full and half resolution, on 1 and 3 threads. */
+TEST_CASE(background_runs_blur_as_the_reference) {
+    enum { w = 150, h = 90 };
+    static float depth[w * h], normal[3 * w * h], reference[w * h], ao[w * h];
+    stepped_floor(w, h, 1 << 30, 0.0f, depth, normal);
+    int background = 0;
+    for (int j = 0; j < h; j++) {
+        for (int i = 0; i < w; i++) {
+            if (((i + 7 * (j / 4)) / 40 + j / 3) % 3 == 0) {
+                depth[j * w + i] = 1e10f;
+                background++;
+            }
+        }
+    }
+    hbao_camera camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
+    const hbao_channel d = {depth, 1, w}, n = {normal, 3, 3 * (int64_t)w};
+    for (int variant = 0; variant < BLUR_VARIANTS; variant++) {
+        hbao_params p = blur_variant(variant);
+        p.background_depth = 1e9f;
+        CHECK_RESULT(hbao_compute(&p, &camera, w, h, &d, &n, reference, w), HBAO_SUCCESS);
+        int blurred = 0;
+        for (int k = 0; k < w * h; k++) blurred += reference[k] < 0.99f;
+        CHECK(blurred > w * h / 10); /* something to blur beside the background */
+        for (int threads = 1; threads <= 3; threads += 2) {
+            for (int implementation = HBAO_IMPLEMENTATION_AVX2;
+                 implementation <= HBAO_IMPLEMENTATION_AVX512; implementation++) {
+                p.threads = threads;
+                p.implementation = implementation;
+                CHECK_RESULT(hbao_compute(&p, &camera, w, h, &d, &n, ao, w), HBAO_SUCCESS);
+                int differ = 0;
+                for (int k = 0; k < w * h; k++)
+                    differ += memcmp(&reference[k], &ao[k], sizeof ao[k]) != 0;
+                if (differ)
+                    printf("  blur %d, half %d, %d threads, implementation %d: %d pixels "
+                           "differ\n",
+                           p.blur_size, p.half_resolution, threads, implementation, differ);
+                CHECK(differ == 0);
+            }
+        }
+    }
+    CHECK(background > w * h / 4);
 }
 
 /* --- a thin fin: the normal weight ----------------------------------------- */
@@ -362,4 +421,5 @@ TEST_MAIN(TEST_ENTRY(flat_plane_at_extreme_depths_is_unoccluded),
           TEST_ENTRY(planes_at_denormal_and_huge_depth_side_by_side),
           TEST_ENTRY(random_depths_over_the_float_range_stay_in_range),
           TEST_ENTRY(identical_output_for_any_band_height),
-          TEST_ENTRY(blur_pixel_and_the_vector_loop_agree), TEST_ENTRY(blur_keeps_a_thin_fin))
+          TEST_ENTRY(blur_pixel_and_the_vector_loop_agree),
+          TEST_ENTRY(background_runs_blur_as_the_reference), TEST_ENTRY(blur_keeps_a_thin_fin))
