@@ -13,7 +13,8 @@
  * Prints one line: the fastest and the median CPU ms of N calls, and a
  * hash of the output's bits (the same for every build that blurs alike).
  * --background P: the upper P per cent of the rows are background (depth
- * and normal 0), as a sky above a horizon. */
+ * 0, as the grid holds it; normals 0, where the grid holds (0, 0, 1): a
+ * background pixel's normal changes no float), as a sky above a horizon. */
 #include <stdint.h>
 
 #include "bench_common.h"

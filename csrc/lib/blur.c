@@ -130,8 +130,9 @@ typedef struct centre_row {
  * the product is exact. The vector loop (blur_lanes.h) gives the same
  * floats lane by lane (its mask and its min and max instructions are
  * exactly these selects and this product; where it leaves the mask out,
- * background_needs_check says why that changes nothing). Background
- * centres give 1. */
+ * background_needs_check says why that changes nothing, and it leaves
+ * out the taps of whole vectors of background centres, background_only).
+ * Background centres give 1. */
 static HBAO_ALWAYS_INLINE float blur_pixel(const tap_set *taps, const centre_row *c,
                                            float sharpness, int width, int i) {
     const float zc = c->z[i];
@@ -324,13 +325,16 @@ static HBAO_ALWAYS_INLINE void write_output(const float *zc, const float *ao, in
  * x86 copies take their minimum and maximum from the instruction set
  * (BLUR_MIN, BLUR_MAX: a < b ? a : b and a > b ? a : b, NaN giving b, as
  * the scalar code's selects), one instruction where GCC's vector selects
- * take two. They skip what changes no float (BLUR_SKIPS), vectors of
- * background centres among it (a sky): bench_blur_ab.sh on an Intel Xeon
- * with AVX-512 (session 47), 1 thread, the upper half background
+ * take two. They also skip work that changes no float (BLUR_SKIPS): the
+ * background test where background_needs_check proves it, and the taps of
+ * vectors of background centres (a sky). The latter, AVX-512 on an Intel
+ * Xeon (session 47), bench_blur_ab.sh on 1 thread against the library
+ * before it (built with this bench_blur.c), the upper half background
  * (bench_blur --background 50): 0.59-0.61 at blur 15, 0.69 at 5; without
- * background 0.996 (20 rounds) and 1.012. Down the columns the four rows'
- * taps are skipped only where all four are background: skipping the taps
- * of each row by itself is not tried. */
+ * background 0.996 (20 rounds) and 1.012; AVX2 not measured. Down the
+ * columns the four rows' taps are skipped only where all four are
+ * background; skipping each row's by itself was not tried. The two skips
+ * share the macro, so they are not compared apart. */
 #define BLUR_LANES 16
 #define BLUR_GROUPS 1
 #define BLUR_SKIPS 0

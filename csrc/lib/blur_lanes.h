@@ -12,8 +12,8 @@
  * rows of centres whose passes down the columns run at once, lanes_rows,
  * up to MAX_COLUMN_ROWS; 1: one at a time, lanes), BLUR_NAME(x) (the copy's
  * names), BLUR_TARGET (its instruction set's function attribute, or
- * nothing), where BLUR_SKIPS is 1 BLUR_ANY(mask) (whether any lane of a
- * VI compare's result is set) and, optionally, BLUR_MIN and BLUR_MAX (the
+ * nothing), and, where BLUR_SKIPS is 1, BLUR_ANY(mask) (whether any lane
+ * of a VI compare's result is set) and, optionally, BLUR_MIN and BLUR_MAX (the
  * instruction set's minimum and maximum of two vectors of BLUR_LANES
  * floats: a < b ? a : b and a > b ? a : b, b where either is NaN). Every
  * operation is blur_pixel's (blur.c), lane by lane and never contracted
@@ -22,6 +22,10 @@
  * with each other (background_runs_blur_as_the_reference among them), and
  * each copy's blur_pixel with its vector loop
  * (blur_pixel_and_the_vector_loop_agree). */
+
+#if BLUR_SKIPS && !defined(BLUR_ANY)
+#error "a copy that skips (BLUR_SKIPS 1) needs BLUR_ANY"
+#endif
 
 /* GCC and clang warn that passing these vectors by value differs between
  * instruction sets; the helpers are always inlined, so no call passes one. */
@@ -132,7 +136,12 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE int BLUR_NAME(background_only)(const float
 #endif
 }
 
-/* value into target[0 .. count * BLUR_LANES - 1] */
+/* value into target[0 .. count * BLUR_LANES - 1]. A skipped vector of
+ * background centres is still written: along a row its values are the
+ * column pass's taps, and a tap on background weighs +0, which would turn a
+ * NaN left in the ring into a NaN sum (test_stages.c,
+ * scratch_memory_is_written_before_it_is_read); down the columns
+ * write_output puts 1 there anyway, and the write keeps every row whole. */
 BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(fill)(float *target, int count, float value) {
     const VF v = (VF){0.0f} + value;
     for (int g = 0; g < count; g++) memcpy(target + g * BLUR_LANES, &v, sizeof v);
@@ -149,7 +158,8 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(fill)(float *target, int co
  * processor cannot hold enough taps in flight to keep its multipliers
  * busy, and two vectors whose chains interleave keep more of them in
  * flight (blur.c says where it pays). The groups are independent, so the
- * result is the same for any count. */
+ * result is the same for any count. Where all their centres are background
+ * (background_only) they are 1, and their taps are not weighed. */
 BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(lanes)(const tap_set *taps,
                                                             const centre_row *c, float sharpness,
                                                             int i, float *target, int along_row,
@@ -180,7 +190,9 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(lanes)(const tap_set *taps,
  * vector of lanes each): taps->count rows of taps, each loaded once and
  * added to each centre it is a tap of, in the order of their rows, as each
  * row's own pass (lanes) adds them. c[0] is the first row's centres, the
- * others follow it; rows is a constant (BLUR_COLUMN_ROWS). */
+ * others follow it; rows is a constant (BLUR_COLUMN_ROWS). Where every
+ * row's centres are background (background_only) they are 1, and no tap is
+ * weighed. */
 BLUR_TARGET static HBAO_ALWAYS_INLINE void
 BLUR_NAME(lanes_rows)(const column_taps *taps, const centre_row *c, float sharpness, int i,
                       float *const *targets, int check, int rows) {

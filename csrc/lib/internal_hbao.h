@@ -241,6 +241,10 @@ void hbao_scratch_give(void *memory);
  * call that runs out of memory leaves the output as it was. For tests
  * (csrc/tests/internal): where set, a take that it answers 1 for fails. */
 extern int (*hbao_scratch_fails)(size_t bytes);
+/* For tests too: where nonzero, every take fills the memory it gives with
+ * the bytes 0xff (NaN as floats), so that a buffer read before it is
+ * written shows in the output. */
+extern int hbao_scratch_poisons;
 /* The threads "one per core" gives (threads = 0): the CPUs this process may
  * run on (hbao_cpus.h), at most HBAO_MAX_THREADS. */
 int hbao_available_cores(void);

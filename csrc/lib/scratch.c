@@ -13,6 +13,7 @@
 #define _DEFAULT_SOURCE /* madvise */
 #include <pthread.h>
 #include <stdlib.h>
+#include <string.h>
 #include <sys/mman.h>
 
 #include "internal_hbao.h"
@@ -54,6 +55,7 @@ static kept_block kept[SCRATCH_BLOCKS];
 static size_t kept_bytes;
 
 int (*hbao_scratch_fails)(size_t bytes) = NULL;
+int hbao_scratch_poisons = 0;
 
 void *hbao_scratch_take(size_t bytes) {
     if (bytes > SIZE_MAX - HEADER) return NULL;
@@ -71,11 +73,13 @@ void *hbao_scratch_take(size_t bytes) {
         kept[best].start = NULL;
     }
     pthread_mutex_unlock(&scratch_lock);
+    const size_t asked = bytes;
     if (start == NULL) {
         start = new_block(&bytes);
         if (start == NULL) return NULL;
         *(size_t *)start = bytes;
     }
+    if (hbao_scratch_poisons) memset(start + HEADER, 0xff, asked);
     return start + HEADER;
 }
 

@@ -6,6 +6,7 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "background_runs.h"
 #include "hbao.h"
 #include "scene.h"
 #include "test_harness.h"
@@ -254,10 +255,10 @@ TEST_CASE(blur_pixel_and_the_vector_loop_agree) {
  * background (blur_lanes.h: background_only; their value is 1 whatever the
  * taps), down the columns only where all the rows the AVX-512 copy blurs at
  * once are (lanes_rows); the portable copy, the reference, skips nothing.
- * Runs of 40 background pixels along the rows, moved every 3 rows and
- * shifted every 4, give vectors that are all background, all geometry and
- * mixed, and groups of rows that differ in them: every copy must give the
- * reference's bits, at full and half resolution, on 1 and 3 threads. */
+ * On a picture with a block and runs of background (background_runs.h),
+ * every copy must give the reference's bits, at full and half resolution,
+ * on 1 and 3 threads, at the default sharpness (whose rows skip the
+ * background test) and at 2 (whose rows test every tap). */
 TEST_CASE(background_runs_blur_as_the_reference) {
     enum { w = 150, h = 90 };
     static float depth[w * h], normal[3 * w * h], reference[w * h], ao[w * h];
@@ -265,7 +266,7 @@ TEST_CASE(background_runs_blur_as_the_reference) {
     int background = 0;
     for (int j = 0; j < h; j++) {
         for (int i = 0; i < w; i++) {
-            if (((i + 7 * (j / 4)) / 40 + j / 3) % 3 == 0) {
+            if (background_runs_at(i, j)) {
                 depth[j * w + i] = 1e10f;
                 background++;
             }
@@ -273,9 +274,10 @@ TEST_CASE(background_runs_blur_as_the_reference) {
     }
     hbao_camera camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
     const hbao_channel d = {depth, 1, w}, n = {normal, 3, 3 * (int64_t)w};
-    for (int variant = 0; variant < BLUR_VARIANTS; variant++) {
-        hbao_params p = blur_variant(variant);
+    for (int variant = 0; variant < 2 * BLUR_VARIANTS; variant++) {
+        hbao_params p = blur_variant(variant % BLUR_VARIANTS);
         p.background_depth = 1e9f;
+        if (variant >= BLUR_VARIANTS) p.blur_sharpness = 2.0f; /* below SELF_MASKING_SHARPNESS */
         CHECK_RESULT(hbao_compute(&p, &camera, w, h, &d, &n, reference, w), HBAO_SUCCESS);
         int blurred = 0;
         for (int k = 0; k < w * h; k++) blurred += reference[k] < 0.99f;
@@ -290,9 +292,10 @@ TEST_CASE(background_runs_blur_as_the_reference) {
                 for (int k = 0; k < w * h; k++)
                     differ += memcmp(&reference[k], &ao[k], sizeof ao[k]) != 0;
                 if (differ)
-                    printf("  blur %d, half %d, %d threads, implementation %d: %d pixels "
-                           "differ\n",
-                           p.blur_size, p.half_resolution, threads, implementation, differ);
+                    printf("  blur %d, sharpness %g, half %d, %d threads, implementation %d: %d "
+                           "pixels differ\n",
+                           p.blur_size, (double)p.blur_sharpness, p.half_resolution, threads,
+                           implementation, differ);
                 CHECK(differ == 0);
             }
         }
