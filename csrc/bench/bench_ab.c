@@ -11,10 +11,13 @@
  *   bench_ab BEFORE/libhbao.so AFTER/libhbao.so [--rounds R] [--calls N]
  *            [--threads T] [--half] [--radius R] [--directions D] [--steps S]
  *            [--blur B] [--size WxH] [--implementation NAME] [--back-faces]
+ *            [--background P]
  *
  * --back-faces: with a back-face layer every surface 0.3 deep, as
  * bench_speed's back-face row (hbao_compute_layers; without it the same
- * function with no layer, which is hbao_compute). */
+ * function with no layer, which is hbao_compute). --background P: the
+ * upper P per cent of the rows background (depth 1e10, as bench_speed's
+ * skips row has the upper half). */
 #ifndef _GNU_SOURCE
 #define _GNU_SOURCE /* RTLD_DEEPBIND */
 #endif
@@ -56,12 +59,12 @@ static void usage(const char *program) {
             "usage: %s BEFORE_LIBRARY AFTER_LIBRARY [--rounds R] [--calls N] [--threads T] "
             "[--half] [--radius R] [--directions D] [--steps S] [--blur B] [--size WxH]\n"
             "  [--implementation scalar|avx2|avx512] (default: the best this CPU has) "
-            "[--back-faces]\n",
+            "[--back-faces] [--background P]\n",
             program);
 }
 
 int main(int argc, char **argv) {
-    int rounds = 3, calls = 15, threads = 1, half = 0, back_faces = 0;
+    int rounds = 3, calls = 15, threads = 1, half = 0, back_faces = 0, background = 0;
     int width = 1920, height = 1080;
     hbao_params params = HBAO_PARAMS_DEFAULT_INITIALIZER;
     float radius = 0.5f;
@@ -88,6 +91,8 @@ int main(int argc, char **argv) {
             half = 1;
         else if (!strcmp(argv[a], "--back-faces"))
             back_faces = 1;
+        else if (!strcmp(argv[a], "--background") && a + 1 < argc)
+            background = atoi(argv[++a]);
         else if (!strcmp(argv[a], "--size") && a + 1 < argc) {
             char end = '\0';
             if (sscanf(argv[++a], "%dx%d%c", &width, &height, &end) != 2) width = 0;
@@ -100,10 +105,10 @@ int main(int argc, char **argv) {
     }
     if (rounds < 1 || rounds > 100 || calls < 1 || calls > 1000 || threads < 1 || threads > 64 ||
         !(radius > 0.0f) || params.implementation < 0 || width < 16 || width > 8192 ||
-        height < 16 || height > 8192) {
+        height < 16 || height > 8192 || background < 0 || background > 100) {
         fprintf(stderr, "bench_ab: --rounds 1-100, --calls 1-1000, --threads 1-64, radius > 0, "
                         "--implementation scalar, avx2 or avx512, --size WxH with W and H in "
-                        "16-8192\n");
+                        "16-8192, --background 0-100\n");
         return 2;
     }
     build builds[2] = {{argv[1], NULL, NULL, 0.0, 0.0}, {argv[2], NULL, NULL, 0.0, 0.0}};
@@ -111,6 +116,7 @@ int main(int argc, char **argv) {
         if (!load(&builds[k], width, height)) return 1;
     bench_scene frame;
     bench_scene_make(&frame, width, height);
+    for (size_t k = 0; k < (size_t)(height * background / 100) * width; k++) frame.depth[k] = 1e10f;
     params.radius = radius;
     params.threads = threads;
     params.half_resolution = half;
@@ -123,11 +129,11 @@ int main(int argc, char **argv) {
     double *times = malloc(sizeof(double) * (size_t)calls);
     if (times == NULL) return 1;
     const char *unit = threads == 1 ? "CPU ms" : "wall ms";
-    printf("%dx%d, %d x %d, blur %d%s%s, radius %g, %d thread(s); per round and build: "
-           "fastest and lower-quartile %s of %d calls\n",
+    printf("%dx%d, %d x %d, blur %d%s%s, %d %% background, radius %g, %d thread(s); per round and "
+           "build: fastest and lower-quartile %s of %d calls\n",
            width, height, params.directions, params.steps, params.blur_size,
-           half ? ", half resolution" : "", back_faces ? ", back faces" : "", radius, threads, unit,
-           calls);
+           half ? ", half resolution" : "", back_faces ? ", back faces" : "", background, radius,
+           threads, unit, calls);
     print_load("before");
     for (int round = 0; round < rounds; round++) {
         for (int k = 0; k < 2; k++) {
