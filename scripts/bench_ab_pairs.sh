@@ -39,7 +39,8 @@ from bench_stats import quartiles  # noqa: E402  (scripts/bench_stats.py)
 
 def settings(path):
     """bench_ab's first line up to its ';': size, directions x steps, blur,
-    radius and threads."""
+    half resolution, back faces and background where set, radius and
+    threads."""
     with open(path, encoding="utf-8") as lines:
         return next(lines, "").split(";")[0].strip()
 

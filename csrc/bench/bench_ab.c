@@ -129,11 +129,13 @@ int main(int argc, char **argv) {
     double *times = malloc(sizeof(double) * (size_t)calls);
     if (times == NULL) return 1;
     const char *unit = threads == 1 ? "CPU ms" : "wall ms";
-    printf("%dx%d, %d x %d, blur %d%s%s, %d %% background, radius %g, %d thread(s); per round and "
-           "build: fastest and lower-quartile %s of %d calls\n",
+    char sky[32] = "";
+    if (background > 0) snprintf(sky, sizeof sky, ", %d %% background", background);
+    printf("%dx%d, %d x %d, blur %d%s%s%s, radius %g, %d thread(s); per round and build: "
+           "fastest and lower-quartile %s of %d calls\n",
            width, height, params.directions, params.steps, params.blur_size,
-           half ? ", half resolution" : "", back_faces ? ", back faces" : "", background, radius,
-           threads, unit, calls);
+           half ? ", half resolution" : "", back_faces ? ", back faces" : "", sky, radius, threads,
+           unit, calls);
     print_load("before");
     for (int round = 0; round < rounds; round++) {
         for (int k = 0; k < 2; k++) {

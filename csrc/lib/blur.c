@@ -405,7 +405,7 @@ static hbao_result blur_grid(const hbao_settings *settings, const hbao_grid *gri
     if (implementation == HBAO_IMPLEMENTATION_AVX512) run = finish_band_avx512;
     if (implementation == HBAO_IMPLEMENTATION_AVX2) run = finish_band_avx2;
 #endif
-    hbao_parallel_rows(settings->threads, bands, run, &job);
+    hbao_parallel_rows(job.pool_sets, bands, run, &job); /* no more threads than sets */
     hbao_scratch_give(job.pool);
     return HBAO_SUCCESS;
 }

@@ -229,7 +229,10 @@ static inline float hbao_sample_height(const hbao_grid *grid, const hbao_height_
 typedef void (*hbao_row_job)(void *context, int row);
 void hbao_parallel_rows(int threads, int rows, hbao_row_job job, void *context);
 /* How many of `threads` hbao_parallel_rows runs `rows` on (the calling
- * thread included): at most as many as there are grabs of rows. */
+ * thread included): at most as many as there are grabs of rows, and at most
+ * `threads`, so that hbao_parallel_rows(hbao_parallel_threads(t, rows),
+ * rows, ...) runs no more threads than that (blur.c's band memory, one set
+ * a thread, counts on it). */
 int hbao_parallel_threads(int threads, int rows);
 
 /* Large working buffers (scratch.c): like malloc and free, but a given
@@ -241,10 +244,10 @@ void hbao_scratch_give(void *memory);
  * call that runs out of memory leaves the output as it was. For tests
  * (csrc/tests/internal): where set, a take that it answers 1 for fails. */
 extern int (*hbao_scratch_fails)(size_t bytes);
-/* For tests too: where nonzero, every take fills the memory it gives with
- * the bytes 0xff (NaN as floats), so that a buffer read before it is
- * written shows in the output. */
-extern int hbao_scratch_poisons;
+/* For tests too: where 0-255, every take fills the memory it gives with
+ * that byte (0xff: NaN as floats; 0x3f: about 0.75), so that a buffer read
+ * before it is written shows in the output; -1: no fill. */
+extern int hbao_scratch_fill;
 /* The threads "one per core" gives (threads = 0): the CPUs this process may
  * run on (hbao_cpus.h), at most HBAO_MAX_THREADS. */
 int hbao_available_cores(void);

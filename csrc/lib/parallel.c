@@ -13,18 +13,20 @@
 
 /* Rows taken per grab: enough to keep the counter off the hot path, few
  * enough to balance rows of uneven cost (background vs. geometry): at most
- * HBAO_ROWS_PER_GRAB, and one where a job has few rows for its threads
- * (under GRABS_PER_THREAD grabs each). The blur's rows are bands, 4 per
- * thread: 4 to a grab handed a 2-thread blur's sky bands to one thread and
- * its geometry to the other, which then took as long as without the sky
+ * HBAO_ROWS_PER_GRAB, and one where a job has under HBAO_GRABS_PER_THREAD
+ * grabs of them for each thread. The blur's rows are bands, 4 per thread:
+ * 4 to a grab handed a 2-thread blur's sky bands to one thread and its
+ * geometry to the other, which then took as long as without the sky
  * (session 47: bench_ab_pairs.sh, 8 x 6 + blur 15 with the upper half
  * background, 1.003 of the time before the blur skipped background
- * vectors on 2 threads, 0.894 on 1). */
+ * vectors on 2 threads, 0.894 on 1); one band a grab took 0.881 of the
+ * time before on 2 threads. The search's tiles (136 at half resolution in
+ * 1080p) and the stages' rows keep 4 a grab up to 17 threads and more. */
 #define HBAO_ROWS_PER_GRAB 4
-#define GRABS_PER_THREAD 8
+#define HBAO_GRABS_PER_THREAD 2
 
 static int rows_per_grab(int threads, int rows) {
-    return rows >= GRABS_PER_THREAD * HBAO_ROWS_PER_GRAB * threads ? HBAO_ROWS_PER_GRAB : 1;
+    return rows / (HBAO_GRABS_PER_THREAD * HBAO_ROWS_PER_GRAB) >= threads ? HBAO_ROWS_PER_GRAB : 1;
 }
 
 typedef struct row_queue {

@@ -55,7 +55,7 @@ static kept_block kept[SCRATCH_BLOCKS];
 static size_t kept_bytes;
 
 int (*hbao_scratch_fails)(size_t bytes) = NULL;
-int hbao_scratch_poisons = 0;
+int hbao_scratch_fill = -1;
 
 void *hbao_scratch_take(size_t bytes) {
     if (bytes > SIZE_MAX - HEADER) return NULL;
@@ -79,7 +79,7 @@ void *hbao_scratch_take(size_t bytes) {
         if (start == NULL) return NULL;
         *(size_t *)start = bytes;
     }
-    if (hbao_scratch_poisons) memset(start + HEADER, 0xff, asked);
+    if (hbao_scratch_fill >= 0) memset(start + HEADER, hbao_scratch_fill, asked);
     return start + HEADER;
 }
 

@@ -10,6 +10,7 @@
 #define _GNU_SOURCE /* sched_setaffinity */
 #endif
 #include <sched.h>
+#include <stdatomic.h>
 #endif
 #include <stdint.h>
 
@@ -843,64 +844,125 @@ TEST_CASE(running_out_of_memory_leaves_the_output_as_it_was) {
     }
 }
 
-/* Every scratch buffer is written before it is read (scratch.c): with
- * every take filled with NaN (hbao_scratch_poisons), each stage gives the
- * bits it gives on memory that held finite values. A slanted floor with
- * background (background_runs.h: blur_lanes.h skips whole vectors of
- * background centres and must still write them), with given
- * normals and without, full and half resolution, blur 0, 5, 15 and 65,
- * every implementation, on 1 and 3 threads. */
-TEST_CASE(scratch_memory_is_written_before_it_is_read) {
-    enum { w = 150, h = 90 };
-    static float depth[w * h], normal[3 * w * h], clean[w * h], poisoned[w * h];
-    for (int j = 0; j < h; j++) {
-        for (int i = 0; i < w; i++) {
-            const int k = j * w + i;
-            depth[k] = background_runs_at(i, j)
-                           ? 1e10f
-                           : 3.0f + 0.02f * (float)j + 0.2f * (float)((i / 11) % 2);
-            normal[3 * k] = (float)((i / 11) % 2) - 0.5f;
-            normal[3 * k + 1] = 0.3f;
-            normal[3 * k + 2] = 1.0f;
-        }
-    }
-    const hbao_camera camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
-    const hbao_channel d = {depth, 1, w}, n = {normal, 3, 3 * (int64_t)w};
+/* The picture, back layer and settings of scratch_memory_is_written_before_it_is_read */
+enum { SCRATCH_W = 150, SCRATCH_H = 90 };
+static float scratch_depth[SCRATCH_W * SCRATCH_H], scratch_back[SCRATCH_W * SCRATCH_H],
+    scratch_normal[3 * SCRATCH_W * SCRATCH_H], scratch_work[SCRATCH_W * SCRATCH_H];
+
+/* One frame of variant v (bits: blur size, half resolution, no given
+ * normals, a back layer, in place) into out, with every scratch take
+ * filled with the byte fill. */
+static hbao_result scratch_frame(int v, int implementation, int threads, int fill, float *out) {
     const int sizes[] = {0, 5, 15, 65};
+    hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+    p.radius = 0.3f;
+    p.background_depth = 1e9f;
+    p.blur_size = sizes[v % 4];
+    p.half_resolution = (v / 4) & 1;
+    p.implementation = implementation;
+    p.threads = threads;
+    const hbao_camera camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
+    const int in_place = (v / 32) & 1;
+    if (in_place) memcpy(scratch_work, scratch_depth, sizeof scratch_work);
+    const hbao_channel d = {in_place ? scratch_work : scratch_depth, 1, SCRATCH_W};
+    const hbao_channel n = {scratch_normal, 3, 3 * (int64_t)SCRATCH_W};
+    const hbao_channel back = {scratch_back, 1, SCRATCH_W};
+    hbao_scratch_fill = fill;
+    const hbao_result result =
+        hbao_compute_layers(&p, &camera, SCRATCH_W, SCRATCH_H, &d, (v / 8) & 1 ? NULL : &n,
+                            (v / 16) & 1 ? &back : NULL, in_place ? scratch_work : out, SCRATCH_W);
+    hbao_scratch_fill = -1;
+    if (in_place) memcpy(out, scratch_work, sizeof scratch_work);
+    return result;
+}
+
+/* Every scratch buffer is written before it is read (scratch.c): a frame
+ * on scratch memory filled with 0x00 gives the bits of frames on memory
+ * filled with 0xff (NaN as floats) and with 0x3f (about 0.75; a NaN depth
+ * reads as background, which can hide an unwritten depth). A slanted floor
+ * with background (background_runs.h: blur_lanes.h skips whole vectors of
+ * background centres and must still write them) and a back layer 0.3 deep
+ * (none known at every seventh pixel), at blur 0, 5, 15 and 65, full and
+ * half resolution, with given normals and without, with and without the
+ * back layer, into its own output and in place over the depth: every
+ * stage's buffers (depth, half depth, normals, phase depths, raw AO, the
+ * blur's bands and rows, the guide's copy, the back layer's), for every
+ * implementation on 1 and 3 threads. */
+TEST_CASE(scratch_memory_is_written_before_it_is_read) {
+    for (int k = 0; k < SCRATCH_W * SCRATCH_H; k++) {
+        const int i = k % SCRATCH_W, j = k / SCRATCH_W;
+        scratch_depth[k] = background_runs_at(i, j)
+                               ? 1e10f
+                               : 3.0f + 0.02f * (float)j + 0.2f * (float)((i / 11) % 2);
+        scratch_back[k] = k % 7 == 0 ? INFINITY : scratch_depth[k] + 0.3f;
+        scratch_normal[3 * k] = (float)((i / 11) % 2) - 0.5f;
+        scratch_normal[3 * k + 1] = 0.3f;
+        scratch_normal[3 * k + 2] = 1.0f;
+    }
+    static float clean[SCRATCH_W * SCRATCH_H], filled[SCRATCH_W * SCRATCH_H];
+    const int fills[] = {0xff, 0x3f};
     int cases = 0;
-    for (int variant = 0; variant < 16; variant++) {
-        hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
-        p.radius = 0.3f;
-        p.background_depth = 1e9f;
-        p.blur_size = sizes[variant % 4];
-        p.half_resolution = (variant / 4) & 1;
-        const hbao_channel *given = variant / 8 ? NULL : &n;
+    for (int v = 0; v < 64; v++) {
         for (int implementation = HBAO_IMPLEMENTATION_SCALAR;
              implementation <= HBAO_IMPLEMENTATION_AVX512; implementation++) {
             for (int threads = 1; threads <= 3; threads += 2) {
-                p.implementation = implementation;
-                p.threads = threads;
-                hbao_release_memory();
-                CHECK_RESULT(hbao_compute(&p, &camera, w, h, &d, given, clean, w), HBAO_SUCCESS);
-                hbao_scratch_poisons = 1;
-                const hbao_result result = hbao_compute(&p, &camera, w, h, &d, given, poisoned, w);
-                hbao_scratch_poisons = 0;
-                CHECK_RESULT(result, HBAO_SUCCESS);
-                int differ = 0;
-                for (int k = 0; k < w * h; k++)
-                    differ += memcmp(&clean[k], &poisoned[k], sizeof clean[k]) != 0;
-                if (differ)
-                    printf("  blur %d, half %d, normals %d, implementation %d, %d threads: %d "
-                           "pixels differ\n",
-                           p.blur_size, p.half_resolution, given != NULL, implementation, threads,
-                           differ);
-                CHECK(differ == 0);
-                cases++;
+                CHECK_RESULT(scratch_frame(v, implementation, threads, 0x00, clean), HBAO_SUCCESS);
+                for (int f = 0; f < 2; f++) {
+                    CHECK_RESULT(scratch_frame(v, implementation, threads, fills[f], filled),
+                                 HBAO_SUCCESS);
+                    int differ = 0;
+                    for (int k = 0; k < SCRATCH_W * SCRATCH_H; k++)
+                        differ += memcmp(&clean[k], &filled[k], sizeof clean[k]) != 0;
+                    if (differ)
+                        printf("  variant %d, implementation %d, %d threads, fill 0x%02x: %d "
+                               "pixels differ\n",
+                               v, implementation, threads, fills[f], differ);
+                    CHECK(differ == 0);
+                    cases++;
+                }
             }
         }
     }
-    CHECK(cases == 16 * 3 * 2);
+    CHECK(cases == 64 * 3 * 2 * 2);
     hbao_release_memory();
+}
+
+/* hbao_parallel_rows runs every row once, on no more threads at once than
+ * hbao_parallel_threads says (blur.c's band memory counts on it), for row
+ * counts around a grab's and thread counts up to HBAO_MAX_THREADS. */
+static atomic_int rows_seen[8200], running_now, running_most;
+static void count_row(void *context, int row) {
+    (void)context;
+    const int now = atomic_fetch_add(&running_now, 1) + 1;
+    int most = atomic_load(&running_most);
+    while (now > most && !atomic_compare_exchange_weak(&running_most, &most, now)) {
+    }
+    atomic_fetch_add(&rows_seen[row], 1);
+    for (volatile int spin = 0; spin < 200; spin++) {
+    }
+    atomic_fetch_sub(&running_now, 1);
+}
+
+TEST_CASE(parallel_rows_run_each_row_once_on_the_threads_they_say) {
+    const int threads[] = {1, 2, 3, 7, 64, HBAO_MAX_THREADS};
+    const int rows[] = {0, 1, 5, 7, 8, 9, 31, 32, 33, 255, 256, 8192};
+    for (size_t t = 0; t < sizeof threads / sizeof threads[0]; t++) {
+        for (size_t r = 0; r < sizeof rows / sizeof rows[0]; r++) {
+            for (int k = 0; k < rows[r]; k++) atomic_store(&rows_seen[k], 0);
+            atomic_store(&running_most, 0);
+            hbao_parallel_rows(threads[t], rows[r], count_row, NULL);
+            int wrong = 0;
+            for (int k = 0; k < rows[r]; k++) wrong += atomic_load(&rows_seen[k]) != 1;
+            const int allowed = hbao_parallel_threads(threads[t], rows[r]);
+            if (wrong || atomic_load(&running_most) > allowed)
+                printf("  %d threads, %d rows: %d rows not run once, %d at once (at most %d)\n",
+                       threads[t], rows[r], wrong, atomic_load(&running_most), allowed);
+            CHECK(wrong == 0);
+            CHECK(atomic_load(&running_most) <= allowed);
+            CHECK(allowed >= 1 || rows[r] == 0);
+            CHECK(allowed <= threads[t]);
+        }
+    }
 }
 
 /* A block larger than the whole kept memory (SCRATCH_MAX_BYTES, 512 MiB:
@@ -965,5 +1027,6 @@ TEST_MAIN(TEST_ENTRY(blur_copies_agree_on_background_at_every_sharpness),
           TEST_ENTRY(a_lone_pixels_normal_that_faces_away_is_turned_round),
           TEST_ENTRY(running_out_of_memory_leaves_the_output_as_it_was),
           TEST_ENTRY(scratch_memory_is_written_before_it_is_read),
+          TEST_ENTRY(parallel_rows_run_each_row_once_on_the_threads_they_say),
           TEST_ENTRY(a_block_too_large_to_keep_leaves_the_kept_ones),
           TEST_ENTRY(default_threads_follow_the_cpus_the_process_may_use))
