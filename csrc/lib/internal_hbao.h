@@ -244,9 +244,11 @@ void hbao_scratch_give(void *memory);
  * call that runs out of memory leaves the output as it was. For tests
  * (csrc/tests/internal): where set, a take that it answers 1 for fails. */
 extern int (*hbao_scratch_fails)(size_t bytes);
-/* For tests too: where 0-255, every take fills the memory it gives with
- * that byte (0xff: NaN as floats; 0x3f: about 0.75), so that a buffer read
- * before it is written shows in the output; -1: no fill. */
+/* For tests too: where 0-255, every take fills the block it gives, to its
+ * whole capacity, with that byte (0xff: NaN as floats; 0x3f: about 0.75),
+ * so that a buffer read before it is written, or past the bytes asked
+ * (which ASan does not see in a kept block), shows in the output; -1: no
+ * fill. */
 extern int hbao_scratch_fill;
 /* The threads "one per core" gives (threads = 0): the CPUs this process may
  * run on (hbao_cpus.h), at most HBAO_MAX_THREADS. */

@@ -73,13 +73,12 @@ void *hbao_scratch_take(size_t bytes) {
         kept[best].start = NULL;
     }
     pthread_mutex_unlock(&scratch_lock);
-    const size_t asked = bytes;
     if (start == NULL) {
         start = new_block(&bytes);
         if (start == NULL) return NULL;
         *(size_t *)start = bytes;
     }
-    if (hbao_scratch_fill >= 0) memset(start + HEADER, hbao_scratch_fill, asked);
+    if (hbao_scratch_fill >= 0) memset(start + HEADER, hbao_scratch_fill, *(size_t *)start);
     return start + HEADER;
 }
 
