@@ -16,7 +16,7 @@
  * --back-faces: with a back-face layer every surface 0.3 deep, as
  * bench_speed's back-face row (hbao_compute_layers; without it the same
  * function with no layer, which is hbao_compute). --background P: the
- * upper P per cent of the rows background (depth 1e10, as bench_speed's
+ * upper P per cent of the rows background (bench_sky, as bench_speed's
  * skips row has the upper half). */
 #ifndef _GNU_SOURCE
 #define _GNU_SOURCE /* RTLD_DEEPBIND */
@@ -116,7 +116,7 @@ int main(int argc, char **argv) {
         if (!load(&builds[k], width, height)) return 1;
     bench_scene frame;
     bench_scene_make(&frame, width, height);
-    for (size_t k = 0; k < (size_t)(height * background / 100) * width; k++) frame.depth[k] = 1e10f;
+    bench_sky(frame.depth, width, height, background);
     params.radius = radius;
     params.threads = threads;
     params.half_resolution = half;

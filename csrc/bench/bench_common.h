@@ -51,6 +51,14 @@ static inline void print_load(const char *when) {
     if (f != NULL) fclose(f);
 }
 
+/* The upper `percent` per cent of the rows of a width-wide depth image
+ * made a sky: a depth of 1e10, beyond any background_depth the benchmarks
+ * set (bench_speed's skips row, bench_ab --background). */
+static inline void bench_sky(float *depth, int width, int height, int percent) {
+    const size_t pixels = (size_t)(height * percent / 100) * (size_t)width;
+    for (size_t k = 0; k < pixels; k++) depth[k] = 1e10f;
+}
+
 /* A room corner (floor, two walls) with a box: every pixel is geometry. */
 typedef struct bench_scene {
     scene_view view;

@@ -119,32 +119,33 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(centre_done)(const BLUR_NAM
     memcpy(target, &blurred, sizeof blurred);
 }
 
-/* Whether the centres at z[i .. i + count * BLUR_LANES - 1] are all
- * background (not above 0: blur_pixel gives each of them 1 whatever its
- * taps); never where the copy skips nothing (BLUR_SKIPS). */
-BLUR_TARGET static HBAO_ALWAYS_INLINE int BLUR_NAME(background_only)(const float *z, int i,
-                                                                     int count) {
+/* The lanes of the centres at z[0 .. BLUR_LANES - 1] that are not
+ * background (above 0) */
+BLUR_TARGET static HBAO_ALWAYS_INLINE VI BLUR_NAME(above)(const float *z) {
+    return BLUR_NAME(load)(z) > 0.0f;
+}
+
+/* Whether centres whose lanes not on background are `above` (OR-ed over
+ * their vectors) are all background, so that blur_pixel gives each of them
+ * 1 whatever its taps; never where the copy skips nothing (BLUR_SKIPS). */
+BLUR_TARGET static HBAO_ALWAYS_INLINE int BLUR_NAME(background_only)(VI above) {
 #if BLUR_SKIPS
-    VI above = {0};
-    for (int g = 0; g < count; g++) above |= BLUR_NAME(load)(z + i + g * BLUR_LANES) > 0.0f;
     return !BLUR_ANY(above);
 #else
-    (void)z;
-    (void)i;
-    (void)count;
+    (void)above;
     return 0;
 #endif
 }
 
-/* value into target[0 .. count * BLUR_LANES - 1]. A skipped vector of
+/* 1 into target[0 .. count * BLUR_LANES - 1]. A skipped vector of
  * background centres is still written: along a row its values are the
  * column pass's taps, and a tap on background weighs +0, which would turn a
  * NaN left in the ring into a NaN sum (test_stages.c,
  * scratch_memory_is_written_before_it_is_read); down the columns
  * write_output puts 1 there anyway, and the write keeps every row whole. */
-BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(fill)(float *target, int count, float value) {
-    const VF v = (VF){0.0f} + value;
-    for (int g = 0; g < count; g++) memcpy(target + g * BLUR_LANES, &v, sizeof v);
+BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(fill_ones)(float *target, int count) {
+    const VF one = (VF){0.0f} + 1.0f;
+    for (int g = 0; g < count; g++) memcpy(target + g * BLUR_LANES, &one, sizeof one);
 }
 
 /* blur_pixel for pixels i .. i + groups * BLUR_LANES - 1, all of whose
@@ -164,8 +165,10 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(lanes)(const tap_set *taps,
                                                             const centre_row *c, float sharpness,
                                                             int i, float *target, int along_row,
                                                             int check, int groups) {
-    if (BLUR_NAME(background_only)(c->z, i, groups)) {
-        BLUR_NAME(fill)(target + i, groups, 1.0f);
+    VI above = {0};
+    for (int g = 0; g < groups; g++) above |= BLUR_NAME(above)(c->z + i + g * BLUR_LANES);
+    if (BLUR_NAME(background_only)(above)) {
+        BLUR_NAME(fill_ones)(target + i, groups);
         return;
     }
     BLUR_NAME(centre) centre[BLUR_GROUPS];
@@ -196,10 +199,10 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(lanes)(const tap_set *taps,
 BLUR_TARGET static HBAO_ALWAYS_INLINE void
 BLUR_NAME(lanes_rows)(const column_taps *taps, const centre_row *c, float sharpness, int i,
                       float *const *targets, int check, int rows) {
-    int background = 1;
-    for (int r = 0; r < rows; r++) background &= BLUR_NAME(background_only)(c[r].z, i, 1);
-    if (background) {
-        for (int r = 0; r < rows; r++) BLUR_NAME(fill)(targets[r] + i, 1, 1.0f);
+    VI above = {0};
+    for (int r = 0; r < rows; r++) above |= BLUR_NAME(above)(c[r].z + i);
+    if (BLUR_NAME(background_only)(above)) {
+        for (int r = 0; r < rows; r++) BLUR_NAME(fill_ones)(targets[r] + i, 1);
         return;
     }
     BLUR_NAME(centre) centre[MAX_COLUMN_ROWS];
