@@ -1,9 +1,11 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """The viewport preview (addon/hbao/viewport) in a real Blender window under
 xvfb-run (Mesa llvmpipe): its GLSL AO against the C library's, and what turning
-it on and off does to the 3D view."""
+it on and off does to the 3D view; and the preview's GPU benchmark, which runs
+the same passes without Blender (scripts/bench_viewport_gl.py), on Mesa's EGL."""
 import json
 import re
+import subprocess
 import sys
 
 import pytest
@@ -22,7 +24,9 @@ ARTIFACTS = REPO / "out" / "test-artifacts"
 # percentile <= 4.1e-5 (measured, every case, with the library's four-term acos
 # of session 45; 5e-6 and 4e-5 with the eight-term one before). The tolerances
 # leave room for GPUs with coarser transcendentals
-# (NVIDIA's sin/cos: ~1e-6 absolute, more after range reduction) and for the
+# (NVIDIA's sin/cos: ~1e-6 absolute, more after range reduction; measured on an
+# NVIDIA H200 with scripts/bench_viewport_gl.py at 1920x1080 and 3840x2160:
+# mean <= 3.0e-6, p99 <= 2.5e-5, docs/speed.md, session 48) and for the
 # rare pixel whose step lands on the neighbouring pixel (floor() of a value
 # within rounding of an integer), while staying below what a real deviation
 # from docs/algorithm.md costs. Measured by mutating the shader (mean, p99 of
@@ -287,3 +291,26 @@ def test_use_node_settings_previews_the_nodes_values(run_in_blender):
         {"radius": 0.9, "steps": 7, "thickness": 0.2, "falloff": "QUADRATIC", **sky},
         rel=1e-6), cases
     assert cases["no_node"] == own, cases
+
+
+def test_gpu_benchmark_runs_the_previews_passes_as_the_library(tmp_path):
+    """scripts/bench_viewport_gl.py runs the preview's passes where no Blender
+    runs (a GPU machine), through scripts/gl_blender_gpu.py's stand-in for
+    Blender's gpu module: here on Mesa's EGL, every setting it times gives the
+    library's AO within the tolerances above, even and odd sizes, so that its
+    GPU figures time the preview's shaders and not a broken copy."""
+    out = tmp_path / "gl.json"
+    completed = subprocess.run(
+        [sys.executable, str(REPO / "scripts" / "bench_viewport_gl.py"), "--repeats", "1",
+         "--size", "200x150", "--size", "201x151", "--json", str(out)],
+        capture_output=True, text=True, timeout=600)
+    assert completed.returncode == 0, completed.stdout + completed.stderr
+    report = json.loads(out.read_text())
+    rows = report["rows"]
+    assert {(row["size"], row["setting"]) for row in rows} == {
+        (size, setting) for size in ("200x150", "201x151")
+        for setting in ("defaults", "half resolution", "8 x 6 + blur 15", "defaults, no blur")}
+    for row in rows:
+        assert row["mean_abs"] <= MEAN_TOLERANCE, row
+        assert row["p99_abs"] <= P99_TOLERANCE, row
+        assert row["gpu_ms"] > 0 and row["fetch_gpu_ms"] > 0, row

@@ -1,0 +1,168 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""The viewport preview's GPU time without Blender, for a GPU machine where
+no Blender runs (the `device` machine: no display, no Blender, Python 3.12).
+
+    scripts/bench_viewport_gl.py [--repeats N] [--size WxH ...] [--json OUT]
+
+Runs the add-on's own passes (addon/hbao/viewport/pipeline.py with the GLSL
+of shader_sources.py, unchanged) on an EGL context of moderngl's, through
+scripts/gl_blender_gpu.py, which stands in for the part of Blender's `gpu`
+module they use. The depth is scripts/synthetic_depth.py's scene through the
+35 mm camera of tests/blender_scripts/viewport_match.py. For each size and
+setting it prints the median GPU time of the passes (OpenGL timer queries:
+normals, AO, blur, upsample, composite), the wall time of a frame waited
+for, the time of what draw.py has Blender do before them (the depth read
+back from a depth buffer and uploaded again, then linearised), and the
+AO's difference from the C library's on the same depth (mean, 99th
+percentile, largest; tests/test_viewport.py allows 2e-4 and 2e-3 in
+Blender), so that a fast wrong shader shows.
+
+Needs numpy, moderngl (pip) and an EGL driver, and the library
+(HBAO_LIBRARY, else build/libhbao.so). In Blender, on the GPU that Blender
+draws with, scripts/bench_viewport.py measures the whole preview.
+"""
+import argparse
+import json
+import os
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import moderngl
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO / "scripts"))
+sys.path.insert(0, str(REPO / "addon"))
+import gl_blender_gpu  # noqa: E402
+from synthetic_depth import synthetic_depth  # noqa: E402
+
+CAMERA = {"type": "PERSP", "lens": 35.0, "sensor_width": 36.0, "sensor_height": 24.0,
+          "sensor_fit": "AUTO", "clip_start": 0.1, "clip_end": 100.0}
+SETTINGS = (("defaults", {}),
+            ("half resolution", {"half_resolution": 1}),
+            ("8 x 6 + blur 15", {"directions": 8, "steps": 6, "blur_size": 15}),
+            ("defaults, no blur", {"blur_size": 0}))
+
+
+def _size(text):
+    width, height = (int(v) for v in text.lower().split("x"))
+    if width < 1 or height < 1:
+        raise argparse.ArgumentTypeError(f"size must be positive, not {text}")
+    return width, height
+
+
+def _timed(context, repeats, draw):
+    """Median GPU milliseconds (timer query) and wall milliseconds of `draw`,
+    each call waited for, after two unmeasured calls."""
+    for _ in range(2):
+        draw()
+    context.finish()
+    gpu_ms, wall_ms = [], []
+    for _ in range(repeats):
+        query = context.query(time=True)
+        start = time.perf_counter()
+        with query:
+            draw()
+        context.finish()
+        wall_ms.append((time.perf_counter() - start) * 1e3)
+        gpu_ms.append(query.elapsed / 1e6)
+    return statistics.median(gpu_ms), statistics.median(wall_ms)
+
+
+def _depth_buffer(context, frame, depth, clip):
+    """A depth-buffer framebuffer of `depth` as a perspective projection with
+    clip distances `clip` stores it ([0, 1], cleared to 1 in the sky), and the
+    projection's depth coefficients (projection.depth_coefficients)."""
+    from hbao.viewport import projection
+    near, far = clip
+    matrix = [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0],
+              [0.0, 0.0, -(far + near) / (far - near), -2.0 * far * near / (far - near)],
+              [0.0, 0.0, -1.0, 0.0]]
+    z = np.clip(depth.astype(np.float64), near, far)
+    ndc = (-(far + near) / (far - near) * -z + -2.0 * far * near / (far - near)) / z
+    stored = np.where(depth >= 1e9, 1.0, 0.5 * ndc + 0.5).astype(np.float32)
+    texture = context.depth_texture((frame.width, frame.height), data=stored[::-1].tobytes())
+    framebuffer = context.framebuffer(depth_attachment=texture)
+    return framebuffer, projection.depth_coefficients(matrix)
+
+
+def run(args):
+    context = moderngl.create_standalone_context(backend="egl", require=430)
+    gl_blender_gpu.install(context)
+    import gpu  # noqa: PLC0415 (gl_blender_gpu's, installed above)
+    from hbao import native  # noqa: PLC0415
+    from hbao.viewport import pipeline, projection, shader_sources  # noqa: PLC0415
+    renderer = f"{context.info['GL_RENDERER']} | {context.info['GL_VERSION']}"
+    print(f"renderer: {renderer}")
+    rows = []
+    for width, height in args.size:
+        frame = projection.frame_from_camera(CAMERA, width, height)
+        depth = synthetic_depth(frame)
+        depth_texture = gpu.types.GPUTexture((width, height), format="R32F",
+                                             data=depth[::-1].tobytes())
+        composite_target = gpu.types.GPUFrameBuffer(
+            color_slots=gpu.types.GPUTexture((width, height), format="RGBA32F"))
+        # What draw.py has Blender do first: read the view's depth buffer
+        # back, upload it, linearise it.
+        buffer, coefficients = _depth_buffer(context, frame, depth,
+                                             (CAMERA["clip_start"], CAMERA["clip_end"]))
+        fetch_pipeline = pipeline.AOPipeline()
+
+        def fetch():
+            stored = buffer.read(components=1, attachment=-1, dtype="f4")
+            upload = gpu.types.GPUTexture((width, height), format="R32F", data=stored)
+            fetch_pipeline.linearize(upload, coefficients)
+
+        fetch_gpu, fetch_wall = _timed(context, args.repeats, fetch)
+        for name, overrides in SETTINGS:
+            params = native.resolve_params(overrides)
+            ao_pipeline = pipeline.AOPipeline()
+
+            def draw():
+                ao = ao_pipeline.ambient_occlusion(
+                    depth_texture, frame, params,
+                    depth_precision=shader_sources.FLOAT_DEPTH_PRECISION)
+                with composite_target.bind():
+                    pipeline.composite(ao, params["strength"])
+                return ao
+
+            gpu_ms, wall_ms = _timed(context, args.repeats, draw)
+            ao = draw()
+            preview = np.frombuffer(ao.texture.read(), dtype=np.float32)
+            preview = np.clip(preview.reshape(height, width)[::-1], 0.0, 1.0)
+            reference = native.compute_ao(depth, None, camera=CAMERA, params=params)
+            difference = np.abs(preview.astype(np.float64) - reference)
+            rows.append({
+                "size": f"{width}x{height}", "setting": name, "gpu_ms": gpu_ms,
+                "wall_ms": wall_ms, "fetch_gpu_ms": fetch_gpu, "fetch_wall_ms": fetch_wall,
+                "mean_abs": float(difference.mean()),
+                "p99_abs": float(np.percentile(difference, 99)),
+                "max_abs": float(difference.max())})
+    print(f"{'size':>9}  {'setting':<18} {'GPU ms':>7} {'wall ms':>8} "
+          f"{'fetch GPU':>9} {'fetch wall':>10} {'mean |d|':>9} {'p99 |d|':>9} {'max |d|':>8}")
+    for row in rows:
+        print(f"{row['size']:>9}  {row['setting']:<18} {row['gpu_ms']:7.2f} "
+              f"{row['wall_ms']:8.2f} {row['fetch_gpu_ms']:9.2f} {row['fetch_wall_ms']:10.2f} "
+              f"{row['mean_abs']:9.1e} {row['p99_abs']:9.1e} {row['max_abs']:8.1e}")
+    if args.json:
+        Path(args.json).write_text(json.dumps({"renderer": renderer, "rows": rows}, indent=1))
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--repeats", type=int, default=20)
+    parser.add_argument("--size", type=_size, action="append")
+    parser.add_argument("--json")
+    args = parser.parse_args()
+    args.size = args.size or [(1920, 1080), (3840, 2160)]
+    if args.repeats < 1:
+        parser.error("--repeats must be at least 1")
+    os.environ.setdefault("HBAO_LIBRARY", str(REPO / "build" / "libhbao.so"))
+    run(args)
+
+
+if __name__ == "__main__":
+    main()
