@@ -11,7 +11,8 @@ scripts/gl_blender_gpu.py, which stands in for the part of Blender's `gpu`
 module they use. The depth is scripts/synthetic_depth.py's scene through the
 35 mm camera of tests/blender_scripts/viewport_match.py. For each size and
 setting it prints the median GPU time of the passes (OpenGL timer queries:
-normals, AO, blur, upsample, composite), the wall time of a frame waited
+normals, AO, blur, upsample, composite) and each pass's own (the blur's
+and the composite's two draws summed), the wall time of a frame waited
 for, the time of what draw.py has Blender do before them (the depth read
 back from a depth buffer and uploaded again, then linearised), and the
 AO's difference from the C library's on the same depth (mean, 99th
@@ -72,6 +73,21 @@ def _timed(context, repeats, draw):
     return statistics.median(gpu_ms), statistics.median(wall_ms)
 
 
+def _pass_times(repeats, draw, names):
+    """Median GPU milliseconds of each pass of `draw` (by shader name in
+    `names`: shader -> name), each draw timed on its own."""
+    times = {}
+    for _ in range(repeats):
+        with gl_blender_gpu.timing_draws() as draws:
+            draw()
+        frame = {}
+        for shader, nanoseconds in draws:
+            frame[names[shader]] = frame.get(names[shader], 0.0) + nanoseconds / 1e6
+        for name, milliseconds in frame.items():
+            times.setdefault(name, []).append(milliseconds)
+    return {name: statistics.median(values) for name, values in times.items()}
+
+
 def _depth_buffer(context, frame, depth, clip):
     """A depth-buffer framebuffer of `depth` as a perspective projection with
     clip distances `clip` stores it ([0, 1], cleared to 1 in the sky), and the
@@ -94,7 +110,7 @@ def run(args):
     gl_blender_gpu.install(context)
     import gpu  # noqa: PLC0415 (gl_blender_gpu's, installed above)
     from hbao import native  # noqa: PLC0415
-    from hbao.viewport import pipeline, projection, shader_sources  # noqa: PLC0415
+    from hbao.viewport import pipeline, projection, shader_sources, shaders  # noqa: PLC0415
     renderer = f"{context.info['GL_RENDERER']} | {context.info['GL_VERSION']}"
     print(f"renderer: {renderer}")
     rows = []
@@ -130,6 +146,8 @@ def run(args):
                 return ao
 
             gpu_ms, wall_ms = _timed(context, args.repeats, draw)
+            names = {shader: name for name, shader in shaders._shaders.items()}
+            passes = _pass_times(args.repeats, draw, names)
             ao = draw()
             preview = np.frombuffer(ao.texture.read(), dtype=np.float32)
             preview = np.clip(preview.reshape(height, width)[::-1], 0.0, 1.0)
@@ -138,6 +156,7 @@ def run(args):
             rows.append({
                 "size": f"{width}x{height}", "setting": name, "gpu_ms": gpu_ms,
                 "wall_ms": wall_ms, "fetch_gpu_ms": fetch_gpu, "fetch_wall_ms": fetch_wall,
+                "passes_ms": passes,
                 "mean_abs": float(difference.mean()),
                 "p99_abs": float(np.percentile(difference, 99)),
                 "max_abs": float(difference.max())})
@@ -147,6 +166,10 @@ def run(args):
         print(f"{row['size']:>9}  {row['setting']:<18} {row['gpu_ms']:7.2f} "
               f"{row['wall_ms']:8.2f} {row['fetch_gpu_ms']:9.2f} {row['fetch_wall_ms']:10.2f} "
               f"{row['mean_abs']:9.1e} {row['p99_abs']:9.1e} {row['max_abs']:8.1e}")
+    print("GPU ms of each pass (median; the blur's and the composite's two draws summed):")
+    for row in rows:
+        passes = "  ".join(f"{name} {ms:.2f}" for name, ms in row["passes_ms"].items())
+        print(f"{row['size']:>9}  {row['setting']:<18} {passes}")
     if args.json:
         Path(args.json).write_text(json.dumps({"renderer": renderer, "rows": rows}, indent=1))
 

@@ -12,7 +12,10 @@ units of their slots, its vertex input and fragment outputs `in`/`out`
 declarations ahead of the sources; blend modes as GPU_blend's.
 
     install(context)  # before importing hbao.viewport
+    with timing_draws() as draws:  # [(shader, GPU nanoseconds)] of each draw
+        ...
 """
+import contextlib
 import sys
 import types
 
@@ -22,6 +25,7 @@ _GLSL_TYPES = {"INT": "int", "IVEC2": "ivec2", "FLOAT": "float", "VEC2": "vec2",
                "VEC3": "vec3", "VEC4": "vec4"}
 _FORMATS = {"R32F": 1, "RG32F": 2, "RGBA32F": 4}
 _CONTEXT = None
+_timed_draws = None
 
 
 class GPUShaderCreateInfo:
@@ -129,7 +133,30 @@ class _Batch:
         self.array = _CONTEXT.vertex_array(shader.program, [(buffer, "2f", name)])
 
     def draw(self, shader):
-        self.array.render(moderngl.TRIANGLES)
+        if _timed_draws is None:
+            self.array.render(moderngl.TRIANGLES)
+            return
+        query = _CONTEXT.query(time=True)
+        with query:
+            self.array.render(moderngl.TRIANGLES)
+        _timed_draws.append((shader, query))
+
+
+@contextlib.contextmanager
+def timing_draws():
+    """Times each draw inside the block with its own timer query (which
+    cannot nest in another): yields a list that receives (shader, GPU
+    nanoseconds) of each draw once the block ends."""
+    global _timed_draws
+    _timed_draws, queries = [], []
+    draws = []
+    try:
+        yield draws
+        queries = _timed_draws
+    finally:
+        _timed_draws = None
+    _CONTEXT.finish()
+    draws.extend((shader, query.elapsed) for shader, query in queries)
 
 
 # GPU_blend's factors, (source, destination), for the modes the preview sets.

@@ -314,3 +314,4 @@ def test_gpu_benchmark_runs_the_previews_passes_as_the_library(tmp_path):
         assert row["mean_abs"] <= MEAN_TOLERANCE, row
         assert row["p99_abs"] <= P99_TOLERANCE, row
         assert row["gpu_ms"] > 0 and row["fetch_gpu_ms"] > 0, row
+        assert {"normals", "ao", "composite"} <= set(row["passes_ms"]), row
