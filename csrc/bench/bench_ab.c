@@ -74,25 +74,25 @@ int main(int argc, char **argv) {
     }
     for (int a = 3; a < argc; a++) {
         if (!strcmp(argv[a], "--rounds") && a + 1 < argc)
-            rounds = atoi(argv[++a]);
+            rounds = (int)bench_whole_number(argv[++a], 1, 100);
         else if (!strcmp(argv[a], "--calls") && a + 1 < argc)
-            calls = atoi(argv[++a]);
+            calls = (int)bench_whole_number(argv[++a], 1, 1000);
         else if (!strcmp(argv[a], "--threads") && a + 1 < argc)
-            threads = atoi(argv[++a]);
+            threads = (int)bench_whole_number(argv[++a], 1, 64);
         else if (!strcmp(argv[a], "--radius") && a + 1 < argc)
-            radius = (float)atof(argv[++a]);
+            radius = bench_positive_number(argv[++a]);
         else if (!strcmp(argv[a], "--directions") && a + 1 < argc)
-            params.directions = atoi(argv[++a]);
+            params.directions = (int)bench_whole_number(argv[++a], 1, HBAO_MAX_DIRECTIONS);
         else if (!strcmp(argv[a], "--steps") && a + 1 < argc)
-            params.steps = atoi(argv[++a]);
+            params.steps = (int)bench_whole_number(argv[++a], 1, HBAO_MAX_STEPS);
         else if (!strcmp(argv[a], "--blur") && a + 1 < argc)
-            params.blur_size = atoi(argv[++a]);
+            params.blur_size = (int)bench_whole_number(argv[++a], 0, HBAO_MAX_BLUR_SIZE);
         else if (!strcmp(argv[a], "--half"))
             half = 1;
         else if (!strcmp(argv[a], "--back-faces"))
             back_faces = 1;
         else if (!strcmp(argv[a], "--background") && a + 1 < argc)
-            background = atoi(argv[++a]);
+            background = (int)bench_whole_number(argv[++a], 0, 100);
         else if (!strcmp(argv[a], "--size") && a + 1 < argc) {
             char end = '\0';
             if (sscanf(argv[++a], "%dx%d%c", &width, &height, &end) != 2) width = 0;
@@ -103,12 +103,15 @@ int main(int argc, char **argv) {
             return 2;
         }
     }
-    if (rounds < 1 || rounds > 100 || calls < 1 || calls > 1000 || threads < 1 || threads > 64 ||
-        !(radius > 0.0f) || params.implementation < 0 || width < 16 || width > 8192 ||
-        height < 16 || height > 8192 || background < 0 || background > 100) {
-        fprintf(stderr, "bench_ab: --rounds 1-100, --calls 1-1000, --threads 1-64, radius > 0, "
-                        "--implementation scalar, avx2 or avx512, --size WxH with W and H in "
-                        "16-8192, --background 0-100\n");
+    if (rounds < 1 || calls < 1 || threads < 1 || !(radius > 0.0f) || params.directions < 1 ||
+        params.steps < 1 || params.blur_size < 0 || params.implementation < 0 || width < 16 ||
+        width > 8192 || height < 16 || height > 8192 || background < 0) {
+        fprintf(stderr,
+                "bench_ab: --rounds 1-100, --calls 1-1000, --threads 1-64, radius > 0, "
+                "--directions 1-%d, --steps 1-%d, --blur 0-%d, --implementation "
+                "scalar, avx2 or avx512, --size WxH with W and H in 16-8192, "
+                "--background 0-100\n",
+                HBAO_MAX_DIRECTIONS, HBAO_MAX_STEPS, HBAO_MAX_BLUR_SIZE);
         return 2;
     }
     build builds[2] = {{argv[1], NULL, NULL, 0.0, 0.0}, {argv[2], NULL, NULL, 0.0, 0.0}};

@@ -29,13 +29,6 @@ static void usage(const char *program) {
             program);
 }
 
-/* A whole number in [low, high] from the whole of text, or low - 1. */
-static long whole_number(const char *text, long low, long high) {
-    char *end;
-    const long value = strtol(text, &end, 10);
-    return end != text && *end == '\0' && value >= low && value <= high ? value : low - 1;
-}
-
 int main(int argc, char **argv) {
     long calls = 10, blur = 15, width = 1920, height = 1080, threads = 1, background = 0;
     int implementation = HBAO_IMPLEMENTATION_AUTO;
@@ -46,9 +39,9 @@ int main(int argc, char **argv) {
         if (value == NULL) {
             bad = 1;
         } else if (!strcmp(argv[a], "--calls")) {
-            bad = (calls = whole_number(value, 1, 1000)) < 1;
+            bad = (calls = bench_whole_number(value, 1, 1000)) < 1;
         } else if (!strcmp(argv[a], "--blur")) {
-            blur = whole_number(value, 1, HBAO_MAX_BLUR_SIZE);
+            blur = bench_whole_number(value, 1, HBAO_MAX_BLUR_SIZE);
             bad = blur < 1 || blur % 2 == 0;
         } else if (!strcmp(argv[a], "--sharpness")) {
             char *end;
@@ -56,9 +49,9 @@ int main(int argc, char **argv) {
             bad = end == value || *end != '\0' ||
                   !(sharpness >= 0.0f && sharpness <= HBAO_MAX_BLUR_SHARPNESS);
         } else if (!strcmp(argv[a], "--background")) {
-            bad = (background = whole_number(value, 0, 100)) < 0;
+            bad = (background = bench_whole_number(value, 0, 100)) < 0;
         } else if (!strcmp(argv[a], "--threads")) {
-            bad = (threads = whole_number(value, 1, 64)) < 1;
+            bad = (threads = bench_whole_number(value, 1, 64)) < 1;
         } else if (!strcmp(argv[a], "--size")) {
             char text[32], *by = NULL;
             if (strlen(value) < sizeof text) {
@@ -66,8 +59,8 @@ int main(int argc, char **argv) {
                 by = strchr(text, 'x');
             }
             if (by != NULL) *by = '\0';
-            bad = by == NULL || (width = whole_number(text, 16, 16384)) < 16 ||
-                  (height = whole_number(by + 1, 16, 16384)) < 16;
+            bad = by == NULL || (width = bench_whole_number(text, 16, 16384)) < 16 ||
+                  (height = bench_whole_number(by + 1, 16, 16384)) < 16;
         } else if (!strcmp(argv[a], "--implementation")) {
             bad = (implementation = bench_implementation(value)) < 0;
         } else {

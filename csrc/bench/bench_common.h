@@ -18,6 +18,21 @@ static inline int compare_doubles(const void *a, const void *b) {
 }
 
 /* hbao_implementation by name (scalar, avx2, avx512); -1 if none */
+/* A whole number in [low, high] from the whole of text, or low - 1: a
+ * benchmark option ("--calls 1O" is refused, not read as 1). */
+static inline long bench_whole_number(const char *text, long low, long high) {
+    char *end;
+    const long value = strtol(text, &end, 10);
+    return end != text && *end == '\0' && value >= low && value <= high ? value : low - 1;
+}
+
+/* A finite number above 0 from the whole of text, or 0. */
+static inline float bench_positive_number(const char *text) {
+    char *end;
+    const float value = strtof(text, &end);
+    return end != text && *end == '\0' && value > 0.0f && value <= 3.4e38f ? value : 0.0f;
+}
+
 static inline int bench_implementation(const char *name) {
     if (!strcmp(name, "scalar")) return HBAO_IMPLEMENTATION_SCALAR;
     if (!strcmp(name, "avx2")) return HBAO_IMPLEMENTATION_AVX2;

@@ -110,9 +110,9 @@ int main(int argc, char **argv) {
     parse_implementations("scalar,avx2,avx512", wanted);
     for (int a = 1; a < argc; a++) {
         if (!strcmp(argv[a], "--runs") && a + 1 < argc)
-            runs = atoi(argv[++a]);
+            runs = (int)bench_whole_number(argv[++a], 1, 1000);
         else if (!strcmp(argv[a], "--radius") && a + 1 < argc)
-            radius = (float)atof(argv[++a]);
+            radius = bench_positive_number(argv[++a]);
         else if (!strcmp(argv[a], "--no-4k"))
             with_4k = 0;
         else if (!strcmp(argv[a], "--quick")) { /* the README's quick look */
