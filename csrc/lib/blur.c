@@ -246,40 +246,50 @@ static HBAO_ALWAYS_INLINE void row_pass(const finish_job *job, int j, tap_set *t
     *c = (centre_row){z, raw, n.nx, n.ny, n.nz};
 }
 
+/* Ring row j + k (inside the image) as a tap down the columns of row j's
+ * centres, whose normals are n: its steps from the centre in the depth and
+ * in the normals, and its AO. The passes of one row and of several
+ * (column_pass, column_rows_pass) take their taps' rows from here. */
+static HBAO_ALWAYS_INLINE void column_tap(const finish_job *job, const band_memory *m, int slots,
+                                          int j, int k, normal_row n, int *depth_step,
+                                          int *normal_step, const float **ao) {
+    *depth_step = k * job->width;
+    *normal_step = (int)(normals_of_row(job->grid, j + k).nx - n.nx);
+    *ao = m->ring[(j + k) % slots];
+}
+
 /* The taps and centres of row j's pass down the column (radius > 0): rows
  * j - r .. j + r of the ring. */
 static HBAO_ALWAYS_INLINE void column_pass(const finish_job *job, const band_memory *m, int slots,
                                            int j, tap_set *taps, centre_row *c) {
-    const int width = job->width, radius = job->radius;
+    const int radius = job->radius;
     taps->count = 0;
     taps->along_row = 0;
     taps->next_row = 0;
     const normal_row n = normals_of_row(job->grid, j);
     for (int k = -radius; k <= radius; k++) {
         if (k == 0 || j + k < 0 || j + k >= job->height) continue;
-        taps->depth_step[taps->count] = k * width;
-        taps->normal_step[taps->count] = (int)(normals_of_row(job->grid, j + k).nx - n.nx);
-        taps->ao[taps->count] = m->ring[(j + k) % slots];
-        taps->spatial[taps->count] = job->spatial[k < 0 ? -k : k];
-        taps->count++;
+        const int t = taps->count++;
+        column_tap(job, m, slots, j, k, n, &taps->depth_step[t], &taps->normal_step[t],
+                   &taps->ao[t]);
+        taps->spatial[t] = job->spatial[k < 0 ? -k : k];
     }
-    *c = (centre_row){job->depth + (size_t)j * width, m->ring[j % slots], n.nx, n.ny, n.nz};
+    *c = (centre_row){job->depth + (size_t)j * job->width, m->ring[j % slots], n.nx, n.ny, n.nz};
 }
 
 /* The taps of rows j .. j + rows - 1's passes down the columns (radius >
  * 0, j + rows <= height): column_taps. */
 static HBAO_ALWAYS_INLINE void column_rows_pass(const finish_job *job, const band_memory *m,
                                                 int slots, int j, int rows, column_taps *taps) {
-    const int width = job->width, radius = job->radius;
+    const int radius = job->radius;
     const normal_row n = normals_of_row(job->grid, j);
     taps->count = 0;
     taps->rows = rows;
     for (int k = -radius; k <= radius + rows - 1; k++) {
         if (j + k < 0 || j + k >= job->height) continue;
         const int t = taps->count++;
-        taps->depth_step[t] = k * width;
-        taps->normal_step[t] = (int)(normals_of_row(job->grid, j + k).nx - n.nx);
-        taps->ao[t] = m->ring[(j + k) % slots];
+        column_tap(job, m, slots, j, k, n, &taps->depth_step[t], &taps->normal_step[t],
+                   &taps->ao[t]);
         for (int c = 0; c < rows; c++) {
             const int offset = k - c < 0 ? c - k : k - c; /* from centre row j + c */
             taps->of[c][t] = offset != 0 && offset <= radius;
