@@ -11,13 +11,17 @@ scripts/gl_blender_gpu.py, which stands in for the part of Blender's `gpu`
 module they use. The depth is scripts/synthetic_depth.py's scene through the
 35 mm camera of tests/blender_scripts/viewport_match.py. For each size and
 setting it prints the median GPU time of the passes (OpenGL timer queries:
-normals, AO, blur, upsample, composite) and each pass's own (the blur's
+[halve,] normals, AO, blur, [upsample,] composite into an 8-bit sRGB
+target as the view's overlay buffer is) and each pass's own (the blur's
 and the composite's two draws summed), the wall time of a frame waited
 for, the time of what draw.py has Blender do before them (the depth read
-back from a depth buffer and uploaded again, then linearised), and the
-AO's difference from the C library's on the same depth (mean, 99th
-percentile, largest; tests/test_viewport.py allows 2e-4 and 2e-3 in
-Blender), so that a fast wrong shader shows.
+back from a depth buffer and uploaded again, then linearised: its GPU time
+includes the GPU's waits for the CPU), and checks: the AO's difference from
+the C library's on the same depth (mean, 99th percentile, largest;
+tests/test_viewport.py allows 2e-4 and 2e-3 in Blender), the composited
+AO's (into a float target), and the linearised depth's largest relative
+error, so that a fast wrong shader shows. A timer query saturates at 2.1 s
+(moderngl reads it as a 32-bit integer): such a time prints as nan.
 
 Needs numpy, moderngl (pip) and an EGL driver, and the library
 (HBAO_LIBRARY, else build/libhbao.so). In Blender, on the GPU that Blender
@@ -55,9 +59,18 @@ def _size(text):
     return width, height
 
 
+# moderngl reads a timer query into a signed 32-bit integer: a draw of
+# 2^31 - 1 ns (2.1 s) or more reads as that (a software renderer at 4K).
+_SATURATED_NS = 2 ** 31 - 1
+
+
+def _milliseconds(nanoseconds):
+    return float("nan") if nanoseconds >= _SATURATED_NS else nanoseconds / 1e6
+
+
 def _timed(context, repeats, draw):
-    """Median GPU milliseconds (timer query) and wall milliseconds of `draw`,
-    each call waited for, after two unmeasured calls."""
+    """Median GPU milliseconds (timer query; NaN where saturated) and wall
+    milliseconds of `draw`, each call waited for, after two unmeasured calls."""
     for _ in range(2):
         draw()
     context.finish()
@@ -69,7 +82,7 @@ def _timed(context, repeats, draw):
             draw()
         context.finish()
         wall_ms.append((time.perf_counter() - start) * 1e3)
-        gpu_ms.append(query.elapsed / 1e6)
+        gpu_ms.append(_milliseconds(query.elapsed))
     return statistics.median(gpu_ms), statistics.median(wall_ms)
 
 
@@ -82,7 +95,7 @@ def _pass_times(repeats, draw, names):
             draw()
         frame = {}
         for shader, nanoseconds in draws:
-            frame[names[shader]] = frame.get(names[shader], 0.0) + nanoseconds / 1e6
+            frame[names[shader]] = frame.get(names[shader], 0.0) + _milliseconds(nanoseconds)
         for name, milliseconds in frame.items():
             times.setdefault(name, []).append(milliseconds)
     return {name: statistics.median(values) for name, values in times.items()}
@@ -105,8 +118,22 @@ def _depth_buffer(context, frame, depth, clip):
     return framebuffer, projection.depth_coefficients(matrix)
 
 
+def _top_down(texture, width, height, components=1):
+    """A float texture's texels, top row first."""
+    texels = np.frombuffer(texture.texture.read(), dtype=np.float32)
+    return texels.reshape(height, width, components)[::-1]
+
+
+def _differences(a, b, prefix):
+    difference = np.abs(a.astype(np.float64) - b)
+    return {f"{prefix}mean_abs": float(difference.mean()),
+            f"{prefix}p99_abs": float(np.percentile(difference, 99)),
+            f"{prefix}max_abs": float(difference.max())}
+
+
 def run(args):
     context = moderngl.create_standalone_context(backend="egl", require=430)
+    context.gc_mode = "auto"  # release textures and queries as Blender would
     gl_blender_gpu.install(context)
     import gpu  # noqa: PLC0415 (gl_blender_gpu's, installed above)
     from hbao import native  # noqa: PLC0415
@@ -117,10 +144,16 @@ def run(args):
     for width, height in args.size:
         frame = projection.frame_from_camera(CAMERA, width, height)
         depth = synthetic_depth(frame)
+        sky = depth >= 1e9
         depth_texture = gpu.types.GPUTexture((width, height), format="R32F",
                                              data=depth[::-1].tobytes())
-        composite_target = gpu.types.GPUFrameBuffer(
-            color_slots=gpu.types.GPUTexture((width, height), format="RGBA32F"))
+        # The composite draws into the view's overlay buffer (8-bit sRGB);
+        # its result is checked in a float target, cleared, as
+        # tests/blender_scripts/viewport_match.py reads it.
+        overlay = gpu.types.GPUFrameBuffer(
+            color_slots=gpu.types.GPUTexture((width, height), format="SRGB8_A8"))
+        check_texture = gpu.types.GPUTexture((width, height), format="RGBA32F")
+        check = gpu.types.GPUFrameBuffer(color_slots=check_texture)
         # What draw.py has Blender do first: read the view's depth buffer
         # back, upload it, linearise it.
         buffer, coefficients = _depth_buffer(context, frame, depth,
@@ -130,48 +163,68 @@ def run(args):
         def fetch():
             stored = buffer.read(components=1, attachment=-1, dtype="f4")
             upload = gpu.types.GPUTexture((width, height), format="R32F", data=stored)
-            fetch_pipeline.linearize(upload, coefficients)
+            return fetch_pipeline.linearize(upload, coefficients)
 
         fetch_gpu, fetch_wall = _timed(context, args.repeats, fetch)
+        linear = _top_down(fetch(), width, height)[..., 0]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            relative = np.abs(linear.astype(np.float64) - depth) / depth
+        fetch_row = {"fetch_gpu_ms": fetch_gpu, "fetch_wall_ms": fetch_wall,
+                     "linear_depth_max_relative": float(relative[~sky].max()),
+                     "linear_sky_zero": bool((linear[sky] == 0.0).all())}
         for name, overrides in SETTINGS:
             params = native.resolve_params(overrides)
             ao_pipeline = pipeline.AOPipeline()
 
-            def draw():
+            def draw(target=overlay):
                 ao = ao_pipeline.ambient_occlusion(
                     depth_texture, frame, params,
                     depth_precision=shader_sources.FLOAT_DEPTH_PRECISION)
-                with composite_target.bind():
+                with target.bind():
                     pipeline.composite(ao, params["strength"])
                 return ao
 
             gpu_ms, wall_ms = _timed(context, args.repeats, draw)
+            # the shaders by name (shaders.py compiles each once, on first use)
             names = {shader: name for name, shader in shaders._shaders.items()}
             passes = _pass_times(args.repeats, draw, names)
-            ao = draw()
-            preview = np.frombuffer(ao.texture.read(), dtype=np.float32)
-            preview = np.clip(preview.reshape(height, width)[::-1], 0.0, 1.0)
+            check.clear(color=(0.0, 0.0, 0.0, 0.0))
+            ao = draw(check)
+            preview = np.clip(_top_down(ao, width, height)[..., 0], 0.0, 1.0)
+            # over a white scene, out = colour + (1 - alpha)
+            composited = _top_down(check_texture, width, height, 4)
+            composited = composited[..., 0] + (1.0 - composited[..., 3])
             reference = native.compute_ao(depth, None, camera=CAMERA, params=params)
-            difference = np.abs(preview.astype(np.float64) - reference)
-            rows.append({
-                "size": f"{width}x{height}", "setting": name, "gpu_ms": gpu_ms,
-                "wall_ms": wall_ms, "fetch_gpu_ms": fetch_gpu, "fetch_wall_ms": fetch_wall,
-                "passes_ms": passes,
-                "mean_abs": float(difference.mean()),
-                "p99_abs": float(np.percentile(difference, 99)),
-                "max_abs": float(difference.max())})
-    print(f"{'size':>9}  {'setting':<18} {'GPU ms':>7} {'wall ms':>8} "
-          f"{'fetch GPU':>9} {'fetch wall':>10} {'mean |d|':>9} {'p99 |d|':>9} {'max |d|':>8}")
+            rows.append({"size": f"{width}x{height}", "setting": name, "gpu_ms": gpu_ms,
+                         "wall_ms": wall_ms, "passes_ms": passes, **fetch_row,
+                         **_differences(preview, reference, ""),
+                         **_differences(composited, reference, "composite_")})
+    _print(rows)
+    if args.json:
+        Path(args.json).write_text(json.dumps({"renderer": renderer, "rows": rows}, indent=1))
+
+
+def _print(rows):
+    print(f"{'size':>9}  {'setting':<18} {'GPU ms':>7} {'wall ms':>8} {'mean |d|':>9} "
+          f"{'p99 |d|':>9} {'max |d|':>8} {'composited p99 |d|':>18}")
     for row in rows:
         print(f"{row['size']:>9}  {row['setting']:<18} {row['gpu_ms']:7.2f} "
-              f"{row['wall_ms']:8.2f} {row['fetch_gpu_ms']:9.2f} {row['fetch_wall_ms']:10.2f} "
-              f"{row['mean_abs']:9.1e} {row['p99_abs']:9.1e} {row['max_abs']:8.1e}")
+              f"{row['wall_ms']:8.2f} {row['mean_abs']:9.1e} {row['p99_abs']:9.1e} "
+              f"{row['max_abs']:8.1e} {row['composite_p99_abs']:18.1e}")
     print("GPU ms of each pass (median; the blur's and the composite's two draws summed):")
     for row in rows:
         passes = "  ".join(f"{name} {ms:.2f}" for name, ms in row["passes_ms"].items())
         print(f"{row['size']:>9}  {row['setting']:<18} {passes}")
-    if args.json:
-        Path(args.json).write_text(json.dumps({"renderer": renderer, "rows": rows}, indent=1))
+    print("The depth read back, uploaded and linearised (draw.py), ms (the GPU time includes "
+          "its waits for the CPU):")
+    for row in rows:
+        if row["setting"] == SETTINGS[0][0]:
+            print(f"{row['size']:>9}  GPU {row['fetch_gpu_ms']:.2f}  wall "
+                  f"{row['fetch_wall_ms']:.2f}  linearised depth: largest relative error "
+                  f"{row['linear_depth_max_relative']:.1e}, sky 0: "
+                  f"{'yes' if row['linear_sky_zero'] else 'NO'}")
+    if any(value != value for row in rows for value in [row["gpu_ms"], *row["passes_ms"].values()]):
+        print("nan: a timer query saturated (a draw of 2.1 s or more); see the wall time")
 
 
 def main():

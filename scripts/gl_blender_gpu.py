@@ -3,13 +3,15 @@
 viewport preview's passes use (addon/hbao/viewport/pipeline.py and
 shaders.py), on an OpenGL context of moderngl's, so that those passes run
 unchanged where no Blender can: on a GPU machine without one
-(scripts/bench_viewport_gl.py). Not a stand-in for tests: the tests draw the
-GLSL in Blender (tests/test_viewport.py).
+(scripts/bench_viewport_gl.py, and its test in tests/test_viewport.py). What
+the preview does in Blender is tested in Blender (tests/test_viewport.py).
 
 What it does as Blender's OpenGL backend does: GPUShaderCreateInfo's push
 constants become uniforms, its samplers sampler2D uniforms on the texture
 units of their slots, its vertex input and fragment outputs `in`/`out`
-declarations ahead of the sources; blend modes as GPU_blend's.
+declarations ahead of the sources; setting a uniform the compiled program
+lacks raises ValueError, as Blender's uniform_float and uniform_int do;
+blend modes as GPU_blend's; the formats named as GPUTexture names them.
 
     install(context)  # before importing hbao.viewport
     with timing_draws() as draws:  # [(shader, GPU nanoseconds)] of each draw
@@ -23,7 +25,12 @@ import moderngl
 
 _GLSL_TYPES = {"INT": "int", "IVEC2": "ivec2", "FLOAT": "float", "VEC2": "vec2",
                "VEC3": "vec3", "VEC4": "vec4"}
-_FORMATS = {"R32F": 1, "RG32F": 2, "RGBA32F": 4}
+# GPUTexture's formats: (components, moderngl dtype, OpenGL internal format
+# or None for moderngl's own). SRGB8_A8 is the 3D view's overlay buffer,
+# which the preview's composite draws into.
+_GL_SRGB8_ALPHA8 = 0x8C43
+_FORMATS = {"R32F": (1, "f4", None), "RG32F": (2, "f4", None), "RGBA32F": (4, "f4", None),
+            "RGBA8": (4, "f1", None), "SRGB8_A8": (4, "f1", _GL_SRGB8_ALPHA8)}
 _CONTEXT = None
 _timed_draws = None
 
@@ -77,8 +84,10 @@ class GPUShader:
         pass  # moderngl binds the program when it draws
 
     def _set(self, name, value):
-        if self.program.get(name, None) is not None:  # the compiler drops unused uniforms
-            self.program[name].value = value
+        uniform = self.program.get(name, None)
+        if uniform is None:  # Blender: "uniform not found" (also where the compiler dropped it)
+            raise ValueError(f"GPUShader.uniform: uniform {name} not found")
+        uniform.value = value
 
     def uniform_sampler(self, name, texture):
         texture.texture.use(location=self.units[name])
@@ -93,9 +102,10 @@ class GPUShader:
 
 class GPUTexture:
     def __init__(self, size, format="RGBA8", data=None):
-        components = _FORMATS[format]
+        components, dtype, internal_format = _FORMATS[format]
         self.width, self.height = size
-        self.texture = _CONTEXT.texture(size, components, data=data, dtype="f4")
+        self.texture = _CONTEXT.texture(size, components, data=data, dtype=dtype,
+                                        internal_format=internal_format)
         self.texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
 
 
@@ -105,6 +115,9 @@ class GPUFrameBuffer:
 
     def bind(self):
         return _Binding(self.framebuffer)
+
+    def clear(self, color):
+        self.framebuffer.clear(*color)
 
 
 class _Binding:
@@ -144,19 +157,40 @@ class _Batch:
 
 @contextlib.contextmanager
 def timing_draws():
-    """Times each draw inside the block with its own timer query (which
-    cannot nest in another): yields a list that receives (shader, GPU
-    nanoseconds) of each draw once the block ends."""
+    """Times each draw inside the block with its own timer query: yields a
+    list that receives (shader, GPU nanoseconds) of each draw once the block
+    ends. Timer queries cannot nest, so neither can these blocks, and no
+    other timer query may be open around one."""
     global _timed_draws
-    _timed_draws, queries = [], []
+    if _timed_draws is not None:
+        raise RuntimeError("timing_draws blocks cannot nest")
+    _timed_draws = queries = []
     draws = []
     try:
         yield draws
-        queries = _timed_draws
     finally:
         _timed_draws = None
     _CONTEXT.finish()
     draws.extend((shader, query.elapsed) for shader, query in queries)
+
+
+def install(context):
+    """Makes `gpu` and `gpu_extras.batch` importable, drawing on moderngl
+    `context`. A standalone context has no framebuffer of its own: the
+    caller binds the one that stands for the view's."""
+    global _CONTEXT
+    _CONTEXT = context
+    gpu = types.ModuleType("gpu")
+    gpu.types = types.SimpleNamespace(
+        GPUShaderCreateInfo=GPUShaderCreateInfo, GPUTexture=GPUTexture,
+        GPUFrameBuffer=GPUFrameBuffer)
+    gpu.shader = types.SimpleNamespace(create_from_info=GPUShader)
+    gpu.state = types.SimpleNamespace(blend_get=lambda: _blend[0], blend_set=_blend_set)
+    extras = types.ModuleType("gpu_extras")
+    batch = types.ModuleType("gpu_extras.batch")
+    batch.batch_for_shader = _Batch
+    extras.batch = batch
+    sys.modules.update({"gpu": gpu, "gpu_extras": extras, "gpu_extras.batch": batch})
 
 
 # GPU_blend's factors, (source, destination), for the modes the preview sets.
@@ -172,21 +206,3 @@ def _blend_set(mode):
     else:
         _CONTEXT.enable(moderngl.BLEND)
         _CONTEXT.blend_func = _BLENDS[mode]
-
-
-def install(context):
-    """Makes `gpu` and `gpu_extras.batch` importable, drawing on moderngl
-    `context`, whose default framebuffer stands for the view's."""
-    global _CONTEXT
-    _CONTEXT = context
-    gpu = types.ModuleType("gpu")
-    gpu.types = types.SimpleNamespace(
-        GPUShaderCreateInfo=GPUShaderCreateInfo, GPUTexture=GPUTexture,
-        GPUFrameBuffer=GPUFrameBuffer)
-    gpu.shader = types.SimpleNamespace(create_from_info=GPUShader)
-    gpu.state = types.SimpleNamespace(blend_get=lambda: _blend[0], blend_set=_blend_set)
-    extras = types.ModuleType("gpu_extras")
-    batch = types.ModuleType("gpu_extras.batch")
-    batch.batch_for_shader = _Batch
-    extras.batch = batch
-    sys.modules.update({"gpu": gpu, "gpu_extras": extras, "gpu_extras.batch": batch})

@@ -29,6 +29,7 @@ PACKAGES=(
     python3 python3-numpy python3-pytest python3-venv
     python3-pycodestyle  # the PEP 8 check of the test suite
     python3-moderngl   # scripts/bench_viewport_gl.py: the preview's passes on a GPU without Blender
+    libegl1            # its EGL context (Mesa's here), which moderngl opens without depending on it
     xvfb xauth         # F12 and viewport tests in a real window
     xdotool            # tests/test_faults_ui.py: a real Escape key press during F12
     time               # scripts/soak.sh: GNU time's peak memory of each run

@@ -4,6 +4,7 @@ xvfb-run (Mesa llvmpipe): its GLSL AO against the C library's, and what turning
 it on and off does to the 3D view; and the preview's GPU benchmark, which runs
 the same passes without Blender (scripts/bench_viewport_gl.py), on Mesa's EGL."""
 import json
+import os
 import re
 import subprocess
 import sys
@@ -293,25 +294,30 @@ def test_use_node_settings_previews_the_nodes_values(run_in_blender):
     assert cases["no_node"] == own, cases
 
 
-def test_gpu_benchmark_runs_the_previews_passes_as_the_library(tmp_path):
+def test_gpu_benchmark_runs_the_previews_passes_as_the_library(tmp_path, built_library):
     """scripts/bench_viewport_gl.py runs the preview's passes where no Blender
     runs (a GPU machine), through scripts/gl_blender_gpu.py's stand-in for
     Blender's gpu module: here on Mesa's EGL, every setting it times gives the
-    library's AO within the tolerances above, even and odd sizes, so that its
-    GPU figures time the preview's shaders and not a broken copy."""
+    library's AO within the tolerances above, before the composite and after
+    it, even and odd sizes, and its linearised depth buffer gives the depth
+    back (float rounding of the buffer's [0, 1] values: about 2e-6 relative
+    here), so that its GPU figures time the preview's shaders and not a
+    broken copy."""
     out = tmp_path / "gl.json"
     completed = subprocess.run(
         [sys.executable, str(REPO / "scripts" / "bench_viewport_gl.py"), "--repeats", "1",
          "--size", "200x150", "--size", "201x151", "--json", str(out)],
-        capture_output=True, text=True, timeout=600)
+        capture_output=True, text=True, timeout=600,
+        env=dict(os.environ, HBAO_LIBRARY=str(built_library)))
     assert completed.returncode == 0, completed.stdout + completed.stderr
-    report = json.loads(out.read_text())
-    rows = report["rows"]
+    rows = json.loads(out.read_text())["rows"]
     assert {(row["size"], row["setting"]) for row in rows} == {
         (size, setting) for size in ("200x150", "201x151")
         for setting in ("defaults", "half resolution", "8 x 6 + blur 15", "defaults, no blur")}
     for row in rows:
-        assert row["mean_abs"] <= MEAN_TOLERANCE, row
-        assert row["p99_abs"] <= P99_TOLERANCE, row
+        for prefix in ("", "composite_"):
+            assert row[prefix + "mean_abs"] <= MEAN_TOLERANCE, row
+            assert row[prefix + "p99_abs"] <= P99_TOLERANCE, row
+        assert row["linear_depth_max_relative"] <= 1e-5 and row["linear_sky_zero"], row
         assert row["gpu_ms"] > 0 and row["fetch_gpu_ms"] > 0, row
         assert {"normals", "ao", "composite"} <= set(row["passes_ms"]), row

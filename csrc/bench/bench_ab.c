@@ -93,10 +93,9 @@ int main(int argc, char **argv) {
             back_faces = 1;
         else if (!strcmp(argv[a], "--background") && a + 1 < argc)
             background = (int)bench_whole_number(argv[++a], 0, 100);
-        else if (!strcmp(argv[a], "--size") && a + 1 < argc) {
-            char end = '\0';
-            if (sscanf(argv[++a], "%dx%d%c", &width, &height, &end) != 2) width = 0;
-        } else if (!strcmp(argv[a], "--implementation") && a + 1 < argc)
+        else if (!strcmp(argv[a], "--size") && a + 1 < argc)
+            bench_size(argv[++a], 16, 8192, &width, &height);
+        else if (!strcmp(argv[a], "--implementation") && a + 1 < argc)
             params.implementation = bench_implementation(argv[++a]);
         else {
             usage(argv[0]);

@@ -53,14 +53,10 @@ int main(int argc, char **argv) {
         } else if (!strcmp(argv[a], "--threads")) {
             bad = (threads = bench_whole_number(value, 1, 64)) < 1;
         } else if (!strcmp(argv[a], "--size")) {
-            char text[32], *by = NULL;
-            if (strlen(value) < sizeof text) {
-                strcpy(text, value);
-                by = strchr(text, 'x');
-            }
-            if (by != NULL) *by = '\0';
-            bad = by == NULL || (width = bench_whole_number(text, 16, 16384)) < 16 ||
-                  (height = bench_whole_number(by + 1, 16, 16384)) < 16;
+            int w, h;
+            bad = !bench_size(value, 16, 16384, &w, &h);
+            width = w;
+            height = h;
         } else if (!strcmp(argv[a], "--implementation")) {
             bad = (implementation = bench_implementation(value)) < 0;
         } else {

@@ -4,6 +4,7 @@
 #ifndef HBAO_BENCH_COMMON_H
 #define HBAO_BENCH_COMMON_H
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -17,22 +18,38 @@ static inline int compare_doubles(const void *a, const void *b) {
     return (x > y) - (x < y);
 }
 
-/* hbao_implementation by name (scalar, avx2, avx512); -1 if none */
-/* A whole number in [low, high] from the whole of text, or low - 1: a
- * benchmark option ("--calls 1O" is refused, not read as 1). */
+/* A whole number in [low, high] (low >= 0) from the whole of text, digits
+ * only, or low - 1: a benchmark option ("--calls 1O" is refused, not read
+ * as 1). */
 static inline long bench_whole_number(const char *text, long low, long high) {
     char *end;
+    if (!(text[0] >= '0' && text[0] <= '9')) return low - 1;
     const long value = strtol(text, &end, 10);
-    return end != text && *end == '\0' && value >= low && value <= high ? value : low - 1;
+    return *end == '\0' && value >= low && value <= high ? value : low - 1;
+}
+
+/* --size WxH, each in [low, high], into *width and *height; 0 (and both
+ * low - 1) if text is not that. */
+static inline int bench_size(const char *text, long low, long high, int *width, int *height) {
+    char copy[32];
+    char *by = strlen(text) < sizeof copy ? strchr(strcpy(copy, text), 'x') : NULL;
+    if (by != NULL) *by = '\0';
+    const long w = by != NULL ? bench_whole_number(copy, low, high) : low - 1;
+    const long h = by != NULL ? bench_whole_number(by + 1, low, high) : low - 1;
+    const int good = w >= low && h >= low;
+    *width = good ? (int)w : (int)low - 1;
+    *height = good ? (int)h : (int)low - 1;
+    return good;
 }
 
 /* A finite number above 0 from the whole of text, or 0. */
 static inline float bench_positive_number(const char *text) {
     char *end;
     const float value = strtof(text, &end);
-    return end != text && *end == '\0' && value > 0.0f && value <= 3.4e38f ? value : 0.0f;
+    return end != text && *end == '\0' && value > 0.0f && isfinite(value) ? value : 0.0f;
 }
 
+/* hbao_implementation by name (scalar, avx2, avx512); -1 if none */
 static inline int bench_implementation(const char *name) {
     if (!strcmp(name, "scalar")) return HBAO_IMPLEMENTATION_SCALAR;
     if (!strcmp(name, "avx2")) return HBAO_IMPLEMENTATION_AVX2;
