@@ -8,8 +8,8 @@ no Blender runs (the `device` machine: no display, no Blender, Python 3.12).
 Runs the add-on's own passes (addon/hbao/viewport/pipeline.py with the GLSL
 of shader_sources.py, unchanged) on an EGL context of moderngl's, through
 scripts/gl_blender_gpu.py, which stands in for the part of Blender's `gpu`
-module they use. The depth is scripts/synthetic_depth.py's scene through the
-35 mm camera of tests/blender_scripts/viewport_match.py. For each size and
+module they use. The depth is scripts/synthetic_depth.py's scene through its
+camera, as in tests/blender_scripts/viewport_match.py. For each size and
 setting it prints the median GPU time of the passes (OpenGL timer queries:
 [halve,] normals, AO, blur, [upsample,] composite into an 8-bit sRGB
 target as the view's overlay buffer is) and each pass's own (the blur's
@@ -23,8 +23,10 @@ AO's (into a float target), and the linearised depth's largest relative
 error, so that a fast wrong shader shows. A timer query saturates at 2.1 s
 (moderngl reads it as a 32-bit integer): such a time prints as nan.
 
-Needs numpy, moderngl (pip) and an EGL driver, and the library
-(HBAO_LIBRARY, else build/libhbao.so). In Blender, on the GPU that Blender
+Needs numpy, moderngl (Debian's python3-moderngl, which scripts/setup.sh
+installs, or pip's), an EGL driver (libegl1) and the library (HBAO_LIBRARY,
+else build/libhbao.so); scripts/gl_bundle.sh bundles all but numpy for a
+bare GPU machine without network. In Blender, on the GPU that Blender
 draws with, scripts/bench_viewport.py measures the whole preview.
 """
 import argparse
@@ -42,10 +44,8 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "scripts"))
 sys.path.insert(0, str(REPO / "addon"))
 import gl_blender_gpu  # noqa: E402
-from synthetic_depth import synthetic_depth  # noqa: E402
+from synthetic_depth import CAMERA, synthetic_depth  # noqa: E402
 
-CAMERA = {"type": "PERSP", "lens": 35.0, "sensor_width": 36.0, "sensor_height": 24.0,
-          "sensor_fit": "AUTO", "clip_start": 0.1, "clip_end": 100.0}
 SETTINGS = (("defaults", {}),
             ("half resolution", {"half_resolution": 1}),
             ("8 x 6 + blur 15", {"directions": 8, "steps": 6, "blur_size": 15}),

@@ -5,6 +5,11 @@ the viewport preview's comparison with the library in Blender
 Blender (scripts/bench_viewport_gl.py) draw the same scene."""
 import numpy as np
 
+# The perspective camera the scene is laid out for (a camera dict as
+# native.compute_ao takes), with the clip range the viewport tests give
+# Blender's camera.
+CAMERA = {"type": "PERSP", "lens": 35.0, "sensor_width": 36.0, "sensor_height": 24.0,
+          "sensor_fit": "AUTO", "clip_start": 0.1, "clip_end": 100.0}
 # The floor's height (camera space) in the cases that do not give their own.
 FLOOR_Y = -1.0
 

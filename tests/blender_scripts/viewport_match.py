@@ -24,7 +24,7 @@ sys.path.insert(0, str(REPO / "scripts"))
 from hbao import native  # noqa: E402
 from hbao.viewport import pipeline, projection, shader_sources  # noqa: E402
 import timer_guard  # noqa: E402
-from synthetic_depth import FLOOR_Y, synthetic_depth  # noqa: E402
+from synthetic_depth import CAMERA, FLOOR_Y, synthetic_depth  # noqa: E402
 
 if bpy.app.background and hasattr(gpu, "init"):
     gpu.init()  # 5.2+: an offscreen GPU context without a window
@@ -33,8 +33,7 @@ WIDTH, HEIGHT = 200, 150
 # (depth, first columns) of posts four columns wide at the lens, each inside
 # a 64-column span of the scene behind them (depths 3 to 8)
 NEAR_POSTS = (0.3, (66, 130))
-PERSPECTIVE_CAMERA = {"type": "PERSP", "lens": 35.0, "sensor_width": 36.0,
-                      "sensor_height": 24.0, "sensor_fit": "AUTO"}
+PERSPECTIVE_CAMERA = CAMERA
 # Pixels 1.5x as tall as wide, lens shifted: the non-square, off-centre frame.
 SHIFTED_CAMERA = dict(PERSPECTIVE_CAMERA, shift_x=0.1, shift_y=-0.05,
                       pixel_aspect_x=1.0, pixel_aspect_y=1.5)
@@ -150,7 +149,7 @@ def blender_frame(camera, width, height):
                  "ortho_scale"):
         if name in camera:
             setattr(data, name, camera[name])
-    data.clip_start, data.clip_end = 0.1, 100.0
+    data.clip_start, data.clip_end = CAMERA["clip_start"], CAMERA["clip_end"]
     obj = bpy.data.objects.new("MatchCamera", data)
     scene.collection.objects.link(obj)
     matrix = obj.calc_matrix_camera(bpy.context.evaluated_depsgraph_get(), x=width, y=height,
