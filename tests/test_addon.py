@@ -1217,10 +1217,13 @@ def assert_hand_over_route(run_in_blender, tmp_path, node_native, spec, held, fr
     for line in lines:
         figures = timing_line.parse(line)
         assert ("(from memory " in line) == from_memory, log[-3000:]
-        assert (figures["save_ms"] + figures["read_ms"] == 0) or not from_memory, line
+        # the log's tail, which says what the render did, for a rare miss:
+        # once (session 48, bpy 5.0 under CI) the back faces' passes took the
+        # file round trip, and 22 reruns since, loaded or not, did not repeat it
+        assert (figures["save_ms"] + figures["read_ms"] == 0) or not from_memory, log[-3000:]
         for kind in figures["extras_ms"]:
             assert (f"{kind} passes {figures['extras_ms'][kind]} ms from memory" in line) \
-                == from_memory, line
+                == from_memory, log[-3000:]
     if "guard_band" in str(spec):
         assert "guard band passes" in log and "back faces passes" in log, log[-3000:]
     assert "Rendering without AO" not in log and "could not take the passes" not in log
