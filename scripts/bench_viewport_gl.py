@@ -37,8 +37,13 @@ import sys
 import time
 from pathlib import Path
 
-import moderngl
 import numpy as np
+
+try:
+    import moderngl
+except ImportError:
+    sys.exit("bench_viewport_gl: moderngl is missing (scripts/setup.sh installs "
+             "python3-moderngl; on a bare GPU machine, scripts/gl_bundle.sh)")
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO / "scripts"))
@@ -132,7 +137,11 @@ def _differences(a, b, prefix):
 
 
 def run(args):
-    context = moderngl.create_standalone_context(backend="egl", require=430)
+    try:
+        context = moderngl.create_standalone_context(backend="egl", require=430)
+    except Exception as error:  # moderngl raises its own or glcontext's errors
+        sys.exit(f"bench_viewport_gl: no OpenGL 4.3 context through EGL ({error}); "
+                 f"scripts/setup.sh installs libegl1 and Mesa's driver")
     context.gc_mode = "auto"  # release textures and queries as Blender would
     gl_blender_gpu.install(context)
     import gpu  # noqa: PLC0415 (gl_blender_gpu's, installed above)

@@ -22,6 +22,7 @@ import sys
 import types
 
 import moderngl
+import numpy as np
 
 _GLSL_TYPES = {"INT": "int", "IVEC2": "ivec2", "FLOAT": "float", "VEC2": "vec2",
                "VEC3": "vec3", "VEC4": "vec4"}
@@ -138,7 +139,6 @@ class _Binding:
 
 class _Batch:
     def __init__(self, shader, primitive, attributes):
-        import numpy as np  # noqa: PLC0415 (numpy only where a batch is made)
         if primitive != "TRIS":
             raise ValueError(f"primitive {primitive} is not stood in for")
         (name, points), = attributes.items()

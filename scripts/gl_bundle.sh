@@ -30,7 +30,8 @@ fi
 
 grep -qx "/gl-bundle/" "$REPO/.git/info/exclude" 2>/dev/null ||
     echo "/gl-bundle/" >> "$REPO/.git/info/exclude"
-rm -rf "$BUNDLE"
+# only what an earlier bundle put there: anything else in gl-bundle/ stays
+rm -rf "$BUNDLE/debs" "$BUNDLE/wheels" "$BUNDLE/libhbao.so"
 mkdir -p "$BUNDLE/debs" "$BUNDLE/wheels"
 cmake -S "$REPO" -B "$REPO/build" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$REPO/build" -j2 --target hbao >/dev/null
