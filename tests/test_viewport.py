@@ -261,6 +261,30 @@ def test_x_ray_says_why_the_preview_draws_nothing(run_blender, tmp_path):
     assert cases["0.5"]["darkened"] == 0.0, cases
 
 
+def test_without_a_gpu_the_panel_says_what_a_frame_costs(run_blender, tmp_path):
+    """Under Xvfb Blender draws with Mesa's software renderer, where the
+    preview took about a second a frame at 1920x1080 and the panel said
+    nothing of it (session 48's figures). draw.py times the preview's
+    passes there, and the panel shows the time and that Half Resolution is
+    faster. Held: the renderer is a software one, every time is positive,
+    full resolution takes at least twice as long as half (a time of the
+    depth's upload alone would not tell them apart), and the note names
+    the last time."""
+    log = run_blender(SCRIPTS / "viewport_software.py", tmp_path, ui=True).stdout
+    assert "SOFTWARE: DONE" in log and "Traceback" not in log, log[-3000:]
+    report = json_line(log, "SOFTWARE")
+    assert report["software"] is True, "Xvfb's Blender draws with Mesa's llvmpipe"
+    for name in ("full", "half"):
+        times = report[f"{name}_ms"]
+        assert all(t is not None and 0.0 < t < 60000.0 for t in times), report
+        assert f"({times[-1]:.0f} ms a frame)" in report[f"{name}_note"], report
+    full = sorted(report["full_ms"])[1]
+    half = sorted(report["half_ms"])[1]
+    assert full > 2.0 * half, report
+    assert "Half Resolution takes under a third" in report["full_note"], report
+    assert "Half Resolution" not in report["half_note"], report
+
+
 def test_the_preview_darkens_the_scene_under_the_overlays_not_them(run_blender, tmp_path):
     """The preview multiplied everything in the view's overlay buffer by the
     AO, so a selection outline across a crease turned near black (an

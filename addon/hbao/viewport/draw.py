@@ -7,6 +7,8 @@ is read back (the gpu module of 3.4 to 5.x exposes no depth texture of the
 viewport; see scripts/bench_viewport.py for what the round trip costs),
 linearised, turned into AO and multiplied over the view.
 """
+from time import perf_counter
+
 import bpy
 import gpu
 from bpy.app.handlers import persistent
@@ -24,6 +26,9 @@ _reported_errors = set()
 # Area pointer -> why its preview draws nothing (the sidebar panel shows it);
 # gone once the view draws again.
 _view_errors = {}
+# Area pointer -> its preview's last frame in ms, where Blender draws with a
+# software renderer (software_renderer(); the panel shows it).
+_frame_ms = {}
 
 
 def _forget_error(area):
@@ -35,6 +40,33 @@ def view_error(area):
     """Why the preview of the 3D view in `area` failed the last time it was
     drawn, or None."""
     return _view_errors.get(area.as_pointer()) if area is not None else None
+
+
+def software_renderer():
+    """Whether Blender draws with a software renderer (Mesa's llvmpipe on a
+    machine without a GPU, or without its driver): the preview's passes then
+    run on the CPU and take about a second a frame at 1920x1080 on 2 cores
+    (docs/speed.md), so the panel says how long they take."""
+    return gpu.platform.device_type_get() == "SOFTWARE"
+
+
+def frame_ms(area):
+    """The preview's last frame in `area` in ms, timed on a software
+    renderer only; or None."""
+    return _frame_ms.get(area.as_pointer()) if area is not None else None
+
+
+def _note_frame_ms(area, milliseconds):
+    """Keep the frame time; ask the sidebar for a redraw where it changed by
+    a tenth or more (not every frame: the sidebar need not redraw with the
+    view)."""
+    key = area.as_pointer()
+    before = _frame_ms.get(key)
+    _frame_ms[key] = milliseconds
+    if before is None or abs(milliseconds - before) > 0.1 * before:
+        for region in area.regions:
+            if region.type == "UI":
+                region.tag_redraw()
 
 
 def handler_registered():
@@ -51,6 +83,7 @@ def sync_handler():
         bpy.types.SpaceView3D.draw_handler_remove(_handler, "WINDOW")
         _handler = None
         _pipelines.clear()
+        _frame_ms.clear()
     _redraw_3d_views()
 
 
@@ -99,7 +132,11 @@ def _draw():
             ao_pipeline = _pipelines[key] = pipeline.AOPipeline()
         if len(_pipelines) > 1:
             _forget_closed_views(context.window_manager)
-        draw_preview(ao_pipeline, region_3d.window_matrix, view_settings.params())
+        software = software_renderer()
+        milliseconds = draw_preview(ao_pipeline, region_3d.window_matrix,
+                                    view_settings.params(), timed=software)
+        if software:
+            _note_frame_ms(context.area, milliseconds)
         _view_errors.pop(context.area.as_pointer(), None)
     except Exception as error:  # never let the preview break the viewport
         message = str(error) or type(error).__name__
@@ -125,17 +162,25 @@ def _forget_closed_views(window_manager):
     for key in list(_pipelines):
         if key not in open_regions:
             del _pipelines[key]
+    open_areas = {area.as_pointer() for window in getattr(window_manager, "windows", ())
+                  for area in window.screen.areas if area.type == "VIEW_3D"}
+    for key in list(_frame_ms):
+        if key not in open_areas:
+            del _frame_ms[key]
 
 
-def draw_preview(ao_pipeline, matrix, params):
+def draw_preview(ao_pipeline, matrix, params, timed=False):
     """AO of the bound framebuffer's depth (drawn with projection `matrix`),
     multiplied over it, using `ao_pipeline`'s targets. Also the unit that
-    scripts/bench_viewport_blender.py times."""
+    scripts/bench_viewport_blender.py times. `timed`: returns the ms from
+    the depth read back (which waits for Blender's own drawing) until the
+    composite is issued; else None."""
     framebuffer = gpu.state.active_framebuffer_get()
     x, y, width, height = gpu.state.viewport_get()
     if width < 1 or height < 1:
-        return
+        return None
     depth = framebuffer.read_depth(x, y, width, height)
+    started = perf_counter()
     depth.dimensions = width * height
     depth_buffer_texture = gpu.types.GPUTexture((width, height), format="R32F", data=depth)
 
@@ -158,6 +203,9 @@ def draw_preview(ao_pipeline, matrix, params):
     finally:
         gpu.state.depth_mask_set(depth_mask)
         gpu.state.depth_test_set(depth_test)
+    # Timed on a software renderer only, which runs the passes as they are
+    # issued: a pixel read back after them (to wait for them) added 3 %.
+    return (perf_counter() - started) * 1000.0 if timed else None
 
 
 def unregister():
@@ -166,4 +214,5 @@ def unregister():
         bpy.types.SpaceView3D.draw_handler_remove(_handler, "WINDOW")
         _handler = None
     _pipelines.clear()
+    _frame_ms.clear()
     pipeline.release()

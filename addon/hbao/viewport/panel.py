@@ -30,6 +30,25 @@ def _wrapped_label(layout, context, text, icon):
     ui_text.labels(layout, text, characters, icon)
 
 
+def software_note(milliseconds, half_resolution):
+    """What the panel says where Blender draws without a GPU
+    (draw.software_renderer): the preview's last frame in ms, and what
+    makes it faster."""
+    text = "No GPU: Blender draws with software OpenGL, so the preview runs on the CPU"
+    if milliseconds is not None:
+        text += f" ({milliseconds:.0f} ms a frame)"
+    if not half_resolution:
+        text += ". Half Resolution takes under a third of the time"
+    return text + "."
+
+
+def _half_resolution(view_settings, scene):
+    try:
+        return bool(view_settings.params(scene).get("half_resolution"))
+    except ValueError:  # a value the library refuses: the draw says so
+        return False
+
+
 def _length(context, value):
     """A length in scene units as Blender's fields show it (the unit
     system's scale applies only where there is a unit system)."""
@@ -89,6 +108,10 @@ class VIEW3D_PT_hbao_preview(bpy.types.Panel):
         error = draw.view_error(context.area) if view_settings.enabled else None
         if error:
             _wrapped_label(layout.box(), context, f"No preview: {error}", "ERROR")
+        elif view_settings.enabled and draw.software_renderer():
+            _wrapped_label(layout, context, software_note(
+                draw.frame_ms(context.area), _half_resolution(view_settings, context.scene)),
+                "INFO")
         # check boxes with their label beside them: the split layout cut
         # "Use Node Settings" and "Half Resolution" short in the sidebar
         layout.prop(view_settings, "use_node_settings")
