@@ -1,0 +1,152 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Run in a real Blender window (xvfb) by tests/test_faults_ui.py: a
+session that Blender leaves refusing Python's writes for good, and the
+add-on's F12 in it.
+
+Blender keeps one flag for the whole process that refuses Python's writes
+and operators while a read-only callback (a draw) runs; each callback
+saves it, sets it and puts back what it saved. Two threads' callbacks that
+overlap out of order leave it set with no callback running
+(docs/blender-integration.md, "Blender refuses writes for the moment").
+This script makes that happen on purpose (fault injection): an editor's
+header's draw (3D view, node or image editor), in the main thread, waits
+until a helper thread has entered an operator's poll, and returns while
+that poll still runs; the poll returns last and puts back the draw's
+"refused".
+
+Steps: F12 with Radius 2 r (kept as OUT/reference); Radius r, F12 (OUT/first);
+the fault, then prints STUCK {json} (whether a write to the scene was
+refused 2 s later); Radius 2 r and F12, done where Blender allows writes
+(a window-manager property's update), as the artist's edit and F12 key
+are, which do not pass through Python (OUT/after); the quit, which
+timer_guard makes through such an update when refused. Prints STUCK DONE
+before the quit.
+
+  blender --addons hbao --python ui_stuck_writes.py -- OUT_DIR
+"""
+import json
+import os
+import shutil
+import sys
+import threading
+import time
+
+import bpy
+
+out_dir = sys.argv[sys.argv.index("--") + 1]
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import f12_job  # noqa: E402
+import timer_guard  # noqa: E402
+
+WAIT_S = 20.0
+scene = f12_job.corner_scene_with_node(out_dir)[0]
+node = scene.node_tree.nodes["HBAO0"]
+node.inputs["Blur Size"].default_value = 0
+radius = node.inputs["Radius"].default_value
+job = f12_job.F12Job()
+
+draw_waits = threading.Event()
+draw_entered = threading.Event()
+poll_entered = threading.Event()
+draw_returned = threading.Event()
+
+
+class TEST_OT_poll_in_thread(bpy.types.Operator):
+    """An operator whose poll, called from the helper thread, runs until
+    the draw has returned."""
+    bl_idname = "test.poll_in_thread"
+    bl_label = "Poll in a thread"
+
+    @classmethod
+    def poll(cls, context):
+        if threading.current_thread() is not threading.main_thread():
+            poll_entered.set()
+            draw_returned.wait(WAIT_S)
+        return True
+
+    def execute(self, context):
+        return {"FINISHED"}
+
+
+def header_draw(_self, _context):
+    if draw_waits.is_set() and not draw_entered.is_set():
+        draw_entered.set()
+        poll_entered.wait(WAIT_S)  # (releases the interpreter's lock)
+        draw_returned.set()
+
+
+def poll_from_thread():
+    draw_entered.wait(WAIT_S)
+    bpy.ops.test.poll_in_thread.poll()
+
+
+def edit_and_f12(_window_manager, _context):
+    """What the artist's edit and F12 key do, which Python's refusal does
+    not reach: run with writes allowed (a property's update)."""
+    node.inputs["Radius"].default_value = 2.0 * radius
+    job.ended = False
+    print("F12", bpy.ops.render.render("INVOKE_DEFAULT"), flush=True)
+    job.started = True
+
+
+bpy.utils.register_class(TEST_OT_poll_in_thread)
+HEADERS = (bpy.types.VIEW3D_HT_header, bpy.types.NODE_HT_header, bpy.types.IMAGE_HT_header)
+for header in HEADERS:
+    header.append(header_draw)
+bpy.types.WindowManager.test_edit_and_f12 = bpy.props.BoolProperty(update=edit_and_f12)
+
+
+def keep(name):
+    path = os.path.join(out_dir, "nodes_0001.exr")
+    os.makedirs(os.path.join(out_dir, name), exist_ok=True)
+    shutil.move(path, os.path.join(out_dir, name))
+
+
+def redraw_all():
+    for window in bpy.context.window_manager.windows:
+        for area in window.screen.areas:
+            area.tag_redraw()
+
+
+def steps():
+    for name, value in (("reference", 2.0 * radius), ("first", radius)):
+        node.inputs["Radius"].default_value = value
+        job.start()
+        while not job.finished():
+            yield 0.2
+        keep(name)
+    threading.Thread(target=poll_from_thread, daemon=True).start()
+    draw_waits.set()
+    started = time.monotonic()
+    while not draw_returned.is_set():
+        if time.monotonic() - started > WAIT_S:
+            timer_guard.give_up("STUCK: the header was not drawn")
+        redraw_all()
+        yield 0.2
+    yield 2.0
+    try:
+        scene.frame_current = scene.frame_current
+        refused = False
+    except AttributeError:
+        refused = True
+    print(f"STUCK {json.dumps({'refused': refused})}", flush=True)
+    bpy.context.window_manager.test_edit_and_f12 = True
+    while not job.finished():
+        yield 0.2
+    keep("after")
+    print("STUCK DONE", flush=True)
+    timer_guard.quit_blender()
+    yield None
+
+
+walker = steps()
+
+
+def step():
+    try:
+        return next(walker)
+    except StopIteration:
+        return None
+
+
+timer_guard.guarded_timer(step, 1.0)
