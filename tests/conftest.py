@@ -11,6 +11,7 @@ Blender has a user interface (Debian's, under Xvfb). Other tests get Debian's
 blender. The summary at the end counts the results per Blender."""
 import collections
 import contextlib
+import importlib.util
 import json
 import os
 import shutil
@@ -158,6 +159,14 @@ def blender_environment(user_scripts, extra=None):
 PASSES_FROM_MEMORY = "HBAO_PASSES_FROM_MEMORY"
 
 
+def _load_quit_marks():
+    spec = importlib.util.spec_from_file_location(
+        "quit_marks", REPO / "tests" / "blender_scripts" / "quit_marks.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
 def pytest_configure(config):
     os.environ.pop(PASSES_FROM_MEMORY, None)
     config.addinivalue_line("markers", "matrix: runs once in every Blender of the matrix")
@@ -192,6 +201,10 @@ def pytest_generate_tests(metafunc):
 
 
 _OUTCOMES = collections.defaultdict(collections.Counter)
+# The test scripts whose quit Blender refused for good: quit_marks.py
+_QUIT_MARKS = _load_quit_marks()
+QUIT_WITH_WRITES_ALLOWED = _QUIT_MARKS.QUIT_WITH_WRITES_ALLOWED
+_REFUSED_QUITS = collections.Counter()
 
 
 @pytest.hookimpl(hookwrapper=True)
@@ -207,6 +220,13 @@ def pytest_runtest_makereport(item, call):
 
 
 def pytest_terminal_summary(terminalreporter):
+    if _REFUSED_QUITS:
+        terminalreporter.section("Blender refused the quit for good")
+        terminalreporter.write_line(
+            "these runs quit with writes allowed (docs/blender-integration.md, \"Rarely the "
+            "refusal does not end\"); ui_stuck_writes.py's on purpose:")
+        for script, runs in sorted(_REFUSED_QUITS.items()):
+            terminalreporter.write_line(f"  {script}: {runs}")
     if not _OUTCOMES:
         return
     terminalreporter.section("tests per Blender")
@@ -271,6 +291,11 @@ def json_line(log, key):
     return json.loads(line[len(key) + 1:])
 
 
+def _script_name(command):
+    scripts = [Path(argument).name for argument in command if argument.endswith(".py")]
+    return scripts[-1] if scripts else " ".join(command)
+
+
 def run_command(command, user_scripts, env=None, check=True, timeout=BLENDER_TIMEOUT_S,
                 addon_errors=False):
     """Run a Blender command line with this checkout's add-on and libraries.
@@ -294,6 +319,8 @@ def run_command(command, user_scripts, env=None, check=True, timeout=BLENDER_TIM
         pytest.fail(f"Blender did not end within {timeout} s (killed):\n"
                     f"{' '.join(command)}\n{stdout[-6000:]}")
     completed = subprocess.CompletedProcess(command, process.returncode, stdout)
+    if QUIT_WITH_WRITES_ALLOWED in stdout:
+        _REFUSED_QUITS[_script_name(command)] += 1
     if check and completed.returncode != 0:
         pytest.fail(f"Blender exited with {completed.returncode}:\n"
                     f"{' '.join(command)}\n{completed.stdout[-6000:]}")

@@ -3,24 +3,19 @@
 session that Blender leaves refusing Python's writes for good, and the
 add-on's F12 in it.
 
-Blender keeps one flag for the whole process that refuses Python's writes
-and operators while a read-only callback (a draw) runs; each callback
-saves it, sets it and puts back what it saved. Two threads' callbacks that
-overlap out of order leave it set with no callback running
-(docs/blender-integration.md, "Blender refuses writes for the moment").
-This script makes that happen on purpose (fault injection): an editor's
-header's draw (3D view, node or image editor), in the main thread, waits
-until a helper thread has entered an operator's poll, and returns while
-that poll still runs; the poll returns last and puts back the draw's
-"refused".
+The fault, made on purpose (docs/blender-integration.md, "Rarely the
+refusal does not end"): an editor's header's draw (3D view, node or image
+editor), in the main thread, waits until a helper thread has entered an
+operator's poll, and returns while that poll still runs; the poll returns
+last (released by the next timer tick, which runs only once the draw has
+returned) and puts back the draw's "refused".
 
-Steps: F12 with Radius 2 r (kept as OUT/reference); Radius r, F12 (OUT/first);
-the fault, then prints STUCK {json} (whether a write to the scene was
-refused 2 s later); Radius 2 r and F12, done where Blender allows writes
-(a window-manager property's update), as the artist's edit and F12 key
-are, which do not pass through Python (OUT/after); the quit, which
-timer_guard makes through such an update when refused. Prints STUCK DONE
-before the quit.
+Steps: F12 with Radius 2 r (kept as OUT/reference); Radius r, F12
+(OUT/first); the fault, then prints STUCK {json} (whether a write to the
+scene was refused 2 s later); Radius 2 r and F12, done where Blender
+allows writes (timer_guard.with_writes_allowed), as the artist's edit and
+F12 key are, which do not pass through Python (OUT/after); STUCK DONE;
+the quit (timer_guard's, through with_writes_allowed when refused).
 
   blender --addons hbao --python ui_stuck_writes.py -- OUT_DIR
 """
@@ -38,7 +33,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import f12_job  # noqa: E402
 import timer_guard  # noqa: E402
 
-WAIT_S = 20.0
+WAIT_S = 20.0  # for the fault's draw and poll
+RENDER_WAIT_S = 120.0
 scene = f12_job.corner_scene_with_node(out_dir)[0]
 node = scene.node_tree.nodes["HBAO0"]
 node.inputs["Blur Size"].default_value = 0
@@ -49,11 +45,12 @@ draw_waits = threading.Event()
 draw_entered = threading.Event()
 poll_entered = threading.Event()
 draw_returned = threading.Event()
+poll_may_return = threading.Event()
 
 
 class TEST_OT_poll_in_thread(bpy.types.Operator):
     """An operator whose poll, called from the helper thread, runs until
-    the draw has returned."""
+    the draw has returned (poll_may_return)."""
     bl_idname = "test.poll_in_thread"
     bl_label = "Poll in a thread"
 
@@ -61,7 +58,7 @@ class TEST_OT_poll_in_thread(bpy.types.Operator):
     def poll(cls, context):
         if threading.current_thread() is not threading.main_thread():
             poll_entered.set()
-            draw_returned.wait(WAIT_S)
+            poll_may_return.wait(WAIT_S)
         return True
 
     def execute(self, context):
@@ -80,20 +77,18 @@ def poll_from_thread():
     bpy.ops.test.poll_in_thread.poll()
 
 
-def edit_and_f12(_window_manager, _context):
+def edit_and_f12():
     """What the artist's edit and F12 key do, which Python's refusal does
-    not reach: run with writes allowed (a property's update)."""
+    not reach."""
     node.inputs["Radius"].default_value = 2.0 * radius
     job.ended = False
-    print("F12", bpy.ops.render.render("INVOKE_DEFAULT"), flush=True)
-    job.started = True
+    return bpy.ops.render.render("INVOKE_DEFAULT")
 
 
 bpy.utils.register_class(TEST_OT_poll_in_thread)
 HEADERS = (bpy.types.VIEW3D_HT_header, bpy.types.NODE_HT_header, bpy.types.IMAGE_HT_header)
 for header in HEADERS:
     header.append(header_draw)
-bpy.types.WindowManager.test_edit_and_f12 = bpy.props.BoolProperty(update=edit_and_f12)
 
 
 def keep(name):
@@ -108,12 +103,18 @@ def redraw_all():
             area.tag_redraw()
 
 
+def wait_for_render(started):
+    while not job.finished():
+        if time.monotonic() - started > RENDER_WAIT_S:
+            timer_guard.give_up("STUCK: the render did not end")
+        yield 0.2
+
+
 def steps():
     for name, value in (("reference", 2.0 * radius), ("first", radius)):
         node.inputs["Radius"].default_value = value
         job.start()
-        while not job.finished():
-            yield 0.2
+        yield from wait_for_render(time.monotonic())
         keep(name)
     threading.Thread(target=poll_from_thread, daemon=True).start()
     draw_waits.set()
@@ -123,6 +124,7 @@ def steps():
             timer_guard.give_up("STUCK: the header was not drawn")
         redraw_all()
         yield 0.2
+    poll_may_return.set()  # (a timer's tick: the draw has returned)
     yield 2.0
     try:
         scene.frame_current = scene.frame_current
@@ -130,9 +132,11 @@ def steps():
     except AttributeError:
         refused = True
     print(f"STUCK {json.dumps({'refused': refused})}", flush=True)
-    bpy.context.window_manager.test_edit_and_f12 = True
-    while not job.finished():
-        yield 0.2
+    started = timer_guard.with_writes_allowed(edit_and_f12)
+    if started != {"RUNNING_MODAL"}:
+        timer_guard.give_up(f"STUCK: F12 gave {started}")
+    job.started = True
+    yield from wait_for_render(time.monotonic())
     keep("after")
     print("STUCK DONE", flush=True)
     timer_guard.quit_blender()

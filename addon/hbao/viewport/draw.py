@@ -26,9 +26,11 @@ _reported_errors = set()
 # Area pointer -> why its preview draws nothing (the sidebar panel shows it);
 # gone once the view draws again.
 _view_errors = {}
-# Area pointer -> its preview's last frame in ms, where Blender draws with a
-# software renderer (software_renderer(); the panel shows it).
+# Region pointer -> its preview's last frame in ms, where Blender draws with
+# a software renderer (software_renderer(); the panel shows it), and the
+# time the sidebar was last asked to show.
 _frame_ms = {}
+_shown_ms = {}
 
 
 def _forget_error(area):
@@ -51,22 +53,27 @@ def software_renderer():
 
 
 def frame_ms(area):
-    """The preview's last frame in `area` in ms, timed on a software
-    renderer only; or None."""
-    return _frame_ms.get(area.as_pointer()) if area is not None else None
+    """The preview's last frame in the 3D view in `area` in ms (the slowest
+    of a quad view's four), timed on a software renderer only; or None."""
+    if area is None:
+        return None
+    times = [_frame_ms[region.as_pointer()] for region in area.regions
+             if region.type == "WINDOW" and region.as_pointer() in _frame_ms]
+    return max(times) if times else None
 
 
-def _note_frame_ms(area, milliseconds):
-    """Keep the frame time; ask the sidebar for a redraw where it changed by
-    a tenth or more (not every frame: the sidebar need not redraw with the
-    view)."""
-    key = area.as_pointer()
-    before = _frame_ms.get(key)
+def _note_frame_ms(area, region, milliseconds):
+    """Keep the frame time; ask the sidebar for a redraw where it differs by
+    a tenth or more from the time it was last asked to show (not every
+    frame: the sidebar need not redraw with the view)."""
+    key = region.as_pointer()
     _frame_ms[key] = milliseconds
-    if before is None or abs(milliseconds - before) > 0.1 * before:
-        for region in area.regions:
-            if region.type == "UI":
-                region.tag_redraw()
+    shown = _shown_ms.get(key)
+    if shown is None or abs(milliseconds - shown) > 0.1 * shown:
+        _shown_ms[key] = milliseconds
+        for sidebar in area.regions:
+            if sidebar.type == "UI":
+                sidebar.tag_redraw()
 
 
 def handler_registered():
@@ -82,8 +89,7 @@ def sync_handler():
     elif not wanted and _handler is not None:
         bpy.types.SpaceView3D.draw_handler_remove(_handler, "WINDOW")
         _handler = None
-        _pipelines.clear()
-        _frame_ms.clear()
+        _forget_views()
     _redraw_3d_views()
 
 
@@ -135,8 +141,8 @@ def _draw():
         software = software_renderer()
         milliseconds = draw_preview(ao_pipeline, region_3d.window_matrix,
                                     view_settings.params(), timed=software)
-        if software:
-            _note_frame_ms(context.area, milliseconds)
+        if milliseconds is not None:
+            _note_frame_ms(context.area, context.region, milliseconds)
         _view_errors.pop(context.area.as_pointer(), None)
     except Exception as error:  # never let the preview break the viewport
         message = str(error) or type(error).__name__
@@ -152,21 +158,23 @@ def _draw():
 
 
 def _forget_closed_views(window_manager):
-    """Drop the targets of regions that no longer exist (a closed 3D view,
-    another workspace's screen). Run while more than one view has targets;
-    the last view's are dropped when the preview is turned off."""
+    """Drop the targets and frame times of regions that no longer exist (a
+    closed 3D view, another workspace's screen). Run while more than one
+    view has targets; the last view's are dropped when the preview is
+    turned off."""
     open_regions = {region.as_pointer()
                     for window in getattr(window_manager, "windows", ())
                     for area in window.screen.areas if area.type == "VIEW_3D"
                     for region in area.regions if region.type == "WINDOW"}
-    for key in list(_pipelines):
-        if key not in open_regions:
-            del _pipelines[key]
-    open_areas = {area.as_pointer() for window in getattr(window_manager, "windows", ())
-                  for area in window.screen.areas if area.type == "VIEW_3D"}
-    for key in list(_frame_ms):
-        if key not in open_areas:
-            del _frame_ms[key]
+    for per_region in (_pipelines, _frame_ms, _shown_ms):
+        for key in list(per_region):
+            if key not in open_regions:
+                del per_region[key]
+
+
+def _forget_views():
+    for per_region in (_pipelines, _frame_ms, _shown_ms):
+        per_region.clear()
 
 
 def draw_preview(ao_pipeline, matrix, params, timed=False):
@@ -213,6 +221,5 @@ def unregister():
     if _handler is not None:
         bpy.types.SpaceView3D.draw_handler_remove(_handler, "WINDOW")
         _handler = None
-    _pipelines.clear()
-    _frame_ms.clear()
+    _forget_views()
     pipeline.release()

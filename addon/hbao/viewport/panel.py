@@ -30,23 +30,36 @@ def _wrapped_label(layout, context, text, icon):
     ui_text.labels(layout, text, characters, icon)
 
 
-def software_note(milliseconds, half_resolution):
-    """What the panel says where Blender draws without a GPU
-    (draw.software_renderer): the preview's last frame in ms, and what
-    makes it faster."""
+def software_note(area, view_settings, scene):
+    """What the panel says of the preview in the 3D view in `area` where
+    Blender draws without a GPU (draw.software_renderer): the last frame's
+    time, and what makes it faster; None where it says nothing of it (a GPU,
+    the preview off, or not drawn there: the panel says why)."""
+    if not view_settings.enabled or not draw.software_renderer():
+        return None
+    if draw.not_drawn(area.spaces.active) is not None or draw.view_error(area):
+        return None
     text = "No GPU: Blender draws with software OpenGL, so the preview runs on the CPU"
+    milliseconds = draw.frame_ms(area)
     if milliseconds is not None:
         text += f" ({milliseconds:.0f} ms a frame)"
-    if not half_resolution:
-        text += ". Half Resolution takes under a third of the time"
+    if not _half_resolution(view_settings, scene):
+        text += ". Half Resolution takes about a third of the time"
     return text + "."
 
 
 def _half_resolution(view_settings, scene):
+    params, _error = _params(view_settings, scene)
+    return bool(params and params.get("half_resolution"))
+
+
+def _params(view_settings, scene):
+    """(the parameters the view previews with, None), or (None, why there
+    are none: the library missing, a value it refuses)."""
     try:
-        return bool(view_settings.params(scene).get("half_resolution"))
-    except ValueError:  # a value the library refuses: the draw says so
-        return False
+        return view_settings.params(scene), None
+    except Exception as error:
+        return None, str(error)
 
 
 def _length(context, value):
@@ -63,10 +76,9 @@ def _node_summary(layout, context, view_settings, node):
     read-only: they are edited on the node."""
     _wrapped_label(layout, context, f"Node \"{node.name}\"'s values (edit them there):",
                    "NODE")
-    try:
-        params = view_settings.params(context.scene)
-    except Exception as error:  # the library missing, or a value it refuses
-        _wrapped_label(layout, context, str(error), "ERROR")
+    params, error = _params(view_settings, context.scene)
+    if params is None:
+        _wrapped_label(layout, context, error, "ERROR")
         return
     lines = [f"Radius {_length(context, params['radius'])}",
              f"Strength {params['strength']:g}",
@@ -108,10 +120,9 @@ class VIEW3D_PT_hbao_preview(bpy.types.Panel):
         error = draw.view_error(context.area) if view_settings.enabled else None
         if error:
             _wrapped_label(layout.box(), context, f"No preview: {error}", "ERROR")
-        elif view_settings.enabled and draw.software_renderer():
-            _wrapped_label(layout, context, software_note(
-                draw.frame_ms(context.area), _half_resolution(view_settings, context.scene)),
-                "INFO")
+        note = software_note(context.area, view_settings, context.scene)
+        if note is not None:
+            _wrapped_label(layout, context, note, "INFO")
         # check boxes with their label beside them: the split layout cut
         # "Use Node Settings" and "Half Resolution" short in the sidebar
         layout.prop(view_settings, "use_node_settings")
