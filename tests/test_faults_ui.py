@@ -290,12 +290,20 @@ def test_f12_in_a_session_that_refuses_pythons_writes_for_good(run_in_blender, t
     set (a write is refused 2 s later); an edit of the node's Radius and an
     F12 there (made as the artist's are, past Python's check) still give
     the AO of that Radius, exactly that of a render of it before the
-    fault, and not the AO before the edit; the script's quit, refused,
-    ends Blender with writes allowed (timer_guard.py; exit 0)."""
+    fault, and not the AO before the edit; the add-on says, once, that
+    Blender refuses changes until it restarts (writes.py; in the console
+    and a popup), not before the fault but after its node poll has been
+    refused for writes.STUCK_AFTER_S; the script's quit, refused, ends
+    Blender with writes allowed (timer_guard.py; exit 0)."""
     out = tmp_path / "stuck"
     log = run_in_blender(SCRIPTS / "ui_stuck_writes.py", out, ui=True).stdout
     assert "STUCK DONE" in log, log[-3000:]
-    assert json_line(log, "STUCK") == {"refused": True}, log[-3000:]
+    assert json_line(log, "STUCK") == {"refused": True, "told": False}, log[-3000:]
+    assert json_line(log, "TOLD") is True, log[-3000:]
+    told = [line for line in log.splitlines()
+            if "Blender has refused every change from Python for" in line]
+    assert len(told) == 1 and "Save the file and restart Blender." in told[0], log[-3000:]
+    assert "could not show the popup" not in log, log[-3000:]
     assert QUIT_WITH_WRITES_ALLOWED in log, log[-3000:]
     reference, first, after = (node_outputs(out / name, 1)["ao"]
                                for name in ("reference", "first", "after"))

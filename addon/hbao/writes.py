@@ -13,8 +13,11 @@ when there is work), every creation is made whole or removed
 (whole_or_removed), and a refusal met midway (the flag changed since)
 leaves the rest of the job for a later call."""
 import contextlib
+import time
 
 import bpy
+
+from .report import log
 
 # Each refusal's text, as 3.4 to 5.x word it ("can't" became "cannot" in 5.0).
 _REFUSALS = ((AttributeError, "Writing to ID classes in this context is not allowed"),
@@ -44,14 +47,81 @@ class HBAO_OT_writes_probe(bpy.types.Operator):
 
 
 def writes_allowed():
-    """Whether Blender lets Python write data now; changes nothing."""
+    """Whether Blender lets Python write data now; changes nothing. A
+    refusal that does not end is told to the artist (_watch_refusal)."""
     try:
         bpy.ops.hbao.writes_probe()
     except RuntimeError as error:  # the poll's failure, or the refusal
-        return not writes_refused(error)
+        allowed = not writes_refused(error)
     except AttributeError:  # the add-on being disabled: the probe is gone
-        return True
-    return True
+        allowed = True
+    else:
+        allowed = True
+    _watch_refusal(allowed)
+    return allowed
+
+
+# Rarely Blender's refusal does not end: two threads' callbacks that
+# overlap out of order leave its flag set until Blender restarts
+# (docs/blender-integration.md, "Rarely the refusal does not end"). Refused
+# for STUCK_AFTER_S while no job that runs Python callbacks in another
+# thread (a render, a bake) runs, the add-on says so, once, in the console
+# and in a popup: every add-on's buttons and scripts fail then, which
+# nothing else explains to the artist.
+STUCK_AFTER_S = 5.0
+_PYTHON_JOBS = ("RENDER", "RENDER_PREVIEW", "OBJECT_BAKE", "COMPOSITE")
+STUCK_MESSAGE = ("Blender has refused every change from Python for {seconds:.0f} s with no render "
+                 "running. It will until it restarts: a fault of Blender's (two of its callbacks "
+                 "overlapped). Every add-on's buttons and scripts fail. Save the file and restart "
+                 "Blender. Until then F12 still renders the HBAO pass, but the HBAO nodes' status "
+                 "lines stay as they are.")
+_refusal = {"since": None, "told": False}
+
+
+def _python_job_running():
+    for job in _PYTHON_JOBS:
+        try:
+            if bpy.app.is_job_running(job):
+                return True
+        except (TypeError, ValueError):  # a job type this Blender does not have
+            pass
+    return False
+
+
+def _watch_refusal(allowed):
+    if allowed or _python_job_running():
+        _refusal["since"] = None
+        if allowed:
+            _refusal["told"] = False
+        return
+    now = time.monotonic()
+    if _refusal["since"] is None:
+        _refusal["since"] = now
+    elif not _refusal["told"] and now - _refusal["since"] >= STUCK_AFTER_S:
+        _refusal["told"] = True
+        _tell_stuck(STUCK_MESSAGE.format(seconds=now - _refusal["since"]))
+
+
+def told_stuck():
+    """Whether the add-on has said that Blender's refusal does not end
+    (since writes were last allowed)."""
+    return _refusal["told"]
+
+
+def _tell_stuck(message):
+    log(message)
+    if bpy.app.background:
+        return
+    lines = [line if line.endswith(".") else line + "." for line in message.split(". ")]
+
+    def draw(menu, _context):
+        for line in lines:
+            menu.layout.label(text=line)
+    try:  # a popup is not refused (window-manager data)
+        bpy.context.window_manager.popup_menu(draw, title="HBAO: Blender refuses changes",
+                                              icon="ERROR")
+    except Exception as error:  # the console has it
+        log(f"could not show the popup: {type(error).__name__}: {error}")
 
 
 @contextlib.contextmanager
@@ -72,4 +142,5 @@ def register():
 
 
 def unregister():
+    _refusal.update(since=None, told=False)
     bpy.utils.unregister_class(HBAO_OT_writes_probe)

@@ -12,10 +12,12 @@ returned) and puts back the draw's "refused".
 
 Steps: F12 with Radius 2 r (kept as OUT/reference); Radius r, F12
 (OUT/first); the fault, then prints STUCK {json} (whether a write to the
-scene was refused 2 s later); Radius 2 r and F12, done where Blender
-allows writes (timer_guard.with_writes_allowed), as the artist's edit and
-F12 key are, which do not pass through Python (OUT/after); STUCK DONE;
-the quit (timer_guard's, through with_writes_allowed when refused).
+scene was refused 2 s later, and whether the add-on had said Blender
+refuses changes then); Radius 2 r and F12, done where Blender allows
+writes (timer_guard.with_writes_allowed), as the artist's edit and F12 key
+are, which do not pass through Python (OUT/after); TOLD (whether the
+add-on said it, up to 20 s later); STUCK DONE; the quit (timer_guard's,
+through with_writes_allowed when refused).
 
   blender --addons hbao --python ui_stuck_writes.py -- OUT_DIR
 """
@@ -131,13 +133,18 @@ def steps():
         refused = False
     except AttributeError:
         refused = True
-    print(f"STUCK {json.dumps({'refused': refused})}", flush=True)
+    writes = sys.modules["hbao.writes"]
+    print(f"STUCK {json.dumps({'refused': refused, 'told': writes.told_stuck()})}", flush=True)
     started = timer_guard.with_writes_allowed(edit_and_f12)
     if started != {"RUNNING_MODAL"}:
         timer_guard.give_up(f"STUCK: F12 gave {started}")
     job.started = True
     yield from wait_for_render(time.monotonic())
     keep("after")
+    started = time.monotonic()  # the add-on's node poll asks for writes meanwhile
+    while not writes.told_stuck() and time.monotonic() - started < WAIT_S:
+        yield 0.25
+    print(f"TOLD {json.dumps(writes.told_stuck())}", flush=True)
     print("STUCK DONE", flush=True)
     timer_guard.quit_blender()
     yield None
