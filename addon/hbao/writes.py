@@ -64,18 +64,21 @@ def writes_allowed():
 # Rarely Blender's refusal does not end: two threads' callbacks that
 # overlap out of order leave its flag set until Blender restarts
 # (docs/blender-integration.md, "Rarely the refusal does not end"). Refused
-# for STUCK_AFTER_S while no job that runs Python callbacks in another
-# thread (a render, a bake) runs, the add-on says so, once, in the console
-# and in a popup: every add-on's buttons and scripts fail then, which
-# nothing else explains to the artist.
+# at every ask for STUCK_AFTER_S while no job that runs Python callbacks in
+# another thread (a render, a bake) runs, the add-on says so, once, in the
+# console and in a popup: every add-on's buttons and scripts fail then,
+# which nothing else explains to the artist.
 STUCK_AFTER_S = 5.0
+# ... asked again at least this often meanwhile (the timers ask every 0.25 s
+# while they have work): two refusals met by chance further apart are not one.
+STUCK_ASKED_WITHIN_S = 1.0
 _PYTHON_JOBS = ("RENDER", "RENDER_PREVIEW", "OBJECT_BAKE", "COMPOSITE")
 STUCK_MESSAGE = ("Blender has refused every change from Python for {seconds:.0f} s with no render "
                  "running. It will until it restarts: a fault of Blender's (two of its callbacks "
                  "overlapped). Every add-on's buttons and scripts fail. Save the file and restart "
                  "Blender. Until then F12 still renders the HBAO pass, but the HBAO nodes' status "
                  "lines stay as they are.")
-_refusal = {"since": None, "told": False}
+_refusal = {"since": None, "last": None, "told": False}
 
 
 def _python_job_running():
@@ -95,9 +98,10 @@ def _watch_refusal(allowed):
             _refusal["told"] = False
         return
     now = time.monotonic()
-    if _refusal["since"] is None:
+    if _refusal["since"] is None or now - _refusal["last"] > STUCK_ASKED_WITHIN_S:
         _refusal["since"] = now
-    elif not _refusal["told"] and now - _refusal["since"] >= STUCK_AFTER_S:
+    _refusal["last"] = now
+    if not _refusal["told"] and now - _refusal["since"] >= STUCK_AFTER_S:
         _refusal["told"] = True
         _tell_stuck(STUCK_MESSAGE.format(seconds=now - _refusal["since"]))
 
@@ -142,5 +146,5 @@ def register():
 
 
 def unregister():
-    _refusal.update(since=None, told=False)
+    _refusal.update(since=None, last=None, told=False)
     bpy.utils.unregister_class(HBAO_OT_writes_probe)
