@@ -13,11 +13,12 @@ when there is work), every creation is made whole or removed
 (whole_or_removed), and a refusal met midway (the flag changed since)
 leaves the rest of the job for a later call."""
 import contextlib
-import time
 
 import bpy
 
-from .report import log
+from . import refusal_watch
+from .callback_guard import never_raises
+from .report import in_main_thread, log
 
 # Each refusal's text, as 3.4 to 5.x word it ("can't" became "cannot" in 5.0).
 _REFUSALS = ((AttributeError, "Writing to ID classes in this context is not allowed"),
@@ -61,24 +62,9 @@ def writes_allowed():
     return allowed
 
 
-# Rarely Blender's refusal does not end: two threads' callbacks that
-# overlap out of order leave its flag set until Blender restarts
-# (docs/blender-integration.md, "Rarely the refusal does not end"). Refused
-# at every ask for STUCK_AFTER_S while no job that runs Python callbacks in
-# another thread (a render, a bake) runs, the add-on says so, once, in the
-# console and in a popup: every add-on's buttons and scripts fail then,
-# which nothing else explains to the artist.
-STUCK_AFTER_S = 5.0
-# ... asked again at least this often meanwhile (the timers ask every 0.25 s
-# while they have work): two refusals met by chance further apart are not one.
-STUCK_ASKED_WITHIN_S = 1.0
+_watch = refusal_watch.RefusalWatch()
 _PYTHON_JOBS = ("RENDER", "RENDER_PREVIEW", "OBJECT_BAKE", "COMPOSITE")
-STUCK_MESSAGE = ("Blender has refused every change from Python for {seconds:.0f} s with no render "
-                 "running. It will until it restarts: a fault of Blender's (two of its callbacks "
-                 "overlapped). Every add-on's buttons and scripts fail. Save the file and restart "
-                 "Blender. Until then F12 still renders the HBAO pass, but the HBAO nodes' status "
-                 "lines stay as they are.")
-_refusal = {"since": None, "last": None, "told": False}
+_popups = []  # the titles of the popups shown (the tests read them)
 
 
 def _python_job_running():
@@ -91,41 +77,33 @@ def _python_job_running():
     return False
 
 
+@never_raises("watch Blender's refusals of writes")
 def _watch_refusal(allowed):
-    if allowed or _python_job_running():
-        _refusal["since"] = None
-        if allowed:
-            _refusal["told"] = False
+    """A refusal that does not end (refusal_watch.py) told to the artist,
+    once: in the console, and in a popup where a timer asked in a window
+    (a popup is window-manager data, which Blender does not refuse)."""
+    seconds = _watch.note(allowed, not allowed and _python_job_running())
+    if seconds is None:
         return
-    now = time.monotonic()
-    if _refusal["since"] is None or now - _refusal["last"] > STUCK_ASKED_WITHIN_S:
-        _refusal["since"] = now
-    _refusal["last"] = now
-    if not _refusal["told"] and now - _refusal["since"] >= STUCK_AFTER_S:
-        _refusal["told"] = True
-        _tell_stuck(STUCK_MESSAGE.format(seconds=now - _refusal["since"]))
+    sentences = refusal_watch.stuck_sentences(seconds)
+    log(" ".join(sentences))
+    if bpy.app.background or not in_main_thread() or bpy.context.window is None:
+        return
+
+    def draw(menu, _context):
+        for sentence in sentences:
+            menu.layout.label(text=sentence)
+    bpy.context.window_manager.popup_menu(draw, title=POPUP_TITLE, icon="ERROR")
+    _popups.append(POPUP_TITLE)
+
+
+POPUP_TITLE = "HBAO: Blender refuses changes"
 
 
 def told_stuck():
     """Whether the add-on has said that Blender's refusal does not end
-    (since writes were last allowed)."""
-    return _refusal["told"]
-
-
-def _tell_stuck(message):
-    log(message)
-    if bpy.app.background:
-        return
-    lines = [line if line.endswith(".") else line + "." for line in message.split(". ")]
-
-    def draw(menu, _context):
-        for line in lines:
-            menu.layout.label(text=line)
-    try:  # a popup is not refused (window-manager data)
-        bpy.context.window_manager.popup_menu(draw, title="HBAO: Blender refuses changes",
-                                              icon="ERROR")
-    except Exception as error:  # the console has it
-        log(f"could not show the popup: {type(error).__name__}: {error}")
+    (since writes were last allowed), and the popups it showed."""
+    return _watch.told, list(_popups)
 
 
 @contextlib.contextmanager
@@ -146,5 +124,6 @@ def register():
 
 
 def unregister():
-    _refusal.update(since=None, last=None, told=False)
+    _watch.reset()
+    _popups.clear()
     bpy.utils.unregister_class(HBAO_OT_writes_probe)

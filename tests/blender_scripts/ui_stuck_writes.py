@@ -15,9 +15,12 @@ Steps: F12 with Radius 2 r (kept as OUT/reference); Radius r, F12
 scene was refused 2 s later, and whether the add-on had said Blender
 refuses changes then); Radius 2 r and F12, done where Blender allows
 writes (timer_guard.with_writes_allowed), as the artist's edit and F12 key
-are, which do not pass through Python (OUT/after); TOLD (whether the
-add-on said it, up to 20 s later); STUCK DONE; the quit (timer_guard's,
-through with_writes_allowed when refused).
+are, which do not pass through Python (OUT/after); TOLD {json} (whether
+the add-on said it within 20 s of the render's end, its popups, and how
+long after its node poll began to ask);
+STUCK DONE; the quit (timer_guard's, through with_writes_allowed when
+refused). From the fault on, the node poll asks for writes (the last
+render's messages posted again).
 
   blender --addons hbao --python ui_stuck_writes.py -- OUT_DIR
 """
@@ -127,6 +130,10 @@ def steps():
         redraw_all()
         yield 0.2
     poll_may_return.set()  # (a timer's tick: the draw has returned)
+    # the node poll asks for writes from now on (what an HBAO render or an
+    # undo leaves it to show)
+    sys.modules["hbao.report"].post_last_node_messages()
+    asking = time.monotonic()
     yield 2.0
     try:
         scene.frame_current = scene.frame_current
@@ -134,17 +141,20 @@ def steps():
     except AttributeError:
         refused = True
     writes = sys.modules["hbao.writes"]
-    print(f"STUCK {json.dumps({'refused': refused, 'told': writes.told_stuck()})}", flush=True)
+    told = writes.told_stuck()[0]
+    print(f"STUCK {json.dumps({'refused': refused, 'told': told})}", flush=True)
     started = timer_guard.with_writes_allowed(edit_and_f12)
     if started != {"RUNNING_MODAL"}:
         timer_guard.give_up(f"STUCK: F12 gave {started}")
     job.started = True
     yield from wait_for_render(time.monotonic())
+    rendered = time.monotonic()
     keep("after")
-    started = time.monotonic()  # the add-on's node poll asks for writes meanwhile
-    while not writes.told_stuck() and time.monotonic() - started < WAIT_S:
+    while not writes.told_stuck()[0] and time.monotonic() - rendered < WAIT_S:
         yield 0.25
-    print(f"TOLD {json.dumps(writes.told_stuck())}", flush=True)
+    told, popups = writes.told_stuck()
+    report = {"told": told, "popups": popups, "after_asking_s": time.monotonic() - asking}
+    print(f"TOLD {json.dumps(report)}", flush=True)
     print("STUCK DONE", flush=True)
     timer_guard.quit_blender()
     yield None

@@ -1,0 +1,64 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""When Blender's refusal of Python's writes has lasted long enough to be
+the kind that does not end (docs/blender-integration.md, "Rarely the
+refusal does not end"): two threads' callbacks that overlap out of order
+leave Blender's flag set until it restarts, and every add-on's buttons and
+scripts fail. writes.py asks this at each of its probes and tells the
+artist once. Without bpy, so that plain pytest holds its rules
+(tests/test_refusal_watch.py)."""
+import time
+
+# Refused at every ask for this long, while no job that runs Python
+# callbacks in another thread (a render, a bake) runs: stuck. A real
+# refusal lasts as long as such a callback, and those run only inside jobs.
+STUCK_AFTER_S = 5.0
+# Asks further apart than this start the count again: two real refusals met
+# by chance minutes apart are not one. The add-on's timers ask every 0.25 s
+# while they have work; the margin is for a main loop's slow pass (a heavy
+# viewport, a save).
+ASKED_WITHIN_S = 2.5
+
+STUCK_SENTENCES = (
+    "Blender has refused every change from Python for {seconds:.0f} s with no render running.",
+    "It will until it restarts: a fault of Blender's (two of its callbacks overlapped).",
+    "Every add-on's buttons and scripts fail.",
+    "Save the file and restart Blender.",
+    "Until then F12 still renders the HBAO pass, but the HBAO nodes' status lines stay as "
+    "they are.")
+
+
+class RefusalWatch:
+    """The refusals of one session's probes, as note() is told them."""
+
+    def __init__(self, clock=time.monotonic):
+        self._clock = clock
+        self.reset()
+
+    def reset(self):
+        self._since = None
+        self._last = None
+        self.told = False
+
+    def note(self, allowed, job_running):
+        """One probe's answer (`allowed`), and whether a job that runs Python
+        callbacks runs now. Returns the seconds the refusal has lasted the
+        first time it counts as stuck (to be told, once), else None. An
+        allowed write ends it, and a later one can be told again."""
+        if allowed or job_running:
+            self._since = None
+            if allowed:
+                self.told = False
+            return None
+        now = self._clock()
+        if self._since is None or now - self._last > ASKED_WITHIN_S:
+            self._since = now
+        self._last = now
+        if self.told or now - self._since < STUCK_AFTER_S:
+            return None
+        self.told = True
+        return now - self._since
+
+
+def stuck_sentences(seconds):
+    """What the artist is told, a sentence a line."""
+    return [sentence.format(seconds=seconds) for sentence in STUCK_SENTENCES]
