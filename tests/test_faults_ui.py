@@ -292,8 +292,8 @@ def test_f12_in_a_session_that_refuses_pythons_writes_for_good(run_in_blender, t
     F12 there (made as the artist's are, past Python's check) still give
     the AO of that Radius, exactly that of a render of it before the
     fault, and not the AO before the edit; the add-on says, once, that
-    Blender refuses changes until it restarts (writes.py; in the console
-    and a popup), not 2 s after the fault while its node poll asks, and
+    Blender refuses changes until it restarts (writes.py; in the console,
+    a popup and a line on the HBAO nodes), not 2 s after the fault while its node poll asks, and
     not sooner than refusal_watch.STUCK_AFTER_S after the poll began to
     ask; the script's quit, refused, ends Blender with writes allowed
     (timer_guard.py; exit 0)."""
@@ -304,8 +304,10 @@ def test_f12_in_a_session_that_refuses_pythons_writes_for_good(run_in_blender, t
     told = json_line(log, "TOLD")
     assert told["told"] is True and told["popups"] == ["HBAO: Blender refuses changes"], told
     assert told["after_asking_s"] >= refusal_watch.STUCK_AFTER_S, told
+    assert told["node_line"][0] == "Blender refuses changes", told
+    assert "Save the file and restart Blender." in told["node_line"][1], told
     lines = [line for line in log.splitlines()
-             if "Blender has refused every change from Python for" in line]
+             if line.startswith("HBAO: Blender has refused every change from Python for")]
     assert len(lines) == 1 and "Save the file and restart Blender." in lines[0], log[-3000:]
     assert QUIT_WITH_WRITES_ALLOWED in log, log[-3000:]
     reference, first, after = (node_outputs(out / name, 1)["ao"]

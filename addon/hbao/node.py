@@ -162,6 +162,7 @@ class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
         layout.prop(self, "half_resolution")
         layout.prop(self, "guard_band")
         layout.prop(self, "back_faces")
+        node_lines.draw(layout, *writes.stuck_line(), "ERROR")
         node_lines.draw(layout, self.status, self.status_details, "ERROR")
         node_lines.draw(layout, self.hint, self.hint_details, "INFO")
 

@@ -14,9 +14,10 @@ import time
 STUCK_AFTER_S = 5.0
 # Asks further apart than this start the count again: two real refusals met
 # by chance minutes apart are not one. The add-on's timers ask every 0.25 s
-# while they have work; the margin is for a main loop's slow pass (a heavy
-# viewport, a save).
-ASKED_WITHIN_S = 2.5
+# while they have work; the margin is for the main loop's slow passes (a
+# heavy viewport, a save; software OpenGL on a loaded machine: a test under
+# CI's load once waited 20 s for the notice with 2.5 s here).
+ASKED_WITHIN_S = 5.0
 
 STUCK_SENTENCES = (
     "Blender has refused every change from Python for {seconds:.0f} s with no render running.",

@@ -65,6 +65,8 @@ def writes_allowed():
 _watch = refusal_watch.RefusalWatch()
 _PYTHON_JOBS = ("RENDER", "RENDER_PREVIEW", "OBJECT_BAKE", "COMPOSITE")
 _popups = []  # the titles of the popups shown (the tests read them)
+_told_text = [""]  # what was said (stuck_line)
+STUCK_LINE = "Blender refuses changes"
 
 
 def _python_job_running():
@@ -86,9 +88,14 @@ def _watch_refusal(allowed):
     if seconds is None:
         return
     sentences = refusal_watch.stuck_sentences(seconds)
-    log(" ".join(sentences))
+    _told_text[0] = " ".join(sentences)
+    log(_told_text[0])
     if bpy.app.background or not in_main_thread() or bpy.context.window is None:
         return
+    for window in bpy.context.window_manager.windows:  # the nodes' line (stuck_line)
+        for area in window.screen.areas:
+            if area.type == "NODE_EDITOR":
+                area.tag_redraw()
 
     def draw(menu, _context):
         for sentence in sentences:
@@ -98,6 +105,12 @@ def _watch_refusal(allowed):
 
 
 POPUP_TITLE = "HBAO: Blender refuses changes"
+
+
+def stuck_line():
+    """The HBAO nodes' line while the add-on has said that Blender's refusal
+    does not end: (short, the full text), or ("", "")."""
+    return (STUCK_LINE, _told_text[0]) if _watch.told else ("", "")
 
 
 def told_stuck():
