@@ -36,7 +36,7 @@ def test_refused_at_every_ask_is_told_once_after_the_limit():
     assert len(told) == 1, told
     at, lasted = told[0]
     assert lasted == pytest.approx(STUCK_AFTER_S) and at - start == pytest.approx(STUCK_AFTER_S)
-    assert watch.told
+    assert watch.told and watch.lasted == lasted
 
 
 def test_not_before_the_limit():
@@ -80,7 +80,7 @@ def test_an_allowed_write_ends_it_and_a_later_one_is_told_again():
     clock = Clock()
     watch = RefusalWatch(clock)
     assert len(asks(watch, clock, STUCK_AFTER_S)) == 1
-    assert watch.note(True, False) is None and not watch.told
+    assert watch.note(True, False) is None and not watch.told and watch.lasted is None
     assert len(asks(watch, clock, STUCK_AFTER_S)) == 1
 
 

@@ -24,8 +24,9 @@ _D = parameters.DEFAULTS
 changed_callbacks = []
 # Called with no arguments by the add-on's timer, in the main thread when no
 # render runs, to bring the nodes' hint lines (hint, hint_details) up to
-# date; each returns whether it changed one (render_record.apply_hints).
-hint_refreshers = []
+# date; each returns whether it changed one (render_record.apply_hints;
+# writes.stuck_line_changed).
+hint_refreshers = [writes.stuck_line_changed]
 
 
 def hbao_nodes(tree):

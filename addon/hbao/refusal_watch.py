@@ -39,6 +39,7 @@ class RefusalWatch:
         self._since = None
         self._last = None
         self.told = False
+        self.lasted = None  # how long the refusal had lasted when it was told
 
     def note(self, allowed, job_running):
         """One probe's answer (`allowed`), and whether a job that runs Python
@@ -48,7 +49,7 @@ class RefusalWatch:
         if allowed or job_running:
             self._since = None
             if allowed:
-                self.told = False
+                self.told, self.lasted = False, None
             return None
         now = self._clock()
         if self._since is None or now - self._last > ASKED_WITHIN_S:
@@ -56,10 +57,15 @@ class RefusalWatch:
         self._last = now
         if self.told or now - self._since < STUCK_AFTER_S:
             return None
-        self.told = True
-        return now - self._since
+        self.told, self.lasted = True, now - self._since
+        return self.lasted
 
 
 def stuck_sentences(seconds):
     """What the artist is told, a sentence a line."""
     return [sentence.format(seconds=seconds) for sentence in STUCK_SENTENCES]
+
+
+def stuck_text(seconds):
+    """The same as one text (the console, a tooltip)."""
+    return " ".join(stuck_sentences(seconds))

@@ -64,9 +64,9 @@ def writes_allowed():
 
 _watch = refusal_watch.RefusalWatch()
 _PYTHON_JOBS = ("RENDER", "RENDER_PREVIEW", "OBJECT_BAKE", "COMPOSITE")
-_popups = []  # the titles of the popups shown (the tests read them)
-_told_text = [""]  # what was said (stuck_line)
+POPUP_TITLE = "HBAO: Blender refuses changes"
 STUCK_LINE = "Blender refuses changes"
+_shown = {"popups": 0, "line": ("", "")}  # popups shown (the tests read it); the nodes' line
 
 
 def _python_job_running():
@@ -82,41 +82,42 @@ def _python_job_running():
 @never_raises("watch Blender's refusals of writes")
 def _watch_refusal(allowed):
     """A refusal that does not end (refusal_watch.py) told to the artist,
-    once: in the console, and in a popup where a timer asked in a window
-    (a popup is window-manager data, which Blender does not refuse)."""
+    once: in the console, in a popup where a timer asked in a window (a
+    popup is window-manager data, which Blender does not refuse), and on
+    the HBAO nodes (stuck_line)."""
     seconds = _watch.note(allowed, not allowed and _python_job_running())
     if seconds is None:
         return
-    sentences = refusal_watch.stuck_sentences(seconds)
-    _told_text[0] = " ".join(sentences)
-    log(_told_text[0])
+    log(refusal_watch.stuck_text(seconds))
     if bpy.app.background or not in_main_thread() or bpy.context.window is None:
         return
-    for window in bpy.context.window_manager.windows:  # the nodes' line (stuck_line)
-        for area in window.screen.areas:
-            if area.type == "NODE_EDITOR":
-                area.tag_redraw()
+    sentences = refusal_watch.stuck_sentences(seconds)
 
     def draw(menu, _context):
         for sentence in sentences:
             menu.layout.label(text=sentence)
     bpy.context.window_manager.popup_menu(draw, title=POPUP_TITLE, icon="ERROR")
-    _popups.append(POPUP_TITLE)
-
-
-POPUP_TITLE = "HBAO: Blender refuses changes"
+    _shown["popups"] += 1
 
 
 def stuck_line():
     """The HBAO nodes' line while the add-on has said that Blender's refusal
     does not end: (short, the full text), or ("", "")."""
-    return (STUCK_LINE, _told_text[0]) if _watch.told else ("", "")
+    return (STUCK_LINE, refusal_watch.stuck_text(_watch.lasted)) if _watch.told else ("", "")
+
+
+def stuck_line_changed():
+    """For node.hint_refreshers: whether stuck_line() changed since the
+    nodes were last redrawn for it."""
+    line = stuck_line()
+    changed, _shown["line"] = line != _shown["line"], line
+    return changed
 
 
 def told_stuck():
     """Whether the add-on has said that Blender's refusal does not end
-    (since writes were last allowed), and the popups it showed."""
-    return _watch.told, list(_popups)
+    (since writes were last allowed), and how many popups it showed."""
+    return _watch.told, _shown["popups"]
 
 
 @contextlib.contextmanager
@@ -138,5 +139,5 @@ def register():
 
 def unregister():
     _watch.reset()
-    _popups.clear()
+    _shown.update(popups=0, line=("", ""))
     bpy.utils.unregister_class(HBAO_OT_writes_probe)

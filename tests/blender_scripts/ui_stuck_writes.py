@@ -16,8 +16,9 @@ scene was refused 2 s later, and whether the add-on had said Blender
 refuses changes then); Radius 2 r and F12, done where Blender allows
 writes (timer_guard.with_writes_allowed), as the artist's edit and F12 key
 are, which do not pass through Python (OUT/after); TOLD {json} (whether
-the add-on said it within 120 s of the render's end, its popups, how long
-after its node poll began to ask, and the HBAO nodes' line);
+the add-on said it within 120 s of the render's end, how many popups, how
+long after its node poll began to ask, the HBAO nodes' line, and whether
+the node poll had redrawn the nodes for it);
 STUCK DONE; the quit (timer_guard's, through with_writes_allowed when
 refused). From the fault on, the node poll asks for writes (the last
 render's messages posted again).
@@ -153,8 +154,11 @@ def steps():
     while not writes.told_stuck()[0] and time.monotonic() - rendered < RENDER_WAIT_S:
         yield 0.25
     told, popups = writes.told_stuck()
-    report = {"told": told, "popups": popups, "after_asking_s": time.monotonic() - asking,
-              "node_line": writes.stuck_line()}
+    after_asking_s = time.monotonic() - asking
+    yield 1.0  # (the node poll's next tick redraws the nodes for their line)
+    report = {"told": told, "popups": popups, "after_asking_s": after_asking_s,
+              "node_line": writes.stuck_line(),
+              "line_redrawn": not writes.stuck_line_changed()}
     print(f"TOLD {json.dumps(report)}", flush=True)
     print("STUCK DONE", flush=True)
     timer_guard.quit_blender()

@@ -7,6 +7,7 @@ is read back (the gpu module of 3.4 to 5.x exposes no depth texture of the
 viewport; see scripts/bench_viewport.py for what the round trip costs),
 linearised, turned into AO and multiplied over the view.
 """
+import functools
 from time import perf_counter
 
 import bpy
@@ -44,11 +45,13 @@ def view_error(area):
     return _view_errors.get(area.as_pointer()) if area is not None else None
 
 
+@functools.cache
 def software_renderer():
     """Whether Blender draws with a software renderer (Mesa's llvmpipe on a
     machine without a GPU, or without its driver): the preview's passes then
     run on the CPU and take about a second a frame at 1920x1080 on 2 cores
-    (docs/speed.md), so the panel says how long they take."""
+    (docs/speed.md), so the panel says how long they take. Asked once: the
+    device does not change while Blender runs."""
     return gpu.platform.device_type_get() == "SOFTWARE"
 
 
