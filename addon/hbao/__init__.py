@@ -10,7 +10,7 @@ viewport.projection/shader_sources work in plain Python (tests, benchmarks).
                timing_line, scratch_names, pass_encoding,
                viewport.projection, viewport.shader_sources
     Blender    compat (every version difference), compat_nodes, writes, preferences, node,
-               helper_lookup, helper_scene, socket_values, planning, handover, engine,
+               node_status, helper_lookup, helper_scene, socket_values, planning, handover, engine,
                engine_guard, render_reports, handlers,
                viewport.*
 """
@@ -56,10 +56,10 @@ def register():
         preferences.show(message)
         if not compat.version_is_new_enough():
             return  # the message says why; a traceback would not
-    from . import (engine, engine_guard, handlers, node, node_setup, pass_capture, recomposite,
-                   render_record, render_reports, report, writes)
-    for module in (writes, node, node_setup, render_record, recomposite, engine, engine_guard,
-                   render_reports, pass_capture, handlers):
+    from . import (engine, engine_guard, handlers, node, node_setup, node_status, pass_capture,
+                   recomposite, render_record, render_reports, report, writes)
+    for module in (writes, node, node_status, node_setup, render_record, recomposite, engine,
+                   engine_guard, render_reports, pass_capture, handlers):
         module.register()
         _registered.append(module)
     try:

@@ -10,7 +10,7 @@ nothing of the hook: it announces that nodes came or went through
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 
-from . import compat, guard_geometry, node_lines, node_place, parameters, report, writes
+from . import compat, guard_geometry, node_lines, node_place, parameters, writes
 from .callback_guard import never_raises
 from .compositor_effects import NODE_IDNAME, is_hbao_node
 from .group_layout import (AO_OUTPUT, AO_PASS_INPUT, DEPTH_INPUT, GROUP_TREE_NAME,  # noqa: F401
@@ -22,11 +22,6 @@ _D = parameters.DEFAULTS
 # Called with no arguments when an HBAO node is added, copied or deleted
 # (the hook's handlers subscribe: node callbacks must not edit the tree).
 changed_callbacks = []
-# Called with no arguments by the add-on's timer, in the main thread when no
-# render runs, to bring the nodes' hint lines (hint, hint_details) up to
-# date; each returns whether it changed one (render_record.apply_hints;
-# writes.stuck_line_changed).
-hint_refreshers = [writes.stuck_line_changed]
 
 
 def hbao_nodes(tree):
@@ -66,7 +61,7 @@ def _announce_change():
 def _settings_changed(node, _context):
     # Nothing to rebuild: the hook reads the node when Blender renders; the
     # AO of an existing render is not computed again (README, Limits), and
-    # the node says so (hint_refreshers).
+    # the node says so (node_status.hint_refreshers).
     node.id_data.update_tag()
 
 
@@ -177,90 +172,13 @@ class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
         return "HBAO"
 
 
-def show_messages(node, messages):
-    """Show `messages` (report.NodeMessage) on `node`: the first one's short
-    form, how many more there are, and every full text in the tooltip."""
-    status = messages[0].short if messages else ""
-    if len(messages) > 1:
-        status += f" (+{len(messages) - 1})"
-    node.status = status
-    node.status_details = "\n".join(messages)
-
-
-@never_raises("update the HBAO nodes' status lines")
-def apply_node_messages():
-    """Show what the hook last said about each node (main thread only: the
-    render thread only posts it, report.post_node_messages). What Blender
-    refuses to write for the moment waits for the next call (the timer's
-    next tick); a node that cannot be written at all (a linked tree) keeps
-    its line, and the console has the messages."""
-    if not report.in_main_thread():
-        return
-    changed = False
-    for scene_name, statuses in report.take_node_messages():
-        scene = bpy.data.scenes.get(scene_name)
-        for node in hbao_nodes(compat.compositor_tree(scene) if scene else None):
-            if node.name not in statuses:
-                continue
-            try:
-                show_messages(node, statuses[node.name])
-            except (AttributeError, RuntimeError) as error:
-                if writes.writes_refused(error):
-                    report.return_node_messages(scene_name, statuses)
-                    break
-                continue
-            changed = True
-    if changed:
-        _redraw_node_editors()
-
-
-def _redraw_node_editors():
-    for window in getattr(bpy.context.window_manager, "windows", ()):
-        for area in window.screen.areas:
-            if area.type == "NODE_EDITOR":
-                area.tag_redraw()
-
-
-# During an F12 render every render handler runs in the job's thread, where
-# nodes may not be written and no timer may be started; this timer, running
-# while the add-on is enabled, shows what the render thread posted once no
-# render job runs (asking writes.writes_allowed first), and keeps the hint
-# lines current. It costs a dictionary check and, per HBAO node of a
-# rendered scene, a comparison per tick.
-_POLL_S = 0.25
-
-
-@never_raises("update the HBAO nodes' status lines", result=_POLL_S)
-def _poll_node_messages():
-    if not bpy.app.is_job_running("RENDER"):
-        if report.has_node_messages() and writes.writes_allowed():
-            apply_node_messages()
-        # (each on its own: one that fails at every tick stops no other)
-        if any([_refresh(refresh) for refresh in hint_refreshers]):
-            _redraw_node_editors()
-    return _POLL_S
-
-
-@never_raises("update an HBAO node's hint line", result=False)
-def _refresh(refresh):
-    return refresh()
-
-
-@bpy.app.handlers.persistent
-@never_raises("update the HBAO nodes' status lines")
-def _on_render_done(*_args):
-    apply_node_messages()  # `-b` and blocking renders: the main thread
-
-
 @bpy.app.handlers.persistent
 @never_raises("update the HBAO node group of the file opened")
 def _on_load_post(*_args):
     upgrade_group_tree()
 
 
-_HANDLERS = (("render_post", _on_render_done),
-             ("render_complete", _on_render_done), ("render_cancel", _on_render_done),
-             ("load_post", _on_load_post))
+_HANDLERS = (("load_post", _on_load_post),)
 
 
 def _draw_add_menu(menu, context):
@@ -281,13 +199,9 @@ def register():
     menu = compat.compositor_filter_menu()
     if menu is not None:
         menu.append(_draw_add_menu)
-    if not bpy.app.background:  # `-b` shows nothing: render_post applies the messages
-        bpy.app.timers.register(_poll_node_messages, first_interval=_POLL_S, persistent=True)
 
 
 def unregister():
-    if bpy.app.timers.is_registered(_poll_node_messages):
-        bpy.app.timers.unregister(_poll_node_messages)
     menu = compat.compositor_filter_menu()
     if menu is not None:
         menu.remove(_draw_add_menu)

@@ -22,7 +22,7 @@ import time
 import bpy
 
 from . import (ao_cache, compat, composite_trigger, handler_hold, helper_scene, layer_passes,
-               node, render_record, writes)
+               node, node_status, render_record, writes)
 from . import camera as camera_model
 from .callback_guard import never_raises
 from .planning import plan_node
@@ -234,7 +234,7 @@ def refresh_changed(in_background=False):
     only: the changed AO computed in a worker thread from the cached
     passes (a first call starts it, a later one finds it done), then the
     helper rendered alone and the compositor run again. A
-    node.hint_refreshers entry (main thread, no render running); returns
+    node_status.hint_refreshers entry (main thread, no render running); returns
     whether it rendered. Without a window (`-b`) nothing composites again,
     so it does nothing unless told to (`in_background`, for the tests and
     the benchmark: then it waits for the computation)."""
@@ -284,8 +284,8 @@ def _on_load_pre(*_args):
 def register():
     # Before render_record's hint refresher, which then finds the record up
     # to date and clears the nodes' hints.
-    if refresh_changed not in node.hint_refreshers:
-        node.hint_refreshers.insert(0, refresh_changed)
+    if refresh_changed not in node_status.hint_refreshers:
+        node_status.hint_refreshers.insert(0, refresh_changed)
     if _on_load_pre not in bpy.app.handlers.load_pre:
         bpy.app.handlers.load_pre.append(_on_load_pre)
 
@@ -293,8 +293,8 @@ def register():
 def unregister():
     if _on_load_pre in bpy.app.handlers.load_pre:
         bpy.app.handlers.load_pre.remove(_on_load_pre)
-    if refresh_changed in node.hint_refreshers:
-        node.hint_refreshers.remove(refresh_changed)
+    if refresh_changed in node_status.hint_refreshers:
+        node_status.hint_refreshers.remove(refresh_changed)
     _computing.clear()
     _failed.clear()
     composite_trigger.forget()

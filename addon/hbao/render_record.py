@@ -12,7 +12,7 @@ writes the node's hint line, which the node only draws. The
 comparison is the render's own plan of the node (planning.plan_node), at the
 frame that was rendered, so a keyframed value that differs at another frame
 does not count as a change."""
-from . import compat, node, render_slots
+from . import compat, node, node_status, render_slots
 from .planning import plan_node
 
 # (short, full): the node's line and its tooltip
@@ -106,7 +106,7 @@ def changed_since_render(hbao_node, main=None):
 
 
 def apply_hints():
-    """Bring every HBAO node's hint line up to date (node.hint_refreshers:
+    """Bring every HBAO node's hint line up to date (node_status.hint_refreshers:
     main thread, no render running). Writes only what changed, since a
     write makes Blender composite again. Returns whether it wrote."""
     import bpy
@@ -124,11 +124,11 @@ def apply_hints():
 
 
 def register():
-    if apply_hints not in node.hint_refreshers:
-        node.hint_refreshers.append(apply_hints)
+    if apply_hints not in node_status.hint_refreshers:
+        node_status.hint_refreshers.append(apply_hints)
 
 
 def unregister():
-    if apply_hints in node.hint_refreshers:
-        node.hint_refreshers.remove(apply_hints)
+    if apply_hints in node_status.hint_refreshers:
+        node_status.hint_refreshers.remove(apply_hints)
     forget()

@@ -10,7 +10,7 @@ LOG_PREFIX = "HBAO:"
 
 # scene name -> {node name: [NodeMessage]}: what the last planned frame said
 # about each HBAO node of the scene, waiting for the main thread to show it on
-# the nodes (node.apply_node_messages). Written by the render thread: one
+# the nodes (node_status.apply_node_messages). Written by the render thread: one
 # dict assignment, atomic under the GIL.
 _pending_node_messages = {}
 # The same, as last posted (not taken): an undo or redo brings back the

@@ -107,7 +107,7 @@ def stuck_line():
 
 
 def stuck_line_changed():
-    """For node.hint_refreshers: whether stuck_line() changed since the
+    """For node_status.hint_refreshers: whether stuck_line() changed since the
     nodes were last redrawn for it."""
     line = stuck_line()
     changed, _shown["line"] = line != _shown["line"], line

@@ -590,8 +590,7 @@ for frame in spec.get("frames", [1]):
 # "sync_tick", "sync_all" and "writes_allowed" where Blender refuses writes.
 hinted = next((n for n in tree.nodes if n.bl_idname == "CompositorNodeHBAO"), None)
 for step in spec.get("after_render", []):
-    from hbao import node as node_module
-    from hbao import recomposite, render_record, report
+    from hbao import node_status, recomposite, render_record, report
 
     def timer_action(action, refused=step.get("refused", False)):
         return while_writes_refused(action) if refused else action()
@@ -607,9 +606,9 @@ for step in spec.get("after_render", []):
             report.post_node_messages(scene.name, [hinted.name],
                                       [report.NodeMessage(hinted.name, value, value)])
         elif key == "poll":  # a tick of the add-on's node timer
-            timer_action(node_module._poll_node_messages)
+            timer_action(node_status._poll_node_messages)
         elif key == "apply":  # what the node timer's tick calls once allowed
-            timer_action(node_module.apply_node_messages)
+            timer_action(node_status.apply_node_messages)
         elif key == "composite_again":  # a refresh's last step
             from hbao import composite_trigger
             timer_action(lambda: composite_trigger.composite_again(scene))

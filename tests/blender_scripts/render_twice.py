@@ -56,7 +56,7 @@ if case.endswith("_in_strips"):
 else:
     bpy.ops.render.render(write_still=False)
 node_module = sys.modules["hbao.node"]
-node_module.apply_node_messages()
+sys.modules["hbao.node_status"].apply_node_messages()
 
 statuses = {n.name: n.status for n in node_module.hbao_nodes(
     sys.modules["hbao.compat"].compositor_tree(scene))}

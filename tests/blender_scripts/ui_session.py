@@ -25,7 +25,7 @@ once it has ended, F12 (kept as OUT/after).
 
 CASE "failing_refresher": Compositing off, F12 (the node says
 "Compositing off: no AO"), a function of the add-on's status poll made to
-raise (fault injection: first in hbao.node.hint_refreshers, and one that
+raise (fault injection: first in hbao.node_status.hint_refreshers, and one that
 counts its calls last), Compositing on, F12; prints STATUS {json} and
 REFRESHED {json} (whether the last one ran) a few seconds later. Blender
 dropped the poll timer at its first error, and the line stayed; then the
@@ -148,7 +148,7 @@ def failing_refresher():
     def counted():
         refreshed[0] += 1
         return False
-    refreshers = sys.modules["hbao"].node.hint_refreshers
+    refreshers = sys.modules["hbao"].node_status.hint_refreshers
     refreshers.insert(0, refresh)
     refreshers.append(counted)
     return SETTLE_S

@@ -1,0 +1,111 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""What the render hook said about each HBAO node (its status line) and the
+nodes' hint lines, brought to the nodes. Nodes are written in the main
+thread only: during an F12 render every render handler runs in the job's
+thread, where nodes may not be written and no timer may be started, so a
+timer, running while the add-on is enabled, shows what the render thread
+posted (report.post_node_messages) once no render job runs, and keeps the
+hint lines current; in `-b`, render_post shows it."""
+import bpy
+
+from . import compat, report, writes
+from .callback_guard import never_raises
+from .node import hbao_nodes
+
+# Called with no arguments by the timer, in the main thread when no render
+# runs, to bring the nodes' hint lines (hint, hint_details) up to date;
+# each returns whether it changed one (render_record.apply_hints;
+# writes.stuck_line_changed).
+hint_refreshers = [writes.stuck_line_changed]
+
+
+def show_messages(node, messages):
+    """Show `messages` (report.NodeMessage) on `node`: the first one's short
+    form, how many more there are, and every full text in the tooltip."""
+    status = messages[0].short if messages else ""
+    if len(messages) > 1:
+        status += f" (+{len(messages) - 1})"
+    node.status = status
+    node.status_details = "\n".join(messages)
+
+
+@never_raises("update the HBAO nodes' status lines")
+def apply_node_messages():
+    """Show what the hook last said about each node (main thread only: the
+    render thread only posts it, report.post_node_messages). What Blender
+    refuses to write for the moment waits for the next call (the timer's
+    next tick); a node that cannot be written at all (a linked tree) keeps
+    its line, and the console has the messages."""
+    if not report.in_main_thread():
+        return
+    changed = False
+    for scene_name, statuses in report.take_node_messages():
+        scene = bpy.data.scenes.get(scene_name)
+        for node in hbao_nodes(compat.compositor_tree(scene) if scene else None):
+            if node.name not in statuses:
+                continue
+            try:
+                show_messages(node, statuses[node.name])
+            except (AttributeError, RuntimeError) as error:
+                if writes.writes_refused(error):
+                    report.return_node_messages(scene_name, statuses)
+                    break
+                continue
+            changed = True
+    if changed:
+        _redraw_node_editors()
+
+
+def _redraw_node_editors():
+    for window in getattr(bpy.context.window_manager, "windows", ()):
+        for area in window.screen.areas:
+            if area.type == "NODE_EDITOR":
+                area.tag_redraw()
+
+
+# The timer asks writes.writes_allowed before it writes. It costs a
+# dictionary check and, per HBAO node of a rendered scene, a comparison per
+# tick.
+_POLL_S = 0.25
+
+
+@never_raises("update the HBAO nodes' status lines", result=_POLL_S)
+def _poll_node_messages():
+    if not bpy.app.is_job_running("RENDER"):
+        if report.has_node_messages() and writes.writes_allowed():
+            apply_node_messages()
+        # (each on its own: one that fails at every tick stops no other)
+        if any([_refresh(refresh) for refresh in hint_refreshers]):
+            _redraw_node_editors()
+    return _POLL_S
+
+
+@never_raises("update an HBAO node's hint line", result=False)
+def _refresh(refresh):
+    return refresh()
+
+
+@bpy.app.handlers.persistent
+@never_raises("update the HBAO nodes' status lines")
+def _on_render_done(*_args):
+    apply_node_messages()  # `-b` and blocking renders: the main thread
+
+
+_HANDLERS = (("render_post", _on_render_done), ("render_complete", _on_render_done),
+             ("render_cancel", _on_render_done))
+
+
+def register():
+    for name, function in _HANDLERS:
+        getattr(bpy.app.handlers, name).append(function)
+    if not bpy.app.background:  # `-b` shows nothing: render_post applies the messages
+        bpy.app.timers.register(_poll_node_messages, first_interval=_POLL_S, persistent=True)
+
+
+def unregister():
+    if bpy.app.timers.is_registered(_poll_node_messages):
+        bpy.app.timers.unregister(_poll_node_messages)
+    for name, function in _HANDLERS:
+        handlers = getattr(bpy.app.handlers, name)
+        while function in handlers:
+            handlers.remove(function)
