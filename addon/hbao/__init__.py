@@ -10,8 +10,8 @@ viewport.projection/shader_sources work in plain Python (tests, benchmarks).
                timing_line, scratch_names, pass_encoding,
                viewport.projection, viewport.shader_sources
     Blender    compat (every version difference), compat_nodes, writes, preferences, node,
-               node_status, helper_lookup, helper_scene, socket_values, planning, handover, engine,
-               engine_guard, render_reports, handlers,
+               node_status, helper_lookup, helper_scene, socket_values, planning, handover,
+               helper_ao, engine, engine_guard, render_reports, handlers,
                viewport.*
 """
 

@@ -12,116 +12,24 @@ import bpy
 import numpy as np
 
 from . import camera as camera_model
-from . import (ao_cache, compat, exr_passes, handover, job_inputs, layer_passes, native,
-               pass_encoding, recomposite, render_record, scratch_files, strip_cameras,
-               timing_line)
+from . import (compat, exr_passes, native, pass_encoding, recomposite, scratch_files,
+               strip_cameras, timing_line)
 from .callback_guard import never_raises
+from .helper_ao import cache, compute_passes, main_of, original, report_warning
 from .helper_lookup import ENGINE_IDNAME, is_helper, pass_names_for_helper
 from .helper_scene import rendered_for_a_scene, scene_for_render
 from .node import hbao_nodes, pass_name
 from .group_layout import GROUP_TREE_VERSION, layout_of
-from .planning import node_names, plan, tell_all_nodes
-from .report import log, post_render_report
+from .planning import tell_all_nodes
+from .report import log
 
 # The prefix of the passes this engine fills (node.pass_name's).
 PASS_PREFIX = "HBAO "
-# The last render's passes and AO, reused for the same passes and settings,
-# and by re-compositing (recomposite.py).
-_cache = ao_cache.last_render
-
-
-def _original(scene):
-    return scene.original if hasattr(scene, "original") else scene
-
-
-def compute_passes(engine, depsgraph, width, height, request=None):
-    """{(view, pass name): bottom-up (height, width) AO} for the helper being
-    rendered (the view None without Stereoscopy): for the render of its main
-    scene, or for `request` (recomposite.Request) from the passes of the
-    last render."""
-    helper = _original(depsgraph.scene)
-    main = main_of(helper, request)
-    if main is None:
-        raise RuntimeError(f"scene {helper.name!r} is not an HBAO helper scene")
-    frame = request.frame if request else main.frame_current + main.frame_subframe
-    jobs, warnings = plan(main, frame)
-    render_record.remember(main.name, frame, jobs, node_names(main), main.as_pointer())
-    for warning in warnings:
-        _report(engine, f"HBAO {warning}")
-        log(warning)
-    if not jobs:
-        if request is not None:
-            request.completed = True
-        return {}
-    native.load_library()
-    if request:
-        inputs_of, timings, views = job_inputs.kept(main, request, _cache)
-    else:
-        inputs_of, timings, views = job_inputs.handed_over(
-            engine, depsgraph, helper, main, jobs, warnings, lambda text: _report(engine, text))
-
-    results = {}
-    # Esc: Blender asks through test_break(); the passes say no AO and
-    # the render ends as Blender decides (the scratch file goes as the
-    # render_helper's removals_after block ends).
-    if engine.test_break():
-        log("render cancelled: no AO computed")
-        _cache.clear()
-        return {}
-    compute_time = 0.0
-    timings["threads"] = max(job.threads for job in jobs)  # (the same for every job)
-    fresh = {}
-    every_job = [(view, job) for view in views for job in jobs]
-    for index, (view, job) in enumerate(every_job):
-        if engine.test_break():
-            log("render cancelled: AO left out")
-            _cache.clear()
-            return {}
-        engine.update_stats("HBAO", f"{job.node_name}: computing AO ({index + 1}/"
-                                    f"{len(every_job)})")
-        inputs, depth, normal, extra = inputs_of(job, view)
-        # A border render without its crop: the main Render Result is the
-        # whole frame (background outside the border), the helper's only
-        # the border. The AO is the whole frame's, cut to the border.
-        border = camera_model.uncropped_border(main, depth.shape, (height, width))
-        if depth.shape != (height, width) and border is None:
-            raise RuntimeError(f"the Render Result is {depth.shape[1]}x{depth.shape[0]}, the "
-                               f"helper scene renders {width}x{height}")
-        compute_start = time.perf_counter()
-        key = ao_cache.key(main.name, job.pass_name, view)
-        ao = _cache.get(key, inputs)
-        if ao is None:
-            ao = layer_passes.compute(job, depth, normal, inputs.camera, extra)
-            for note in native.last_notes():  # (this thread's compute)
-                log(f"node {job.node_name!r}: {note}")
-                _report(engine, f"HBAO: node {job.node_name!r}: {note}")
-        else:
-            timings["cached"] = timings.get("cached", 0) + 1
-        fresh[key] = (inputs, ao)
-        if border is not None:  # bottom-up rows, as the border's y
-            x0, x1, y0, y1 = border
-            ao = np.ascontiguousarray(ao[y0:y1, x0:x1])
-        results[(view, job.pass_name)] = ao
-        compute_time += time.perf_counter() - compute_start
-        engine.update_progress((index + 1) / len(every_job))
-    _cache.keep_only(fresh)
-    timings["ao"] = compute_time
-    engine.hbao_timings = timings
-    if request is not None:
-        request.completed = True
-    return results
-
-
-def _report(engine, text):
-    """A warning in the render's report, and (report.py) in the Info editor."""
-    engine.report({"WARNING"}, text)
-    if not bpy.app.background:  # `-b`: the console has it; nothing would take it
-        post_render_report(text)
 
 
 def _report_failure(engine, message):
     log(message)
-    _report(engine, f"HBAO: {message}")
+    report_warning(engine, f"HBAO: {message}")
 
 
 # What an artist who renders the helper scene itself (made it the active
@@ -138,12 +46,6 @@ NOT_FOR_RENDERING = ("\"{label}\" is the HBAO add-on's internal engine and rende
 # A node's status line when a native library cannot be loaded (the full
 # text, in the tooltip and the render's report, says what to do).
 LIBRARY_SHORT = "Library not loaded: AO off"
-
-
-def main_of(helper, request):
-    """The main scene a render of `helper` is for (the request's, when
-    re-compositing), or None."""
-    return bpy.data.scenes.get(request.main) if request else scene_for_render(helper)
 
 
 INTERRUPTED = "stopped while the AO was computed: this frame renders without AO"
@@ -182,7 +84,7 @@ def _fill_passes(result, results, width, height, layouts):
 
 def render_helper(engine, depsgraph):
     """HBAOPassEngine.render(): fill every registered AO pass, "no AO" where it failed."""
-    scene = _original(depsgraph.scene)
+    scene = original(depsgraph.scene)
     request = recomposite.request_for(scene)
     main = scene_for_render(scene) if is_helper(scene) else None
     if request is None and (main is None or not rendered_for_a_scene(scene)):
@@ -220,7 +122,7 @@ def render_helper(engine, depsgraph):
                 results = compute_passes(engine, depsgraph, width, height, request)
         except (native.HBAOLibraryError, exr_passes.EXRLibraryError) as error:
             results = {}
-            _cache.clear()  # nothing kept that this render's record would not match
+            cache.clear()  # nothing kept that this render's record would not match
             _report_failure(engine, f"{error} Rendering without AO.")
             tell_all_nodes(main_of(scene, request), LIBRARY_SHORT, f"{error} Rendering without AO.")
         except camera_model.CameraError as error:  # a camera the library cannot model
@@ -230,7 +132,7 @@ def render_helper(engine, depsgraph):
                            f"{error}. Rendering without AO.")
         except Exception as error:  # the render must complete: no AO
             results = {}
-            _cache.clear()
+            cache.clear()
             detail = f"{type(error).__name__}: {error}. Rendering without AO."
             _report_failure(engine, detail)
             tell_all_nodes(main_of(scene, request), "Error: AO off (see Info)", detail)
@@ -266,7 +168,7 @@ class HBAOPassEngine(bpy.types.RenderEngine):
 
     def update_render_passes(self, scene=None, renderlayer=None):
         self.register_pass(scene, renderlayer, "Combined", 4, "RGBA", "COLOR")
-        for name in pass_names_for_helper(_original(scene)):
+        for name in pass_names_for_helper(original(scene)):
             self.register_pass(scene, renderlayer, name, 1, "X", "VALUE")
 
     def render(self, depsgraph):
@@ -294,7 +196,7 @@ def unregister():
     for handlers in _HANDLERS:
         if _on_render_end in handlers:
             handlers.remove(_on_render_end)
-    _cache.clear()
+    cache.clear()
     native.release_memory()
     if not bpy.app.is_job_running("RENDER"):  # (3.4 crashed: blender-integration.md)
         bpy.utils.unregister_class(HBAOPassEngine)

@@ -25,6 +25,6 @@ def watched(*args, **kwargs):
     return ao
 
 
-layer_passes.compute = watched  # the add-on's own function, which engine.py calls
+layer_passes.compute = watched  # the add-on's own function, which helper_ao.py calls
 runpy.run_path(RENDER_SCRIPT, run_name="__main__")
 print("SCRATCH AT AO", json.dumps(seen), flush=True)
