@@ -2,30 +2,35 @@
 """Where a 1080p frame's time goes, part by part of the horizon search:
 builds copies of the library with a part of the search taken out (in a
 temporary copy of csrc/, never in the working tree), times each against
-the library as it is with build/bench_ab (paired calls, the same
-machine in the same minutes) and prints each part's share.
+the library as it is with build/bench_ab (the two builds' calls in
+alternating rounds, so both see the machine of the same minutes) and
+prints each part's share.
 
 Parts, each the difference between two builds (1 thread unless said):
 - the stages around the search: the frame at radius 1e-4, where no horizon
-  is searched (depth conversion, normals, deinterleaving, blur, output);
+  is searched (depth conversion, normals, deinterleaving, blur, output;
+  and each block's set-up up to its test for active pixels, which then
+  finds none: that much of the set-up is counted here);
 - the blocks' set-up, the directions' slices and the steps' plans: the
   build without the step loop and without its prefetches, less the stages;
 - the plans' prefetches (the memory the steps read): the build without
   the step loop, less the same without the prefetches;
-- the step loop (each step's depth load, its height above the tangent plane
-  and the test whether it can raise a horizon): the build whose steps stop
-  after that test, less the build without the step loop;
+- the step loop (each step's depth load and the test of its height above
+  the tangent plane, whether it can raise a horizon): the build whose steps
+  stop after that test, less the build without the step loop;
 - the rising steps' work (square root, division, horizon update, past the
   normal, the direction's visibility): the library, less the build whose
   steps stop after the test.
 The builds without a part give wrong AO (bench_ab says DIFFERENT): they
-only time what is left. Only the one-layer search is taken apart.
+only time what is left. Only the one-layer search of the SIMD kernels is
+taken apart: --back-faces and --implementation scalar are refused.
 
   python3 scripts/bench_search_parts.py [--rounds 8] [bench_ab options]
 
 bench_ab options (--threads 2, --half, --implementation avx2, --steps 6 ...)
 pass through; --radius is the script's own (its stages run sets it).
-Needs build/bench_ab (scripts/bench_ab_pairs.sh builds it where missing)."""
+Needs build/bench_ab: cmake --build build --target bench_ab (a build
+configured with -DHBAO_BUILD_BENCHMARKS=ON, the default)."""
 import argparse
 import re
 import shutil
@@ -112,9 +117,15 @@ def main():
         parser.error("--rounds: at least 3")
     if "--radius" in options:
         parser.error("--radius is the script's own (the stages run sets it)")
+    if "--back-faces" in options or any(o in ("scalar", "--implementation=scalar")
+                                        for o in options):
+        parser.error("only the SIMD kernels' one-layer search is taken apart: "
+                     "--back-faces and --implementation scalar would show the whole search "
+                     "as set-up")
     if not BENCH.is_file():
         sys.exit("bench_search_parts.py: build/bench_ab is missing: "
-                 "run scripts/bench_ab_pairs.sh once, or build with -DHBAO_BUILD_BENCHMARKS=ON")
+                 "cmake --build build --target bench_ab "
+                 "(configured with -DHBAO_BUILD_BENCHMARKS=ON)")
     if "--threads" not in options:
         options = options + ["--threads", "1"]
     with tempfile.TemporaryDirectory(prefix="hbao-parts-") as temp:

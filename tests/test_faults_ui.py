@@ -247,7 +247,7 @@ def test_undo_and_redo_keep_the_hook(run_in_blender, tmp_path, case):
 
 def test_an_error_in_the_status_poll_does_not_stop_it(run_in_blender, tmp_path):
     """Blender drops a timer that raises, for the rest of the session: an
-    error in the add-on's half-second poll (ui_session.py failing_refresher:
+    error in the add-on's quarter-second poll (ui_session.py failing_refresher:
     the first of its functions made to raise) left every node's status line
     as it was until Blender restarted; guarded as a whole, the poll stopped
     at that function every tick (the review). Observed: the error is logged

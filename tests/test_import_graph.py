@@ -89,6 +89,7 @@ def test_the_node_does_not_know_the_hook():
     hook = {"hbao.helper_scene", "hbao.helper_lookup", "hbao.handlers", "hbao.engine",
             "hbao.helper_ao", "hbao.planning", "hbao.handover", "hbao.socket_values"}
     assert not _graph()["hbao.node"] & hook
+    assert not _graph()["hbao.node_status"] & hook
     # The graph reader must see real edges, or the two tests above prove nothing.
     assert "hbao.node" in _graph()["hbao.helper_scene"]
 

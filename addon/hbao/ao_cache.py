@@ -108,6 +108,6 @@ class AOCache:
 
 
 # The last render's passes and AO of every node, keyed (main scene name, pass
-# name): the render engine fills it (engine.py), re-compositing reads it
+# name): helper_ao.compute_passes fills it, re-compositing reads it
 # (recomposite.py).
 last_render = AOCache()

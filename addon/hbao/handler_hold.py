@@ -9,7 +9,7 @@ import bpy
 # add-on's, not a render of the artist's: a pipeline's handlers (one that
 # notifies a farm, or saves each render) must not run for it on every change
 # of a value, with a scene they do not know. The add-on's own handlers do
-# run (node.py's shows the engine's messages on the nodes).
+# run (node_status.py's shows the engine's messages on the nodes).
 RENDER_HANDLERS = ("render_init", "render_pre", "render_stats", "render_post", "render_write",
                    "render_complete", "render_cancel", "frame_change_pre", "frame_change_post")
 

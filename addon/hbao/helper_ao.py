@@ -68,7 +68,7 @@ def compute_passes(engine, depsgraph, width, height, request=None):
     results = {}
     # Esc: Blender asks through test_break(); the passes say no AO and
     # the render ends as Blender decides (the scratch file goes as the
-    # render_helper's removals_after block ends).
+    # engine.render_helper's removals_after block ends).
     if engine.test_break():
         log("render cancelled: no AO computed")
         cache.clear()

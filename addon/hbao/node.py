@@ -2,7 +2,7 @@
 """The HBAO compositor node (Add > Filter > HBAO).
 
 It is a custom group node: its group multiplies Image by the AO pass that the
-render hook (helper_scene.py, engine.py) computes with this node's settings
+render hook (helper_scene.py, helper_ao.py) computes with this node's settings
 and publishes through a Render Layers node. The group's inputs other than
 Image only carry the artist's values; the hook reads them. The node knows
 nothing of the hook: it announces that nodes came or went through
