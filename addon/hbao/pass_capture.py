@@ -16,10 +16,9 @@ and reading the whole Render Result.
 
 Anything else keeps the file round trip, which gives the same arrays
 (docs/blender-integration.md, hook step 3: what and why), as does a capture
-that is missing, all zeros or not of the result's size. The wrappers call
-the engine's own method first and return what it returns; a failed copy is
-logged and costs the render nothing. unregister() puts the engine's own
-methods back, or leaves wrappers that only pass through.
+that is missing, all zeros or not of the result's size. The wrapping is
+engine_wrap.py's: a failed copy is logged and costs the render nothing,
+and unregister() puts the engine's own methods back.
 """
 import os
 from time import perf_counter as _clock
@@ -27,8 +26,7 @@ from time import perf_counter as _clock
 import bpy
 import numpy as np
 
-from . import compat
-from .report import log
+from . import compat, engine_wrap
 
 SUPPORTED = compat.VERSION >= (4, 5, 0)  # (3.4 crashes reading a pass without pixels)
 # Set to 0: always the file round trip (to compare, or where a wrapper misbehaves).
@@ -37,9 +35,6 @@ SWITCH_VARIABLE = "HBAO_PASSES_FROM_MEMORY"
 # The channels of each pass taken, as handover.py reads them.
 _CHANNELS = {"Depth": 1, "Normal": 3}
 
-# Engine classes wrapped: {class: ({method name: its own function}, the
-# wrappers' state, {method name: the wrapper})}.
-_wrapped = {}
 # The scenes whose renders are taken (watch()): {scene pointer: {layer: with Normal}}.
 _watched = {}
 # What the engines left: {(scene pointer, view layer name): {"views": {view
@@ -47,72 +42,6 @@ _watched = {}
 _taken = {}
 _extras = {}  # {main scene pointer: [its extra renders' scene pointers]}
 _later = {}  # layers written in render_frame_finish(): {engine pointer: [(scene, layer)]}
-
-
-def _engine_class(engine_name):
-    """The registered Python class of the render engine `engine_name`, or
-    None (an engine written in C, or the add-on's own). A class replaced by
-    a new registration (Cycles reloaded) stays among the subclasses while
-    anything holds it: the last registered one is Blender's."""
-    found = None
-    for engine_class in bpy.types.RenderEngine.__subclasses__():
-        if getattr(engine_class, "bl_idname", None) == engine_name \
-                and getattr(engine_class, "is_registered", True):
-            found = engine_class
-    if found is None:
-        return None
-    module = found.__module__
-    if module == __package__ or module.startswith(__package__ + "."):
-        return None
-    return found if "render" in found.__dict__ else None
-
-
-def _guarded(step, *args):
-    try:
-        step(*args)
-    except Exception as error:  # the render goes on; the file route stays
-        log(f"could not take the passes from the render in memory "
-            f"({type(error).__name__}: {error}); saving them instead")
-
-
-def _wrap(engine_class):
-    """Wrap the engine's render() and, where it has one, its
-    render_frame_finish(), in which Cycles writes a tiled render's pixels."""
-    own = {name: engine_class.__dict__[name] for name in ("render", "render_frame_finish")
-           if name in engine_class.__dict__}
-    state = {"active": True}
-
-    def render(self, depsgraph):
-        result = own["render"](self, depsgraph)
-        if state["active"] and _watched and not self.is_preview:
-            _guarded(_after_layer, self, depsgraph, "render_frame_finish" in own)
-        return result
-
-    def render_frame_finish(self):
-        result = own["render_frame_finish"](self)
-        if state["active"] and _later:
-            _guarded(_after_frame, self)
-        return result
-
-    wrappers = {name: function for name, function in (
-        ("render", render), ("render_frame_finish", render_frame_finish)) if name in own}
-    for name, function in wrappers.items():
-        setattr(engine_class, name, function)
-    _wrapped[engine_class] = (own, state, wrappers)
-
-
-def _needs_wrapping(engine_class):
-    """Not wrapped yet, or its own render() put back since (by another
-    add-on that had wrapped it before this one); a wrapper of another
-    add-on's over this one's keeps this one inside."""
-    entry = _wrapped.get(engine_class)
-    if entry is None:
-        return True
-    own, state, _wrappers = entry
-    if engine_class.__dict__.get("render") is own["render"]:
-        state["active"] = False
-        return True
-    return False
 
 
 # The geometry node that makes strokes, with no Grease Pencil data behind them
@@ -152,13 +81,10 @@ def _watch_one(scene, layers):
     if not SUPPORTED or not layers or scene.render.use_border \
             or os.environ.get(SWITCH_VARIABLE, "1").strip() == "0":
         return False
-    engine_class = _engine_class(scene.render.engine)
+    engine_class = engine_wrap.engine_class(scene.render.engine)
     if engine_class is None:
         return False
-    for stale in [cls for cls in _wrapped if not getattr(cls, "is_registered", True)]:
-        _wrapped.pop(stale)[1]["active"] = False  # (let go of a replaced class)
-    if _needs_wrapping(engine_class):
-        _wrap(engine_class)
+    engine_wrap.wrap(engine_class, _after_layer, _after_frame)
     _watched[scene.as_pointer()] = dict(layers)
     return True
 
@@ -195,6 +121,8 @@ def _pass_array(render_pass, width, height):
 def _after_layer(engine, depsgraph, finishes):
     """Take the layer `engine` has just rendered, or, where its pixels are
     not there yet and the engine `finishes` the frame, after that."""
+    if not _watched:
+        return
     pointer = depsgraph.scene.as_pointer()
     layer_name = depsgraph.view_layer.name
     if layer_name not in _watched.get(pointer, ()):
@@ -204,6 +132,8 @@ def _after_layer(engine, depsgraph, finishes):
 
 
 def _after_frame(engine):
+    if not _later:
+        return
     for pointer, layer_name in _later.pop(engine.as_pointer(), []):
         if layer_name in _watched.get(pointer, ()):
             _take(engine, pointer, layer_name)
@@ -291,10 +221,4 @@ def unregister():
     _taken.clear()
     _later.clear()
     _extras.clear()
-    for engine_class, (own, state, wrappers) in list(_wrapped.items()):
-        state["active"] = False
-        for name, function in own.items():
-            if engine_class.__dict__.get(name) is wrappers[name]:
-                setattr(engine_class, name, function)
-            # else wrapped again by someone else since: the chain stays, ours passes through
-    _wrapped.clear()
+    engine_wrap.unwrap_all()
