@@ -215,7 +215,7 @@ def test_disabling_the_add_on_in_a_session_leaves_the_plain_render(run_in_blende
     assert np.abs(images["disabled_under_another"] - images["muted"]).max() \
         <= SAME_RENDER_TOLERANCE
     # Cycles' own render() back once the add-on is disabled, wrapped once
-    # again when it is enabled (pass_capture.py; 3.4 is never wrapped); a
+    # again when it is enabled (engine_wrap.py; 3.4 is never wrapped); a
     # later wrapper of another add-on's kept.
     wrapped = "wrapped" if blender.version_tuple >= (4, 5) else "own"
     assert json_line(completed.stdout, "ENGINE RENDER") == {

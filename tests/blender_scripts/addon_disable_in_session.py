@@ -6,7 +6,7 @@ each render's final image is written to OUT/<step>.exr (32-bit float):
 enabled, muted (the node muted: the plain render), disabled (the add-on
 disabled in the session), enabled_again, disabled_under_another (disabled
 again after another add-on wrapped Cycles' render over the add-on's
-wrapper, pass_capture.py). Prints ENGINE RENDER {json} (what Cycles'
+wrapper, engine_wrap.py). Prints ENGINE RENDER {json} (what Cycles'
 render() was after each step) and DISABLED IN SESSION DONE.
 
   blender -b --addons hbao --python addon_disable_in_session.py -- OUT
@@ -48,7 +48,7 @@ def note(step):
     render_function = cycles.CyclesRender.__dict__["render"]
     seen[step] = ("own" if render_function is own_render else
                   "another's" if render_function is another_render else
-                  "wrapped" if render_function.__module__.endswith(".pass_capture") else
+                  "wrapped" if render_function.__module__.endswith(".engine_wrap") else
                   "unknown")
 
 
