@@ -21,11 +21,9 @@ import time
 
 import bpy
 
-from . import (ao_cache, compat, composite_trigger, handler_hold, helper_scene, layer_passes,
-               node, node_status, render_record, writes)
-from . import camera as camera_model
+from . import (ao_cache, composite_trigger, handler_hold, helper_scene, layer_passes, node_status,
+               refresh_due, render_record, writes)
 from .callback_guard import never_raises
-from .planning import plan_node
 from .report import log
 
 
@@ -44,20 +42,7 @@ class Request:
 _request = None
 
 
-class _Due:
-    """A scene whose last render can be brought up to its nodes' settings:
-    the render's record (the object itself: a new render makes a new one),
-    the nodes' current signatures, and the jobs whose AO changed."""
-
-    def __init__(self, record, signatures, changed):
-        self.record, self.signatures, self.changed = record, signatures, changed
-
-    def same_as(self, other):
-        return (other is not None and self.record is other.record
-                and self.signatures == other.signatures)
-
-
-# Main scene name -> the _Due whose refresh failed: not tried again (every
+# Main scene name -> the refresh_due.Due whose refresh failed: not tried again (every
 # tick) until the settings change or the scene renders again.
 _failed = {}
 
@@ -110,46 +95,6 @@ def request_for(helper):
     """The refresh whose render is rendering `helper` now, or None."""
     request = _request
     return request if request is not None and request.helper == helper.name else None
-
-
-def _needs_refresh(main, helper):
-    """A _Due when `main`'s last render can be brought up to its nodes'
-    current settings from the cached passes, else None. The record must be
-    this scene's (not one renamed to its name; a file load clears them), and
-    the helper's render must come out the size of the kept passes: its old
-    pass is gone once it renders again, so a mismatch found then would
-    leave the compositor without AO."""
-    record = render_record.last_render(main.name)
-    # A stereo or multi-view render's passes are kept per view, which a
-    # refresh does not read (job_inputs.kept): such a render is done again.
-    if record is None or helper.render.use_border or main.render.use_multiview:
-        return None
-    frame, signatures, identity = record
-    if identity != main.as_pointer():
-        return None
-    changed, current_signatures = [], []
-    for hbao_node in node.hbao_nodes(compat.compositor_tree(main)):
-        if hbao_node.mute or not any(output.is_linked for output in hbao_node.outputs):
-            continue  # the compositor shows those at once
-        if hbao_node.name not in signatures:
-            return None  # added since the render
-        try:
-            job = plan_node(hbao_node, main, frame, [])
-        except Exception:  # the next render says what is wrong
-            return None
-        if job is not None:
-            kept = ao_cache.last_render.entry(ao_cache.key(main.name, job.pass_name))
-            width, height = camera_model.render_size(helper)
-            if kept is None or kept[0].arrays[0].shape != (height, width):
-                return None
-        recorded, current = signatures[hbao_node.name], render_record.signature_of(job)
-        current_signatures.append((hbao_node.name, current))
-        if current == recorded:
-            continue
-        if current is not None and not render_record.same_passes(recorded, current):
-            return None
-        changed.append(job)
-    return _Due(record, tuple(current_signatures), changed) if changed else None
 
 
 def _work(main, jobs):
@@ -247,7 +192,7 @@ def refresh_changed(in_background=False):
     for main in list(bpy.data.scenes):
         has_record = render_record.last_render(main.name) is not None  # (else: nothing to do)
         helper = helper_scene.helper_scene_of(main) if has_record else None
-        due = _needs_refresh(main, helper) if helper is not None else None
+        due = refresh_due.due_for(main, helper) if helper is not None else None
         if due is None:
             computation = _computing.get(main.name)
             if computation is not None and computation.done():

@@ -659,7 +659,7 @@ for step in spec.get("after_render", []):
             try:
                 # What the timer's first tick does in a window: start the worker.
                 helper = helper_scene.helper_scene_of(scene)
-                due = recomposite._needs_refresh(scene, helper)
+                due = sys.modules["hbao.refresh_due"].due_for(scene, helper)
                 assert not recomposite._refresh(scene, helper, due, False)
                 computation = recomposite._computing[scene.name]
                 assert started.wait(60), "the refresh's worker did not start"
