@@ -4,12 +4,10 @@ it has one, its render_frame_finish() wrapped, so that the add-on's step
 runs in the engine's own call, right after it (pass_capture.py: the passes
 are copied out of the engine's result there, the only place Python can
 read them). The wrappers call the engine's own method first and return
-what it returns; a step that fails is logged and costs the render nothing.
+what it returns; the steps must not raise (pass_capture.py guards its own).
 unwrap_all() puts the engine's own methods back, or leaves wrappers that
 only pass through where another add-on has wrapped them since."""
 import bpy
-
-from .report import log
 
 # Engine classes wrapped: {class: ({method name: its own function}, the
 # wrappers' state, {method name: the wrapper})}.
@@ -34,21 +32,13 @@ def engine_class(engine_name):
     return found if "render" in found.__dict__ else None
 
 
-def _guarded(step, *args):
-    try:
-        step(*args)
-    except Exception as error:  # the render goes on; the file route stays
-        log(f"could not take the passes from the render in memory "
-            f"({type(error).__name__}: {error}); saving them instead")
-
-
 def wrap(wrapped_class, after_render, after_frame):
     """Wrap `wrapped_class` (engine_class's) where it is not wrapped yet:
     after its render(), after_render(engine, depsgraph, finishes) runs
     (finishes: whether the class has a render_frame_finish(), which Cycles
     writes a tiled render's pixels in), and after its render_frame_finish()
-    after_frame(engine); neither for a preview render. Lets go of classes
-    replaced by a new registration."""
+    after_frame(engine); after_render not for a preview render. Neither may
+    raise. Lets go of classes replaced by a new registration."""
     for stale in [cls for cls in _wrapped if not getattr(cls, "is_registered", True)]:
         _wrapped.pop(stale)[1]["active"] = False
     if not _needs_wrapping(wrapped_class):
@@ -60,13 +50,13 @@ def wrap(wrapped_class, after_render, after_frame):
     def render(self, depsgraph):
         result = own["render"](self, depsgraph)
         if state["active"] and not self.is_preview:
-            _guarded(after_render, self, depsgraph, "render_frame_finish" in own)
+            after_render(self, depsgraph, "render_frame_finish" in own)
         return result
 
     def render_frame_finish(self):
         result = own["render_frame_finish"](self)
         if state["active"]:
-            _guarded(after_frame, self)
+            after_frame(self)
         return result
 
     wrappers = {name: function for name, function in (

@@ -20,6 +20,7 @@ that is missing, all zeros or not of the result's size. The wrapping is
 engine_wrap.py's: a failed copy is logged and costs the render nothing,
 and unregister() puts the engine's own methods back.
 """
+import functools
 import os
 from time import perf_counter as _clock
 
@@ -27,6 +28,7 @@ import bpy
 import numpy as np
 
 from . import compat, engine_wrap
+from .report import log
 
 SUPPORTED = compat.VERSION >= (4, 5, 0)  # (3.4 crashes reading a pass without pixels)
 # Set to 0: always the file round trip (to compare, or where a wrapper misbehaves).
@@ -118,6 +120,20 @@ def _pass_array(render_pass, width, height):
     return array[::-1]
 
 
+def _falls_back_to_the_file(step):
+    """A step the engine's wrapper runs: a failure is logged, and the
+    render goes on with the file round trip."""
+    @functools.wraps(step)
+    def guarded(*args):
+        try:
+            step(*args)
+        except Exception as error:  # the render goes on; the file route stays
+            log(f"could not take the passes from the render in memory "
+                f"({type(error).__name__}: {error}); saving them instead")
+    return guarded
+
+
+@_falls_back_to_the_file
 def _after_layer(engine, depsgraph, finishes):
     """Take the layer `engine` has just rendered, or, where its pixels are
     not there yet and the engine `finishes` the frame, after that."""
@@ -131,6 +147,7 @@ def _after_layer(engine, depsgraph, finishes):
         _later.setdefault(engine.as_pointer(), []).append((pointer, layer_name))
 
 
+@_falls_back_to_the_file
 def _after_frame(engine):
     if not _later:
         return
