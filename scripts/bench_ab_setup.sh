@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
-# Sourced by bench_ab_copies.sh and bench_ab_pairs.sh, which set REPO first.
+# Sourced by bench_ab_copies.sh, bench_ab_pairs.sh and bench_threads.sh, which set REPO first.
 
 # bench_ab_arguments SCRIPT "$@": sets before and after from the first two
 # arguments, or prints SCRIPT's usage and exits 2 when they are not files.

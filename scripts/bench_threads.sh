@@ -1,14 +1,19 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: GPL-2.0-or-later
 # What a frame loses on two threads, and whether the library or the
-# machine loses it: build/bench_ab times the library (two file copies of
-# build/libhbao.so, so that bench_ab has its two builds) on one thread
-# alone, then as two one-thread processes side by side (what the machine's
-# two cores cost each other: shared caches, memory, the VM's neighbours),
-# then on two threads. Prints each time, the side-by-side processes against
-# the one alone, and two threads' wall time against half of one thread's
-# CPU time: the part of that beyond the side-by-side ratio is the library's
-# own (threads started and joined at each stage, the last rows' imbalance).
+# machine loses it: build/bench_ab times the library as it is in build/ now
+# (two file copies of build/libhbao.so, so that bench_ab has its two
+# builds) on one thread alone, then as two one-thread processes side by
+# side (what the machine's two cores cost each other: shared caches,
+# memory), then on two threads. Prints each time, the side-by-side
+# processes against the one alone, and two threads' wall time against half
+# of one thread's CPU time; their quotient is the library's own share
+# (threads started and joined at each stage, the last rows' imbalance).
+# That share is an estimate: the one-thread cases are CPU time, which
+# leaves out time the VM takes away, while two threads' is wall time; two
+# processes each work on a whole frame where two threads share one; and
+# the two processes do not start in step. bench_ab prints tenths of a
+# millisecond, so a frame of a few milliseconds gives coarse ratios.
 # docs/speed.md, session 51.
 #   scripts/bench_threads.sh [bench_ab options, not --threads]
 # The three cases run in turn REPEATS times, so that the VM's drift from
@@ -20,10 +25,12 @@ REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 # shellcheck source=bench_ab_setup.sh
 . "$REPO/scripts/bench_ab_setup.sh"
 for argument in "$@"; do
-    if [ "$argument" = --threads ]; then
+    case $argument in
+    --threads | --threads=*)
         echo "$0: the thread counts are this script's (1, two of 1, and 2): leave out --threads" >&2
         exit 2
-    fi
+        ;;
+    esac
 done
 rounds=${ROUNDS:-10}
 calls=${CALLS:-3}
@@ -31,69 +38,88 @@ repeats=${REPEATS:-3}
 bench_ab_count "$0" ROUNDS "$rounds" 3
 bench_ab_count "$0" CALLS "$calls" 3
 bench_ab_count "$0" REPEATS "$repeats" 2
-bench_ab_program
 library="$REPO/build/libhbao.so"
 if [ ! -f "$library" ]; then
     echo "$0: $library missing: build the library first (cmake --build build)" >&2
     exit 1
 fi
+bench_ab_program
 work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+side=""
+# a background bench_ab ignores the terminal's interrupt: stop it too
+trap '[ -z "$side" ] || kill "$side" 2>/dev/null || true; rm -rf "$work"' EXIT
+trap 'exit 130' INT
+trap 'exit 143' TERM
 cp "$library" "$work/first.so"
 cp "$library" "$work/second.so"
-measure() { # measure N: the three cases once, into $work/N.alone, .side_a, .side_b, .two
+# one_run OUTPUT THREADS [bench_ab options]
+one_run() {
+    local output=$1 threads=$2
+    shift 2
+    "$bench" "$work/first.so" "$work/second.so" --rounds "$rounds" --calls "$calls" \
+        --threads "$threads" "$@" >"$output" 2>&1
+}
+# measure N [bench_ab options]: the three cases once, into $work/N.alone,
+# .side_a, .side_b and .two
+measure() {
     local n=$1
     shift
-    "$bench" "$work/first.so" "$work/second.so" --rounds "$rounds" --calls "$calls" \
-        --threads 1 "$@" >"$work/$n.alone" 2>&1 || { cat "$work/$n.alone" >&2; exit 1; }
-    "$bench" "$work/first.so" "$work/second.so" --rounds "$rounds" --calls "$calls" \
-        --threads 1 "$@" >"$work/$n.side_a" 2>&1 &
-    local side=$!
-    "$bench" "$work/first.so" "$work/second.so" --rounds "$rounds" --calls "$calls" \
-        --threads 1 "$@" >"$work/$n.side_b" 2>&1 ||
-        { wait "$side" || true; cat "$work/$n.side_b" >&2; exit 1; }
-    wait "$side" || { cat "$work/$n.side_a" >&2; exit 1; }
-    "$bench" "$work/first.so" "$work/second.so" --rounds "$rounds" --calls "$calls" \
-        --threads 2 "$@" >"$work/$n.two" 2>&1 || { cat "$work/$n.two" >&2; exit 1; }
+    one_run "$work/$n.alone" 1 "$@" || { cat "$work/$n.alone" >&2; exit 1; }
+    one_run "$work/$n.side_a" 1 "$@" &
+    side=$!
+    one_run "$work/$n.side_b" 1 "$@" || { cat "$work/$n.side_b" >&2; exit 1; }
+    wait "$side" || { side=""; cat "$work/$n.side_a" >&2; exit 1; }
+    side=""
+    one_run "$work/$n.two" 2 "$@" || { cat "$work/$n.two" >&2; exit 1; }
 }
 for ((n = 1; n <= repeats; n++)); do measure "$n" "$@"; done
-python3 - "$work" "$repeats" "$*" <<'PY'
+python3 - "$work" "$repeats" "$rounds" "$calls" <<'PY'
 import re
-import statistics
 import sys
 from pathlib import Path
+from statistics import median
 
 work, repeats = Path(sys.argv[1]), int(sys.argv[2])
+rounds, calls = sys.argv[3], sys.argv[4]
 
 
-def fastest(name):
+def fastest(name, unit):
     """The mean over rounds of both builds' fastest calls (they are one
-    library), and its unit."""
+    library), in `unit` ms ("CPU" on one thread, "wall" on two)."""
     text = (work / name).read_text()
     match = re.search(r"fastest / lower quartile: before ([0-9.]+) / [0-9.]+, "
                       r"after ([0-9.]+) / [0-9.]+ (CPU|wall) ms", text)
-    if match is None:
-        sys.exit(f"bench_threads: no timing line in bench_ab's output:\n{text}")
-    return (float(match.group(1)) + float(match.group(2))) / 2.0, match.group(3)
+    if match is None or match.group(3) != unit:
+        sys.exit(f"bench_threads.sh: no {unit} time in bench_ab's output:\n{text}")
+    value = (float(match.group(1)) + float(match.group(2))) / 2.0
+    if value <= 0.0:
+        sys.exit(f"bench_threads.sh: bench_ab timed {name} at 0.0 ms: give a larger --size")
+    return value
+
+
+def settings():
+    """bench_ab's first line up to its ';' (size, directions x steps, blur
+    and the other options it was given), without its thread count."""
+    line = (work / "1.alone").read_text().split("\n")[0].split(";")[0].strip()
+    return ", ".join(item for item in line.split(", ") if not item.endswith("thread(s)"))
 
 
 turns = []
 for n in range(1, repeats + 1):
-    alone = fastest(f"{n}.alone")[0]
-    side = [fastest(f"{n}.side_a")[0], fastest(f"{n}.side_b")[0]]
-    two, unit = fastest(f"{n}.two")
-    turns.append((alone, side, two, unit))
-median = statistics.median
+    alone = fastest(f"{n}.alone", "CPU")
+    side = [fastest(f"{n}.side_a", "CPU"), fastest(f"{n}.side_b", "CPU")]
+    turns.append((alone, side, fastest(f"{n}.two", "wall")))
 alone = median(t[0] for t in turns)
 side = median(s for t in turns for s in t[1])
 two = median(t[2] for t in turns)
 side_ratio = median(s / t[0] for t in turns for s in t[1])
 two_ratio = median(t[2] / (t[0] / 2.0) for t in turns)
-print(f"bench_threads: build/bench_ab {sys.argv[3] or '(the defaults)'}; the mean over rounds "
-      f"of the fastest call, median of {repeats} turns (ratios: median of each turn's)")
+print(f"bench_ab: {settings()}, {rounds} rounds of {calls} calls; "
+      f"the mean over rounds of the fastest call, median of {repeats} turns "
+      "(ratios: the median of each turn's)")
 print(f"one thread alone: {alone:.1f} CPU ms")
 print(f"two one-thread processes side by side: {side:.1f} CPU ms each, {side_ratio:.3f}x alone "
       "(the machine's own contention)")
-print(f"two threads: {two:.1f} {turns[0][3]} ms, {two_ratio:.3f}x half of one thread alone "
+print(f"two threads: {two:.1f} wall ms, {two_ratio:.3f}x half of one thread alone "
       f"(the library's own share: about {two_ratio / side_ratio:.3f}x)")
 PY
