@@ -34,15 +34,7 @@ import statistics
 import sys
 
 sys.path.insert(0, sys.argv[4])
-from bench_stats import quartiles  # noqa: E402  (scripts/bench_stats.py)
-
-
-def settings(path):
-    """bench_ab's first line up to its ';': size, directions x steps, blur,
-    half resolution, back faces and background where set, radius and
-    threads."""
-    with open(path, encoding="utf-8") as lines:
-        return next(lines, "").split(";")[0].strip()
+from bench_stats import bench_ab_settings, quartiles  # noqa: E402  (scripts/bench_stats.py)
 
 
 def ratios(path):
@@ -57,7 +49,7 @@ def ratios(path):
     return [b / a for a, b in zip(first, second)]
 
 
-print(f"bench_ab: {settings(sys.argv[1])}")
+print(f"bench_ab: {bench_ab_settings(open(sys.argv[1], encoding='utf-8').read())}")
 forward_rounds = ratios(sys.argv[1])
 reverse_rounds = [1.0 / ratio for ratio in ratios(sys.argv[2])]
 forward = statistics.median(forward_rounds)

@@ -32,13 +32,14 @@ pass through; --radius is the script's own (its stages run sets it).
 Needs build/bench_ab: cmake --build build --target bench_ab (a build
 configured with -DHBAO_BUILD_BENCHMARKS=ON, the default)."""
 import argparse
-import re
 import shutil
 import statistics
 import subprocess
 import sys
 import tempfile
 from pathlib import Path
+
+from bench_stats import bench_ab_result  # scripts/bench_stats.py, beside this script
 
 REPO = Path(__file__).resolve().parent.parent
 BENCH = REPO / "build" / "bench_ab"
@@ -61,9 +62,6 @@ VARIANTS = {
     "no_step_loop_no_prefetch": [(KERNEL, TANGENT_TEST, NO_STEP_LOOP)]
     + [(path, PREFETCH_ON, PREFETCH_OFF) for path in PREFETCH_FILES],
 }
-
-RESULT = re.compile(r"fastest / lower quartile: before ([0-9.]+) / [0-9.]+, "
-                    r"after ([0-9.]+) / [0-9.]+ (CPU|wall) ms; after / before ([0-9.]+) /")
 
 
 def patched_copy(work, name, patches):
@@ -103,10 +101,11 @@ def paired(before, after, rounds, options):
     wall on more) and its after / before ratio."""
     out = subprocess.run([str(BENCH), str(before), str(after), "--rounds", str(rounds)]
                          + options, capture_output=True, text=True, check=True).stdout
-    found = RESULT.search(out)
+    found = bench_ab_result(out)
     if found is None:
         sys.exit("bench_search_parts.py: bench_ab printed no result:\n" + out)
-    return float(found.group(1)), found.group(3), float(found.group(4))
+    before_ms, _, unit, ratio = found
+    return before_ms, unit, ratio
 
 
 def main():

@@ -73,35 +73,29 @@ measure() {
     one_run "$work/$n.two" 2 "$@" || { cat "$work/$n.two" >&2; exit 1; }
 }
 for ((n = 1; n <= repeats; n++)); do measure "$n" "$@"; done
-python3 - "$work" "$repeats" "$rounds" "$calls" <<'PY'
-import re
+python3 - "$work" "$repeats" "$rounds" "$calls" "$REPO/scripts" <<'PY'
 import sys
 from pathlib import Path
 from statistics import median
+
+sys.path.insert(0, sys.argv[5])
+from bench_stats import bench_ab_result, bench_ab_settings  # noqa: E402  (scripts/bench_stats.py)
 
 work, repeats = Path(sys.argv[1]), int(sys.argv[2])
 rounds, calls = sys.argv[3], sys.argv[4]
 
 
 def fastest(name, unit):
-    """The mean over rounds of both builds' fastest calls (they are one
-    library), in `unit` ms ("CPU" on one thread, "wall" on two)."""
+    """The mean of both builds' fastest calls (they are one library), in
+    `unit` ms ("CPU" on one thread, "wall" on two)."""
     text = (work / name).read_text()
-    match = re.search(r"fastest / lower quartile: before ([0-9.]+) / [0-9.]+, "
-                      r"after ([0-9.]+) / [0-9.]+ (CPU|wall) ms", text)
-    if match is None or match.group(3) != unit:
+    found = bench_ab_result(text)
+    if found is None or found[2] != unit:
         sys.exit(f"bench_threads.sh: no {unit} time in bench_ab's output:\n{text}")
-    value = (float(match.group(1)) + float(match.group(2))) / 2.0
+    value = (found[0] + found[1]) / 2.0
     if value <= 0.0:
         sys.exit(f"bench_threads.sh: bench_ab timed {name} at 0.0 ms: give a larger --size")
     return value
-
-
-def settings():
-    """bench_ab's first line up to its ';' (size, directions x steps, blur
-    and the other options it was given), without its thread count."""
-    line = (work / "1.alone").read_text().split("\n")[0].split(";")[0].strip()
-    return ", ".join(item for item in line.split(", ") if not item.endswith("thread(s)"))
 
 
 turns = []
@@ -114,7 +108,10 @@ side = median(s for t in turns for s in t[1])
 two = median(t[2] for t in turns)
 side_ratio = median(s / t[0] for t in turns for s in t[1])
 two_ratio = median(t[2] / (t[0] / 2.0) for t in turns)
-print(f"bench_ab: {settings()}, {rounds} rounds of {calls} calls; "
+# the settings without bench_ab's thread count: this script sets it per case
+settings = ", ".join(item for item in bench_ab_settings((work / "1.alone").read_text()).split(", ")
+                     if not item.endswith("thread(s)"))
+print(f"bench_ab: {settings}, {rounds} rounds of {calls} calls; "
       f"the mean over rounds of the fastest call, median of {repeats} turns "
       "(ratios: the median of each turn's)")
 print(f"one thread alone: {alone:.1f} CPU ms")
