@@ -39,22 +39,31 @@ def pareto_front(points):
     return front
 
 
-def monte_carlo_scale(series):
-    """a in rmse = a / sqrt(samples), fitted in log space to the Cycles series
-    [(samples, seconds, rmse), ...] (every point weighs the same)."""
-    samples = np.array([s for s, _, _ in series], np.float64)
-    rmse = np.array([e for _, _, e in series], np.float64)
-    return math.exp(float(np.mean(np.log(rmse) + 0.5 * np.log(samples))))
+def samples_for_rmse(points, target_rmse):
+    """The sample count at which Cycles reaches target_rmse, from its measured
+    [(samples, rmse), ...]: on the straight line in log RMSE against log
+    samples through the two counts that bracket it (the last two where none
+    reaches it; 1 where one sample does). At a few samples Cycles' error falls
+    faster than a / sqrt(N) (its sampling is stratified: RMSE x sqrt(N) falls
+    by about two fifths from 1 to 8 samples in the quick benchmark's scenes), so one a
+    fitted to the whole series would put the count too low or too high."""
+    points = sorted(points)
+    if target_rmse >= points[0][1]:
+        return 1.0
+    more = next((k for k, (_, rmse) in enumerate(points) if rmse <= target_rmse),
+                len(points) - 1)
+    (fewer_samples, high), (more_samples, low) = points[more - 1], points[more]
+    slope = math.log(high / low) / math.log(more_samples / fewer_samples)
+    return max(1.0, fewer_samples * math.exp(math.log(high / target_rmse) / slope))
 
 
 def cycles_time_for_rmse(series, target_rmse):
     """Seconds Cycles needs to reach target_rmse, from its measured series
-    [(samples, seconds, rmse), ...]: Monte Carlo error falls as a / sqrt(N) and
-    the time grows as t0 + c N, both fitted by least squares. Returns
-    (samples, seconds); samples below 1 are clamped to 1 (one sample is the
-    least a render takes)."""
+    [(samples, seconds, rmse), ...]: the sample count by samples_for_rmse, the
+    time at it on t0 + c N fitted by least squares. Returns (samples,
+    seconds)."""
     samples = np.array([s for s, _, _ in series], np.float64)
     seconds = np.array([t for _, t, _ in series], np.float64)
-    needed = max(1.0, (monte_carlo_scale(series) / target_rmse) ** 2)
+    needed = samples_for_rmse([(s, e) for s, _, e in series], target_rmse)
     slope, intercept = np.polyfit(samples, seconds, 1)
     return needed, float(max(intercept + slope * needed, seconds.min()))
