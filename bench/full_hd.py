@@ -6,24 +6,23 @@ a Cycles AO render with as many samples as reach the same RMSE.
     /usr/bin/python3 bench/full_hd.py     (after scripts/benchmark.sh --quick)
 
 The ground truth is made as the quick benchmark's is at 480x270: Cycles' AO
-pass at REFERENCE_SAMPLES samples (seed 0), with its Depth and Normal, which
-HBAO is given. Cycles renders at 1, 2, 4, ... samples (seed 1) until one
-reaches HBAO's RMSE against it, and the equal-error count is read between
-the last two by a straight line in log RMSE against log samples: at these
-counts Cycles' error falls faster than 1 / sqrt(samples) (its sampling is
-stratified), so a / sqrt(samples) fitted to a few counts would put the
-count too high. A render at that count rounded up is timed and its own
-RMSE reported. Cycles' time is its whole bpy.ops.render.render() with only
-the AO pass (2 threads), fitted linear in samples through all its renders
-and read at the exact count; HBAO's is compute_ao alone (2 threads, median
-of HBAO_RUNS).
+pass at as many samples (seed 0), with its Depth and Normal, which HBAO is
+given. Cycles' equal-error count N is the least whole count whose render
+(seed 1) reaches HBAO's RMSE against it: renders at 1, 2, 4, ... samples
+until one reaches it, then at each count after the power of 2 before, in
+turn (bench/metrics.py, equal_error_count). Cycles' error falls unevenly
+at these counts (powers of 2 do best), so a count read between powers of
+2 alone would be too low. The fraction within N - 1 to N is
+read log-log linear, and Cycles' time is its whole bpy.ops.render.render()
+with only the AO pass (2 threads), fitted linear in samples through all
+its renders and read at that count; HBAO's is compute_ao alone (2
+threads, median of HBAO_RUNS).
 
 Two rows a scene: the library's defaults, and the scene's most efficient
 setting: of the quick benchmark's CANDIDATES settings with the least
-RMSE^2 x time at 480x270, the one with the least at 1080p (Cycles' time
-grows as 1 / RMSE^2, so that setting is the one Cycles is the most times
-slower than). Writes docs/benchmark-1080p.md. The renders are cached with
-the quick benchmark's (.cache/bench/renders/).
+RMSE^2 x time at 480x270, the one at which Cycles takes the most times
+HBAO's time at 1080p (chosen per scene). Writes docs/benchmark-1080p.md.
+The renders are cached with the quick benchmark's (.cache/bench/renders/).
 """
 import json
 import math
@@ -35,6 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
+import config
 import metrics
 import run_benchmark
 import sweep
@@ -43,8 +43,8 @@ from report import SHIPPED_DEFAULT
 WIDTH, HEIGHT = 1920, 1080
 THREADS = 2
 HBAO_RUNS = 5
-REFERENCE_SAMPLES = 256  # the quick benchmark's (config.QUICK)
-MOST_SAMPLES = 64  # a quarter of the ground truth's: beyond, its own noise counts
+REFERENCE_SAMPLES = config.QUICK.reference_samples
+MOST_SAMPLES = REFERENCE_SAMPLES // 4  # beyond, the ground truth's own noise counts
 CANDIDATES = 5
 GOAL = 100.0  # issue 11: HBAO at least this many times faster at equal error
 
@@ -70,13 +70,13 @@ class Scene:
         self.cycles = {}  # samples -> (seconds, RMSE)
 
     def render(self, job):
-        path = self.renders / job["id"]
-        if not path.with_suffix(".npz").exists():
+        meta = self.renders / f"{job['id']}.json"  # render_jobs.py writes it last
+        if not meta.exists():
             run_benchmark.render_scene(self.name, {job["id"]: job}, self.renders, self.env,
                                        self.bunny_json)
-        with np.load(path.with_suffix(".npz")) as data:
+        with np.load(self.renders / f"{job['id']}.npz") as data:
             arrays = {key: data[key] for key in data.files}
-        arrays["meta"] = json.loads(path.with_suffix(".json").read_text())
+        arrays["meta"] = json.loads(meta.read_text())
         return arrays
 
     def rmse(self, ao):
@@ -89,16 +89,11 @@ class Scene:
         return self.cycles[samples]
 
     def samples_for(self, rmse):
-        """The Cycles sample count of RMSE `rmse`: between the powers of 2 whose
-        renders bracket it, log-log linear."""
-        fewer, more = None, 1
-        while self.cycles_at(more)[1] > rmse:
-            if more >= MOST_SAMPLES:
-                sys.exit(f"{self.name}: Cycles at {more} samples does not reach RMSE {rmse:.4f}")
-            fewer, more = more, 2 * more
-        if fewer is None:
-            return 1.0
-        return metrics.samples_for_rmse([(n, self.cycles_at(n)[1]) for n in (fewer, more)], rmse)
+        """metrics.equal_error_count of Cycles' renders for RMSE `rmse`."""
+        try:
+            return metrics.equal_error_count(lambda n: self.cycles_at(n)[1], rmse, MOST_SAMPLES)
+        except ValueError as error:
+            sys.exit(f"{self.name}: {error}")
 
     def hbao(self, setting, native):
         """(RMSE, seconds) of HBAO at `setting`."""
@@ -111,29 +106,25 @@ def measure(scene, entry, native):
     """One row: HBAO at the quick sweep entry's setting against Cycles at its
     1080p RMSE."""
     rmse, hbao_seconds = scene.hbao(entry["setting"], native)
-    needed = scene.samples_for(rmse)
-    _, cycles_rmse = scene.cycles_at(math.ceil(needed))
+    needed, whole = scene.samples_for(rmse)
+    _, cycles_rmse = scene.cycles_at(whole)
     points = sorted((s, t) for s, (t, _) in scene.cycles.items())
-    slope, intercept = np.polyfit([s for s, _ in points], [t for _, t in points], 1)
-    cycles_seconds = float(intercept + slope * needed)
+    cycles_seconds = metrics.cycles_seconds_at(points, needed)
     print(f"{scene.name} {entry['key']}: HBAO RMSE {rmse:.4f} in {hbao_seconds * 1000:.1f} ms; "
           f"Cycles {needed:.1f} samples {cycles_seconds:.2f} s: "
           f"{cycles_seconds / hbao_seconds:.0f}x", flush=True)
     return {"scene": scene.name, "key": entry["key"], "quick_rmse": entry["rmse"], "rmse": rmse,
-            "samples": needed, "cycles_rmse": cycles_rmse, "cycles_samples": math.ceil(needed),
+            "samples": needed, "cycles_rmse": cycles_rmse, "cycles_samples": whole,
             "cycles_points": points, "cycles_seconds": cycles_seconds,
             "hbao_seconds": hbao_seconds, "ratio": cycles_seconds / hbao_seconds}
 
 
 def most_efficient(scene, entries, native):
-    """The quick sweep entry of the least RMSE^2 x time at 1080p, among the
-    CANDIDATES of the least at 480x270."""
+    """The row of the largest Cycles / HBAO ratio at 1080p among the quick
+    sweep's CANDIDATES entries of the least RMSE^2 x time at 480x270."""
     candidates = sorted(entries, key=lambda e: e["rmse"] ** 2 * e["seconds"])[:CANDIDATES]
-
-    def cost(entry):
-        rmse, seconds = scene.hbao(entry["setting"], native)
-        return rmse * rmse * seconds
-    return min(candidates, key=cost)
+    return max((measure(scene, entry, native) for entry in candidates),
+               key=lambda row: row["ratio"])
 
 
 def main():
@@ -156,7 +147,7 @@ def main():
         scene = Scene(name, renders_root / name, env, cache / "bunny.json")
         entry = next(e for e in result["sweep"] if e["key"] == default_key)
         defaults.append(measure(scene, entry, native))
-        efficient.append(measure(scene, most_efficient(scene, result["sweep"], native), native))
+        efficient.append(most_efficient(scene, result["sweep"], native))
         series[name] = sorted((s, rmse) for s, (_, rmse) in scene.cycles.items())
     write_report(repo / "docs" / "benchmark-1080p.md", defaults, efficient, series, setting,
                  default_key, time.perf_counter() - started)
@@ -165,8 +156,9 @@ def main():
 def table(rows, with_setting):
     """The rows as a Markdown table (with each row's setting where they differ)."""
     setting_head, setting_rule = ("setting | ", "---|") if with_setting else ("", "")
-    lines = [f"| scene | {setting_head}HBAO RMSE (480x270) | Cycles samples for it | "
-             "Cycles RMSE there | Cycles s (measured: samples, s) | HBAO ms | Cycles / HBAO | "
+    lines = [f"| scene | {setting_head}HBAO RMSE (at 480x270) | Cycles samples for it | "
+             "Cycles RMSE at the whole count | Cycles s (measured: samples, s) | HBAO ms | "
+             "Cycles / HBAO | "
              f"goal {GOAL:.0f}x |",
              f"|---|{setting_rule}---:|---:|---:|---|---:|---:|---|"]
     for row in rows:
@@ -190,23 +182,24 @@ def write_report(path, defaults, efficient, series, setting, key, wall_s):
         f"HBAO with each scene's radius against a Cycles AO render with as many samples as give "
         f"the same RMSE against a 1080p ground truth: Cycles' AO at {REFERENCE_SAMPLES} samples "
         "(seed 0), whose Depth and Normal HBAO is given, as the quick benchmark's at 480x270 "
-        "(docs/benchmark.md; its RMSE in brackets). Cycles renders at 1, 2, 4, ... samples "
-        "(seed 1) until one reaches HBAO's RMSE, and the equal-error count is read between the "
-        "last two on a straight line in log RMSE against log samples; a render at that count "
-        "rounded up shows the RMSE Cycles reaches there. At these counts Cycles' error falls "
-        "faster than 1 / sqrt(samples) (its sampling is stratified: below), so a / sqrt(samples) "
-        "fitted to a few counts would ask too many samples of it. "
-        "Cycles: the whole `bpy.ops.render.render()` with only "
-        "the AO pass, 2 threads, its time fitted linear in samples through all its renders and "
-        f"read at the exact count. HBAO: `compute_ao`, 2 threads, median of {HBAO_RUNS}, "
-        "without the add-on's pass hand-over (docs/speed.md and docs/benchmark.md give it).", "",
+        "(docs/benchmark.md; its RMSE in brackets). Cycles' equal-error count: the least whole "
+        "count N whose render (seed 1) reaches HBAO's RMSE, found from renders at 1, 2, 4, ... "
+        "samples until one reaches it, then at each count after the power of 2 before; the "
+        "fraction within N - 1 to N read on a straight line in log RMSE against log samples. "
+        "Cycles' error falls faster than 1 / sqrt(samples) at these counts, and unevenly, "
+        "powers of 2 doing best (the series below), so neither a / sqrt(samples) fitted to a "
+        "few counts nor a reading between powers of 2 would do. "
+        "Cycles: the whole `bpy.ops.render.render()` with only the AO pass, 2 threads, its "
+        "time fitted linear in samples through all its renders and read at the count. HBAO: "
+        f"`compute_ao`, 2 threads, median of {HBAO_RUNS}, without the add-on's pass hand-over "
+        "(docs/speed.md and docs/benchmark.md give it).", "",
         f"## The library's defaults ({key})", ""]
     lines += table(defaults, False)
     lines += [
         "", "## Each scene's most efficient setting", "",
-        f"The setting with the least RMSE² x time at 1080p among the {CANDIDATES} with the "
-        "least at 480x270 in the quick benchmark's sweep: Cycles' time grows as 1 / RMSE², so "
-        "it is the setting that Cycles is the most times slower than at equal error.", ""]
+        f"Of the {CANDIDATES} settings with the least RMSE² x time at 480x270 in the quick "
+        "benchmark's sweep, the one at which Cycles takes the most times HBAO's time here, "
+        "chosen for each scene on its own.", ""]
     lines += table(efficient, True)
     lines += ["", "Cycles' RMSE against the ground truth (samples: RMSE, RMSE x sqrt(samples)):",
               ""]

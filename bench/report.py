@@ -314,8 +314,9 @@ def write(results, images, native, docs):
               f"Per scene: the fastest swept setting within RMSE {config.RMSE_TARGET} of the "
               "ground truth, the Cycles render time for the same RMSE (its sample count "
               "read between the two measured counts that bracket the RMSE, on a straight "
-              "line in log RMSE against log samples; its time linear in samples) and the "
-              "ratio; then the "
+              "line in log RMSE against log samples: powers of 2, at which Cycles' sampling "
+              "does best, so the count is if anything too low; its time linear in samples) "
+              "and the ratio; then the "
               "recommended default's and EEVEE's errors.", "",
               "| scene | fastest setting within target | HBAO ms | RMSE | Cycles samples | "
               "Cycles ms | Cycles / HBAO | recommended: RMSE (ms) | Cycles ms for it | "
