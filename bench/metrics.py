@@ -98,11 +98,3 @@ def cycles_seconds_at(series, samples):
     seconds = np.array([t for _, t in series], np.float64)
     slope, intercept = np.polyfit(counts, seconds, 1)
     return float(max(intercept + slope * samples, seconds.min()))
-
-
-def cycles_time_for_rmse(series, target_rmse):
-    """Seconds Cycles needs to reach target_rmse, from its measured series
-    [(samples, seconds, rmse), ...]: the sample count by samples_for_rmse, the
-    time at it by cycles_seconds_at. Returns (samples, seconds)."""
-    needed = samples_for_rmse([(s, e) for s, _, e in series], target_rmse)
-    return needed, cycles_seconds_at([(s, t) for s, t, _ in series], needed)

@@ -57,17 +57,23 @@ def recommend(results):
             "seconds": {s["scene"]: t[key]["seconds"] for s, t in zip(scenes, tables)}}
 
 
-def headline(scene_result):
-    """The fastest setting within RMSE_TARGET, Cycles' time for its RMSE."""
+def headline_entry(scene_result):
+    """(entry, reached): the fastest swept setting within RMSE_TARGET, or
+    the most accurate where none is."""
     within = [e for e in scene_result["sweep"] if e["rmse"] <= config.RMSE_TARGET]
-    row = {"scene": scene_result["scene"], "reached": bool(within)}
     entry = (min(within, key=lambda e: e["seconds"]) if within
              else min(scene_result["sweep"], key=lambda e: e["rmse"]))
-    series = [(c["samples"], c["seconds"], c["rmse"]) for c in scene_result["cycles"]]
-    samples, seconds = metrics.cycles_time_for_rmse(series, entry["rmse"])
-    row.update(entry=entry, cycles_samples=samples, cycles_seconds=seconds,
-               ratio=seconds / entry["seconds"])
-    return row
+    return entry, bool(within)
+
+
+def headline(scene_result):
+    """The headline entry, and Cycles' time for its RMSE (run_benchmark.py,
+    equal_error)."""
+    entry, reached = headline_entry(scene_result)
+    cycles = scene_result["equal_error"][entry["key"]]
+    return {"scene": scene_result["scene"], "reached": reached, "entry": entry,
+            "cycles_samples": cycles["samples"], "cycles_seconds": cycles["seconds"],
+            "ratio": cycles["seconds"] / entry["seconds"]}
 
 
 def _ms(seconds):
@@ -312,25 +318,22 @@ def write(results, images, native, docs):
 
     lines += ["## Headline", "",
               f"Per scene: the fastest swept setting within RMSE {config.RMSE_TARGET} of the "
-              "ground truth, the Cycles render time for the same RMSE (its sample count "
-              "read between the two measured counts that bracket the RMSE, on a straight "
-              "line in log RMSE against log samples: powers of 2, at which Cycles' sampling "
-              "does best, so the count is if anything too low; its time linear in samples) "
+              "ground truth, the Cycles render time for the same RMSE (its sample count: "
+              "the least whole count whose render reaches the RMSE, the fraction within it "
+              "read log-log, as docs/benchmark-1080p.md says; its time linear in samples) "
               "and the ratio; then the "
               "recommended default's and EEVEE's errors.", "",
               "| scene | fastest setting within target | HBAO ms | RMSE | Cycles samples | "
               "Cycles ms | Cycles / HBAO | recommended: RMSE (ms) | Cycles ms for it | "
               "EEVEE RMSE | recommended / EEVEE RMSE without border |",
               "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
-    headlines = {}
     for s in scenes:
         h = headline(s)
-        headlines[s["scene"]] = h
         e = h["entry"]
         name = e["key"] if h["reached"] else f"none; best: {e['key']}"
         rec_entry = _by_key(s)[recommended["key"]]
-        series = [(c["samples"], c["seconds"], c["rmse"]) for c in s["cycles"]]
-        rec_samples, rec_cycles = metrics.cycles_time_for_rmse(series, rec_entry["rmse"])
+        rec_samples = s["equal_error"][recommended["key"]]["samples"]
+        rec_cycles = s["equal_error"][recommended["key"]]["seconds"]
         lines.append(f"| {s['scene']} | {name} | {_ms(e['seconds'])} | {_fmt(e['rmse'])} | "
                      f"{h['cycles_samples']:.1f} | {_ms(h['cycles_seconds'])} | "
                      f"{h['ratio']:.0f}x | {_fmt(rec_entry['rmse'])} "

@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 import config
+import metrics
 import report
 import sweep
 from hbao import timing_line  # sweep puts the add-on on sys.path
@@ -63,6 +64,15 @@ def run_blender(script, args, env, addon=False):
     return completed.stdout
 
 
+def cycles_job(mode, samples):
+    """Cycles' AO pass at `samples` samples (seed 1, the reference's is 0),
+    timed over mode.cycles_repeats renders below mode.cycles_repeat_below."""
+    repeats = mode.cycles_repeats if samples < mode.cycles_repeat_below else 1
+    return {"id": f"cycles-{mode.width}x{mode.height}-s{samples}-seed1-r{repeats}",
+            "width": mode.width, "height": mode.height, "threads": 2, "engine": "CYCLES",
+            "samples": samples, "seed": 1, "passes": ["ao"], "repeats": repeats}
+
+
 def accuracy_jobs(mode):
     """name -> job for one scene: the reference with its passes, the Cycles
     series (another seed), EEVEE's GTAO."""
@@ -72,15 +82,36 @@ def accuracy_jobs(mode):
                               samples=mode.reference_samples, seed=0,
                               passes=["depth", "normal", "ao"], repeats=1)}
     for samples in mode.cycles_series:
-        repeats = mode.cycles_repeats if samples < mode.cycles_repeat_below else 1
-        jobs[f"cycles{samples}"] = dict(size, id=f"cycles-{mode.width}x{mode.height}-"
-                                        f"s{samples}-seed1-r{repeats}", engine="CYCLES",
-                                        samples=samples, seed=1, passes=["ao"],
-                                        repeats=repeats)
+        jobs[f"cycles{samples}"] = cycles_job(mode, samples)
     jobs["eevee"] = dict(size, id=f"eevee-{mode.width}x{mode.height}-s{mode.eevee_samples}",
                          engine="BLENDER_EEVEE", samples=mode.eevee_samples, passes=["ao"],
                          repeats=1)
     return jobs
+
+
+def equal_error(data, result, keys, mode, renders, env, bunny_json):
+    """{key: Cycles' equal-error count and time} for the sweep entries `keys`
+    of one scene (metrics.equal_error_count over the Cycles series, rendering
+    the whole counts between its powers of 2 that the search asks for)."""
+    measured = {c["samples"]: (c["seconds"], c["rmse"]) for c in result["cycles"]}
+
+    def rmse_at(samples):
+        if samples not in measured:
+            job = cycles_job(mode, samples)
+            render_scene(data.scene, {job["id"]: job}, renders, env, bunny_json)
+            meta = json.loads((renders / f"{job['id']}.json").read_text())
+            with np.load(renders / f"{job['id']}.npz") as arrays:
+                error = metrics.error_stats(arrays["ao"], data.truth, data.mask)["rmse"]
+            measured[samples] = (meta["time_s"], error)
+        return measured[samples][1]
+
+    entries = {e["key"]: e for e in result["sweep"]}
+    counts = {key: metrics.equal_error_count(rmse_at, entries[key]["rmse"],
+                                             max(mode.cycles_series)) for key in keys}
+    times = sorted((n, t) for n, (t, _) in measured.items())  # every render, once all are made
+    return {key: {"samples": count, "whole": whole, "whole_rmse": measured[whole][1],
+                  "seconds": metrics.cycles_seconds_at(times, count)}
+            for key, (count, whole) in counts.items()}
 
 
 def timing_jobs():
@@ -204,6 +235,12 @@ def main():
 
     recommended = report.recommend(results)
     results["recommended"] = recommended
+    for scene in scenes:
+        result = results["scenes"][scene]
+        keys = {report.headline_entry(result)[0]["key"], recommended["key"]}
+        result["equal_error"] = equal_error(images[scene][0], result, keys, mode,
+                                            renders / scene, env, bunny_json)
+    log(f"equal-error counts done after {time.perf_counter() - started:.0f} s")
     timing_settings = {"recommended": recommended["setting"],
                        "shipped defaults": report.SHIPPED_DEFAULT,
                        "16x16 full": dict(report.SHIPPED_DEFAULT, directions=16, steps=16)}

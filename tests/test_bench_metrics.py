@@ -1,8 +1,9 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """bench/metrics.py's equal-error reading of a Cycles series (the 480x270
-and 1080p benchmarks' Cycles / HBAO ratios rest on it): the sample count
-for an RMSE, read log-log linear between the two measured counts that
-bracket it. Plain pytest, no Blender."""
+and 1080p benchmarks' Cycles / HBAO ratios rest on it): the least whole
+sample count whose render reaches an RMSE, the fraction read log-log
+linear between two measured counts, and Cycles' time there. Plain pytest,
+no Blender."""
 import math
 import sys
 
@@ -51,12 +52,11 @@ def test_the_series_may_come_in_any_order():
     assert metrics.samples_for_rmse(SERIES[::-1], power_law(6)) == pytest.approx(6, rel=1e-9)
 
 
-def test_cycles_time_is_read_at_that_count():
+def test_cycles_time_is_read_off_its_line_and_at_least_its_fastest_render():
     # seconds = 0.5 + 0.25 samples
-    series = [(n, 0.5 + 0.25 * n, rmse) for n, rmse in SERIES]
-    samples, seconds = metrics.cycles_time_for_rmse(series, power_law(6))
-    assert samples == pytest.approx(6, rel=1e-9)
-    assert seconds == pytest.approx(0.5 + 0.25 * 6, rel=1e-9)
+    series = [(n, 0.5 + 0.25 * n) for n, _ in SERIES]
+    assert metrics.cycles_seconds_at(series, 6.3) == pytest.approx(0.5 + 0.25 * 6.3)
+    assert metrics.cycles_seconds_at([(1, 1.0), (2, 1.1), (4, 1.3)], 0.0) == pytest.approx(1.0)
 
 
 def test_the_last_two_counts_extend_the_series_bent_or_not():
