@@ -66,14 +66,16 @@ def headline_entry(scene_result):
     return entry, bool(within)
 
 
-def headline(scene_result):
-    """The headline entry, and Cycles' time for its RMSE (run_benchmark.py,
-    equal_error)."""
-    entry, reached = headline_entry(scene_result)
-    cycles = scene_result["equal_error"][entry["key"]]
-    return {"scene": scene_result["scene"], "reached": reached, "entry": entry,
-            "cycles_samples": cycles["samples"], "cycles_seconds": cycles["seconds"],
-            "ratio": cycles["seconds"] / entry["seconds"]}
+def cycles_for(scene_result, key):
+    """(samples, ms, ratio) of Cycles at the RMSE of sweep entry `key`
+    (run_benchmark.py, equal_error), as the report's cells; "more than" the
+    series' most samples where they do not reach it."""
+    cycles = scene_result["equal_error"][key]
+    if cycles is None:
+        most = max(c["samples"] for c in scene_result["cycles"])
+        return f"> {most}", "–", "–"
+    ratio = cycles["seconds"] / _by_key(scene_result)[key]["seconds"]
+    return f"{cycles['samples']:.1f}", _ms(cycles["seconds"]), f"{ratio:.0f}x"
 
 
 def _ms(seconds):
@@ -319,26 +321,25 @@ def write(results, images, native, docs):
     lines += ["## Headline", "",
               f"Per scene: the fastest swept setting within RMSE {config.RMSE_TARGET} of the "
               "ground truth, the Cycles render time for the same RMSE (its sample count: "
-              "the least whole count whose render reaches the RMSE, the fraction within it "
-              "read log-log, as docs/benchmark-1080p.md says; its time linear in samples) "
-              "and the ratio; then the "
+              "the least whole count whose render reaches the RMSE, found in the series and "
+              "in renders at the whole counts between its powers of 2, the fraction within it "
+              "read log-log; its time linear in samples through every render) and the ratio; "
+              "then the "
               "recommended default's and EEVEE's errors.", "",
               "| scene | fastest setting within target | HBAO ms | RMSE | Cycles samples | "
               "Cycles ms | Cycles / HBAO | recommended: RMSE (ms) | Cycles ms for it | "
               "EEVEE RMSE | recommended / EEVEE RMSE without border |",
               "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for s in scenes:
-        h = headline(s)
-        e = h["entry"]
-        name = e["key"] if h["reached"] else f"none; best: {e['key']}"
+        e, reached = headline_entry(s)
+        name = e["key"] if reached else f"none; best: {e['key']}"
+        samples, cycles_ms, ratio = cycles_for(s, e["key"])
         rec_entry = _by_key(s)[recommended["key"]]
-        rec_samples = s["equal_error"][recommended["key"]]["samples"]
-        rec_cycles = s["equal_error"][recommended["key"]]["seconds"]
+        rec_samples, rec_ms, _ = cycles_for(s, recommended["key"])
         lines.append(f"| {s['scene']} | {name} | {_ms(e['seconds'])} | {_fmt(e['rmse'])} | "
-                     f"{h['cycles_samples']:.1f} | {_ms(h['cycles_seconds'])} | "
-                     f"{h['ratio']:.0f}x | {_fmt(rec_entry['rmse'])} "
-                     f"({_ms(rec_entry['seconds'])}) | {_ms(rec_cycles)} "
-                     f"({rec_samples:.1f} samples) | {_fmt(s['eevee']['rmse'])} | "
+                     f"{samples} | {cycles_ms} | {ratio} | {_fmt(rec_entry['rmse'])} "
+                     f"({_ms(rec_entry['seconds'])}) | {rec_ms} "
+                     f"({rec_samples} samples) | {_fmt(s['eevee']['rmse'])} | "
                      f"{_fmt(rec_entry['inner_rmse'])} / {_fmt(s['eevee']['inner_rmse'])} |")
     lines += ["", "Cycles' time includes its fixed cost per render (scene sync, BVH). "
               "HBAO's time excludes the pass hand-over of the add-on (see *The add-on's "
