@@ -32,8 +32,6 @@ import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
-
 import config
 import metrics
 import run_benchmark
@@ -70,14 +68,7 @@ class Scene:
         self.cycles = {}  # samples -> (seconds, RMSE)
 
     def render(self, job):
-        meta = self.renders / f"{job['id']}.json"  # render_jobs.py writes it last
-        if not meta.exists():
-            run_benchmark.render_scene(self.name, {job["id"]: job}, self.renders, self.env,
-                                       self.bunny_json)
-        with np.load(self.renders / f"{job['id']}.npz") as data:
-            arrays = {key: data[key] for key in data.files}
-        arrays["meta"] = json.loads(meta.read_text())
-        return arrays
+        return run_benchmark.rendered(self.name, job, self.renders, self.env, self.bunny_json)
 
     def rmse(self, ao):
         return metrics.error_stats(ao, self.truth, self.mask)["rmse"]

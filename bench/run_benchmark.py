@@ -104,12 +104,10 @@ def equal_error(data, result, keys, mode, renders, env, bunny_json):
 
     def rmse_at(samples):
         if samples not in measured:
-            job = cycles_job(mode, samples, mode.cycles_repeats)
-            render_scene(data.scene, {job["id"]: job}, renders, env, bunny_json)
-            meta = json.loads((renders / f"{job['id']}.json").read_text())
-            with np.load(renders / f"{job['id']}.npz") as arrays:
-                error = metrics.error_stats(arrays["ao"], data.truth, data.mask)["rmse"]
-            measured[samples] = (meta["time_s"], error)
+            render = rendered(data.scene, cycles_job(mode, samples, mode.cycles_repeats),
+                              renders, env, bunny_json)
+            error = metrics.error_stats(render["ao"], data.truth, data.mask)["rmse"]
+            measured[samples] = (render["meta"]["time_s"], error)
         return measured[samples][1]
 
     entries = {e["key"]: e for e in result["sweep"]}
@@ -157,6 +155,18 @@ def render_scene(scene, jobs, cache, env, bunny_json):
     for line in output.splitlines():
         if line.startswith("bench:"):
             log(f"{scene}: {line[7:]}")
+
+
+def rendered(scene, job, cache, env, bunny_json):
+    """A job's arrays and its meta (arrays["meta"]), rendered first where the
+    cache lacks it (the .json, which render_jobs.py writes last)."""
+    meta = cache / f"{job['id']}.json"
+    if not meta.exists():
+        render_scene(scene, {job["id"]: job}, cache, env, bunny_json)
+    with np.load(cache / f"{job['id']}.npz") as data:
+        arrays = {key: data[key] for key in data.files}
+    arrays["meta"] = json.loads(meta.read_text())
+    return arrays
 
 
 def resolution_timings(native, cache, mode, settings):
