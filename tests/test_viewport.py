@@ -119,6 +119,8 @@ _LIBRARY_CONSTANTS = [
      "HBAO_BLOCK_PIXELS"),
     ("BLOCK_DEPTH_RATIO", shader_sources.AO_DEFINES["BLOCK_DEPTH_RATIO"], "internal_hbao.h",
      "HBAO_BLOCK_DEPTH_RATIO"),
+    ("BEYOND_BAND_DIVISOR", shader_sources.AO_DEFINES["BEYOND_BAND_DIVISOR"], "internal_hbao.h",
+     "HBAO_BEYOND_BAND_DIVISOR"),
     ("NORMAL_SHARPNESS", shader_sources.BLUR_DEFINES["NORMAL_SHARPNESS"], "internal_finish.h",
      "HBAO_BLUR_NORMAL_SHARPNESS"),
     ("FALLOFF_REACH", shader_sources.FALLOFF_DEFINES["FALLOFF_REACH"], "internal_finish.h",

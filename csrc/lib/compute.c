@@ -219,9 +219,10 @@ hbao_result hbao_compute_layers(const hbao_params *params, const hbao_camera *ca
     float *grid_ao = hbao_scratch_take(grid_pixels * sizeof(float));
     float *grid_back = back_depth != NULL ? hbao_scratch_take(grid_pixels * sizeof(float)) : NULL;
     grid.normal = hbao_scratch_take((grid_pixels * 3 + HBAO_NORMAL_PADDING) * sizeof(float));
+    grid.beyond = hbao_scratch_take(hbao_beyond_floats(grid.width, grid.height) * sizeof(float));
     grid.depth = grid_depth;
     grid.back = grid_back;
-    if (grid_depth == NULL || grid_ao == NULL || grid.normal == NULL ||
+    if (grid_depth == NULL || grid_ao == NULL || grid.normal == NULL || grid.beyond == NULL ||
         (back_depth != NULL && grid_back == NULL)) {
         result = HBAO_ERROR_OUT_OF_MEMORY;
         goto done;
@@ -256,6 +257,7 @@ hbao_result hbao_compute_layers(const hbao_params *params, const hbao_camera *ca
      * hbao_compute()'s, exactly, not its sector-quantised twin. */
     if (grid.back != NULL && !any_finite(grid.back, grid_pixels)) grid.back = NULL;
     hbao_compute_normals(&s, camera, &grid, normal, scale);
+    hbao_beyond_planes(&grid);
 
     last_notes = hbao_compute_horizons(&s, &grid, grid_ao);
     result = hbao_finish(&s, &grid, grid_ao, &guide, width, height, ao, ao_row_stride);
@@ -266,5 +268,6 @@ done:
     hbao_scratch_give(grid_ao);
     hbao_scratch_give(grid_back);
     hbao_scratch_give(grid.normal);
+    hbao_scratch_give(grid.beyond);
     return result;
 }

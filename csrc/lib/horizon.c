@@ -41,20 +41,35 @@ typedef struct march {
 
 enum { SAMPLE_END = -1, SAMPLE_SKIP = 0, SAMPLE_OK = 1, SAMPLE_FAR = 2 };
 
+/* A step's sample: its grid pixel (outside the image past its edges), its
+ * depth and its back depth (INFINITY: unknown, as beyond the image). */
+typedef struct sample_point {
+    int si, sj;
+    float zs, zb;
+} sample_point;
+
 /* The vector to the sample of a step and its squared length; *at receives
- * the sample's index in the grid, and *height (where not NULL) the sample's
- * height above the tangent plane (hbao_sample_height). */
-static inline int march_sample(const march *m, int step, float delta[3], float *dist2, size_t *at,
-                               float *height) {
+ * the sample (sample_point), and *height (where not NULL) the sample's
+ * height above the tangent plane (hbao_sample_height). A sample outside the
+ * image has the depth of hbao_beyond_depth. */
+static inline int march_sample(const march *m, int step, float delta[3], float *dist2,
+                               sample_point *at, float *height) {
     const hbao_grid *g = m->grid;
     int ox, oy;
     if (!hbao_step_offset(g, m->dc, m->ds, m->inv_ycor, m->jitter, m->step_px, step, &ox, &oy))
         return SAMPLE_END;
     const int si = m->i + ox, sj = m->j + oy;
-    if (si < 0 || sj < 0 || si >= g->width || sj >= g->height) return SAMPLE_END;
+    const int band = g->beyond_band;
+    if (si < -band || sj < -band || si >= g->width + band || sj >= g->height + band)
+        return SAMPLE_END;
     if (ox == 0 && oy == 0) return SAMPLE_SKIP;
-    *at = (size_t)sj * g->width + si;
-    const float zs = g->depth[*at];
+    const int inside = si >= 0 && sj >= 0 && si < g->width && sj < g->height;
+    const size_t index = inside ? (size_t)sj * g->width + si : 0;
+    const float zs = inside ? g->depth[index] : hbao_beyond_depth(g, si, sj);
+    at->si = si;
+    at->sj = sj;
+    at->zs = zs;
+    at->zb = g->back != NULL && inside ? g->back[index] : INFINITY;
     if (zs <= 0.0f || zs < m->near_limit) return SAMPLE_SKIP;
     if (height != NULL)
         *height = hbao_sample_height(g, &m->height, zs, (float)ox, hbao_grid_y(g, sj));
@@ -137,7 +152,7 @@ static float direction_occlusion_hbao(const hbao_settings *s, const march *m, co
     float occlusion = 0.0f;
     for (int step = 0; step < s->steps; step++) {
         float delta[3], dist2;
-        size_t at;
+        sample_point at;
         float height;
         const int status = march_sample(m, step, delta, &dist2, &at, &height);
         if (status == SAMPLE_END) break;
@@ -228,7 +243,7 @@ static float direction_occlusion_cosine(const hbao_settings *s, const march *m, 
 
     for (int step = 0; step < s->steps; step++) {
         float delta[3], dist2;
-        size_t at;
+        sample_point at;
         float height;
         const int status = march_sample(m, step, delta, &dist2, &at, &height);
         if (status == SAMPLE_END) break;
@@ -329,14 +344,14 @@ static inline float sector_fraction_cosine(const march *m, const slice *sl, cons
 }
 
 /* A sample's back point, where its back face is known: the view ray
- * through the sample's pixel (grid index at) at its back depth, as a vector
- * from the pixel and its squared length. Returns 0 where unknown. */
-static inline int back_point(const march *m, size_t at, float delta[3], float *dist2) {
+ * through the sample's pixel at its back depth, as a vector from the pixel
+ * and its squared length. Returns 0 where unknown. */
+static inline int back_point(const march *m, const sample_point *at, float delta[3],
+                             float *dist2) {
     const hbao_grid *g = m->grid;
-    if (!(g->back[at] < INFINITY)) return 0;
+    if (!(at->zb < INFINITY)) return 0;
     float q[3];
-    hbao_grid_position(g, (int)(at % (size_t)g->width), (int)(at / (size_t)g->width),
-                       hbao_back_depth(g, at, m->min_thickness), q);
+    hbao_grid_position(g, at->si, at->sj, hbao_back_depth(at->zs, at->zb, m->min_thickness), q);
     delta[0] = q[0] - m->p[0];
     delta[1] = q[1] - m->p[1];
     delta[2] = q[2] - m->p[2];
@@ -352,7 +367,8 @@ static inline int back_point(const march *m, size_t at, float delta[3], float *d
  * length, about radius^2). Returns 0 where it does not enter before the back
  * depth. (Without the layer a sample beyond the radius is ignored, as
  * before: the layer is what tells a thin object from a solid one.) */
-static inline int enter_the_ball(const march *m, size_t at, float delta[3], float *dist2) {
+static inline int enter_the_ball(const march *m, const sample_point *at, float delta[3],
+                                 float *dist2) {
     const hbao_grid *g = m->grid;
     const float q[3] = {delta[0] + m->p[0], delta[1] + m->p[1], delta[2] + m->p[2]};
     float d[3] = {0.0f, 0.0f, -1.0f};
@@ -364,7 +380,7 @@ static inline int enter_the_ball(const march *m, size_t at, float delta[3], floa
     const float disc = b * b - (*dist2 - m->radius2);
     if (!(b < 0.0f) || !(disc >= 0.0f)) return 0;
     const float t = -b - sqrtf(disc);
-    if (!(-(q[2] + t * d[2]) <= g->back[at])) return 0;
+    if (!(-(q[2] + t * d[2]) <= at->zb)) return 0;
     for (int c = 0; c < 3; c++) delta[c] += t * d[c];
     *dist2 = delta[0] * delta[0] + delta[1] * delta[1] + delta[2] * delta[2];
     return *dist2 > 0.0f;
@@ -379,14 +395,15 @@ static inline int enter_the_ball(const march *m, size_t at, float delta[3], floa
  * depth behind, so the height must not rise with depth. Not where V lies
  * below the plane (a sample below it can then count, as in the one-layer
  * search). The SIMD kernels leave the same samples out, lane by lane. */
-static inline int layer_sample_below(const march *m, size_t at, int ox, int sj) {
+static inline int layer_sample_below(const march *m, const sample_point *at) {
     const hbao_grid *g = m->grid;
     if (m->n_dot_v < 0.0f) return 0;
-    const float across = hbao_height_across(&m->height, (float)ox, hbao_grid_y(g, sj));
-    if (!(hbao_height_at(g, &m->height, across, g->depth[at]) <= 0.0f)) return 0;
-    if (g->back[at] < INFINITY)
-        return hbao_height_at(g, &m->height, across, hbao_back_depth(g, at, m->min_thickness)) <=
-               0.0f;
+    const float across =
+        hbao_height_across(&m->height, (float)(at->si - m->i), hbao_grid_y(g, at->sj));
+    if (!(hbao_height_at(g, &m->height, across, at->zs) <= 0.0f)) return 0;
+    if (at->zb < INFINITY)
+        return hbao_height_at(g, &m->height, across,
+                              hbao_back_depth(at->zs, at->zb, m->min_thickness)) <= 0.0f;
     return g->orthographic ? m->height.depth >= 0.0f : across <= 0.0f;
 }
 
@@ -394,13 +411,12 @@ static inline int layer_sample_below(const march *m, size_t at, int ox, int sj) 
  * plane is skipped (layer_sample_below), and a sample beyond the radius
  * whose occluder enters it is a sample at the entry point (enter_the_ball). */
 static inline int march_layer_sample(const march *m, int step, float delta[3], float *dist2,
-                                     size_t *at) {
+                                     sample_point *at) {
     const int status = march_sample(m, step, delta, dist2, at, NULL);
     if (status != SAMPLE_OK && status != SAMPLE_FAR) return status;
-    const int si = (int)(*at % (size_t)m->grid->width), sj = (int)(*at / (size_t)m->grid->width);
-    if (layer_sample_below(m, *at, si - m->i, sj)) return SAMPLE_SKIP;
+    if (layer_sample_below(m, at)) return SAMPLE_SKIP;
     if (status != SAMPLE_FAR) return status;
-    return enter_the_ball(m, *at, delta, dist2) ? SAMPLE_OK : SAMPLE_SKIP;
+    return enter_the_ball(m, at, delta, dist2) ? SAMPLE_OK : SAMPLE_SKIP;
 }
 
 /* direction_occlusion_cosine with the back layer. */
@@ -421,7 +437,7 @@ static float direction_occlusion_cosine_layers(const hbao_settings *s, const mar
     float occlusion = 0.0f; /* in sectors */
     for (int step = 0; step < s->steps; step++) {
         float delta[3], dist2;
-        size_t at;
+        sample_point at;
         const int status = march_layer_sample(m, step, delta, &dist2, &at);
         if (status == SAMPLE_END) break;
         if (status != SAMPLE_OK) continue;
@@ -429,7 +445,7 @@ static float direction_occlusion_cosine_layers(const hbao_settings *s, const mar
                                                    check_past_normal, s->sin_bias, inv_bias);
         float delta_back[3], dist2_back;
         const float behind =
-            back_point(m, at, delta_back, &dist2_back)
+            back_point(m, &at, delta_back, &dist2_back)
                 ? sector_fraction_cosine(m, sl, n, v, delta_back, dist2_back, gamma,
                                          check_past_normal, s->sin_bias, inv_bias)
                 : 1.0f;
@@ -454,7 +470,7 @@ static float direction_occlusion_hbao_layers(const hbao_settings *s, const march
     float past = 0.0f;
     for (int step = 0; step < s->steps; step++) {
         float delta[3], dist2;
-        size_t at;
+        sample_point at;
         const int status = march_layer_sample(m, step, delta, &dist2, &at);
         if (status == SAMPLE_END) break;
         if (status != SAMPLE_OK) continue;
@@ -467,7 +483,7 @@ static float direction_occlusion_hbao_layers(const hbao_settings *s, const march
         const float front = (1.0f - sin_s) * inv_range;
         float delta_back[3], dist2_back;
         const float behind =
-            back_point(m, at, delta_back, &dist2_back)
+            back_point(m, &at, delta_back, &dist2_back)
                 ? (1.0f - sample_elevation(m, n, delta_back, 1.0f / sqrtf(dist2_back))) * inv_range
                 : 1.0f;
         occlusion += mark_sectors(&marked, front, behind,

@@ -377,34 +377,89 @@ static inline const float *SIMD_NAME(lane_address)(const float *row, int first) 
     return (const float *)((uintptr_t)row + (uintptr_t)(intptr_t)first * sizeof(float));
 }
 
-/* A step that is not plain: lanes whose column leaves the image stop (in
- * *alive), and only the lanes inside read. Returns 0 where every lane's
- * sample row, or every lane's column, has left the image: the direction's
+/* The depths of the lanes of `beyond` (the others' from zs) for a step of
+ * pixel offset ox to grid row sj, all of whose lanes lie past the image's
+ * edges: hbao_beyond_depth lane by lane. Not inlined: few steps need it, and
+ * inlined it took the step's fetch out of the search loops (1.06 of the
+ * time, bench_ab_pairs.sh). */
+static __attribute__((noinline)) VF SIMD_NAME(beyond_depths)(const SIMD_NAME(block) * b, int ox,
+                                                              int sj, VM beyond, VF zs) {
+    const hbao_grid *g = b->grid;
+    const VF si = V_ADD(b->lane_float, V_SET((float)ox)); /* exact: |si| < 2^24 */
+    VF terms[4];
+    if (sj < 0 || sj >= g->height) {
+        /* above or below the image: the top or bottom row's planes */
+        const size_t length = hbao_beyond_row_floats(g->width);
+        const int x = b->first_i + ox + HBAO_BEYOND_PAD(g->width);
+        const float *plane =
+            g->beyond + ((size_t)(sj >= 0) * 16 + (size_t)(x & 3)) * length + (size_t)(x >> 2);
+        for (int q = 0; q < 4; q++) terms[q] = V_LOADU(plane + (size_t)q * 4 * length);
+    } else {
+        /* beside it: the left or right column's plane of row sj */
+        const float *sides = g->beyond + 32 * hbao_beyond_row_floats(g->width);
+        const float *l = sides + (size_t)sj * 4, *r = sides + ((size_t)g->height + sj) * 4;
+        const VM left = V_LT(si, V_SET(0.0f));
+        for (int q = 0; q < 4; q++) terms[q] = V_SELECT(left, V_SET(r[q]), V_SET(l[q]));
+    }
+    const VF x = V_MUL(V_ADD(si, V_SET(g->x_offset)), V_SET(g->x_step));
+    const VF across = V_ADD(V_MUL(terms[0], x), V_MUL(terms[1], V_SET(hbao_grid_y(g, sj))));
+#if SIMD_ORTHOGRAPHIC
+    const VF z = V_DIV(V_SUB(across, terms[3]), terms[2]);
+#else
+    const VF z = V_DIV(terms[3], V_SUB(across, terms[2]));
+#endif
+    const VF depth = V_ZERO_UNLESS(M_AND(V_GT(z, V_SET(0.0f)), V_LT(z, V_SET(INFINITY))), z);
+    return V_SELECT(beyond, zs, depth);
+}
+
+/* A step that is not plain: lanes whose column leaves the band past the
+ * image's sides (grid->beyond_band) stop (in *alive); of the others, those
+ * inside the image read their depths from phase_depth, those beyond it take
+ * hbao_beyond_depth's (the surface at the image's edge continued as its
+ * tangent plane), with their back unknown. Returns 0 where every lane's
+ * sample row, or every lane's column, has left the band: the direction's
  * search ends there (no step can bring a lane back: the steps move away
  * from the pixel). */
 static int SIMD_NAME(fetch_at_side)(const SIMD_NAME(block) * b, int ox, int oy, VM *alive,
                                     SIMD_NAME(fetch) * f) {
     const hbao_grid *g = b->grid;
+    const int band = g->beyond_band;
     const int phase_width = b->job->phase_width;
     const int sj = b->j + oy;
-    if (sj < 0 || sj >= g->height) return 0;
+    if (sj < -band || sj >= g->height + band) return 0;
     const VF si = I_TO_F(I_ADD(b->lane_i, I_SET(ox))); /* exact: |si| < 2^24 */
-    *alive = M_AND(*alive, M_AND(V_GE(si, V_SET(0.0f)), V_LT(si, V_SET((float)g->width))));
+    const VM within = M_AND(V_GE(si, V_SET(0.0f)), V_LT(si, V_SET((float)g->width)));
+    if (band > 0)
+        *alive = M_AND(*alive, M_AND(V_GE(si, V_SET((float)-band)),
+                                     V_LT(si, V_SET((float)g->width + (float)band))));
+    else
+        *alive = M_AND(*alive, within);
     if (!M_ANY(*alive)) return 0;
     const VM candidate = (ox == 0 && oy == 0) ? M_NONE() : *alive;
-    const int moved = b->phase + ox;
-    const int new_phase = moved & 3;                        /* moved mod 4, two's complement */
-    const int first = b->first_x + (moved - new_phase) / 4; /* exact */
-    const size_t row_start = ((size_t)new_phase * g->height + sj) * phase_width;
-    /* the lanes whose index lies in the row (exact small integers) */
-    const VF index = I_TO_F(I_ADD(I_LANES, I_SET(first)));
-    const VM in_row = M_AND(V_GE(index, V_SET(0.0f)), V_LT(index, V_SET((float)phase_width)));
-    const float *depths = SIMD_NAME(lane_address)(b->job->phase_depth + row_start, first);
-    f->zs = V_ZERO_UNLESS(candidate, V_LOAD_LANES(in_row, depths, V_SET(0.0f)));
-    if (b->job->phase_back != NULL) {
-        const float *backs = SIMD_NAME(lane_address)(b->job->phase_back + row_start, first);
-        f->zb = V_LOAD_LANES(in_row, backs, V_SET(INFINITY));
+    const int row_inside = sj >= 0 && sj < g->height;
+    const VM inside = row_inside ? M_AND(candidate, within) : M_NONE();
+    VF zs = V_SET(0.0f);
+    if (row_inside) {
+        const int moved = b->phase + ox;
+        const int new_phase = moved & 3;                        /* moved mod 4, two's complement */
+        const int first = b->first_x + (moved - new_phase) / 4; /* exact */
+        const size_t row_start = ((size_t)new_phase * g->height + sj) * phase_width;
+        /* the lanes whose index lies in the row (exact small integers) */
+        const VF index = I_TO_F(I_ADD(I_LANES, I_SET(first)));
+        const VM in_row =
+            M_AND(inside, M_AND(V_GE(index, V_SET(0.0f)), V_LT(index, V_SET((float)phase_width))));
+        const float *depths = SIMD_NAME(lane_address)(b->job->phase_depth + row_start, first);
+        zs = V_LOAD_LANES(in_row, depths, V_SET(0.0f));
+        if (b->job->phase_back != NULL) {
+            const float *backs = SIMD_NAME(lane_address)(b->job->phase_back + row_start, first);
+            f->zb = V_LOAD_LANES(in_row, backs, V_SET(INFINITY));
+        }
+    } else if (b->job->phase_back != NULL) {
+        f->zb = V_SET(INFINITY);
     }
+    const VM beyond = M_ANDNOT(inside, candidate);
+    if (M_ANY(beyond)) zs = SIMD_NAME(beyond_depths)(b, ox, sj, beyond, zs);
+    f->zs = zs;
     f->row = hbao_grid_y(g, sj);
     f->ox = (float)ox;
     f->candidate = candidate;
@@ -425,7 +480,7 @@ static inline void SIMD_NAME(fetch_plain)(const SIMD_NAME(block) * b, const SIMD
 
 /* Step `step` of plan t into *f: 1, or 0 where it repeats the previous
  * step's pixel, or -1 where the direction's search ends because every lane
- * has left the image (*alive: the lanes still inside). Where the projected
+ * has left the band past the image (*alive: the lanes still within it). Where the projected
  * radius spans fewer pixels than there are steps, steps snap to the same
  * pixel; a repeated sample cannot raise a horizon that its first visit set
  * (every test compares with > or reaches the same stop), so leaving it out
@@ -442,8 +497,8 @@ static inline int SIMD_NAME(fetch_step)(const SIMD_NAME(block) * b, const SIMD_N
 }
 
 /* Fills fetches[0..n) with plan t's steps and returns n: the steps before
- * every lane has left the image, less the steps that repeat the previous
- * step's pixel. */
+ * every lane has left the band past the image, less the steps that repeat
+ * the previous step's pixel. */
 static inline int SIMD_NAME(fetch_steps)(const SIMD_NAME(block) * b, const SIMD_NAME(steps) * t,
                                          VM active, SIMD_NAME(fetch) * fetches) {
     VM alive = active;
@@ -638,8 +693,8 @@ static VF SIMD_NAME(direction_occlusion_hbao)(const hbao_settings *s, const SIMD
     const int any_check = M_ANY(M_AND(check_past_normal, active));
     VF sin_max = V_SET(s->sin_bias);
     VF occlusion = V_SET(0.0f);
-    VM inside = active;
-    VM alive = active; /* lanes that have not stopped past the normal */
+    VM inside = active; /* lanes within the band past the image */
+    VM alive = active;  /* lanes that have not stopped past the normal */
     for (int step = 0; step < t->count && M_ANY(alive); step++) {
         SIMD_NAME(fetch) f;
         const int got = SIMD_NAME(fetch_step)(b, t, step, &inside, &f);
@@ -812,7 +867,7 @@ static VF SIMD_NAME(direction_occlusion_cosine)(const hbao_settings *s, const SI
             SIMD_NAME(cosine_step)(b, sl, &f, active, &c);
         }
     }
-    VM inside = active;
+    VM inside = active; /* lanes within the band past the image */
     for (; step < t->count; step++) {
         SIMD_NAME(fetch) f;
         const int got = SIMD_NAME(fetch_step)(b, t, step, &inside, &f);

@@ -310,6 +310,42 @@ TEST_CASE(scaling_depth_and_radius_keeps_ao) {
 /* Brute force, written here independently from docs/algorithm.md: the
  * cosine estimator with 512 directions, marching every quarter pixel up to
  * the radius, in double precision, with the scene's exact normals. */
+/* The camera-space point a sample at pixel (si, sj) sees: the rendered
+ * depth's inside the image; outside it, the documented rule (docs/algorithm.md,
+ * "Beyond the frame"), computed here in doubles from the scene's rays: the
+ * surface at the nearest edge pixel continued as its tangent plane, met by
+ * the pixel's ray. 0 where there is none (background, or the plane behind
+ * the camera). The caller ends a direction past the band beyond the edges
+ * (the longer side / 16). */
+static int beyond_point(const scene_view *view, const float *depth, const float *normal_w, int si,
+                        int sj, double q[3]) {
+    const int ei = si < 0 ? 0 : si >= view->width ? view->width - 1 : si;
+    const int ej = sj < 0 ? 0 : sj >= view->height ? view->height - 1 : sj;
+    const size_t at = (size_t)ej * view->width + ei;
+    const double ze = depth[at];
+    if (ze >= 1e9) return 0;
+    double o[3], d[3];
+    scene_pixel_ray(view, ei, ej, o, d);
+    if (ei == si && ej == sj) {
+        for (int c = 0; c < 3; c++) q[c] = o[c] + ze * d[c];
+        return 1;
+    }
+    const float *m = view->camera.world_to_camera;
+    const float *nw = normal_w + 3 * at;
+    double n[3], e[3];
+    for (int r = 0; r < 3; r++) {
+        n[r] = m[4 * r] * nw[0] + m[4 * r + 1] * nw[1] + m[4 * r + 2] * nw[2];
+        e[r] = o[r] + ze * d[r];
+    }
+    scene_pixel_ray(view, si, sj, o, d);
+    const double facing = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
+    const double t =
+        (n[0] * (e[0] - o[0]) + n[1] * (e[1] - o[1]) + n[2] * (e[2] - o[2])) / facing;
+    if (!(t > 0.0) || !isfinite(t)) return 0;
+    for (int c = 0; c < 3; c++) q[c] = o[c] + t * d[c];
+    return 1;
+}
+
 static double brute_force_cosine(const scene_view *view, const float *depth, const float *normal_w,
                                  int i, int j, double radius) {
     const int directions = 512;
@@ -346,13 +382,13 @@ static double brute_force_cosine(const scene_view *view, const float *depth, con
         const double h_open = h;
         for (double t = 1.0; t <= radius_px; t += 0.25) {
             const int si = (int)floor(i + 0.5 + dc * t), sj = (int)floor(j + 0.5 - ds * t);
-            if (si < 0 || sj < 0 || si >= view->width || sj >= view->height) break;
+            const int band = (view->width > view->height ? view->width : view->height) / 16;
+            if (si < -band || sj < -band || si >= view->width + band || sj >= view->height + band)
+                break;
             if (si == i && sj == j) continue;
-            const double zs = depth[(size_t)sj * view->width + si];
-            if (zs >= 1e9) continue;
             double q[3];
-            scene_pixel_ray(view, si, sj, o, d);
-            for (int c = 0; c < 3; c++) q[c] = o[c] + zs * d[c] - p[c];
+            if (!beyond_point(view, depth, normal_w, si, sj, q)) continue;
+            for (int c = 0; c < 3; c++) q[c] -= p[c];
             const double dist = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
             if (dist >= radius) continue;
             /* the sample's angle from V: through its elevation above the
@@ -471,6 +507,58 @@ TEST_CASE(past_the_normal_matches_brute_force_under_a_table) {
      * that. */
     CHECK(error_sum / count < 0.04);
     free(ao);
+    free(depth);
+    free(normal);
+}
+
+/* Beyond the frame (docs/algorithm.md): a step past the image's edge sees
+ * the surface at the nearest edge pixel continued as its tangent plane. The
+ * wall's foot is darkened by the floor in front of it; a frame whose bottom
+ * edge cuts the floor a few pixels below the crease keeps that floor, so the
+ * wall pixels just above the crease get nearly the AO of a frame that shows
+ * it: measured 0.0024 apart, where the rule before (a direction ends at the
+ * edge) left them 0.23 apart, their AO without most of the floor's
+ * occlusion (0.41). */
+TEST_CASE(steps_past_the_frame_see_the_edge_surface_continued) {
+    const scene s = corner_scene();
+    const double eye[3] = {-2.5, 0.0, 2.0}, target[3] = {0.0, 0.0, 0.3};
+    const int w = 160, h = 120;
+    scene_view view = make_view(w, h, eye, target);
+    float *depth, *normal;
+    scene_render(&s, &view, &depth, &normal);
+    int crease = -1; /* the first floor row at the middle column */
+    for (int j = 0; j < h && crease < 0; j++)
+        if (normal[3 * ((size_t)j * w + w / 2) + 2] > 0.5f) crease = j;
+    CHECK(crease > 20 && crease < h - 20);
+    hbao_params p = exact_params(HBAO_INTEGRATION_COSINE);
+    p.radius = 0.3f;
+    p.directions = 8;
+    p.steps = 12;
+    float *full = run(&p, &view, depth, normal);
+    const int window_height = crease + 3;
+    hbao_camera window;
+    CHECK_RESULT(hbao_camera_crop(&view.camera, w, h, 0, 0, w, window_height, &window),
+                 HBAO_SUCCESS);
+    float *cut = malloc((size_t)w * window_height * sizeof(float));
+    const hbao_channel d = {depth, 1, w}, n = {normal, 3, 3 * (int64_t)w};
+    CHECK_RESULT(hbao_compute(&p, &window, w, window_height, &d, &n, cut, w), HBAO_SUCCESS);
+    double difference = 0.0, occlusion = 0.0;
+    int count = 0;
+    for (int j = crease - 4; j < crease; j++)
+        for (int i = 8; i < w - 8; i++) {
+            const size_t k = (size_t)j * w + i;
+            if (normal[3 * k] > -0.5f) continue; /* the wall's pixels */
+            difference += fabs(cut[k] - full[k]);
+            occlusion += 1.0 - full[k];
+            count++;
+        }
+    CHECK(count > 300);
+    printf("  %d wall pixels above the crease: occlusion %.3f, |cut frame - whole frame| %.4f\n",
+           count, occlusion / count, difference / count);
+    CHECK(occlusion / count > 0.1);
+    CHECK(difference / count < 0.02);
+    free(cut);
+    free(full);
     free(depth);
     free(normal);
 }
@@ -1777,6 +1865,7 @@ TEST_MAIN(TEST_ENTRY(plane_facing_camera_is_unoccluded), TEST_ENTRY(tilted_plane
           TEST_ENTRY(scaling_depth_and_radius_keeps_ao),
           TEST_ENTRY(more_samples_converge_to_brute_force),
           TEST_ENTRY(past_the_normal_matches_brute_force_under_a_table),
+          TEST_ENTRY(steps_past_the_frame_see_the_edge_surface_continued),
           TEST_ENTRY(random_and_degenerate_inputs_give_finite_ao_in_range),
           TEST_ENTRY(identical_output_for_any_thread_count),
           TEST_ENTRY(bottom_up_rows_with_negative_stride),

@@ -57,6 +57,25 @@ float block_radius(ivec2 p, float z)
     return radius_in_pixels(leader);
 }
 
+/* csrc/lib/internal_hbao.h, hbao_beyond_depth (docs/algorithm.md, "Beyond
+ * the frame"): the depth a step sees at pixel q outside the image, the
+ * surface at the nearest edge pixel continued as its tangent plane and met
+ * by q's view ray; 0 (background) where there is none. */
+float beyond_depth(ivec2 q)
+{
+    ivec2 e = clamp(q, ivec2(0), image_size - 1);
+    float ze = depth_at(e);
+    if (is_background(ze)) {
+        return 0.0;
+    }
+    vec3 n = texelFetch(normal_texture, ivec2(e.x, image_size.y - 1 - e.y), 0).xyz;
+    float plane = dot(n, position_at(e, ze));
+    /* the ray's points are start + z (position_at(q, 1) - start) */
+    vec3 start = position_at(q, 0.0);
+    float z = (plane - dot(n, start)) / dot(n, position_at(q, 1.0) - start);
+    return z > 0.0 && !isinf(z) ? z : 0.0;
+}
+
 /* Cosine-weighted visibility of a half slice from V up to angle h. */
 float slice_visibility(float h, float gamma)
 {
@@ -92,6 +111,7 @@ float occlusion(ivec2 p)
     float jitter = (float(PATTERN[(p.y & 3) + 4 * (p.x & 3)]) + 0.5) / 16.0;
     float sin_bias = sin(angle_bias);
     float step_px = (block_radius(p, z) - 1.0) / float(steps);
+    int beyond_band = max(image_size.x, image_size.y) / BEYOND_BAND_DIVISOR;
 
     float hbao_sum = 0.0;
     float cosine_open = 0.0;
@@ -123,15 +143,20 @@ float occlusion(ivec2 p)
         for (int s = 0; s < steps; s++) {
             /* The block's offset, the same for its 16 pixels. */
             float t = 1.0 + (float(s) + jitter) * step_px;
-            ivec2 q = p + ivec2(floor(0.5 + cos_theta * t),
-                                floor(0.5 - sin_theta * t * inv_ycor));
-            if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, image_size))) {
+            ivec2 offset = ivec2(floor(0.5 + cos_theta * t), floor(0.5 - sin_theta * t * inv_ycor));
+            ivec2 q = p + offset;
+            /* a whole image away (hbao_step_offset), or past the band beyond
+             * the edges */
+            if (any(greaterThanEqual(abs(offset), image_size))
+                || any(lessThan(q, ivec2(-beyond_band)))
+                || any(greaterThanEqual(q, image_size + beyond_band))) {
                 break;
             }
             if (q == p) {
                 continue;
             }
-            float zs = depth_at(q);
+            bool in_image = all(greaterThanEqual(q, ivec2(0))) && all(lessThan(q, image_size));
+            float zs = in_image ? depth_at(q) : beyond_depth(q);
             if (is_background(zs) || zs < near_limit) {
                 continue;
             }

@@ -234,6 +234,9 @@ AO_DEFINES = {
     # csrc/lib/internal_hbao.h, HBAO_BLOCK_PIXELS: the pixels of a block,
     # which share one step length (tests/test_viewport.py compares the two).
     "BLOCK_PIXELS": 16,
+    # csrc/lib/internal_hbao.h, HBAO_BEYOND_BAND_DIVISOR: steps go on past the
+    # image's edges for its longer side over this many pixels.
+    "BEYOND_BAND_DIVISOR": 16,
     # csrc/lib/internal_hbao.h, HBAO_BLOCK_DEPTH_RATIO: how much farther than
     # its class's nearest pixel a pixel of the class lies at most.
     "BLOCK_DEPTH_RATIO": 4.0,
