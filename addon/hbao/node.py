@@ -88,9 +88,10 @@ class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
     guard_band: FloatProperty(
         name="Guard Band", default=0.0, min=0.0, max=100.0 * guard_geometry.MAX_GUARD_BAND,
         subtype="PERCENTAGE", update=_extra_render_changed, options=set(),
-        description="Darkens image borders that come out too bright, by also looking this far "
-                    "past each side (% of the frame); costs a quick extra render (Cycles, 1 "
-                    "sample, Depth and Normal only). 0 = off")
+        description="Lets image borders see what lies past the frame, by also looking this "
+                    "far past each side (% of the frame); without it, the surfaces at the "
+                    "frame's edge are taken as going on flat. Costs a quick extra render "
+                    "(Cycles, 1 sample, Depth and Normal only). 0 = off")
     back_faces: BoolProperty(
         name="Back Faces", default=False, update=_extra_render_changed, options=set(),
         description="Lets light pass between an object and the surface behind it, which "

@@ -346,8 +346,7 @@ static inline float sector_fraction_cosine(const march *m, const slice *sl, cons
 /* A sample's back point, where its back face is known: the view ray
  * through the sample's pixel at its back depth, as a vector from the pixel
  * and its squared length. Returns 0 where unknown. */
-static inline int back_point(const march *m, const sample_point *at, float delta[3],
-                             float *dist2) {
+static inline int back_point(const march *m, const sample_point *at, float delta[3], float *dist2) {
     const hbao_grid *g = m->grid;
     if (!(at->zb < INFINITY)) return 0;
     float q[3];

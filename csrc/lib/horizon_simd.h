@@ -383,7 +383,7 @@ static inline const float *SIMD_NAME(lane_address)(const float *row, int first) 
  * inlined it took the step's fetch out of the search loops (1.06 of the
  * time, bench_ab_pairs.sh). */
 static __attribute__((noinline)) VF SIMD_NAME(beyond_depths)(const SIMD_NAME(block) * b, int ox,
-                                                              int sj, VM beyond, VF zs) {
+                                                             int sj, VM beyond, VF zs) {
     const hbao_grid *g = b->grid;
     const VF si = V_ADD(b->lane_float, V_SET((float)ox)); /* exact: |si| < 2^24 */
     VF terms[4];

@@ -176,7 +176,6 @@ static inline void hbao_grid_position(const hbao_grid *grid, int i, int j, float
     position[2] = -depth;
 }
 
-
 /* A sample's height above the pixel's tangent plane, dot(n, Q - P) lowered
  * by the depth's rounding tolerance, written as a plane in the sample's
  * pixel offset ox and grid row y: in perspective Q = zs (x, y, -1), so the
@@ -356,7 +355,8 @@ static inline float hbao_beyond_depth(const hbao_grid *grid, int si, int sj) {
     if (sj < 0 || sj >= grid->height) {
         const size_t length = hbao_beyond_row_floats(grid->width);
         const int x = si + HBAO_BEYOND_PAD(grid->width); /* >= 1: si > -width */
-        plane = grid->beyond + ((size_t)(sj >= 0) * 16 + (size_t)(x & 3)) * length + (size_t)(x >> 2);
+        plane =
+            grid->beyond + ((size_t)(sj >= 0) * 16 + (size_t)(x & 3)) * length + (size_t)(x >> 2);
         term = 4 * length;
     } else {
         plane = grid->beyond + 32 * hbao_beyond_row_floats(grid->width) +

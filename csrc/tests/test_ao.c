@@ -339,8 +339,7 @@ static int beyond_point(const scene_view *view, const float *depth, const float 
     }
     scene_pixel_ray(view, si, sj, o, d);
     const double facing = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
-    const double t =
-        (n[0] * (e[0] - o[0]) + n[1] * (e[1] - o[1]) + n[2] * (e[2] - o[2])) / facing;
+    const double t = (n[0] * (e[0] - o[0]) + n[1] * (e[1] - o[1]) + n[2] * (e[2] - o[2])) / facing;
     if (!(t > 0.0) || !isfinite(t)) return 0;
     for (int c = 0; c < 3; c++) q[c] = o[c] + t * d[c];
     return 1;
