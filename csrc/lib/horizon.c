@@ -688,9 +688,9 @@ static void horizon_tile(void *context, int tile) {
 /* hbao_horizon_job.phase_depth (and phase_back), row by row. */
 typedef struct deinterleave_job {
     const hbao_grid *grid;
-    int phase_width;
-    float *phase_depth;
-    float *phase_back; /* NULL without the back layer */
+    int phase_width, phase_rows, phase_pad;
+    float *phase_depth; /* the origins, as in hbao_horizon_job */
+    float *phase_back;  /* NULL without the back layer */
 } deinterleave_job;
 
 #if defined(__clang__) || (defined(__GNUC__) && __GNUC__ >= 12)
@@ -698,19 +698,31 @@ typedef struct deinterleave_job {
 typedef float four_floats __attribute__((vector_size(16)));
 #endif
 
-/* Row j of the grid into its four column phases: phase a gets columns
- * 4 x + a, beyond where x runs past the row. */
-static void deinterleave(const hbao_grid *g, const float *row, int j, int phase_width, float beyond,
-                         float *phases) {
-    float *out[4];
-    for (int a = 0; a < 4; a++) out[a] = phases + ((size_t)a * g->height + j) * phase_width;
+/* What phase_depth holds at column i of row j outside the image: the
+ * band's depth (hbao_beyond_depth), 0 past the band. */
+static float outside_depth(const hbao_grid *g, int i, int j) {
+    const int band = g->beyond_band;
+    if (i < -band || i >= g->width + band || j < -band || j >= g->height + band) return 0.0f;
+    return hbao_beyond_depth(g, i, j);
+}
+
+/* Row j of the grid into its four column phases (out[a]: phase a's row at
+ * X = 0): phase a gets columns 4 X + a, for X from -pad up to
+ * phase_width - pad; outside the image, outside_depth (depth) or INFINITY
+ * (the back layer's, unknown). A row outside the image (j < 0 or j >=
+ * height) is all outside. */
+static void deinterleave(const hbao_grid *g, const float *row, int j, int phase_width, int pad,
+                         int back, float *const out[4]) {
+    const int inside_row = j >= 0 && j < g->height;
+    for (int a = 0; a < 4; a++)
+        for (int x = -pad; x < 0; x++) out[a][x] = back ? INFINITY : outside_depth(g, 4 * x + a, j);
     int x = 0;
 #ifdef HBAO_SHUFFLE_VECTOR
     /* 16 columns at a time, a 4 x 4 transpose in vector registers (SSE2's
      * baseline), where the element loop below takes a load and a store per
      * float: the stages around the search (bench_ab_copies.sh, 1080p,
      * radius 1e-4, blur 0) 0.971 on 1 thread, 0.967 on 2. */
-    for (; 4 * (x + 4) <= g->width; x += 4) {
+    for (; inside_row && 4 * (x + 4) <= g->width; x += 4) {
         four_floats r[4], o[4];
         memcpy(r, row + 4 * x, sizeof r);
         const four_floats low01 = __builtin_shufflevector(r[0], r[1], 0, 4, 1, 5);
@@ -724,21 +736,30 @@ static void deinterleave(const hbao_grid *g, const float *row, int j, int phase_
         for (int a = 0; a < 4; a++) memcpy(out[a] + x, &o[a], sizeof o[a]);
     }
 #endif
-    for (; x < phase_width; x++) {
+    for (; x < phase_width - pad; x++) {
         for (int a = 0; a < 4; a++) {
             const int i = 4 * x + a;
-            out[a][x] = i < g->width ? row[i] : beyond;
+            out[a][x] = inside_row && i < g->width ? row[i]
+                        : back                     ? INFINITY
+                                                   : outside_depth(g, i, j);
         }
     }
 }
 
-static void deinterleave_row(void *context, int j) {
+static void deinterleave_row(void *context, int r) {
     const deinterleave_job *job = context;
     const hbao_grid *g = job->grid;
-    deinterleave(g, g->depth + (size_t)j * g->width, j, job->phase_width, 0.0f, job->phase_depth);
-    if (job->phase_back != NULL)
-        deinterleave(g, g->back + (size_t)j * g->width, j, job->phase_width, INFINITY,
-                     job->phase_back);
+    const int j = r - g->beyond_band;
+    const size_t offset = j >= 0 && j < g->height ? (size_t)j * g->width : 0;
+    float *out[4];
+    for (int a = 0; a < 4; a++)
+        out[a] = job->phase_depth + ((ptrdiff_t)a * job->phase_rows + j) * job->phase_width;
+    deinterleave(g, g->depth + offset, j, job->phase_width, job->phase_pad, 0, out);
+    if (job->phase_back != NULL) {
+        for (int a = 0; a < 4; a++)
+            out[a] = job->phase_back + ((ptrdiff_t)a * job->phase_rows + j) * job->phase_width;
+        deinterleave(g, g->back + offset, j, job->phase_width, job->phase_pad, 1, out);
+    }
 }
 
 /* The kernel asked for, or the best one below it that this CPU runs. */
@@ -792,11 +813,18 @@ uint32_t hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *g
     job.phase_depth = NULL;
     job.phase_back = NULL;
     /* whole blocks, so that a block's depths are always one full load */
-    job.phase_width =
-        ((grid->width + 3) / 4 + HBAO_BLOCK_PIXELS - 1) / HBAO_BLOCK_PIXELS * HBAO_BLOCK_PIXELS;
-    job.int_indices = (int64_t)4 * grid->height * job.phase_width <= INT32_MAX;
+    /* whole blocks, so that a block's depths are always one full load, and
+     * a block's lanes stepped into the band too */
+    const int band = grid->beyond_band;
+    job.phase_pad = (band + 3) / 4 + 1;
+    job.phase_rows = grid->height + 2 * band;
+    job.phase_width = (job.phase_pad + (grid->width + band + 3) / 4 + 2 * HBAO_BLOCK_PIXELS - 1) /
+                      HBAO_BLOCK_PIXELS * HBAO_BLOCK_PIXELS;
+    job.int_indices = (int64_t)4 * job.phase_rows * job.phase_width <= INT32_MAX;
+    /* the origin: row 0, X = 0 of phase 0 */
+    const ptrdiff_t origin = (ptrdiff_t)band * job.phase_width + job.phase_pad;
     if (tiled.simd != NULL) {
-        const size_t bytes = (size_t)4 * grid->height * job.phase_width * sizeof(float);
+        const size_t bytes = (size_t)4 * job.phase_rows * job.phase_width * sizeof(float);
         phase_depth = hbao_scratch_take(bytes);
         if (grid->back != NULL) phase_back = hbao_scratch_take(bytes);
         /* Without memory for the copies the scalar reference computes the
@@ -810,10 +838,12 @@ uint32_t hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *g
         }
     }
     if (phase_depth != NULL) {
-        deinterleave_job split = {grid, job.phase_width, phase_depth, phase_back};
-        hbao_parallel_rows(settings->threads, grid->height, deinterleave_row, &split);
-        job.phase_depth = phase_depth;
-        job.phase_back = phase_back;
+        deinterleave_job split = {
+            grid,          job.phase_width,      job.phase_rows,
+            job.phase_pad, phase_depth + origin, phase_back != NULL ? phase_back + origin : NULL};
+        hbao_parallel_rows(settings->threads, job.phase_rows, deinterleave_row, &split);
+        job.phase_depth = split.phase_depth;
+        job.phase_back = split.phase_back;
     }
     hbao_parallel_rows(settings->threads, tiled.tiles_across * tiled.tiles_down, horizon_tile,
                        &tiled);

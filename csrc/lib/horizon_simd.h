@@ -196,12 +196,12 @@ static inline VI SIMD_NAME(floor_to_int)(VF x) {
  * index `step`: hbao_step_offset with the same float operations, and what
  * a plain step's fetch needs. */
 typedef struct SIMD_NAME(step_lanes) {
-    VF x, y;     /* the offsets, as floats */
-    VI ox, oy;   /* and as whole pixels */
-    VI index;    /* the lanes' depths in phase_depth (for plain steps) */
-    VF row;      /* the samples' grid row (hbao_grid_y) */
-    VF ox_float; /* ox, as floats (exact) */
-    VM row_inside;
+    VF x, y;        /* the offsets, as floats */
+    VI ox, oy;      /* and as whole pixels */
+    VI index;       /* the lanes' depths in phase_depth (for plain steps) */
+    VF row;         /* the samples' grid row (hbao_grid_y) */
+    VF ox_float;    /* ox, as floats (exact) */
+    VM row_in_band; /* the sample row within the band past the image */
 } SIMD_NAME(step_lanes);
 
 static inline void SIMD_NAME(step_lanes_of)(const SIMD_NAME(block) * b, VF step, VF dc, VF ds,
@@ -215,42 +215,49 @@ static inline void SIMD_NAME(step_lanes_of)(const SIMD_NAME(block) * b, VF step,
     const VI sj = I_ADD(I_SET(b->j), v->oy);
     const VF sj_float = I_TO_F(sj);
     v->ox_float = I_TO_F(v->ox);
-    v->row_inside = M_AND(V_GE(sj_float, V_SET(0.0f)), V_LT(sj_float, V_SET((float)g->height)));
+    const float band = (float)g->beyond_band;
+    v->row_in_band =
+        M_AND(V_GE(sj_float, V_SET(-band)), V_LT(sj_float, V_SET((float)g->height + band)));
     /* lane k samples column first_i + 4 k + ox: phase (phase + ox) mod
      * 4, index first_x + k + floor((phase + ox) / 4) of that phase's row */
     const VI moved = I_ADD(I_SET(b->phase), v->ox);
-    const VI row_index = I_ADD(I_MULLO(I_AND(moved, I_SET(3)), I_SET(g->height)), sj);
+    const VI row_index = I_ADD(I_MULLO(I_AND(moved, I_SET(3)), I_SET(b->job->phase_rows)), sj);
     v->index = I_ADD(I_MULLO(row_index, I_SET(b->job->phase_width)),
                      I_ADD(I_SET(b->first_x), I_SRAI(moved, 2)));
     v->row = V_MUL(V_ADD(sj_float, V_SET(g->y_offset)), V_SET(g->y_step));
 }
 
-/* The lanes whose step is plain: the sample row inside, and lane 0's and
- * the last lane's columns (exact small integers as floats). */
-static inline unsigned SIMD_NAME(plain_bits)(const SIMD_NAME(block) * b,
-                                             const SIMD_NAME(step_lanes) * v) {
-    const VF column0 = V_ADD(V_SET((float)b->first_i), v->ox_float);
-    const VM plain =
-        M_AND(v->row_inside, M_AND(V_GE(column0, V_SET(0.0f)),
-                                   V_LT(V_ADD(column0, V_SET((float)(4 * (SIMD_LANES - 1)))),
-                                        V_SET((float)b->grid->width))));
-    return (unsigned)M_BITS(plain);
-}
-
-/* The lanes whose step lies less than an image away. A plain step does:
- * lane 0 of a searched block lies inside the image (0 <= first_i < width,
- * 0 <= j < height: its block has a foreground lane, and phase_depth's
- * padding is background), so 0 <= first_i + ox and first_i + ox +
- * 4 (SIMD_LANES - 1) < width give 1 - width <= -first_i <= ox <= x < ox +
- * 1 <= width, and 0 <= j + oy < height the same of y; so where every step
- * is plain the test is left out
- * (bench_ab_pairs.sh, 1080p, Zen 5, 1 thread, against testing every plan:
- * 0.986 at the defaults, 0.987 at 8 x 6 + blur 15; session 45). */
-static inline unsigned SIMD_NAME(inside_bits)(const hbao_grid *g, const SIMD_NAME(step_lanes) * v) {
-    const VM inside = M_AND(
+/* The lanes whose step's offset lies less than an image away */
+static inline VM SIMD_NAME(inside_lanes)(const hbao_grid *g, const SIMD_NAME(step_lanes) * v) {
+    return M_AND(
         M_AND(V_GE(v->x, V_SET((float)(1 - g->width))), V_LT(v->x, V_SET((float)g->width))),
         M_AND(V_GE(v->y, V_SET((float)(1 - g->height))), V_LT(v->y, V_SET((float)g->height))));
-    return (unsigned)M_BITS(inside);
+}
+
+/* The lanes whose step is plain: the sample row, and lane 0's and the last
+ * lane's columns (exact small integers as floats), within the band past the
+ * image (grid->beyond_band), whose depths phase_depth holds, and the step
+ * less than an image away (inside_bits: a block near one side can reach
+ * the band past the other). */
+static inline unsigned SIMD_NAME(plain_bits)(const SIMD_NAME(block) * b,
+                                             const SIMD_NAME(step_lanes) * v) {
+    const hbao_grid *g = b->grid;
+    const VF column0 = V_ADD(V_SET((float)b->first_i), v->ox_float);
+    const float band = (float)g->beyond_band;
+    const VM in_band =
+        M_AND(v->row_in_band, M_AND(V_GE(column0, V_SET(-band)),
+                                    V_LT(V_ADD(column0, V_SET((float)(4 * (SIMD_LANES - 1)))),
+                                         V_SET((float)g->width + band))));
+    return (unsigned)M_BITS(M_AND(in_band, SIMD_NAME(inside_lanes)(g, v)));
+}
+
+/* The lanes whose step lies less than an image away (hbao_step_offset).
+ * A plain step does (plain_bits), so where every step is plain the test is
+ * left out (bench_ab_pairs.sh, 1080p, Zen 5, 1 thread, against testing
+ * every plan: 0.986 at the defaults, 0.987 at 8 x 6 + blur 15; session
+ * 45). */
+static inline unsigned SIMD_NAME(inside_bits)(const hbao_grid *g, const SIMD_NAME(step_lanes) * v) {
+    return (unsigned)M_BITS(SIMD_NAME(inside_lanes)(g, v));
 }
 
 /* plan_two's t: its count and plain_end from the bits of its `steps`
@@ -377,89 +384,39 @@ static inline const float *SIMD_NAME(lane_address)(const float *row, int first) 
     return (const float *)((uintptr_t)row + (uintptr_t)(intptr_t)first * sizeof(float));
 }
 
-/* The depths of the lanes of `beyond` (the others' from zs) for a step of
- * pixel offset ox to grid row sj, all of whose lanes lie past the image's
- * edges: hbao_beyond_depth lane by lane. Not inlined: few steps need it, and
- * inlined it took the step's fetch out of the search loops (1.06 of the
- * time, bench_ab_pairs.sh). */
-static __attribute__((noinline)) VF SIMD_NAME(beyond_depths)(const SIMD_NAME(block) * b, int ox,
-                                                             int sj, VM beyond, VF zs) {
-    const hbao_grid *g = b->grid;
-    const VF si = V_ADD(b->lane_float, V_SET((float)ox)); /* exact: |si| < 2^24 */
-    VF terms[4];
-    if (sj < 0 || sj >= g->height) {
-        /* above or below the image: the top or bottom row's planes */
-        const size_t length = hbao_beyond_row_floats(g->width);
-        const int x = b->first_i + ox + HBAO_BEYOND_PAD(g->width);
-        const float *plane =
-            g->beyond + ((size_t)(sj >= 0) * 16 + (size_t)(x & 3)) * length + (size_t)(x >> 2);
-        for (int q = 0; q < 4; q++) terms[q] = V_LOADU(plane + (size_t)q * 4 * length);
-    } else {
-        /* beside it: the left or right column's plane of row sj */
-        const float *sides = g->beyond + 32 * hbao_beyond_row_floats(g->width);
-        const float *l = sides + (size_t)sj * 4, *r = sides + ((size_t)g->height + sj) * 4;
-        const VM left = V_LT(si, V_SET(0.0f));
-        for (int q = 0; q < 4; q++) terms[q] = V_SELECT(left, V_SET(r[q]), V_SET(l[q]));
-    }
-    const VF x = V_MUL(V_ADD(si, V_SET(g->x_offset)), V_SET(g->x_step));
-    const VF across = V_ADD(V_MUL(terms[0], x), V_MUL(terms[1], V_SET(hbao_grid_y(g, sj))));
-#if SIMD_ORTHOGRAPHIC
-    const VF z = V_DIV(V_SUB(across, terms[3]), terms[2]);
-#else
-    const VF z = V_DIV(terms[3], V_SUB(across, terms[2]));
-#endif
-    const VF depth = V_ZERO_UNLESS(M_AND(V_GT(z, V_SET(0.0f)), V_LT(z, V_SET(INFINITY))), z);
-    return V_SELECT(beyond, zs, depth);
-}
-
 /* A step that is not plain: lanes whose column leaves the band past the
- * image's sides (grid->beyond_band) stop (in *alive); of the others, those
- * inside the image read their depths from phase_depth, those beyond it take
- * hbao_beyond_depth's (the surface at the image's edge continued as its
- * tangent plane), with their back unknown. Returns 0 where every lane's
- * sample row, or every lane's column, has left the band: the direction's
- * search ends there (no step can bring a lane back: the steps move away
- * from the pixel). */
+ * image's sides (grid->beyond_band) stop (in *alive), and only the lanes
+ * within it read (phase_depth holds the band's depths: the image's edge
+ * continued, hbao_beyond_depth). Returns 0 where every lane's sample row,
+ * or every lane's column, has left the band: the direction's search ends
+ * there (no step can bring a lane back: the steps move away from the
+ * pixel). */
 static int SIMD_NAME(fetch_at_side)(const SIMD_NAME(block) * b, int ox, int oy, VM *alive,
                                     SIMD_NAME(fetch) * f) {
     const hbao_grid *g = b->grid;
-    const int band = g->beyond_band;
-    const int phase_width = b->job->phase_width;
+    const hbao_horizon_job *job = b->job;
+    const int band = g->beyond_band, phase_width = job->phase_width;
     const int sj = b->j + oy;
     if (sj < -band || sj >= g->height + band) return 0;
     const VF si = I_TO_F(I_ADD(b->lane_i, I_SET(ox))); /* exact: |si| < 2^24 */
-    const VM within = M_AND(V_GE(si, V_SET(0.0f)), V_LT(si, V_SET((float)g->width)));
-    if (band > 0)
-        *alive = M_AND(*alive, M_AND(V_GE(si, V_SET((float)-band)),
-                                     V_LT(si, V_SET((float)g->width + (float)band))));
-    else
-        *alive = M_AND(*alive, within);
+    *alive = M_AND(*alive, M_AND(V_GE(si, V_SET((float)-band)),
+                                 V_LT(si, V_SET((float)g->width + (float)band))));
     if (!M_ANY(*alive)) return 0;
     const VM candidate = (ox == 0 && oy == 0) ? M_NONE() : *alive;
-    const int row_inside = sj >= 0 && sj < g->height;
-    const VM inside = row_inside ? M_AND(candidate, within) : M_NONE();
-    VF zs = V_SET(0.0f);
-    if (row_inside) {
-        const int moved = b->phase + ox;
-        const int new_phase = moved & 3;                        /* moved mod 4, two's complement */
-        const int first = b->first_x + (moved - new_phase) / 4; /* exact */
-        const size_t row_start = ((size_t)new_phase * g->height + sj) * phase_width;
-        /* the lanes whose index lies in the row (exact small integers) */
-        const VF index = I_TO_F(I_ADD(I_LANES, I_SET(first)));
-        const VM in_row =
-            M_AND(inside, M_AND(V_GE(index, V_SET(0.0f)), V_LT(index, V_SET((float)phase_width))));
-        const float *depths = SIMD_NAME(lane_address)(b->job->phase_depth + row_start, first);
-        zs = V_LOAD_LANES(in_row, depths, V_SET(0.0f));
-        if (b->job->phase_back != NULL) {
-            const float *backs = SIMD_NAME(lane_address)(b->job->phase_back + row_start, first);
-            f->zb = V_LOAD_LANES(in_row, backs, V_SET(INFINITY));
-        }
-    } else if (b->job->phase_back != NULL) {
-        f->zb = V_SET(INFINITY);
+    const int moved = b->phase + ox;
+    const int new_phase = moved & 3;                        /* moved mod 4, two's complement */
+    const int first = b->first_x + (moved - new_phase) / 4; /* exact */
+    const ptrdiff_t row_start = ((ptrdiff_t)new_phase * job->phase_rows + sj) * phase_width;
+    /* the lanes whose index lies in the row (exact small integers) */
+    const VF index = I_TO_F(I_ADD(I_LANES, I_SET(first)));
+    const VM in_row = M_AND(V_GE(index, V_SET((float)-job->phase_pad)),
+                            V_LT(index, V_SET((float)(phase_width - job->phase_pad))));
+    const float *depths = SIMD_NAME(lane_address)(job->phase_depth + row_start, first);
+    f->zs = V_ZERO_UNLESS(candidate, V_LOAD_LANES(in_row, depths, V_SET(0.0f)));
+    if (job->phase_back != NULL) {
+        const float *backs = SIMD_NAME(lane_address)(job->phase_back + row_start, first);
+        f->zb = V_LOAD_LANES(in_row, backs, V_SET(INFINITY));
     }
-    const VM beyond = M_ANDNOT(inside, candidate);
-    if (M_ANY(beyond)) zs = SIMD_NAME(beyond_depths)(b, ox, sj, beyond, zs);
-    f->zs = zs;
     f->row = hbao_grid_y(g, sj);
     f->ox = (float)ox;
     f->candidate = candidate;
@@ -1145,6 +1102,17 @@ SIMD_NAME(plan_ahead)(const SIMD_NAME(block) * b, const float *group_cos, const 
 #define SIMD_SLICE_ROOM SIMD_DIRECTION_GROUP
 #endif
 
+/* The depths of the block of phase a at x0 in row j: its row of
+ * phase_depth, background (0) for the lanes past the image's width (where
+ * phase_depth holds the band past the edge). */
+static inline VF SIMD_NAME(block_depths)(const hbao_horizon_job *job, int x0, int j, int a) {
+    const VF z =
+        V_LOADU(job->phase_depth + ((size_t)a * job->phase_rows + j) * job->phase_width + x0 / 4);
+    if (x0 + 4 * HBAO_BLOCK_PIXELS <= job->grid->width) return z;
+    const VF column = I_TO_F(I_ADD(I_SET(x0 + a), I_MULLO(I_LANES, I_SET(4))));
+    return V_ZERO_UNLESS(V_LT(column, V_SET((float)job->grid->width)), z);
+}
+
 /* Sets up *b, the block of phase a at x0 in row j, with the block's step
  * step_px, and returns its active lanes. What the steps' plan reads is set
  * first; the rest only where a lane is active. */
@@ -1162,9 +1130,7 @@ static VM SIMD_NAME(block_setup)(const hbao_horizon_job *job, int x0, int j, int
     b->jitter = job->jitter[a + 4 * (j & 3)];
     b->step_px = step_px;
     b->inv_ycor = 1.0f / g->ycor;
-    /* phase_depth rows are padded to whole blocks with zeros: background */
-    const VF z =
-        V_LOADU(job->phase_depth + ((size_t)a * g->height + j) * job->phase_width + b->first_x);
+    const VF z = SIMD_NAME(block_depths)(job, x0, j, a);
     b->lane_i = I_ADD(I_SET(first_i), I_MULLO(I_LANES, I_SET(4)));
     b->lane_float = I_TO_F(b->lane_i);
     const VF column = V_MUL(V_ADD(b->lane_float, V_SET(g->x_offset)), V_SET(g->x_step));
@@ -1364,21 +1330,13 @@ static inline void SIMD_NAME(block_ao)(const hbao_horizon_job *job, int x0, int 
         SIMD_NAME(block_ao_one_layer)(job, x0, x1, j, a, step_px, lanes_wanted);
 }
 
-/* The block's row of phase_depth (its depths, padded with background
- * beyond the image's width) */
-static inline const float *SIMD_NAME(block_depths)(const hbao_horizon_job *job, int x0, int j,
-                                                   int a) {
-    const hbao_grid *g = job->grid;
-    return job->phase_depth + ((size_t)a * g->height + j) * job->phase_width + x0 / 4;
-}
-
 /* The step of a block that is one class (hbao_block_classes), or
  * HBAO_BLOCK_CLASSES where it is several: its nearest foreground depth, and
  * whether any lies beyond the class it leads, from one load, not 16 strided
  * ones. */
 #define HBAO_BLOCK_CLASSES (-2.0f)
 static inline float SIMD_NAME(block_step)(const hbao_horizon_job *job, int x0, int j, int a) {
-    const VF z = V_LOADU(SIMD_NAME(block_depths)(job, x0, j, a));
+    const VF z = SIMD_NAME(block_depths)(job, x0, j, a);
     const VM foreground = M_AND(V_GT(z, V_SET(0.0f)), V_LT(z, V_SET(INFINITY)));
     /* the least of positive floats and INFINITY: the same in any order.
      * Against the lanes stored and compared one after the other,
@@ -1396,8 +1354,7 @@ static inline float SIMD_NAME(block_step)(const hbao_horizon_job *job, int x0, i
 static void SIMD_NAME(block_in_classes)(const hbao_horizon_job *job, int x0, int x1, int j, int a) {
     float z[HBAO_BLOCK_PIXELS], class_step[HBAO_BLOCK_PIXELS];
     unsigned class_lanes[HBAO_BLOCK_PIXELS];
-    const float *row = SIMD_NAME(block_depths)(job, x0, j, a);
-    for (int k = 0; k < HBAO_BLOCK_PIXELS; k++) z[k] = row[k];
+    V_STOREU(z, SIMD_NAME(block_depths)(job, x0, j, a));
     float *out = job->ao + (size_t)j * job->grid->width;
     for (int i = x0 + a; i < x1; i += 4) out[i] = 1.0f; /* the lanes of no class */
     const int classes = hbao_block_classes(job->settings, job->grid, z, class_step, class_lanes);

@@ -283,13 +283,20 @@ typedef struct hbao_horizon_job {
     float direction_sin[16][HBAO_MAX_DIRECTIONS];
     float jitter[16];
     /* The depth deinterleaved by column phase (SIMD kernels only; NULL for
-     * the scalar reference): phase_depth[(a * height + j) * phase_width + X]
-     * is grid depth (4 X + a, j), 0 beyond the row's end. */
+     * the scalar reference), with the band past the image's edges that
+     * steps see (grid->beyond_band) filled in: phase_depth[(a * phase_rows
+     * + j) * phase_width + X] is grid depth (4 X + a, j) inside the image,
+     * hbao_beyond_depth's in the band, 0 past it, for rows j from
+     * -beyond_band to height + beyond_band - 1 and X from -phase_pad to
+     * phase_width - phase_pad - 1 (the pointer is the origin's, inside its
+     * buffer). A block's step into the band is then a plain load, like a
+     * step inside the image. */
     const float *phase_depth;
-    /* grid->back deinterleaved the same way (NULL without the layer) */
+    /* grid->back deinterleaved the same way, INFINITY (unknown) outside the
+     * image (NULL without the layer) */
     const float *phase_back;
-    int phase_width;
-    /* whether every index into phase_depth fits an int32 (4 * height *
+    int phase_width, phase_rows, phase_pad;
+    /* whether every index into phase_depth fits an int32 (4 * phase_rows *
      * phase_width < 2^31): the SIMD kernels' step plan then computes them */
     int int_indices;
 } hbao_horizon_job;

@@ -1023,13 +1023,18 @@ TEST_CASE(simd_paths_match_scalar_reference_bit_for_bit) {
      * background_needs_check) and the vector loop must test it. The
      * direction count cycles through an odd one, even ones that the SIMD
      * kernels set up in opposite pairs (6, 16: horizon_simd.h, block_ao) and
-     * an even one above those (18), set up one by one. */
+     * an even one above those (18), set up one by one. Variants 96 to 111
+     * repeat 0 to 15 with a radius of 8, whose steps reach past the band
+     * beyond the edges and a whole image away: a block near one side steps
+     * into the band past the other (a plain step there must still end the
+     * direction, as hbao_step_offset does). */
     const int direction_counts[4] = {7, 6, 16, 18};
     float *back = malloc(bytes);
     for (int k = 0; k < view.width * view.height; k++)
         back[k] = k % 3 == 0 ? 0.0f : depth[k] + 0.05f + 0.1f * (float)(k % 5);
-    for (int variant = 0; variant < 96; variant++) {
-        const float *layer = variant & 64 ? back : NULL;
+    for (int variant = 0; variant < 112; variant++) {
+        const int far = variant >= 96;
+        const float *layer = (far ? variant & 4 : variant & 64) ? back : NULL;
         hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
         p.thickness = (variant & 16) ? 0.2f : 0.0f;
         p.integration = variant & 1;
@@ -1038,8 +1043,8 @@ TEST_CASE(simd_paths_match_scalar_reference_bit_for_bit) {
         p.half_resolution = (variant >> 2) & 1;
         p.angle_bias_degrees = (variant & 8) ? 0.0f : 20.0f;
         p.directions = direction_counts[(variant + variant / 8) % 4];
-        p.steps = (variant & 32) ? 40 : 5;
-        p.radius = (variant & 32) ? 0.3f : 0.9f;
+        p.steps = far ? 12 : (variant & 32) ? 40 : 5;
+        p.radius = far ? 8.0f : (variant & 32) ? 0.3f : 0.9f;
         view.camera.projection =
             (variant & 8) ? HBAO_PROJECTION_ORTHOGRAPHIC : HBAO_PROJECTION_PERSPECTIVE;
         p.implementation = HBAO_IMPLEMENTATION_SCALAR;
