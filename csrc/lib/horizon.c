@@ -698,24 +698,14 @@ typedef struct deinterleave_job {
 typedef float four_floats __attribute__((vector_size(16)));
 #endif
 
-/* What phase_depth holds at column i of row j outside the image: the
- * band's depth (hbao_beyond_depth), 0 past the band. */
-static float outside_depth(const hbao_grid *g, int i, int j) {
-    const int band = g->beyond_band;
-    if (i < -band || i >= g->width + band || j < -band || j >= g->height + band) return 0.0f;
-    return hbao_beyond_depth(g, i, j);
-}
-
 /* Row j of the grid into its four column phases (out[a]: phase a's row at
  * X = 0): phase a gets columns 4 X + a, for X from -pad up to
- * phase_width - pad; outside the image, outside_depth (depth) or INFINITY
- * (the back layer's, unknown). A row outside the image (j < 0 or j >=
- * height) is all outside. */
+ * phase_width - pad; outside the image, hbao_beyond_fill's depths, or
+ * INFINITY where `back` (the back layer's: unknown). A row outside the
+ * image (j < 0 or j >= height) is all outside. */
 static void deinterleave(const hbao_grid *g, const float *row, int j, int phase_width, int pad,
                          int back, float *const out[4]) {
     const int inside_row = j >= 0 && j < g->height;
-    for (int a = 0; a < 4; a++)
-        for (int x = -pad; x < 0; x++) out[a][x] = back ? INFINITY : outside_depth(g, 4 * x + a, j);
     int x = 0;
 #ifdef HBAO_SHUFFLE_VECTOR
     /* 16 columns at a time, a 4 x 4 transpose in vector registers (SSE2's
@@ -736,12 +726,20 @@ static void deinterleave(const hbao_grid *g, const float *row, int j, int phase_
         for (int a = 0; a < 4; a++) memcpy(out[a] + x, &o[a], sizeof o[a]);
     }
 #endif
-    for (; x < phase_width - pad; x++) {
-        for (int a = 0; a < 4; a++) {
-            const int i = 4 * x + a;
-            out[a][x] = inside_row && i < g->width ? row[i]
-                        : back                     ? INFINITY
-                                                   : outside_depth(g, i, j);
+    for (int a = 0; a < 4; a++) {
+        /* the phase's columns inside the image: X < ceil((width - a) / 4) */
+        const int inside_end = inside_row ? (g->width - a + 3) / 4 : 0;
+        for (int i = x; i < inside_end; i++) out[a][i] = row[4 * i + a];
+        const int outside_from = inside_end > x ? inside_end : (inside_row ? x : -pad);
+        if (back) {
+            for (int i = -pad; i < 0; i++) out[a][i] = INFINITY;
+            for (int i = outside_from > 0 ? outside_from : 0; i < phase_width - pad; i++)
+                out[a][i] = INFINITY;
+        } else if (inside_row) {
+            hbao_beyond_fill(g, j, a, -pad, 0, out[a]);
+            hbao_beyond_fill(g, j, a, outside_from, phase_width - pad, out[a]);
+        } else {
+            hbao_beyond_fill(g, j, a, -pad, phase_width - pad, out[a]);
         }
     }
 }

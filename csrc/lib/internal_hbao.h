@@ -386,6 +386,10 @@ static inline float hbao_beyond_depth(const hbao_grid *grid, int si, int sj) {
 /* beyond.c: grid->beyond from the grid's depth and normals, and
  * grid->beyond_band. */
 void hbao_beyond_planes(hbao_grid *grid);
+/* beyond.c: out[x] = the depth at column 4 x + a of row j, for x in [from,
+ * to), every such column outside the image (hbao_beyond_depth within the
+ * band, 0 past it). */
+void hbao_beyond_fill(const hbao_grid *grid, int j, int a, int from, int to, float *out);
 /* Floats after grid->normal's last row: more than a block spans, so that a
  * kernel may load a block's normals as whole vectors from its first pixel
  * on, even in the z row of the grid's last row. */
