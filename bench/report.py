@@ -344,9 +344,10 @@ def write(results, images, native, docs):
     lines += ["", "Cycles' time includes its fixed cost per render (scene sync, BVH). "
               "HBAO's time excludes the pass hand-over of the add-on (see *The add-on's "
               "render path*). *Without border*: the RMSE over the image without a border "
-              f"of {scenes[0]['border_fraction']:g} of its width, where occluders outside "
-              "the image are missing (screen-space methods, EEVEE's included, cannot see "
-              "them).", ""]
+              f"of {scenes[0]['border_fraction']:g} of its width, where what occludes "
+              "lies partly outside the image, which a screen-space method cannot see "
+              "(HBAO takes the surfaces at the image's edge as going on flat; EEVEE "
+              "sees nothing there).", ""]
 
     shipped_key = sweep.setting_key(SHIPPED_DEFAULT)
     earlier_key = sweep.setting_key(EARLIER_DEFAULT)
@@ -439,7 +440,8 @@ def write(results, images, native, docs):
     lines += ["", "Converged (" + next(c["key"] for c in scenes[0]["converged"]).split(" ")[0]
               + ", no blur) RMSE, the method's own error per mode; in brackets without "
               f"a border of {scenes[0]['border_fraction']:g} of the width (occluders "
-              "outside the image are invisible to a screen-space method):", "",
+              "outside the image are invisible to a screen-space method, which at best "
+              "guesses them):", "",
               "| integration/falloff | " + " | ".join(s["scene"] for s in scenes) + " |",
               "|---|" + "---:|" * len(scenes)]
     for k, c0 in enumerate(scenes[0]["converged"]):

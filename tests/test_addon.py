@@ -1283,21 +1283,24 @@ def test_guard_band_sees_occluders_outside_the_frame(run_in_blender, tmp_path, n
     """Two nodes, one with a guard band of 12.5 % (an extra 1-sample Cycles
     render through a camera 1.25 times as wide). The truth: the library on a
     real render 1.25 times as large through that wider camera (120x80, the
-    same pixel scale), cropped to the frame. Near the frame's edges the node
-    without a band is too bright (no samples outside); the band's AO is far
-    closer to the truth there, and no worse inside."""
+    same pixel scale), cropped to the frame. A box stands on the floor just
+    past the frame's right side: near the frame's edges the node without a
+    band is too bright (it takes the floor there as going on flat, without
+    the box); the band's AO is far closer to the truth there, and no worse
+    inside."""
     width, height, scale = 96, 64, 1.25
     columns, rows = 12, 8  # 12.5 % of 96 and 64
     node = {"radius": 1.0}
     out, log = render(run_in_blender, tmp_path,
-                      {"resolution": [width, height],
+                      {"resolution": [width, height], "box_past_frame": True,
                        "nodes": [dict(node, name="HBAO0"),
                                  dict(node, name="HBAO1", guard_band=12.5)]})
     assert "guard band" in log and "no guard band" not in log, log[-3000:]
     assert extra_renders(log)["frame 1"] == [".HBAO guard band Scene"]
     wide_out, _ = render(run_in_blender, tmp_path,
                          {"resolution": [int(width * scale), int(height * scale)],
-                          "widen_camera": scale, "nodes": [node]}, name="wide")
+                          "box_past_frame": True, "widen_camera": scale, "nodes": [node]},
+                         name="wide")
     wide = library_ao(node_native, wide_out, 1, node_params(radius=1.0))
     truth = wide[rows:rows + height, columns:columns + width]
     without = node_outputs(out, 1, "HBAO0")["ao"]

@@ -71,6 +71,7 @@ import sys
 import threading
 
 import bpy
+from mathutils import Vector
 
 argv = sys.argv[sys.argv.index("--") + 1:]
 spec = json.loads(argv[0])
@@ -78,6 +79,7 @@ out_dir = argv[1]
 REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(REPO, "scripts"))
 import blender_scenes  # noqa: E402
+import scene_parts  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from writes_refused import while_writes_refused  # noqa: E402
@@ -88,6 +90,13 @@ samples = spec.get("samples", 4)
 engine = spec.get("engine", "CYCLES")
 scene = bpy.context.scene
 blender_scenes.SCENE_BUILDERS[spec.get("scene", "corner")](scene, resolution, engine, samples)
+if spec.get("box_past_frame"):  # a box on the floor just past the frame's right side
+    frame = scene.camera.data.view_frame(scene=scene)
+    per_unit = max(corner.x for corner in frame) / -frame[0].z  # half the width per unit away
+    away = scene["hbao_target_distance"]
+    centre = scene.camera.matrix_world @ Vector((1.15 * per_unit * away, 0.0, -away))
+    scene_parts.box("Past the frame", (centre.x, centre.y, 0.6), (0.3, 0.3, 1.2),
+                    scene.collection)
 if spec.get("ao_reference"):
     blender_scenes.configure_ao_reference(scene, spec["ao_reference"])
 if spec.get("orthographic"):
