@@ -26,7 +26,9 @@ static void edge_plane(const hbao_grid *grid, int i, int j, float *plane, size_t
 
 void hbao_beyond_planes(hbao_grid *grid) {
     const int width = grid->width, height = grid->height;
-    grid->beyond_band = (width > height ? width : height) / HBAO_BEYOND_BAND_DIVISOR;
+    const int band = (width > height ? width : height) / HBAO_BEYOND_BAND_DIVISOR;
+    grid->beyond_columns = band < width - 1 ? band : width - 1;
+    grid->beyond_rows = band < height - 1 ? band : height - 1;
     const size_t length = hbao_beyond_row_floats(width);
     const int pad = HBAO_BEYOND_PAD(width);
     for (int r = 0; r < 2; r++) {
@@ -46,13 +48,14 @@ void hbao_beyond_planes(hbao_grid *grid) {
 
 /* out[x] for x in [from, to): what the depth holds at column 4 x + a of row
  * j, every such column outside the image: hbao_beyond_depth's within the
- * band past the edges (grid->beyond_band), 0 past it. The same operations
+ * band past the edges (grid->beyond_columns, beyond_rows), 0 past it. The same operations
  * as hbao_beyond_depth, as loops over whole runs that the compiler
  * vectorizes (the SIMD kernels' deinterleaved depth carries the band:
  * horizon.c). */
 void hbao_beyond_fill(const hbao_grid *grid, int j, int a, int from, int to, float *out) {
-    const int width = grid->width, height = grid->height, band = grid->beyond_band;
-    if (j < -band || j >= height + band) {
+    const int width = grid->width, height = grid->height;
+    const int band = grid->beyond_columns, rows = grid->beyond_rows;
+    if (j < -rows || j >= height + rows) {
         for (int x = from; x < to; x++) out[x] = 0.0f;
         return;
     }

@@ -59,8 +59,8 @@ static inline int march_sample(const march *m, int step, float delta[3], float *
     if (!hbao_step_offset(g, m->dc, m->ds, m->inv_ycor, m->jitter, m->step_px, step, &ox, &oy))
         return SAMPLE_END;
     const int si = m->i + ox, sj = m->j + oy;
-    const int band = g->beyond_band;
-    if (si < -band || sj < -band || si >= g->width + band || sj >= g->height + band)
+    const int columns = g->beyond_columns, rows = g->beyond_rows;
+    if (si < -columns || sj < -rows || si >= g->width + columns || sj >= g->height + rows)
         return SAMPLE_END;
     if (ox == 0 && oy == 0) return SAMPLE_SKIP;
     const int inside = si >= 0 && sj >= 0 && si < g->width && sj < g->height;
@@ -747,7 +747,7 @@ static void deinterleave(const hbao_grid *g, const float *row, int j, int phase_
 static void deinterleave_row(void *context, int r) {
     const deinterleave_job *job = context;
     const hbao_grid *g = job->grid;
-    const int j = r - g->beyond_band;
+    const int j = r - g->beyond_rows;
     const size_t offset = j >= 0 && j < g->height ? (size_t)j * g->width : 0;
     float *out[4];
     for (int a = 0; a < 4; a++)
@@ -810,17 +810,17 @@ uint32_t hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *g
     float *phase_depth = NULL, *phase_back = NULL;
     job.phase_depth = NULL;
     job.phase_back = NULL;
-    /* whole blocks, so that a block's depths are always one full load */
     /* whole blocks, so that a block's depths are always one full load, and
      * a block's lanes stepped into the band too */
-    const int band = grid->beyond_band;
-    job.phase_pad = (band + 3) / 4 + 1;
-    job.phase_rows = grid->height + 2 * band;
-    job.phase_width = (job.phase_pad + (grid->width + band + 3) / 4 + 2 * HBAO_BLOCK_PIXELS - 1) /
-                      HBAO_BLOCK_PIXELS * HBAO_BLOCK_PIXELS;
+    const int columns = grid->beyond_columns, rows = grid->beyond_rows;
+    job.phase_pad = (columns + 3) / 4 + 1;
+    job.phase_rows = grid->height + 2 * rows;
+    job.phase_width =
+        (job.phase_pad + (grid->width + columns + 3) / 4 + 2 * HBAO_BLOCK_PIXELS - 1) /
+        HBAO_BLOCK_PIXELS * HBAO_BLOCK_PIXELS;
     job.int_indices = (int64_t)4 * job.phase_rows * job.phase_width <= INT32_MAX;
     /* the origin: row 0, X = 0 of phase 0 */
-    const ptrdiff_t origin = (ptrdiff_t)band * job.phase_width + job.phase_pad;
+    const ptrdiff_t origin = (ptrdiff_t)rows * job.phase_width + job.phase_pad;
     if (tiled.simd != NULL) {
         const size_t bytes = (size_t)4 * job.phase_rows * job.phase_width * sizeof(float);
         phase_depth = hbao_scratch_take(bytes);

@@ -215,9 +215,9 @@ static inline void SIMD_NAME(step_lanes_of)(const SIMD_NAME(block) * b, VF step,
     const VI sj = I_ADD(I_SET(b->j), v->oy);
     const VF sj_float = I_TO_F(sj);
     v->ox_float = I_TO_F(v->ox);
-    const float band = (float)g->beyond_band;
+    const float rows = (float)g->beyond_rows;
     v->row_in_band =
-        M_AND(V_GE(sj_float, V_SET(-band)), V_LT(sj_float, V_SET((float)g->height + band)));
+        M_AND(V_GE(sj_float, V_SET(-rows)), V_LT(sj_float, V_SET((float)g->height + rows)));
     /* lane k samples column first_i + 4 k + ox: phase (phase + ox) mod
      * 4, index first_x + k + floor((phase + ox) / 4) of that phase's row */
     const VI moved = I_ADD(I_SET(b->phase), v->ox);
@@ -236,14 +236,14 @@ static inline VM SIMD_NAME(inside_lanes)(const hbao_grid *g, const SIMD_NAME(ste
 
 /* The lanes whose step is plain: the sample row, and lane 0's and the last
  * lane's columns (exact small integers as floats), within the band past the
- * image (grid->beyond_band), whose depths phase_depth holds, and the step
+ * image (grid->beyond_columns, beyond_rows), whose depths phase_depth holds, and the step
  * less than an image away (inside_bits: a block near one side can reach
  * the band past the other). */
 static inline unsigned SIMD_NAME(plain_bits)(const SIMD_NAME(block) * b,
                                              const SIMD_NAME(step_lanes) * v) {
     const hbao_grid *g = b->grid;
     const VF column0 = V_ADD(V_SET((float)b->first_i), v->ox_float);
-    const float band = (float)g->beyond_band;
+    const float band = (float)g->beyond_columns;
     const VM in_band =
         M_AND(v->row_in_band, M_AND(V_GE(column0, V_SET(-band)),
                                     V_LT(V_ADD(column0, V_SET((float)(4 * (SIMD_LANES - 1)))),
@@ -385,7 +385,7 @@ static inline const float *SIMD_NAME(lane_address)(const float *row, int first) 
 }
 
 /* A step that is not plain: lanes whose column leaves the band past the
- * image's sides (grid->beyond_band) stop (in *alive), and only the lanes
+ * image's sides (grid->beyond_columns) stop (in *alive), and only the lanes
  * within it read (phase_depth holds the band's depths: the image's edge
  * continued, hbao_beyond_depth). Returns 0 where every lane's sample row,
  * or every lane's column, has left the band: the direction's search ends
@@ -395,9 +395,9 @@ static int SIMD_NAME(fetch_at_side)(const SIMD_NAME(block) * b, int ox, int oy, 
                                     SIMD_NAME(fetch) * f) {
     const hbao_grid *g = b->grid;
     const hbao_horizon_job *job = b->job;
-    const int band = g->beyond_band, phase_width = job->phase_width;
+    const int band = g->beyond_columns, phase_width = job->phase_width;
     const int sj = b->j + oy;
-    if (sj < -band || sj >= g->height + band) return 0;
+    if (sj < -g->beyond_rows || sj >= g->height + g->beyond_rows) return 0;
     const VF si = I_TO_F(I_ADD(b->lane_i, I_SET(ox))); /* exact: |si| < 2^24 */
     *alive = M_AND(*alive, M_AND(V_GE(si, V_SET((float)-band)),
                                  V_LT(si, V_SET((float)g->width + (float)band))));

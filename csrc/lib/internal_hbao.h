@@ -93,7 +93,12 @@ typedef struct hbao_grid {
      * edge see continued (hbao_beyond_depth; beyond.c fills them once the
      * normals are known): hbao_beyond_floats(width, height) floats. */
     float *beyond;
-    int beyond_band; /* how far past the edges steps go on, in grid pixels */
+    /* How far past the edges steps go on, in grid pixels, past the left and
+     * right sides and past the top and bottom: the band of
+     * HBAO_BEYOND_BAND_DIVISOR, but no more than a step less than an image
+     * away can reach (width - 1, height - 1), which bounds the band's
+     * memory for a grid much longer than wide */
+    int beyond_columns, beyond_rows;
 } hbao_grid;
 
 /* Component c (x, y, z) of row j's normals; row `height` is the padding */
@@ -284,10 +289,11 @@ typedef struct hbao_horizon_job {
     float jitter[16];
     /* The depth deinterleaved by column phase (SIMD kernels only; NULL for
      * the scalar reference), with the band past the image's edges that
-     * steps see (grid->beyond_band) filled in: phase_depth[(a * phase_rows
-     * + j) * phase_width + X] is grid depth (4 X + a, j) inside the image,
-     * hbao_beyond_depth's in the band, 0 past it, for rows j from
-     * -beyond_band to height + beyond_band - 1 and X from -phase_pad to
+     * steps see (grid->beyond_columns, beyond_rows) filled in:
+     * phase_depth[(a * phase_rows + j) * phase_width + X] is grid depth
+     * (4 X + a, j) inside the image, hbao_beyond_depth's in the band, 0 past
+     * it, for rows j from -beyond_rows to height + beyond_rows - 1 and X
+     * from -phase_pad to
      * phase_width - phase_pad - 1 (the pointer is the origin's, inside its
      * buffer). A block's step into the band is then a plain load, like a
      * step inside the image. */
@@ -322,10 +328,11 @@ typedef struct hbao_horizon_job {
  * grid->beyond holds each edge pixel's plane as four floats, n0 n1 n2 and
  * dot(n, P) (NaN where the pixel is background), in two tables:
  * - the top and bottom rows' (samples above or below the image, corners
- *   included), for columns -HBAO_BEYOND_PAD(width) .. 2 width + pad, each
+ *   included), for columns -HBAO_BEYOND_PAD(width) .. 2 width + pad (a
+ *   step less than an image away reaches 1 - width .. 2 width - 2), each
  *   column taking the plane of the nearest column inside, and laid out as
- *   phase_depth is (by column phase, so a SIMD block's lanes, four columns
- *   apart, are one contiguous load): float (row r, term q, column c) at
+ *   phase_depth is (by column phase, so that a phase row's run of the band
+ *   is a run of each term: hbao_beyond_fill): float (row r, term q, column c) at
  *   ((4 r + q) 4 + x % 4) hbao_beyond_row_floats(width) + x / 4, x = c +
  *   pad;
  * - the left and right columns' (samples beside the image), four floats a
@@ -334,7 +341,7 @@ typedef struct hbao_horizon_job {
 #define HBAO_BEYOND_PAD(width) (((width) + 3) / 4 * 4)
 
 /* Floats of one phase row of the row tables: columns up to 2 width past
- * the pad, and a whole vector more, so that any block's lanes load. */
+ * the pad, and a vector's more to spare. */
 static inline size_t hbao_beyond_row_floats(int width) {
     return ((size_t)HBAO_BEYOND_PAD(width) + 2 * (size_t)width + 3) / 4 + HBAO_BLOCK_PIXELS;
 }
@@ -375,7 +382,7 @@ static inline float hbao_beyond_depth(const hbao_grid *grid, int si, int sj) {
 }
 
 /* Steps go on past the edges for the image's longer side over this many
- * pixels (grid->beyond_band), then end their direction as at a whole
+ * pixels (grid->beyond_columns, beyond_rows), then end their direction as at a whole
  * image away: 120 pixels at 1920x1080. bench/guard_band.py's real guard
  * bands, 480x270: a band of 1/16 of the width reached nearly all that 1/8
  * and 1/4 did. Continued without end (an image away), the four 1080p
@@ -384,7 +391,7 @@ static inline float hbao_beyond_depth(const hbao_grid *grid, int si, int sj) {
 #define HBAO_BEYOND_BAND_DIVISOR 16
 
 /* beyond.c: grid->beyond from the grid's depth and normals, and
- * grid->beyond_band. */
+ * grid->beyond_columns and beyond_rows. */
 void hbao_beyond_planes(hbao_grid *grid);
 /* beyond.c: out[x] = the depth at column 4 x + a of row j, for x in [from,
  * to), every such column outside the image (hbao_beyond_depth within the

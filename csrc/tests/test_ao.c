@@ -1067,6 +1067,38 @@ TEST_CASE(simd_paths_match_scalar_reference_bit_for_bit) {
     free(normal);
 }
 
+/* A grid far taller than wide (or wider than tall): the band past the
+ * edges (max(W, H) / 16) is cut to what a step less than an image away can
+ * reach on each axis, so the padded depth the SIMD kernels read and the
+ * fill of its band stay within their buffers (an early form read before
+ * the plane tables at 1 x 1152 and sized 2.4 GB for 65536 x 1), and every
+ * kernel still gives the reference's floats. */
+TEST_CASE(long_thin_images_match_the_scalar_reference) {
+    const int sizes[][2] = {{3, 1200}, {1, 1152}, {1200, 2}, {5, 5}};
+    for (int k = 0; k < 4; k++) {
+        scene_view view;
+        float *depth, *normal;
+        render_standard_view(corner_scene(), sizes[k][0], sizes[k][1], &view, &depth, &normal);
+        const size_t bytes = (size_t)view.width * view.height * sizeof(float);
+        hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+        p.radius = 2.0f;
+        p.implementation = HBAO_IMPLEMENTATION_SCALAR;
+        float *scalar = run(&p, &view, depth, normal);
+        for (int kernel = HBAO_IMPLEMENTATION_AVX2; kernel <= HBAO_IMPLEMENTATION_AVX512;
+             kernel++) {
+            p.implementation = kernel;
+            float *fast = run(&p, &view, depth, normal);
+            CHECK(memcmp(scalar, fast, bytes) == 0);
+            for (size_t q = 0; q < bytes / sizeof(float); q++)
+                CHECK(fast[q] >= 0.0f && fast[q] <= 1.0f);
+            free(fast);
+        }
+        free(scalar);
+        free(depth);
+        free(normal);
+    }
+}
+
 /* The SIMD kernels plan a direction's steps a vector at a time, and two
  * directions in one vector where the steps fit in half of it (up to 8); a
  * group's plans are made ahead, two at a time or one (horizon_simd.h,
@@ -1881,6 +1913,7 @@ TEST_MAIN(TEST_ENTRY(plane_facing_camera_is_unoccluded), TEST_ENTRY(tilted_plane
           TEST_ENTRY(strength_is_a_power), TEST_ENTRY(background_never_occludes),
           TEST_ENTRY(tiny_projected_radius_gives_one),
           TEST_ENTRY(simd_paths_match_scalar_reference_bit_for_bit),
+          TEST_ENTRY(long_thin_images_match_the_scalar_reference),
           TEST_ENTRY(every_step_and_direction_count_matches_the_scalar_reference),
           TEST_ENTRY(a_post_at_the_lens_leaves_the_ao_of_its_blocks),
           TEST_ENTRY(a_back_layer_of_the_half_float_sky_is_no_back_layer),

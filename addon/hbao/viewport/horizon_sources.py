@@ -157,7 +157,8 @@ float occlusion(ivec2 p)
             }
             bool in_image = all(greaterThanEqual(q, ivec2(0))) && all(lessThan(q, image_size));
             float zs = in_image ? depth_at(q) : beyond_depth(q);
-            if (is_background(zs) || zs < near_limit) {
+            /* a continued plane's depth is any positive one, as the library's */
+            if ((in_image ? is_background(zs) : !(zs > 0.0)) || zs < near_limit) {
                 continue;
             }
             vec3 delta = position_at(q, zs) - position;
