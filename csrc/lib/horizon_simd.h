@@ -148,7 +148,7 @@ typedef struct SIMD_NAME(fetch) {
     VF zb;        /* the back layer's depth there (INFINITY: unknown) */
     float row;    /* the samples' hbao_grid y, the same for all lanes */
     float ox;     /* the step's pixel offset along the row, as a float */
-    VM candidate; /* inside the image, on another pixel */
+    VM candidate; /* within the band past the image, on another pixel */
 } SIMD_NAME(fetch);
 
 /* A direction's steps for a whole block, worked out SIMD_LANES steps at a
