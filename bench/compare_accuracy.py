@@ -10,16 +10,14 @@ change to the horizon search or the blur that is meant to keep the accuracy
 
 Needs the renders of `scripts/benchmark.sh --quick` in .cache/bench/."""
 import itertools
-import json
-import os
 import statistics
-import subprocess
 import sys
 from pathlib import Path
 
 import config
 import run_benchmark
 import sweep
+import two_builds
 
 REPO = Path(__file__).resolve().parent.parent
 
@@ -40,23 +38,14 @@ def measure():
             key = sweep.setting_key(setting)
             rmse.setdefault(key, {})[scene] = sweep.metrics.error_stats(
                 ao, data.truth, data.mask)["rmse"]
-    print(json.dumps(rmse))
-
-
-def run_with(library):
-    env = dict(os.environ, HBAO_LIBRARY=str(Path(library).resolve()))
-    done = subprocess.run([sys.executable, __file__, "--measure"], env=env, check=True,
-                          capture_output=True, text=True)
-    return json.loads(done.stdout)
+    return rmse
 
 
 def main():
-    if sys.argv[1:] == ["--measure"]:
-        measure()
+    builds = two_builds.before_and_after(__file__, measure, __doc__)
+    if builds is None:
         return
-    if len(sys.argv) != 3:
-        sys.exit(__doc__)
-    before, after = run_with(sys.argv[1]), run_with(sys.argv[2])
+    before, after = builds
     scenes = sorted(next(iter(before.values())))
     print("| setting | " + " | ".join(scenes) + " | mean change |")
     print("|---" * (len(scenes) + 2) + "|")

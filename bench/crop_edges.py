@@ -12,13 +12,9 @@ continued that does not go on, such as a curved body that the crop cuts).
     /usr/bin/python3 bench/crop_edges.py BEFORE.so AFTER.so
 
 Needs the renders of `scripts/benchmark.sh --quick` in .cache/bench/."""
-import json
-import os
 import random
 import statistics
-import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 
@@ -26,6 +22,7 @@ import config
 import metrics
 import run_benchmark
 import sweep
+import two_builds
 
 CROPS = 12
 EDGE_PIXELS = 24
@@ -64,23 +61,14 @@ def measure():
             counted = edge & foreground[y:y + h, x:x + w]
             errors.append(float(np.abs(ao - whole[y:y + h, x:x + w])[counted].mean()))
         found[scene] = errors
-    print(json.dumps(found))
-
-
-def run_with(library):
-    env = dict(os.environ, HBAO_LIBRARY=str(Path(library).resolve()))
-    done = subprocess.run([sys.executable, __file__, "--measure"], env=env, check=True,
-                          capture_output=True, text=True)
-    return json.loads(done.stdout)
+    return found
 
 
 def main():
-    if sys.argv[1:] == ["--measure"]:
-        measure()
+    builds = two_builds.before_and_after(__file__, measure, __doc__)
+    if builds is None:
         return
-    if len(sys.argv) != 3:
-        sys.exit(__doc__)
-    before, after = run_with(sys.argv[1]), run_with(sys.argv[2])
+    before, after = builds
     print(f"Mean |crop AO - whole frame's AO| within {EDGE_PIXELS} px of the crop's edges, "
           f"{CROPS} crops a scene (seed {SEED}):\n")
     print("| scene | before: mean (worst crop) | after: mean (worst crop) | crops worse after |")
