@@ -4,10 +4,12 @@
 # prints ms per frame for the settings issue 11 sets targets for (the
 # defaults at 1920x1080 full and half resolution, 8 x 6 with a 15-pixel blur,
 # the defaults at 3840x2160), one column per implementation this CPU has
-# (scalar on 1 thread, AVX2 and AVX-512 on 1 and 2 threads), the blur's share
+# (scalar on 1 thread; the generic kernel, AVX2 and AVX-512 on 1 and 2
+# threads), the blur's share
 # and the targets beside the medians. With the default 5 runs it takes a few
 # minutes, most of it in the scalar column.
-#   scripts/bench_speed.sh [--runs N] [--implementations scalar,avx2,avx512] [--no-4k] [--quick]
+#   scripts/bench_speed.sh [--runs N] [--implementations scalar,generic,avx2,avx512] [--no-4k]
+#                          [--quick]
 #                          [--radius R]      (--quick = --runs 3 --no-4k)
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"

@@ -2,7 +2,8 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 # Installs what building, testing and running the demo need on Debian 12 or 13
 # (Debian's Blender, the C toolchain, clang with its sanitizer and libFuzzer
-# runtime, OpenEXR, libpng, cJSON, libdeflate, numpy, pytest, Xvfb). PyPI's bpy builds come
+# runtime, a cross compiler for ARM64 and qemu-user to run its tests, OpenEXR,
+# libpng, cJSON, libdeflate, numpy, pytest, Xvfb). PyPI's bpy builds come
 # from scripts/setup_bpy.sh. Idempotent: does nothing when everything is there.
 set -euo pipefail
 
@@ -21,6 +22,7 @@ PACKAGES=(
     cmake gcc make pkg-config
     clang "libclang-rt-$LLVM-dev"  # the SIMD kernels; fuzz targets (libFuzzer, ASan, UBSan); LLVM $LLVM
     clang-format                 # the C style check (.clang-format)
+    gcc-aarch64-linux-gnu libc6-dev-arm64-cross qemu-user  # scripts/test_arm64.sh: ARM64 build, run emulated
     libopenexr-dev     # OpenEXRCore, the EXR reader/writer of the CLI
     openexr            # exrheader: the reference reader our written EXRs are checked with
     libpng-dev         # --preview PNGs

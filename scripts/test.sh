@@ -4,8 +4,9 @@
 #   1. install what is missing (scripts/setup.sh),
 #   2. build (Release) and run the C tests (ctest),
 #   3. build again with AddressSanitizer + UndefinedBehaviorSanitizer and run
-#      the C tests and a mutation pass of the CLI under it, then 60 s of the
-#      libFuzzer targets (scripts/fuzz.sh),
+#      the C tests and a mutation pass of the CLI under it; cross-build for
+#      ARM64 and run the C tests under qemu-user (scripts/test_arm64.sh); then
+#      60 s of the libFuzzer targets (scripts/fuzz.sh),
 #   4. check PEP 8 of all Python code,
 #   5. run the Python tests (pytest): the ctypes binding, the CLI on EXRs
 #      written by Blender, the add-on in real headless and Xvfb Blender renders,
@@ -40,6 +41,9 @@ ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
     ctest --test-dir build-sanitize --output-on-failure --no-tests=error -j"$JOBS"
 # 100 mutations per fixture keep this step short; the script defaults to 500
 scripts/fuzz_cli.sh 100 1
+
+echo "== ARM64: cross-built, C tests under qemu-user (the generic kernel on Advanced SIMD)"
+scripts/test_arm64.sh
 
 echo "== coverage-guided fuzzing (libFuzzer + ASan + UBSan), 60 s"
 scripts/fuzz.sh 60

@@ -58,7 +58,7 @@ static void usage(const char *program) {
     fprintf(stderr,
             "usage: %s BEFORE_LIBRARY AFTER_LIBRARY [--rounds R] [--calls N] [--threads T] "
             "[--half] [--radius R] [--directions D] [--steps S] [--blur B] [--size WxH]\n"
-            "  [--implementation scalar|avx2|avx512] (default: the best this CPU has) "
+            "  [--implementation scalar|generic|avx2|avx512] (default: the best this CPU has) "
             "[--back-faces] [--background P]\n",
             program);
 }
@@ -108,7 +108,7 @@ int main(int argc, char **argv) {
         fprintf(stderr,
                 "bench_ab: --rounds 1-100, --calls 1-1000, --threads 1-64, radius > 0, "
                 "--directions 1-%d, --steps 1-%d, --blur 0-%d, --implementation "
-                "scalar, avx2 or avx512, --size WxH with W and H in 16-8192, "
+                "scalar, generic, avx2 or avx512, --size WxH with W and H in 16-8192, "
                 "--background 0-100\n",
                 HBAO_MAX_DIRECTIONS, HBAO_MAX_STEPS, HBAO_MAX_BLUR_SIZE);
         return 2;

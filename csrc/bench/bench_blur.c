@@ -8,7 +8,7 @@
  * sources (the stage is internal). scripts/bench_blur_ab.sh runs two
  * builds of it against each other.
  *   bench_blur [--calls N] [--blur B] [--sharpness S] [--size WxH]
- *              [--threads T] [--implementation scalar|avx2|avx512]
+ *              [--threads T] [--implementation scalar|generic|avx2|avx512]
  *              [--background P]
  * Prints one line: the fastest and the median CPU ms of N calls, and a
  * hash of the output's bits (the same for every build that blurs alike).
@@ -24,7 +24,7 @@
 static void usage(const char *program) {
     fprintf(stderr,
             "usage: %s [--calls N] [--blur B] [--sharpness S] [--size WxH] [--threads T]\n"
-            "  [--implementation scalar|avx2|avx512] (default: the best this CPU has)\n"
+            "  [--implementation scalar|generic|avx2|avx512] (default: the best this CPU has)\n"
             "  [--background P] (the upper P per cent of the rows background; default 0)\n",
             program);
 }
@@ -68,7 +68,7 @@ int main(int argc, char **argv) {
         fprintf(stderr,
                 "bench_blur: --calls 1-1000, --blur an odd size 1-%d, --sharpness 0-%g, "
                 "--size WxH with each 16-16384, --threads 1-64, --implementation "
-                "scalar|avx2|avx512, --background 0-100\n",
+                "scalar|generic|avx2|avx512, --background 0-100\n",
                 HBAO_MAX_BLUR_SIZE, (double)HBAO_MAX_BLUR_SHARPNESS);
         return 2;
     }

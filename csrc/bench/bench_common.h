@@ -49,19 +49,23 @@ static inline float bench_positive_number(const char *text) {
     return end != text && *end == '\0' && value > 0.0f && isfinite(value) ? value : 0.0f;
 }
 
-/* hbao_implementation by name (scalar, avx2, avx512); -1 if none */
+/* hbao_implementation by name (scalar, generic, avx2, avx512); -1 if none */
 static inline int bench_implementation(const char *name) {
     if (!strcmp(name, "scalar")) return HBAO_IMPLEMENTATION_SCALAR;
+    if (!strcmp(name, "generic")) return HBAO_IMPLEMENTATION_GENERIC;
     if (!strcmp(name, "avx2")) return HBAO_IMPLEMENTATION_AVX2;
     if (!strcmp(name, "avx512")) return HBAO_IMPLEMENTATION_AVX512;
     return -1;
 }
 
 /* The name an hbao_implementation is printed by (AUTO, SCALAR, AVX2,
- * AVX512) */
+ * AVX512, GENERIC) */
 static inline const char *bench_implementation_label(int implementation) {
-    static const char *const labels[] = {"auto", "scalar", "AVX2", "AVX-512"};
-    return implementation >= 0 && implementation < 4 ? labels[implementation] : "?";
+    static const char *const labels[] = {"auto", "scalar", "AVX2", "AVX-512", "generic"};
+    _Static_assert(sizeof labels / sizeof labels[0] == HBAO_IMPLEMENTATION_COUNT, "a label each");
+    return implementation >= 0 && implementation < HBAO_IMPLEMENTATION_COUNT
+               ? labels[implementation]
+               : "?";
 }
 
 static inline double clock_seconds(clockid_t clock) {

@@ -4,8 +4,8 @@
  * settings issue 11 sets targets for: the defaults (cosine 4 x 16, blur 5)
  * at 1920x1080 full and half resolution, 8 x 6 with a 15-pixel blur, and the
  * defaults at 3840x2160. Each row is timed for every implementation the CPU
- * has (the scalar reference on 1 thread, AVX2 and AVX-512 on 1 and 2
- * threads; --implementations picks which), median of --runs rounds after a
+ * has (the scalar reference on 1 thread, the generic kernel, AVX2 and
+ * AVX-512 on 1 and 2 threads; --implementations picks which), median of --runs rounds after a
  * warm-up round; a round times every column once, so that ratios compare
  * like with like on a loaded machine. The blur's share is the row's time
  * minus the same row without blur, over the row's time, on the last column. Prints
@@ -41,6 +41,8 @@ typedef struct bench_column {
 
 static const bench_column all_columns[] = {
     {"scalar, 1 thread", HBAO_IMPLEMENTATION_SCALAR, 1},
+    {"generic, 1 thread", HBAO_IMPLEMENTATION_GENERIC, 1},
+    {"generic, 2 threads", HBAO_IMPLEMENTATION_GENERIC, 2},
     {"AVX2, 1 thread", HBAO_IMPLEMENTATION_AVX2, 1},
     {"AVX2, 2 threads", HBAO_IMPLEMENTATION_AVX2, 2},
     {"AVX-512, 1 thread", HBAO_IMPLEMENTATION_AVX512, 1},
@@ -98,7 +100,7 @@ static int parse_implementations(const char *list, int wanted[COLUMN_COUNT]) {
 static void usage(const char *program) {
     fprintf(stderr,
             "usage: %s [--runs N] [--implementations LIST] [--no-4k] [--quick] [--radius R]\n"
-            "  LIST: comma-separated scalar,avx2,avx512 (default: all this CPU has)\n"
+            "  LIST: comma-separated scalar,generic,avx2,avx512 (default: all this CPU has)\n"
             "  --quick: --runs 3 --no-4k\n",
             program);
 }
@@ -107,7 +109,7 @@ int main(int argc, char **argv) {
     int runs = 5, with_4k = 1;
     float radius = 0.5f;
     int wanted[COLUMN_COUNT];
-    parse_implementations("scalar,avx2,avx512", wanted);
+    parse_implementations("scalar,generic,avx2,avx512", wanted);
     for (int a = 1; a < argc; a++) {
         if (!strcmp(argv[a], "--runs") && a + 1 < argc)
             runs = (int)bench_whole_number(argv[++a], 1, 1000);
@@ -136,7 +138,9 @@ int main(int argc, char **argv) {
      * kernel (the library's rule), so it is left out instead. */
     const int best = hbao_best_implementation();
     for (int c = 0; c < COLUMN_COUNT; c++)
-        if (all_columns[c].implementation > best) wanted[c] = 0;
+        if (hbao_implementation_that_runs(all_columns[c].implementation) !=
+            all_columns[c].implementation)
+            wanted[c] = 0;
 
     const bench_row rows[] = {
         {"defaults, full", 1920, 1080, HBAO_DEFAULT_DIRECTIONS, HBAO_DEFAULT_STEPS,

@@ -178,14 +178,20 @@ typedef struct hbao_params {
     float thickness;
 } hbao_params;
 
-/** The horizon search exists as a portable scalar reference and as SIMD
- *  kernels chosen at run time. A kernel the CPU lacks falls back to the best
- *  one below it. Unknown values are rejected. */
+/** The horizon search exists as a portable scalar reference and as kernels
+ *  that search 16 pixels at once, chosen at run time; every one gives the
+ *  reference's floats to the bit. From the slowest to the fastest: SCALAR,
+ *  GENERIC, AVX2, AVX512. A kernel the CPU (or the compiler that built the
+ *  library) lacks falls back to the fastest one slower than it. Unknown
+ *  values are rejected. */
 typedef enum hbao_implementation {
-    HBAO_IMPLEMENTATION_AUTO = 0,   /**< the fastest this CPU runs */
-    HBAO_IMPLEMENTATION_SCALAR = 1, /**< portable C, the reference */
-    HBAO_IMPLEMENTATION_AVX2 = 2,   /**< 8 pixels at a time (x86-64) */
-    HBAO_IMPLEMENTATION_AVX512 = 3  /**< 16 pixels at a time (x86-64) */
+    HBAO_IMPLEMENTATION_AUTO = 0,    /**< the fastest this CPU runs */
+    HBAO_IMPLEMENTATION_SCALAR = 1,  /**< portable C, a pixel at a time: the reference */
+    HBAO_IMPLEMENTATION_AVX2 = 2,    /**< in pairs of AVX2 registers (x86-64) */
+    HBAO_IMPLEMENTATION_AVX512 = 3,  /**< in AVX-512 registers (x86-64) */
+    HBAO_IMPLEMENTATION_GENERIC = 4, /**< in the compiler's generic vectors, for any
+                                          CPU: SSE2 on x86-64, Advanced SIMD on ARM64 */
+    HBAO_IMPLEMENTATION_COUNT        /**< not an implementation: one past the last */
 } hbao_implementation;
 
 /* The defaults were chosen with the accuracy benchmark (docs/benchmark.md):
@@ -342,6 +348,13 @@ HBAO_EXPORT void hbao_camera_default(hbao_camera *camera);
 
 /** The hbao_implementation that HBAO_IMPLEMENTATION_AUTO runs on this CPU. */
 HBAO_EXPORT int32_t hbao_best_implementation(void);
+
+/** The hbao_implementation that runs on this CPU when `requested` is asked
+ *  for: itself where the CPU and the build have it, else the fastest one
+ *  slower than it (hbao_implementation's order); AUTO gives
+ *  hbao_best_implementation(). An unknown value gives SCALAR (hbao_compute
+ *  rejects it). */
+HBAO_EXPORT int32_t hbao_implementation_that_runs(int32_t requested);
 
 /** hbao_compute and hbao_compute_layers keep their large working buffers
  *  (about 24 bytes per pixel at full resolution, at most 512 MiB in all) for

@@ -760,21 +760,51 @@ static void deinterleave_row(void *context, int r) {
     }
 }
 
-/* The kernel asked for, or the best one below it that this CPU runs. */
-static hbao_horizon_span choose_kernel(int implementation) {
-    if (implementation == HBAO_IMPLEMENTATION_SCALAR) return NULL;
-    const int any = implementation == HBAO_IMPLEMENTATION_AUTO;
-    if ((any || implementation >= HBAO_IMPLEMENTATION_AVX512) && hbao_horizon_avx512_available())
-        return hbao_horizon_span_avx512;
-    if ((any || implementation >= HBAO_IMPLEMENTATION_AVX2) && hbao_horizon_avx2_available())
-        return hbao_horizon_span_avx2;
-    return NULL;
+/* The implementations from the slowest to the fastest (hbao.h): a kernel
+ * the CPU lacks falls back to the one before it here, the one place that
+ * orders them (hbao_implementation_that_runs). */
+static const int32_t by_speed[] = {HBAO_IMPLEMENTATION_SCALAR, HBAO_IMPLEMENTATION_GENERIC,
+                                   HBAO_IMPLEMENTATION_AVX2, HBAO_IMPLEMENTATION_AVX512};
+#define IMPLEMENTATIONS ((int)(sizeof by_speed / sizeof by_speed[0]))
+
+static int runs_here(int32_t implementation) {
+    switch (implementation) {
+        case HBAO_IMPLEMENTATION_GENERIC:
+            return hbao_horizon_generic_available();
+        case HBAO_IMPLEMENTATION_AVX2:
+            return hbao_horizon_avx2_available();
+        case HBAO_IMPLEMENTATION_AVX512:
+            return hbao_horizon_avx512_available();
+        default:
+            return 1; /* the scalar reference */
+    }
+}
+
+int32_t hbao_implementation_that_runs(int32_t requested) {
+    int k = IMPLEMENTATIONS - 1;
+    if (requested != HBAO_IMPLEMENTATION_AUTO)
+        while (k > 0 && by_speed[k] != requested) k--;
+    while (k > 0 && !runs_here(by_speed[k])) k--;
+    return by_speed[k];
+}
+
+/* The kernel that runs for the implementation asked for; NULL: the scalar
+ * reference. */
+static hbao_horizon_span choose_kernel(int32_t implementation) {
+    switch (hbao_implementation_that_runs(implementation)) {
+        case HBAO_IMPLEMENTATION_AVX512:
+            return hbao_horizon_span_avx512;
+        case HBAO_IMPLEMENTATION_AVX2:
+            return hbao_horizon_span_avx2;
+        case HBAO_IMPLEMENTATION_GENERIC:
+            return hbao_horizon_span_generic;
+        default:
+            return NULL;
+    }
 }
 
 int32_t hbao_best_implementation(void) {
-    if (hbao_horizon_avx512_available()) return HBAO_IMPLEMENTATION_AVX512;
-    if (hbao_horizon_avx2_available()) return HBAO_IMPLEMENTATION_AVX2;
-    return HBAO_IMPLEMENTATION_SCALAR;
+    return hbao_implementation_that_runs(HBAO_IMPLEMENTATION_AUTO);
 }
 
 uint32_t hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *grid, float *ao) {

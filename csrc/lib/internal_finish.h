@@ -77,12 +77,16 @@ static inline float hbao_blur_power(float base) {
 #endif
 #define HBAO_ALWAYS_INLINE inline __attribute__((always_inline))
 
-/* The copy to run for a requested hbao_implementation: AUTO and anything the
- * CPU lacks fall back to the best one it has (as the horizon kernels do). */
+/* The copy to run for a requested hbao_implementation: that of the
+ * implementation that runs (hbao_implementation_that_runs), the baseline
+ * copy for the scalar reference and the generic kernel (their stages are the
+ * same portable code, vectorized for the baseline). */
 static inline int hbao_finish_implementation(int requested) {
 #ifdef HBAO_FINISH_X86
-    const int best = hbao_best_implementation();
-    return requested == HBAO_IMPLEMENTATION_AUTO || requested > best ? best : requested;
+    const int runs = hbao_implementation_that_runs(requested);
+    return runs == HBAO_IMPLEMENTATION_AVX2 || runs == HBAO_IMPLEMENTATION_AVX512
+               ? runs
+               : HBAO_IMPLEMENTATION_SCALAR;
 #else
     (void)requested;
     return HBAO_IMPLEMENTATION_SCALAR;

@@ -458,8 +458,8 @@ static inline int hbao_step_offset(const hbao_grid *grid, float dc, float ds, fl
 /* The scalar reference for one pixel (horizon.c), with its block's step. */
 float hbao_horizon_pixel(const hbao_horizon_job *job, int i, int j, float step_px);
 
-/* SIMD kernels (horizon_avx2.c, horizon_avx512.c, both made from
- * horizon_simd.h): whether this CPU and build can run each, and the kernel
+/* SIMD kernels (horizon_generic.c, horizon_avx2.c, horizon_avx512.c, all
+ * made from horizon_simd.h): whether this CPU and build can run each, and the kernel
  * that computes pixels [x0, x1) of row j bit-identically to
  * hbao_horizon_pixel(); x0 is a multiple of HBAO_BLOCK_SPAN and x1 - x0 at
  * most HBAO_BLOCK_SPAN. */
@@ -468,6 +468,8 @@ int hbao_horizon_avx2_available(void);
 void hbao_horizon_span_avx2(const hbao_horizon_job *job, int x0, int x1, int j);
 int hbao_horizon_avx512_available(void);
 void hbao_horizon_span_avx512(const hbao_horizon_job *job, int x0, int x1, int j);
+int hbao_horizon_generic_available(void);
+void hbao_horizon_span_generic(const hbao_horizon_job *job, int x0, int x1, int j);
 
 /* sqrt(1 - c^2), 0 where rounding takes c past 1: the sine of an angle
  * from its cosine (a horizon's, from its elevation or its angle to V). */

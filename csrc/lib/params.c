@@ -53,7 +53,7 @@ hbao_result hbao_params_resolve(const hbao_params *in, hbao_params *out, uint32_
     if (isnan(p.background_depth) || !(p.background_depth > 0.0f))
         invalid |= HBAO_PARAM_FIELD_BACKGROUND_DEPTH;
     if (p.implementation < HBAO_IMPLEMENTATION_AUTO ||
-        p.implementation > HBAO_IMPLEMENTATION_AVX512)
+        p.implementation >= HBAO_IMPLEMENTATION_COUNT)
         invalid |= HBAO_PARAM_FIELD_IMPLEMENTATION;
     if (invalid != 0) {
         if (clamped_fields != NULL) *clamped_fields = invalid;
