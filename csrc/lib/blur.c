@@ -320,8 +320,14 @@ static HBAO_ALWAYS_INLINE void write_output(const float *zc, const float *ao, in
  * 15-pixel blur took 2.6 times as long as with 8. Two AVX2 vectors side by
  * side instead (BLUR_GROUPS 2, each in registers of its own) took 0.87 of
  * one's time (scripts/bench_blur_ab.sh), three no less than two. The
- * baseline copy keeps 16 lanes (four SSE2 registers), which its loop runs
- * faster than 8, and one group (two were slower). The AVX-512 copy takes
+ * baseline copy (the scalar reference's and the generic kernel's, and
+ * every CPU's but x86-64's) takes four vectors of the baseline's 4 lanes
+ * (SSE2, Advanced SIMD) side by side: with 16 lanes in one vector (as
+ * before session 54) GCC compared them a lane at a time, with a branch
+ * each, on SSE2. bench_blur_ab.sh, 1080p, 1 thread, Intel Xeon, against
+ * that: 0.342 at blur 15 (133 ms -> 46), 0.352 at blur 5; two groups
+ * 1.017 of four, eight 0.984 (quartiles 0.965-1.020), and four with two
+ * rows down the columns 1.028. The AVX-512 copy takes
  * two groups as well: on a Zen 5 (AMD EPYC, AVX-512, session 41),
  * bench_blur_ab.sh on 1 thread, blur 3 0.916, 5 0.998-1.055 (three runs),
  * 7 1.026, 9 0.954, 11 0.932, 15 0.900; three and four groups 0.937 and
@@ -345,8 +351,8 @@ static HBAO_ALWAYS_INLINE void write_output(const float *zc, const float *ao, in
  * columns the four rows' taps are skipped only where all four are
  * background; skipping each row's by itself was not tried. The two skips
  * share the macro, so they are not compared apart. */
-#define BLUR_LANES 16
-#define BLUR_GROUPS 1
+#define BLUR_LANES 4
+#define BLUR_GROUPS 4
 #define BLUR_SKIPS 0
 #define BLUR_COLUMN_ROWS 1
 #define BLUR_NAME(name) name##_portable
