@@ -2721,6 +2721,8 @@ def test_help_and_version(hbao_tool):
         assert flag in shown.stdout
     version = run_ok(hbao_tool, "--version").stdout
     assert version.startswith("hbao 0.5.0") and "libhbao 0.5.0" in version
+    # the kernel this CPU runs, which a farm's nodes may differ in
+    assert re.search(r"; horizon search: (AVX-512|AVX2|generic)\)$", version.strip())
     # They win over everything else, a bad value of another flag too.
     for arguments in (["--help", "--radius", "abc"], ["--radius", "abc", "-h"],
                       ["x.exr", "--version", "--help"]):

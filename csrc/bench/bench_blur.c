@@ -130,7 +130,7 @@ int main(int argc, char **argv) {
     printf("bench_blur %ldx%ld, blur %ld, sharpness %g, %ld thread(s), %ld %% background, %s: "
            "fastest %.2f, median %.2f CPU ms over %ld calls; output hash %016llx\n",
            width, height, blur, (double)sharpness, threads, background,
-           bench_implementation_label(hbao_finish_implementation(implementation)), fastest,
+           hbao_implementation_name(hbao_finish_implementation(implementation)), fastest,
            median_of(times, (int)calls), calls, (unsigned long long)hash);
     free(times);
     free(out);

@@ -58,16 +58,6 @@ static inline int bench_implementation(const char *name) {
     return -1;
 }
 
-/* The name an hbao_implementation is printed by (AUTO, SCALAR, AVX2,
- * AVX512, GENERIC) */
-static inline const char *bench_implementation_label(int implementation) {
-    static const char *const labels[] = {"auto", "scalar", "AVX2", "AVX-512", "generic"};
-    _Static_assert(sizeof labels / sizeof labels[0] == HBAO_IMPLEMENTATION_COUNT, "a label each");
-    return implementation >= 0 && implementation < HBAO_IMPLEMENTATION_COUNT
-               ? labels[implementation]
-               : "?";
-}
-
 static inline double clock_seconds(clockid_t clock) {
     struct timespec t;
     clock_gettime(clock, &t);

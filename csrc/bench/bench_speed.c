@@ -165,7 +165,7 @@ int main(int argc, char **argv) {
         "((time - time without blur) / time, on the last column: wall, with the least and the "
         "greatest round's; CPU; the blur's own CPU ms) are medians of the per-round values.\n",
         HBAO_DEFAULT_DIRECTIONS, HBAO_DEFAULT_STEPS, HBAO_DEFAULT_BLUR_SIZE,
-        bench_implementation_label(best), HBAO_KERNELS_BUILT_BY);
+        hbao_implementation_name(best), HBAO_KERNELS_BUILT_BY);
     print_load("before");
     printf("\n| settings | size |");
     int last_column = -1, scalar_column = -1;
@@ -300,7 +300,7 @@ int main(int argc, char **argv) {
         double *cpu = malloc((size_t)runs * sizeof(double));
         if (ao == NULL || cpu == NULL) return 1;
         printf("\n## Stages around the horizon search, 1920x1080, %s, 1 thread, median CPU ms\n\n",
-               bench_implementation_label(best));
+               hbao_implementation_name(best));
         printf(
             "Radius 1e-4 (under a pixel everywhere, so no horizon is searched): depth conversion, "
             "normals, [upsample], blur, output. Median CPU ms (fastest call's).\n\n");

@@ -356,6 +356,10 @@ HBAO_EXPORT int32_t hbao_best_implementation(void);
  *  rejects it). */
 HBAO_EXPORT int32_t hbao_implementation_that_runs(int32_t requested);
 
+/** An hbao_implementation's name ("auto", "scalar", "AVX2", "AVX-512",
+ *  "generic"), or "unknown implementation". */
+HBAO_EXPORT const char *hbao_implementation_name(int32_t implementation);
+
 /** hbao_compute and hbao_compute_layers keep their large working buffers
  *  (about 24 bytes per pixel at full resolution, at most 512 MiB in all) for
  *  the next call, which then skips faulting fresh pages in: a fifth of a

@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
-/* Version, result messages and defaults: the small parts of the public API. */
+/* Version, result messages, implementation names and defaults: the small
+ * parts of the public API. */
 #include "internal_hbao.h"
 
 int32_t hbao_version(void) {
@@ -25,6 +26,14 @@ const char *hbao_note_message(uint32_t note) {
                "most samples fall outside the image and the AO comes out too light: lower the "
                "radius, or render more pixels";
     return "unknown note";
+}
+
+const char *hbao_implementation_name(int32_t implementation) {
+    static const char *const names[] = {"auto", "scalar", "AVX2", "AVX-512", "generic"};
+    _Static_assert(sizeof names / sizeof names[0] == HBAO_IMPLEMENTATION_COUNT, "a name each");
+    if (implementation < 0 || implementation >= HBAO_IMPLEMENTATION_COUNT)
+        return "unknown implementation";
+    return names[implementation];
 }
 
 void hbao_params_default(hbao_params *params) {

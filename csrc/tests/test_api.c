@@ -393,6 +393,11 @@ TEST_CASE(each_implementation_runs_itself_or_a_slower_one) {
         CHECK(hbao_implementation_that_runs(runs) == runs);
     }
     CHECK(hbao_implementation_that_runs(HBAO_IMPLEMENTATION_COUNT) == HBAO_IMPLEMENTATION_SCALAR);
+    CHECK(strcmp(hbao_implementation_name(HBAO_IMPLEMENTATION_GENERIC), "generic") == 0);
+    CHECK(strcmp(hbao_implementation_name(HBAO_IMPLEMENTATION_AVX512), "AVX-512") == 0);
+    CHECK(strcmp(hbao_implementation_name(HBAO_IMPLEMENTATION_COUNT), "unknown implementation") ==
+          0);
+    CHECK(strcmp(hbao_implementation_name(-1), "unknown implementation") == 0);
     CHECK(hbao_implementation_that_runs(-1) == HBAO_IMPLEMENTATION_SCALAR);
 #if defined(__x86_64__)
     __builtin_cpu_init();
