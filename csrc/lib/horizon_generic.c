@@ -7,13 +7,18 @@
  * scalar reference used to run. Every operation is the reference's, lane by
  * lane and never contracted into an FMA (-ffp-contract=off), so it gives
  * the same floats to the bit (the tests hold it to the reference beside the
- * other kernels, test_ao.c and test_planes.c, on ARM64 as well:
- * scripts/test_arm64.sh). bench_speed, 1080p defaults, 1 thread, on an
+ * other kernels, test_ao.c and test_planes.c; on ARM64 as well, under qemu:
+ * scripts/test_arm64.sh, whose --all runs every test). bench_speed, 1080p defaults, 1 thread, on an
  * Intel Xeon (SSE2 code): 197 ms against the reference's 2174 (AVX2 97,
  * AVX-512 74); 4K 807 against 9473 (session 54). */
+#include <float.h>
+
 #include "internal_hbao.h"
 
-#if defined(__GNUC__) || defined(__clang__)
+/* GCC's vector types with __builtin_convertvector (GCC 9 on, clang), and
+ * floats evaluated in their own precision, as the scalar reference's are
+ * (not so with x87 arithmetic, 32-bit x86's default) */
+#if (defined(__clang__) || (defined(__GNUC__) && __GNUC__ >= 9)) && FLT_EVAL_METHOD == 0
 #include <math.h>
 #include <string.h>
 
@@ -86,11 +91,17 @@ GENERIC f4 sqrt4(f4 u) {
 }
 #define SQRT sqrt4
 #endif
-/* Where |u| < 2^23 (every use's range: the steps' offsets and the sector
- * bounds), x86's truncating conversion; other lanes give 0 here, never a
- * conversion out of range (undefined in C). */
+/* x86's truncating conversion, INT32_MIN where it overflows or for NaN:
+ * lanes with |u| >= 2^23 (a whole float) give INT32_MIN, the others the
+ * conversion (of 0 in the former, never out of range, undefined in C).
+ * The search's uses are small whole numbers in range, but a step's offset
+ * can be huge or NaN where the steps leave the image far behind; the
+ * template reads no such lane (plan_steps stops the count before it), and
+ * it gets x86's value all the same. */
 #define EXACT 8388608.0f /* 2^23: from here on every float is whole */
-#define CVTT(u) __builtin_convertvector(ZERO_UNLESS4(ABS(u) < EXACT, (u)), i4)
+#define CVTT(u)                                                                                    \
+    ((__builtin_convertvector(ZERO_UNLESS4(ABS(u) < EXACT, (u)), i4) & (ABS(u) < EXACT)) |         \
+     (~(ABS(u) < EXACT) & INT32_MIN))
 /* floor and ceil, exact: truncated and corrected below 2^23, the float
  * itself from there (and for NaN). The sign of a zero may differ from
  * floorf's, which no use sees (each is converted to an integer). */
@@ -300,17 +311,20 @@ void hbao_horizon_span_generic(const hbao_horizon_job *job, int x0, int x1, int 
         span_generic(job, x0, x1, j);
 }
 
-#else /* a compiler without GCC's vector types: never chosen */
+#else /* without GCC's vector types, or with excess precision: never chosen */
 
 int hbao_horizon_generic_available(void) {
     return 0;
 }
 
 void hbao_horizon_span_generic(const hbao_horizon_job *job, int x0, int x1, int j) {
-    (void)job;
-    (void)x0;
-    (void)x1;
-    (void)j;
+    float *out = job->ao + (size_t)j * job->grid->width;
+    for (int a = 0; a < 4; a++) {
+        float step[HBAO_BLOCK_PIXELS];
+        hbao_block_steps(job, x0, x1, j, a, step);
+        for (int i = x0 + a; i < x1; i += 4)
+            out[i] = hbao_horizon_pixel(job, i, j, step[(i - x0) / 4]);
+    }
 }
 
 #endif

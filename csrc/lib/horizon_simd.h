@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
 /* The horizon search on SIMD_LANES neighbouring pixels at once, written once
  * for every instruction set: a file that includes this header first defines
- * the vector vocabulary below (horizon_avx2.c, horizon_avx512.c). The kernel
+ * the vector vocabulary below (horizon_avx2.c, horizon_avx512.c,
+ * horizon_generic.c). The kernel
  * performs the same float operations in the same order as the scalar
  * reference in horizon.c (no FMA contraction), so every instance gives
  * bit-identical results (tested in test_ao.c and test_planes.c); where the
@@ -112,7 +113,8 @@ static inline void SIMD_NAME(slice_setup)(const VF v[3], const VF n[3], const VF
 }
 
 /* A vector holds a whole block: its HBAO_BLOCK_PIXELS pixels (internal_hbao.h)
- * are the lanes (AVX-512's registers; AVX2's in pairs, horizon_avx2.c). */
+ * are the lanes (AVX-512's registers; AVX2's in pairs, horizon_avx2.c; four
+ * of the baseline's 4-lane vectors, horizon_generic.c). */
 _Static_assert(SIMD_LANES == HBAO_BLOCK_PIXELS, "a vector is a block");
 
 /* The lanes' pixels (a block's) and what does not change between
@@ -359,8 +361,10 @@ static inline void SIMD_NAME(plan_two)(const SIMD_NAME(block) * b, float dc0, fl
 #ifndef SIMD_PREFETCH
 /* prefetcht0 as a statement the compiler keeps: GCC 12 deleted every
  * __builtin_prefetch of prefetch_steps when its loop took the least of two
- * halves' plain_end (the copies are x86 only). Every prefetch of this file
- * (prefetch_normals too) goes through it. */
+ * halves' plain_end (in the x86 copies; the generic copy, for any CPU,
+ * defines it as __builtin_prefetch, which GCC 12 keeps there: prefetcht0
+ * on x86-64, prfm on ARM64). Every prefetch of this file (prefetch_normals
+ * too) goes through it. */
 #define SIMD_PREFETCH(p) __asm__ volatile("prefetcht0 %0" : : "m"(*(const char *)(p)))
 #endif
 static inline void SIMD_NAME(prefetch_steps)(const SIMD_NAME(block) * b,
