@@ -659,6 +659,16 @@ typedef struct tiled_job {
     hbao_horizon_span simd; /* NULL: the scalar reference */
 } tiled_job;
 
+void hbao_horizon_span_reference(const hbao_horizon_job *job, int x0, int x1, int j) {
+    float *out = job->ao + (size_t)j * job->grid->width;
+    for (int a = 0; a < 4; a++) {
+        float step[HBAO_BLOCK_PIXELS];
+        hbao_block_steps(job, x0, x1, j, a, step);
+        for (int i = x0 + a; i < x1; i += 4)
+            out[i] = hbao_horizon_pixel(job, i, j, step[(i - x0) / 4]);
+    }
+}
+
 static void horizon_tile(void *context, int tile) {
     const tiled_job *tiled = context;
     const horizon_job *job = tiled->job;
@@ -670,17 +680,10 @@ static void horizon_tile(void *context, int tile) {
     for (int j = y0; j < y1; j++) {
         for (int s0 = x0; s0 < x1; s0 += HBAO_BLOCK_SPAN) {
             const int s1 = s0 + HBAO_BLOCK_SPAN < x1 ? s0 + HBAO_BLOCK_SPAN : x1;
-            if (tiled->simd != NULL) {
+            if (tiled->simd != NULL)
                 tiled->simd(job, s0, s1, j);
-            } else {
-                float *out = job->ao + (size_t)j * width;
-                for (int a = 0; a < 4; a++) {
-                    float step[HBAO_BLOCK_PIXELS];
-                    hbao_block_steps(job, s0, s1, j, a, step);
-                    for (int i = s0 + a; i < s1; i += 4)
-                        out[i] = hbao_horizon_pixel(job, i, j, step[(i - s0) / 4]);
-                }
-            }
+            else
+                hbao_horizon_span_reference(job, s0, s1, j);
         }
     }
 }

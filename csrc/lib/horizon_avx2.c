@@ -240,13 +240,7 @@ int hbao_horizon_avx2_available(void) {
 }
 
 void hbao_horizon_span_avx2(const hbao_horizon_job *job, int x0, int x1, int j) {
-    float *out = job->ao + (size_t)j * job->grid->width;
-    for (int a = 0; a < 4; a++) {
-        float step[HBAO_BLOCK_PIXELS];
-        hbao_block_steps(job, x0, x1, j, a, step);
-        for (int i = x0 + a; i < x1; i += 4)
-            out[i] = hbao_horizon_pixel(job, i, j, step[(i - x0) / 4]);
-    }
+    hbao_horizon_span_reference(job, x0, x1, j);
 }
 
 #endif

@@ -468,6 +468,9 @@ int hbao_horizon_avx2_available(void);
 void hbao_horizon_span_avx2(const hbao_horizon_job *job, int x0, int x1, int j);
 int hbao_horizon_avx512_available(void);
 void hbao_horizon_span_avx512(const hbao_horizon_job *job, int x0, int x1, int j);
+/* The scalar reference's span: what the kernels' copies built without their
+ * instruction set run (never chosen) */
+void hbao_horizon_span_reference(const hbao_horizon_job *job, int x0, int x1, int j);
 int hbao_horizon_generic_available(void);
 void hbao_horizon_span_generic(const hbao_horizon_job *job, int x0, int x1, int j);
 
