@@ -99,9 +99,13 @@ GENERIC f4 sqrt4(f4 u) {
  * template reads no such lane (plan_steps stops the count before it), and
  * it gets x86's value all the same. */
 #define EXACT 8388608.0f /* 2^23: from here on every float is whole */
+#if defined(__SSE2__)
+#define CVTT(u) ((i4)_mm_cvttps_epi32((__m128)(u))) /* itself: 0.98 of the time of the below */
+#else
 #define CVTT(u)                                                                                    \
     ((__builtin_convertvector(ZERO_UNLESS4(ABS(u) < EXACT, (u)), i4) & (ABS(u) < EXACT)) |         \
      (~(ABS(u) < EXACT) & INT32_MIN))
+#endif
 /* floor and ceil, exact: truncated and corrected below 2^23, the float
  * itself from there (and for NaN). The sign of a zero may differ from
  * floorf's, which no use sees (each is converted to an integer). */
