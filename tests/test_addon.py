@@ -671,6 +671,8 @@ def test_the_ao_uses_the_threads_blender_renders_with(run_in_blender, tmp_path, 
     figures = [timing_line.parse(line) for line in log.splitlines()
                if line.startswith("HBAO: 1 AO pass(es) ")]
     assert [f["threads"] for f in figures] == [1, 3, 1], log[-3000:]
+    # and the horizon search that ran, as the library names it
+    assert [f["search"] for f in figures] == [node_native.search_name()] * 3, log[-3000:]
     assert [f["reused"] for f in figures] == [0, 1, 1]
     expected = library_ao(node_native, out, 1, node_params(radius=0.6, blur_size=0))
     assert np.abs(node_outputs(out, 1)["ao"] - expected).max() <= EXACT

@@ -17,7 +17,7 @@ def test_a_computed_frame():
                     "(save 50, read 14, write 6)")
     assert timing_line.parse("HBAO: " + line) == {
         "passes": 2, "width": 1920, "height": 1080, "total_ms": 192, "ao_ms": 122,
-        "threads": 0, "reused": 0, "handover_ms": 70, "save_ms": 50, "read_ms": 14,
+        "threads": 0, "search": "", "reused": 0, "handover_ms": 70, "save_ms": 50, "read_ms": 14,
         "capture_ms": 0, "write_ms": 6, "recomposited": False, "extras_ms": {}}
 
 
@@ -25,6 +25,9 @@ def test_a_computed_frame():
     ({"cached": 1}, {"reused": 1, "recomposited": False, "extras_ms": {}}),
     ({"threads": 1}, {"threads": 1, "reused": 0}),
     ({"threads": 16, "cached": 1}, {"threads": 16, "reused": 1}),
+    ({"threads": 4, "search": "AVX-512", "cached": 1},
+     {"threads": 4, "search": "AVX-512", "reused": 1}),
+    ({"threads": 1, "search": "generic"}, {"threads": 1, "search": "generic", "reused": 0}),
     ({"cached": 2, "kept": 0.118}, {"reused": 2, "recomposited": True, "extras_ms": {}}),
     ({"guard band save": 0.061, "guard band read": 0.0192, "back faces save": 0.05,
       "back faces read": 0.0204},

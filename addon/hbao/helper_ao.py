@@ -75,6 +75,7 @@ def compute_passes(engine, depsgraph, width, height, request=None):
         return {}
     compute_time = 0.0
     timings["threads"] = max(job.threads for job in jobs)  # (the same for every job)
+    timings["search"] = native.search_name()
     fresh = {}
     every_job = [(view, job) for view in views for job in jobs]
     for index, (view, job) in enumerate(every_job):

@@ -14,7 +14,7 @@ import numpy as np
 from .native_library import (BINDING_VERSION_MAJOR, LIBRARY_ENVIRONMENT_VARIABLE,  # noqa: F401
                              LIBRARY_FILE_NAME, HBAOError, HBAOLibraryError, check,
                              library_path, library_version, load_library, release_memory,
-                             unload_library)
+                             search_name, unload_library)
 from .native_params import (PARAMETER_NAMES, default_params, params_struct,  # noqa: F401
                             resolve_params)
 from .native_structs import HBAOCamera, HBAOChannel, HBAOParams, HBAOView  # noqa: F401
@@ -25,7 +25,7 @@ __all__ = [
     "HBAOError", "HBAOLibraryError", "compute_ao", "default_params", "resolve_params",
     "camera_view", "camera_crop",
     "library_path", "load_library", "unload_library", "library_version", "release_memory",
-    "PARAMETER_NAMES", "FALLOFF_NAMES", "INTEGRATION_NAMES",
+    "search_name", "PARAMETER_NAMES", "FALLOFF_NAMES", "INTEGRATION_NAMES",
 ]
 
 # Enum names as Blender spells them, mapped to the header's values (parameters.py).

@@ -37,6 +37,8 @@ _CAMERA_P = ctypes.POINTER(HBAOCamera)
 _CHANNEL_P = ctypes.POINTER(HBAOChannel)
 _FUNCTIONS = {
     "hbao_version": (ctypes.c_int32, []),
+    "hbao_best_implementation": (ctypes.c_int32, []),
+    "hbao_implementation_name": (ctypes.c_char_p, [ctypes.c_int32]),
     "hbao_result_message": (ctypes.c_char_p, [ctypes.c_int32]),
     "hbao_params_default": (None, [_PARAMS_P]),
     "hbao_params_resolve": (ctypes.c_int32, [_PARAMS_P, _PARAMS_P,
@@ -101,6 +103,13 @@ def release_memory():
 def library_version():
     """The loaded library's version as 'major.minor.patch'."""
     return _version_text(load_library().hbao_version())
+
+
+def search_name():
+    """The horizon search this CPU runs ("AVX-512", "AVX2", "generic" where
+    a CPU has no AVX2): a farm's nodes may differ."""
+    library = load_library()
+    return library.hbao_implementation_name(library.hbao_best_implementation()).decode("ascii")
 
 
 def check(result):
