@@ -15,6 +15,7 @@ from conftest import REPO
 # imports bpy only in register()).
 sys.path.insert(0, str(REPO / "addon"))
 from hbao import native as native_module  # noqa: E402
+from hbao import native_library  # noqa: E402
 
 HEADER = REPO / "csrc" / "include" / "hbao.h"
 # Every image in these tests is small: the library's cost is irrelevant here.
@@ -278,27 +279,16 @@ def test_missing_library_names_the_path(monkeypatch, tmp_path):
 
 def test_incompatible_library_is_refused(monkeypatch, tmp_path):
     """A library with the right symbols but another major version: refused on load."""
+    # every function the binding declares (native_library._FUNCTIONS), as a
+    # stub; the version says 1.0.0
+    own = {"hbao_version": "int32_t hbao_version(void) { return 10000; }",
+           "hbao_params_size": "size_t hbao_params_size(void) { return 48; }",
+           "hbao_camera_size": "size_t hbao_camera_size(void) { return 104; }",
+           "hbao_view_size": "size_t hbao_view_size(void) { return 40; }"}
+    stubs = [own.get(name, f"int32_t {name}(void) {{ return 0; }}")
+             for name in native_library._FUNCTIONS]
     source = tmp_path / "fake.c"
-    source.write_text(
-        "#include <stddef.h>\n#include <stdint.h>\n"
-        "int32_t hbao_version(void) { return 10000; }\n"
-        "const char *hbao_result_message(int32_t r) { (void)r; return \"x\"; }\n"
-        "void hbao_params_default(void *p) { (void)p; }\n"
-        "void hbao_camera_default(void *c) { (void)c; }\n"
-        "size_t hbao_params_size(void) { return 48; }\n"
-        "size_t hbao_camera_size(void) { return 104; }\n"
-        "int32_t hbao_compute(void) { return 0; }\n"
-        "int32_t hbao_compute_layers(void) { return 0; }\n"
-        "void hbao_release_memory(void) {}\n"
-        "uint32_t hbao_last_notes(void) { return 0; }\n"
-        "const char *hbao_note_message(uint32_t n) { (void)n; return 0; }\n"
-        "float hbao_clip_background_depth(float s, float e, float d)"
-        " { (void)s; (void)e; return d; }\n"
-        "size_t hbao_view_size(void) { return 40; }\n"
-        "int32_t hbao_camera_view(void) { return 0; }\n"
-        "int32_t hbao_camera_crop(void) { return 0; }\n"
-        "int32_t hbao_params_resolve(void) { return 0; }\n"
-        "const char *hbao_param_field_name(uint32_t b) { (void)b; return 0; }\n")
+    source.write_text("#include <stddef.h>\n#include <stdint.h>\n" + "\n".join(stubs) + "\n")
     fake = tmp_path / "libfake.so"
     subprocess.run(["cc", "-shared", "-fPIC", "-o", str(fake), str(source)], check=True)
     monkeypatch.setenv("HBAO_LIBRARY", str(fake))
