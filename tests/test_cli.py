@@ -2720,7 +2720,7 @@ def test_help_and_version(hbao_tool):
                  "--keep-input", "--layer", "--preview", "--info", "identity"):
         assert flag in shown.stdout
     version = run_ok(hbao_tool, "--version").stdout
-    assert version.startswith("hbao 0.5.0") and "libhbao 0.5.0" in version
+    assert version.startswith("hbao 0.6.0") and "libhbao 0.6.0" in version
     # the kernel this CPU runs, which a farm's nodes may differ in
     assert re.search(r"; horizon search: (AVX-512|AVX2|generic)\)$", version.strip())
     # They win over everything else, a bad value of another flag too.

@@ -277,24 +277,46 @@ def test_missing_library_names_the_path(monkeypatch, tmp_path):
         module.compute_ao(np.ones((4, 4), np.float32))
 
 
-def test_incompatible_library_is_refused(monkeypatch, tmp_path):
-    """A library with the right symbols but another major version: refused on load."""
-    # every function the binding declares (native_library._FUNCTIONS), as a
-    # stub; the version says 1.0.0
-    own = {"hbao_version": "int32_t hbao_version(void) { return 10000; }",
+@pytest.mark.parametrize("version, left_out, message", [
+    # another major version, with every function the binding declares
+    (10000, (), "version 1.0.0, this add-on needs 0.6 or a later 0.x"),
+    # 0.5.0, which lacked hbao_implementation_name: named by its version,
+    # not by the first function it lacks
+    (500, ("hbao_implementation_name",), "version 0.5.0, this add-on needs 0.6 or a later 0.x"),
+])
+def test_incompatible_library_is_refused(monkeypatch, tmp_path, version, left_out, message):
+    """A library of a version the binding cannot call: refused on load, by its version."""
+    # the functions the binding declares (native_library._FUNCTIONS) but
+    # left_out, as stubs
+    own = {"hbao_version": f"int32_t hbao_version(void) {{ return {version}; }}",
            "hbao_params_size": "size_t hbao_params_size(void) { return 48; }",
            "hbao_camera_size": "size_t hbao_camera_size(void) { return 104; }",
            "hbao_view_size": "size_t hbao_view_size(void) { return 40; }"}
     stubs = [own.get(name, f"int32_t {name}(void) {{ return 0; }}")
-             for name in native_library._FUNCTIONS]
+             for name in native_library._FUNCTIONS if name not in left_out]
     source = tmp_path / "fake.c"
     source.write_text("#include <stddef.h>\n#include <stdint.h>\n" + "\n".join(stubs) + "\n")
     fake = tmp_path / "libfake.so"
     subprocess.run(["cc", "-shared", "-fPIC", "-o", str(fake), str(source)], check=True)
     monkeypatch.setenv("HBAO_LIBRARY", str(fake))
     module = _load_native()
-    with pytest.raises(module.HBAOLibraryError, match="version 1.0.0"):
+    with pytest.raises(module.HBAOLibraryError, match=re.escape(message)):
         module.load_library()
+
+
+def test_the_binding_calls_the_header_it_mirrors():
+    """The header's version is one the binding accepts, and the oldest it
+    accepts is no newer than the header: a release that adds a function
+    the binding declares raises both together."""
+    header = HEADER.read_text()
+    major, minor, patch = (int(re.search(rf"#define HBAO_VERSION_{part} (\d+)", header).group(1))
+                           for part in ("MAJOR", "MINOR", "PATCH"))
+    assert native_library._binding_calls(major * 10000 + minor * 100 + patch)
+    assert native_library.BINDING_VERSION_MAJOR == major
+    assert native_library.BINDING_VERSION_MINOR <= minor
+    assert not native_library._binding_calls(major * 10000 + (native_library.BINDING_VERSION_MINOR
+                                                              - 1) * 100 + 99)
+    assert not native_library._binding_calls((major + 1) * 10000 + minor * 100)
 
 
 def test_clamping_happens_once_and_says_so(native):
@@ -436,3 +458,23 @@ def test_a_usual_compute_has_no_notes_and_each_note_has_words(native):
     assert b"the reference search computed the AO" in library.hbao_note_message(1)
     assert b"lower the radius" in library.hbao_note_message(2)
     assert library.hbao_note_message(4) == b"unknown note"
+
+
+def test_an_exr_library_of_another_interface_is_refused(monkeypatch, tmp_path):
+    """libhbao_exr's handshake is its interface version: another one is
+    refused by its number before any other function is looked up."""
+    from hbao import exr_passes
+    source = tmp_path / "fake_exr.c"
+    source.write_text("#include <stdint.h>\n"
+                      "int32_t hbao_exr_interface_version(void) { return 1; }\n")
+    fake = tmp_path / "libfake_exr.so"
+    subprocess.run(["cc", "-shared", "-fPIC", "-o", str(fake), str(source)], check=True)
+    monkeypatch.setenv(exr_passes.LIBRARY_ENVIRONMENT_VARIABLE, str(fake))
+    exr_passes.unload_library()
+    try:
+        with pytest.raises(exr_passes.EXRLibraryError,
+                           match=f"is version 1, this add-on needs "
+                                 f"{exr_passes.BINDING_INTERFACE_VERSION}:"):
+            exr_passes.load_library()
+    finally:
+        exr_passes.unload_library()

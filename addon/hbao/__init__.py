@@ -18,7 +18,7 @@ viewport.projection/shader_sources work in plain Python (tests, benchmarks).
 bl_info = {
     "name": "HBAO",
     "author": "HBAO contributors",
-    "version": (0, 5, 0),
+    "version": (0, 6, 0),
     "blender": (3, 4, 0),
     "location": "Compositor > Add > Filter > HBAO; 3D View > Sidebar > HBAO",
     "description": "Horizon-based ambient occlusion from the Depth and Normal passes",

@@ -93,7 +93,8 @@ _LIBRARY = library_loading.NativeLibrary(
     "hbao_exr", LIBRARY_ENVIRONMENT_VARIABLE, Path(__file__).resolve().parent / "lib",
     _FUNCTIONS, EXRLibraryError,
     handshake=library_loading.Handshake(
-        "hbao_exr_interface_version", BINDING_INTERFACE_VERSION,
+        "hbao_exr_interface_version", lambda version: version == BINDING_INTERFACE_VERSION,
+        str(BINDING_INTERFACE_VERSION),
         [("hbao_exr_channel_request", "hbao_exr_channel_request_size", _ChannelRequest)]),
     load_hint="It needs OpenEXRCore (libOpenEXRCore-3_1.so) installed or next to it; "
               "rebuild or reinstall the add-on with scripts/install_addon.sh.")

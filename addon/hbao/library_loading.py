@@ -46,26 +46,28 @@ def mapped_from_a_replaced_file(path, maps="/proc/self/maps"):
 
 class Handshake:
     """What a library must report to match its binding: `version_function()`
-    must give a value whose `version_key(value)` is `expected`, and each
+    must give a value that `accepts(value)` holds true (`expected_text` says
+    which, in messages; `describe(value)` prints a version), and each
     (C type name, size function, ctypes structure) of `structures` must have
     the structure's size, or the library and the binding disagree on memory
-    layout. `describe(value)` prints a version for messages."""
+    layout. The version is asked before any other function is looked up, so
+    that an older library, which lacks the newer functions, is named by its
+    version."""
 
-    def __init__(self, version_function, expected, structures, version_key=None,
-                 describe=str, expected_text=None):
+    def __init__(self, version_function, accepts, expected_text, structures, describe=str):
         self.version_function = version_function
-        self.expected = expected
-        self.expected_text = expected_text or str(expected)
+        self.accepts = accepts
+        self.expected_text = expected_text
         self.structures = structures
-        self.version_key = version_key or (lambda value: value)
         self.describe = describe
 
-    def check(self, library, path, name, error_class):
-        version = getattr(library, self.version_function)()
-        if self.version_key(version) != self.expected:
+    def check_version(self, version, path, name, error_class):
+        if not self.accepts(version):
             raise error_class(
                 f"{name} at {path} is version {self.describe(version)}, this add-on needs "
                 f"{self.expected_text}: install the library that came with the add-on.")
+
+    def check_structures(self, library, path, name, error_class):
         for c_type, size_function, structure in self.structures:
             size = getattr(library, size_function)()
             if size != ctypes.sizeof(structure):
@@ -134,15 +136,28 @@ class NativeLibrary:
         except OSError as error:
             raise self.error_class(f"{name} at {path} could not be loaded: {error}. "
                                    f"{self.load_hint}") from error
-        for function_name, (restype, argtypes) in self.functions.items():
-            try:
-                function = getattr(library, function_name)
-            except AttributeError as error:
-                raise self.error_class(
-                    f"{name} at {path} lacks {function_name}(): it is not a compatible "
-                    f"{name}; rebuild it from this add-on's sources.") from error
-            function.restype = restype
-            function.argtypes = argtypes
+        # The version first (the handshake's function is declared with the
+        # others), then every function, then the structures' sizes.
+        names = list(self.functions)
         if self.handshake is not None:
-            self.handshake.check(library, path, name, self.error_class)
+            names.remove(self.handshake.version_function)
+            self._bind(library, path, self.handshake.version_function)
+            version = getattr(library, self.handshake.version_function)()
+            self.handshake.check_version(version, path, name, self.error_class)
+        for function_name in names:
+            self._bind(library, path, function_name)
+        if self.handshake is not None:
+            self.handshake.check_structures(library, path, name, self.error_class)
         return library
+
+    def _bind(self, library, path, function_name):
+        """Declares `function_name`'s types on `library`; error_class where it lacks it."""
+        restype, argtypes = self.functions[function_name]
+        try:
+            function = getattr(library, function_name)
+        except AttributeError as error:
+            raise self.error_class(
+                f"{self.name} at {path} lacks {function_name}(): it is not a compatible "
+                f"{self.name}; rebuild it from this add-on's sources.") from error
+        function.restype = restype
+        function.argtypes = argtypes

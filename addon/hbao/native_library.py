@@ -3,8 +3,10 @@
 its errors, the version and struct-size handshake. Needs neither numpy nor bpy.
 
 The library is loaded once, lazily, on first use; the load checks that the
-library's major version and struct sizes match this binding, so that a stale
-or foreign libhbao.so fails with a message instead of corrupting memory."""
+library's version is one this binding can call (BINDING_VERSION_MAJOR, from
+BINDING_VERSION_MINOR on) and that its struct sizes match this binding, so
+that a stale or foreign libhbao.so fails with a message instead of
+corrupting memory."""
 import ctypes
 from pathlib import Path
 
@@ -13,6 +15,11 @@ from .native_structs import HBAOCamera, HBAOChannel, HBAOParams, HBAOView
 
 #: The header's HBAO_VERSION_MAJOR this binding mirrors.
 BINDING_VERSION_MAJOR = 0
+#: The oldest HBAO_VERSION_MINOR of that major version that has every
+#: function of _FUNCTIONS (0.6: hbao_implementation_name). While the major
+#: version is 0 a later minor version may change what this binding relies
+#: on, so its tests run against the header it mirrors (test_native.py).
+BINDING_VERSION_MINOR = 6
 #: Environment variable that names the library to load instead of lib/libhbao.so.
 LIBRARY_ENVIRONMENT_VARIABLE = "HBAO_LIBRARY"
 HBAO_SUCCESS = 0
@@ -68,17 +75,23 @@ def _version_text(packed):
     return f"{packed // 10000}.{packed // 100 % 100}.{packed % 100}"
 
 
+def _binding_calls(packed):
+    """Whether this binding can call a library of packed version `packed`
+    (HBAO_VERSION: major * 10000 + minor * 100 + patch)."""
+    return (packed // 10000 == BINDING_VERSION_MAJOR
+            and packed // 100 % 100 >= BINDING_VERSION_MINOR)
+
+
 _LIBRARY = library_loading.NativeLibrary(
     "hbao", LIBRARY_ENVIRONMENT_VARIABLE, Path(__file__).resolve().parent / "lib",
     _FUNCTIONS, HBAOLibraryError,
     handshake=library_loading.Handshake(
-        "hbao_version", BINDING_VERSION_MAJOR,
+        "hbao_version", _binding_calls,
+        f"{BINDING_VERSION_MAJOR}.{BINDING_VERSION_MINOR} or a later {BINDING_VERSION_MAJOR}.x",
         [("hbao_params", "hbao_params_size", HBAOParams),
          ("hbao_camera", "hbao_camera_size", HBAOCamera),
          ("hbao_view", "hbao_view_size", HBAOView)],
-        version_key=lambda packed: packed // 10000,
-        describe=_version_text,
-        expected_text=f"{BINDING_VERSION_MAJOR}.x"),
+        describe=_version_text),
     load_hint="Rebuild it for this machine.")
 #: The platform's file name of the library (libhbao.so on Linux).
 LIBRARY_FILE_NAME = _LIBRARY.file_name
