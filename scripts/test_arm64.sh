@@ -11,11 +11,12 @@
 #
 # Under the emulator a case takes some 30 times its native time. Without
 # --all the cases that took more than 40 s of one core each are left out
-# (about 2100 of the 2600 s that all 92 take; measured on the 2-core Intel
-# Xeon VM of session 54): the native build runs them on every kernel this
+# (about 1550 of the 2050 s that all 92 take, on the 2-core Intel Xeon VM of
+# sessions 54-55; the scratch-memory case 247 s since it runs each kernel
+# once, 796 before): the native build runs them on every kernel this
 # CPU has, the generic one among them. What is left still compares the
 # generic kernel with the reference on planes, half depths, back faces,
-# thickness and long thin images. --all runs every case (about 22 minutes
+# thickness and long thin images. --all runs every case (about 17 minutes
 # on 2 cores). Needs what scripts/setup.sh installs (the cross compiler,
 # its C library, qemu-user).
 set -eu
