@@ -61,10 +61,10 @@
 extern "C" {
 #endif
 
-/* A minor version that adds to this header is a new minor version (0.6:
+/* A release that adds to this header raises the minor version (0.6:
  * HBAO_IMPLEMENTATION_GENERIC, hbao_implementation_that_runs and
- * hbao_implementation_name); the add-on's binding names the oldest it can
- * call (addon/hbao/native_library.py, BINDING_VERSION_MINOR). */
+ * hbao_implementation_name); the add-on's binding names the oldest minor
+ * version it can call (addon/hbao/native_library.py, BINDING_VERSION_MINOR). */
 #define HBAO_VERSION_MAJOR 0
 #define HBAO_VERSION_MINOR 6
 #define HBAO_VERSION_PATCH 0
