@@ -279,10 +279,12 @@ def test_missing_library_names_the_path(monkeypatch, tmp_path):
 
 @pytest.mark.parametrize("version, left_out, message", [
     # another major version, with every function the binding declares
-    (10000, (), "version 1.0.0, this add-on needs 0.6 or a later 0.x"),
+    (10000, (), "version 1.0.0, this add-on needs 0.6.x"),
+    # a later 0.x, which may have changed what the binding calls
+    (700, (), "version 0.7.0, this add-on needs 0.6.x"),
     # 0.5.0, which lacked hbao_implementation_name: named by its version,
     # not by the first function it lacks
-    (500, ("hbao_implementation_name",), "version 0.5.0, this add-on needs 0.6 or a later 0.x"),
+    (500, ("hbao_implementation_name",), "version 0.5.0, this add-on needs 0.6.x"),
 ])
 def test_incompatible_library_is_refused(monkeypatch, tmp_path, version, left_out, message):
     """A library of a version the binding cannot call: refused on load, by its version."""
@@ -305,18 +307,19 @@ def test_incompatible_library_is_refused(monkeypatch, tmp_path, version, left_ou
 
 
 def test_the_binding_calls_the_header_it_mirrors():
-    """The header's version is one the binding accepts, and the oldest it
-    accepts is no newer than the header: a release that adds a function
-    the binding declares raises both together."""
+    """The binding's version is the header's: a release that changes the
+    minor version changes the binding's with it, after a look at what the
+    binding calls. Any patch of it is accepted, and no other version."""
     header = HEADER.read_text()
     major, minor, patch = (int(re.search(rf"#define HBAO_VERSION_{part} (\d+)", header).group(1))
                            for part in ("MAJOR", "MINOR", "PATCH"))
-    assert native_library._binding_calls(major * 10000 + minor * 100 + patch)
-    assert native_library.BINDING_VERSION_MAJOR == major
-    assert native_library.BINDING_VERSION_MINOR <= minor
-    assert not native_library._binding_calls(major * 10000 + (native_library.BINDING_VERSION_MINOR
-                                                              - 1) * 100 + 99)
-    assert not native_library._binding_calls((major + 1) * 10000 + minor * 100)
+    assert (native_library.BINDING_VERSION_MAJOR, native_library.BINDING_VERSION_MINOR) == (
+        major, minor)
+    for accepted in (0, patch, 99):
+        assert native_library._binding_calls(major * 10000 + minor * 100 + accepted)
+    for refused in ((major, minor - 1, 99), (major, minor + 1, 0), (major + 1, minor, patch)):
+        assert not native_library._binding_calls(refused[0] * 10000 + refused[1] * 100
+                                                 + refused[2])
 
 
 def test_clamping_happens_once_and_says_so(native):

@@ -3,10 +3,10 @@
 its errors, the version and struct-size handshake. Needs neither numpy nor bpy.
 
 The library is loaded once, lazily, on first use; the load checks that the
-library's version is one this binding can call (BINDING_VERSION_MAJOR, from
-BINDING_VERSION_MINOR on) and that its struct sizes match this binding, so
-that a stale or foreign libhbao.so fails with a message instead of
-corrupting memory."""
+library's version is the one this binding mirrors (BINDING_VERSION_MAJOR and
+BINDING_VERSION_MINOR; any patch) and that its struct sizes match this
+binding, so that a stale or foreign libhbao.so fails with a message instead
+of corrupting memory."""
 import ctypes
 from pathlib import Path
 
@@ -15,10 +15,11 @@ from .native_structs import HBAOCamera, HBAOChannel, HBAOParams, HBAOView
 
 #: The header's HBAO_VERSION_MAJOR this binding mirrors.
 BINDING_VERSION_MAJOR = 0
-#: The oldest HBAO_VERSION_MINOR of that major version that has every
-#: function of _FUNCTIONS (0.6: hbao_implementation_name). While the major
-#: version is 0 a later minor version may change what this binding relies
-#: on, so its tests run against the header it mirrors (test_native.py).
+#: And its HBAO_VERSION_MINOR. While the major version is 0 a minor version
+#: may change anything (0.6 added hbao_implementation_name, which this
+#: binding calls), so only the minor version this binding was written for is
+#: accepted: a library of another one is refused by its version, not called
+#: with what it may no longer mean. test_native.py holds both to hbao.h.
 BINDING_VERSION_MINOR = 6
 #: Environment variable that names the library to load instead of lib/libhbao.so.
 LIBRARY_ENVIRONMENT_VARIABLE = "HBAO_LIBRARY"
@@ -79,7 +80,7 @@ def _binding_calls(packed):
     """Whether this binding can call a library of packed version `packed`
     (HBAO_VERSION: major * 10000 + minor * 100 + patch)."""
     return (packed // 10000 == BINDING_VERSION_MAJOR
-            and packed // 100 % 100 >= BINDING_VERSION_MINOR)
+            and packed // 100 % 100 == BINDING_VERSION_MINOR)
 
 
 _LIBRARY = library_loading.NativeLibrary(
@@ -87,7 +88,7 @@ _LIBRARY = library_loading.NativeLibrary(
     _FUNCTIONS, HBAOLibraryError,
     handshake=library_loading.Handshake(
         "hbao_version", _binding_calls,
-        f"{BINDING_VERSION_MAJOR}.{BINDING_VERSION_MINOR} or a later {BINDING_VERSION_MAJOR}.x",
+        f"{BINDING_VERSION_MAJOR}.{BINDING_VERSION_MINOR}.x",
         [("hbao_params", "hbao_params_size", HBAOParams),
          ("hbao_camera", "hbao_camera_size", HBAOCamera),
          ("hbao_view", "hbao_view_size", HBAOView)],

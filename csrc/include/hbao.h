@@ -63,8 +63,9 @@ extern "C" {
 
 /* A release that adds to this header raises the minor version (0.6:
  * HBAO_IMPLEMENTATION_GENERIC, hbao_implementation_that_runs and
- * hbao_implementation_name); the add-on's binding names the oldest minor
- * version it can call (addon/hbao/native_library.py, BINDING_VERSION_MINOR). */
+ * hbao_implementation_name); while the major version is 0 the add-on's
+ * binding accepts only the minor version it mirrors (any patch):
+ * addon/hbao/native_library.py, BINDING_VERSION_MINOR. */
 #define HBAO_VERSION_MAJOR 0
 #define HBAO_VERSION_MINOR 6
 #define HBAO_VERSION_PATCH 0
