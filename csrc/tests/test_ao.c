@@ -1052,8 +1052,7 @@ TEST_CASE(simd_paths_match_scalar_reference_bit_for_bit) {
         for (int k = 0; k < 4; k++) {
             /* a kernel this CPU lacks runs another of the list; AUTO is
              * always run */
-            if (kernels[k] != HBAO_IMPLEMENTATION_AUTO &&
-                hbao_implementation_that_runs(kernels[k]) != kernels[k])
+            if (kernels[k] != HBAO_IMPLEMENTATION_AUTO && !implementation_runs_itself(kernels[k]))
                 continue;
             p.implementation = kernels[k];
             float *fast = run_layers(&p, &view, depth, (variant & 4) ? NULL : normal, layer);
@@ -1091,8 +1090,7 @@ TEST_CASE(long_thin_images_match_the_scalar_reference) {
         float *scalar = run(&p, &view, depth, normal);
         for (int kernel = HBAO_IMPLEMENTATION_AVX2; kernel <= HBAO_IMPLEMENTATION_GENERIC;
              kernel++) {
-            if (hbao_implementation_that_runs(kernel) != kernel)
-                continue; /* runs another of the list */
+            if (!implementation_runs_itself(kernel)) continue; /* runs another of the list */
             p.implementation = kernel;
             float *fast = run(&p, &view, depth, normal);
             CHECK(memcmp(scalar, fast, bytes) == 0);
@@ -1144,7 +1142,7 @@ TEST_CASE(every_step_and_direction_count_matches_the_scalar_reference) {
                 p.implementation = HBAO_IMPLEMENTATION_SCALAR;
                 float *scalar = run_layers(&p, &view, depth, normal, layer);
                 for (int k = 0; k < 3; k++) {
-                    if (hbao_implementation_that_runs(kernels[k]) != kernels[k])
+                    if (!implementation_runs_itself(kernels[k]))
                         continue; /* runs another of the list */
                     p.implementation = kernels[k];
                     float *fast = run_layers(&p, &view, depth, normal, layer);
@@ -1199,8 +1197,7 @@ TEST_CASE(a_post_at_the_lens_leaves_the_ao_of_its_blocks) {
         p.radius = 0.3f; /* about 16 pixels at the corner */
         p.directions = 8;
         p.steps = 16;
-        if (hbao_implementation_that_runs(kernels[kernel]) != kernels[kernel])
-            continue; /* runs another of the list */
+        if (!implementation_runs_itself(kernels[kernel])) continue; /* runs another of the list */
         p.implementation = kernels[kernel];
         float *plain = run(&p, &view, depth, normal);
         float *with_post = run(&p, &view, post_depth, post_normal);
@@ -1325,7 +1322,7 @@ TEST_CASE(thin_occluders_do_not_darken_what_is_behind_them) {
              implementation <= HBAO_IMPLEMENTATION_GENERIC; implementation++) {
             hbao_params p = exact_params(integration);
             p.radius = 0.8f;
-            if (hbao_implementation_that_runs(implementation) != implementation)
+            if (!implementation_runs_itself(implementation))
                 continue; /* runs another of the list */
             p.implementation = implementation;
             float *thick = run(&p, &view, depth, normal);
@@ -1428,7 +1425,7 @@ TEST_CASE(back_face_layer_lets_light_pass_behind_a_thin_plate) {
             CHECK(error_layered < 0.9 * error_plain); /* measured 0.40x to 0.89x */
             for (int implementation = HBAO_IMPLEMENTATION_AVX2;
                  implementation <= HBAO_IMPLEMENTATION_GENERIC; implementation++) {
-                if (hbao_implementation_that_runs(implementation) != implementation)
+                if (!implementation_runs_itself(implementation))
                     continue; /* runs another of the list */
                 p.implementation = implementation;
                 float *fast = run_layers(&p, &view, depth, normal, back);
@@ -1693,7 +1690,7 @@ TEST_CASE(thickness_skips_exactly_the_occluders_wholly_in_front) {
             for (int integration = 0; integration <= 1; integration++) {
                 for (int implementation = HBAO_IMPLEMENTATION_SCALAR;
                      implementation < HBAO_IMPLEMENTATION_COUNT; implementation++) {
-                    if (hbao_implementation_that_runs(implementation) != implementation)
+                    if (!implementation_runs_itself(implementation))
                         continue; /* not on this CPU: another of the loop runs */
                     for (int c = 0; c < 2; c++) {
                         hbao_params p =
@@ -1754,7 +1751,7 @@ TEST_CASE(angle_bias_matches_the_closed_form_on_a_cone) {
                         }
                         for (int implementation = HBAO_IMPLEMENTATION_SCALAR;
                              implementation < HBAO_IMPLEMENTATION_COUNT; implementation++) {
-                            if (hbao_implementation_that_runs(implementation) != implementation)
+                            if (!implementation_runs_itself(implementation))
                                 continue; /* not on this CPU: another of the loop runs */
                             hbao_params p = cone_params(integration, radius, directions, 16, half,
                                                         implementation);
@@ -1812,7 +1809,7 @@ TEST_CASE(back_layer_takes_occluders_half_the_radius_thick) {
                 const double expected = 1.0 - (floor(32.0 * f - 0.5) + 1.0) / 32.0;
                 for (int implementation = HBAO_IMPLEMENTATION_SCALAR;
                      implementation < HBAO_IMPLEMENTATION_COUNT; implementation++) {
-                    if (hbao_implementation_that_runs(implementation) != implementation)
+                    if (!implementation_runs_itself(implementation))
                         continue; /* not on this CPU: another of the loop runs */
                     const hbao_params p =
                         cone_params(integration, radius, 8, 64, half, implementation);

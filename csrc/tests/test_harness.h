@@ -11,7 +11,17 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "hbao.h"
+
 static int test_failures;
+
+/* Whether the library runs `implementation` itself on this CPU. Where it
+ * does not, it runs the slower one that hbao_implementation_that_runs names,
+ * in every stage; a test's loop over implementations meets that one in its
+ * own turn, so it skips this one rather than run that one twice. */
+static inline int implementation_runs_itself(int32_t implementation) {
+    return hbao_implementation_that_runs(implementation) == implementation;
+}
 
 #define TEST_CASE(name) static void name(void)
 
