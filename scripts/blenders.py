@@ -81,8 +81,21 @@ class Blender:
                 command += ["--python-exit-code", "1"]
             command += ["--python", str(script), "--"] + [str(a) for a in args]
         if ui:
-            command = ["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24"] + command
+            command = ["xvfb-run", "-a", "--server-num", str(_first_display()),
+                       "-s", "-screen 0 1280x1024x24"] + command
         return command
+
+
+# xvfb-run -a takes the first display number from here whose lock file is
+# free; two xvfb-runs that start at once can both find the same one free,
+# and the later Xvfb then fails to start. Runners started side by side (the
+# test suite's pytest workers) each set HBAO_XVFB_FIRST_DISPLAY to a range
+# of their own.
+XVFB_FIRST_DISPLAY = "HBAO_XVFB_FIRST_DISPLAY"
+
+
+def _first_display():
+    return int(os.environ.get(XVFB_FIRST_DISPLAY, "99"))
 
 
 def _version_of(command):

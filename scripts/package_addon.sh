@@ -20,7 +20,7 @@ if [ ! -f "$BUILD/libhbao.so" ] || [ ! -f "$BUILD/libhbao_exr.so" ]; then
 fi
 VERSION="$(sed -n 's/^version = "\(.*\)"/\1/p' "$REPO/addon/hbao/blender_manifest.toml")"
 STAGE="$(mktemp -d)"
-trap 'rm -rf "$STAGE"' EXIT
+trap 'rm -rf "$STAGE" "$REPO"/dist/*.partial.$$' EXIT
 # shellcheck source=addon_files.sh
 . "$REPO/scripts/addon_files.sh"
 mkdir -p "$REPO/dist"
@@ -40,8 +40,10 @@ for licence in /usr/share/doc/libopenexr*/copyright; do
         break
     fi
 done
+# Each zip is written beside its name and renamed into place: a reader (an
+# install, or another packaging run at the same time) sees the old zip or
+# the new one, never half of one.
 ZIP="$REPO/dist/hbao-$VERSION.zip"
-rm -f "$ZIP"
 # Each folder has an entry of its own ("hbao/" first): Blender's Install with
 # Overwrite removes the folders and files a zip names at its top level, and a
 # zip of files alone names none, so it was extracted over the old add-on,
@@ -54,7 +56,8 @@ with zipfile.ZipFile(sys.argv[1], "w", zipfile.ZIP_DEFLATED) as archive:
         archive.write(root)
         for name in sorted(files):
             archive.write(os.path.join(root, name))
-' "$ZIP")
+' "$STAGE/legacy.zip")
+mv "$STAGE/legacy.zip" "$ZIP.partial.$$" && mv "$ZIP.partial.$$" "$ZIP"
 echo "$ZIP"
 
 # Blender's extension tool runs without Blender; the newest bpy here has it.
@@ -66,7 +69,7 @@ fi
 read -r TOOL_PYTHON TOOL_SCRIPT <<<"$TOOL"
 "$TOOL_PYTHON" "$TOOL_SCRIPT" validate "$STAGE/hbao" >&2
 EXTENSION_ZIP="$REPO/dist/hbao-$VERSION-extension.zip"
-rm -f "$EXTENSION_ZIP"
 "$TOOL_PYTHON" "$TOOL_SCRIPT" build --source-dir "$STAGE/hbao" \
-    --output-filepath "$EXTENSION_ZIP" >&2
+    --output-filepath "$STAGE/extension.zip" >&2
+mv "$STAGE/extension.zip" "$EXTENSION_ZIP.partial.$$" && mv "$EXTENSION_ZIP.partial.$$" "$EXTENSION_ZIP"
 echo "$EXTENSION_ZIP"

@@ -29,6 +29,7 @@ PACKAGES=(
     libcjson-dev       # --camera FILE.json
     libdeflate-dev     # the CLI's inflate of ZIP chunks (csrc/tool/zip_chunks.c)
     python3 python3-numpy python3-pytest python3-venv
+    python3-pytest-xdist  # scripts/test.sh: the Python tests on one worker a core
     python3-pycodestyle  # the PEP 8 check of the test suite
     python3-moderngl   # scripts/bench_viewport_gl.py: the preview's passes on a GPU without Blender
     libegl1            # its EGL context (Mesa's here), which moderngl opens without depending on it

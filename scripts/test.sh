@@ -57,5 +57,9 @@ echo "== soak: a 50-frame animation with the node and 200 CLI runs (memory, time
 scripts/soak.sh --frames 50 --runs 200 --report out/soak/test-report.md
 
 echo "== Python tests (real Blender: Debian's blender and bpy 4.5, 5.0, newest 5.x)"
-# Debian's blender + the three bpy builds: a missing one fails the run.
-HBAO_EXPECTED_BLENDERS=4 "$PYTHON" -m pytest tests -q -p no:cacheprovider
+# Debian's blender + the three bpy builds: a missing one fails the run. One
+# pytest-xdist worker a job: most tests wait on one Blender's start and a
+# small render, so two side by side took 0.6 of the time on 2 cores (a
+# module whose module fixtures run Blender stays on one worker: loadgroup).
+HBAO_EXPECTED_BLENDERS=4 "$PYTHON" -m pytest tests -q -p no:cacheprovider \
+    -n "$JOBS" --dist loadgroup

@@ -169,6 +169,13 @@ def _load_quit_marks():
 
 def pytest_configure(config):
     os.environ.pop(PASSES_FROM_MEMORY, None)
+    # Under pytest-xdist (scripts/test.sh runs the suite on one worker a
+    # core) each worker starts its Xvfbs from display numbers of its own.
+    worker = os.environ.get("PYTEST_XDIST_WORKER", "")
+    if worker.startswith("gw"):
+        os.environ[blenders.XVFB_FIRST_DISPLAY] = str(200 + 100 * int(worker[2:]))
+    config.addinivalue_line(
+        "markers", "xdist_group(name): tests that share a module fixture run on one worker")
     config.addinivalue_line("markers", "matrix: runs once in every Blender of the matrix")
     config.addinivalue_line("markers", "ui: needs Blender's user interface (Xvfb)")
     config.addinivalue_line("markers", "extension: needs Blender 4.2+ (extensions)")
@@ -200,32 +207,49 @@ def pytest_generate_tests(metafunc):
     metafunc.parametrize("blender", candidates, ids=[b.name for b in candidates])
 
 
+# The results per Blender and the refused quits, counted where the reports
+# arrive: in pytest's own process, or in pytest-xdist's controller, which
+# gets each worker's reports with their user_properties.
 _OUTCOMES = collections.defaultdict(collections.Counter)
 # The test scripts whose quit Blender refused for good: quit_marks.py
 _QUIT_MARKS = _load_quit_marks()
 QUIT_WITH_WRITES_ALLOWED = _QUIT_MARKS.QUIT_WITH_WRITES_ALLOWED
+# run_command's tally in this process, handed on with the next report
 _REFUSED_QUITS = collections.Counter()
+_REFUSED_QUITS_REPORTED = collections.Counter()
+_BLENDER_PROPERTY, _QUITS_PROPERTY = "hbao_blender", "hbao_refused_quits"
 
 
 @pytest.hookimpl(hookwrapper=True)
 def pytest_runtest_makereport(item, call):
     outcome = yield
     report = outcome.get_result()
+    if _REFUSED_QUITS:
+        report.user_properties.append((_QUITS_PROPERTY, dict(_REFUSED_QUITS)))
+        _REFUSED_QUITS.clear()
     params = item.callspec.params.values() if hasattr(item, "callspec") else ()
     blender = next((p for p in params if isinstance(p, blenders.Blender)), None)
+    if blender is not None:
+        report.user_properties.append((_BLENDER_PROPERTY, blender.name))
+
+
+def pytest_runtest_logreport(report):
+    properties = dict(report.user_properties)
+    _REFUSED_QUITS_REPORTED.update(properties.get(_QUITS_PROPERTY, {}))
+    blender = properties.get(_BLENDER_PROPERTY)
     if blender is None:
         return
     if report.when == "call" or (report.when == "setup" and report.outcome != "passed"):
-        _OUTCOMES[blender.name][report.outcome] += 1
+        _OUTCOMES[blender][report.outcome] += 1
 
 
 def pytest_terminal_summary(terminalreporter):
-    if _REFUSED_QUITS:
+    if _REFUSED_QUITS_REPORTED:
         terminalreporter.section("Blender refused the quit for good")
         terminalreporter.write_line(
             "these runs quit with writes allowed (docs/blender-integration.md, \"Rarely the "
             "refusal does not end\"); ui_stuck_writes.py's on purpose:")
-        for script, runs in sorted(_REFUSED_QUITS.items()):
+        for script, runs in sorted(_REFUSED_QUITS_REPORTED.items()):
             terminalreporter.write_line(f"  {script}: {runs}")
     if not _OUTCOMES:
         return

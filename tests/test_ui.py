@@ -14,7 +14,8 @@ from conftest import REPO, json_line
 
 SCRIPTS = REPO / "tests" / "blender_scripts"
 ARTIFACTS = REPO / "out" / "test-artifacts"
-pytestmark = pytest.mark.ui
+# One worker runs the module (its module fixtures run Blender once a worker).
+pytestmark = [pytest.mark.ui, pytest.mark.xdist_group("test_ui")]
 
 
 @pytest.fixture(scope="module")

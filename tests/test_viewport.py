@@ -18,6 +18,8 @@ from hbao.viewport import camera_sources, projection, shader_sources  # noqa: E4
 
 SCRIPTS = REPO / "tests" / "blender_scripts"
 ARTIFACTS = REPO / "out" / "test-artifacts"
+# One worker runs the module (its module fixtures run Blender once a worker).
+pytestmark = pytest.mark.xdist_group("test_viewport")
 
 # The GLSL follows csrc/lib/ operation for operation in float32; what differs is
 # the GPU's sin/cos/atan/acos/exp (the library uses its own polynomial acos) and
