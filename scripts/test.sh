@@ -61,5 +61,11 @@ echo "== Python tests (real Blender: Debian's blender and bpy 4.5, 5.0, newest 5
 # pytest-xdist worker a job: most tests wait on one Blender's start and a
 # small render, so two side by side took 0.6 of the time on 2 cores (a
 # module whose module fixtures run Blender stays on one worker: loadgroup).
-HBAO_EXPECTED_BLENDERS=4 "$PYTHON" -m pytest tests -q -p no:cacheprovider \
-    -n "$JOBS" --dist loadgroup
+# A PYTHON without pytest-xdist (setup.sh installs Debian's) runs them one
+# at a time.
+WORKERS=(-n "$JOBS" --dist loadgroup)
+if ! "$PYTHON" -c "import xdist" 2>/dev/null; then
+    echo "test.sh: $PYTHON has no pytest-xdist: the Python tests run one at a time"
+    WORKERS=()
+fi
+HBAO_EXPECTED_BLENDERS=4 "$PYTHON" -m pytest tests -q -p no:cacheprovider "${WORKERS[@]}"
