@@ -95,7 +95,10 @@ XVFB_FIRST_DISPLAY = "HBAO_XVFB_FIRST_DISPLAY"
 
 
 def _first_display():
-    return int(os.environ.get(XVFB_FIRST_DISPLAY, "99"))
+    value = os.environ.get(XVFB_FIRST_DISPLAY, "99")
+    if not value.isdigit():
+        raise ValueError(f"{XVFB_FIRST_DISPLAY}={value!r}: give an X display number, such as 99")
+    return int(value)
 
 
 def _version_of(command):
