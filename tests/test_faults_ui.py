@@ -10,7 +10,7 @@ import pytest
 
 from conftest import QUIT_WITH_WRITES_ALLOWED, REPO, json_line
 from hbao import refusal_watch
-from test_addon import node_outputs
+from test_addon import exr, node_outputs
 from test_faults import no_leftovers  # noqa: F401  (the fixture)
 
 pytestmark = [pytest.mark.matrix, pytest.mark.ui]
@@ -288,20 +288,31 @@ def test_f12_in_a_session_that_refuses_pythons_writes_for_good(run_in_blender, t
     the test's F12 or quit refused for minutes). The cause, made here on
     purpose (ui_stuck_writes.py): a draw and another thread's callback that
     overlap out of order leave Blender's flag set. Observed: the flag stays
-    set (a write is refused 2 s later); an edit of the node's Radius and an
-    F12 there (made as the artist's are, past Python's check) still give
-    the AO of that Radius, exactly that of a render of it before the
-    fault, and not the AO before the edit; the add-on says, once, that
-    Blender refuses changes until it restarts (writes.py; in the console,
-    a popup and a line on the HBAO nodes), not 2 s after the fault while its node poll asks, and
-    not sooner than refusal_watch.STUCK_AFTER_S after the poll began to
-    ask; the script's quit, refused, ends Blender with writes allowed
-    (timer_guard.py; exit 0)."""
+    set (a write is refused 2 s later, and after the artist's edits); the
+    add-on says, once, that Blender refuses changes until it restarts
+    (writes.py; in the console, a popup and a line on the HBAO nodes), not
+    2 s after the fault while its node poll asks, and not sooner than
+    refusal_watch.STUCK_AFTER_S after the poll began to ask; from then on
+    it makes its own changes where Blender still allows them
+    (writes.run_writing): the node messages and a render report it had
+    wait no longer (the report reaches the Info editor), and a
+    second HBAO node that the artist added after the fault is linked to
+    its AO pass. An edit of the first node's Radius and an F12 there (made
+    as the artist's are, past Python's check) give both nodes the AO of
+    that Radius, exactly that of a render of it before the fault, not the
+    AO before the edit and not the new node's AO of 1; the script's quit,
+    refused, ends Blender with writes allowed (timer_guard.py; exit 0)."""
     out = tmp_path / "stuck"
     log = run_in_blender(SCRIPTS / "ui_stuck_writes.py", out, ui=True).stdout
     assert "STUCK DONE" in log, log[-3000:]
     assert json_line(log, "STUCK") == {"refused": True, "told": False}, log[-3000:]
+    assert json_line(log, "ADDED") == {"refused": True}, log[-3000:]
     told = json_line(log, "TOLD")
+    assert told["messages_shown"] is True and told["added_linked"] is True, told
+    assert "a render report posted in the stuck session" in json_line(log, "INFO"), log[-3000:]
+    edited = log[log.index("RADIUS r"):]
+    assert "re-composited with new settings from the last render's passes" in edited, edited
+    assert json_line(log, "HINT") == "", log[-3000:]
     assert told["told"] is True and told["popups"] == 1, told
     assert told["line_redrawn"] is True, told
     assert told["after_asking_s"] >= refusal_watch.STUCK_AFTER_S, told
@@ -315,3 +326,5 @@ def test_f12_in_a_session_that_refuses_pythons_writes_for_good(run_in_blender, t
                                for name in ("reference", "first", "after"))
     assert not np.array_equal(first, reference)
     assert np.array_equal(after, reference)
+    added = exr.read_channels(out / "after" / "nodes_0001.exr", ["HBAO1_AO.V"])["HBAO1_AO.V"]
+    assert np.array_equal(added, reference)

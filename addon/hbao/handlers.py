@@ -56,7 +56,8 @@ def _timer_sync():
 
 @never_raises("update the HBAO hooks", result=False)
 def _sync_refused():
-    return not writes.writes_allowed() or _sync_everything()
+    ran, refused = writes.run_writing(_sync_everything)
+    return not ran or refused
 
 
 def _sync_all_or_later():

@@ -63,7 +63,7 @@ def _redraw_node_editors():
                 area.tag_redraw()
 
 
-# The timer asks writes.writes_allowed before it writes. It costs a
+# The timer asks writes.run_writing before it writes. It costs a
 # dictionary check and, per HBAO node of a rendered scene, a comparison per
 # tick.
 _POLL_S = 0.25
@@ -72,12 +72,19 @@ _POLL_S = 0.25
 @never_raises("update the HBAO nodes' status lines", result=_POLL_S)
 def _poll_node_messages():
     if not bpy.app.is_job_running("RENDER"):
-        if report.has_node_messages() and writes.writes_allowed():
-            apply_node_messages()
-        # (each on its own: one that fails at every tick stops no other)
-        if any([_refresh(refresh) for refresh in hint_refreshers]):
+        if report.has_node_messages():
+            writes.run_writing(apply_node_messages)
+        # where Blender's refusal does not end, through writes.run_writing
+        # (which asks Blender first: only then, not at every tick)
+        stuck = writes.told_stuck()[0]
+        if writes.run_writing(_refresh_all)[1] if stuck else _refresh_all():
             _redraw_node_editors()
     return _POLL_S
+
+
+def _refresh_all():
+    # (each on its own: one that fails at every tick stops no other)
+    return any([_refresh(refresh) for refresh in hint_refreshers])
 
 
 @never_raises("update an HBAO node's hint line", result=False)

@@ -2,10 +2,11 @@
 """When Blender's refusal of Python's writes has lasted long enough to be
 the kind that does not end (docs/blender-integration.md, "Rarely the
 refusal does not end"): two threads' callbacks that overlap out of order
-leave Blender's flag set until it restarts, and every add-on's buttons and
-scripts fail. writes.py asks this at each of its probes and tells the
-artist once. Without bpy, so that plain pytest holds its rules
-(tests/test_refusal_watch.py)."""
+leave Blender's flag set until it restarts, and Python's writes fail
+(add-ons' timers and handlers, scripts). writes.py asks this at each of
+its probes, tells the artist once, and from then on makes the add-on's own
+writes where Blender still allows them (writes.run_writing). Without bpy,
+so that plain pytest holds its rules (tests/test_refusal_watch.py)."""
 import time
 
 # Refused at every ask for this long, while no job that runs Python
@@ -22,10 +23,9 @@ ASKED_WITHIN_S = 5.0
 STUCK_SENTENCES = (
     "Blender has refused every change from Python for {seconds:.0f} s with no render running.",
     "It will until it restarts: a fault of Blender's (two of its callbacks overlapped).",
-    "Every add-on's buttons and scripts fail.",
+    "Other add-ons and scripts may stop working.",
     "Save the file and restart Blender.",
-    "Until then F12 still renders the HBAO pass, but the HBAO nodes' status lines stay as "
-    "they are.")
+    "Meanwhile the HBAO nodes go on working: the add-on works around it.")
 
 
 class RefusalWatch:

@@ -34,13 +34,18 @@ class HBAO_OT_render_report(bpy.types.Operator):
         return {"FINISHED"}
 
 
+def _show_reports():
+    windows = bpy.context.window_manager.windows
+    with bpy.context.temp_override(window=windows[0], screen=windows[0].screen):
+        bpy.ops.hbao.render_report("INVOKE_DEFAULT")
+
+
 @never_raises("show the render's reports in the Info editor", result=_POLL_S)
 def _poll():
     if report.has_render_reports() and not bpy.app.is_job_running("RENDER"):
-        windows = bpy.context.window_manager.windows
         try:
-            with bpy.context.temp_override(window=windows[0], screen=windows[0].screen):
-                bpy.ops.hbao.render_report("INVOKE_DEFAULT")
+            if not writes.run_writing(_show_reports)[0]:
+                return _POLL_S  # they wait for the next tick
         except (RuntimeError, IndexError, AttributeError) as error:
             if writes.writes_refused(error):
                 return _POLL_S  # they wait for the next tick

@@ -11,7 +11,10 @@ and then writes would leave half-made data behind: it asks writes_allowed()
 first (an operator call, which also brings the view layer up to date: only
 when there is work), every creation is made whole or removed
 (whole_or_removed), and a refusal met midway (the flag changed since)
-leaves the rest of the job for a later call."""
+leaves the rest of the job for a later call. Rarely the refusal does not
+end until Blender restarts (refusal_watch.py): the add-on says so, and
+run_writing then makes its timers' writes where Blender still allows
+them."""
 import contextlib
 
 import bpy
@@ -79,12 +82,64 @@ def _python_job_running():
     return False
 
 
+# A lifted write under way (run_writing): the probes it makes are not the
+# session's answer (Blender allows them only inside it).
+_lifting = [False]
+_lifted_calls = []  # [action, its result, the exception it raised]
+_LIFT_PROPERTY = "hbao_writes_lifted"
+
+
+def run_writing(action):
+    """(True, action()) where Blender lets Python write now, else (False,
+    None), for a timer's job that writes. Where the refusal is the kind
+    that does not end (told: refusal_watch.py), in the main thread while no
+    job that runs Python callbacks in another thread runs (no callback can
+    then be reading), action runs inside a property's update callback,
+    which Blender runs with writes allowed (docs/blender-integration.md,
+    "Rarely the refusal does not end"): so the hook still follows the
+    artist's nodes, and their status lines and the render's reports still
+    reach them, until Blender restarts. What action raises goes on."""
+    if writes_allowed():
+        return True, action()
+    if not (_watch.told and in_main_thread() and not _python_job_running()):
+        return False, None
+    call = [action, None, None]
+    _lifted_calls.append(call)
+    try:
+        window_manager = bpy.context.window_manager
+        # window-manager data is not refused; its update callback runs action
+        setattr(window_manager, _LIFT_PROPERTY, not getattr(window_manager, _LIFT_PROPERTY))
+    except (AttributeError, RuntimeError) as error:
+        if not writes_refused(error):
+            raise
+        return False, None
+    finally:
+        _lifted_calls.remove(call)
+    if call[2] is not None:
+        raise call[2]
+    return True, call[1]
+
+
+def _run_lifted(_window_manager, _context):
+    _lifting[0] = True
+    try:
+        for call in _lifted_calls:
+            try:
+                call[1] = call[0]()
+            except Exception as error:  # raised again by run_writing
+                call[2] = error
+    finally:
+        _lifting[0] = False
+
+
 @never_raises("watch Blender's refusals of writes")
 def _watch_refusal(allowed):
     """A refusal that does not end (refusal_watch.py) told to the artist,
     once: in the console, in a popup where a timer asked in a window (a
     popup is window-manager data, which Blender does not refuse), and on
     the HBAO nodes (stuck_line)."""
+    if _lifting[0]:
+        return
     seconds = _watch.note(allowed, not allowed and _python_job_running())
     if seconds is None:
         return
@@ -135,9 +190,13 @@ def whole_or_removed(remove):
 
 def register():
     bpy.utils.register_class(HBAO_OT_writes_probe)
+    setattr(bpy.types.WindowManager, _LIFT_PROPERTY,
+            bpy.props.BoolProperty(options={"HIDDEN", "SKIP_SAVE"}, update=_run_lifted))
 
 
 def unregister():
     _watch.reset()
     _shown.update(popups=0, line=("", ""))
+    if hasattr(bpy.types.WindowManager, _LIFT_PROPERTY):
+        delattr(bpy.types.WindowManager, _LIFT_PROPERTY)
     bpy.utils.unregister_class(HBAO_OT_writes_probe)

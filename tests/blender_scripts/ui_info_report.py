@@ -21,6 +21,7 @@ out_dir, shot_dir = sys.argv[sys.argv.index("--") + 1:][:2]
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import f12_job  # noqa: E402
 import timer_guard  # noqa: E402
+from info_editor import info_reports  # noqa: E402
 from writes_refused import while_writes_refused  # noqa: E402
 
 from hbao import render_reports, report  # noqa: E402
@@ -33,24 +34,6 @@ scene, node = f12_job.corner_scene_with_node(out_dir)
 node.id_data.links.remove(node.inputs["Depth"].links[0])
 state = {"phase": "start", "since": time.monotonic()}
 job = f12_job.F12Job()
-
-
-def info_reports():
-    """The Info editor's reports, as Ctrl+C in it copies them."""
-    window = bpy.context.window_manager.windows[0]
-    area = max(window.screen.areas, key=lambda a: a.width * a.height)
-    area.type = "INFO"
-    region = next(r for r in area.regions if r.type == "WINDOW")
-    bpy.context.window_manager.clipboard = ""
-    with bpy.context.temp_override(window=window, screen=window.screen, area=area,
-                                   region=region):
-        bpy.ops.info.select_all(action="SELECT")
-        bpy.ops.info.report_copy()
-        bpy.ops.wm.redraw_timer(type="DRAW_WIN_SWAP", iterations=2)
-    with bpy.context.temp_override(window=window, screen=window.screen):
-        bpy.ops.screen.screenshot(filepath=os.path.join(shot_dir, "ui_info_report.png"),
-                                  check_existing=False)
-    return bpy.context.window_manager.clipboard
 
 
 def tick():
@@ -70,7 +53,7 @@ def tick():
             print("INFO: PENDING AFTER A REFUSED TICK", report.has_render_reports(), flush=True)
             state.update(phase="settle", since=now)
     elif state["phase"] == "settle" and now - state["since"] > SETTLE_S:
-        print(f"INFO {json.dumps(info_reports())}", flush=True)
+        print(f"INFO {json.dumps(info_reports(shot_dir))}", flush=True)
         print("INFO: DONE", flush=True)
         while_writes_refused(timer_guard.quit_blender)  # quits once Blender lets it
         return None

@@ -13,15 +13,23 @@ returned) and puts back the draw's "refused".
 Steps: F12 with Radius 2 r (kept as OUT/reference); Radius r, F12
 (OUT/first); the fault, then prints STUCK {json} (whether a write to the
 scene was refused 2 s later, and whether the add-on had said Blender
-refuses changes then); Radius 2 r and F12, done where Blender allows
-writes (timer_guard.with_writes_allowed), as the artist's edit and F12 key
-are, which do not pass through Python (OUT/after); TOLD {json} (whether
-the add-on said it within 120 s of the render's end, how many popups, how
-long after its node poll began to ask, the HBAO nodes' line, and whether
-the node poll had redrawn the nodes for it);
-STUCK DONE; the quit (timer_guard's, through with_writes_allowed when
-refused). From the fault on, the node poll asks for writes (the last
-render's messages posted again).
+refuses changes then); the artist's edits, done where Blender allows
+writes (timer_guard.with_writes_allowed), as the editor's are, which do
+not pass through Python: Radius 2 r, and a second HBAO node (HBAO1, Radius
+2 r) added, linked to the passes and to a File Output input; ADDED {json}
+(whether a write was still refused then); TOLD {json} once the add-on has
+said it (within 120 s: how many popups, how long after its node poll
+began to ask, the HBAO nodes' line, whether the node poll had redrawn the
+nodes for it, whether the node messages it had were shown, and whether
+the add-on had linked the new node's AO pass); F12, made as the artist's
+key is (OUT/after); RADIUS r, the artist's edit of the first node's
+Radius back to r, and 4 s later HINT "its hint line" (the add-on
+re-composites from the render's passes meanwhile: its log line follows);
+INFO "text": the Info editor's reports (a render report posted at the
+fault among them; a screenshot, OUT/ui_stuck_info.png); STUCK DONE; the quit (timer_guard's, through
+with_writes_allowed when refused). From the fault on, the node poll asks
+for writes (the last render's messages posted again, and a render
+report).
 
   blender --addons hbao --python ui_stuck_writes.py -- OUT_DIR
 """
@@ -37,9 +45,13 @@ import bpy
 out_dir = sys.argv[sys.argv.index("--") + 1]
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import f12_job  # noqa: E402
+import file_output  # noqa: E402
+from info_editor import info_reports  # noqa: E402
 import timer_guard  # noqa: E402
 
 WAIT_S = 20.0  # for the fault's draw and poll
+STUCK_REPORT = "a render report posted in the stuck session"
+RECOMPOSITE_S = 4.0  # for the add-on's timer (0.25 s) to re-composite
 RENDER_WAIT_S = 120.0
 scene = f12_job.corner_scene_with_node(out_dir)[0]
 node = scene.node_tree.nodes["HBAO0"]
@@ -83,10 +95,43 @@ def poll_from_thread():
     bpy.ops.test.poll_in_thread.poll()
 
 
-def edit_and_f12():
-    """What the artist's edit and F12 key do, which Python's refusal does
-    not reach."""
+def still_refused():
+    """Whether Blender refuses a write to the scene from Python now."""
+    try:
+        scene.frame_current = scene.frame_current
+        return False
+    except AttributeError:
+        return True
+
+
+def edit_and_add_node():
+    """What the artist's edits in the node editor do, which Python's
+    refusal does not reach: the first node's Radius 2 r; Add > HBAO (its
+    init runs where Blender allows writes, as an operator's does), the
+    Render Layers' passes linked to it, its Radius and Blur Size set as the
+    first node's, its AO given a File Output input. Returns the new node."""
     node.inputs["Radius"].default_value = 2.0 * radius
+    tree = scene.node_tree
+    added = tree.nodes.new("CompositorNodeHBAO")
+    added.name = "HBAO1"
+    layers = node.inputs["Depth"].links[0].from_node
+    for name in ("Image", "Depth", "Normal"):
+        tree.links.new(layers.outputs[name], added.inputs[name])
+    added.inputs["Radius"].default_value = 2.0 * radius
+    added.inputs["Blur Size"].default_value = 0
+    files = next(n for n in tree.nodes if n.bl_idname == "CompositorNodeOutputFile")
+    tree.links.new(added.outputs["AO"],
+                   file_output.new_input(files, "HBAO1_AO", added.outputs["AO"]))
+    return added
+
+
+def edit_radius():
+    """The artist's edit of the first node's Radius back to r."""
+    node.inputs["Radius"].default_value = radius
+
+
+def f12():
+    """What the artist's F12 key does."""
     job.ended = False
     return bpy.ops.render.render("INVOKE_DEFAULT")
 
@@ -133,33 +178,44 @@ def steps():
     poll_may_return.set()  # (a timer's tick: the draw has returned)
     # the node poll asks for writes from now on (what an HBAO render or an
     # undo leaves it to show)
-    sys.modules["hbao.report"].post_last_node_messages()
+    hbao_report = sys.modules["hbao.report"]
+    hbao_report.post_last_node_messages()
+    hbao_report.post_render_report(STUCK_REPORT)  # (for the Info editor)
     asking = time.monotonic()
     yield 2.0
-    try:
-        scene.frame_current = scene.frame_current
-        refused = False
-    except AttributeError:
-        refused = True
     writes = sys.modules["hbao.writes"]
-    told = writes.told_stuck()[0]
-    print(f"STUCK {json.dumps({'refused': refused, 'told': told})}", flush=True)
-    started = timer_guard.with_writes_allowed(edit_and_f12)
-    if started != {"RUNNING_MODAL"}:
-        timer_guard.give_up(f"STUCK: F12 gave {started}")
-    job.started = True
-    yield from wait_for_render(time.monotonic())
-    rendered = time.monotonic()
-    keep("after")
-    while not writes.told_stuck()[0] and time.monotonic() - rendered < RENDER_WAIT_S:
+    report = {"refused": still_refused(), "told": writes.told_stuck()[0]}
+    print(f"STUCK {json.dumps(report)}", flush=True)
+    added = timer_guard.with_writes_allowed(edit_and_add_node)
+    print(f"ADDED {json.dumps({'refused': still_refused()})}", flush=True)
+    ao_pass = added.inputs[sys.modules["hbao.group_layout"].AO_PASS_INPUT]
+    waited = time.monotonic()
+    while not (writes.told_stuck()[0] and ao_pass.is_linked
+               and not hbao_report.has_render_reports()):
+        if time.monotonic() - waited > RENDER_WAIT_S:
+            break
         yield 0.25
     told, popups = writes.told_stuck()
     after_asking_s = time.monotonic() - asking
     yield 1.0  # (the node poll's next tick redraws the nodes for their line)
     report = {"told": told, "popups": popups, "after_asking_s": after_asking_s,
               "node_line": writes.stuck_line(),
-              "line_redrawn": not writes.stuck_line_changed()}
+              "line_redrawn": not writes.stuck_line_changed(),
+              "messages_shown": not hbao_report.has_node_messages(),
+              "added_linked": ao_pass.is_linked}
     print(f"TOLD {json.dumps(report)}", flush=True)
+    started = timer_guard.with_writes_allowed(f12)
+    if started != {"RUNNING_MODAL"}:
+        timer_guard.give_up(f"STUCK: F12 gave {started}")
+    job.started = True
+    yield from wait_for_render(time.monotonic())
+    keep("after")
+    print("RADIUS r", flush=True)  # (the log's re-composite line comes after this)
+    timer_guard.with_writes_allowed(edit_radius)
+    yield RECOMPOSITE_S
+    print(f"HINT {json.dumps(node.hint)}", flush=True)
+    info = timer_guard.with_writes_allowed(lambda: info_reports(out_dir, "ui_stuck_info.png"))
+    print(f"INFO {json.dumps(info)}", flush=True)
     print("STUCK DONE", flush=True)
     timer_guard.quit_blender()
     yield None
