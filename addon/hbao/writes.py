@@ -85,7 +85,7 @@ def _python_job_running():
 # A lifted write under way (run_writing): the probes it makes are not the
 # session's answer (Blender allows them only inside it).
 _lifting = [False]
-_lifted_calls = []  # [action, its result, the exception it raised]
+_lifted_calls = []  # [action, its result, the exception it raised], the newest last
 _LIFT_PROPERTY = "hbao_writes_lifted"
 
 
@@ -121,13 +121,16 @@ def run_writing(action):
 
 
 def _run_lifted(_window_manager, _context):
+    """The update callback: run_writing's newest call (inside it, writes
+    are allowed, so a nested run_writing calls its action at once)."""
+    if not _lifted_calls:
+        return  # (the property set some other way)
+    call = _lifted_calls[-1]
     _lifting[0] = True
     try:
-        for call in _lifted_calls:
-            try:
-                call[1] = call[0]()
-            except Exception as error:  # raised again by run_writing
-                call[2] = error
+        call[1] = call[0]()
+    except Exception as error:  # raised again by run_writing
+        call[2] = error
     finally:
         _lifting[0] = False
 
