@@ -74,10 +74,7 @@ def _poll_node_messages():
     if not bpy.app.is_job_running("RENDER"):
         if report.has_node_messages():
             writes.run_writing(apply_node_messages)
-        # where Blender's refusal does not end, through writes.run_writing
-        # (which asks Blender first: only then, not at every tick)
-        stuck = writes.told_stuck()[0]
-        if writes.run_writing(_refresh_all)[1] if stuck else _refresh_all():
+        if writes.run_writing(_refresh_all, ask=False)[1]:
             _redraw_node_editors()
     return _POLL_S
 

@@ -89,9 +89,12 @@ _lifted_calls = []  # [action, its result, the exception it raised], the newest 
 _LIFT_PROPERTY = "hbao_writes_lifted"
 
 
-def run_writing(action):
+def run_writing(action, ask=True):
     """(True, action()) where Blender lets Python write now, else (False,
-    None), for a timer's job that writes. Where the refusal is the kind
+    None), for a timer's job that writes. ask=False, for a job that runs at
+    every tick and meets a refusal by itself (writes only what changed):
+    Blender is not asked first unless its refusal has been told, and
+    action() just runs. Where the refusal is the kind
     that does not end (told: refusal_watch.py), in the main thread while no
     job that runs Python callbacks in another thread runs (no callback can
     then be reading), action runs inside a property's update callback,
@@ -99,7 +102,7 @@ def run_writing(action):
     "Rarely the refusal does not end"): so the hook still follows the
     artist's nodes, and their status lines and the render's reports still
     reach them, until Blender restarts. What action raises goes on."""
-    if writes_allowed():
+    if (not ask and not _watch.told) or writes_allowed():
         return True, action()
     if not (_watch.told and in_main_thread() and not _python_job_running()):
         return False, None
