@@ -44,8 +44,12 @@ def _show_reports():
 def _poll():
     if report.has_render_reports() and not bpy.app.is_job_running("RENDER"):
         try:
-            if not writes.run_writing(_show_reports)[0]:
-                return _POLL_S  # they wait for the next tick
+            # Not asked first: one more operator poll right after a render,
+            # while a callback of the render's thread may still run, is
+            # one more chance of the overlap that leaves the refusal stuck
+            # (a fresh-clone run of session 57 met it twice while this
+            # asked). A refusal raises, below.
+            writes.run_writing(_show_reports, ask=False)
         except (RuntimeError, IndexError, AttributeError) as error:
             if writes.writes_refused(error):
                 return _POLL_S  # they wait for the next tick
