@@ -159,9 +159,9 @@ def blender_environment(user_scripts, extra=None):
 PASSES_FROM_MEMORY = "HBAO_PASSES_FROM_MEMORY"
 
 
-def _load_quit_marks():
+def _load_stuck_marks():
     spec = importlib.util.spec_from_file_location(
-        "quit_marks", REPO / "tests" / "blender_scripts" / "quit_marks.py")
+        "stuck_marks", REPO / "tests" / "blender_scripts" / "stuck_marks.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
@@ -215,26 +215,27 @@ def pytest_generate_tests(metafunc):
     metafunc.parametrize("blender", candidates, ids=[b.name for b in candidates])
 
 
-# The results per Blender and the refused quits, counted where the reports
-# arrive: in pytest's own process, or in pytest-xdist's controller, which
-# gets each worker's reports with their user_properties.
+# The results per Blender and the steps and quits Blender refused for good,
+# counted where the reports arrive: in pytest's own process, or in
+# pytest-xdist's controller, which gets each worker's reports with their
+# user_properties.
 _OUTCOMES = collections.defaultdict(collections.Counter)
-# The test scripts whose quit Blender refused for good: quit_marks.py
-_QUIT_MARKS = _load_quit_marks()
-QUIT_WITH_WRITES_ALLOWED = _QUIT_MARKS.QUIT_WITH_WRITES_ALLOWED
-# run_command's tally in this process, handed on with the next report
-_REFUSED_QUITS = collections.Counter()
-_REFUSED_QUITS_REPORTED = collections.Counter()
-_BLENDER_PROPERTY, _QUITS_PROPERTY = "hbao_blender", "hbao_refused_quits"
+# What the test scripts ran with writes allowed, refused for good: stuck_marks.py
+STUCK_MARKS = _load_stuck_marks()
+# run_command's tally in this process ("script: LABEL" -> runs), handed on
+# with the next report
+_REFUSED = collections.Counter()
+_REFUSED_REPORTED = collections.Counter()
+_BLENDER_PROPERTY, _REFUSED_PROPERTY = "hbao_blender", "hbao_refused_for_good"
 
 
 @pytest.hookimpl(hookwrapper=True)
 def pytest_runtest_makereport(item, call):
     outcome = yield
     report = outcome.get_result()
-    if _REFUSED_QUITS:
-        report.user_properties.append((_QUITS_PROPERTY, dict(_REFUSED_QUITS)))
-        _REFUSED_QUITS.clear()
+    if _REFUSED:
+        report.user_properties.append((_REFUSED_PROPERTY, dict(_REFUSED)))
+        _REFUSED.clear()
     params = item.callspec.params.values() if hasattr(item, "callspec") else ()
     blender = next((p for p in params if isinstance(p, blenders.Blender)), None)
     if blender is not None:
@@ -243,7 +244,7 @@ def pytest_runtest_makereport(item, call):
 
 def pytest_runtest_logreport(report):
     properties = dict(report.user_properties)
-    _REFUSED_QUITS_REPORTED.update(properties.get(_QUITS_PROPERTY, {}))
+    _REFUSED_REPORTED.update(properties.get(_REFUSED_PROPERTY, {}))
     blender = properties.get(_BLENDER_PROPERTY)
     if blender is None:
         return
@@ -252,13 +253,13 @@ def pytest_runtest_logreport(report):
 
 
 def pytest_terminal_summary(terminalreporter):
-    if _REFUSED_QUITS_REPORTED:
-        terminalreporter.section("Blender refused the quit for good")
+    if _REFUSED_REPORTED:
+        terminalreporter.section("Blender refused a step or the quit for good")
         terminalreporter.write_line(
-            "these runs quit with writes allowed (docs/blender-integration.md, \"Rarely the "
-            "refusal does not end\"); ui_stuck_writes.py's on purpose:")
-        for script, runs in sorted(_REFUSED_QUITS_REPORTED.items()):
-            terminalreporter.write_line(f"  {script}: {runs}")
+            "these ran with writes allowed (docs/blender-integration.md, \"Rarely the refusal "
+            "does not end\"); ui_stuck_writes.py's on purpose (script: what, runs):")
+        for what, runs in sorted(_REFUSED_REPORTED.items()):
+            terminalreporter.write_line(f"  {what}: {runs}")
     if not _OUTCOMES:
         return
     terminalreporter.section("tests per Blender")
@@ -351,8 +352,8 @@ def run_command(command, user_scripts, env=None, check=True, timeout=BLENDER_TIM
         pytest.fail(f"Blender did not end within {timeout} s (killed):\n"
                     f"{' '.join(command)}\n{stdout[-6000:]}")
     completed = subprocess.CompletedProcess(command, process.returncode, stdout)
-    if QUIT_WITH_WRITES_ALLOWED in stdout:
-        _REFUSED_QUITS[_script_name(command)] += 1
+    for label in STUCK_MARKS.stuck_labels(stdout):
+        _REFUSED[f"{_script_name(command)}: {label}"] += 1
     if check and completed.returncode != 0:
         pytest.fail(f"Blender exited with {completed.returncode}:\n"
                     f"{' '.join(command)}\n{completed.stdout[-6000:]}")

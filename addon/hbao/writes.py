@@ -72,7 +72,10 @@ STUCK_LINE = "Blender refuses changes"
 _shown = {"popups": 0, "line": ("", "")}  # popups shown (the tests read it); the nodes' line
 
 
-def _python_job_running():
+def python_job_running():
+    """Whether a job runs that runs Python callbacks in another thread (a
+    render, a bake, compositing): Blender's refusal of writes is then
+    expected, and no write may be lifted past it."""
     for job in _PYTHON_JOBS:
         try:
             if bpy.app.is_job_running(job):
@@ -104,7 +107,7 @@ def run_writing(action, ask=True):
     reach them, until Blender restarts. What action raises goes on."""
     if (not ask and not _watch.told) or writes_allowed():
         return True, action()
-    if not (_watch.told and in_main_thread() and not _python_job_running()):
+    if not (_watch.told and in_main_thread() and not python_job_running()):
         return False, None
     call = [action, None, None]
     _lifted_calls.append(call)
@@ -146,7 +149,7 @@ def _watch_refusal(allowed):
     the HBAO nodes (stuck_line)."""
     if _lifting[0]:
         return
-    seconds = _watch.note(allowed, not allowed and _python_job_running())
+    seconds = _watch.note(allowed, not allowed and python_job_running())
     if seconds is None:
         return
     log(refusal_watch.stuck_text(seconds))

@@ -21,7 +21,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(
 from bpy_blender import remove_session_temp_folder  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from quit_marks import QUIT_WITH_WRITES_ALLOWED  # noqa: E402
+from stuck_marks import WITH_WRITES_ALLOWED  # noqa: E402
 
 
 def give_up(message):
@@ -76,43 +76,75 @@ def _note_accepted(label):
               f"({entry[1]} times)", flush=True)
 
 
-def refused_for_now(operation, label):
+# A refusal that lasts STUCK_AFTER_S while no job that runs Python
+# callbacks in another thread runs (no render: writes.python_job_running)
+# is that stuck state. A script's steps stand for the artist's edits and
+# key presses, which Python's refusal does not reach: such a step, or its
+# operator, then runs with writes allowed (with_writes_allowed), after a
+# line that says so (stuck_marks.py; the test summary lists such runs).
+# CI met the state by chance in a UI test's Ctrl+Z (session 57: refused
+# for 57 s, the test failed).
+STUCK_AFTER_S = 10.0
+
+
+def _stuck(label, after_s):
+    """Whether `label` has been refused for after_s with no such job."""
+    entry = _refused.get(label)
+    return (entry is not None and time.monotonic() - entry[0] >= after_s
+            and not writes.python_job_running())
+
+
+def _allowed_after_refusals(label, function):
+    print(f"{label}: refused for {time.monotonic() - _refused[label][0]:.1f} s; "
+          f"{WITH_WRITES_ALLOWED}", flush=True)
+    return with_writes_allowed(function)
+
+
+def refused_for_now(operation, label, stuck_after_s=STUCK_AFTER_S):
     """Calls operation() (an operator); True, after saying so, when Blender
     refused it for the moment: while another thread runs a read-only
     callback (a draw, Cycles' render) it refuses operators in every thread,
-    the timers' too (a CI run, session 16: the quit after an F12 render)."""
+    the timers' too (a CI run, session 16: the quit after an F12 render).
+    Refused for stuck_after_s, it runs with writes allowed (above)."""
     try:
         operation()
     except RuntimeError as error:
         if not writes.writes_refused(error):
             raise
         _note_refusal(label, error)
-        return True
+        if not _stuck(label, stuck_after_s):
+            return True
+        print(f"{label}:", _allowed_after_refusals(label, operation), flush=True)
     _note_accepted(label)
     return False
 
 
-def guarded_timer(step, first_interval, persistent=False):
+def guarded_timer(step, first_interval, persistent=False, label="STEP"):
     """bpy.app.timers.register(step), except that an exception in step ends
     Blender (exit status 1, the traceback printed) instead of unregistering
     the timer silently and leaving Blender idle until the test's timeout.
     A step that Blender refused a write or an operator runs again
-    REFUSED_RETRY_S later, up to REFUSED_RETRIES times in a row: a step
-    changes its state only after its writes and operators, or makes them
-    once (f12_job.F12Job asks for its render again itself). A `persistent`
-    timer goes on after a file is opened."""
+    REFUSED_RETRY_S later, up to REFUSED_RETRIES times in a row, and with
+    writes allowed once refused for STUCK_AFTER_S (above): a step changes
+    its state only after its writes and operators, or makes them once
+    (f12_job.F12Job asks for its render again itself). A `persistent`
+    timer goes on after a file is opened. Timers that run at once keep
+    their refusals apart by their `label` (STEP for most)."""
     refusals = [0]
 
     def guarded():
         try:
-            interval = step()
+            if _stuck(label, STUCK_AFTER_S):
+                interval = _allowed_after_refusals(label, step)
+            else:
+                interval = step()
             refusals[0] = 0
-            _note_accepted("STEP")
+            _note_accepted(label)
             return interval
         except Exception as error:
             if writes.writes_refused(error) and refusals[0] < REFUSED_RETRIES:
                 refusals[0] += 1
-                _note_refusal("STEP", error)
+                _note_refusal(label, error)
                 return REFUSED_RETRY_S
             print("SCRIPT ERROR in the timer:", traceback.format_exc(), sep="\n", flush=True)
             os._exit(1)
@@ -144,11 +176,15 @@ _allowed_calls = []  # the calls under way: [function, its result, the exception
 
 
 def _run_allowed(_window_manager, _context):
-    for call in _allowed_calls:
-        try:
-            call[1] = call[0]()
-        except Exception as error:  # raised again by with_writes_allowed
-            call[2] = error
+    """The update callback: with_writes_allowed's newest call only (a
+    nested call's update would run the outer call again)."""
+    if not _allowed_calls:
+        return
+    call = _allowed_calls[-1]
+    try:
+        call[1] = call[0]()
+    except Exception as error:  # raised again by with_writes_allowed
+        call[2] = error
 
 
 bpy.types.WindowManager.timer_guard_writes_allowed = bpy.props.BoolProperty(update=_run_allowed)
@@ -183,21 +219,16 @@ def quit_blender():
     with_writes_allowed: Blender 3.4 under Xvfb refused every quit
     for the whole grace after a script's work was done (a CI run of
     session 48, and earlier ones), the refusal described above, and the
-    test failed although Blender had done all that it was asked. Such a
-    run says QUIT_WITH_WRITES_ALLOWED, and the test summary lists it."""
+    test failed although Blender had done all that it was asked."""
     bpy.app.timers.register(lambda: give_up("QUIT: Blender did not end"),
                             first_interval=QUIT_GRACE_S)
-    if refused_for_now(bpy.ops.wm.quit_blender, "QUIT"):
+    if _quit_refused():
         bpy.app.timers.register(_quit_again, first_interval=REFUSED_RETRY_S)
 
 
+def _quit_refused():
+    return refused_for_now(bpy.ops.wm.quit_blender, "QUIT", QUIT_DIRECTLY_S)
+
+
 def _quit_again():
-    if not refused_for_now(bpy.ops.wm.quit_blender, "QUIT"):
-        return None
-    first_refusal = _refused["QUIT"][0]
-    if time.monotonic() - first_refusal < QUIT_DIRECTLY_S:
-        return REFUSED_RETRY_S
-    print(f"QUIT: refused for {time.monotonic() - first_refusal:.1f} s; "
-          f"{QUIT_WITH_WRITES_ALLOWED}:", with_writes_allowed(bpy.ops.wm.quit_blender),
-          flush=True)
-    return None
+    return REFUSED_RETRY_S if _quit_refused() else None

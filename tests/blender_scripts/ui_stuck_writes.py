@@ -21,10 +21,12 @@ not pass through Python: Radius 2 r, and a second HBAO node (HBAO1, Radius
 said it (within 120 s: how many popups, how long after its node poll
 began to ask, the HBAO nodes' line, whether the node poll had redrawn the
 nodes for it, whether the node messages it had were shown, and whether
-the add-on had linked the new node's AO pass); F12, made as the artist's
-key is (OUT/after); RADIUS r, the artist's edit of the first node's
-Radius back to r, and 4 s later HINT "its hint line" (the add-on
-re-composites from the render's passes meanwhile: its log line follows);
+the add-on had linked the new node's AO pass); F12 (OUT/after), refused,
+then made with writes allowed by timer_guard's refused_for_now, as the
+artist's key is made; RADIUS r, the artist's edit of the first node's
+Radius back to r, a guarded step (EDIT) refused and then run with writes
+allowed, and 4 s later HINT "its hint line" (the add-on re-composites
+from the render's passes meanwhile: its log line follows);
 INFO "text": the Info editor's reports (a render report posted at the
 fault among them; a screenshot, OUT/ui_stuck_info.png); STUCK DONE; the quit (timer_guard's, through
 with_writes_allowed when refused). From the fault on, the node poll asks
@@ -130,12 +132,6 @@ def edit_radius():
     node.inputs["Radius"].default_value = radius
 
 
-def f12():
-    """What the artist's F12 key does."""
-    job.ended = False
-    return bpy.ops.render.render("INVOKE_DEFAULT")
-
-
 bpy.utils.register_class(TEST_OT_poll_in_thread)
 HEADERS = (bpy.types.VIEW3D_HT_header, bpy.types.NODE_HT_header, bpy.types.IMAGE_HT_header)
 for header in HEADERS:
@@ -204,14 +200,18 @@ def steps():
               "messages_shown": not hbao_report.has_node_messages(),
               "added_linked": ao_pass.is_linked}
     print(f"TOLD {json.dumps(report)}", flush=True)
-    started = timer_guard.with_writes_allowed(f12)
-    if started != {"RUNNING_MODAL"}:
-        timer_guard.give_up(f"STUCK: F12 gave {started}")
-    job.started = True
+    job.start()  # (refused: timer_guard makes it with writes allowed)
     yield from wait_for_render(time.monotonic())
     keep("after")
     print("RADIUS r", flush=True)  # (the log's re-composite line comes after this)
-    timer_guard.with_writes_allowed(edit_radius)
+    edited = []
+
+    def edit_radius_step():
+        edit_radius()  # (refused: timer_guard runs the step with writes allowed)
+        edited.append(True)
+    timer_guard.guarded_timer(edit_radius_step, 0.0, label="EDIT")
+    while not edited:
+        yield 0.25
     yield RECOMPOSITE_S
     print(f"HINT {json.dumps(node.hint)}", flush=True)
     info = timer_guard.with_writes_allowed(lambda: info_reports(out_dir, "ui_stuck_info.png"))
