@@ -5,15 +5,12 @@ import math
 import platform
 import statistics
 
-import matplotlib
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402  (after the backend choice)
-import numpy as np  # noqa: E402
+import numpy as np
 
-import config  # noqa: E402
-import metrics  # noqa: E402
-import sweep  # noqa: E402  (puts the add-on on sys.path)
-from hbao.parameters import DEFAULTS as PARAMETER_DEFAULTS  # noqa: E402
+import config
+import metrics
+import sweep  # (puts the add-on on sys.path)
+from hbao.parameters import DEFAULTS as PARAMETER_DEFAULTS
 
 # The node's defaults before this benchmark first chose them.
 EARLIER_DEFAULT = {"directions": 8, "steps": 6, "half_resolution": False, "blur_size": 5,
@@ -29,6 +26,17 @@ ERROR_MAP_RANGE = 0.25
 # Gap between the panels of an image strip, in pixels.
 STRIP_GAP = 4
 PLOT_DPI = 90
+
+
+@functools.cache
+def _pyplot():
+    """matplotlib's pyplot, drawing into files: imported only where the
+    report draws (scripts/benchmark.sh installs it), so that the test
+    suite's imports of this module and run_benchmark.py need no matplotlib."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot
+    return matplotlib.pyplot
 
 
 def _by_key(scene_result):
@@ -87,6 +95,7 @@ def _fmt(value, digits=4):
 
 
 def plot_scene(scene_result, recommended_key, path):
+    plt = _pyplot()
     fig, axis = plt.subplots(figsize=(7.0, 4.6), dpi=PLOT_DPI)
     sweep_entries = scene_result["sweep"]
     main = [e for e in sweep_entries if e["setting"]["integration"] == "COSINE"
@@ -139,6 +148,7 @@ def _grey_rgb(image, mask):
 
 def write_strip(data, ao, path):
     """reference | HBAO | signed error map (blue: HBAO darker, red: brighter)."""
+    plt = _pyplot()
     error = np.clip((ao - data.truth) / ERROR_MAP_RANGE, -1.0, 1.0)
     error_rgb = plt.get_cmap("RdBu_r")((error + 1.0) / 2.0)[..., :3]
     error_rgb[~data.mask] = (0.0, 0.0, 0.0)
@@ -151,6 +161,7 @@ def write_strip(data, ao, path):
 def write_comparison(truth, mask, columns, path):
     """Top row: reference | each AO of `columns`; bottom row, under each AO,
     its signed error map (blue: darker than the reference, red: brighter)."""
+    plt = _pyplot()
     height, width = truth.shape
     gap_column = np.ones((height, STRIP_GAP, 3))
     top = [_grey_rgb(truth, mask)]
