@@ -7,10 +7,12 @@ alternating rounds, so both see the machine of the same minutes) and
 prints each part's share.
 
 Parts, each the difference between two builds (1 thread unless said):
-- the stages around the search: the frame at radius 1e-4, where no horizon
-  is searched (depth conversion, normals, deinterleaving, blur, output;
-  and each block's set-up up to its test for active pixels, which then
-  finds none: that much of the set-up is counted here);
+- the stages around the search: the frame at radius 1e-4 with one pixel
+  brought near (bench_ab --near-pixel: without a sampled pixel the library
+  computes nothing), where only that pixel's horizons are searched (depth
+  conversion, normals, deinterleaving, blur, output; and each block's
+  set-up up to its test for active pixels, which then finds none: that
+  much of the set-up is counted here);
 - the blocks' set-up, the directions' slices and the steps' plans: the
   build without the step loop and without its prefetches, less the stages;
 - the plans' prefetches (the memory the steps read): the build without
@@ -137,12 +139,13 @@ def main():
             full, unit, ratio = paired(library, path, args.rounds, options)
             fulls.append(full)
             times[name] = ratio
-        stages, _, _ = paired(library, library, args.rounds, options + ["--radius", "1e-4"])
+        stages, _, _ = paired(library, library, args.rounds,
+                              options + ["--radius", "1e-4", "--near-pixel"])
     full = statistics.median(fulls)
     for name in times:
         times[name] *= full
     parts = [
-        ("stages around the search (radius 1e-4)", stages),
+        ("stages around the search (radius 1e-4, one pixel near)", stages),
         ("blocks' set-up, slices and plans", times["no_step_loop_no_prefetch"] - stages),
         ("the plans' prefetches (the steps' memory)",
          times["no_step_loop"] - times["no_step_loop_no_prefetch"]),

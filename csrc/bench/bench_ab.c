@@ -11,13 +11,15 @@
  *   bench_ab BEFORE/libhbao.so AFTER/libhbao.so [--rounds R] [--calls N]
  *            [--threads T] [--half] [--radius R] [--directions D] [--steps S]
  *            [--blur B] [--size WxH] [--implementation NAME] [--back-faces]
- *            [--background P]
+ *            [--background P] [--near-pixel]
  *
  * --back-faces: with a back-face layer every surface 0.3 deep, as
  * bench_speed's back-face row (hbao_compute_layers; without it the same
  * function with no layer, which is hbao_compute). --background P: the
  * upper P per cent of the rows background (bench_sky, as bench_speed's
- * skips row has the upper half). */
+ * skips row has the upper half). --near-pixel: one pixel brought near
+ * (bench_near_pixel), so that a radius under a pixel elsewhere still runs
+ * every stage around the search (scripts/bench_search_parts.py). */
 #ifndef _GNU_SOURCE
 #define _GNU_SOURCE /* RTLD_DEEPBIND */
 #endif
@@ -59,12 +61,13 @@ static void usage(const char *program) {
             "usage: %s BEFORE_LIBRARY AFTER_LIBRARY [--rounds R] [--calls N] [--threads T] "
             "[--half] [--radius R] [--directions D] [--steps S] [--blur B] [--size WxH]\n"
             "  [--implementation scalar|generic|avx2|avx512] (default: the best this CPU has) "
-            "[--back-faces] [--background P]\n",
+            "[--back-faces] [--background P] [--near-pixel]\n",
             program);
 }
 
 int main(int argc, char **argv) {
-    int rounds = 3, calls = 15, threads = 1, half = 0, back_faces = 0, background = 0;
+    int rounds = 3, calls = 15, threads = 1, half = 0, back_faces = 0, background = 0,
+        near_pixel = 0;
     int width = 1920, height = 1080;
     hbao_params params = HBAO_PARAMS_DEFAULT_INITIALIZER;
     float radius = 0.5f;
@@ -93,6 +96,8 @@ int main(int argc, char **argv) {
             back_faces = 1;
         else if (!strcmp(argv[a], "--background") && a + 1 < argc)
             background = (int)bench_whole_number(argv[++a], 0, 100);
+        else if (!strcmp(argv[a], "--near-pixel"))
+            near_pixel = 1;
         else if (!strcmp(argv[a], "--size") && a + 1 < argc)
             bench_size(argv[++a], 16, 8192, &width, &height);
         else if (!strcmp(argv[a], "--implementation") && a + 1 < argc)
@@ -119,6 +124,7 @@ int main(int argc, char **argv) {
     bench_scene frame;
     bench_scene_make(&frame, width, height);
     bench_sky(frame.depth, width, height, background);
+    if (near_pixel) bench_near_pixel(frame.depth);
     params.radius = radius;
     params.threads = threads;
     params.half_resolution = half;
@@ -131,8 +137,9 @@ int main(int argc, char **argv) {
     double *times = malloc(sizeof(double) * (size_t)calls);
     if (times == NULL) return 1;
     const char *unit = threads == 1 ? "CPU ms" : "wall ms";
-    char sky[32] = "";
+    char sky[48] = "";
     if (background > 0) snprintf(sky, sizeof sky, ", %d %% background", background);
+    if (near_pixel) snprintf(sky + strlen(sky), sizeof sky - strlen(sky), ", one pixel near");
     printf("%dx%d, %d x %d, blur %d%s%s%s, radius %g, %d thread(s); per round and build: "
            "fastest and lower-quartile %s of %d calls\n",
            width, height, params.directions, params.steps, params.blur_size,

@@ -85,6 +85,17 @@ static inline void bench_sky(float *depth, int width, int height, int percent) {
     for (size_t k = 0; k < pixels; k++) depth[k] = 1e10f;
 }
 
+/* The top-left pixel of a depth image brought to a depth of 1e-6, so near
+ * that its projected radius is a pixel or more at any radius the benchmarks
+ * set: a frame whose radius is under a pixel elsewhere still runs every
+ * stage around the search, and the search is that one pixel's. Without it
+ * such a frame computes nothing (hbao_compute writes 1s where no pixel is
+ * sampled). bench_speed's stages table and its skips row, bench_ab
+ * --near-pixel. */
+static inline void bench_near_pixel(float *depth) {
+    depth[0] = 1e-6f;
+}
+
 /* A room corner (floor, two walls) with a box: every pixel is geometry. */
 typedef struct bench_scene {
     scene_view view;

@@ -296,14 +296,15 @@ int main(int argc, char **argv) {
     {
         bench_scene b;
         bench_scene_make(&b, 1920, 1080);
+        bench_near_pixel(b.depth);
         float *ao = malloc((size_t)1920 * 1080 * sizeof(float));
         double *cpu = malloc((size_t)runs * sizeof(double));
         if (ao == NULL || cpu == NULL) return 1;
         printf("\n## Stages around the horizon search, 1920x1080, %s, 1 thread, median CPU ms\n\n",
                hbao_implementation_name(best));
-        printf(
-            "Radius 1e-4 (under a pixel everywhere, so no horizon is searched): depth conversion, "
-            "normals, [upsample], blur, output. Median CPU ms (fastest call's).\n\n");
+        printf("Radius 1e-4 (under a pixel everywhere but at one pixel brought near, so that the "
+               "search is that pixel's): depth conversion, normals, [upsample], blur, output. "
+               "Median CPU ms (fastest call's).\n\n");
         printf("| resolution | blur 0 | blur %d | blur 15 | blur %d alone | blur 15 alone |\n",
                HBAO_DEFAULT_BLUR_SIZE, HBAO_DEFAULT_BLUR_SIZE);
         printf("|---|---|---|---|---|---|\n");
@@ -348,13 +349,16 @@ int main(int argc, char **argv) {
         bench_scene b;
         bench_scene_make(&b, 1920, 1080);
         const size_t pixels = (size_t)1920 * 1080;
-        enum { CASES = 4 };
+        enum { CASES = 5 };
         float *ao = malloc(pixels * sizeof(float)), *sky = malloc(pixels * sizeof(float));
+        float *near = malloc(pixels * sizeof(float));
         double *wall = malloc((size_t)CASES * runs * sizeof(double));
         double *ratio = malloc((size_t)runs * sizeof(double));
-        if (ao == NULL || sky == NULL || wall == NULL || ratio == NULL) return 1;
+        if (ao == NULL || sky == NULL || near == NULL || wall == NULL || ratio == NULL) return 1;
         memcpy(sky, b.depth, pixels * sizeof(float));
         bench_sky(sky, 1920, 1080, 50); /* the upper half: background */
+        memcpy(near, b.depth, pixels * sizeof(float));
+        bench_near_pixel(near);
         float *const full_depth = b.depth;
         printf("\n## Skips, 1920x1080, defaults, %s, wall ms\n\n", all_columns[last_column].name);
         printf("A round times every case once. Time: the median round, with the fastest and the "
@@ -364,12 +368,15 @@ int main(int argc, char **argv) {
         const struct {
             const char *what, *frame;
             float radius;
-            int sky;
+            int depth; /* 0: the scene's; 1: sky; 2: one pixel near */
         } cases[CASES] = {
             {"nothing (reference)", "every pixel geometry, radius 0.5", 0.5f, 0},
             {"background pixels and blocks", "upper half background, radius 0.5", 0.5f, 1},
             {"steps that land on the same pixel", "radius 0.02 (about 10 pixels)", 0.02f, 0},
-            {"the horizon search (radius under a pixel)", "radius 1e-4", 1e-4f, 0},
+            {"the horizon search (radius under a pixel but at one pixel)",
+             "radius 1e-4, one pixel near", 1e-4f, 2},
+            {"everything but the depths (radius under a pixel everywhere)", "radius 1e-4", 1e-4f,
+             0},
         };
         for (int round = -1; round < runs; round++) {
             for (int c = 0; c < CASES; c++) {
@@ -377,7 +384,7 @@ int main(int argc, char **argv) {
                 p.radius = cases[c].radius;
                 p.implementation = all_columns[last_column].implementation;
                 p.threads = all_columns[last_column].threads;
-                b.depth = cases[c].sky ? sky : full_depth;
+                b.depth = cases[c].depth == 1 ? sky : cases[c].depth == 2 ? near : full_depth;
                 timing t;
                 if (!time_call(&p, &b, ao, &t)) return 1;
                 if (round >= 0) wall[c * runs + round] = t.wall;
@@ -397,6 +404,7 @@ int main(int argc, char **argv) {
         b.depth = full_depth;
         free(ao);
         free(sky);
+        free(near);
         free(wall);
         free(ratio);
         free(b.depth);

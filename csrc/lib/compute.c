@@ -253,6 +253,11 @@ hbao_result hbao_compute_layers(const hbao_params *params, const hbao_camera *ca
         }
     }
     hbao_grid_set_projection(&grid, camera, width, height, scale);
+    if (!hbao_grid_sampled(&s, &grid)) {
+        /* every projected radius under a pixel: 1s, as the stages give */
+        fill_ones(ao, ao_row_stride, width, height);
+        goto done;
+    }
     /* A layer with no back face known anywhere is no layer: the result is
      * hbao_compute()'s, exactly, not its sector-quantised twin. */
     if (grid.back != NULL && !any_finite(grid.back, grid_pixels)) grid.back = NULL;

@@ -573,6 +573,20 @@ float hbao_block_step_at(const hbao_settings *s, const hbao_grid *g, float neare
     return largest >= 1.0f ? (largest - 1.0f) / (float)s->steps : HBAO_BLOCK_UNSAMPLED;
 }
 
+int hbao_grid_sampled(const hbao_settings *s, const hbao_grid *g) {
+    /* The nearest foreground depth of each row (NaN and +inf are no
+     * foreground: a pixel there is 1, hbao_horizon_pixel), tested as a
+     * block's nearest depth is. */
+    for (int j = 0; j < g->height; j++) {
+        const float *row = g->depth + (size_t)j * g->width;
+        float nearest = INFINITY;
+        for (int i = 0; i < g->width; i++)
+            nearest = row[i] > 0.0f && row[i] < nearest ? row[i] : nearest;
+        if (hbao_block_step_at(s, g, nearest) != HBAO_BLOCK_UNSAMPLED) return 1;
+    }
+    return 0;
+}
+
 /* HBAO_NOTE_RADIUS_BEYOND_IMAGE where, at more than half of the foreground
  * pixels among about 4096 spread over the grid (every k-th of every k-th
  * row), the projected radius exceeds the grid's shorter side. The radius is

@@ -278,6 +278,13 @@ void hbao_compute_normals(const hbao_settings *settings, const hbao_camera *came
  * HBAO_NOTE_* bits of what it did other than usual. */
 uint32_t hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *grid, float *ao);
 
+/* horizon.c: whether any pixel of the grid (its depths and projection set)
+ * is sampled, its projected radius a pixel or more. Where none is, every
+ * raw AO is 1, and so is everything the blur, the upsample and any
+ * strength make of it, exactly: hbao_compute_layers then writes 1s and
+ * computes nothing else. Stops at the first row that has such a pixel. */
+int hbao_grid_sampled(const hbao_settings *settings, const hbao_grid *grid);
+
 /* What every horizon kernel needs: settings, grid and per-pattern-cell
  * tables (4x4 interleaved rotation and jitter, docs/algorithm.md). */
 typedef struct hbao_horizon_job {

@@ -27,6 +27,17 @@ static uint32_t next_random(uint32_t *state) {
     return test_random(state) >> 8;
 }
 
+/* A w x h grid of these depths and normals, nothing else set. */
+static hbao_grid grid_of(int w, int h, float *depth, float *normal) {
+    hbao_grid grid;
+    memset(&grid, 0, sizeof grid);
+    grid.width = w;
+    grid.height = h;
+    grid.depth = depth;
+    grid.normal = normal;
+    return grid;
+}
+
 /* A w x h grid whose rows mix background (0) with ordinary depths and, on
  * rows of their own, depths so small that the blur's depth factor is
  * capped (1e-40, and 1e-38 above sharpness 3.4) or so large that it is
@@ -36,11 +47,7 @@ static uint32_t next_random(uint32_t *state) {
  * something); a random raw AO. */
 static void make_grid(hbao_grid *grid, int w, int h, float *depth, float *normal, float *raw) {
     static const float small[] = {1e-40f, 1e-38f, 1e-30f}, large[] = {1e30f, 3e38f};
-    memset(grid, 0, sizeof *grid);
-    grid->width = w;
-    grid->height = h;
-    grid->depth = depth;
-    grid->normal = normal;
+    *grid = grid_of(w, h, depth, normal);
     uint32_t state = 2024u;
     for (int j = 0; j < h; j++) {
         /* 0: ordinary; 1: small depths too; 2: no background; 3: sparse;
@@ -197,12 +204,7 @@ TEST_CASE(blur_follows_its_formula) {
     enum { w = 61, h = 37 };
     static float depth[w * h], normal[3 * w * h + HBAO_NORMAL_PADDING], raw[w * h], out[w * h];
     static double in[w * h], rows[w * h], expected[w * h];
-    hbao_grid grid;
-    memset(&grid, 0, sizeof grid);
-    grid.width = w;
-    grid.height = h;
-    grid.depth = depth;
-    grid.normal = normal;
+    hbao_grid grid = grid_of(w, h, depth, normal);
     uint32_t state = 77u;
     for (int j = 0; j < h; j++) {
         for (int i = 0; i < w; i++) {
@@ -463,11 +465,7 @@ TEST_CASE(upsample_weighs_depth_as_documented) {
 static void make_normals(hbao_grid *grid, int w, int h, float *depth, float *normal,
                          const float *given, const hbao_camera *camera, int implementation,
                          int threads) {
-    memset(grid, 0, sizeof *grid);
-    grid->width = w;
-    grid->height = h;
-    grid->depth = depth;
-    grid->normal = normal;
+    *grid = grid_of(w, h, depth, normal);
     const hbao_camera default_camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
     if (camera == NULL) camera = &default_camera;
     hbao_grid_set_projection(grid, camera, w, h, 1);
@@ -1023,6 +1021,85 @@ TEST_CASE(default_threads_follow_the_cpus_the_process_may_use) {
 #endif
 }
 
+/* A frame sampled nowhere (hbao_grid_sampled 0: every projected radius under
+ * a pixel) is all 1s from hbao_compute(), which then computes nothing but
+ * the depths: the stages it leaves out give exactly that. On a grid of
+ * random depths (background among them), perspective and orthographic:
+ * hbao_grid_sampled says whether any foreground pixel's projected radius,
+ * as hbao_horizon_pixel forms it, is a pixel or more, for radii around
+ * the nearest pixel's threshold; where it is 0, the normals, the horizons
+ * and the blur (radius 7, strength 2) give 1 at every pixel, with every
+ * copy, and hbao_compute() gives 1 at full and half resolution. */
+TEST_CASE(a_frame_sampled_nowhere_is_the_stages_ones) {
+    enum { w = 61, h = 23 };
+    static float depth[w * h], converted[w * h], normal[3 * w * h + HBAO_NORMAL_PADDING];
+    static float raw[w * h], out[w * h];
+    float *beyond = malloc(hbao_beyond_floats(w, h) * sizeof(float));
+    CHECK(beyond != NULL);
+    uint32_t state = 58u;
+    float nearest = INFINITY;
+    for (int k = 0; k < w * h; k++) {
+        const uint32_t r = next_random(&state);
+        depth[k] = r % 7 == 0 ? 1e10f : 2.0f + (float)(r % 4000) / 1000.0f;
+        if (depth[k] < nearest) nearest = depth[k];
+    }
+    for (int projection = 0; projection < 2; projection++) {
+        hbao_camera camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
+        camera.projection = projection ? HBAO_PROJECTION_ORTHOGRAPHIC : HBAO_PROJECTION_PERSPECTIVE;
+        hbao_grid grid = grid_of(w, h, converted, normal);
+        grid.beyond = beyond;
+        hbao_grid_set_projection(&grid, &camera, w, h, 1);
+        /* the radius at which the nearest pixel's projected radius is 1 */
+        const float threshold = projection ? grid.pixel_size : grid.pixel_size * nearest;
+        static const float factors[] = {0.5f, 0.999f, 0.9999999f, 1.0f, 1.0000001f, 1.001f};
+        for (size_t f = 0; f < sizeof factors / sizeof factors[0]; f++) {
+            hbao_params params = HBAO_PARAMS_DEFAULT_INITIALIZER;
+            params.radius = threshold * factors[f];
+            params.blur_size = 15;
+            params.strength = 2.0f;
+            params.threads = 2;
+            hbao_settings settings;
+            CHECK_RESULT(hbao_settings_make(&params, &settings), HBAO_SUCCESS);
+            for (int k = 0; k < w * h; k++) converted[k] = depth[k] < 1e10f ? depth[k] : 0.0f;
+            int any = 0;
+            for (int k = 0; k < w * h; k++) {
+                const float z = converted[k];
+                const float radius_px = projection ? settings.radius / grid.pixel_size
+                                                   : settings.radius / (grid.pixel_size * z);
+                any |= z > 0.0f && radius_px >= 1.0f;
+            }
+            const int sampled = hbao_grid_sampled(&settings, &grid);
+            if (sampled != any)
+                printf("  projection %d, radius %.9g (x %.9g): sampled %d, a pixel's radius %d\n",
+                       projection, (double)settings.radius, (double)factors[f], sampled, any);
+            CHECK(sampled == any);
+            if (sampled) continue;
+            for (int implementation = HBAO_IMPLEMENTATION_SCALAR;
+                 implementation <= HBAO_IMPLEMENTATION_AVX512; implementation++) {
+                settings.implementation = implementation;
+                hbao_compute_normals(&settings, &camera, &grid, NULL, 1);
+                hbao_beyond_planes(&grid);
+                CHECK(hbao_compute_horizons(&settings, &grid, raw) == 0u);
+                CHECK_RESULT(hbao_finish(&settings, &grid, raw, NULL, w, h, out, w), HBAO_SUCCESS);
+                int ones = 0;
+                for (int k = 0; k < w * h; k++) ones += raw[k] == 1.0f && out[k] == 1.0f;
+                CHECK(ones == w * h);
+            }
+            for (int half = 0; half < 2; half++) {
+                params.half_resolution = half;
+                hbao_channel channel = {depth, 1, w};
+                for (int k = 0; k < w * h; k++) out[k] = 0.5f;
+                CHECK_RESULT(hbao_compute(&params, &camera, w, h, &channel, NULL, out, w),
+                             HBAO_SUCCESS);
+                int ones = 0;
+                for (int k = 0; k < w * h; k++) ones += out[k] == 1.0f;
+                CHECK(ones == w * h);
+            }
+        }
+    }
+    free(beyond);
+}
+
 TEST_MAIN(TEST_ENTRY(blur_copies_agree_on_background_at_every_sharpness),
           TEST_ENTRY(blur_follows_its_formula), TEST_ENTRY(half_resolution_blur_reaches_as_far),
           TEST_ENTRY(upsample_weights_are_bilinear_on_a_flat_depth),
@@ -1037,4 +1114,5 @@ TEST_MAIN(TEST_ENTRY(blur_copies_agree_on_background_at_every_sharpness),
           TEST_ENTRY(scratch_memory_is_written_before_it_is_read),
           TEST_ENTRY(parallel_rows_run_each_row_once_on_the_threads_they_say),
           TEST_ENTRY(a_block_too_large_to_keep_leaves_the_kept_ones),
-          TEST_ENTRY(default_threads_follow_the_cpus_the_process_may_use))
+          TEST_ENTRY(default_threads_follow_the_cpus_the_process_may_use),
+          TEST_ENTRY(a_frame_sampled_nowhere_is_the_stages_ones))
