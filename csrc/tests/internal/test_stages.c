@@ -1097,6 +1097,22 @@ TEST_CASE(a_frame_sampled_nowhere_is_the_stages_ones) {
             }
         }
     }
+    /* Sampled only in its last rows (the rest 1000 times as far, its radius
+     * under a pixel there): every row reaches the test, and the AO is
+     * computed, below 1 at many of those rows' pixels. */
+    static float far[w * h], ao[w * h];
+    for (int k = 0; k < w * h; k++) far[k] = k < w * (h - 3) ? depth[k] * 1000.0f : depth[k];
+    hbao_params params = HBAO_PARAMS_DEFAULT_INITIALIZER;
+    params.radius = 0.5f;
+    const hbao_camera camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
+    for (int half = 0; half < 2; half++) {
+        params.half_resolution = half;
+        const hbao_channel channel = {far, 1, w};
+        CHECK_RESULT(hbao_compute(&params, &camera, w, h, &channel, NULL, ao, w), HBAO_SUCCESS);
+        int darker = 0;
+        for (int k = w * (h - 3); k < w * h; k++) darker += ao[k] < 1.0f;
+        CHECK(darker > w / 4); /* (106 and 53 of 183 when written) */
+    }
     free(beyond);
 }
 
