@@ -301,9 +301,9 @@ def test_f12_in_a_session_that_refuses_pythons_writes_for_good(run_in_blender, t
     as the artist's are, past Python's check) give both nodes the AO of
     that Radius, exactly that of a render of it before the fault, not the
     AO before the edit and not the new node's AO of 1. The script's own
-    F12, Radius edit and quit, refused, run with writes allowed after
-    timer_guard's waits (its fallback for CI runs that meet the state by
-    chance; exit 0)."""
+    Radius edit and F12 (and its quit, where the refusal lasts), refused,
+    run with writes allowed after timer_guard's waits (its fallback for CI
+    runs that meet the state by chance; exit 0)."""
     out = tmp_path / "stuck"
     log = run_in_blender(SCRIPTS / "ui_stuck_writes.py", out, ui=True).stdout
     assert "STUCK DONE" in log, log[-3000:]
@@ -323,8 +323,10 @@ def test_f12_in_a_session_that_refuses_pythons_writes_for_good(run_in_blender, t
     lines = [line for line in log.splitlines()
              if line.startswith("HBAO: Blender has refused every change from Python for")]
     assert len(lines) == 1 and "Save the file and restart Blender." in lines[0], log[-3000:]
-    # the script's F12, edit and quit: refused, then run with writes allowed
-    assert STUCK_MARKS.stuck_labels(log) == ["F12", "EDIT", "QUIT"], log[-3000:]
+    # the script's edit and F12: refused, then run with writes allowed; its
+    # quit too unless the render ended the refusal (a CI run of session 58)
+    assert STUCK_MARKS.stuck_labels(log) in (["EDIT", "F12"], ["EDIT", "F12", "QUIT"]), \
+        log[-3000:]
     reference, first, after = (node_outputs(out / name, 1)["ao"]
                                for name in ("reference", "first", "after"))
     assert not np.array_equal(first, reference)

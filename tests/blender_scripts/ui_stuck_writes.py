@@ -21,17 +21,18 @@ not pass through Python: Radius 2 r, and a second HBAO node (HBAO1, Radius
 said it (within 120 s: how many popups, how long after its node poll
 began to ask, the HBAO nodes' line, whether the node poll had redrawn the
 nodes for it, whether the node messages it had were shown, and whether
-the add-on had linked the new node's AO pass); F12 (OUT/after), refused,
-then made with writes allowed by timer_guard's refused_for_now, as the
-artist's key is made; RADIUS r, the artist's edit of the first node's
-Radius back to r, a guarded step (EDIT) refused and then run with writes
-allowed, and 4 s later HINT "its hint line" (the add-on re-composites
-from the render's passes meanwhile: its log line follows);
+the add-on had linked the new node's AO pass); the Radius set to 2 r
+again by a guarded step (EDIT), refused and then run with writes allowed
+by timer_guard; F12 (OUT/after), refused, then made with writes allowed
+by timer_guard's refused_for_now, as the artist's key is made; RADIUS r,
+the artist's edit of the first node's Radius back to r, and 4 s later
+HINT "its hint line" (the add-on re-composites from the render's passes
+meanwhile: its log line follows);
 INFO "text": the Info editor's reports (a render report posted at the
-fault among them; a screenshot, OUT/ui_stuck_info.png); STUCK DONE; the quit (timer_guard's, through
-with_writes_allowed when refused). From the fault on, the node poll asks
-for writes (the last render's messages posted again, and a render
-report).
+fault among them; a screenshot, OUT/ui_stuck_info.png); STUCK DONE; the
+quit (timer_guard's, through with_writes_allowed when refused: the render
+may have ended the refusal). From the fault on, the node poll asks for
+writes (the last render's messages posted again, and a render report).
 
   blender --addons hbao --python ui_stuck_writes.py -- OUT_DIR
 """
@@ -200,18 +201,20 @@ def steps():
               "messages_shown": not hbao_report.has_node_messages(),
               "added_linked": ao_pass.is_linked}
     print(f"TOLD {json.dumps(report)}", flush=True)
+    edited = []
+
+    def edit_again_step():
+        # (refused: timer_guard runs the step with writes allowed)
+        node.inputs["Radius"].default_value = 2.0 * radius
+        edited.append(True)
+    timer_guard.guarded_timer(edit_again_step, 0.0, label="EDIT")
+    while not edited:
+        yield 0.25
     job.start()  # (refused: timer_guard makes it with writes allowed)
     yield from wait_for_render(time.monotonic())
     keep("after")
     print("RADIUS r", flush=True)  # (the log's re-composite line comes after this)
-    edited = []
-
-    def edit_radius_step():
-        edit_radius()  # (refused: timer_guard runs the step with writes allowed)
-        edited.append(True)
-    timer_guard.guarded_timer(edit_radius_step, 0.0, label="EDIT")
-    while not edited:
-        yield 0.25
+    timer_guard.with_writes_allowed(edit_radius)
     yield RECOMPOSITE_S
     print(f"HINT {json.dumps(node.hint)}", flush=True)
     info = timer_guard.with_writes_allowed(lambda: info_reports(out_dir, "ui_stuck_info.png"))
