@@ -20,6 +20,12 @@
  * averages normals over samples, so anti-aliased edges are short; background
  * is zero) and is reconstructed from depth instead. */
 #define HBAO_MIN_NORMAL_LENGTH 0.1f
+/* The least float whose sqrtf is at least HBAO_MIN_NORMAL_LENGTH (2 ulps
+ * below 0.1f * 0.1f): sqrtf rounds correctly and never decreases, so a
+ * squared length s has sqrtf(s) >= HBAO_MIN_NORMAL_LENGTH exactly where
+ * s >= this, and the test needs no square root (test_stages.c holds both
+ * sides of it). */
+#define HBAO_MIN_NORMAL_LENGTH_SQUARED 0x1.47ae14p-7f
 
 /* How strongly the half-resolution upsample rejects samples at other depths,
  * in units of 1 / relative depth difference (docs/algorithm.md). */

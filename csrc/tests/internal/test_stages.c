@@ -557,6 +557,27 @@ TEST_CASE(depth_precision_is_told_from_every_row) {
     }
 }
 
+/* For every copy of the given normals' stage, with the camera of a quarter
+ * turn about its view axis (which sees the world normal (0, 0.6, 0.8) as
+ * (0.6, 0, 0.8)): the pixels whose normal is not that where `usable` is
+ * set, or not the face normal (0, 0, 1) of the plane facing the camera
+ * where `unusable` is, printed for each copy that has any. */
+static int quarter_turn_normals_off(int w, int h, float *depth, float *normal, const float *given,
+                                    const hbao_camera *camera, const int *usable,
+                                    const int *unusable) {
+    int total = 0;
+    for (int implementation = HBAO_IMPLEMENTATION_SCALAR;
+         implementation <= HBAO_IMPLEMENTATION_AVX512; implementation++) {
+        hbao_grid grid;
+        make_normals(&grid, w, h, depth, normal, given, camera, implementation, 1);
+        const int off = normals_off(&grid, usable, 0.6f, 0.0f, 0.8f) +
+                        normals_off(&grid, unusable, 0.0f, 0.0f, 1.0f);
+        if (off) printf("  implementation %d: %d normals off\n", implementation, off);
+        total += off;
+    }
+    return total;
+}
+
 /* A given normal is used, turned into the camera, normalized and made to
  * face the viewer, where it is at least HBAO_MIN_NORMAL_LENGTH long and
  * finite; shorter ones (Blender's Normal pass is 0 where nothing was
@@ -584,15 +605,42 @@ TEST_CASE(given_normals_too_short_give_the_face_normal) {
         usable[k] = kind < usable_kinds;
         unusable[k] = !usable[k];
     }
-    for (int implementation = HBAO_IMPLEMENTATION_SCALAR;
-         implementation <= HBAO_IMPLEMENTATION_AVX512; implementation++) {
-        hbao_grid grid;
-        make_normals(&grid, w, h, depth, normal, given, &camera, implementation, 1);
-        const int off = normals_off(&grid, usable, 0.6f, 0.0f, 0.8f) +
-                        normals_off(&grid, unusable, 0.0f, 0.0f, 1.0f);
-        if (off) printf("  implementation %d: %d normals off\n", implementation, off);
-        CHECK(off == 0);
+    CHECK(quarter_turn_normals_off(w, h, depth, normal, given, &camera, usable, unusable) == 0);
+}
+
+/* A given normal's length is tested through its square
+ * (HBAO_MIN_NORMAL_LENGTH_SQUARED) exactly as through its square root: the
+ * constant is the least float whose square root reaches
+ * HBAO_MIN_NORMAL_LENGTH, and normals from 16 ulps shorter to 16 longer
+ * than that length (both answers met) are used, or give the face normal
+ * (0, 0, 1), as sqrtf of their squared length decides; every copy. */
+TEST_CASE(a_given_normal_is_used_as_the_square_root_of_its_length_decides) {
+    enum { w = 150, h = 5 };
+    static float depth[w * h], normal[3 * w * h + HBAO_NORMAL_PADDING], given[3 * w * h];
+    static int usable[w * h], unusable[w * h];
+    const float least = HBAO_MIN_NORMAL_LENGTH_SQUARED;
+    CHECK(sqrtf(least) >= HBAO_MIN_NORMAL_LENGTH);
+    CHECK(!(sqrtf(nextafterf(least, 0.0f)) >= HBAO_MIN_NORMAL_LENGTH));
+    hbao_camera camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
+    static const float quarter_turn[16] = {0, 1, 0, 0, -1, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    memcpy(camera.world_to_camera, quarter_turn, sizeof quarter_turn);
+    int used = 0;
+    for (int k = 0; k < w * h; k++) {
+        depth[k] = 5.1f;
+        float length = HBAO_MIN_NORMAL_LENGTH;
+        for (int ulps = k % 33 - 16; ulps != 0; ulps += ulps < 0 ? 1 : -1)
+            length = nextafterf(length, ulps < 0 ? 0.0f : 1.0f);
+        const float y = 0.6f * length, z = 0.8f * length;
+        given[3 * k] = 0.0f;
+        given[3 * k + 1] = y;
+        given[3 * k + 2] = z;
+        /* normals.c's squared length: x, y and z in that order */
+        usable[k] = sqrtf(0.0f * 0.0f + y * y + z * z) >= HBAO_MIN_NORMAL_LENGTH;
+        unusable[k] = !usable[k];
+        used += usable[k];
     }
+    CHECK(used > 0 && used < w * h);
+    CHECK(quarter_turn_normals_off(w, h, depth, normal, given, &camera, usable, unusable) == 0);
 }
 
 /* A given normal is turned to face the viewer along the pixel's own ray:
@@ -1123,6 +1171,7 @@ TEST_MAIN(TEST_ENTRY(blur_copies_agree_on_background_at_every_sharpness),
           TEST_ENTRY(face_normals_keep_to_their_side_of_a_step),
           TEST_ENTRY(depth_precision_is_told_from_every_row),
           TEST_ENTRY(given_normals_too_short_give_the_face_normal),
+          TEST_ENTRY(a_given_normal_is_used_as_the_square_root_of_its_length_decides),
           TEST_ENTRY(given_normals_face_the_viewer_along_its_ray),
           TEST_ENTRY(given_normals_choose_how_to_face_the_viewer),
           TEST_ENTRY(a_lone_pixels_normal_that_faces_away_is_turned_round),
