@@ -157,11 +157,23 @@ static int any_finite(const float *values, size_t count) {
     return 0;
 }
 
-static void fill_ones(float *ao, int64_t row_stride, int width, int height) {
-    for (int j = 0; j < height; j++) {
-        float *row = ao + (int64_t)j * row_stride;
-        for (int i = 0; i < width; i++) row[i] = 1.0f;
-    }
+typedef struct ones_job {
+    float *ao;
+    int64_t row_stride;
+    int width;
+} ones_job;
+
+static void ones_row(void *context, int j) {
+    const ones_job *job = context;
+    float *row = job->ao + (int64_t)j * job->row_stride;
+    for (int i = 0; i < job->width; i++) row[i] = 1.0f;
+}
+
+/* 1 at every output pixel, the rows shared among the threads */
+static void fill_ones(const hbao_settings *s, float *ao, int64_t row_stride, int width,
+                      int height) {
+    ones_job job = {ao, row_stride, width};
+    hbao_parallel_rows(s->threads, height, ones_row, &job);
 }
 
 /* The calling thread's last call's HBAO_NOTE_* bits (hbao_last_notes). */
@@ -202,7 +214,7 @@ hbao_result hbao_compute_layers(const hbao_params *params, const hbao_camera *ca
     result = hbao_validate_camera(camera);
     if (result != HBAO_SUCCESS) return result;
     if (s.radius == 0.0f) {
-        fill_ones(ao, ao_row_stride, width, height);
+        fill_ones(&s, ao, ao_row_stride, width, height);
         return HBAO_SUCCESS;
     }
 
@@ -255,7 +267,7 @@ hbao_result hbao_compute_layers(const hbao_params *params, const hbao_camera *ca
     hbao_grid_set_projection(&grid, camera, width, height, scale);
     if (!hbao_grid_sampled(&s, &grid)) {
         /* every projected radius under a pixel: 1s, as the stages give */
-        fill_ones(ao, ao_row_stride, width, height);
+        fill_ones(&s, ao, ao_row_stride, width, height);
         goto done;
     }
     /* A layer with no back face known anywhere is no layer: the result is

@@ -3,6 +3,7 @@
  * jittered steps inside the projected radius and integrate the occlusion of
  * the highest horizon found, per docs/algorithm.md. */
 #include <math.h>
+#include <stdatomic.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -573,26 +574,57 @@ float hbao_block_step_at(const hbao_settings *s, const hbao_grid *g, float neare
     return largest >= 1.0f ? (largest - 1.0f) / (float)s->steps : HBAO_BLOCK_UNSAMPLED;
 }
 
-/* hbao_grid_sampled's rows: every SAMPLED_ROW_STRIDE-th first (0, 16, 32...,
- * then 1, 17, ...), so that geometry in a band of that many rows anywhere
- * is met in the first pass, whatever lies above and below it. In order
- * from row 0, a frame whose upper 90 % is sky took 1.07x its time (the rows
- * scanned on one thread, bench_ab_pairs.sh --background 90). */
+/* hbao_grid_sampled's rows: every SAMPLED_ROW_STRIDE-th first (0, 16, 32...),
+ * so that geometry in a band of that many rows anywhere is met in the first
+ * pass, whatever lies above and below it. In order from row 0, a frame
+ * whose upper 90 % is sky took 1.07x its time (the rows scanned on one
+ * thread, bench_ab_pairs.sh --background 90). The first pass is one
+ * thread's (an ordinary frame stops at its first row); where it finds no
+ * sampled row, the bands' other rows are shared among the threads, which
+ * stop as soon as any has found one. */
 #define SAMPLED_ROW_STRIDE 16
 
-int hbao_grid_sampled(const hbao_settings *s, const hbao_grid *g) {
-    /* The nearest foreground depth of each row (NaN and +inf are no
-     * foreground: a pixel there is 1, hbao_horizon_pixel), tested as a
-     * block's nearest depth is. */
-    for (int first = 0; first < SAMPLED_ROW_STRIDE; first++)
-        for (int j = first; j < g->height; j += SAMPLED_ROW_STRIDE) {
-            const float *row = g->depth + (size_t)j * g->width;
-            float nearest = INFINITY;
-            for (int i = 0; i < g->width; i++)
-                nearest = row[i] > 0.0f && row[i] < nearest ? row[i] : nearest;
-            if (hbao_block_step_at(s, g, nearest) != HBAO_BLOCK_UNSAMPLED) return 1;
+/* Whether row j has a sampled pixel: its nearest foreground depth (NaN and
+ * +inf are no foreground: a pixel there is 1, hbao_horizon_pixel), tested
+ * as a block's nearest depth is. */
+static int row_sampled(const hbao_settings *s, const hbao_grid *g, int j) {
+    const float *row = g->depth + (size_t)j * g->width;
+    float nearest = INFINITY;
+    for (int i = 0; i < g->width; i++)
+        nearest = row[i] > 0.0f && row[i] < nearest ? row[i] : nearest;
+    return hbao_block_step_at(s, g, nearest) != HBAO_BLOCK_UNSAMPLED;
+}
+
+typedef struct sampled_job {
+    const hbao_settings *settings;
+    const hbao_grid *grid;
+    atomic_int found; /* a row with a sampled pixel has been found */
+} sampled_job;
+
+/* Band b's rows after its first (b * SAMPLED_ROW_STRIDE + 1 ...) */
+static void band_sampled(void *context, int band) {
+    sampled_job *job = context;
+    const int first = band * SAMPLED_ROW_STRIDE;
+    const int end = first + SAMPLED_ROW_STRIDE < job->grid->height ? first + SAMPLED_ROW_STRIDE
+                                                                   : job->grid->height;
+    for (int j = first + 1; j < end; j++) {
+        if (atomic_load_explicit(&job->found, memory_order_relaxed)) return;
+        if (row_sampled(job->settings, job->grid, j)) {
+            atomic_store_explicit(&job->found, 1, memory_order_relaxed);
+            return;
         }
-    return 0;
+    }
+}
+
+int hbao_grid_sampled(const hbao_settings *s, const hbao_grid *g) {
+    for (int j = 0; j < g->height; j += SAMPLED_ROW_STRIDE)
+        if (row_sampled(s, g, j)) return 1;
+    sampled_job job = {s, g, 0};
+    atomic_init(&job.found, 0);
+    /* the rows' threads have all finished when this returns */
+    hbao_parallel_rows(s->threads, (g->height + SAMPLED_ROW_STRIDE - 1) / SAMPLED_ROW_STRIDE,
+                       band_sampled, &job);
+    return atomic_load(&job.found);
 }
 
 /* HBAO_NOTE_RADIUS_BEYOND_IMAGE where, at more than half of the foreground

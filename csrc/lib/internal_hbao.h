@@ -288,7 +288,8 @@ uint32_t hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *g
  * is sampled, its projected radius a pixel or more. Where none is, every
  * raw AO is 1, and so is everything the blur, the upsample and any
  * strength make of it, exactly: hbao_compute_layers then writes 1s and
- * computes nothing else. Stops at the first row that has such a pixel. */
+ * computes nothing else. Stops once a row that has such a pixel is found
+ * (its rows in the order and on the threads that horizon.c gives). */
 int hbao_grid_sampled(const hbao_settings *settings, const hbao_grid *grid);
 
 /* What every horizon kernel needs: settings, grid and per-pattern-cell
