@@ -16,6 +16,8 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
 BPY_RUNNER = REPO / "scripts" / "bpy_blender.py"
+# Run before a UI script that opens no file: no splash over the window.
+NO_SPLASH = "import bpy; bpy.context.preferences.view.show_splash = False"
 # Where scripts/setup_bpy.sh keeps its virtual environments: outside the
 # checkout, so that every clone (and CI's fresh clone) reuses one download.
 BPY_ROOT = Path(os.environ.get("HBAO_BPY_ROOT", Path.home() / ".cache" / "hbao" / "bpy"))
@@ -79,6 +81,13 @@ class Blender:
         if script is not None:
             if self.kind == "app":
                 command += ["--python-exit-code", "1"]
+            if ui and blend is None:
+                # Without a file to open, Blender's window starts under its
+                # splash (with factory settings, its Quick Setup), which
+                # would hide half of what the script's screenshots show;
+                # the preference is read when the splash is due, after the
+                # command line's scripts have run.
+                command += ["--python-expr", NO_SPLASH]
             command += ["--python", str(script), "--"] + [str(a) for a in args]
         if ui:
             command = ["xvfb-run", "-a", "--server-num", str(_first_display()),
