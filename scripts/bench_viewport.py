@@ -23,6 +23,8 @@ import sys
 import tempfile
 from pathlib import Path
 
+from blenders import NO_SPLASH  # scripts/blenders.py, beside this script
+
 REPO = Path(__file__).resolve().parents[1]
 INNER = REPO / "scripts" / "bench_viewport_blender.py"
 # Large enough for a 1920x1080 window plus Blender's UI around the view.
@@ -63,7 +65,8 @@ def main():
         for name, path in libraries.items():
             env.setdefault(name, str(path))
         command = [blender, "--factory-startup", "-noaudio", "--addons", "hbao",
-                   "--python-exit-code", "1", "--python", str(INNER), "--",
+                   "--python-exit-code", "1", "--python-expr", NO_SPLASH,
+                   "--python", str(INNER), "--",
                    "--repeats", str(args.repeats)]
         if args.backend_check:
             command.append("--backend-check")

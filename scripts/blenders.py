@@ -81,12 +81,14 @@ class Blender:
         if script is not None:
             if self.kind == "app":
                 command += ["--python-exit-code", "1"]
-            if ui and blend is None:
-                # Without a file to open, Blender's window starts under its
-                # splash (with factory settings, its Quick Setup), which
-                # would hide half of what the script's screenshots show;
-                # the preference is read when the splash is due, after the
-                # command line's scripts have run.
+            if ui:
+                # Blender's window starts under its splash where no file is
+                # opened (and in newer Blenders, by their source, with a
+                # file too where no preferences were ever saved, as in the
+                # tests' fresh user folder, which also makes it the Quick
+                # Setup), which would hide half of what the script's
+                # screenshots show. The preference is read when the splash
+                # is due, after the command line's scripts have run.
                 command += ["--python-expr", NO_SPLASH]
             command += ["--python", str(script), "--"] + [str(a) for a in args]
         if ui:

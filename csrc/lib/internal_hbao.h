@@ -20,7 +20,7 @@
  * averages normals over samples, so anti-aliased edges are short; background
  * is zero) and is reconstructed from depth instead. */
 #define HBAO_MIN_NORMAL_LENGTH 0.1f
-/* The least float whose sqrtf is at least HBAO_MIN_NORMAL_LENGTH (2 ulps
+/* The least float whose sqrtf is at least HBAO_MIN_NORMAL_LENGTH (1 ulp
  * below 0.1f * 0.1f): sqrtf rounds correctly and never decreases, so a
  * squared length s has sqrtf(s) >= HBAO_MIN_NORMAL_LENGTH exactly where
  * s >= this, and the test needs no square root (test_stages.c holds both

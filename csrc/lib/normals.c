@@ -326,7 +326,7 @@ static HBAO_ALWAYS_INLINE void given_normals_row(const normal_job *job, int j) {
             const float w0 = wx[k] * w_shrink, w1 = wy[k] * w_shrink, w2 = wz[k] * w_shrink;
             /* its squared length, tested as the length's square root
              * would be (HBAO_MIN_NORMAL_LENGTH_SQUARED): one square root
-             * fewer a pixel, the stages without the search 0.955 of the
+             * fewer a pixel, the stages without the search 0.947 of the
              * time (docs/speed.md, session 59) */
             const float world_length2 = w0 * w0 + w1 * w1 + w2 * w2;
             const float t0 = m[0] * w0 + m[1] * w1 + m[2] * w2;
@@ -337,9 +337,9 @@ static HBAO_ALWAYS_INLINE void given_normals_row(const normal_job *job, int j) {
             const float length = sqrtf(n0 * n0 + n1 * n1 + n2 * n2);
             const float inverse = 1.0f / length;
             const float u0 = n0 * inverse, u1 = n1 * inverse, u2 = n2 * inverse;
-            /* isfinite(x) as x <= FLT_MAX on |x|: NaN fails, and it
-             * vectorizes (the squared length is finite exactly where the
-             * length is) */
+            /* isfinite(x) as x <= FLT_MAX (on |x| where x may be
+             * negative): NaN fails, and it vectorizes; the squared length
+             * is finite exactly where the length is */
             usable[k] = z[k] > 0.0f && world_length2 <= 3.40282347e38f &&
                         world_length2 >= HBAO_MIN_NORMAL_LENGTH_SQUARED &&
                         fabsf(length) <= 3.40282347e38f && length > 0.0f;
