@@ -16,7 +16,7 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
 BPY_RUNNER = REPO / "scripts" / "bpy_blender.py"
-# Run before a UI script that opens no file: no splash over the window.
+# Run before every UI script: no splash over the window (Blender.command).
 NO_SPLASH = "import bpy; bpy.context.preferences.view.show_splash = False"
 # Where scripts/setup_bpy.sh keeps its virtual environments: outside the
 # checkout, so that every clone (and CI's fresh clone) reuses one download.

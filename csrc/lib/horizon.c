@@ -619,7 +619,7 @@ static void band_sampled(void *context, int band) {
 int hbao_grid_sampled(const hbao_settings *s, const hbao_grid *g) {
     for (int j = 0; j < g->height; j += SAMPLED_ROW_STRIDE)
         if (row_sampled(s, g, j)) return 1;
-    sampled_job job = {s, g, 0};
+    sampled_job job = {.settings = s, .grid = g};
     atomic_init(&job.found, 0);
     /* the rows' threads have all finished when this returns */
     hbao_parallel_rows(s->threads, (g->height + SAMPLED_ROW_STRIDE - 1) / SAMPLED_ROW_STRIDE,
