@@ -540,6 +540,16 @@ def test_layer_selection(hbao_tool, tmp_path):
                        "--layer", "Nope")
     assert_clean_error(missing, EXIT_RUNTIME, "Nope", '"Back"', '"Front"')
     assert not (tmp_path / "x.exr").exists()
+    # A name longer than any channel: refused by the name given, whichever
+    # flag gave it (--back-layer's was called --layer's)
+    for flag in ("--layer", "--back-layer"):
+        long_name = "Long" + "x" * 4096
+        too_long = run_tool(hbao_tool, fixture_path("two_layers"), "-o", tmp_path / "x.exr",
+                            "--layer" if flag == "--back-layer" else "--back-layer", "Back",
+                            flag, long_name)
+        assert_clean_error(too_long, EXIT_USAGE, 'layer "Longxxxx', "name too long")
+        assert "--layer:" not in too_long.stderr
+        assert not (tmp_path / "x.exr").exists()
 
 
 def test_missing_depth_pass_is_an_error(hbao_tool, tmp_path):

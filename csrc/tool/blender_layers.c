@@ -204,7 +204,10 @@ int blender_find_passes(const exr_input *input, const char *requested, const cha
     if (requested != NULL) {
         char depth[BLENDER_CHANNEL_NAME_MAX];
         if (!set_name(depth, requested, (int)strlen(requested), depth_suffix))
-            return tool_fail(error, TOOL_EXIT_USAGE, "--layer: name too long");
+            /* --layer's or --back-layer's: named by its start, which the
+             * artist typed, not by a flag that may be the other one */
+            return tool_fail(error, TOOL_EXIT_USAGE, "layer \"%.24s...\": name too long",
+                             requested);
         if (exr_input_find_channel(input, depth) < 0) {
             char problem[BLENDER_CHANNEL_NAME_MAX + 64];
             snprintf(problem, sizeof problem, "no layer \"%s\" with a Depth pass (%s)", requested,
