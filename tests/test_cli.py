@@ -2530,10 +2530,11 @@ def test_sequence_refuses_an_output_that_links_to_another_frames_input(hbao_tool
 def test_an_output_that_is_a_render_is_never_replaced(hbao_tool, tmp_path):
     """-o 'render_00#0.exr' --frames 1-2 names render_0010.exr and
     render_0020.exr: renders of frames the run does not list (another farm
-    task's), which it replaced. An existing -o with a Depth pass and no
-    hbaoSettings (not an hbao output) is refused, in one run and in a
-    sequence; an hbao output with the passes copied (--keep-input) is still
-    replaced."""
+    task's), which it replaced. An existing -o or --preview with a Depth
+    pass and no hbaoSettings (not an hbao output) is refused, in one run
+    and in a sequence (a --preview that named a render had replaced it with
+    a PNG, exit 0); an hbao output with the passes copied (--keep-input) is
+    still replaced."""
     for frame in (1, 2, 10, 20):
         shutil.copyfile(fixture_path("cycles_float_zip"), tmp_path / f"render_{frame:04d}.exr")
     before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
@@ -2544,6 +2545,14 @@ def test_an_output_that_is_a_render_is_never_replaced(hbao_tool, tmp_path):
     single = run_tool(hbao_tool, tmp_path / "render_0001.exr", "-o",
                       tmp_path / "render_0002.exr", "--no-normals")
     assert_clean_error(single, EXIT_USAGE, "is a render (it has a Depth pass)")
+    previews = run_tool(hbao_tool, tmp_path / "render_####.exr", "-o", tmp_path / "ao_####.exr",
+                        "--preview", tmp_path / "render_00#0.exr", "--frames", "1-2",
+                        "--no-normals")
+    assert_clean_error(previews, EXIT_USAGE, "2 of 2 frames failed",
+                       f"--preview {tmp_path / 'render_0020.exr'} is a render")
+    preview = run_tool(hbao_tool, tmp_path / "render_0001.exr", "-o", tmp_path / "ao.exr",
+                       "--preview", tmp_path / "render_0002.exr", "--no-normals")
+    assert_clean_error(preview, EXIT_USAGE, "--preview", "is a render (it has a Depth pass)")
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
     kept = tmp_path / "kept.exr"
     for _ in range(2):  # written, then replaced by the same run

@@ -38,12 +38,14 @@ static int refuse_overwriting_input(const char *output, const char *flag,
     return TOOL_EXIT_SUCCESS;
 }
 
-/* An existing -o that is a render (an EXR with a Depth pass the tool would
- * read) but not an hbao output (no RUN_SETTINGS_ATTRIBUTE): an -o pattern
- * that lands on another chunk's renders (-o 'render_00#0.exr' --frames 1-2
- * names render_0010.exr) replaced them. A file that is no readable EXR, or
- * one without a Depth pass, is replaced as before. */
-static int refuse_replacing_a_render(const char *output, tool_error *error) {
+/* An existing output (flag: -o or --preview) that is a render (an EXR with
+ * a Depth pass the tool would read) but not an hbao output (no
+ * RUN_SETTINGS_ATTRIBUTE): an -o pattern that lands on another chunk's
+ * renders (-o 'render_00#0.exr' --frames 1-2 names render_0010.exr)
+ * replaced them, and a --preview pattern or path did so too (with a PNG).
+ * A file that is no readable EXR, or one without a Depth pass, is replaced
+ * as before. */
+static int refuse_replacing_a_render(const char *output, const char *flag, tool_error *error) {
     struct stat status;
     if (stat(output, &status) != 0 || !S_ISREG(status.st_mode)) return TOOL_EXIT_SUCCESS;
     exr_input existing;
@@ -57,9 +59,9 @@ static int refuse_replacing_a_render(const char *output, tool_error *error) {
     exr_input_close(&existing);
     if (!render) return TOOL_EXIT_SUCCESS;
     return tool_fail(error, TOOL_EXIT_USAGE,
-                     "-o %s is a render (it has a Depth pass), not an hbao output: refusing to "
+                     "%s %s is a render (it has a Depth pass), not an hbao output: refusing to "
                      "replace it (remove it first if it is to go)",
-                     output);
+                     flag, output);
 }
 
 /* The input replaced or rewritten since it was opened (a render farm
@@ -247,9 +249,11 @@ typedef struct output_files {
 static int begin_outputs(const cli_options *options, output_files *files, tool_error *error) {
     int status = atomic_file_begin(&files->exr, options->output_path, error);
     if (status == TOOL_EXIT_SUCCESS)
-        status = refuse_replacing_a_render(options->output_path, error);
+        status = refuse_replacing_a_render(options->output_path, "-o", error);
     if (status == TOOL_EXIT_SUCCESS && options->preview_path != NULL)
         status = atomic_file_begin(&files->png, options->preview_path, error);
+    if (status == TOOL_EXIT_SUCCESS && options->preview_path != NULL)
+        status = refuse_replacing_a_render(options->preview_path, "--preview", error);
     if (status == TOOL_EXIT_SUCCESS && atomic_file_same_destination(&files->exr, &files->png))
         status = tool_fail(error, TOOL_EXIT_USAGE, "--preview %s and -o %s name the same file",
                            options->preview_path, options->output_path);
