@@ -32,8 +32,9 @@ import json
 import math
 import os
 import re
+import secrets
+import stat
 import sys
-import tempfile
 from pathlib import Path
 
 import bpy
@@ -136,6 +137,21 @@ def cameras_at(scene, frame):
     return found
 
 
+def _new_file_beside(path):
+    """A new, hidden file in `path`'s folder, opened for writing, and its
+    path. Not tempfile.mkstemp(), which makes it its owner's only (0600),
+    whatever the folder's default ACL grants a farm's other users; opened
+    as any program opens a new file (0666), the kernel applies the umask or
+    that ACL."""
+    for _attempt in range(100):
+        temporary = path.parent / f".export-cameras-{secrets.token_hex(4)}"
+        try:
+            return os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666), temporary
+        except FileExistsError:
+            continue
+    raise FileExistsError(f"no free temporary name in {path.parent}")
+
+
 def write_if_changed(path, text):
     """Write `text` to `path` whole, unless it already holds it. Returns
     whether it was written."""
@@ -145,13 +161,17 @@ def write_if_changed(path, text):
     except (FileNotFoundError, UnicodeDecodeError):
         pass
     path.parent.mkdir(parents=True, exist_ok=True)
-    descriptor, temporary = tempfile.mkstemp(prefix=".export-cameras-", dir=path.parent)
     try:
-        # mkstemp makes the file its owner's only: a farm's workers, another
-        # user, must read it, as a file the shell creates
-        umask = os.umask(0)
-        os.umask(umask)
-        os.fchmod(descriptor, 0o666 & ~umask)
+        kept_mode = stat.S_IMODE(path.stat().st_mode)
+    except FileNotFoundError:
+        kept_mode = None
+    descriptor, temporary = _new_file_beside(path)
+    try:
+        # A new file has the permissions the kernel gives any new file there
+        # (the umask, or the folder's default ACL: a farm's shared folder);
+        # a file it replaces keeps its own.
+        if kept_mode is not None:
+            os.fchmod(descriptor, kept_mode)
         with os.fdopen(descriptor, "w", encoding="utf-8") as stream:
             stream.write(text)
         os.replace(temporary, path)

@@ -38,6 +38,7 @@ PACKAGES=(
     time               # scripts/soak.sh: GNU time's peak memory of each run
     binutils           # readelf: tests/test_cli.py checks where the tool finds libhbao
     locales            # localedef's sources: tests/test_faults.py makes an ISO-8859-1 locale
+    acl                # setfacl, getfacl: tests/test_cli.py checks outputs under a default ACL
 )
 
 missing=()

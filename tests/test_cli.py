@@ -22,6 +22,7 @@ import socket
 import stat
 import struct
 import subprocess
+import tempfile
 import threading
 import time
 import zlib
@@ -2261,6 +2262,24 @@ def test_export_cameras_writes_each_frames_camera(hbao_tool, run_in_blender, ble
     stepped = run_in_blender(EXPORT_CAMERAS, pattern, "--frames", "1-4x3", blend=blend)
     assert "2 frames, 1 files written, 1 already up to date" in stepped.stdout
     assert sorted(p.name for p in (tmp_path / "cams").iterdir()) == ["cam_01.json", "cam_04.json"]
+    # In a folder with a default ACL (a farm's shared folder granting a group
+    # write access), a new file has the ACL's permissions, as any program's
+    # new file there; a file it rewrites keeps its own (the script set the
+    # umask's mode on both, taking the group's write access away: a review)
+    shared = tmp_path / "shared"
+    shared.mkdir()
+    subprocess.run(["setfacl", "-m", "g:users:rwx", "-d", "-m", "g:users:rwx", str(shared)],
+                   check=True)
+    (shared / "reference").write_bytes(b"")
+    (shared / "cam_01.json").write_text("{}")  # another camera's: rewritten
+    (shared / "cam_01.json").chmod(0o600)
+    run_in_blender(EXPORT_CAMERAS, shared / "cam_##.json", "--frames", "1-2", blend=blend)
+    assert json.loads((shared / "cam_01.json").read_text()) == cameras[1]
+    assert stat.S_IMODE((shared / "cam_01.json").stat().st_mode) == 0o600
+    assert acl_text(shared / "cam_02.json") == acl_text(shared / "reference")
+    assert "group:users:rwx" in acl_text(shared / "cam_02.json")
+    assert sorted(p.name for p in shared.iterdir()) == ["cam_01.json", "cam_02.json",
+                                                        "reference"]
 
 
 @pytest.mark.matrix
@@ -2558,6 +2577,92 @@ def test_an_output_that_is_a_render_is_never_replaced(hbao_tool, tmp_path):
     for _ in range(2):  # written, then replaced by the same run
         run_ok(hbao_tool, tmp_path / "render_0001.exr", "-o", kept, "--keep-input",
                "--no-normals")
+
+
+def acl_text(path):
+    """getfacl's lines for `path` without its name: the ACL and its mask."""
+    completed = subprocess.run(["getfacl", "--omit-header", "--absolute-names", str(path)],
+                               capture_output=True, text=True, check=True)
+    return completed.stdout
+
+
+@pytest.mark.parametrize("tmpfile", ["1", "0"])
+def test_outputs_get_a_new_files_permissions_and_keep_an_existing_ones(
+        hbao_tool, tmp_path, tmpfile):
+    """A new output has the permissions the kernel gives a new file: the
+    umask, or the folder's default ACL (a farm's shared folder granting a
+    group write access). The tool worked the mode out itself (0666 and the
+    umask) and set it, which took the ACL's group write access away (a
+    review found it). An existing output keeps its own permissions (it was
+    reset to the umask's). Both ways of making the temporary file
+    (O_TMPFILE, and named files: HBAO_TMPFILE=0)."""
+    env = dict(os.environ, HBAO_TMPFILE=tmpfile)
+    source, camera = fixture_path("cycles_float_zip"), tmp_path / "cam.json"
+    shutil.copyfile(FIXTURES / "cycles_float_zip.camera.json", camera)
+
+    def compute(output, *more):
+        completed = subprocess.run(
+            [str(hbao_tool), str(source), "-o", str(output), "--preview",
+             str(output.with_suffix(".png")), "--camera", str(camera), *more],
+            capture_output=True, text=True, timeout=TOOL_TIMEOUT_S, env=env,
+            preexec_fn=lambda: os.umask(0o027))
+        assert completed.returncode == 0, completed.stderr
+
+    compute(tmp_path / "new.exr")
+    for made in (tmp_path / "new.exr", tmp_path / "new.png"):
+        assert stat.S_IMODE(made.stat().st_mode) == 0o640, made
+    shared = tmp_path / "shared"
+    shared.mkdir()
+    subprocess.run(["setfacl", "-m", "g:users:rwx", "-d", "-m", "g:users:rwx", str(shared)],
+                   check=True)
+    reference = shared / "reference"
+    reference.write_bytes(b"")  # as any program creates a file there (open, 0666)
+    assert "group:users:rwx" in acl_text(reference)
+    compute(shared / "ao.exr")
+    for made in (shared / "ao.exr", shared / "ao.png"):
+        assert acl_text(made) == acl_text(reference), made
+    os.chmod(tmp_path / "new.exr", 0o600)  # made private: stays private when replaced
+    os.chmod(tmp_path / "new.png", 0o604)
+    compute(tmp_path / "new.exr", "--radius", "0.3")
+    assert stat.S_IMODE((tmp_path / "new.exr").stat().st_mode) == 0o600
+    assert stat.S_IMODE((tmp_path / "new.png").stat().st_mode) == 0o604
+    assert leftover_temporary_files(tmp_path) == [] and leftover_temporary_files(shared) == []
+
+
+def test_an_output_its_user_may_not_write_is_not_replaced(hbao_tool):
+    """An existing output the user may not write (an approved frame made
+    read-only) is refused, as open() for writing (and Blender's own render
+    output) would refuse it; the rename replaced it, its folder being
+    writable. Run as another user (nobody) where the tests run as root,
+    whom no permission stops."""
+    folder = Path(tempfile.mkdtemp(prefix="hbao-readonly-"))  # nobody reaches it, not tmp_path
+    try:
+        folder.chmod(0o777)
+        shutil.copyfile(fixture_path("cycles_float_zip"), folder / "in.exr")
+        shutil.copyfile(FIXTURES / "cycles_float_zip.camera.json", folder / "cam.json")
+        for name in ("in.exr", "cam.json"):
+            (folder / name).chmod(0o644)
+        approved = folder / "ao.exr"
+        approved.write_bytes(b"approved")
+        approved.chmod(0o444)
+        as_user = {"user": 65534} if os.geteuid() == 0 else {}
+        for tmpfile in ("1", "0"):
+            for preview in ((), ("--preview", folder / "ao.exr")):
+                arguments = (["-o", approved] if not preview
+                             else ["-o", folder / "other.exr", *preview])
+                completed = subprocess.run(
+                    [str(hbao_tool), str(folder / "in.exr"), *map(str, arguments), "--camera",
+                     str(folder / "cam.json")], capture_output=True, text=True,
+                    timeout=TOOL_TIMEOUT_S, env=dict(os.environ, HBAO_TMPFILE=tmpfile),
+                    **as_user)
+                assert_clean_error(completed, EXIT_RUNTIME, f"{approved} is not writable",
+                                   "refusing to replace it")
+                assert approved.read_bytes() == b"approved"
+                assert stat.S_IMODE(approved.stat().st_mode) == 0o444
+                left = sorted(p.name for p in folder.iterdir())
+                assert left == ["ao.exr", "cam.json", "in.exr"]
+    finally:
+        shutil.rmtree(folder)
 
 
 def test_sequence_refuses_outputs_that_are_another_frames_or_its_own(hbao_tool, tmp_path):

@@ -36,8 +36,8 @@ static const int cleanup_signals[] = {SIGINT, SIGTERM, SIGHUP};
 static char cleanup_paths[CLEANUP_SLOTS][PATH_MAX];
 static volatile sig_atomic_t cleanup_active[CLEANUP_SLOTS];
 static bool handlers_installed;
-/* Frames of a sequence write their outputs from several threads: the slots,
- * the handler installation and the umask() probe take turns. */
+/* Frames of a sequence write their outputs from several threads: the slots
+ * and the handler installation take turns. */
 static pthread_mutex_t slots_lock = PTHREAD_MUTEX_INITIALIZER;
 
 static void remove_temporary_files(int signal_number) {
@@ -162,6 +162,32 @@ static bool destination_directory(const atomic_file *file, char directory[PATH_M
  * name is given through /proc/self/fd (linkat), so this needs /proc; -1
  * where either is missing (file systems without O_TMPFILE: NFS before 4.2,
  * some FUSE ones), and the named temporary below is used instead. */
+/* An output's temporary file is created with the mode a plain
+ * open(O_CREAT, 0666) asks for, so that the kernel applies the umask or,
+ * where the folder has a default ACL, that ACL (a farm's shared folder
+ * giving a group write access): a mode worked out here and set with
+ * fchmod() applied the umask where the ACL should have decided, and took
+ * the group's write access away. An existing output's own permissions are
+ * kept instead (atomic_file_begin). */
+#define NEW_FILE_MODE 0666
+
+/* The six letters that end a temporary file's name (TEMPORARY_PREFIX
+ * "XXXXXX"), from *seed, which it moves on: tried until one is free. */
+static void next_temporary_suffix(char *suffix, uint64_t *seed) {
+    static const char letters[] = "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789";
+    *seed = *seed * 6364136223846793005u + 1442695040888963407u;
+    for (int k = 0; k < 6; ++k) suffix[k] = letters[(*seed >> (8 * k + 10)) % 62];
+}
+
+/* A seed for next_temporary_suffix: this process, this file and this
+ * moment, so that runs on a farm's nodes sharing a folder start apart. */
+static uint64_t temporary_seed(const atomic_file *file) {
+    struct timespec now;
+    clock_gettime(CLOCK_REALTIME, &now);
+    return (uint64_t)getpid() * 2654435761u ^ (uint64_t)(uintptr_t)file ^
+           ((uint64_t)now.tv_sec << 30) ^ (uint64_t)now.tv_nsec;
+}
+
 static int open_unnamed_in_directory(const atomic_file *file) {
 #ifdef O_TMPFILE
     /* HBAO_TMPFILE=0: named temporaries only (the tests' way to the other
@@ -170,9 +196,10 @@ static int open_unnamed_in_directory(const atomic_file *file) {
     if (wanted != NULL && strcmp(wanted, "0") == 0) return -1;
     char directory[PATH_MAX];
     if (access("/proc/self/fd", X_OK) != 0 || !destination_directory(file, directory)) return -1;
-    /* read too: the finished file is read back for its seal (output_seal.h),
-     * as mkstemp's are */
-    return open(directory, O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
+    /* read too: the finished file is read back for its seal (output_seal.h);
+     * 0666, so that the kernel gives it a new file's permissions (the umask,
+     * or the folder's default ACL: NEW_FILE_MODE) */
+    return open(directory, O_TMPFILE | O_RDWR | O_CLOEXEC, NEW_FILE_MODE);
 #else
     (void)file;
     return -1;
@@ -197,7 +224,7 @@ static int name_unnamed(atomic_file *file);
  * alternate frame by frame, and each is swept once. */
 #define SWEPT_FOLDERS 8
 
-/* Whether `name` is one mkstemp made from TEMPORARY_PREFIX "XXXXXX". */
+/* Whether `name` is a temporary's: TEMPORARY_PREFIX and six letters. */
 static bool is_temporary_name(const char *name) {
     const size_t prefix = sizeof TEMPORARY_PREFIX - 1;
     return strncmp(name, TEMPORARY_PREFIX, prefix) == 0 && strlen(name) == prefix + 6;
@@ -277,12 +304,20 @@ static int create_named_temporary(atomic_file *file, tool_error *error) {
         }
         close(file->fd);
     }
-    sigset_t previous;
-    block_cleanup_signals(&previous);
-    file->fd = mkstemp(file->temporary_path);
-    int saved = errno;
-    if (file->fd >= 0) file->cleanup_slot = claim_cleanup_slot(file->temporary_path);
-    restore_signals(&previous);
+    /* not mkstemp(), which creates 0600 whatever the folder's ACL says */
+    char *suffix = file->temporary_path + strlen(file->temporary_path) - 6;
+    uint64_t seed = temporary_seed(file);
+    int saved = EEXIST;
+    for (int attempt = 0; attempt < 100 && file->fd < 0 && saved == EEXIST; ++attempt) {
+        next_temporary_suffix(suffix, &seed);
+        sigset_t previous;
+        block_cleanup_signals(&previous);
+        file->fd = open(file->temporary_path, O_CREAT | O_EXCL | O_RDWR | O_CLOEXEC | O_NOCTTY,
+                        NEW_FILE_MODE);
+        saved = errno;
+        if (file->fd >= 0) file->cleanup_slot = claim_cleanup_slot(file->temporary_path);
+        restore_signals(&previous);
+    }
     if (file->fd < 0)
         return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot create a file next to %s: %s",
                          file->name, strerror(saved));
@@ -343,20 +378,25 @@ int atomic_file_begin(atomic_file *file, const char *destination, tool_error *er
         if (status != TOOL_EXIT_SUCCESS) return status;
     }
 
+    /* An existing output the user may not write (an approved frame made
+     * read-only) is refused, as open() for writing would refuse it (and
+     * Blender's own render output): the rename would replace it all the
+     * same, its folder being writable. (root may write any.) */
+    if (!file->write_through && exists && S_ISREG(existing.st_mode) &&
+        access(file->destination, W_OK) != 0 && errno == EACCES)
+        return tool_fail(error, TOOL_EXIT_RUNTIME,
+                         "%s is not writable (read-only, or another user's): refusing to "
+                         "replace it (make it writable, or remove it, if it is to go)",
+                         destination);
     status = file->write_through ? create_unnamed_temporary(file, error)
                                  : create_named_temporary(file, error);
     if (status != TOOL_EXIT_SUCCESS) return status;
     file->active = true;
-    if (file->write_through) return TOOL_EXIT_SUCCESS;
-    /* mkstemp creates 0600; give the result the permissions a plain
-     * open(O_CREAT, 0666) would have. umask() can only be read by setting
-     * it, so other threads must not create files meanwhile. */
-    sigset_t previous;
-    block_cleanup_signals(&previous);
-    mode_t mask = umask(0);
-    umask(mask);
-    restore_signals(&previous);
-    if (fchmod(file->fd, 0666 & ~mask) != 0) {
+    /* The temporary has a new file's permissions (NEW_FILE_MODE); an
+     * existing output's own are kept, as an editor saving over it keeps
+     * them (a file made private stays private). */
+    if (!file->write_through && exists && S_ISREG(existing.st_mode) &&
+        fchmod(file->fd, existing.st_mode & 0777) != 0) {
         int saved = errno;
         atomic_file_abort(file);
         return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot set permissions of %s: %s", destination,
@@ -424,14 +464,12 @@ static int copy_through(atomic_file *file, tool_error *error) {
  * and six characters), recorded for the signal handler; called with the
  * cleanup signals blocked and the slots locked. 0, or -1 with errno set. */
 static int name_unnamed(atomic_file *file) {
-    static const char letters[] = "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789";
     char proc_path[64];
     snprintf(proc_path, sizeof proc_path, "/proc/self/fd/%d", file->fd);
     char *suffix = file->temporary_path + strlen(file->temporary_path) - 6;
-    uint64_t seed = (uint64_t)getpid() * 2654435761u ^ (uint64_t)(uintptr_t)file;
+    uint64_t seed = temporary_seed(file);
     for (int attempt = 0; attempt < 100; ++attempt) {
-        seed = seed * 6364136223846793005u + 1442695040888963407u;
-        for (int k = 0; k < 6; ++k) suffix[k] = letters[(seed >> (8 * k + 10)) % 62];
+        next_temporary_suffix(suffix, &seed);
         if (linkat(AT_FDCWD, proc_path, AT_FDCWD, file->temporary_path, AT_SYMLINK_FOLLOW) == 0) {
             file->unnamed = false;
             file->cleanup_slot = claim_cleanup_slot(file->temporary_path);

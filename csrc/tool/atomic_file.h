@@ -60,8 +60,9 @@ typedef struct atomic_file {
     { .fd = -1, .cleanup_slot = -1 }
 
 /** Prepare writing `destination` (kept by pointer for messages): create the
- *  temporary file (mode 0666 & ~umask) or refuse a destination that must not
- *  be written. */
+ *  temporary file (a new file's permissions: the umask or the folder's
+ *  default ACL; an existing output's own where it replaces one) or refuse a
+ *  destination that must not be written (a directory, a read-only file). */
 int atomic_file_begin(atomic_file *file, const char *destination, tool_error *error);
 
 /** `path` with its symbolic links followed, a dangling one too (where
