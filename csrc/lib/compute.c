@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: GPL-2.0-or-later */
 /* hbao_compute(): argument checks and the pipeline. */
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -13,6 +14,10 @@ hbao_result hbao_settings_make(const hbao_params *params, hbao_settings *s) {
     const hbao_result resolved = hbao_params_resolve(params, &p, NULL);
     if (resolved != HBAO_SUCCESS) return resolved;
     s->radius = p.radius;
+    {
+        const float inverse = 1.0f / (p.radius * p.radius);
+        s->inv_radius2 = inverse < FLT_MAX ? inverse : FLT_MAX;
+    }
     s->sin_bias = sinf(p.angle_bias_degrees * (HBAO_PI / 180.0f));
     s->bias_elevation_sine = hbao_sine_from_cosine(s->sin_bias);
     s->bias_elevation_acos = hbao_acos(s->sin_bias);

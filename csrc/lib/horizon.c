@@ -146,7 +146,7 @@ static inline int past_the_normal(const march *m, const slice *sl, const float v
 static float direction_occlusion_hbao(const hbao_settings *s, const march *m, const float v[3],
                                       const slice *sl) {
     const int quadratic = s->falloff == HBAO_FALLOFF_QUADRATIC;
-    const float inv_radius2 = 1.0f / m->radius2;
+    const float inv_radius2 = s->inv_radius2;
     const float half_occluded = 0.5f * (1.0f - s->sin_bias);
     const int check_past_normal = sl->usable && sl->sin_gamma > 0.0f;
     float sin_max = s->sin_bias;
@@ -228,7 +228,7 @@ static float direction_occlusion_cosine(const hbao_settings *s, const march *m, 
     const float inv_np = sl->inv_np;
     const int check_past_normal = sl->sin_gamma > 0.0f;
     const int quadratic = s->falloff == HBAO_FALLOFF_QUADRATIC;
-    const float inv_radius2 = 1.0f / m->radius2;
+    const float inv_radius2 = s->inv_radius2;
 
     /* Horizon state: the highest elevation sine (starting at the bias), and
      * once past the normal, the highest cosine to V. */
@@ -427,7 +427,7 @@ static float direction_occlusion_cosine_layers(const hbao_settings *s, const mar
     *open_part = 0.25f * (2.0f * sl->cos_gamma + (2.0f * gamma + HBAO_PI) * sl->sin_gamma);
     const int check_past_normal = sl->sin_gamma > 0.0f;
     const int quadratic = s->falloff == HBAO_FALLOFF_QUADRATIC;
-    const float inv_radius2 = 1.0f / m->radius2;
+    const float inv_radius2 = s->inv_radius2;
     float h, cos_h, sin_h;
     horizon_from_elevation(s->sin_bias, gamma, sl, &h, &cos_h, &sin_h);
     const float visibility_bias = half_slice_visibility(h, cos_h, sin_h, sl);
@@ -460,7 +460,7 @@ static float direction_occlusion_cosine_layers(const hbao_settings *s, const mar
 static float direction_occlusion_hbao_layers(const hbao_settings *s, const march *m,
                                              const float n[3], const float v[3], const slice *sl) {
     const int quadratic = s->falloff == HBAO_FALLOFF_QUADRATIC;
-    const float inv_radius2 = 1.0f / m->radius2;
+    const float inv_radius2 = s->inv_radius2;
     const float range = 1.0f - s->sin_bias;
     const float inv_range = 1.0f / range;
     const float half_occluded = 0.5f * range;

@@ -1148,7 +1148,7 @@ static VM SIMD_NAME(block_setup)(const hbao_horizon_job *job, int x0, int j, int
     const VM active = M_AND(V_GT(z, V_SET(0.0f)), V_GE(radius_px, V_SET(1.0f)));
     if (!M_ANY(active)) return active;
     b->radius2 = V_SET(s->radius * s->radius);
-    b->inv_radius2 = V_SET(1.0f / (s->radius * s->radius));
+    b->inv_radius2 = V_SET(s->inv_radius2);
     if (SIMD_ORTHOGRAPHIC) {
         b->v[0] = V_SET(0.0f);
         b->v[1] = V_SET(0.0f);

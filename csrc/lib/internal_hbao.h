@@ -34,6 +34,13 @@
 /* Parameters after clamping to the documented limits. */
 typedef struct hbao_settings {
     float radius;
+    /* The quadratic falloff's 1 / radius^2 (its weight is 1 - dist2 *
+     * inv_radius2), at most FLT_MAX: under a radius of 2^-64 the reciprocal
+     * overflowed to +inf, a weight became -inf, and a step the SIMD copies
+     * skip as a repeat of its pixel (it changes nothing) gave the scalar
+     * reference -inf * 0 = NaN: the copies disagreed (a review). Capped,
+     * the weight of a sample within the radius stays finite. */
+    float inv_radius2;
     float sin_bias; /* of the angle bias */
     /* the bias elevation's (sin_bias as an elevation) sine and arc cosine,
      * as horizon_from_elevation computes them: where every horizon starts */

@@ -4,6 +4,7 @@
  * convergence towards a brute-force reference, threads, half resolution,
  * blur, strength and background handling, and cones whose closed forms pin
  * the thickness, the angle bias and the back layer's minimum thickness. */
+#include <math.h>
 #include <stdint.h>
 #include <string.h>
 
@@ -1126,6 +1127,56 @@ TEST_CASE(long_thin_images_match_the_scalar_reference) {
     }
 }
 
+/* A radius under 2^-64 scene units, every length with it (a scene modelled
+ * in tiny units): 1 / radius^2 overflowed to +inf, the quadratic falloff's
+ * weight of a sample became -inf, and a step on the pixel of the step
+ * before, which the SIMD kernels skip (it changes nothing), gave the
+ * scalar reference -inf * 0 = NaN, an AO of 0: on 224 of this scene's
+ * pixels at 2^-64 the kernels disagreed with it (a review). The factor is
+ * capped at FLT_MAX (hbao_settings.inv_radius2): every kernel gives the
+ * reference's floats, and none is 0 where the scene at its own scale has
+ * no pixel darker than 0.2. More steps than the radius has pixels, so that
+ * steps repeat pixels; given normals tilted off the depth's. */
+TEST_CASE(a_tiny_radius_with_quadratic_falloff_matches_the_scalar_reference) {
+    enum { W = 64, H = 48 };
+    static float depth[W * H], normal[3 * W * H], scalar[W * H], fast[W * H];
+    const int kernels[] = {HBAO_IMPLEMENTATION_GENERIC, HBAO_IMPLEMENTATION_AVX2,
+                           HBAO_IMPLEMENTATION_AVX512};
+    const int exponents[] = {0, 64, 70, 100};
+    for (int e = 0; e < 4; e++)
+        for (int integration = 0; integration < 2; integration++) {
+            for (int j = 0; j < H; j++)
+                for (int i = 0; i < W; i++) {
+                    float z = 4.0f + 0.05f * (float)(H - j); /* a floor, a box on it */
+                    if (i > 20 && i < 40 && j > 15 && j < 35) z -= 0.6f;
+                    depth[j * W + i] = ldexpf(z, -exponents[e]);
+                    const float a = 0.15f * (float)((i * 7 + j * 3) % 11);
+                    normal[3 * (j * W + i) + 0] = sinf(a);
+                    normal[3 * (j * W + i) + 1] = 0.3f;
+                    normal[3 * (j * W + i) + 2] = cosf(a);
+                }
+            hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+            p.radius = ldexpf(0.3f, -exponents[e]);
+            p.steps = 32;
+            p.falloff = HBAO_FALLOFF_QUADRATIC;
+            p.integration = integration;
+            p.blur_size = 0;
+            const hbao_camera camera = HBAO_CAMERA_DEFAULT_INITIALIZER;
+            const hbao_channel d = {depth, 1, W}, n = {normal, 3, 3 * W};
+            p.implementation = HBAO_IMPLEMENTATION_SCALAR;
+            CHECK(hbao_compute(&p, &camera, W, H, &d, &n, scalar, W) == HBAO_SUCCESS);
+            float darkest = 1.0f;
+            for (int k = 0; k < W * H; k++) darkest = scalar[k] < darkest ? scalar[k] : darkest;
+            CHECK(darkest > 0.2f);
+            for (int k = 0; k < 3; k++) {
+                if (!implementation_runs_itself(kernels[k])) continue;
+                p.implementation = kernels[k];
+                CHECK(hbao_compute(&p, &camera, W, H, &d, &n, fast, W) == HBAO_SUCCESS);
+                CHECK(memcmp(scalar, fast, sizeof fast) == 0);
+            }
+        }
+}
+
 /* The SIMD kernels plan a direction's steps a vector at a time, and two
  * directions in one vector where the steps fit in half of it (up to 8); a
  * group's plans are made ahead, two at a time or one (horizon_simd.h,
@@ -1959,6 +2010,7 @@ TEST_MAIN(TEST_ENTRY(plane_facing_camera_is_unoccluded), TEST_ENTRY(tilted_plane
           TEST_ENTRY(simd_paths_match_scalar_reference_part_4_of_4),
           TEST_ENTRY(long_thin_images_match_the_scalar_reference),
           TEST_ENTRY(every_step_and_direction_count_matches_the_scalar_reference),
+          TEST_ENTRY(a_tiny_radius_with_quadratic_falloff_matches_the_scalar_reference),
           TEST_ENTRY(a_post_at_the_lens_leaves_the_ao_of_its_blocks),
           TEST_ENTRY(a_back_layer_of_the_half_float_sky_is_no_back_layer),
           TEST_ENTRY(thin_occluders_do_not_darken_what_is_behind_them),
