@@ -35,7 +35,11 @@
  *   ortho_scale) by a power of two leaves the AO bit for bit the same
  *   while those lengths stay between about 1e-16 and 1e19 scene units (and
  *   no depth lands exactly on HBAO_HALF_FLOAT_SKY, which is background)
- *   (test_planes.c, ao_is_the_same_at_every_scale). Beyond 1e19 (only with
+ *   (test_planes.c, ao_is_the_same_at_every_scale). Depths that are all
+ *   half floats (a half-float Depth pass) are an exception: their rounding
+ *   is told from the values (docs/algorithm.md, "Depth precision"), and a
+ *   scale that takes them out of the half-float range, or into it, changes
+ *   the tolerance it gives, and so the AO. Beyond 1e19 (only with
  *   a background_depth above it) squared distances overflow, and toward
  *   the denormals (below about 1e-17; below 1.2e-38 the depth weights no
  *   longer tell depths apart) they lose precision: the AO there is finite
