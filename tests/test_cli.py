@@ -2629,6 +2629,34 @@ def test_outputs_get_a_new_files_permissions_and_keep_an_existing_ones(
     assert leftover_temporary_files(tmp_path) == [] and leftover_temporary_files(shared) == []
 
 
+def test_where_an_unnamed_file_cannot_be_named_a_named_one_is_written(hbao_tool, tmp_path):
+    """A file system or sandbox may allow O_TMPFILE and refuse linking the
+    file to a name (linkat): the tool learns it before the work and makes a
+    named temporary instead. Since a94eeb4 that path kept the closed
+    unnamed file's descriptor and wrote into it ("Bad file descriptor",
+    exit 1: a re-read of the change found it). linkat is refused here by a
+    preloaded shim, compiled for the test."""
+    shim = tmp_path / "no_linkat.c"
+    shim.write_text("#include <errno.h>\n"
+                    "int linkat(int a, const char *b, int c, const char *d, int e) {\n"
+                    "    (void)a; (void)b; (void)c; (void)d; (void)e;\n"
+                    "    errno = EPERM;\n"
+                    "    return -1;\n"
+                    "}\n")
+    library = tmp_path / "no_linkat.so"
+    subprocess.run(["cc", "-shared", "-fPIC", "-o", str(library), str(shim)], check=True)
+    out = tmp_path / "out"
+    out.mkdir()
+    for preview in ((), ("--preview", out / "ao.png")):
+        completed = run_tool(hbao_tool, fixture_path("cycles_float_zip"), "-o", out / "ao.exr",
+                             "--no-normals", *preview,
+                             env=dict(os.environ, LD_PRELOAD=str(library)))
+        assert completed.returncode == 0, completed.stderr
+        assert "AO" in channels_by_name(info(hbao_tool, out / "ao.exr"))
+        assert leftover_temporary_files(out) == []
+    assert (out / "ao.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
 def test_an_output_its_user_may_not_write_is_not_replaced(hbao_tool):
     """An existing output the user may not write (an approved frame made
     read-only) is refused, as open() for writing (and Blender's own render

@@ -303,6 +303,7 @@ static int create_named_temporary(atomic_file *file, tool_error *error) {
             return TOOL_EXIT_SUCCESS;
         }
         close(file->fd);
+        file->fd = -1; /* a named file instead, below */
     }
     /* not mkstemp(), which creates 0600 whatever the folder's ACL says */
     char *suffix = file->temporary_path + strlen(file->temporary_path) - 6;
