@@ -156,12 +156,6 @@ static bool destination_directory(const atomic_file *file, char directory[PATH_M
     return snprintf(directory, PATH_MAX, "%.*s", length, file->destination) < PATH_MAX;
 }
 
-/* An unnamed file in the destination's directory (Linux's O_TMPFILE), named
- * only at commit: a run killed by a signal no handler sees (SIGKILL, the
- * out-of-memory killer, a farm's hard timeout) leaves nothing behind. The
- * name is given through /proc/self/fd (linkat), so this needs /proc; -1
- * where either is missing (file systems without O_TMPFILE: NFS before 4.2,
- * some FUSE ones), and the named temporary below is used instead. */
 /* An output's temporary file is created with the mode a plain
  * open(O_CREAT, 0666) asks for, so that the kernel applies the umask or,
  * where the folder has a default ACL, that ACL (a farm's shared folder
@@ -188,6 +182,12 @@ static uint64_t temporary_seed(const atomic_file *file) {
            ((uint64_t)now.tv_sec << 30) ^ (uint64_t)now.tv_nsec;
 }
 
+/* An unnamed file in the destination's directory (Linux's O_TMPFILE), named
+ * only at commit: a run killed by a signal no handler sees (SIGKILL, the
+ * out-of-memory killer, a farm's hard timeout) leaves nothing behind. The
+ * name is given through /proc/self/fd (linkat), so this needs /proc; -1
+ * where either is missing (file systems without O_TMPFILE: NFS before 4.2,
+ * some FUSE ones), and the named temporary below is used instead. */
 static int open_unnamed_in_directory(const atomic_file *file) {
 #ifdef O_TMPFILE
     /* HBAO_TMPFILE=0: named temporaries only (the tests' way to the other
