@@ -379,12 +379,13 @@ int atomic_file_begin(atomic_file *file, const char *destination, tool_error *er
         if (status != TOOL_EXIT_SUCCESS) return status;
     }
 
-    /* An existing output the user may not write (an approved frame made
-     * read-only) is refused, as open() for writing would refuse it (and
-     * Blender's own render output): the rename would replace it all the
-     * same, its folder being writable. (root may write any.) */
-    if (!file->write_through && exists && S_ISREG(existing.st_mode) &&
-        access(file->destination, W_OK) != 0 && errno == EACCES)
+    /* An existing regular file that the rename will replace. One the user
+     * may not write (an approved frame made read-only) is refused, as
+     * open() for writing would refuse it (and Blender's own render output):
+     * the rename would replace it all the same, its folder being writable.
+     * (root may write any.) */
+    const bool replaces = !file->write_through && exists && S_ISREG(existing.st_mode);
+    if (replaces && access(file->destination, W_OK) != 0 && errno == EACCES)
         return tool_fail(error, TOOL_EXIT_RUNTIME,
                          "%s is not writable (read-only, or another user's): refusing to "
                          "replace it (make it writable, or remove it, if it is to go)",
@@ -396,8 +397,7 @@ int atomic_file_begin(atomic_file *file, const char *destination, tool_error *er
     /* The temporary has a new file's permissions (NEW_FILE_MODE); an
      * existing output's own are kept, as an editor saving over it keeps
      * them (a file made private stays private). */
-    if (!file->write_through && exists && S_ISREG(existing.st_mode) &&
-        fchmod(file->fd, existing.st_mode & 0777) != 0) {
+    if (replaces && fchmod(file->fd, existing.st_mode & 0777) != 0) {
         int saved = errno;
         atomic_file_abort(file);
         return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot set permissions of %s: %s", destination,
