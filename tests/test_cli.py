@@ -2726,6 +2726,12 @@ def test_sequence_refuses_outputs_that_are_another_frames_or_its_own(hbao_tool, 
     (["in.exr", "-o", "ao.exr", "--jobs", "2"], "go with --frames"),
     (["in.exr", "-o", "ao.exr", "--force"], "go with --frames"),
     (["--info", "in_#.exr", "--frames", "1"], "drop --frames"),
+    # flags that do nothing with --info were accepted silently
+    (["--info", "in.exr", "--layer", "Back"], "takes only --json: drop --layer"),
+    (["--info", "in.exr", "--json", "-j", "2"], "takes only --json: drop -j"),
+    (["--info", "in.exr", "--radius", "-1"], "takes only --json: drop --radius"),
+    (["in.exr", "--keep-input", "--info"], "takes only --json: drop --keep-input"),
+    (["--info", "in.exr", "--threads=2", "--force"], "takes only --json: drop --threads=2"),
     # "-" is no file name here (it made a file called "-")
     (["in.exr", "-o", "-"], '-o is "-": give /dev/stdout'),
     (["in.exr", "-o", "ao.exr", "--preview", "-"], '--preview is "-"'),

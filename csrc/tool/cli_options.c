@@ -502,6 +502,9 @@ int cli_parse(int argc, char **argv, cli_options *options, tool_error *error) {
     }
     bool only_positionals = false;
     bool given[OPTION_COUNT] = {false};
+    /* the first option, as typed, that does nothing with --info (every one
+     * but --info and --json) */
+    const char *not_for_info = NULL;
     for (int i = 1; i < argc; ++i) {
         const char *argument = argv[i];
         if (only_positionals || argument[0] != '-' || strcmp(argument, "-") == 0) {
@@ -539,6 +542,8 @@ int cli_parse(int argc, char **argv, cli_options *options, tool_error *error) {
                              spec->name);
         }
         given[index] = true;
+        if (not_for_info == NULL && spec->id != OPTION_INFO && spec->id != OPTION_JSON)
+            not_for_info = argument;
         const char *value = NULL;
         if (spec->takes_value) {
             if (inline_value != NULL) {
@@ -565,6 +570,12 @@ int cli_parse(int argc, char **argv, cli_options *options, tool_error *error) {
             return tool_fail(error, TOOL_EXIT_USAGE, "--info writes nothing: drop -o/--preview");
         if (sequence)
             return tool_fail(error, TOOL_EXIT_USAGE, "--info reads one file: drop --frames");
+        /* a flag that would change nothing there (--layer, --radius -1, -j)
+         * is refused rather than ignored: its user expected an effect */
+        if (not_for_info != NULL)
+            return tool_fail(error, TOOL_EXIT_USAGE,
+                             "--info prints what the file holds and takes only --json: drop %s",
+                             not_for_info);
         return TOOL_EXIT_SUCCESS;
     }
     if (!sequence && (options->jobs != 1 || options->force))
