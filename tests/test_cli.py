@@ -1566,9 +1566,12 @@ def test_sequence_computes_every_frame_and_lists_the_failed_ones(hbao_tool, tmp_
     folder, sources = sequence_folder(tmp_path)
     completed = run_sequence(hbao_tool, folder, "--jobs", "2")
     assert_clean_error(completed, EXIT_RUNTIME, "2 of 5 frames failed: 3, 5")
+    # frame 5, with no input, fails before the others run, in one line; the
+    # progress counts the four that run
+    assert "no input for 1 of the 5 frames (5; the first, " in completed.stderr
     progress = [line for line in completed.stderr.splitlines() if line.startswith("hbao: [")]
-    assert len(progress) == 5 and all(f"[{k}/5]" in progress[k - 1] for k in range(1, 6))
-    assert sum("failed" in line for line in progress) == 2
+    assert len(progress) == 4 and all(f"[{k}/4]" in progress[k - 1] for k in range(1, 5))
+    assert sum("failed" in line for line in progress) == 1
     # Each frame's output is what a single run on that frame writes, byte for
     # byte (the library's result does not depend on the thread count).
     for frame, name in sources.items():
@@ -1580,6 +1583,58 @@ def test_sequence_computes_every_frame_and_lists_the_failed_ones(hbao_tool, tmp_
         assert not (folder / f"ao_{frame:04d}.exr").exists()
         assert not (folder / f"ao_{frame:04d}.png").exists()
     assert leftover_temporary_files(folder) == []
+
+
+def test_a_mistyped_frame_range_fails_its_missing_frames_at_once(hbao_tool, tmp_path):
+    """--frames 0-1048574 (Blender's every frame) over five renders ran a
+    million frames that failed one by one, a line each, for some 20 s: the
+    frames with no input now fail before the run, in one line of ranges, and
+    the summary gives ranges too. Where no listed frame has its input, that
+    is the error, and nothing runs."""
+    folder, sources = sequence_folder(tmp_path)
+    completed = run_tool(hbao_tool, folder / "render_####.exr", "-o", folder / "ao_####.exr",
+                         "--frames", "0-1048574", "--no-normals", "-j", "2")
+    assert_clean_error(completed, EXIT_RUNTIME,
+                       "1048572 of 1048575 frames failed: 0, 3, 5-1048574")
+    assert "no input for 1048571 of the 1048575 frames (0, 5-1048574; the first, " \
+        in completed.stderr
+    assert len(completed.stderr.splitlines()) == 6, completed.stderr  # warning, 4 frames, error
+    for frame in sources:
+        assert (folder / f"ao_{frame:04d}.exr").exists()
+    nothing = run_tool(hbao_tool, folder / "typo_####.exr", "-o", folder / "t_####.exr",
+                       "--frames", "1-250")
+    assert_clean_error(nothing, EXIT_RUNTIME, "no input for any of the 250 listed frames",
+                       "typo_0001.exr: No such file or directory")
+    assert len(nothing.stderr.splitlines()) == 1 and not list(folder.glob("t_*"))
+
+
+def test_an_input_dated_ahead_of_the_clock_is_computed_once(hbao_tool, tmp_path):
+    """A render whose time lies ahead of this machine's clock (a render node
+    whose clock is ahead, over NFS) left every output older than its input,
+    so each rerun recomputed every frame. An output whose seal names the
+    input as it is now is up to date; one without a seal is still redone
+    (nothing then says it was computed from that input), and so is one
+    whose input changed since (its time or size)."""
+    folder, sources = sequence_folder(tmp_path)
+    ahead = time.time_ns() + 3600 * 10**9
+    for frame in sources:
+        os.utime(folder / f"render_{frame:04d}.exr", ns=(ahead, ahead))
+    run_sequence(hbao_tool, folder)
+    assert all(os.stat(folder / f"ao_{f:04d}.exr").st_mtime_ns < ahead for f in sources)
+    written = {f: os.stat(folder / f"ao_{f:04d}.exr").st_mtime_ns for f in sources}
+    again = run_sequence(hbao_tool, folder)
+    assert again.stderr.count("is up to date, skipped") == 3, again.stderr
+    assert {f: os.stat(folder / f"ao_{f:04d}.exr").st_mtime_ns for f in sources} == written
+    os.removexattr(folder / "ao_0001.exr", SEAL)
+    later = ahead + 10**9
+    os.utime(folder / "render_0002.exr", ns=(later, later))
+    redone = run_sequence(hbao_tool, folder)
+    assert redone.stderr.count("is up to date, skipped") == 1, redone.stderr
+    assert "frame 1: " in redone.stderr and "frame 2: " in redone.stderr
+    for frame, name in sources.items():
+        single = tmp_path / f"single_{frame}.exr"
+        run_ok(hbao_tool, fixture_path(name), "-o", single, "--no-normals")
+        assert (folder / f"ao_{frame:04d}.exr").read_bytes() == single.read_bytes()
 
 
 def test_sequence_skips_up_to_date_frames(hbao_tool, tmp_path):
@@ -2387,15 +2442,24 @@ def test_export_cameras_frames_are_the_clis(hbao_tool, tmp_path):
             frames = frame_lists.parse(text)
         except ValueError:
             frames = None
+        # a file that is no EXR for the first frame (so that not every
+        # listed frame lacks its input, which is one error without a list)
+        for stale in tmp_path.glob("none_*.exr"):
+            stale.unlink()
+        if frames:
+            (tmp_path / f"none_{frames[0]}.exr").write_bytes(b"")
         completed = run_tool(hbao_tool, tmp_path / "none_#.exr", "-o", tmp_path / "x_#.exr",
                              "--frames", text, "--no-normals", "-j", "32")
-        # taken: every frame tried, each failing (no input); refused: a usage error
+        # taken: every frame failing (no EXR, no input); refused: a usage error
         assert completed.returncode == (EXIT_USAGE if frames is None else EXIT_RUNTIME), \
             (text[:40], completed.stderr[-300:])
         if frames is not None and len(frames) < 50:
-            failed = re.search(r"failed: ([0-9, ]+)", completed.stderr)
-            assert failed and [int(f) for f in failed.group(1).split(", ")] == frames, \
-                (text, completed.stderr[-300:])
+            failed = re.search(r"failed: ([0-9, -]+)", completed.stderr)
+            listed = []
+            for item in failed.group(1).split(", ") if failed else []:
+                first, _, last = item.partition("-")
+                listed += range(int(first), int(last or first) + 1)
+            assert listed == frames, (text, completed.stderr[-300:])
 
 
 @pytest.mark.parametrize("arguments, status, fragment", [

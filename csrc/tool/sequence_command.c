@@ -26,14 +26,16 @@ typedef struct frame_outcome {
     int32_t frame;
     int status;   /* TOOL_EXIT_* */
     bool skipped; /* up to date */
+    bool missing; /* no input: failed before the run (missing_inputs) */
 } frame_outcome;
 
 typedef struct sequence_run {
     const cli_options *options;
     frame_outcome *outcomes;
     int64_t count;
+    int64_t to_run;        /* the frames with an input (missing_inputs) */
     int64_t next;          /* the next frame to start */
-    int64_t finished;      /* for the progress count */
+    int64_t finished;      /* for the progress count, of to_run */
     bool camera_per_frame; /* per_frame_camera */
     pthread_mutex_t lock;
 } sequence_run;
@@ -52,9 +54,10 @@ static bool newer_or_equal(const struct stat *a, const struct stat *b) {
  * or damaged since the tool wrote it (an interrupted copy, rsync --inplace,
  * a block overwritten or a hole punched in place) is redone, not skipped
  * with its header intact, and so is a sealed one computed from another
- * input than the file there now. */
+ * input than the file there now. sealed_only: only a sealed output will do
+ * (up_to_date: one older than its input). */
 static bool output_is_whole(const cli_options *frame, const struct stat *input,
-                            const char *settings) {
+                            const char *settings, bool sealed_only) {
     exr_input output;
     tool_error ignored = {{0}};
     if (exr_input_open(&output, frame->output_path, &ignored) != TOOL_EXIT_SUCCESS) return false;
@@ -64,7 +67,7 @@ static bool output_is_whole(const cli_options *frame, const struct stat *input,
         const output_seal_state seal =
             output.stream.open ? output_seal_check(output.stream.fd, frame->input_path, input)
                                : OUTPUT_SEAL_ABSENT;
-        if (seal == OUTPUT_SEAL_ABSENT) {
+        if (seal == OUTPUT_SEAL_ABSENT && !sealed_only) {
             float *pixels = malloc((size_t)output.width * (size_t)output.height * sizeof *pixels);
             const exr_channel_request request = {frame->ao_channel, EXR_PIXEL_FLOAT,
                                                  (uint8_t *)pixels, (int32_t)sizeof *pixels,
@@ -106,14 +109,19 @@ static bool preview_is_current(const cli_options *frame, const struct stat *outp
  * output exists and is at least as new as the input and the camera file, the
  * preview is current (preview_is_current), and the EXR's header holds the
  * settings this run would write (run_settings.h) and it is whole
- * (output_is_whole).
+ * (output_is_whole). An output older than its input is up to date where
+ * its seal names the input as it is now (name, size and time: the output
+ * was computed from it): an input whose time lies ahead of this machine's
+ * clock (written by a render node whose clock is ahead, over NFS) was
+ * recomputed on every run.
  * (An input re-rendered while its frame was computed gets no output:
  * ao_command's refuse_changed_input.) */
 static bool up_to_date(const cli_options *frame) {
     struct stat input, output, other;
     if (stat(frame->input_path, &input) != 0 || stat(frame->output_path, &output) != 0 ||
-        !S_ISREG(output.st_mode) || !newer_or_equal(&output, &input))
+        !S_ISREG(output.st_mode))
         return false;
+    const bool older_than_input = !newer_or_equal(&output, &input);
     /* an output that is its input: ao_command refuses it, --force or not */
     if (output.st_dev == input.st_dev && output.st_ino == input.st_ino) return false;
     /* a camera file by its time too; a pipe's (--camera /dev/stdin) is the
@@ -125,7 +133,7 @@ static bool up_to_date(const cli_options *frame) {
     if (frame->preview_path != NULL && !preview_is_current(frame, &output)) return false;
     char settings[RUN_SETTINGS_MAX];
     return run_settings_text(frame, frame->camera_file, settings) &&
-           output_is_whole(frame, &input, settings);
+           output_is_whole(frame, &input, settings, older_than_input);
 }
 
 static void report(sequence_run *run, const frame_outcome *outcome, const char *output,
@@ -135,10 +143,10 @@ static void report(sequence_run *run, const frame_outcome *outcome, const char *
     flockfile(stderr);
     if (outcome->status != TOOL_EXIT_SUCCESS)
         fprintf(stderr, "hbao: [%lld/%lld] frame %d failed: %s\n", (long long)done,
-                (long long)run->count, outcome->frame, message);
+                (long long)run->to_run, outcome->frame, message);
     else
         fprintf(stderr, "hbao: [%lld/%lld] frame %d: %s%s\n", (long long)done,
-                (long long)run->count, outcome->frame, output,
+                (long long)run->to_run, outcome->frame, output,
                 outcome->skipped ? " is up to date, skipped" : "");
     funlockfile(stderr);
     pthread_mutex_unlock(&run->lock);
@@ -199,35 +207,103 @@ static void *worker(void *context) {
         const int64_t index = run->next++;
         pthread_mutex_unlock(&run->lock);
         if (index >= run->count) return NULL;
-        run_frame(run, &run->outcomes[index]);
+        if (!run->outcomes[index].missing) run_frame(run, &run->outcomes[index]);
     }
 }
 
-/* "3 of 250 frames failed: 4, 17, 200" (the list shortened to fit). */
-static int summarize(const sequence_run *run, tool_error *error) {
+/* The frames of `outcomes` that `take` picks, as ranges of frames listed
+ * one after the other ("4, 17-30, 200"; 1-250x2 gives no ranges), written
+ * into list[size] (shortened with ", ..." to fit); returns how many. */
+#define FRAME_RANGES_TEXT 512
+static int64_t frame_ranges(const sequence_run *run, bool (*take)(const frame_outcome *),
+                            char list[FRAME_RANGES_TEXT]) {
     static const char ellipsis[] = ", ...";
-    int status = TOOL_EXIT_SUCCESS;
-    int64_t failed = 0;
-    char list[512] = "";
+    int64_t taken = 0;
+    size_t used = 0;
     bool shortened = false;
+    list[0] = '\0';
     for (int64_t i = 0; i < run->count; ++i) {
-        const frame_outcome *outcome = &run->outcomes[i];
-        if (outcome->status == TOOL_EXIT_SUCCESS) continue;
-        if (outcome->status > status) status = outcome->status;
-        char item[24];
-        snprintf(item, sizeof item, "%s%d", failed > 0 ? ", " : "", outcome->frame);
-        ++failed;
+        if (!take(&run->outcomes[i])) continue;
+        int64_t last = i; /* the range's end: following frames, each taken */
+        while (last + 1 < run->count && take(&run->outcomes[last + 1]) &&
+               run->outcomes[last + 1].frame == run->outcomes[last].frame + 1)
+            ++last;
+        char item[40];
+        const int first = run->outcomes[i].frame, end = run->outcomes[last].frame;
+        if (first == end)
+            snprintf(item, sizeof item, "%s%d", taken > 0 ? ", " : "", first);
+        else
+            snprintf(item, sizeof item, "%s%d-%d", taken > 0 ? ", " : "", first, end);
+        taken += last - i + 1;
+        i = last;
         if (shortened) continue;
-        if (strlen(list) + strlen(item) + sizeof ellipsis > sizeof list) {
-            strcat(list, ellipsis);
+        if (used + strlen(item) + sizeof ellipsis > FRAME_RANGES_TEXT) {
+            strcpy(list + used, ellipsis);
             shortened = true;
         } else {
-            strcat(list, item);
+            strcpy(list + used, item);
+            used += strlen(item);
         }
     }
+    return taken;
+}
+
+static bool failed_frame(const frame_outcome *outcome) {
+    return outcome->status != TOOL_EXIT_SUCCESS;
+}
+
+static bool missing_frame(const frame_outcome *outcome) {
+    return outcome->missing;
+}
+
+/* "3 of 250 frames failed: 4, 17-18" (the list shortened to fit). */
+static int summarize(const sequence_run *run, tool_error *error) {
+    int status = TOOL_EXIT_SUCCESS;
+    for (int64_t i = 0; i < run->count; ++i)
+        if (run->outcomes[i].status > status) status = run->outcomes[i].status;
+    char list[FRAME_RANGES_TEXT];
+    const int64_t failed = frame_ranges(run, failed_frame, list);
     if (failed == 0) return TOOL_EXIT_SUCCESS;
     return tool_fail(error, status, "%lld of %lld frames failed: %s", (long long)failed,
                      (long long)run->count, list);
+}
+
+/* The listed frames whose input is not there fail before any frame runs,
+ * said in one line of ranges: a mistyped --frames 0-1048574 over 250
+ * renders printed a million lines, one a failed frame, for some 20 s.
+ * Where no frame has its input, that is the error, with nothing run. An
+ * input that cannot be looked up for another reason (a folder without
+ * permission), or a symbolic link to no file (yet: it may name another
+ * frame's output, refuse_other_frames_files), fails in its frame. */
+static int missing_inputs(sequence_run *run, tool_error *error) {
+    const char *pattern = run->options->input_path;
+    char path[PATH_MAX], first[PATH_MAX] = "";
+    int reason = 0;
+    struct stat status;
+    int64_t missing = 0;
+    for (int64_t i = 0; i < run->count; ++i) {
+        frame_outcome *outcome = &run->outcomes[i];
+        if (!frame_pattern_path(pattern, outcome->frame, path, sizeof path) ||
+            lstat(path, &status) == 0 || (errno != ENOENT && errno != ENOTDIR))
+            continue;
+        if (missing++ == 0) {
+            reason = errno;
+            strcpy(first, path);
+        }
+        outcome->missing = true;
+        outcome->status = TOOL_EXIT_RUNTIME;
+    }
+    run->to_run = run->count - missing;
+    if (missing == 0) return TOOL_EXIT_SUCCESS;
+    if (missing == run->count)
+        return tool_fail(error, TOOL_EXIT_RUNTIME,
+                         "no input for any of the %lld listed frames (%s): %s: %s",
+                         (long long)run->count, pattern, first, strerror(reason));
+    char list[FRAME_RANGES_TEXT];
+    frame_ranges(run, missing_frame, list);
+    tool_warn("no input for %lld of the %lld frames (%s; the first, %s: %s): they fail",
+              (long long)missing, (long long)run->count, list, first, strerror(reason));
+    return TOOL_EXIT_SUCCESS;
 }
 
 /* A frame's output or preview that is another frame's input (its render,
@@ -295,14 +371,15 @@ static bool dangling_link_target(const char *path, char target[PATH_MAX]) {
  * memory: the names' checks still run). */
 #define FRAME_FILE_KINDS 4
 static frame_file *frames_files(const char *const patterns[FRAME_FILE_KINDS],
-                                const frame_list *frames, int64_t count, size_t *found) {
+                                const sequence_run *run, size_t *found) {
     *found = 0;
-    frame_file *files = malloc((size_t)count * FRAME_FILE_KINDS * sizeof *files);
+    frame_file *files = malloc((size_t)run->count * FRAME_FILE_KINDS * sizeof *files);
     if (files == NULL) return NULL;
     char path[PATH_MAX];
     struct stat status;
-    for (int64_t i = 0; i < count; ++i) {
-        const int32_t frame = frame_list_at(frames, i);
+    for (int64_t i = 0; i < run->count; ++i) {
+        if (run->outcomes[i].missing) continue; /* nothing read, nothing written */
+        const int32_t frame = run->outcomes[i].frame;
         for (int kind = 0; kind < FRAME_FILE_KINDS; ++kind) {
             if (patterns[kind] == NULL ||
                 !frame_pattern_path(patterns[kind], frame, path, sizeof path))
@@ -376,8 +453,9 @@ static bool is_shared_camera(const char *camera, const struct stat *camera_statu
            (status.st_nlink == 1 || same_resolved_path(path, camera));
 }
 
-static int refuse_other_frames_files(const cli_options *options, int64_t count,
-                                     bool camera_per_frame, tool_error *error) {
+static int refuse_other_frames_files(const sequence_run *run, tool_error *error) {
+    const cli_options *options = run->options;
+    const bool camera_per_frame = run->camera_per_frame;
     char canonical[5][PATH_MAX];
     /* the frames' files: renders, cameras where each has its own, outputs
      * and previews (their indices in `files` are frame_file.kind) */
@@ -397,10 +475,13 @@ static int refuse_other_frames_files(const cli_options *options, int64_t count,
     const bool camera_exists = camera != NULL && stat(camera, &camera_status) == 0;
     char path[PATH_MAX];
     size_t found;
-    frame_file *files = frames_files(files_patterns, &options->frames, count, &found);
+    frame_file *files = frames_files(files_patterns, run, &found);
     int status = TOOL_EXIT_SUCCESS;
-    for (int64_t i = 0; i < count; ++i) {
-        const int32_t frame = frame_list_at(&options->frames, i);
+    /* the frames that run write (the others' files: in frames_files, and
+     * by name, frame_list_contains) */
+    for (int64_t i = 0; i < run->count; ++i) {
+        if (run->outcomes[i].missing) continue;
+        const int32_t frame = run->outcomes[i].frame;
         for (int k = 0; k < 2; ++k) {
             if (patterns[k] == NULL || !frame_pattern_path(patterns[k], frame, path, sizeof path))
                 continue;
@@ -444,9 +525,6 @@ done:
 
 int sequence_command(const cli_options *options, tool_error *error) {
     const bool camera_per_frame = per_frame_camera(options);
-    const int refused = refuse_other_frames_files(options, frame_list_count(&options->frames),
-                                                  camera_per_frame, error);
-    if (refused != TOOL_EXIT_SUCCESS) return refused;
     sequence_run run = {0};
     run.camera_per_frame = camera_per_frame;
     run.count = frame_list_count(&options->frames);
@@ -454,6 +532,13 @@ int sequence_command(const cli_options *options, tool_error *error) {
     if (run.outcomes == NULL) return tool_fail(error, TOOL_EXIT_RUNTIME, "out of memory");
     for (int64_t i = 0; i < run.count; ++i)
         run.outcomes[i].frame = frame_list_at(&options->frames, i);
+    run.options = options;
+    int refused = missing_inputs(&run, error);
+    if (refused == TOOL_EXIT_SUCCESS) refused = refuse_other_frames_files(&run, error);
+    if (refused != TOOL_EXIT_SUCCESS) {
+        free(run.outcomes);
+        return refused;
+    }
 
     cli_options shared = *options;
     camera_settings camera_file;
@@ -467,7 +552,7 @@ int sequence_command(const cli_options *options, tool_error *error) {
         shared.camera_file = &camera_file;
     }
     int jobs = options->jobs < 1 ? 1 : options->jobs;
-    if (jobs > run.count) jobs = (int)run.count;
+    if (jobs > run.to_run) jobs = (int)run.to_run;
     /* Frames at once share the cores: each frame's computation gets its
      * part, unless --threads says otherwise. */
     if (shared.params.threads == 0 && jobs > 1) {
