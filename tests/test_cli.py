@@ -1680,6 +1680,37 @@ def test_sequence_redoes_frames_computed_with_other_flags(hbao_tool, tmp_path):
     assert "frame 1: " in redone.stderr and b"hbaoSettings" in foreign.read_bytes()
 
 
+def test_sequence_flags_that_say_the_same_in_other_words_skip_frames(hbao_tool, tmp_path):
+    """The stamp holds what the AO was computed with, not the flags as typed:
+    a farm rerun that adds --layer naming the file's only layer, or gives as
+    flags what the camera file or the header already says, recomputed every
+    frame. It now skips them; a flag that changes a value still recomputes,
+    and writes what a single run writes."""
+    name = "cycles_float_zip"
+    for frame in (1, 2):
+        shutil.copyfile(fixture_path(name), tmp_path / f"r_{frame}.exr")
+    camera = json.loads(camera_path(name).read_text())
+
+    def run(*extra):
+        return run_ok(hbao_tool, tmp_path / "r_#.exr", "-o", tmp_path / "ao_#.exr",
+                      "--frames", "1-2", "--camera", camera_path(name), *extra).stderr
+
+    run()
+    for same in (["--layer", "ViewLayer"], ["--camera-type", camera["type"]],
+                 ["--lens", str(camera["lens"]), "--sensor-width", str(camera["sensor_width"])],
+                 ["--pixel-aspect-x", "1", "--pixel-aspect-y", "1"]):  # the header's
+        stderr = run(*same)
+        assert stderr.count("is up to date, skipped") == 2, (same, stderr)
+    assert "is up to date" not in run("--no-normals")  # another computation
+    assert run("--layer", "ViewLayer", "--no-normals").count("is up to date, skipped") == 2
+    other = run("--lens", str(2 * camera["lens"]))
+    assert "is up to date" not in other
+    single = tmp_path / "single.exr"
+    run_ok(hbao_tool, fixture_path(name), "-o", single, "--camera", camera_path(name),
+           "--lens", str(2 * camera["lens"]))
+    assert (tmp_path / "ao_2.exr").read_bytes() == single.read_bytes()
+
+
 def test_sequence_redoes_an_output_cut_short_or_damaged_since(hbao_tool, tmp_path):
     """An output whose header is whole but whose pixels are not (cut short by
     an interrupted copy, its end overwritten) is not up to date: it was

@@ -7,6 +7,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "ao_plan.h"
 #include "atomic_file.h"
 #include "blender_layers.h"
 #include "camera_json.h"
@@ -80,31 +81,6 @@ static int refuse_changed_input(const exr_input *input, tool_error *error) {
                      "%s changed while its AO was computed (re-rendered?); nothing written: "
                      "run again",
                      input->path);
-}
-
-/* Defaults, then the EXR header's pixel aspect, then the JSON file, then flags. */
-static int resolve_camera(const cli_options *options, const exr_input *input,
-                          camera_settings *resolved, camera_settings *from_file,
-                          tool_error *error) {
-    camera_settings_init(resolved);
-    if (input->has_pixel_aspect_ratio && input->pixel_aspect_ratio > 0.0f &&
-        isfinite(input->pixel_aspect_ratio)) {
-        /* pixelAspectRatio = pixel width / pixel height = aspect_x / aspect_y. */
-        resolved->camera.pixel_aspect_x = input->pixel_aspect_ratio;
-        resolved->camera.pixel_aspect_y = 1.0f;
-        resolved->fields_set |= CAMERA_FIELD_PIXEL_ASPECT_X | CAMERA_FIELD_PIXEL_ASPECT_Y;
-    }
-    camera_settings_init(from_file);
-    if (options->camera_file != NULL) {
-        *from_file = *options->camera_file;
-        camera_settings_apply(resolved, from_file);
-    } else if (options->camera_path != NULL) {
-        int status = camera_json_load(options->camera_path, from_file, error);
-        if (status != TOOL_EXIT_SUCCESS) return status;
-        camera_settings_apply(resolved, from_file);
-    }
-    camera_settings_apply(resolved, &options->camera_flags);
-    return TOOL_EXIT_SUCCESS;
 }
 
 void ao_buffers_free(ao_buffers *buffers) {
@@ -320,8 +296,7 @@ static int choose_output_windows(const cli_options *options, const exr_input *in
 
 static int write_outputs(const cli_options *options, const exr_input *input,
                          exr_output_channel *channels, int channel_count, const float *ao,
-                         const camera_settings *camera_file, output_files *files,
-                         tool_error *error) {
+                         const ao_plan *plan, output_files *files, tool_error *error) {
     output_windows windows;
     int status = choose_output_windows(options, input, &windows, error);
     if (status != TOOL_EXIT_SUCCESS) return status;
@@ -342,7 +317,7 @@ static int write_outputs(const cli_options *options, const exr_input *input,
                                 NULL,
                                 input->threads}; /* as many as the AO and the read */
     char settings[RUN_SETTINGS_MAX];
-    if (run_settings_text(options, camera_file, settings)) {
+    if (run_settings_text(options, plan, settings)) {
         layout.stamp_name = RUN_SETTINGS_ATTRIBUTE;
         layout.stamp_text = settings;
     }
@@ -390,69 +365,53 @@ static void warn_if_depth_is_constant(const exr_input *input, const char *channe
 
 int ao_compute_input(const cli_options *options, exr_input *input, ao_buffers *buffers,
                      tool_error *error) {
-    blender_passes passes;
-    int status = blender_find_passes(input, options->layer, options->back_layer, &passes, error);
+    const ao_plan *plan = &buffers->plan;
+    int status = ao_plan_make(options, input, &buffers->plan, error);
     if (status != TOOL_EXIT_SUCCESS) return status;
-
-    camera_settings camera;
-    status = resolve_camera(options, input, &camera, &buffers->camera_file, error);
-    if (status != TOOL_EXIT_SUCCESS) return status;
-    const bool use_normals = passes.has_normal && !options->ignore_normals;
+    const blender_passes *passes = &plan->passes;
+    const bool use_normals = plan->use_normals;
     /* Blender before 5.0 cuts channel names past 64 bytes: a view layer
      * named with 56 bytes or more loses its Normal pass so (a layer of
      * Depth alone, by choice, is read as it is, quietly) */
-    if (passes.normal_expected && !passes.has_normal && !options->ignore_normals &&
-        strlen(passes.layer) >= BLENDER_NORMAL_LAYER_NAME_MAX)
+    if (passes->normal_expected && !passes->has_normal && !options->ignore_normals &&
+        strlen(passes->layer) >= BLENDER_NORMAL_LAYER_NAME_MAX)
         tool_warn("%s: no Normal pass (%.*sX/Y/Z): normals are reconstructed from depth; "
                   "Blender before 5.0 cuts the Normal pass's channel names of a view layer "
                   "named with %d bytes or more",
-                  input->path, (int)strlen(passes.normal[0]) - 1, passes.normal[0],
+                  input->path, (int)strlen(passes->normal[0]) - 1, passes->normal[0],
                   BLENDER_NORMAL_LAYER_NAME_MAX);
-    hbao_camera cropped;
-    const hbao_result cropping = camera_for_data_window(&camera.camera, &input->display_window,
-                                                        &input->data_window, &cropped);
-    if (cropping != HBAO_SUCCESS)
-        return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: cannot compute AO: %s", options->input_path,
-                         hbao_result_message(cropping));
-
-    blender_passes back_passes;
-    if (options->back_layer != NULL) {
-        status = blender_find_passes(input, options->back_layer, NULL, &back_passes, error);
-        if (status != TOOL_EXIT_SUCCESS) return status;
-    }
     /* The passes are decoded with as many threads as the AO is computed. */
     input->threads = options->params.threads > 0 ? options->params.threads : exr_usable_cores();
-    status = read_passes(input, &passes, use_normals,
-                         options->back_layer != NULL ? &back_passes : NULL, buffers, error);
+    status = read_passes(input, passes, use_normals,
+                         options->back_layer != NULL ? &plan->back_passes : NULL, buffers, error);
     if (status != TOOL_EXIT_SUCCESS) return status;
     /* A camera file meant to describe the camera: without the matrix, the
      * normals would be turned wrongly and the frame would still succeed
-     * (a farm would keep it). Without any camera, a warning, as before. */
-    if (use_normals && !(camera.fields_set & CAMERA_FIELD_WORLD_TO_CAMERA) &&
+     * (a farm would keep it). Without any camera, a warning. */
+    if (use_normals && !(plan->camera.fields_set & CAMERA_FIELD_WORLD_TO_CAMERA) &&
         options->camera_path != NULL)
         return tool_fail(error, TOOL_EXIT_RUNTIME,
                          "%s has no world_to_camera, which the Normal pass (%s, in world space) "
                          "needs; add it (scripts/export_cameras.py writes it), or give "
                          "--world-to-camera or --no-normals",
-                         options->camera_path, passes.normal[0]);
-    if (use_normals && !(camera.fields_set & CAMERA_FIELD_WORLD_TO_CAMERA))
+                         options->camera_path, passes->normal[0]);
+    if (use_normals && !(plan->camera.fields_set & CAMERA_FIELD_WORLD_TO_CAMERA))
         tool_warn("the Normal pass (%s) is in world space but no world-to-camera matrix was "
                   "given; using the identity, which is right only for a camera at the origin "
                   "looking down -Z. Give --camera FILE.json or --world-to-camera, or "
                   "--no-normals to reconstruct normals from depth",
-                  passes.normal[0]);
+                  passes->normal[0]);
 
-    /* a sky written at the camera's clip end (EEVEE in 4.5 and 5.0) is background */
-    hbao_params params = options->params;
-    params.background_depth = camera_background_depth(&camera, params.background_depth);
-    if (strcmp(passes.depth, "Z") == 0) /* a single-layer EXR's */
-        warn_if_depth_is_constant(input, passes.depth, buffers->depth, params.background_depth);
+    if (strcmp(passes->depth, "Z") == 0) /* a single-layer EXR's */
+        warn_if_depth_is_constant(input, passes->depth, buffers->depth,
+                                  plan->params.background_depth);
     hbao_channel depth = {buffers->depth, 1, input->width};
     hbao_channel normal = {buffers->normal, 3, (int64_t)input->width * 3};
     hbao_channel back = {buffers->back, 1, input->width};
-    hbao_result result = hbao_compute_layers(
-        &params, &cropped, input->width, input->height, &depth, use_normals ? &normal : NULL,
-        buffers->back != NULL ? &back : NULL, buffers->ao, input->width);
+    hbao_result result =
+        hbao_compute_layers(&plan->params, &plan->cropped, input->width, input->height, &depth,
+                            use_normals ? &normal : NULL, buffers->back != NULL ? &back : NULL,
+                            buffers->ao, input->width);
     if (result != HBAO_SUCCESS)
         return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: cannot compute AO: %s", options->input_path,
                          hbao_result_message(result));
@@ -504,7 +463,7 @@ int ao_command(const cli_options *options, tool_error *error) {
         status = read_copies(&input, options->ao_channel, &buffers, outputs, &output_count, error);
         if (status != TOOL_EXIT_SUCCESS) goto done;
     }
-    status = write_outputs(options, &input, outputs, output_count, buffers.ao, &buffers.camera_file,
+    status = write_outputs(options, &input, outputs, output_count, buffers.ao, &buffers.plan,
                            &files, error);
 
 done:

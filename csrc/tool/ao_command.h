@@ -3,12 +3,12 @@
 #ifndef HBAO_TOOL_AO_COMMAND_H
 #define HBAO_TOOL_AO_COMMAND_H
 
-#include "camera_settings.h"
+#include "ao_plan.h"
 #include "cli_options.h"
 #include "exr_reader.h"
 #include "tool_error.h"
 
-/** The images of one run; any pointer may be NULL. */
+/** What one run computed: its plan and its images; any pointer may be NULL. */
 typedef struct ao_buffers {
     float *depth;
     float *normal;    /**< X Y Z interleaved; NULL when not used */
@@ -16,13 +16,14 @@ typedef struct ao_buffers {
     float *ao;        /**< width x height, rows top first */
     uint8_t **copies; /**< --keep-input: one native-type buffer per input channel */
     int copy_count;
-    camera_settings camera_file; /**< what --camera held, for the output's hbaoSettings */
+    ao_plan plan; /**< what the AO was computed with, for the output's hbaoSettings */
 } ao_buffers;
 
 void ao_buffers_free(ao_buffers *buffers);
 
-/** Everything between an opened input and its AO: find the passes, resolve
- *  the camera, read Depth (and Normal), run hbao_compute into buffers->ao. */
+/** Everything between an opened input and its AO: its plan (ao_plan_make,
+ *  into buffers->plan), read Depth (and Normal), run hbao_compute into
+ *  buffers->ao. */
 int ao_compute_input(const cli_options *options, exr_input *input, ao_buffers *buffers,
                      tool_error *error);
 

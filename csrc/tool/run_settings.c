@@ -6,8 +6,6 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "camera_json.h"
-
 /* Appends to text[*used ...]; *used past RUN_SETTINGS_MAX - 1 marks a text that
  * did not fit. */
 static void append(char *text, size_t *used, const char *format, ...)
@@ -25,30 +23,23 @@ static void append(char *text, size_t *used, const char *format, ...) {
     *used = written < 0 ? RUN_SETTINGS_MAX : *used + (size_t)written;
 }
 
-/* The fields a camera_settings sets and their values: "<bits>[ <values>]". */
-static void append_camera(char *text, size_t *used, const camera_settings *settings) {
-    const hbao_camera *c = &settings->camera;
-    append(text, used, "%u", (unsigned)settings->fields_set);
-    if (settings->fields_set == 0) return;
-    append(text, used, " %d %.9g %.9g %.9g %d %.9g %.9g %.9g %.9g %.9g", (int)c->projection,
+/* The camera the AO is computed with: every hbao_camera value, whether a
+ * default, the header's, the camera file's or a flag's. */
+static void append_camera(char *text, size_t *used, const hbao_camera *c) {
+    append(text, used, "camera %d %.9g %.9g %.9g %d %.9g %.9g %.9g %.9g %.9g", (int)c->projection,
            (double)c->lens, (double)c->sensor_width, (double)c->sensor_height, (int)c->sensor_fit,
            (double)c->shift_x, (double)c->shift_y, (double)c->ortho_scale,
            (double)c->pixel_aspect_x, (double)c->pixel_aspect_y);
     for (int i = 0; i < 16; ++i) append(text, used, " %.9g", (double)c->world_to_camera[i]);
-    /* which depths are background (camera_background_depth); its bit is in
-     * fields_set */
-    if (settings->fields_set & CAMERA_FIELD_CLIP_END)
-        append(text, used, " clip end %.9g", (double)settings->clip_end);
-    if (settings->fields_set & CAMERA_FIELD_CLIP_START)
-        append(text, used, " clip start %.9g", (double)settings->clip_start);
 }
 
-bool run_settings_text(const cli_options *options, const camera_settings *camera_file,
+bool run_settings_text(const cli_options *options, const ao_plan *plan,
                        char text[RUN_SETTINGS_MAX]) {
-    const hbao_params *p = &options->params;
+    const hbao_params *p = &plan->params;
     size_t used = 0;
     text[0] = '\0';
-    /* %.9g: every float32 value prints to a text that reads back exactly. */
+    /* %.9g: every float32 value prints to a text that reads back exactly.
+     * The background depth is the one the camera's clip range made. */
     append(text, &used,
            "hbao %d; radius %.9g; angle bias %.9g; directions %d; steps %d; falloff %d; "
            "integration %d; blur size %d; blur sharpness %.9g; half resolution %d; "
@@ -58,29 +49,14 @@ bool run_settings_text(const cli_options *options, const camera_settings *camera
            (double)p->blur_sharpness, (int)p->half_resolution, (double)p->strength,
            (double)p->background_depth, (double)p->thickness);
     append(text, &used,
-           "keep input %d; no normals %d; compression %d; crop to display %d; overscan %d; ",
-           (int)options->keep_input, (int)options->ignore_normals, (int)options->compression,
+           "keep input %d; normals %d; compression %d; crop to display %d; overscan %d; ",
+           (int)options->keep_input, (int)plan->use_normals, (int)options->compression,
            (int)options->crop_to_display, (int)options->overscan);
-    append(text, &used, "camera flags ");
-    append_camera(text, &used, &options->camera_flags);
-    /* The camera file by what it holds, not by its name or time: a rerun
-     * that adds a forgotten --camera, or names another file, recomputes.
-     * (Runs without one keep the text of earlier versions.) */
-    if (options->camera_path != NULL) {
-        camera_settings file;
-        if (camera_file == NULL) {
-            camera_settings_init(&file);
-            tool_error ignored = {{0}};
-            if (camera_json_load(options->camera_path, &file, &ignored) != TOOL_EXIT_SUCCESS)
-                return false;
-            camera_file = &file;
-        }
-        append(text, &used, "; camera file ");
-        append_camera(text, &used, camera_file);
-    }
-    append(text, &used, "; layer %s; back layer %s; AO channel %s",
-           options->layer ? options->layer : "(first)",
-           options->back_layer ? options->back_layer : "(none)", options->ao_channel);
+    append_camera(text, &used, &plan->camera.camera);
+    /* the layers by the names found (a file's only layer, named or not, is
+     * one layer) */
+    append(text, &used, "; layer %s; back layer %s; AO channel %s", plan->passes.layer,
+           options->back_layer != NULL ? plan->back_passes.layer : "(none)", options->ao_channel);
     return used < RUN_SETTINGS_MAX - 1;
 }
 

@@ -8,27 +8,29 @@
 #include <openexr.h>
 #include <stdbool.h>
 
+#include "ao_plan.h"
 #include "cli_options.h"
 
 /** The header attribute (a string) that holds the settings. */
 #define RUN_SETTINGS_ATTRIBUTE "hbaoSettings"
-/** Room for the longest text: 13 parameters, twice 27 camera numbers (the
- *  flags' and the camera file's), a layer and a channel name. */
+/** Room for the longest text: 13 parameters, 26 camera numbers, two layer
+ *  names and a channel name. */
 #define RUN_SETTINGS_MAX 2048
 
 /**
- * Everything besides the input file that decides the output EXR's content:
- * the library version, the resolved parameters (but the thread count and the
- * SIMD implementation, which change no value), the layer, the AO channel's
- * name, --keep-input, --no-normals, the compression, --crop-to-display,
- * --overscan, the camera flags and what the camera file (--camera) holds. Two
- * runs with equal text write equal files from equal inputs. camera_file:
- * what the run read from --camera (so that the stamp is what the AO was
- * computed with, and the file is read once), or NULL to read it here. False
- * when the text did not fit (a layer name of kilobytes), or the camera file
- * cannot be read: it then must not be used to skip work.
+ * Everything besides the input file that decides the output EXR's content,
+ * as the run computes it (ao_plan.h): the library version, the parameters
+ * (but the thread count and the SIMD implementation, which change no
+ * value; the background depth as the camera's clip range made it), whether
+ * normals are read, --keep-input, the compression, --crop-to-display,
+ * --overscan, every value of the camera (however it was given: a default,
+ * the header, --camera, a flag), the layers found and the AO channel's
+ * name. Two runs with equal text write equal files from equal inputs, and
+ * flags that say the same in other words give the same text. False when the
+ * text did not fit (a layer name of kilobytes): it then must not be used to
+ * skip work.
  */
-bool run_settings_text(const cli_options *options, const camera_settings *camera_file,
+bool run_settings_text(const cli_options *options, const ao_plan *plan,
                        char text[RUN_SETTINGS_MAX]);
 
 /** Whether the EXR opened as `context` holds RUN_SETTINGS_ATTRIBUTE equal

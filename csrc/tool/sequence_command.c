@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "ao_command.h"
+#include "ao_plan.h"
 #include "atomic_file.h"
 #include "camera_json.h"
 #include "canonical_path.h"
@@ -105,6 +106,20 @@ static bool preview_is_current(const cli_options *frame, const struct stat *outp
     return current;
 }
 
+/* The stamp (run_settings.h) that computing `frame` would write, from its
+ * input's header (ao_plan_make; no pixel is read). False where the input
+ * cannot be planned: the frame then runs, and says why it fails. */
+static bool planned_settings(const cli_options *frame, char settings[RUN_SETTINGS_MAX]) {
+    exr_input input;
+    tool_error ignored = {{0}};
+    if (exr_input_open(&input, frame->input_path, &ignored) != TOOL_EXIT_SUCCESS) return false;
+    ao_plan plan;
+    const bool planned = ao_plan_make(frame, &input, &plan, &ignored) == TOOL_EXIT_SUCCESS &&
+                         run_settings_text(frame, &plan, settings);
+    exr_input_close(&input);
+    return planned;
+}
+
 /* Up to date, as make decides, and computed with the same flags: every
  * output exists and is at least as new as the input and the camera file, the
  * preview is current (preview_is_current), and the EXR's header holds the
@@ -132,7 +147,7 @@ static bool up_to_date(const cli_options *frame) {
         return false;
     if (frame->preview_path != NULL && !preview_is_current(frame, &output)) return false;
     char settings[RUN_SETTINGS_MAX];
-    return run_settings_text(frame, frame->camera_file, settings) &&
+    return planned_settings(frame, settings) &&
            output_is_whole(frame, &input, settings, older_than_input);
 }
 
