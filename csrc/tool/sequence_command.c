@@ -228,7 +228,7 @@ static void *worker(void *context) {
 
 /* The frames of `outcomes` that `take` picks, as ranges of frames listed
  * one after the other ("4, 17-30, 200"; 1-250x2 gives no ranges), written
- * into list[size] (shortened with ", ..." to fit); returns how many. */
+ * into list (shortened with ", ..." to fit); returns how many. */
 #define FRAME_RANGES_TEXT 512
 static int64_t frame_ranges(const sequence_run *run, bool (*take)(const frame_outcome *),
                             char list[FRAME_RANGES_TEXT]) {
