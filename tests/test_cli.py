@@ -1609,9 +1609,9 @@ def test_a_mistyped_frame_range_fails_its_missing_frames_at_once(hbao_tool, tmp_
 
 
 def test_an_input_dated_ahead_of_the_clock_is_computed_once(hbao_tool, tmp_path):
-    """A render whose time lies ahead of this machine's clock (a render node
-    whose clock is ahead, over NFS) left every output older than its input,
-    so each rerun recomputed every frame. An output whose seal names the
+    """A render (or camera file) whose time lies ahead of this machine's
+    clock (a render node whose clock is ahead, over NFS) left every output
+    older than its input, so each rerun recomputed every frame. An output whose seal names the
     input as it is now is up to date; one without a seal is still redone
     (nothing then says it was computed from that input), and so is one
     whose input changed since (its time or size)."""
@@ -1625,6 +1625,19 @@ def test_an_input_dated_ahead_of_the_clock_is_computed_once(hbao_tool, tmp_path)
     again = run_sequence(hbao_tool, folder)
     assert again.stderr.count("is up to date, skipped") == 3, again.stderr
     assert {f: os.stat(folder / f"ao_{f:04d}.exr").st_mtime_ns for f in sources} == written
+    # a camera file counts by what it holds, not by its time: dated ahead
+    # too (as the render node that exported it), or written again with the
+    # same values, it redid every frame
+    camera = tmp_path / "cam.json"
+    shutil.copyfile(FIXTURES / "cycles_float_zip.camera.json", camera)
+    run_sequence(hbao_tool, folder, "--camera", camera)
+    os.utime(camera, ns=(ahead, ahead))
+    dated = run_sequence(hbao_tool, folder, "--camera", camera)
+    assert dated.stderr.count("is up to date, skipped") == 3, dated.stderr
+    camera.write_text(camera.read_text())
+    rewritten = run_sequence(hbao_tool, folder, "--camera", camera)
+    assert rewritten.stderr.count("is up to date, skipped") == 3, rewritten.stderr
+    run_sequence(hbao_tool, folder)
     os.removexattr(folder / "ao_0001.exr", SEAL)
     later = ahead + 10**9
     os.utime(folder / "render_0002.exr", ns=(later, later))

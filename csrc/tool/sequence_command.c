@@ -121,7 +121,7 @@ static bool planned_settings(const cli_options *frame, char settings[RUN_SETTING
 }
 
 /* Up to date, as make decides, and computed with the same flags: every
- * output exists and is at least as new as the input and the camera file, the
+ * output exists and is at least as new as the input, the
  * preview is current (preview_is_current), and the EXR's header holds the
  * settings this run would write (run_settings.h) and it is whole
  * (output_is_whole). An output older than its input is up to date where
@@ -132,19 +132,19 @@ static bool planned_settings(const cli_options *frame, char settings[RUN_SETTING
  * (An input re-rendered while its frame was computed gets no output:
  * ao_command's refuse_changed_input.) */
 static bool up_to_date(const cli_options *frame) {
-    struct stat input, output, other;
+    struct stat input, output;
     if (stat(frame->input_path, &input) != 0 || stat(frame->output_path, &output) != 0 ||
         !S_ISREG(output.st_mode))
         return false;
     const bool older_than_input = !newer_or_equal(&output, &input);
     /* an output that is its input: ao_command refuses it, --force or not */
     if (output.st_dev == input.st_dev && output.st_ino == input.st_ino) return false;
-    /* a camera file by its time too; a pipe's (--camera /dev/stdin) is the
-     * time it was written to: by what it holds only (the settings below) */
-    if (frame->camera_path != NULL &&
-        (stat(frame->camera_path, &other) != 0 ||
-         (S_ISREG(other.st_mode) && !newer_or_equal(&output, &other))))
-        return false;
+    /* The camera file counts by what it holds (every camera value and the
+     * background depth are in the settings below), not by its time: one
+     * dated ahead of this machine's clock was redone on every run, and one
+     * rewritten with the same values (an export run again) redid every
+     * frame. One that cannot be read is no plan: the frame runs, and says
+     * why it fails. */
     if (frame->preview_path != NULL && !preview_is_current(frame, &output)) return false;
     char settings[RUN_SETTINGS_MAX];
     return planned_settings(frame, settings) &&
