@@ -1608,6 +1608,25 @@ def test_a_mistyped_frame_range_fails_its_missing_frames_at_once(hbao_tool, tmp_
     assert len(nothing.stderr.splitlines()) == 1 and not list(folder.glob("t_*"))
 
 
+def test_an_output_reaching_a_frame_without_input_is_refused(hbao_tool, tmp_path):
+    """A frame with no input is left out of the up-front checks' reads of
+    inputs, but its output that exists still counts: frame 1's output
+    reaching frame 2's through a folder's link (frame 2's render not there
+    yet) put frame 1's AO in frame 2's file, exit 1 for frame 2 alone (a
+    review of 7e7c494, which left such frames out whole)."""
+    shutil.copyfile(fixture_path("cycles_float_zip"), tmp_path / "r_1.exr")
+    (tmp_path / "d2").mkdir()
+    (tmp_path / "d2" / "ao.exr").write_bytes(b"frame 2's earlier output")
+    (tmp_path / "d1").symlink_to("d2")
+    # names relative to the folder, which the names' checks do not match
+    # with the link's resolved path: only the file's identity tells
+    completed = subprocess.run([str(hbao_tool), "r_#.exr", "-o", "d#/ao.exr", "--frames", "1-2",
+                                "--no-normals"], cwd=tmp_path, capture_output=True, text=True,
+                               timeout=TOOL_TIMEOUT_S)
+    assert_clean_error(completed, EXIT_USAGE, "-o of frame 1", "is the -o of frame 2 by another")
+    assert (tmp_path / "d2" / "ao.exr").read_bytes() == b"frame 2's earlier output"
+
+
 def test_an_input_dated_ahead_of_the_clock_is_computed_once(hbao_tool, tmp_path):
     """A render (or camera file) whose time lies ahead of this machine's
     clock (a render node whose clock is ahead, over NFS) left every output
