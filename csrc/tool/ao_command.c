@@ -2,7 +2,6 @@
 #include "ao_command.h"
 
 #include <errno.h>
-#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -10,7 +9,6 @@
 #include "ao_plan.h"
 #include "atomic_file.h"
 #include "blender_layers.h"
-#include "camera_json.h"
 #include "exr_reader.h"
 #include "exr_writer.h"
 #include "output_seal.h"
