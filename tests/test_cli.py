@@ -1714,10 +1714,11 @@ def test_sequence_redoes_frames_computed_with_other_flags(hbao_tool, tmp_path):
 
 def test_sequence_flags_that_say_the_same_in_other_words_skip_frames(hbao_tool, tmp_path):
     """The stamp holds what the AO was computed with, not the flags as typed:
-    a farm rerun that adds --layer naming the file's only layer, or gives as
-    flags what the camera file or the header already says, recomputed every
-    frame. It now skips them; a flag that changes a value still recomputes,
-    and writes what a single run writes."""
+    a farm rerun that adds --layer naming the file's only layer, gives as
+    flags what the camera file or the header already says, or a blur size or
+    sharpness that computes the same, recomputed every frame. It now skips
+    them; a flag that changes a value still recomputes, and writes what a
+    single run writes."""
     name = "cycles_float_zip"
     for frame in (1, 2):
         shutil.copyfile(fixture_path(name), tmp_path / f"r_{frame}.exr")
@@ -1735,6 +1736,15 @@ def test_sequence_flags_that_say_the_same_in_other_words_skip_frames(hbao_tool, 
         assert stderr.count("is up to date, skipped") == 2, (same, stderr)
     assert "is up to date" not in run("--no-normals")  # another computation
     assert run("--layer", "ViewLayer", "--no-normals").count("is up to date, skipped") == 2
+    # the blur as its kernel (hbao_params_resolve): an even size rounds down
+    # (6 is the default 5), and 0 to 2 are no blur, whose sharpness does nothing
+    assert run("--no-normals", "--blur", "6").count("is up to date, skipped") == 2
+    assert "is up to date" not in run("--no-normals", "--blur", "0")
+    for same in (["--blur", "1"], ["--blur", "2", "--blur-sharpness", "8"],
+                 ["--blur", "0", "--blur-sharpness", "5000"]):
+        stderr = run("--no-normals", *same)
+        assert stderr.count("is up to date, skipped") == 2, (same, stderr)
+        assert "limit" not in stderr, stderr  # no warning for a value that does nothing
     other = run("--lens", str(2 * camera["lens"]))
     assert "is up to date" not in other
     single = tmp_path / "single.exr"

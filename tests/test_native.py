@@ -330,7 +330,9 @@ def test_clamping_happens_once_and_says_so(native):
                                       "strength": 20.0}, warnings)
     assert resolved["steps"] == 64  # HBAO_MAX_STEPS
     assert resolved["directions"] == 1
-    assert resolved["blur_size"] == 8  # rounded, not clamped: no warning
+    # rounded by the binding to 8, then the kernel's size (even sizes round
+    # down), not clamped: no warning
+    assert resolved["blur_size"] == 7
     assert resolved["strength"] == 16.0  # HBAO_MAX_STRENGTH
     assert sorted(warnings) == sorted([
         "Steps 500 is above the limit 64; using 64",
@@ -339,6 +341,13 @@ def test_clamping_happens_once_and_says_so(native):
     untouched = []
     native.resolve_params(native_module.default_params(), untouched)
     assert untouched == []
+    # No blur: its sharpness does nothing, so it resolves to 0 unwarned, and
+    # the AO cache finds the settings equal (hbao_params_resolve).
+    quiet = []
+    for size, sharpness in ((0, 32.0), (1, 5000.0), (2, 8.0)):
+        resolved = native.resolve_params({"blur_size": size, "blur_sharpness": sharpness}, quiet)
+        assert (resolved["blur_size"], resolved["blur_sharpness"]) == (0, 0.0)
+    assert quiet == []
 
 
 @pytest.mark.parametrize("params, message", [

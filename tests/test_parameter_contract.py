@@ -19,7 +19,8 @@ from hbao.viewport import shader_sources  # noqa: E402
 
 HEADER = (REPO / "csrc" / "include" / "hbao.h").read_text()
 LIBRARY_SOURCES = {path.name: path.read_text()
-                   for path in sorted((REPO / "csrc" / "lib").glob("*.c"))}
+                   for pattern in ("*.c", "*.h")
+                   for path in sorted((REPO / "csrc" / "lib").glob(pattern))}
 # Header limits with no Python copy: the binding passes threads through, and
 # the library checks them itself.
 UNMIRRORED_MAXIMA = {"THREADS"}
@@ -75,12 +76,12 @@ def header_struct(name):
 
 
 def library_pattern(pattern, what):
-    """The first match of `pattern` in csrc/lib/*.c, or a failure naming `what`."""
+    """The first match of `pattern` in csrc/lib/*.c and *.h, or a failure naming `what`."""
     for source in LIBRARY_SOURCES.values():
         match = re.search(pattern, source)
         if match:
             return match
-    pytest.fail(f"{what} not found in csrc/lib/*.c: the library's form changed; update "
+    pytest.fail(f"{what} not found in csrc/lib/*.[ch]: the library's form changed; update "
                 f"this test's pattern and check the Python copy")
 
 

@@ -77,8 +77,8 @@ DESCRIPTIONS = {
                           "ignored: raise it if flat or finely tessellated surfaces look dirty",
     "directions": "Directions searched around each pixel: more is smoother and slower",
     "steps": "Samples along each direction: more finds thinner occluders, and is slower",
-    "blur_size": "Width in pixels of the edge-aware blur that hides the sampling pattern; 0 or "
-                 "1 = no blur (the pattern shows)",
+    "blur_size": "Width in pixels of the edge-aware blur that hides the sampling pattern; 0 to "
+                 "2 = no blur (the pattern shows); even widths blur as the odd one below",
     "blur_sharpness": "How strongly the blur stops at depth edges; 0 = a plain blur",
     "strength": "How dark the AO is: 1 as computed, 2 darker, 0.5 lighter, 0 none (the AO is "
                 "raised to this power)",
@@ -107,8 +107,8 @@ INTEGRATION_ITEMS = [
                      "creases than Cycles"),
 ]
 
-# The blur (csrc/lib/compute.c and blur.c): a kernel of size b has radius
-# (b - 1) / 2 taps each side for b >= 2 (even sizes round down, 0 and 1 mean
+# The blur (csrc/lib/internal_hbao.h and blur.c): a kernel of size b has radius
+# (b - 1) / 2 taps each side for b >= 2 (even sizes round down, 0, 1 and 2 mean
 # no blur), and its Gaussian has sigma = BLUR_SIGMA_PER_TAP * (radius +
 # BLUR_SIGMA_TAP_OFFSET), so the outermost tap keeps a weight of about
 # exp(-2): wide enough to hide the 4x4 pattern, narrow enough to stay local.

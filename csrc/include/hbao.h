@@ -153,11 +153,13 @@ typedef struct hbao_params {
     int32_t falloff;
     /** hbao_integration; default COSINE. */
     int32_t integration;
-    /** Width in pixels of the cross-bilateral blur kernel; 0 or 1 = no blur.
-     *  Even sizes round down to the odd size below. Clamped to [0, 65]. */
+    /** Width in pixels of the cross-bilateral blur kernel; 0, 1 or 2 = no
+     *  blur. Even sizes round down to the odd size below.
+     *  Clamped to [0, 65]; hbao_params_resolve() gives 0 or the odd size. */
     int32_t blur_size;
     /** How strongly the blur stops at depth edges; 0 = plain Gaussian.
-     *  Clamped to [0, 1000]. */
+     *  Clamped to [0, 1000]; hbao_params_resolve() gives 0 where there is
+     *  no blur (and reports no clamp there). */
     float blur_sharpness;
     /** Non-zero: AO at half resolution (every other pixel of every other
      *  row), blurred there with half the taps (the same reach), then a
@@ -333,8 +335,11 @@ typedef enum hbao_param_field {
  * +infinity, a negative radius or thickness, a background_depth <= 0,
  * unknown enum values) give
  * HBAO_ERROR_INVALID_PARAMETER, and then *clamped_fields holds the bits of
- * those invalid fields instead and *out is unchanged. `out` may be `in`;
- * clamped_fields may be NULL.
+ * those invalid fields instead and *out is unchanged. Settings that give
+ * the same AO come back as the same values, without a bit: the blur size
+ * as 0 or odd, the blur sharpness as 0 where nothing is blurred. So two
+ * resolved parameter sets that differ compute different things, as far as
+ * these rules go. `out` may be `in`; clamped_fields may be NULL.
  */
 HBAO_EXPORT hbao_result hbao_params_resolve(const hbao_params *in, hbao_params *out,
                                             uint32_t *clamped_fields);

@@ -25,7 +25,7 @@ hbao_result hbao_settings_make(const hbao_params *params, hbao_settings *s) {
     s->steps = p.steps;
     s->falloff = p.falloff;
     s->integration = p.integration;
-    s->blur_radius = p.blur_size >= 2 ? (p.blur_size - 1) / 2 : 0;
+    s->blur_radius = hbao_blur_kernel_radius(p.blur_size);
     s->blur_sharpness = p.blur_sharpness;
     s->half_resolution = p.half_resolution;
     s->grid_blur_radius = s->half_resolution ? (s->blur_radius + 1) / 2 : s->blur_radius;

@@ -63,6 +63,15 @@ typedef struct hbao_settings {
     float thickness;    /* occluder thickness, 0 = infinite (hbao_params) */
 } hbao_settings;
 
+/* The blur's taps on each side for a kernel of `size` pixels (hbao_params'
+ * blur_size): even sizes round down, and 0, 1 and 2 are no blur. The one
+ * rule: hbao_params_resolve gives the size in its canonical form by it,
+ * hbao_settings_make the radius (the add-on's parameters.py holds a copy
+ * for the viewport's shader, tests/test_parameter_contract.py to this). */
+static inline int hbao_blur_kernel_radius(int32_t size) {
+    return size >= 2 ? (size - 1) / 2 : 0;
+}
+
 /* A depth value as the pipeline uses it: background (not finite, <= 0,
  * >= background_depth, or exactly HBAO_HALF_FLOAT_SKY) as 0. z > 0 && z <
  * background fails for NaN, -inf and +inf (+inf < +inf is false where the

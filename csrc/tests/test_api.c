@@ -251,8 +251,11 @@ TEST_CASE(params_resolve_clamps_each_field_and_names_it) {
             CHECK_RESULT(hbao_params_resolve(&in, &out, &fields), HBAO_SUCCESS);
             CHECK(fields == cases[k].field);
             CHECK(cases[k].get(&out) == (high ? cases[k].high_limit : cases[k].low_limit));
-            /* the other fields are untouched */
+            /* the other fields are untouched, but for the sharpness of no
+             * blur (params_resolve_says_one_setting_one_way) */
             cases[k].set(&out, high);
+            if (out.blur_sharpness == 0.0f && in.blur_size < 3)
+                out.blur_sharpness = in.blur_sharpness;
             CHECK(memcmp(&in, &out, sizeof in) == 0);
         }
         CHECK(hbao_param_field_name(cases[k].field) != NULL);
@@ -282,6 +285,68 @@ TEST_CASE(params_resolve_clamps_each_field_and_names_it) {
     CHECK(hbao_param_field_name(0) == NULL);
     CHECK(hbao_param_field_name(HBAO_PARAM_FIELD_STEPS | HBAO_PARAM_FIELD_RADIUS) == NULL);
     CHECK(hbao_param_field_name(1u << 31) == NULL);
+}
+
+/* Settings that compute the same AO resolve to the same values, without a
+ * bit: the blur size as 0 or odd (even sizes round down; 0 to 2 are no
+ * blur), and the sharpness of no blur as 0, whatever it was (above its
+ * limit too: no warning for a value that does nothing). The CLI's sequence
+ * stamp and the add-on's AO cache compare resolved values. */
+TEST_CASE(params_resolve_says_one_setting_one_way) {
+    const hbao_params defaults = HBAO_PARAMS_DEFAULT_INITIALIZER;
+    const struct {
+        int32_t size;
+        float sharpness;
+        int32_t resolved_size;
+        float resolved_sharpness;
+        uint32_t fields;
+    } cases[] = {
+        {0, 32.0f, 0, 0.0f, 0},
+        {1, 8.0f, 0, 0.0f, 0},
+        {2, 1e6f, 0, 0.0f, 0},
+        {-5, 7.0f, 0, 0.0f, HBAO_PARAM_FIELD_BLUR_SIZE},
+        {3, 8.0f, 3, 8.0f, 0},
+        {6, 8.0f, 5, 8.0f, 0},
+        {64, 1e6f, 63, HBAO_MAX_BLUR_SHARPNESS, HBAO_PARAM_FIELD_BLUR_SHARPNESS},
+        {HBAO_MAX_BLUR_SIZE + 1, 0.0f, HBAO_MAX_BLUR_SIZE, 0.0f, HBAO_PARAM_FIELD_BLUR_SIZE},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        hbao_params in = defaults, out;
+        uint32_t fields = 0xffffffffu;
+        in.blur_size = cases[k].size;
+        in.blur_sharpness = cases[k].sharpness;
+        CHECK_RESULT(hbao_params_resolve(&in, &out, &fields), HBAO_SUCCESS);
+        CHECK(out.blur_size == cases[k].resolved_size);
+        CHECK(out.blur_sharpness == cases[k].resolved_sharpness);
+        CHECK(fields == cases[k].fields);
+        /* resolving is idempotent */
+        hbao_params again;
+        CHECK_RESULT(hbao_params_resolve(&out, &again, &fields), HBAO_SUCCESS);
+        CHECK(fields == 0 && memcmp(&out, &again, sizeof out) == 0);
+    }
+    /* A NaN sharpness is refused with or without blur. */
+    hbao_params in = defaults, out;
+    uint32_t fields;
+    in.blur_size = 0;
+    in.blur_sharpness = NAN;
+    CHECK_RESULT(hbao_params_resolve(&in, &out, &fields), HBAO_ERROR_INVALID_PARAMETER);
+    CHECK(fields == HBAO_PARAM_FIELD_BLUR_SHARPNESS);
+    /* The resolved values compute what the given ones do, to the bit. */
+    fill_inputs();
+    const hbao_camera c = HBAO_CAMERA_DEFAULT_INITIALIZER;
+    static float given_ao[W * H];
+    const int32_t sizes[][2] = {{6, 5}, {2, 0}, {1, 0}};
+    for (size_t k = 0; k < sizeof sizes / sizeof sizes[0]; k++) {
+        in = defaults;
+        in.blur_size = sizes[k][0];
+        in.blur_sharpness = 3.0f;
+        CHECK_RESULT(compute_with(&in, &c), HBAO_SUCCESS);
+        memcpy(given_ao, ao, sizeof given_ao);
+        CHECK_RESULT(hbao_params_resolve(&in, &out, NULL), HBAO_SUCCESS);
+        CHECK(out.blur_size == sizes[k][1]);
+        CHECK_RESULT(compute_with(&out, &c), HBAO_SUCCESS);
+        CHECK(memcmp(given_ao, ao, sizeof given_ao) == 0);
+    }
 }
 
 /* Values with no nearest legal value are refused, their bits reported, and
@@ -554,6 +619,7 @@ TEST_MAIN(TEST_ENTRY(null_arguments_are_rejected), TEST_ENTRY(sizes_and_strides_
           TEST_ENTRY(world_to_camera_check_is_scale_free),
           TEST_ENTRY(params_resolve_clamps_each_field_and_names_it),
           TEST_ENTRY(params_resolve_rejects_what_cannot_be_clamped),
+          TEST_ENTRY(params_resolve_says_one_setting_one_way),
           TEST_ENTRY(out_of_range_counts_are_clamped), TEST_ENTRY(zero_radius_gives_ones),
           TEST_ENTRY(messages_version_and_sizes),
           TEST_ENTRY(each_implementation_runs_itself_or_a_slower_one),
