@@ -23,7 +23,8 @@ a Stereo 3D eye's camera as Blender places it, a Multi-View view's own
 camera. A file that already holds what
 would be written is left as it is, its time too, so that a rerun of the
 CLI's sequence does not recompute that frame; the others are written whole
-(a temporary file renamed over them). Exit status 2 for bad
+(a temporary file renamed over them), but for one the user may not write
+(read-only, or another user's), which is refused. Exit status 2 for bad
 arguments, 1 when a frame has no camera the CLI can use or a file cannot be
 written.
 """
@@ -165,6 +166,14 @@ def write_if_changed(path, text):
         kept_mode = stat.S_IMODE(path.stat().st_mode)
     except FileNotFoundError:
         kept_mode = None
+    # One the user may not write (a camera approved and made read-only, or
+    # another user's) is refused, as the CLI refuses such an output and
+    # open() for writing would: the rename would replace it all the same,
+    # its folder being writable. (root may write any.)
+    if kept_mode is not None and not os.access(path, os.W_OK):
+        raise PermissionError(f"{path} is not writable (read-only, or another user's): "
+                              "refusing to replace it (make it writable, or remove it, if it "
+                              "is to go)")
     descriptor, temporary = _new_file_beside(path)
     try:
         # A new file has the permissions the kernel gives any new file there

@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import FIXTURES, REPO, SCRIPTS, small_tmpfs
+from conftest import BLENDER_TIMEOUT_S, DEBIAN_BLENDER, FIXTURES, REPO, SCRIPTS, small_tmpfs
 
 # Every fixture that holds a Depth pass, with the view layer the tool picks.
 DEPTH_FIXTURES = ["cycles_float_zip", "cycles_half_piz", "cycles_float_none", "cycles_half_b44",
@@ -2554,6 +2554,55 @@ def test_export_cameras_refuses_bad_arguments(run_blender, tmp_path, arguments, 
     assert completed.returncode == status, completed.stdout
     assert fragment in completed.stdout
     assert not any(tmp_path.rglob("*")), "nothing is written"
+
+
+def test_export_cameras_does_not_replace_a_file_its_user_may_not_write(run_blender):
+    """A camera file the user may not write (approved and made read-only) is
+    refused, as the CLI refuses such an output: the script's rename replaced
+    it, its folder being writable. One that already holds the camera is left
+    as it is, read-only or not. Blender runs as another user (nobody) where
+    the tests run as root, whom no permission stops."""
+    folder = Path(tempfile.mkdtemp(prefix="hbao-readonly-"))  # nobody reaches it, not tmp_path
+    try:
+        folder.chmod(0o777)
+        blend = folder / "anim.blend"
+        run_blender(SCRIPTS_IN_BLENDER / "animated_camera.py", blend, folder / "expected.json",
+                    addon=False)
+        blend.chmod(0o644)
+        approved = folder / "cam_2.json"
+        approved.write_text("{}\n")
+        approved.chmod(0o444)
+        as_user = {"user": 65534, "group": 65534, "extra_groups": []} \
+            if os.geteuid() == 0 else {}
+        home = folder / "home"
+        home.mkdir(mode=0o777)
+        home.chmod(0o777)
+        env = dict(os.environ, HOME=str(home), BLENDER_USER_SCRIPTS=str(home / "scripts"),
+                   BLENDER_USER_CONFIG=str(home / "config"), PYTHONUNBUFFERED="1")
+        env.pop("PYTHONPATH", None)
+
+        def export(frames):
+            command = DEBIAN_BLENDER.command(EXPORT_CAMERAS, (folder / "cam_#.json", "--frames",
+                                                              frames), blend=blend, addons=())
+            return subprocess.run(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                                  text=True, env=env, timeout=BLENDER_TIMEOUT_S, **as_user)
+
+        completed = export("1-3")
+        assert completed.returncode == 1, completed.stdout
+        assert (f"export_cameras.py: error: {approved} is not writable (read-only, or another "
+                "user's): refusing to replace it") in completed.stdout, completed.stdout
+        assert approved.read_text() == "{}\n" and stat.S_IMODE(approved.stat().st_mode) == 0o444
+        first = json.loads((folder / "cam_1.json").read_text())  # written before frame 2
+        assert "world_to_camera" in first
+        assert sorted(p.name for p in folder.glob("*.json")) == [
+            "cam_1.json", "cam_2.json", "expected.json"], "no temporary file left"
+        # read-only but already holding the camera: up to date, exit 0
+        (folder / "cam_1.json").chmod(0o444)
+        again = export("1")
+        assert again.returncode == 0, again.stdout
+        assert "0 files written, 1 already up to date" in again.stdout
+    finally:
+        shutil.rmtree(folder)
 
 
 def test_export_cameras_says_which_frame_has_no_camera(run_blender, tmp_path):
