@@ -17,7 +17,8 @@
 # kernel this CPU has, the generic one among them. What is left compares
 # the generic kernel with the reference on the widest set of settings (the
 # four parts of simd_paths_match_scalar_reference, 60-100 s each here, kept
-# since session 56: the step's tests took 254 s instead of 106), planes,
+# since session 56: the step's tests took 254 s instead of 106; a quarter
+# less since session 62, which stopped running AUTO's kernel twice), planes,
 # half depths, back faces, thickness and long thin images. --all runs every
 # case (about 17 minutes on 2 cores). Needs what scripts/setup.sh installs
 # (the cross compiler, its C library, qemu-user).
