@@ -335,11 +335,13 @@ typedef enum hbao_param_field {
  * +infinity, a negative radius or thickness, a background_depth <= 0,
  * unknown enum values) give
  * HBAO_ERROR_INVALID_PARAMETER, and then *clamped_fields holds the bits of
- * those invalid fields instead and *out is unchanged. Settings that give
- * the same AO come back as the same values, without a bit: the blur size
- * as 0 or odd, the blur sharpness as 0 where nothing is blurred. So two
- * resolved parameter sets that differ compute different things, as far as
- * these rules go. `out` may be `in`; clamped_fields may be NULL.
+ * those invalid fields instead and *out is unchanged. A setting written in
+ * more than one way comes back in one, without a bit, so that what compares
+ * resolved values finds them equal: the blur size as 0 or odd, the blur
+ * sharpness as 0 where nothing is blurred, and -0 as 0. (Different values
+ * may still compute the same AO: at half resolution blur sizes 3 and 5 run
+ * the same kernel on the half grid.) `out` may be `in`; clamped_fields may
+ * be NULL.
  */
 HBAO_EXPORT hbao_result hbao_params_resolve(const hbao_params *in, hbao_params *out,
                                             uint32_t *clamped_fields);

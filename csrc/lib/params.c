@@ -17,6 +17,7 @@ static void clamp_int(int32_t *value, int32_t low, int32_t high, uint32_t field,
 /* The size of the blur kernel that hbao_blur_kernel_radius gives `size`'s
  * taps (even sizes round down; 0, 1 and 2 are no blur), said in one way:
  * 0 or odd. */
+_Static_assert(HBAO_MAX_BLUR_SIZE % 2 == 1, "the largest size is a kernel's, as resolved");
 static int32_t canonical_blur_size(int32_t size) {
     const int32_t radius = hbao_blur_kernel_radius(size);
     return radius > 0 ? 2 * radius + 1 : 0;
@@ -51,16 +52,21 @@ hbao_result hbao_params_resolve(const hbao_params *in, hbao_params *out, uint32_
     clamp_int(&p.blur_size, 0, HBAO_MAX_BLUR_SIZE, HBAO_PARAM_FIELD_BLUR_SIZE, &clamped);
     clamp_float(&p.blur_sharpness, 0.0f, HBAO_MAX_BLUR_SHARPNESS, HBAO_PARAM_FIELD_BLUR_SHARPNESS,
                 &clamped, &invalid);
-    /* Settings that give the same AO come back the same, so that what
-     * compares settings (the CLI's sequence stamp, the add-on's AO cache)
-     * finds them equal: a blur size as its kernel's, and no sharpness (nor
-     * its clamp's warning) where nothing is blurred. */
+    /* A setting written in more than one way comes back in one, so that
+     * what compares settings (the CLI's sequence stamp, the add-on's AO
+     * cache) finds them equal: a blur size as its kernel's, no sharpness
+     * (nor its clamp's warning) where nothing is blurred, and -0 as 0 (the
+     * stamp prints "-0"). */
     p.blur_size = canonical_blur_size(p.blur_size);
     if (p.blur_size == 0 && isfinite(p.blur_sharpness)) {
         p.blur_sharpness = 0.0f;
         clamped &= ~(uint32_t)HBAO_PARAM_FIELD_BLUR_SHARPNESS;
     }
     p.half_resolution = p.half_resolution != 0;
+    float *const floats[] = {&p.radius, &p.angle_bias_degrees, &p.blur_sharpness, &p.strength,
+                             &p.thickness};
+    for (size_t k = 0; k < sizeof floats / sizeof floats[0]; k++)
+        if (*floats[k] == 0.0f) *floats[k] = 0.0f;
     clamp_float(&p.strength, 0.0f, HBAO_MAX_STRENGTH, HBAO_PARAM_FIELD_STRENGTH, &clamped,
                 &invalid);
     /* 0 means one thread per core, and so does any negative count. */

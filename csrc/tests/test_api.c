@@ -324,9 +324,21 @@ TEST_CASE(params_resolve_says_one_setting_one_way) {
         CHECK_RESULT(hbao_params_resolve(&out, &again, &fields), HBAO_SUCCESS);
         CHECK(fields == 0 && memcmp(&out, &again, sizeof out) == 0);
     }
-    /* A NaN sharpness is refused with or without blur. */
+    /* -0 comes back as 0 (the CLI's stamp prints "-0") */
     hbao_params in = defaults, out;
     uint32_t fields;
+    in.radius = -0.0f;
+    in.angle_bias_degrees = -0.0f;
+    in.blur_sharpness = -0.0f;
+    in.strength = -0.0f;
+    in.thickness = -0.0f;
+    CHECK_RESULT(hbao_params_resolve(&in, &out, &fields), HBAO_SUCCESS);
+    CHECK(fields == 0);
+    CHECK(!signbit(out.radius) && !signbit(out.angle_bias_degrees) &&
+          !signbit(out.blur_sharpness) && !signbit(out.strength) && !signbit(out.thickness));
+    CHECK(out.radius == 0.0f && out.blur_sharpness == 0.0f && out.thickness == 0.0f);
+    /* A NaN sharpness is refused with or without blur. */
+    in = defaults;
     in.blur_size = 0;
     in.blur_sharpness = NAN;
     CHECK_RESULT(hbao_params_resolve(&in, &out, &fields), HBAO_ERROR_INVALID_PARAMETER);

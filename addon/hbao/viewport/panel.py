@@ -149,7 +149,7 @@ class VIEW3D_PT_hbao_preview(bpy.types.Panel):
         column.separator()
         column.prop(view_settings, "blur_size")
         row = column.row()
-        row.active = view_settings.blur_size >= 2
+        row.active = parameters.blur_kernel_radius(view_settings.blur_size) > 0
         row.prop(view_settings, "blur_sharpness", text="Sharpness")
         column.separator()
         flags = column.column()
