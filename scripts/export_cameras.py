@@ -159,8 +159,8 @@ def write_if_changed(path, text):
     try:
         if path.read_text(encoding="utf-8") == text:
             return False
-    except (FileNotFoundError, UnicodeDecodeError):
-        pass
+    except (FileNotFoundError, UnicodeDecodeError, PermissionError):
+        pass  # (one it may not read is written, if it may write it, or refused below)
     path.parent.mkdir(parents=True, exist_ok=True)
     try:
         kept_mode = stat.S_IMODE(path.stat().st_mode)

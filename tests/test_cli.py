@@ -2572,6 +2572,9 @@ def test_export_cameras_does_not_replace_a_file_its_user_may_not_write(run_blend
         approved = folder / "cam_2.json"
         approved.write_text("{}\n")
         approved.chmod(0o444)
+        private = folder / "cam_3.json"  # another user's, which it may not even read
+        private.write_text("{}\n")
+        private.chmod(0o600)
         as_user = {"user": 65534, "group": 65534, "extra_groups": []} \
             if os.geteuid() == 0 else {}
         home = folder / "home"
@@ -2595,7 +2598,12 @@ def test_export_cameras_does_not_replace_a_file_its_user_may_not_write(run_blend
         first = json.loads((folder / "cam_1.json").read_text())  # written before frame 2
         assert "world_to_camera" in first
         assert sorted(p.name for p in folder.glob("*.json")) == [
-            "cam_1.json", "cam_2.json", "expected.json"], "no temporary file left"
+            "cam_1.json", "cam_2.json", "cam_3.json", "expected.json"], "no temporary file left"
+        completed = export("3")
+        assert completed.returncode == 1, completed.stdout
+        assert f"error: {private} is not writable (read-only, or another user's)" in \
+            completed.stdout, completed.stdout
+        assert private.read_text() == "{}\n"
         # read-only but already holding the camera: up to date, exit 0
         (folder / "cam_1.json").chmod(0o444)
         again = export("1")
