@@ -1020,9 +1020,10 @@ static void simd_paths_match_scalar_reference(int part) {
         n[0] = n[1] = n[2] = 0.01f;
     }
     const size_t bytes = (size_t)view.width * view.height * sizeof(float);
-    /* (AUTO is the kernel that hbao_implementation_that_runs names for it,
-     * the fastest of these that runs: test_api's
-     * each_implementation_runs_itself_or_a_slower_one. Run again here, it
+    /* (AUTO runs the code of the kernel that hbao_implementation_that_runs
+     * names for it, the fastest of these that runs: every stage chooses its
+     * copy through that function, horizon.c's choose_kernel and
+     * internal_finish.h's hbao_finish_implementation. Run again here, it
      * took a quarter of this test's time under qemu, scripts/test_arm64.sh:
      * part 1 took 70.3 s of one core, 52.6 s without it.) */
     const int kernels[] = {HBAO_IMPLEMENTATION_GENERIC, HBAO_IMPLEMENTATION_AVX2,
