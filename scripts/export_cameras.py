@@ -23,8 +23,9 @@ a Stereo 3D eye's camera as Blender places it, a Multi-View view's own
 camera. A file that already holds what
 would be written is left as it is, its time too, so that a rerun of the
 CLI's sequence does not recompute that frame; the others are written whole
-(a temporary file renamed over them), but for one the user may not write
-(read-only, or another user's), which is refused. Exit status 2 for bad
+(a temporary file renamed over them; through a symbolic link, the file it
+names), but for one the user may not write (read-only, or another user's),
+which is refused. Exit status 2 for bad
 arguments, 1 when a frame has no camera the CLI can use or a file cannot be
 written.
 """
@@ -155,26 +156,29 @@ def _new_file_beside(path):
 
 def write_if_changed(path, text):
     """Write `text` to `path` whole, unless it already holds it. Returns
-    whether it was written."""
+    whether it was written. A symbolic link is written through, as the CLI
+    writes its outputs: the file it names is replaced (made, where there is
+    none yet), and the link stays."""
+    target = Path(os.path.realpath(path))
     try:
-        if path.read_text(encoding="utf-8") == text:
+        if target.read_text(encoding="utf-8") == text:
             return False
     except (FileNotFoundError, UnicodeDecodeError, PermissionError):
         pass  # (one it may not read is written, if it may write it, or refused below)
-    path.parent.mkdir(parents=True, exist_ok=True)
+    target.parent.mkdir(parents=True, exist_ok=True)
     try:
-        kept_mode = stat.S_IMODE(path.stat().st_mode)
+        kept_mode = stat.S_IMODE(target.stat().st_mode)
     except FileNotFoundError:
         kept_mode = None
     # One the user may not write (a camera approved and made read-only, or
     # another user's) is refused, as the CLI refuses such an output and
     # open() for writing would: the rename would replace it all the same,
     # its folder being writable. (root may write any.)
-    if kept_mode is not None and not os.access(path, os.W_OK):
+    if kept_mode is not None and not os.access(target, os.W_OK):
         raise PermissionError(f"{path} is not writable (read-only, or another user's): "
                               "refusing to replace it (make it writable, or remove it, if it "
                               "is to go)")
-    descriptor, temporary = _new_file_beside(path)
+    descriptor, temporary = _new_file_beside(target)
     try:
         # A new file has the permissions the kernel gives any new file there
         # (the umask, or the folder's default ACL: a farm's shared folder);
@@ -183,7 +187,7 @@ def write_if_changed(path, text):
             os.fchmod(descriptor, kept_mode)
         with os.fdopen(descriptor, "w", encoding="utf-8") as stream:
             stream.write(text)
-        os.replace(temporary, path)
+        os.replace(temporary, target)
     except BaseException:
         os.unlink(temporary)
         raise

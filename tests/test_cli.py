@@ -2560,8 +2560,10 @@ def test_export_cameras_does_not_replace_a_file_its_user_may_not_write(run_blend
     """A camera file the user may not write (approved and made read-only) is
     refused, as the CLI refuses such an output: the script's rename replaced
     it, its folder being writable. One that already holds the camera is left
-    as it is, read-only or not. Blender runs as another user (nobody) where
-    the tests run as root, whom no permission stops."""
+    as it is, read-only or not. A symbolic link is written through, as the
+    CLI writes its outputs (the script replaced the link with a file).
+    Blender runs as another user (nobody) where the tests run as root, whom
+    no permission stops."""
     folder = Path(tempfile.mkdtemp(prefix="hbao-readonly-"))  # nobody reaches it, not tmp_path
     try:
         folder.chmod(0o777)
@@ -2609,6 +2611,20 @@ def test_export_cameras_does_not_replace_a_file_its_user_may_not_write(run_blend
         again = export("1")
         assert again.returncode == 0, again.stdout
         assert "0 files written, 1 already up to date" in again.stdout
+        # a symbolic link is written through, as the CLI writes its outputs:
+        # the file it names is made, then replaced; the link stays
+        shared = folder / "shared"
+        shared.mkdir(mode=0o777)
+        shared.chmod(0o777)
+        os.symlink(shared / "cam.json", folder / "cam_4.json")
+        for written in ("1 files written", "0 files written, 1 already up to date"):
+            assert written in export("4").stdout
+            assert (folder / "cam_4.json").is_symlink()
+            assert "world_to_camera" in json.loads((shared / "cam.json").read_text())
+        (shared / "cam.json").write_text("{}\n")
+        assert "1 files written" in export("4").stdout
+        assert (folder / "cam_4.json").is_symlink() and list(shared.iterdir()) == [
+            shared / "cam.json"]
     finally:
         shutil.rmtree(folder)
 
