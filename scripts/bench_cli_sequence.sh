@@ -12,7 +12,7 @@
 # --preview: each frame also writes its PNG preview (--preview 'ao_####.png'),
 # which the second run checks too.
 #   scripts/bench_cli_sequence.sh [--frames N] [--jobs J] [--preview]
-#   (BLENDER=/path/to/blender renders)
+#   (BLENDER=/path/to/blender renders; HBAO=/path/to/hbao runs another build)
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 FRAMES=250
@@ -38,7 +38,7 @@ JOBS=$((10#$JOBS))
 [ "$FRAMES" -ge 1 ] && [ "$FRAMES" -le 9999 ] && [ "$JOBS" -ge 1 ] && [ "$JOBS" -le 32 ] || usage
 
 RENDER="$("$REPO/scripts/bench_cli_render.sh")"
-HBAO="$REPO/build/hbao"
+HBAO="${HBAO:-$REPO/build/hbao}"  # (HBAO=path: another build of the tool)
 
 WORK="$(mktemp -d)"
 trap 'rm -rf "$WORK"' EXIT

@@ -2,12 +2,15 @@
 #include "exr_writer.h"
 
 #include <errno.h>
+#include <libdeflate.h>
 #include <pthread.h>
 #include <stdbool.h>
+#include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
 #include "exr_reader.h"
+#include "zip_chunks.h"
 
 /* OpenEXRCore writes through this callback so that the tool decides where
  * the bytes go (an atomic_file's temporary file). */
@@ -129,6 +132,7 @@ typedef struct chunk_writing {
 typedef struct chunk_encoder {
     exr_encode_pipeline_t pipeline;
     exr_result_t (*library_compress)(exr_encode_pipeline_t *pipeline);
+    struct libdeflate_compressor *deflater; /* ZIP and ZIPS (compress_zip) */
     int ready;
     chunk_writing *writing;
     int64_t chunk;
@@ -164,6 +168,49 @@ static exr_result_t compress_or_store(exr_encode_pipeline_t *pipeline) {
     return result;
 }
 
+/* The pipeline's buffers come from here (alloc_fn, free_fn), so that
+ * compress_zip may size the ones it fills with the same allocator. */
+static void *pipeline_alloc(exr_transcoding_pipeline_buffer_id_t buffer, size_t bytes) {
+    (void)buffer;
+    return malloc(bytes);
+}
+
+static void pipeline_free(exr_transcoding_pipeline_buffer_id_t buffer, void *memory) {
+    (void)buffer;
+    free(memory);
+}
+
+/* At least `bytes` in *memory (a buffer of *size bytes, 0: not the
+ * pipeline's own, as compressed_buffer aliasing packed_buffer). */
+static bool reserve(void **memory, size_t *size, size_t bytes) {
+    if (*memory != NULL && *size >= bytes) return true;
+    if (*size > 0) free(*memory);
+    *memory = malloc(bytes);
+    *size = *memory != NULL ? bytes : 0;
+    return *memory != NULL;
+}
+
+/* ZIP and ZIPS chunks deflated by libdeflate (zip_chunks_compress), in
+ * place of OpenEXRCore 3.1's zlib: the same layout, a standard zlib stream
+ * that any reader inflates; a chunk that deflate does not make smaller is
+ * stored, as compress_or_store makes sure for the library's compressors. */
+static exr_result_t compress_zip(exr_encode_pipeline_t *pipeline) {
+    chunk_encoder *encoder = (chunk_encoder *)pipeline;
+    if (encoder->deflater == NULL)
+        encoder->deflater = libdeflate_alloc_compressor(ZIP_CHUNKS_LEVEL);
+    if (encoder->deflater == NULL) return EXR_ERR_OUT_OF_MEMORY;
+    const size_t count = pipeline->packed_bytes;
+    size_t capacity = libdeflate_zlib_compress_bound(encoder->deflater, count);
+    if (capacity < count) capacity = count;
+    if (!reserve(&pipeline->scratch_buffer_1, &pipeline->scratch_alloc_size_1, count) ||
+        !reserve(&pipeline->compressed_buffer, &pipeline->compressed_alloc_size, capacity))
+        return EXR_ERR_OUT_OF_MEMORY;
+    pipeline->compressed_bytes = zip_chunks_compress(
+        encoder->deflater, pipeline->packed_buffer, count, pipeline->scratch_buffer_1,
+        pipeline->compressed_buffer, pipeline->compressed_alloc_size);
+    return EXR_ERR_SUCCESS;
+}
+
 #define CHUNK_CHECK(call, what)                                                                    \
     do {                                                                                           \
         exr_result_t check_result_ = (call);                                                       \
@@ -182,6 +229,8 @@ static int write_chunk(chunk_writing *writing, chunk_encoder *encoder, int order
     if (!encoder->ready) {
         CHUNK_CHECK(exr_encoding_initialize(writing->context, writing->part, &chunk, pipeline),
                     "cannot start encoding");
+        pipeline->alloc_fn = pipeline_alloc;
+        pipeline->free_fn = pipeline_free;
         encoder->ready = 1;
     } else {
         CHUNK_CHECK(exr_encoding_update(writing->context, writing->part, &chunk, pipeline),
@@ -203,7 +252,12 @@ static int write_chunk(chunk_writing *writing, chunk_encoder *encoder, int order
     }
     CHUNK_CHECK(exr_encoding_choose_default_routines(writing->context, writing->part, pipeline),
                 "cannot encode this channel layout");
-    if (pipeline->compress_fn != NULL) {
+    exr_compression_t compression = EXR_COMPRESSION_NONE;
+    CHUNK_CHECK(exr_get_compression(writing->context, writing->part, &compression),
+                "no compression");
+    if (compression == EXR_COMPRESSION_ZIP || compression == EXR_COMPRESSION_ZIPS) {
+        pipeline->compress_fn = compress_zip;
+    } else if (pipeline->compress_fn != NULL) {
         encoder->library_compress = pipeline->compress_fn;
         pipeline->compress_fn = compress_or_store;
     }
@@ -214,6 +268,8 @@ static int write_chunk(chunk_writing *writing, chunk_encoder *encoder, int order
 }
 
 static int finish_encoder(chunk_writing *writing, chunk_encoder *encoder, tool_error *error) {
+    libdeflate_free_compressor(encoder->deflater);
+    encoder->deflater = NULL;
     if (!encoder->ready) return TOOL_EXIT_SUCCESS;
     encoder->ready = 0;
     CHUNK_CHECK(exr_encoding_destroy(writing->context, &encoder->pipeline),
@@ -224,7 +280,7 @@ static int finish_encoder(chunk_writing *writing, chunk_encoder *encoder, tool_e
 static void *write_chunks(void *argument) {
     chunk_writing *writing = argument;
     exr_clear_last_error(); /* this thread's copy of OpenEXRCore's detail */
-    chunk_encoder encoder = {EXR_ENCODE_PIPELINE_INITIALIZER, NULL, 0, writing, 0, 0};
+    chunk_encoder encoder = {EXR_ENCODE_PIPELINE_INITIALIZER, NULL, NULL, 0, writing, 0, 0};
     tool_error error;
     for (;;) {
         pthread_mutex_lock(&writing->lock);
@@ -257,7 +313,7 @@ static int write_data(chunk_writing *writing, int threads, tool_error *error) {
     exr_get_compression(writing->context, writing->part, &compression);
     if (threads <= 1 || compression == EXR_COMPRESSION_NONE) {
         /* one pipeline, OpenEXRCore's own order check */
-        chunk_encoder encoder = {EXR_ENCODE_PIPELINE_INITIALIZER, NULL, 0, writing, 0, 0};
+        chunk_encoder encoder = {EXR_ENCODE_PIPELINE_INITIALIZER, NULL, NULL, 0, writing, 0, 0};
         int status = TOOL_EXIT_SUCCESS;
         for (; encoder.chunk < writing->chunks && status == TOOL_EXIT_SUCCESS; ++encoder.chunk)
             status = write_chunk(writing, &encoder, 0, error);

@@ -2,6 +2,7 @@
 #include "zip_chunks.h"
 
 #include <libdeflate.h>
+#include <string.h>
 #ifdef __SSE2__
 #include <emmintrin.h>
 #endif
@@ -50,6 +51,54 @@ static void interleave(const uint8_t *bytes, size_t count, uint8_t *out) {
         out[2 * k + 1] = odd[k];
     }
     if (count % 2 != 0) out[count - 1] = even[count / 2];
+}
+
+/* The writer's half of the layout: even bytes first, odd ones after them,
+ * then each byte but the first as its difference from the one before it,
+ * plus 128 (the reverse of interleave and running_sum). */
+static void deinterleave(const uint8_t *bytes, size_t count, uint8_t *out) {
+    uint8_t *even = out, *odd = out + (count + 1) / 2;
+    size_t k = 0;
+#ifdef __SSE2__
+    const __m128i low = _mm_set1_epi16(0x00ff);
+    for (; k + 16 <= count / 2; k += 16) {
+        const __m128i a = _mm_loadu_si128((const __m128i *)(bytes + 2 * k));
+        const __m128i b = _mm_loadu_si128((const __m128i *)(bytes + 2 * k + 16));
+        _mm_storeu_si128((__m128i *)(even + k),
+                         _mm_packus_epi16(_mm_and_si128(a, low), _mm_and_si128(b, low)));
+        _mm_storeu_si128((__m128i *)(odd + k),
+                         _mm_packus_epi16(_mm_srli_epi16(a, 8), _mm_srli_epi16(b, 8)));
+    }
+#endif
+    for (; k < count / 2; ++k) {
+        even[k] = bytes[2 * k];
+        odd[k] = bytes[2 * k + 1];
+    }
+    if (count % 2 != 0) even[count / 2] = bytes[count - 1];
+}
+
+/* In place, from the end, so that each byte's predecessor is still its own. */
+static void differences(uint8_t *bytes, size_t count) {
+    size_t i = count;
+#ifdef __SSE2__
+    const __m128i bias = _mm_set1_epi8((char)0x80);
+    for (; i >= 17; i -= 16) {
+        const __m128i v = _mm_loadu_si128((const __m128i *)(bytes + i - 16));
+        const __m128i before = _mm_loadu_si128((const __m128i *)(bytes + i - 17));
+        _mm_storeu_si128((__m128i *)(bytes + i - 16), _mm_xor_si128(_mm_sub_epi8(v, before), bias));
+    }
+#endif
+    for (; i > 1; --i) bytes[i - 1] = (uint8_t)(bytes[i - 1] - bytes[i - 2] + 128);
+}
+
+size_t zip_chunks_compress(struct libdeflate_compressor *deflater, const uint8_t *packed,
+                           size_t count, uint8_t *scratch, uint8_t *out, size_t capacity) {
+    deinterleave(packed, count, scratch);
+    differences(scratch, count);
+    const size_t deflated = libdeflate_zlib_compress(deflater, scratch, count, out, capacity);
+    if (deflated > 0 && deflated < count) return deflated;
+    memcpy(out, packed, count);
+    return count;
 }
 
 exr_result_t zip_chunks_decompress(exr_decode_pipeline_t *decode, exr_scratch *scratch) {
