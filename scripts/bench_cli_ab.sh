@@ -7,7 +7,9 @@
 # each. Prints each build's median CPU seconds (user + system) and wall
 # seconds a frame, fastest and slowest round in brackets, the median of the
 # rounds' after/before ratios, and whether the two builds' outputs decode to
-# the same AO (hbao --info's channel statistics).
+# the same AO (hbao --info's channel statistics). BEFORE and AFTER are copies
+# of the tool (build/hbao-before, say: the tool finds libhbao.so.0 in its own
+# folder), not build/hbao itself, which making the render rebuilds.
 #   scripts/bench_cli_ab.sh BEFORE/hbao AFTER/hbao [--runs N] [--threads T] [-- FLAGS...]
 #   (BLENDER=/path/to/blender renders)
 set -euo pipefail
@@ -22,6 +24,12 @@ BEFORE="$1"
 AFTER="$2"
 shift 2
 [ -x "$BEFORE" ] && [ -x "$AFTER" ] || { echo "$0: BEFORE and AFTER must be programs" >&2; exit 2; }
+for build in "$BEFORE" "$AFTER"; do
+    if [ "$(realpath "$build")" = "$(realpath -m "$REPO/build/hbao")" ]; then
+        echo "$0: $build is rebuilt from this tree before the frames: give a copy" >&2
+        exit 2
+    fi
+done
 RUNS=15
 THREADS=1
 FLAGS=()
@@ -57,11 +65,16 @@ frame "$BEFORE" before >/dev/null
 frame "$AFTER" after >/dev/null
 : >"$WORK/rounds.txt"
 for ((round = 1; round <= RUNS; round++)); do
-    echo "$(frame "$BEFORE" before) $(frame "$AFTER" after)" >>"$WORK/rounds.txt"
+    # (assignments, so that a failed frame stops the script: set -e does
+    # not see a substitution inside echo's arguments)
+    before=$(frame "$BEFORE" before)
+    after=$(frame "$AFTER" after)
+    echo "$before $after" >>"$WORK/rounds.txt"
 done
+ao_before=$("$BEFORE" --info "$WORK/before.exr" | grep -E '^ +AO ')
+ao_after=$("$AFTER" --info "$WORK/after.exr" | grep -E '^ +AO ')
 same=no
-if [ "$("$BEFORE" --info "$WORK/before.exr" | grep -E '^ +AO ')" = \
-     "$("$AFTER" --info "$WORK/after.exr" | grep -E '^ +AO ')" ]; then
+if [ -n "$ao_before" ] && [ "$ao_before" = "$ao_after" ]; then
     same=yes
 fi
 echo "hbao on $(basename "$RENDER").exr, --threads $THREADS ${FLAGS[*]}, $RUNS rounds," \

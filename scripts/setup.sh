@@ -27,7 +27,7 @@ PACKAGES=(
     openexr            # exrheader: the reference reader our written EXRs are checked with
     libpng-dev         # --preview PNGs
     libcjson-dev       # --camera FILE.json
-    libdeflate-dev     # the CLI's inflate of ZIP chunks (csrc/tool/zip_chunks.c)
+    libdeflate-dev     # the CLI's inflate and deflate of ZIP chunks (csrc/tool/zip_chunks.c)
     python3 python3-numpy python3-pytest python3-venv
     python3-pytest-xdist  # scripts/test.sh: the Python tests on one worker a core
     python3-pycodestyle  # the PEP 8 check of the test suite

@@ -433,6 +433,7 @@ def zip_chunk_size(chunk):
     data = split.astype(np.uint8).tobytes()
     library = _libdeflate()
     deflater = library.libdeflate_alloc_compressor(level)
+    assert deflater, f"libdeflate has no compressor of level {level}"
     out = ctypes.create_string_buffer(2 * len(data) + 1024)
     try:
         return library.libdeflate_zlib_compress(deflater, data, len(data), out, len(out))
@@ -469,9 +470,9 @@ def chunk_of_exactly_its_own_size():
 def test_a_zip_chunk_that_does_not_shrink_is_stored(hbao_tool, tmp_path):
     """A chunk whose deflated bytes come to exactly its own size is read
     back as stored: OpenEXRCore (3.1.5 here; its issue 2306) kept the zlib
-    bytes, and the output came back as garbage (exr_writer.c,
-    compress_or_store). The tool now deflates ZIP chunks itself (compress_zip,
-    zip_chunks_compress), and stores such a chunk as its packed bytes."""
+    bytes, and the output came back as garbage (exr_writer.c). The tool now
+    deflates ZIP chunks itself (compress_zip, zip_chunks_compress), and
+    stores such a chunk as its packed bytes."""
     source = tmp_path / "in.exr"
     source.write_bytes(scanline_exr(chunk_of_exactly_its_own_size(), 1, 16))
     described = {}

@@ -158,7 +158,10 @@ static exr_result_t wait_for_turn(exr_encode_pipeline_t *pipeline) {
  * 2306) kept its zlib bytes when they came to exactly the packed size, so
  * ZIP and ZIPS wrote such a chunk as garbage: rare and data-dependent (2 of
  * 48 radii on one 320x180 test scene). The packed bytes themselves are then
- * what the chunk must hold, whichever compressor ran. */
+ * what the chunk must hold, whichever compressor ran. ZIP and ZIPS now go
+ * through compress_zip, which stores such a chunk itself; 3.1.5's RLE and
+ * PIZ, the other compressions the CLI writes, store a chunk that does not
+ * shrink already, and this keeps the rule for them in any version. */
 static exr_result_t compress_or_store(exr_encode_pipeline_t *pipeline) {
     chunk_encoder *encoder = (chunk_encoder *)pipeline;
     const exr_result_t result = encoder->library_compress(pipeline);
