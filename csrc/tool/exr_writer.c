@@ -118,6 +118,7 @@ typedef struct chunk_writing {
     const exr_output_channel *channels;
     int count;
     int32_t lines_per_chunk;
+    exr_compression_t compression; /* the part's, as its header was written */
     int64_t chunks;
     pthread_mutex_t lock;
     pthread_cond_t written; /* next_to_write moved, or a chunk failed */
@@ -183,12 +184,13 @@ static void pipeline_free(exr_transcoding_pipeline_buffer_id_t buffer, void *mem
     free(memory);
 }
 
-/* At least `bytes` in *memory (a buffer of *size bytes, 0: not the
- * pipeline's own, as compressed_buffer aliasing packed_buffer). */
-static bool reserve(void **memory, size_t *size, size_t bytes) {
+/* At least `bytes` in the pipeline's buffer `id` at *memory (of *size bytes;
+ * 0: not the pipeline's own, as compressed_buffer aliasing packed_buffer). */
+static bool reserve(exr_transcoding_pipeline_buffer_id_t id, void **memory, size_t *size,
+                    size_t bytes) {
     if (*memory != NULL && *size >= bytes) return true;
-    if (*size > 0) free(*memory);
-    *memory = malloc(bytes);
+    if (*size > 0) pipeline_free(id, *memory);
+    *memory = pipeline_alloc(id, bytes);
     *size = *memory != NULL ? bytes : 0;
     return *memory != NULL;
 }
@@ -205,8 +207,10 @@ static exr_result_t compress_zip(exr_encode_pipeline_t *pipeline) {
     const size_t count = pipeline->packed_bytes;
     size_t capacity = libdeflate_zlib_compress_bound(encoder->deflater, count);
     if (capacity < count) capacity = count;
-    if (!reserve(&pipeline->scratch_buffer_1, &pipeline->scratch_alloc_size_1, count) ||
-        !reserve(&pipeline->compressed_buffer, &pipeline->compressed_alloc_size, capacity))
+    if (!reserve(EXR_TRANSCODE_BUFFER_SCRATCH1, &pipeline->scratch_buffer_1,
+                 &pipeline->scratch_alloc_size_1, count) ||
+        !reserve(EXR_TRANSCODE_BUFFER_COMPRESSED, &pipeline->compressed_buffer,
+                 &pipeline->compressed_alloc_size, capacity))
         return EXR_ERR_OUT_OF_MEMORY;
     pipeline->compressed_bytes = zip_chunks_compress(
         encoder->deflater, pipeline->packed_buffer, count, pipeline->scratch_buffer_1,
@@ -255,10 +259,8 @@ static int write_chunk(chunk_writing *writing, chunk_encoder *encoder, int order
     }
     CHUNK_CHECK(exr_encoding_choose_default_routines(writing->context, writing->part, pipeline),
                 "cannot encode this channel layout");
-    exr_compression_t compression = EXR_COMPRESSION_NONE;
-    CHUNK_CHECK(exr_get_compression(writing->context, writing->part, &compression),
-                "no compression");
-    if (compression == EXR_COMPRESSION_ZIP || compression == EXR_COMPRESSION_ZIPS) {
+    if (writing->compression == EXR_COMPRESSION_ZIP ||
+        writing->compression == EXR_COMPRESSION_ZIPS) {
         pipeline->compress_fn = compress_zip;
     } else if (pipeline->compress_fn != NULL) {
         encoder->library_compress = pipeline->compress_fn;
@@ -312,9 +314,7 @@ static void *write_chunks(void *argument) {
 static int write_data(chunk_writing *writing, int threads, tool_error *error) {
     if (threads > EXR_MAX_WRITE_THREADS) threads = EXR_MAX_WRITE_THREADS;
     if (threads > writing->chunks) threads = (int)writing->chunks;
-    exr_compression_t compression = EXR_COMPRESSION_NONE;
-    exr_get_compression(writing->context, writing->part, &compression);
-    if (threads <= 1 || compression == EXR_COMPRESSION_NONE) {
+    if (threads <= 1 || writing->compression == EXR_COMPRESSION_NONE) {
         /* one pipeline, OpenEXRCore's own order check */
         chunk_encoder encoder = {EXR_ENCODE_PIPELINE_INITIALIZER, NULL, NULL, 0, writing, 0, 0};
         int status = TOOL_EXIT_SUCCESS;
@@ -410,6 +410,7 @@ int exr_write_image(int fd, const char *name, const exr_output_layout *layout,
     writing.channels = channels;
     writing.count = count;
     writing.lines_per_chunk = lines_per_chunk;
+    writing.compression = layout->compression;
     writing.chunks =
         ((int64_t)layout->data_window.max_y - layout->data_window.min_y + lines_per_chunk) /
         lines_per_chunk;
