@@ -11,6 +11,7 @@
 #include "blender_layers.h"
 #include "exr_reader.h"
 #include "exr_writer.h"
+#include "frame_memory.h"
 #include "output_seal.h"
 #include "png_writer.h"
 #include "run_settings.h"
@@ -82,11 +83,11 @@ static int refuse_changed_input(const exr_input *input, tool_error *error) {
 }
 
 void ao_buffers_free(ao_buffers *buffers) {
-    free(buffers->depth);
-    free(buffers->normal);
-    free(buffers->back);
-    free(buffers->ao);
-    for (int c = 0; c < buffers->copy_count; ++c) free(buffers->copies[c]);
+    frame_memory_free(buffers->depth);
+    frame_memory_free(buffers->normal);
+    frame_memory_free(buffers->back);
+    frame_memory_free(buffers->ao);
+    for (int c = 0; c < buffers->copy_count; ++c) frame_memory_free(buffers->copies[c]);
     free(buffers->copies);
     memset(buffers, 0, sizeof *buffers);
 }
@@ -141,10 +142,10 @@ static int read_passes(exr_input *input, const blender_passes *passes, bool use_
         status = refuse_integer_pass(input, back->depth, "depths", error);
     if (status != TOOL_EXIT_SUCCESS) return status;
     const size_t pixel_count = (size_t)input->width * (size_t)input->height;
-    buffers->depth = malloc(pixel_count * sizeof(float));
-    buffers->ao = malloc(pixel_count * sizeof(float));
-    if (use_normals) buffers->normal = malloc(3 * pixel_count * sizeof(float));
-    if (back != NULL) buffers->back = malloc(pixel_count * sizeof(float));
+    buffers->depth = frame_memory_alloc(pixel_count * sizeof(float));
+    buffers->ao = frame_memory_alloc(pixel_count * sizeof(float));
+    if (use_normals) buffers->normal = frame_memory_alloc(3 * pixel_count * sizeof(float));
+    if (back != NULL) buffers->back = frame_memory_alloc(pixel_count * sizeof(float));
     if (buffers->depth == NULL || buffers->ao == NULL || (use_normals && buffers->normal == NULL) ||
         (back != NULL && buffers->back == NULL))
         return tool_fail(error, TOOL_EXIT_RUNTIME,
@@ -188,7 +189,7 @@ static int read_copies(exr_input *input, const char *ao_channel, ao_buffers *buf
             continue;
         }
         const int size = exr_pixel_type_size(channel->pixel_type);
-        uint8_t *data = malloc(pixel_count * (size_t)size);
+        uint8_t *data = frame_memory_alloc(pixel_count * (size_t)size);
         if (data == NULL) {
             free(requests);
             return tool_fail(error, TOOL_EXIT_RUNTIME,

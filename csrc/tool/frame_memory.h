@@ -1,0 +1,22 @@
+/* SPDX-License-Identifier: GPL-2.0-or-later */
+/* Memory for a frame's planes: the passes the tool reads, the AO it
+ * computes, --keep-input's channels. A process faults every page of them in
+ * and has the kernel clear it; in 4 KiB pages that was a sixth of a 1080p
+ * frame's CPU time on one thread (clear_page; docs/speed.md, session 63),
+ * in huge pages it is a few milliseconds. */
+#ifndef HBAO_FRAME_MEMORY_H
+#define HBAO_FRAME_MEMORY_H
+
+#include <stddef.h>
+
+/** `bytes` of memory, not cleared, or NULL (out of memory, or 0 bytes).
+ *  A plane of a huge page or more is a mapping of its own, of whole huge
+ *  pages, which the kernel is asked to back with huge pages (transparent
+ *  huge pages "madvise", Debian's setting, do not otherwise; a hint, which
+ *  a kernel may ignore). Freed by frame_memory_free, never by free(). */
+void *frame_memory_alloc(size_t bytes);
+
+/** Frees what frame_memory_alloc gave; NULL: nothing. */
+void frame_memory_free(void *memory);
+
+#endif /* HBAO_FRAME_MEMORY_H */
