@@ -15,7 +15,11 @@
  * halves interleaved into the destination. The running sum is a chain of
  * dependent additions, a byte a cycle at best; with SSE2 (every x86-64)
  * 16 bytes at a time: within a vector in four shifted additions, then the
- * previous vector's last byte added to each (the same sums modulo 256). */
+ * previous vector's last byte added to each (the same sums modulo 256).
+ * That byte is spread over the lanes from the register: read back from the
+ * bytes just stored, it waited on the store every vector, 2.6 times as long
+ * a chunk (a 1080p render's 983 040-byte chunk: 0.34 ms, now 0.13; 23 ms
+ * a frame, session 63). */
 static void running_sum(uint8_t *bytes, size_t count) {
     size_t i = 1;
 #ifdef __SSE2__
@@ -29,7 +33,9 @@ static void running_sum(uint8_t *bytes, size_t count) {
         v = _mm_add_epi8(v, _mm_slli_si128(v, 8));
         v = _mm_add_epi8(v, carry);
         _mm_storeu_si128((__m128i *)(bytes + i), v);
-        carry = _mm_set1_epi8((char)bytes[i + 15]);
+        /* byte 15 into every lane: bytes 8-15 doubled, word 7 into words
+         * 4-7, double word 3 into all four */
+        carry = _mm_shuffle_epi32(_mm_shufflehi_epi16(_mm_unpackhi_epi8(v, v), 0xFF), 0xFF);
     }
 #endif
     for (; i < count; ++i) bytes[i] = (uint8_t)(bytes[i - 1] + bytes[i] - 128);
