@@ -87,7 +87,7 @@ void ao_buffers_free(ao_buffers *buffers) {
     frame_memory_free(buffers->normal);
     frame_memory_free(buffers->back);
     frame_memory_free(buffers->ao);
-    for (int c = 0; c < buffers->copy_count; ++c) frame_memory_free(buffers->copies[c]);
+    for (int c = 0; c < buffers->copy_count; ++c) free(buffers->copies[c]);
     free(buffers->copies);
     memset(buffers, 0, sizeof *buffers);
 }
@@ -189,7 +189,7 @@ static int read_copies(exr_input *input, const char *ao_channel, ao_buffers *buf
             continue;
         }
         const int size = exr_pixel_type_size(channel->pixel_type);
-        uint8_t *data = frame_memory_alloc(pixel_count * (size_t)size);
+        uint8_t *data = malloc(pixel_count * (size_t)size);
         if (data == NULL) {
             free(requests);
             return tool_fail(error, TOOL_EXIT_RUNTIME,
