@@ -14,8 +14,8 @@
 #include <stddef.h>
 
 /** `bytes` of memory, not cleared, or NULL (out of memory, or 0 bytes).
- *  A plane of a huge page or more is a mapping of its own, of whole huge
- *  pages, which the kernel is asked to back with huge pages (transparent
+ *  A plane of 2 MiB or more (with a 64-byte header) is a mapping of its
+ *  own, of whole huge pages, which the kernel is asked to back with huge pages (transparent
  *  huge pages "madvise", Debian's setting, do not otherwise; a hint, which
  *  a kernel may ignore). Freed by frame_memory_free, never by free(). */
 void *frame_memory_alloc(size_t bytes);
