@@ -10,38 +10,26 @@
  * them all. Thread-safe; which block a call
  * gets never changes its results (every buffer is written before it is
  * read). */
-#define _DEFAULT_SOURCE /* madvise */
 #include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/mman.h>
 
+#include "huge_block.h"
 #include "internal_hbao.h"
 
 #define SCRATCH_BLOCKS 16
 #define SCRATCH_MAX_BYTES ((size_t)512 << 20)
 /* Each block starts with its capacity; the caller's memory follows, aligned
- * as malloc aligns. */
+ * as malloc aligns. A block of at least a huge page is a mapping of whole
+ * huge pages (csrc/memory/huge_block.h), so hbao_release_memory() hands it
+ * back to the system whatever the host's malloc thresholds. */
 #define HEADER ((size_t)64)
-/* Blocks of at least a huge page are whole huge pages, and the kernel is
- * asked to back them with huge pages (where transparent huge pages are
- * "madvise", as on Debian, it does not otherwise): the search's samples
- * reach hundreds of rows away, over more 4 KiB pages than the TLB holds.
- * bench_ab_pairs.sh, 1080p defaults on a Zen 3: 0.968 and 0.977 on 1
- * thread, 0.992 on 2; 8 x 6 + blur 15 0.982. */
-#define HUGE_PAGE ((size_t)2 << 20)
 
 /* A new block for `bytes` (*bytes: its capacity, which may be larger). */
 static unsigned char *new_block(size_t *bytes) {
-    if (HEADER + *bytes < HUGE_PAGE || HEADER + *bytes > SIZE_MAX - HUGE_PAGE)
-        return malloc(HEADER + *bytes);
-    const size_t whole = (HEADER + *bytes + HUGE_PAGE - 1) / HUGE_PAGE * HUGE_PAGE;
-    void *start = NULL;
-    if (posix_memalign(&start, HUGE_PAGE, whole) != 0) return NULL;
-#if defined(MADV_HUGEPAGE)
-    (void)madvise(start, whole, MADV_HUGEPAGE); /* a hint: without it, small pages */
-#endif
-    *bytes = whole - HEADER;
+    size_t whole = 0;
+    unsigned char *start = hbao_huge_block_alloc(HEADER + *bytes, &whole);
+    if (start != NULL) *bytes = whole - HEADER;
     return start;
 }
 
@@ -87,7 +75,7 @@ void hbao_scratch_give(void *memory) {
     unsigned char *start = (unsigned char *)memory - HEADER;
     const size_t capacity = *(size_t *)start;
     if (capacity > SCRATCH_MAX_BYTES) { /* never kept: dropping the kept blocks makes no room */
-        free(start);
+        hbao_huge_block_free(start);
         return;
     }
     pthread_mutex_lock(&scratch_lock);
@@ -106,7 +94,7 @@ void hbao_scratch_give(void *memory) {
         }
         const int fits = capacity <= SCRATCH_MAX_BYTES - kept_bytes;
         if ((slot >= 0 && fits) || smallest < 0 || kept[smallest].capacity >= capacity) break;
-        free(kept[smallest].start);
+        hbao_huge_block_free(kept[smallest].start);
         kept_bytes -= kept[smallest].capacity;
         kept[smallest].start = NULL;
     }
@@ -117,13 +105,13 @@ void hbao_scratch_give(void *memory) {
         start = NULL;
     }
     pthread_mutex_unlock(&scratch_lock);
-    free(start); /* not kept: no room */
+    hbao_huge_block_free(start); /* not kept: no room */
 }
 
 void hbao_release_memory(void) {
     pthread_mutex_lock(&scratch_lock);
     for (int k = 0; k < SCRATCH_BLOCKS; k++) {
-        free(kept[k].start);
+        hbao_huge_block_free(kept[k].start);
         kept[k].start = NULL;
     }
     kept_bytes = 0;
