@@ -11,31 +11,20 @@
  * gets never changes its results (every buffer is written before it is
  * read). */
 #include <pthread.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "huge_block.h"
 #include "internal_hbao.h"
 
+/* A block of at least a huge page is a mapping of whole huge pages
+ * (csrc/memory/huge_block.h), so hbao_release_memory() hands it back to
+ * the system whatever the host's malloc thresholds. */
 #define SCRATCH_BLOCKS 16
 #define SCRATCH_MAX_BYTES ((size_t)512 << 20)
-/* Each block starts with its capacity; the caller's memory follows, aligned
- * as malloc aligns. A block of at least a huge page is a mapping of whole
- * huge pages (csrc/memory/huge_block.h), so hbao_release_memory() hands it
- * back to the system whatever the host's malloc thresholds. */
-#define HEADER ((size_t)64)
-
-/* A new block for `bytes` (*bytes: its capacity, which may be larger). */
-static unsigned char *new_block(size_t *bytes) {
-    size_t whole = 0;
-    unsigned char *start = hbao_huge_block_alloc(HEADER + *bytes, &whole);
-    if (start != NULL) *bytes = whole - HEADER;
-    return start;
-}
 
 typedef struct kept_block {
-    unsigned char *start; /* NULL: free slot */
-    size_t capacity;      /* bytes after the header */
+    void *memory;    /* NULL: free slot */
+    size_t capacity; /* hbao_huge_block_capacity(memory) */
 } kept_block;
 
 static pthread_mutex_t scratch_lock = PTHREAD_MUTEX_INITIALIZER;
@@ -46,36 +35,31 @@ int (*hbao_scratch_fails)(size_t bytes) = NULL;
 int hbao_scratch_fill = -1;
 
 void *hbao_scratch_take(size_t bytes) {
-    if (bytes > SIZE_MAX - HEADER) return NULL;
     if (hbao_scratch_fails != NULL && hbao_scratch_fails(bytes)) return NULL;
-    unsigned char *start = NULL;
+    void *memory = NULL;
     pthread_mutex_lock(&scratch_lock);
     int best = -1;
     for (int k = 0; k < SCRATCH_BLOCKS; k++) /* the smallest that fits */
-        if (kept[k].start != NULL && kept[k].capacity >= bytes &&
+        if (kept[k].memory != NULL && kept[k].capacity >= bytes &&
             (best < 0 || kept[k].capacity < kept[best].capacity))
             best = k;
     if (best >= 0) {
-        start = kept[best].start;
+        memory = kept[best].memory;
         kept_bytes -= kept[best].capacity;
-        kept[best].start = NULL;
+        kept[best].memory = NULL;
     }
     pthread_mutex_unlock(&scratch_lock);
-    if (start == NULL) {
-        start = new_block(&bytes);
-        if (start == NULL) return NULL;
-        *(size_t *)start = bytes;
-    }
-    if (hbao_scratch_fill >= 0) memset(start + HEADER, hbao_scratch_fill, *(size_t *)start);
-    return start + HEADER;
+    if (memory == NULL) memory = hbao_huge_block_alloc(bytes);
+    if (memory == NULL) return NULL;
+    if (hbao_scratch_fill >= 0) memset(memory, hbao_scratch_fill, hbao_huge_block_capacity(memory));
+    return memory;
 }
 
 void hbao_scratch_give(void *memory) {
     if (memory == NULL) return;
-    unsigned char *start = (unsigned char *)memory - HEADER;
-    const size_t capacity = *(size_t *)start;
+    const size_t capacity = hbao_huge_block_capacity(memory);
     if (capacity > SCRATCH_MAX_BYTES) { /* never kept: dropping the kept blocks makes no room */
-        hbao_huge_block_free(start);
+        hbao_huge_block_free(memory);
         return;
     }
     pthread_mutex_lock(&scratch_lock);
@@ -86,7 +70,7 @@ void hbao_scratch_give(void *memory) {
         int smallest = -1;
         slot = -1;
         for (int k = 0; k < SCRATCH_BLOCKS; k++) {
-            if (kept[k].start == NULL) {
+            if (kept[k].memory == NULL) {
                 if (slot < 0) slot = k;
             } else if (smallest < 0 || kept[k].capacity < kept[smallest].capacity) {
                 smallest = k;
@@ -94,25 +78,25 @@ void hbao_scratch_give(void *memory) {
         }
         const int fits = capacity <= SCRATCH_MAX_BYTES - kept_bytes;
         if ((slot >= 0 && fits) || smallest < 0 || kept[smallest].capacity >= capacity) break;
-        hbao_huge_block_free(kept[smallest].start);
+        hbao_huge_block_free(kept[smallest].memory);
         kept_bytes -= kept[smallest].capacity;
-        kept[smallest].start = NULL;
+        kept[smallest].memory = NULL;
     }
     if (slot >= 0 && capacity <= SCRATCH_MAX_BYTES - kept_bytes) {
-        kept[slot].start = start;
+        kept[slot].memory = memory;
         kept[slot].capacity = capacity;
         kept_bytes += capacity;
-        start = NULL;
+        memory = NULL;
     }
     pthread_mutex_unlock(&scratch_lock);
-    hbao_huge_block_free(start); /* not kept: no room */
+    hbao_huge_block_free(memory); /* not kept: no room */
 }
 
 void hbao_release_memory(void) {
     pthread_mutex_lock(&scratch_lock);
     for (int k = 0; k < SCRATCH_BLOCKS; k++) {
-        hbao_huge_block_free(kept[k].start);
-        kept[k].start = NULL;
+        hbao_huge_block_free(kept[k].memory);
+        kept[k].memory = NULL;
     }
     kept_bytes = 0;
     pthread_mutex_unlock(&scratch_lock);

@@ -14,9 +14,9 @@
  *   it: in 4 KiB pages a sixth of a CLI frame's CPU time on one thread, in
  *   huge pages a few milliseconds where the kernel has them at hand (session
  *   63).
- * Why mapped, each block on its own, and not from malloc: in the C
- * library's heap (where a host such as Blender has raised malloc's mapping
- * threshold, a block may land there) the hint stays on the heap's pages
+ * Why mapped, each block on its own, and not from malloc: a block may land
+ * in the C library's heap (glibc raises its mapping threshold by itself
+ * after a large free, and a host may raise it), and there the hint stays on the heap's pages
  * after the block is freed, and each time the heap shrinks and grows again
  * the kernel clears a whole huge page for a few kilobytes (a draft of the
  * tool's planes from posix_memalign: --keep-input took 1.04 of the time);
@@ -44,16 +44,19 @@
 /** The size of a huge page on x86-64, and on ARM64 with 4 KiB pages. */
 #define HBAO_HUGE_PAGE ((size_t)2 << 20)
 
-/** At least `bytes` of memory, not cleared, aligned as malloc aligns (a
- *  mapped block on 64 bytes), or NULL (out of memory, 0 bytes, or more
- *  than SIZE_MAX / 2). *capacity (where not NULL): the bytes the caller may
- *  use, `bytes` or more. A block of 2 MiB or more (with its 64-byte header)
- *  is a mapping of its own, of whole huge pages, which the kernel is asked
- *  to back with huge pages (MADV_HUGEPAGE: transparent huge pages
+/** At least `bytes` of memory (0 included), not cleared, aligned as malloc
+ *  aligns (a mapped block on 64 bytes), or NULL (out of memory, or about
+ *  SIZE_MAX / 2 bytes or more). A block of 2 MiB or more (with its 64-byte
+ *  header) is a mapping of its own, of whole huge pages, which the kernel is
+ *  asked to back with huge pages (MADV_HUGEPAGE: transparent huge pages
  *  "madvise", Debian's setting, do not otherwise; a hint, which a kernel
  *  may ignore), unless HBAO_HUGE_BLOCK_MAPS is 0. A smaller one comes from
  *  malloc. Freed by hbao_huge_block_free, never by free(). */
-void *hbao_huge_block_alloc(size_t bytes, size_t *capacity);
+void *hbao_huge_block_alloc(size_t bytes);
+
+/** The bytes a block from hbao_huge_block_alloc holds for its caller:
+ *  those asked for, or more (a mapping's whole huge pages). */
+size_t hbao_huge_block_capacity(const void *memory);
 
 /** Frees what hbao_huge_block_alloc gave; NULL: nothing. */
 void hbao_huge_block_free(void *memory);

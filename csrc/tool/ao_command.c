@@ -148,10 +148,10 @@ static int read_passes(exr_input *input, const blender_passes *passes, bool use_
      * measured, whose kernel cleared huge pages it had not used lately at a
      * tenth of the speed (a 320 MB buffer: 250 ms the first time, 34 ms the
      * next; docs/speed.md, session 63). */
-    buffers->depth = hbao_huge_block_alloc(pixel_count * sizeof(float), NULL);
-    buffers->ao = hbao_huge_block_alloc(pixel_count * sizeof(float), NULL);
-    if (use_normals) buffers->normal = hbao_huge_block_alloc(3 * pixel_count * sizeof(float), NULL);
-    if (back != NULL) buffers->back = hbao_huge_block_alloc(pixel_count * sizeof(float), NULL);
+    buffers->depth = hbao_huge_block_alloc(pixel_count * sizeof(float));
+    buffers->ao = hbao_huge_block_alloc(pixel_count * sizeof(float));
+    if (use_normals) buffers->normal = hbao_huge_block_alloc(3 * pixel_count * sizeof(float));
+    if (back != NULL) buffers->back = hbao_huge_block_alloc(pixel_count * sizeof(float));
     if (buffers->depth == NULL || buffers->ao == NULL || (use_normals && buffers->normal == NULL) ||
         (back != NULL && buffers->back == NULL))
         return tool_fail(error, TOOL_EXIT_RUNTIME,
