@@ -19,12 +19,36 @@ JOBS="${JOBS:-2}"
 # python3 earlier on PATH, e.g. pyenv's, may not).
 PYTHON="${PYTHON:-/usr/bin/python3}"
 
+# Each stage's wall time, printed as it ends and together when the run ends
+# (passed or failed): where the suite's minutes go.
+STAGE_NAME="setup (scripts/setup.sh, setup_bpy.sh)"
+STAGE_START=$SECONDS
+STAGE_TIMES=()
+stage_end() {
+    local seconds=$((SECONDS - STAGE_START))
+    STAGE_TIMES+=("$(printf '%5d s  %s' "$seconds" "$STAGE_NAME")")
+    echo "-- $STAGE_NAME: $seconds s"
+}
+stage() { # stage TITLE: ends the stage before and starts TITLE
+    stage_end
+    STAGE_NAME=$1
+    STAGE_START=$SECONDS
+    echo "== $1"
+}
+stage_summary() {
+    local status=$?
+    stage_end
+    echo "== stage times (wall; $SECONDS s in all, exit status $status)"
+    printf '%s\n' "${STAGE_TIMES[@]}"
+}
+trap stage_summary EXIT
+
 "$REPO/scripts/setup.sh"
 # PyPI's bpy 4.5 LTS, 5.0 and the newest 5.x for the Blender matrix (reused
 # from ~/.cache/hbao/bpy between runs).
 "$REPO/scripts/setup_bpy.sh"
 
-echo "== build (Release) and C tests"
+stage "build (Release) and C tests"
 # Options are given explicitly: a build folder configured earlier (e.g. by
 # fuzz_cli.sh, which turns the tests off) keeps its cached values otherwise.
 OPTIONS=(-DHBAO_BUILD_TOOL=ON -DHBAO_BUILD_TESTS=ON)
@@ -33,7 +57,7 @@ cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DHBAO_SANITIZE=OFF -DHBAO_BUILD_
 cmake --build build -j"$JOBS"
 ctest --test-dir build --output-on-failure --no-tests=error -j"$JOBS"
 
-echo "== build with AddressSanitizer + UndefinedBehaviorSanitizer and C tests"
+stage "build with AddressSanitizer + UndefinedBehaviorSanitizer and C tests"
 cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=Debug -DHBAO_SANITIZE=ON \
     -DHBAO_BUILD_BENCHMARKS=OFF "${OPTIONS[@]}" >/dev/null
 cmake --build build-sanitize -j"$JOBS"
@@ -42,21 +66,21 @@ ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
 # 100 mutations per fixture keep this step short; the script defaults to 500
 scripts/fuzz_cli.sh 100 1
 
-echo "== ARM64: cross-built, C tests under qemu-user (the generic kernel on Advanced SIMD)"
+stage "ARM64: cross-built, C tests under qemu-user (the generic kernel on Advanced SIMD)"
 scripts/test_arm64.sh
 
-echo "== coverage-guided fuzzing (libFuzzer + ASan + UBSan), 60 s"
+stage "coverage-guided fuzzing (libFuzzer + ASan + UBSan), 60 s"
 scripts/fuzz.sh 60
 
-echo "== style: PEP 8 (Python), .clang-format (C)"
+stage "style: PEP 8 (Python), .clang-format (C)"
 "$PYTHON" -m pycodestyle addon scripts tests $( [ -d bench ] && echo bench )
 # shellcheck disable=SC2046
 clang-format --dry-run --Werror $(git ls-files 'csrc/*.c' 'csrc/*.h')
 
-echo "== soak: a 50-frame animation with the node and 200 CLI runs (memory, time, leftovers)"
+stage "soak: a 50-frame animation with the node and 200 CLI runs (memory, time, leftovers)"
 scripts/soak.sh --frames 50 --runs 200 --report out/soak/test-report.md
 
-echo "== Python tests (real Blender: Debian's blender and bpy 4.5, 5.0, newest 5.x)"
+stage "Python tests (real Blender: Debian's blender and bpy 4.5, 5.0, newest 5.x)"
 # Debian's blender + the three bpy builds: a missing one fails the run. One
 # pytest-xdist worker a job: most tests wait on one Blender's start and a
 # small render, so two side by side took 0.6 of the time on 2 cores (a
