@@ -28,11 +28,12 @@ def inside_blender():
     import bpy  # noqa: F401  (Blender's libraries and allocator in the process)
     import numpy as np
     sys.path.insert(0, str(REPO / "addon"))
+    sys.path.insert(0, str(REPO / "scripts"))
     from hbao import native
+    from process_memory import status_kib
 
     def rss_mb():
-        with open("/proc/self/statm") as statm:
-            return int(statm.read().split()[1]) * os.sysconf("SC_PAGESIZE") / 2**20
+        return status_kib("VmRSS") / 1024
 
     y, x = np.mgrid[0:1080, 0:1920]
     depth = (3.0 + 0.001 * x + 0.5 * ((x // 40 + y // 40) % 2)).astype(np.float32)

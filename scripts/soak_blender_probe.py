@@ -17,10 +17,14 @@ survive the factory-settings reset and the file load that bpy_blender.py
 does after this script has run."""
 import os
 import resource
+import sys
 import time
 
 import bpy
 from bpy.app.handlers import persistent
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from process_memory import status_kib  # noqa: E402  (scripts/process_memory.py)
 
 TAG = "HBAO-SOAK"
 # Self-test of the soak's memory check: this many KiB are allocated, touched
@@ -28,14 +32,6 @@ TAG = "HBAO-SOAK"
 INJECTED_LEAK_KIB = int(os.environ.get("HBAO_SOAK_INJECT_LEAK_KIB", "0"))
 _frame_started = {}
 _leaked = []
-
-
-def _status_kib(field):
-    with open("/proc/self/status") as status:
-        for line in status:
-            if line.startswith(field + ":"):
-                return int(line.split()[1])
-    return -1
 
 
 def _cpu_seconds():
@@ -54,9 +50,9 @@ def _on_render_write(scene, *_args):
     now = time.monotonic()
     if INJECTED_LEAK_KIB:
         _leaked.append(bytearray(b"\x01" * (INJECTED_LEAK_KIB * 1024)))
-    print(f"{TAG} frame={scene.frame_current} rss_kib={_status_kib('VmRSS')} "
-          f"hwm_kib={_status_kib('VmHWM')} anon_kib={_status_kib('RssAnon')} "
-          f"swap_kib={_status_kib('VmSwap')} cpu_s={_cpu_seconds():.3f} "
+    print(f"{TAG} frame={scene.frame_current} rss_kib={status_kib('VmRSS')} "
+          f"hwm_kib={status_kib('VmHWM')} anon_kib={status_kib('RssAnon')} "
+          f"swap_kib={status_kib('VmSwap')} cpu_s={_cpu_seconds():.3f} "
           f"pre_cpu_s={_frame_started.get('cpu', 0.0):.3f} "
           f"pre_s={_frame_started.get('t', now):.4f} write_s={now:.4f} pid={os.getpid()}",
           flush=True)
