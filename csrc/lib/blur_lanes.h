@@ -304,27 +304,29 @@ BLUR_TARGET static HBAO_ALWAYS_INLINE void BLUR_NAME(row_ends)(const tap_set *ta
     memcpy(target + from, out, (size_t)count * sizeof(float));
 }
 
-/* One pass over a row of centres into target: the vector loop where every
- * tap lies inside the row; near a row's ends row_ends; at a column pass's
- * end (under a vector) blur_pixel (blur.c). */
+/* One pass over centres x0 .. x1 - 1 of a row into target: the vector
+ * loop where every tap lies inside the row; near a row's ends row_ends; at
+ * a column pass's end (under a vector) blur_pixel (blur.c). */
 BLUR_TARGET static HBAO_ALWAYS_INLINE void
 BLUR_NAME(blur_pass)(const tap_set *taps, const centre_row *c, float sharpness, int width,
-                     int radius, float *target, int check) {
+                     int radius, int x0, int x1, float *target, int check) {
     if (taps->along_row) {
-        const int first = radius < width ? radius : width, last = width - radius;
-        if (first > 0)
-            BLUR_NAME(row_ends)(taps, c, sharpness, width, radius, 0, first, target, check);
+        int first = radius < width ? radius : width, last = width - radius;
+        if (first < x0) first = x0;
+        if (first > x1) first = x1;
+        if (last > x1) last = x1;
+        if (first > x0)
+            BLUR_NAME(row_ends)(taps, c, sharpness, width, radius, x0, first, target, check);
         int i = first;
         if (first < last)
             i = check ? BLUR_NAME(vectors)(taps, c, sharpness, first, last, target, 1, 1)
                       : BLUR_NAME(vectors)(taps, c, sharpness, first, last, target, 1, 0);
-        if (i < width)
-            BLUR_NAME(row_ends)(taps, c, sharpness, width, radius, i, width, target, check);
+        if (i < x1) BLUR_NAME(row_ends)(taps, c, sharpness, width, radius, i, x1, target, check);
         return;
     }
-    int i = check ? BLUR_NAME(vectors)(taps, c, sharpness, 0, width, target, 0, 1)
-                  : BLUR_NAME(vectors)(taps, c, sharpness, 0, width, target, 0, 0);
-    for (; i < width; i++) target[i] = blur_pixel(taps, c, sharpness, width, i);
+    int i = check ? BLUR_NAME(vectors)(taps, c, sharpness, x0, x1, target, 0, 1)
+                  : BLUR_NAME(vectors)(taps, c, sharpness, x0, x1, target, 0, 0);
+    for (; i < x1; i++) target[i] = blur_pixel(taps, c, sharpness, width, i);
 }
 
 /* The column passes of taps->rows rows (column_rows_pass), centres c[0]
@@ -334,25 +336,30 @@ BLUR_NAME(blur_pass)(const tap_set *taps, const centre_row *c, float sharpness, 
  * not gives the same floats. */
 BLUR_TARGET static HBAO_ALWAYS_INLINE void
 BLUR_NAME(blur_rows)(const column_taps *taps, const tap_set *single, const centre_row *c, int check,
-                     float sharpness, int width, float *const *targets, int rows) {
-    int i = 0;
+                     float sharpness, int width, int x0, int x1, float *const *targets, int rows) {
+    int i = x0;
     if (check)
-        for (; i + BLUR_LANES <= width; i += BLUR_LANES)
+        for (; i + BLUR_LANES <= x1; i += BLUR_LANES)
             BLUR_NAME(lanes_rows)(taps, c, sharpness, i, targets, 1, rows);
     else
-        for (; i + BLUR_LANES <= width; i += BLUR_LANES)
+        for (; i + BLUR_LANES <= x1; i += BLUR_LANES)
             BLUR_NAME(lanes_rows)(taps, c, sharpness, i, targets, 0, rows);
-    for (; i < width; i++)
+    for (; i < x1; i++)
         for (int r = 0; r < rows; r++)
             targets[r][i] = blur_pixel(&single[r], &c[r], sharpness, width, i);
 }
 
-/* The copy's job for one band of output rows: each row is made (blurred
- * along itself into the ring) once a column pass needs it, then the band's
- * rows are blurred down their columns and written out. */
-BLUR_TARGET static void BLUR_NAME(finish_band)(void *context, int band) {
+/* The copy's job for one strip of a band of output rows (part: the band
+ * times the job's strips, plus the strip): each row's columns x0 .. x1 - 1
+ * are made (blurred along the row into the ring) once a column pass needs
+ * them, then the band's rows are blurred down those columns and written
+ * out. A row pass reads the taps r columns either side of the strip from
+ * the grid; the ring's other columns are never read. */
+BLUR_TARGET static void BLUR_NAME(finish_band)(void *context, int part) {
     finish_job *job = context;
     const int width = job->width, radius = job->radius, height = job->height;
+    const int band = part / job->strips, x0 = part % job->strips * job->strip_columns;
+    const int x1 = x0 + job->strip_columns < width ? x0 + job->strip_columns : width;
     const int slots = 2 * radius + BLUR_COLUMN_ROWS;
     const int first = band * job->band_rows;
     const int last = first + job->band_rows < height ? first + job->band_rows : height;
@@ -371,24 +378,26 @@ BLUR_TARGET static void BLUR_NAME(finish_band)(void *context, int band) {
         for (; next <= needed; next++) {
             float *slot = m.ring[next % slots];
             if (radius == 0) {
-                memcpy(slot, job->grid_ao + (size_t)next * width, (size_t)width * sizeof(float));
+                memcpy(slot + x0, job->grid_ao + (size_t)next * width + x0,
+                       (size_t)(x1 - x0) * sizeof(float));
                 continue;
             }
             row_pass(job, next, &taps, &c);
-            checks[next % slots] = BLUR_NAME(background_needs_check)(c.z, width, job->sharpness);
+            checks[next % slots] =
+                BLUR_NAME(background_needs_check)(c.z + x0, x1 - x0, job->sharpness);
             BLUR_NAME(blur_pass)
-            (&taps, &c, job->sharpness, width, radius, slot, checks[next % slots]);
+            (&taps, &c, job->sharpness, width, radius, x0, x1, slot, checks[next % slots]);
         }
         if (radius == 0) {
-            write_output(job->depth + (size_t)j * width, m.ring[j % slots], width, job->strength,
-                         job->out + (int64_t)j * job->out_row_stride);
+            write_output(job->depth + (size_t)j * width + x0, m.ring[j % slots] + x0, x1 - x0,
+                         job->strength, job->out + (int64_t)j * job->out_row_stride + x0);
             j++;
             continue;
         }
         if (rows == 1) {
             column_pass(job, &m, slots, j, &taps, &c);
             BLUR_NAME(blur_pass)
-            (&taps, &c, job->sharpness, width, radius, m.finished[0], checks[j % slots]);
+            (&taps, &c, job->sharpness, width, radius, x0, x1, m.finished[0], checks[j % slots]);
         } else {
             for (int r = 0; r < rows; r++)
                 column_pass(job, &m, slots, j + r, &single[r], &centres[r]);
@@ -396,12 +405,12 @@ BLUR_TARGET static void BLUR_NAME(finish_band)(void *context, int band) {
             int check = 0; /* any row's */
             for (int r = 0; r < rows; r++) check |= checks[(j + r) % slots];
             BLUR_NAME(blur_rows)
-            (&rows_taps, single, centres, check, job->sharpness, width, m.finished,
+            (&rows_taps, single, centres, check, job->sharpness, width, x0, x1, m.finished,
              BLUR_COLUMN_ROWS);
         }
         for (int r = 0; r < rows; r++)
-            write_output(job->depth + (size_t)(j + r) * width, m.finished[r], width, job->strength,
-                         job->out + (int64_t)(j + r) * job->out_row_stride);
+            write_output(job->depth + (size_t)(j + r) * width + x0, m.finished[r] + x0, x1 - x0,
+                         job->strength, job->out + (int64_t)(j + r) * job->out_row_stride + x0);
         j += rows;
     }
     band_memory_give(job, set);

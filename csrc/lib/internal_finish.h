@@ -105,6 +105,14 @@ static inline float hbao_clamp_ao(float value) {
  * written to out. depth: the caller's depth channel, which only the half
  * resolution's upsample reads (NULL will do at full resolution).
  * HBAO_ERROR_OUT_OF_MEMORY if its buffers cannot be allocated. */
+/* The width of the strips of columns that the blur cuts a band's rows of
+ * `width` pixels into at `radius` (blur.c, STRIP_BYTES_PER_PIXEL): the
+ * whole row where its 2r + 1 rows of taps fit in `budget` bytes, else as
+ * many strips as bring each strip's within it, each at least 256 columns
+ * wide; and the budget for this machine's cores. */
+int hbao_blur_strip_columns(int width, int radius, double budget);
+double hbao_blur_strip_budget(void);
+
 hbao_result hbao_finish(const hbao_settings *settings, const hbao_grid *grid, const float *grid_ao,
                         const hbao_channel *depth, int width, int height, float *out,
                         int64_t out_row_stride);

@@ -61,6 +61,10 @@ typedef struct hbao_settings {
     float background_depth;
     int implementation; /* hbao_implementation as asked for */
     float thickness;    /* occluder thickness, 0 = infinite (hbao_params) */
+    /* The width of the blur's strips of columns (blur.c, strip_columns);
+     * 0, as hbao_settings_make sets it: blur.c's rule. The tests set it to
+     * cut any image into strips, which give the same floats. */
+    int blur_strip_columns;
 } hbao_settings;
 
 /* The blur's taps on each side for a kernel of `size` pixels (hbao_params'
@@ -286,6 +290,9 @@ extern int hbao_scratch_fill;
 /* The threads "one per core" gives (threads = 0): the CPUs this process may
  * run on (hbao_cpus.h), at most HBAO_MAX_THREADS. */
 int hbao_available_cores(void);
+/* The second-level cache of one core in bytes, as the C library reports
+ * it (glibc: CPUID), or 0 where it is not known. */
+long hbao_core_cache_bytes(void);
 
 /* compute.c: the pipeline's settings from params (resolved within their
  * limits, hbao_params_resolve), or the error that hbao_compute returns. */

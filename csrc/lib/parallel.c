@@ -53,6 +53,21 @@ int hbao_available_cores(void) {
     return cores > HBAO_MAX_THREADS ? HBAO_MAX_THREADS : cores;
 }
 
+long hbao_core_cache_bytes(void) {
+#ifdef _SC_LEVEL2_CACHE_SIZE
+    static atomic_long known = -1; /* asked once: CPUID traps to a VM's host */
+    long bytes = atomic_load_explicit(&known, memory_order_relaxed);
+    if (bytes < 0) {
+        bytes = sysconf(_SC_LEVEL2_CACHE_SIZE);
+        if (bytes < 0) bytes = 0;
+        atomic_store_explicit(&known, bytes, memory_order_relaxed);
+    }
+    return bytes;
+#else
+    return 0;
+#endif
+}
+
 int hbao_parallel_threads(int threads, int rows) {
     const int grab = rows_per_grab(threads, rows);
     const int useful = (rows + grab - 1) / grab;
