@@ -9,15 +9,15 @@
  * builds of it against each other.
  *   bench_blur [--calls N] [--blur B] [--sharpness S] [--size WxH]
  *              [--threads T] [--implementation scalar|generic|avx2|avx512]
- *              [--background P] [--strip-columns C]
+ *              [--background P] [--strips S]
  * Prints one line: the fastest and the median CPU ms of N calls, and a
  * hash of the output's bits (the same for every build that blurs alike).
  * --background P: the upper P per cent of the rows are background (depth
  * 0, as the grid holds it; normals 0, where the grid holds (0, 0, 1): a
  * background pixel's normal changes no float), as a sky above a horizon.
- * --strip-columns C: the blur's strips C columns wide (blur.c,
- * hbao_blur_strip_columns; default 0: the library's rule for this
- * machine); the line says the width blurred in. */
+ * --strips S: the blur's rows in S strips of columns (blur.c,
+ * hbao_blur_strips; default 0: the library's rule for this machine); the
+ * line says how many it blurred in. */
 #include <stdint.h>
 
 #include "bench_common.h"
@@ -29,13 +29,13 @@ static void usage(const char *program) {
             "usage: %s [--calls N] [--blur B] [--sharpness S] [--size WxH] [--threads T]\n"
             "  [--implementation scalar|generic|avx2|avx512] (default: the best this CPU has)\n"
             "  [--background P] (the upper P per cent of the rows background; default 0)\n"
-            "  [--strip-columns C] (the blur's strips' width; default 0: the library's rule)\n",
+            "  [--strips S] (the blur's strips of columns; default 0: the library's rule)\n",
             program);
 }
 
 int main(int argc, char **argv) {
     long calls = 10, blur = 15, width = 1920, height = 1080, threads = 1, background = 0;
-    long strip_columns = 0;
+    long strips = 0;
     int implementation = HBAO_IMPLEMENTATION_AUTO;
     float sharpness = HBAO_DEFAULT_BLUR_SHARPNESS;
     int bad = 0;
@@ -55,8 +55,8 @@ int main(int argc, char **argv) {
                   !(sharpness >= 0.0f && sharpness <= HBAO_MAX_BLUR_SHARPNESS);
         } else if (!strcmp(argv[a], "--background")) {
             bad = (background = bench_whole_number(value, 0, 100)) < 0;
-        } else if (!strcmp(argv[a], "--strip-columns")) {
-            bad = (strip_columns = bench_whole_number(value, 0, 16384)) < 0;
+        } else if (!strcmp(argv[a], "--strips")) {
+            bad = (strips = bench_whole_number(value, 0, 16384)) < 0;
         } else if (!strcmp(argv[a], "--threads")) {
             bad = (threads = bench_whole_number(value, 1, 64)) < 1;
         } else if (!strcmp(argv[a], "--size")) {
@@ -75,7 +75,7 @@ int main(int argc, char **argv) {
         fprintf(stderr,
                 "bench_blur: --calls 1-1000, --blur an odd size 1-%d, --sharpness 0-%g, "
                 "--size WxH with each 16-16384, --threads 1-64, --implementation "
-                "scalar|generic|avx2|avx512, --background 0-100, --strip-columns 0-16384\n",
+                "scalar|generic|avx2|avx512, --background 0-100, --strips 0-16384\n",
                 HBAO_MAX_BLUR_SIZE, (double)HBAO_MAX_BLUR_SHARPNESS);
         return 2;
     }
@@ -118,11 +118,10 @@ int main(int argc, char **argv) {
     s.strength = 1.0f;
     s.threads = threads;
     s.implementation = implementation;
-    s.blur_strip_columns = (int)strip_columns;
-    const int strips_of =
-        strip_columns > 0
-            ? (int)strip_columns
-            : hbao_blur_strip_columns((int)width, s.grid_blur_radius, hbao_blur_strip_budget());
+    s.blur_strips = (int)strips;
+    const int strips_in =
+        strips > 0 ? (int)strips
+                   : hbao_blur_strips((int)width, s.grid_blur_radius, hbao_blur_strip_budget());
     for (int call = 0; call < calls; call++) {
         const double start = clock_seconds(CLOCK_PROCESS_CPUTIME_ID);
         if (hbao_finish(&s, &grid, raw, NULL, width, height, out, width) != HBAO_SUCCESS) {
@@ -140,10 +139,10 @@ int main(int argc, char **argv) {
     for (int call = 1; call < calls; call++)
         fastest = times[call] < fastest ? times[call] : fastest;
     printf("bench_blur %ldx%ld, blur %ld, sharpness %g, %ld thread(s), %ld %% background, "
-           "strips of %d columns, %s: fastest %.2f, median %.2f CPU ms over %ld calls; output hash "
+           "%d strip(s), %s: fastest %.2f, median %.2f CPU ms over %ld calls; output hash "
            "%016llx\n",
            width, height, blur, (double)sharpness, threads, background,
-           strips_of < width ? strips_of : (int)width,
+           strips_in < width ? strips_in : (int)width,
            hbao_implementation_name(hbao_finish_implementation(implementation)), fastest,
            median_of(times, (int)calls), calls, (unsigned long long)hash);
     free(times);

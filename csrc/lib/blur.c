@@ -44,32 +44,34 @@
 /* Strips: a pass down the columns reads the 2r + 1 rows of its taps, each
  * pixel's depth, normal and AO in the ring (20 bytes), and the next row's
  * pass reads them again; a wide image's rows at a large radius do not stay
- * in a core's second-level cache (1080p at blur 15: 576 KiB; a Zen 3 core
+ * in a core's second-level cache (1080p at blur 15: 563 KiB; a Zen 3 core
  * has 512), and were read from the third level each time. A band is then
- * blurred in strips of columns, each a job of its own, whose rows take at
- * most STRIP_CACHE_SHARE of the cache: every pixel has the same taps, so
- * the floats are the same (test_stages.c, blur_strips_give_the_same_floats).
- * On a Zen 3 (session 65; scripts/bench_blur_ab.sh, 10 rounds, 1 thread):
- * 1080p at blur 15 in two strips 0.937 of the time (2 threads 0.939), at
- * blur 33 in four 0.800; a draft's budget of a half cut blur 9's rows (345
- * KiB) and 3840 x 2160's at blur 5 (375 KiB) in two, which gained nothing
- * (1.00, 1.00-1.05), so strips start at three quarters. Whole frames
- * (bench_ab_pairs.sh, 10 rounds): 8 x 6 + blur 15 0.973 on 1 thread and
- * 0.959 on 2; the defaults (not cut) 0.991 and 0.998. A strip is at least
- * MIN_STRIP_COLUMNS wide, so that the passes' set-up for each row stays a
- * small share. Where the cache's size is not known, STRIP_BYTES_UNKNOWN
- * (three quarters of a Zen 3's). */
+ * blurred in strips of columns of equal width (to a column), each a job of
+ * its own, as many as bring each strip's rows within STRIP_CACHE_SHARE of
+ * the cache, or as keep each at least MIN_STRIP_COLUMNS wide (so that the
+ * passes' set-up for each row stays a small share), whichever are fewer:
+ * every pixel has the same taps, so the floats are the same (test_stages.c,
+ * blur_strips_give_the_same_floats). On a Zen 3 (session 65;
+ * scripts/bench_blur_ab.sh, 10 rounds, 1 thread): 1080p at blur 15 in two
+ * strips 0.937 of the time (2 threads 0.939), at blur 33 in four 0.800; a
+ * draft's budget of a half cut blur 9's rows (338 KiB) and 3840 x 2160's at
+ * blur 5 (375 KiB) in two, which gained nothing (1.00, 1.00-1.05), so
+ * strips start at three quarters. Whole frames (bench_ab_pairs.sh, 10
+ * rounds): 8 x 6 + blur 15 0.973 on 1 thread and 0.959 on 2; the defaults
+ * (not cut) 0.991 and 0.998. Where the cache's size is not known,
+ * STRIP_BYTES_UNKNOWN (three quarters of a Zen 3's). Without a blur
+ * (radius 0) a band's rows are only copied: one strip. */
 #define STRIP_BYTES_PER_PIXEL 20
 #define STRIP_CACHE_SHARE 0.75
 #define STRIP_BYTES_UNKNOWN (384 * 1024)
 #define MIN_STRIP_COLUMNS 256
 
-int hbao_blur_strip_columns(int width, int radius, double budget) {
-    const double bytes = (2.0 * radius + 1.0) * STRIP_BYTES_PER_PIXEL * width;
-    int strips = (int)ceil(bytes / budget);
-    if (strips > width / MIN_STRIP_COLUMNS) strips = width / MIN_STRIP_COLUMNS;
-    if (strips < 1) strips = 1;
-    return (width + strips - 1) / strips;
+int hbao_blur_strips(int width, int radius, double budget) {
+    const int most = width / MIN_STRIP_COLUMNS;
+    if (radius == 0 || most <= 1) return 1;
+    const double strips = ceil((2.0 * radius + 1.0) * STRIP_BYTES_PER_PIXEL * width / budget);
+    if (!(strips < (double)most)) return most; /* NaN and infinity too */
+    return strips > 1.0 ? (int)strips : 1;
 }
 
 double hbao_blur_strip_budget(void) {
@@ -85,7 +87,7 @@ typedef struct finish_job {
     int width, height;     /* the grid's */
     int radius;            /* taps on each side; 0 = no blur */
     int band_rows;
-    int strips, strip_columns; /* each band's columns, in strips (hbao_blur_strip_columns) */
+    int strips; /* each band's columns in this many strips (hbao_blur_strips) */
     float sharpness;
     float strength;
     float spatial[MAX_BLUR_RADIUS + 1]; /* Gaussian weight by tap distance */
@@ -254,6 +256,10 @@ static int band_memory_take(finish_job *job, band_memory *m, int slots) {
     while (atomic_flag_test_and_set(&job->pool_taken[set])) set = (set + 1) % job->pool_sets;
     const size_t row = (size_t)job->width;
     m->block = job->pool + (size_t)set * job->pool_set_floats;
+    /* for tests (hbao_scratch_fill): a part reusing a set finds it filled
+     * again, so that reading a column another part wrote shows */
+    if (hbao_scratch_fill >= 0)
+        memset(m->block, hbao_scratch_fill, job->pool_set_floats * sizeof(float));
     for (int r = 0; r < MAX_COLUMN_ROWS; r++) m->finished[r] = m->block + (size_t)r * row;
     for (int s = 0; s < slots; s++) m->ring[s] = m->block + (MAX_COLUMN_ROWS + (size_t)s) * row;
     return set;
@@ -447,14 +453,13 @@ static hbao_result blur_grid(const hbao_settings *settings, const hbao_grid *gri
     if (band_rows < MIN_BAND_ROWS) band_rows = MIN_BAND_ROWS;
     job.band_rows = band_rows;
     const int bands = (height + band_rows - 1) / band_rows;
-    job.strip_columns =
-        settings->blur_strip_columns > 0
-            ? settings->blur_strip_columns
-            : hbao_blur_strip_columns(job.width, job.radius, hbao_blur_strip_budget());
-    if (job.strip_columns > job.width) job.strip_columns = job.width;
-    job.strips = (job.width + job.strip_columns - 1) / job.strip_columns;
+    job.strips = settings->blur_strips > 0
+                     ? settings->blur_strips
+                     : hbao_blur_strips(job.width, job.radius, hbao_blur_strip_budget());
+    if (job.strips > job.width) job.strips = job.width;
     const int parts = bands * job.strips;
-    job.pool_sets = hbao_parallel_threads(settings->threads, parts);
+    /* one part a grab (hbao_parallel_each), on as many threads as sets */
+    job.pool_sets = settings->threads < parts ? settings->threads : parts;
     if (job.pool_sets < 1) job.pool_sets = 1;
     job.pool_set_floats = (size_t)BAND_ROWS(job.radius) * (size_t)job.width;
     job.pool = hbao_scratch_take((size_t)job.pool_sets * job.pool_set_floats * sizeof(float));
@@ -467,7 +472,7 @@ static hbao_result blur_grid(const hbao_settings *settings, const hbao_grid *gri
     if (implementation == HBAO_IMPLEMENTATION_AVX512) run = finish_band_avx512;
     if (implementation == HBAO_IMPLEMENTATION_AVX2) run = finish_band_avx2;
 #endif
-    hbao_parallel_rows(job.pool_sets, parts, run, &job); /* no more threads than sets */
+    hbao_parallel_each(job.pool_sets, parts, run, &job); /* no more threads than sets */
     hbao_scratch_give(job.pool);
     return HBAO_SUCCESS;
 }

@@ -358,8 +358,9 @@ BLUR_NAME(blur_rows)(const column_taps *taps, const tap_set *single, const centr
 BLUR_TARGET static void BLUR_NAME(finish_band)(void *context, int part) {
     finish_job *job = context;
     const int width = job->width, radius = job->radius, height = job->height;
-    const int band = part / job->strips, x0 = part % job->strips * job->strip_columns;
-    const int x1 = x0 + job->strip_columns < width ? x0 + job->strip_columns : width;
+    const int band = part / job->strips, strip = part % job->strips;
+    const int x0 = (int)((int64_t)strip * width / job->strips);
+    const int x1 = (int)((int64_t)(strip + 1) * width / job->strips);
     const int slots = 2 * radius + BLUR_COLUMN_ROWS;
     const int first = band * job->band_rows;
     const int last = first + job->band_rows < height ? first + job->band_rows : height;

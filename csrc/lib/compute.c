@@ -34,7 +34,7 @@ hbao_result hbao_settings_make(const hbao_params *params, hbao_settings *s) {
     s->background_depth = p.background_depth;
     s->implementation = p.implementation;
     s->thickness = p.thickness;
-    s->blur_strip_columns = 0; /* blur.c's rule */
+    s->blur_strips = 0; /* blur.c's rule */
     return HBAO_SUCCESS;
 }
 

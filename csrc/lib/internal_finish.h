@@ -105,14 +105,6 @@ static inline float hbao_clamp_ao(float value) {
  * written to out. depth: the caller's depth channel, which only the half
  * resolution's upsample reads (NULL will do at full resolution).
  * HBAO_ERROR_OUT_OF_MEMORY if its buffers cannot be allocated. */
-/* The width of the strips of columns that the blur cuts a band's rows of
- * `width` pixels into at `radius` (blur.c, STRIP_BYTES_PER_PIXEL): the
- * whole row where its 2r + 1 rows of taps fit in `budget` bytes, else as
- * many strips as bring each strip's within it, each at least 256 columns
- * wide; and the budget for this machine's cores. */
-int hbao_blur_strip_columns(int width, int radius, double budget);
-double hbao_blur_strip_budget(void);
-
 hbao_result hbao_finish(const hbao_settings *settings, const hbao_grid *grid, const float *grid_ao,
                         const hbao_channel *depth, int width, int height, float *out,
                         int64_t out_row_stride);
@@ -123,5 +115,13 @@ hbao_result hbao_finish(const hbao_settings *settings, const hbao_grid *grid, co
  * implementation: as resolved by hbao_finish_implementation(). */
 void hbao_upsample_row(int implementation, const hbao_grid *half, const float *half_ao,
                        const hbao_channel *depth, float background, int width, int j, float *ao);
+
+/* How many strips of columns the blur cuts a band's rows of `width`
+ * pixels into at `radius` (blur.c, STRIP_BYTES_PER_PIXEL): one where the
+ * 2r + 1 rows of taps fit in `budget` bytes, else as many as bring each
+ * strip's within it, but no more than keep each at least 256 columns wide;
+ * one without a blur (radius 0). And the budget for this machine's cores. */
+int hbao_blur_strips(int width, int radius, double budget);
+double hbao_blur_strip_budget(void);
 
 #endif /* HBAO_INTERNAL_FINISH_H */

@@ -61,10 +61,11 @@ typedef struct hbao_settings {
     float background_depth;
     int implementation; /* hbao_implementation as asked for */
     float thickness;    /* occluder thickness, 0 = infinite (hbao_params) */
-    /* The width of the blur's strips of columns (blur.c, strip_columns);
-     * 0, as hbao_settings_make sets it: blur.c's rule. The tests set it to
-     * cut any image into strips, which give the same floats. */
-    int blur_strip_columns;
+    /* How many strips of columns the blur cuts a band's rows into (blur.c,
+     * hbao_blur_strips; at most one a column); 0, as hbao_settings_make
+     * sets it: blur.c's rule. The tests set it to cut any image into
+     * strips, which give the same floats. */
+    int blur_strips;
 } hbao_settings;
 
 /* The blur's taps on each side for a kernel of `size` pixels (hbao_params'
@@ -271,6 +272,9 @@ void hbao_parallel_rows(int threads, int rows, hbao_row_job job, void *context);
  * rows, ...) runs no more threads than that (blur.c's band memory, one set
  * a thread, counts on it). */
 int hbao_parallel_threads(int threads, int rows);
+/* hbao_parallel_rows with one job a grab, on at most min(threads, jobs)
+ * threads: for a few jobs of uneven cost (the blur's bands, blur.c). */
+void hbao_parallel_each(int threads, int jobs, hbao_row_job job, void *context);
 
 /* Large working buffers (scratch.c): like malloc and free, but a given
  * buffer is kept for the next call (hbao_release_memory frees them). */

@@ -7,6 +7,7 @@
 #endif
 #include <pthread.h>
 #include <stdatomic.h>
+#include <unistd.h> /* sysconf */
 
 #include "hbao_cpus.h"
 #include "internal_hbao.h"
@@ -14,14 +15,15 @@
 /* Rows taken per grab: enough to keep the counter off the hot path, few
  * enough to balance rows of uneven cost (background vs. geometry): at most
  * HBAO_ROWS_PER_GRAB, and one where a job has under HBAO_GRABS_PER_THREAD
- * grabs of them for each thread. The blur's rows are bands, 4 per thread:
- * 4 to a grab handed a 2-thread blur's sky bands to one thread and its
- * geometry to the other, which then took as long as without the sky
- * (session 47: bench_ab_pairs.sh, 8 x 6 + blur 15 with the upper half
- * background, 1.003 of the time before the blur skipped background
- * vectors on 2 threads, 0.894 on 1); one band a grab took 0.881 of the
- * time before on 2 threads. The search's tiles (136 at half resolution in
- * 1080p) and the stages' rows keep 4 a grab up to 17 threads and more. */
+ * grabs of them for each thread. The search's tiles (136 at half
+ * resolution in 1080p) and the stages' rows keep 4 a grab up to 17 threads
+ * and more. The blur's jobs (bands, 4 per thread, or their strips of
+ * columns) go one a grab (hbao_parallel_each): 4 to a grab handed a
+ * 2-thread blur's sky bands to one thread and its geometry to the other,
+ * which then took as long as without the sky (session 47: bench_ab_pairs.sh,
+ * 8 x 6 + blur 15 with the upper half background, 1.003 of the time before
+ * the blur skipped background vectors on 2 threads, 0.894 on 1); one band a
+ * grab took 0.881 of the time before on 2 threads. */
 #define HBAO_ROWS_PER_GRAB 4
 #define HBAO_GRABS_PER_THREAD 2
 
@@ -74,15 +76,15 @@ int hbao_parallel_threads(int threads, int rows) {
     return threads > useful ? useful : threads;
 }
 
-void hbao_parallel_rows(int threads, int rows, hbao_row_job job, void *context) {
+/* job for rows [0, rows), `grab` at a time, on up to `threads` threads */
+static void run_rows(int threads, int rows, int grab, hbao_row_job job, void *context) {
     row_queue queue;
     atomic_init(&queue.next_row, 0);
     queue.rows = rows;
-    queue.grab = rows_per_grab(threads, rows);
+    queue.grab = grab;
     queue.job = job;
     queue.context = context;
 
-    threads = hbao_parallel_threads(threads, rows);
     pthread_t workers[HBAO_MAX_THREADS];
     int started = 0;
     for (int t = 1; t < threads; t++) {
@@ -91,4 +93,13 @@ void hbao_parallel_rows(int threads, int rows, hbao_row_job job, void *context) 
     }
     drain_rows(&queue);
     for (int t = 0; t < started; t++) pthread_join(workers[t], NULL);
+}
+
+void hbao_parallel_rows(int threads, int rows, hbao_row_job job, void *context) {
+    run_rows(hbao_parallel_threads(threads, rows), rows, rows_per_grab(threads, rows), job,
+             context);
+}
+
+void hbao_parallel_each(int threads, int jobs, hbao_row_job job, void *context) {
+    run_rows(threads < jobs ? threads : jobs, jobs, 1, job, context);
 }

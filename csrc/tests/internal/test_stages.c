@@ -156,76 +156,116 @@ TEST_CASE(blur_copies_agree_on_background_at_every_sharpness) {
 #endif
 }
 
+/* The blur of picture `grid` (raw AO `raw`, out_stride floats a row of
+ * out) in `strips` strips against `whole` (one strip, packed), with the
+ * scratch filled with NaN, so that a strip reading a column of its rows
+ * that it did not write shows, and with the output's padding (out_stride
+ * past the width) left as it was. */
+static void compare_strips(const hbao_grid *grid, const float *raw, hbao_settings settings,
+                           int strips, const float *whole, float *out, int out_stride) {
+    const int w = grid->width, h = grid->height;
+    settings.blur_strips = strips;
+    for (int k = 0; k < out_stride * h; k++) out[k] = -2.0f;
+    hbao_scratch_fill = 0xff;
+    CHECK_RESULT(hbao_finish(&settings, grid, raw, NULL, w, h, out, out_stride), HBAO_SUCCESS);
+    hbao_scratch_fill = -1;
+    int differ = 0, padding = 0;
+    for (int j = 0; j < h; j++) {
+        for (int i = 0; i < w; i++)
+            differ += memcmp(&whole[j * w + i], &out[j * out_stride + i], sizeof *out) != 0;
+        for (int i = w; i < out_stride; i++) padding += out[j * out_stride + i] != -2.0f;
+    }
+    if (differ || padding)
+        printf("  %dx%d, sharpness %g, radius %d, implementation %d, %d strips, %d threads: %d "
+               "pixels differ, %d of the padding written\n",
+               w, h, (double)settings.blur_sharpness, settings.blur_radius, settings.implementation,
+               strips, settings.threads, differ, padding);
+    CHECK(differ == 0 && padding == 0);
+}
+
 /* A band of the blur's rows may be blurred in strips of columns (blur.c,
- * hbao_blur_strip_columns: wide rows at a large radius), each pixel with
- * the same taps: every strip width, from one column (every pixel a strip's
- * end) to the whole row, and widths that leave a last strip narrower than
- * the radius, must give the floats of the unsplit rows, for every copy, at
- * a sharpness whose rows skip the background test (32) and one whose rows
- * test every tap (2), on 1 and 3 threads. The scratch is filled with NaN,
- * so that a strip reading a column of its rows that it did not write
- * shows. Then the rule's widths, and that hbao_compute's settings take
- * them. */
+ * hbao_blur_strips: wide rows at a large radius), each pixel with the same
+ * taps: from one strip to one a column (every pixel a strip's end), and
+ * strips narrower than the radius or a vector, must give the floats of the
+ * unsplit rows, for every copy, at a sharpness whose rows skip the
+ * background test (32) and one whose rows test every tap (2), on 1 and 3
+ * threads; also on pictures of one and two rows and narrower than a vector,
+ * into an output whose rows are wider than the picture. Then the rule's
+ * counts, and that hbao_compute's settings take them. */
 TEST_CASE(blur_strips_give_the_same_floats) {
-    enum { w = 97, h = 41 };
+    enum { w = 97, h = 41, small_w = 7 };
     static float depth[w * h], normal[3 * w * h + HBAO_NORMAL_PADDING], raw[w * h];
-    static float whole[w * h], strips[w * h];
+    static float whole[w * h], out[(w + 3) * h];
     hbao_grid grid;
     make_grid(&grid, w, h, depth, normal, raw);
-    static const int radii[] = {0, 1, 7, 32}, widths[] = {1, 5, 17, 40, 48, 96};
+    static const int radii[] = {0, 1, 7, 32}, counts[] = {2, 3, 6, 19, 40, w, 2 * w};
     static const float sharpness[] = {2.0f, 32.0f};
     for (size_t s = 0; s < sizeof sharpness / sizeof sharpness[0]; s++) {
         for (size_t r = 0; r < sizeof radii / sizeof radii[0]; r++) {
             for (int implementation = HBAO_IMPLEMENTATION_SCALAR;
                  implementation <= HBAO_IMPLEMENTATION_AVX512; implementation++) {
                 hbao_settings settings = blur_settings(radii[r], sharpness[s], 1, implementation);
-                settings.blur_strip_columns = w;
+                settings.blur_strips = 1;
                 CHECK_RESULT(hbao_finish(&settings, &grid, raw, NULL, w, h, whole, w),
                              HBAO_SUCCESS);
-                for (size_t k = 0; k < sizeof widths / sizeof widths[0]; k++) {
+                for (size_t k = 0; k < sizeof counts / sizeof counts[0]; k++) {
                     for (int threads = 1; threads <= 3; threads += 2) {
-                        settings.blur_strip_columns = widths[k];
                         settings.threads = threads;
-                        memset(strips, 0xff, sizeof strips);
-                        hbao_scratch_fill = 0xff;
-                        CHECK_RESULT(hbao_finish(&settings, &grid, raw, NULL, w, h, strips, w),
-                                     HBAO_SUCCESS);
-                        hbao_scratch_fill = -1;
-                        int differ = 0;
-                        for (int q = 0; q < w * h; q++)
-                            differ += memcmp(&whole[q], &strips[q], sizeof whole[q]) != 0;
-                        if (differ)
-                            printf("  sharpness %g, radius %d, implementation %d, strips of %d, "
-                                   "%d threads: %d pixels differ\n",
-                                   (double)sharpness[s], radii[r], implementation, widths[k],
-                                   threads, differ);
-                        CHECK(differ == 0);
+                        compare_strips(&grid, raw, settings, counts[k], whole, out, w + 3);
                     }
+                }
+                /* the first 1, 2 rows and small_w columns of the picture */
+                for (int rows = 1; rows <= 2; rows++) {
+                    hbao_grid part = grid;
+                    part.width = small_w;
+                    part.height = rows;
+                    static float small_depth[small_w * 2], small_raw[small_w * 2],
+                        small_normal[3 * small_w * 2 + HBAO_NORMAL_PADDING];
+                    for (int j = 0; j < rows; j++)
+                        for (int i = 0; i < small_w; i++) {
+                            small_depth[j * small_w + i] = depth[j * w + i];
+                            small_raw[j * small_w + i] = raw[j * w + i];
+                        }
+                    part.depth = small_depth;
+                    part.normal = small_normal;
+                    for (int j = 0; j < rows; j++)
+                        for (int c = 0; c < 3; c++)
+                            for (int i = 0; i < small_w; i++)
+                                hbao_grid_normal_row(&part, j, c)[i] =
+                                    hbao_grid_normal_row(&grid, j, c)[i];
+                    settings.threads = 1;
+                    settings.blur_strips = 1;
+                    CHECK_RESULT(hbao_finish(&settings, &part, small_raw, NULL, small_w, rows,
+                                             whole, small_w),
+                                 HBAO_SUCCESS);
+                    for (int strips = 2; strips <= small_w; strips += 5)
+                        compare_strips(&part, small_raw, settings, strips, whole, out, w);
                 }
             }
         }
     }
     /* The rule, at 384 KiB (three quarters of a Zen 3 core's cache): a
-     * 1080p row at blur 15 (576 KiB of rows) in two strips, at blur 5
-     * (188 KiB) and a 4K row at blur 5 (375 KiB) whole, at blur 65 in as
-     * many as keep each 256 columns wide (7); a row under two such strips
-     * whole. The budget is positive wherever the cache's size is not
-     * known. */
+     * 1080p row at blur 15 (563 KiB of rows) in two strips, at blur 5 (188
+     * KiB) and a 4K row at blur 5 (375 KiB) whole, at blur 65 in as many as
+     * keep each 256 columns wide (7); a row under two such strips whole,
+     * and no blur whole. */
     const double budget = 384.0 * 1024.0;
-    CHECK(hbao_blur_strip_columns(1920, 7, budget) == 960);
-    CHECK(hbao_blur_strip_columns(1920, 2, budget) == 1920);
-    CHECK(hbao_blur_strip_columns(3840, 2, budget) == 3840);
-    CHECK(hbao_blur_strip_columns(1920, 32, budget) == 275);
-    CHECK(hbao_blur_strip_columns(500, 32, budget) == 500);
+    CHECK(hbao_blur_strips(1920, 7, budget) == 2);
+    CHECK(hbao_blur_strips(1920, 2, budget) == 1);
+    CHECK(hbao_blur_strips(3840, 2, budget) == 1);
+    CHECK(hbao_blur_strips(1920, 32, budget) == 7);
+    CHECK(hbao_blur_strips(500, 32, budget) == 1);
+    CHECK(hbao_blur_strips(16384, 0, budget) == 1);
+    CHECK(hbao_blur_strips(16384, 32, 0.0) == 64); /* no budget at all: the most */
     CHECK(hbao_blur_strip_budget() > 0.0);
-    /* hbao_compute's settings leave the width to the rule (a draft left it
+    /* hbao_compute's settings leave the count to the rule (a draft left it
      * unset, whatever the stack held: the same floats in narrow strips,
      * 1.7 times the defaults' time at 1080p) */
     hbao_settings made;
     memset(&made, 0x01, sizeof made);
     const hbao_params params = HBAO_PARAMS_DEFAULT_INITIALIZER;
     CHECK_RESULT(hbao_settings_make(&params, &made), HBAO_SUCCESS);
-    CHECK(made.blur_strip_columns == 0);
+    CHECK(made.blur_strips == 0);
 }
 
 /* The blur's range weight F (docs/algorithm.md, "After sampling"), in
