@@ -54,7 +54,13 @@ for target in $targets; do
     runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
     runs=${runs:-0}
     total=$((total + runs))
-    if [ "$status" -ne 0 ]; then
+    if [ "$status" -eq 72 ] && grep -q "^==[0-9]*== libFuzzer: run interrupted" "$log"; then
+        # libFuzzer's exit status for a SIGINT or SIGTERM (-interrupted_exitcode):
+        # the run was stopped, nothing was found (a CI run cancelled in session 65
+        # read as a finding); the script still fails
+        echo "fuzz.sh: $target: interrupted after $runs executions (a signal); log $log"
+        exit 1
+    elif [ "$status" -ne 0 ]; then
         findings=$((findings + 1))
         echo "fuzz.sh: $target: FINDING after $runs executions (exit $status); log $log:"
         grep -E "ERROR|SUMMARY|runtime error|fuzz:|Test unit written" "$log" | head -n 20
