@@ -458,8 +458,8 @@ static hbao_result blur_grid(const hbao_settings *settings, const hbao_grid *gri
                      : hbao_blur_strips(job.width, job.radius, hbao_blur_strip_budget());
     if (job.strips > job.width) job.strips = job.width;
     const int parts = bands * job.strips;
-    /* one part a grab (hbao_parallel_each), on as many threads as sets */
-    job.pool_sets = settings->threads < parts ? settings->threads : parts;
+    /* one part a grab, on no more threads than sets */
+    job.pool_sets = hbao_parallel_each_threads(settings->threads, parts);
     if (job.pool_sets < 1) job.pool_sets = 1;
     job.pool_set_floats = (size_t)BAND_ROWS(job.radius) * (size_t)job.width;
     job.pool = hbao_scratch_take((size_t)job.pool_sets * job.pool_set_floats * sizeof(float));

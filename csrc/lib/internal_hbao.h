@@ -268,13 +268,14 @@ typedef void (*hbao_row_job)(void *context, int row);
 void hbao_parallel_rows(int threads, int rows, hbao_row_job job, void *context);
 /* How many of `threads` hbao_parallel_rows runs `rows` on (the calling
  * thread included): at most as many as there are grabs of rows, and at most
- * `threads`, so that hbao_parallel_rows(hbao_parallel_threads(t, rows),
- * rows, ...) runs no more threads than that (blur.c's band memory, one set
- * a thread, counts on it). */
+ * `threads`. */
 int hbao_parallel_threads(int threads, int rows);
-/* hbao_parallel_rows with one job a grab, on at most min(threads, jobs)
- * threads: for a few jobs of uneven cost (the blur's bands, blur.c). */
+/* hbao_parallel_rows with one job a grab: for a few jobs of uneven cost
+ * (the blur's bands and their strips, blur.c). It runs them on
+ * hbao_parallel_each_threads(threads, jobs) threads at most, the calling
+ * thread included (blur.c's band memory, one set a thread, counts on it). */
 void hbao_parallel_each(int threads, int jobs, hbao_row_job job, void *context);
+int hbao_parallel_each_threads(int threads, int jobs);
 
 /* Large working buffers (scratch.c): like malloc and free, but a given
  * buffer is kept for the next call (hbao_release_memory frees them). */

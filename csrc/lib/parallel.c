@@ -100,6 +100,10 @@ void hbao_parallel_rows(int threads, int rows, hbao_row_job job, void *context) 
              context);
 }
 
+int hbao_parallel_each_threads(int threads, int jobs) {
+    return threads < jobs ? threads : jobs;
+}
+
 void hbao_parallel_each(int threads, int jobs, hbao_row_job job, void *context) {
-    run_rows(threads < jobs ? threads : jobs, jobs, 1, job, context);
+    run_rows(hbao_parallel_each_threads(threads, jobs), jobs, 1, job, context);
 }

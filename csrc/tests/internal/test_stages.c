@@ -1105,8 +1105,10 @@ TEST_CASE(scratch_memory_is_written_before_it_is_read) {
 }
 
 /* hbao_parallel_rows runs every row once, on no more threads at once than
- * hbao_parallel_threads says (blur.c's band memory counts on it), for row
- * counts around a grab's and thread counts up to HBAO_MAX_THREADS. */
+ * hbao_parallel_threads says, and hbao_parallel_each every job once on no
+ * more than hbao_parallel_each_threads says (blur.c's band memory counts on
+ * it), for row counts around a grab's and thread counts up to
+ * HBAO_MAX_THREADS. */
 static atomic_int rows_seen[8200], running_now, running_most;
 static void count_row(void *context, int row) {
     (void)context;
@@ -1138,6 +1140,21 @@ TEST_CASE(parallel_rows_run_each_row_once_on_the_threads_they_say) {
             CHECK(atomic_load(&running_most) <= allowed);
             CHECK(allowed >= 1 || rows[r] == 0);
             CHECK(allowed <= threads[t]);
+            /* one a grab (the blur's jobs): each once, on no more threads
+             * than hbao_parallel_each_threads says */
+            for (int k = 0; k < rows[r]; k++) atomic_store(&rows_seen[k], 0);
+            atomic_store(&running_most, 0);
+            hbao_parallel_each(threads[t], rows[r], count_row, NULL);
+            const int each = hbao_parallel_each_threads(threads[t], rows[r]);
+            wrong = 0;
+            for (int k = 0; k < rows[r]; k++) wrong += atomic_load(&rows_seen[k]) != 1;
+            if (wrong || atomic_load(&running_most) > each)
+                printf("  each: %d threads, %d jobs: %d not run once, %d at once (at most %d)\n",
+                       threads[t], rows[r], wrong, atomic_load(&running_most), each);
+            CHECK(wrong == 0);
+            CHECK(atomic_load(&running_most) <= each);
+            CHECK(each >= 1 || rows[r] == 0);
+            CHECK(each <= threads[t] && each <= rows[r]);
         }
     }
 }
