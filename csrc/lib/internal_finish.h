@@ -116,6 +116,13 @@ hbao_result hbao_finish(const hbao_settings *settings, const hbao_grid *grid, co
 void hbao_upsample_row(int implementation, const hbao_grid *half, const float *half_ao,
                        const hbao_channel *depth, float background, int width, int j, float *ao);
 
+/* The upsample's chunks of half columns: where the half grid is background
+ * at a chunk's HBAO_UPSAMPLE_SKY_CHUNK + 1 columns on both of a row's half
+ * rows, no pixel of the chunk has a usable sample, and it writes 1 there
+ * without weighing any. 16 (32 pixels): whole vectors of SSE2's 4 lanes and
+ * AVX-512's 16. */
+#define HBAO_UPSAMPLE_SKY_CHUNK 16
+
 /* How many strips of columns the blur cuts a band's rows of `width`
  * pixels into at `radius` (blur.c, STRIP_BYTES_PER_PIXEL): one where the
  * 2r + 1 rows of taps fit in `budget` bytes, else as many as bring each

@@ -98,6 +98,32 @@ static HBAO_ALWAYS_INLINE float odd_pixel(const half_rows *h, int two_rows, floa
     return finish_pixel(z, sum, weight_sum, nearest_ao);
 }
 
+/* Whether the half grid is background (depth 0) at columns first to
+ * first + SKY_CHUNK of both rows (internal_finish.h): then no candidate of
+ * the chunk's pairs is usable, and each of its 2 * SKY_CHUNK pixels is
+ * finish_pixel's 1 (the nearest candidate's AO where none weighs enough, 1
+ * where none is usable; 1 on background). A sky above geometry at half
+ * resolution. Testing the row's own depths instead (32 strided reads a
+ * chunk) cost frames without sky 1-2 %; the first column's test alone
+ * leaves most chunks of geometry. */
+#define SKY_CHUNK HBAO_UPSAMPLE_SKY_CHUNK
+static HBAO_ALWAYS_INLINE int sky_chunk(const half_rows *h, int first) {
+    if ((h->z_top[first] > 0.0f) | (h->z_bottom[first] > 0.0f)) return 0;
+    int any = (h->z_top[first + SKY_CHUNK] > 0.0f) | (h->z_bottom[first + SKY_CHUNK] > 0.0f);
+    for (int i = first; i < first + SKY_CHUNK; i++)
+        any |= (h->z_top[i] > 0.0f) | (h->z_bottom[i] > 0.0f);
+    return !any;
+}
+
+/* Pixels 2k and 2k + 1 of a pair (half columns k and k + 1) */
+static HBAO_ALWAYS_INLINE void upsample_pair(const half_rows *h, int two_rows, const float *z_row,
+                                             int64_t stride, float background, int k,
+                                             float *restrict out) {
+    out[2 * k] = even_pixel(h, two_rows, guide_depth(z_row, stride, background, 2 * k), k);
+    out[2 * k + 1] =
+        odd_pixel(h, two_rows, guide_depth(z_row, stride, background, 2 * k + 1), k, k + 1, 0.5f);
+}
+
 /* One full-resolution row; candidates in the order (left, top), (right,
  * top), (left, bottom), (right, bottom). Pixel 2k sits on half column k and
  * pixel 2k + 1 between columns k and k + 1: one loop over k makes both, so
@@ -124,10 +150,20 @@ static HBAO_ALWAYS_INLINE void upsample_rows(const hbao_grid *half, const float 
     /* odd pixels with a half column to their right; the last one may have
      * none (width even, half_width = width / 2) */
     const int pairs = odd_count < half_width - 1 ? odd_count : half_width - 1;
-    for (int k = 0; k < pairs; k++) {
-        out[2 * k] = even_pixel(&h, two_rows, guide_depth(z_row, stride, background, 2 * k), k);
-        out[2 * k + 1] = odd_pixel(&h, two_rows, guide_depth(z_row, stride, background, 2 * k + 1),
-                                   k, k + 1, 0.5f);
+    int first = 0;
+    while (first < pairs) {
+        /* a run of sky chunks */
+        while (first + SKY_CHUNK <= pairs && sky_chunk(&h, first)) {
+            for (int i = 0; i < 2 * SKY_CHUNK; i++) out[2 * first + i] = 1.0f;
+            first += SKY_CHUNK;
+        }
+        /* then one of the others (or the pairs left), made in one loop */
+        int end = first + SKY_CHUNK;
+        while (end + SKY_CHUNK <= pairs && !sky_chunk(&h, end)) end += SKY_CHUNK;
+        end = end < pairs ? end : pairs;
+        for (int k = first; k < end; k++)
+            upsample_pair(&h, two_rows, z_row, stride, background, k, out);
+        first = end;
     }
     for (int k = pairs; k < even_count; k++)
         out[2 * k] = even_pixel(&h, two_rows, guide_depth(z_row, stride, background, 2 * k), k);

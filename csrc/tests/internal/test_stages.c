@@ -505,6 +505,41 @@ static double documented_upsample(const hbao_grid *half, const float *half_ao, i
     return ao < 0.0 ? 0.0 : (ao > 1.0 ? 1.0 : ao);
 }
 
+/* How many pixels copy `implementation` (resolved by
+ * hbao_finish_implementation) upsamples more than 1e-5 from
+ * documented_upsample, half_ao on `half` guided by `guide` (width x height;
+ * row: width floats of room). Pixels whose weights sum to within 1 % of the
+ * fallback's 1e-6 are not compared (float and double may take different
+ * sides): the scalar copy counts them in *not_compared, and in *blended and
+ * *fallen_back the pixels that a fallback at 1e-5 or 1e-7 would move by more
+ * than 0.05. */
+static int upsample_off_documented(const hbao_grid *half, const float *half_ao,
+                                   const hbao_channel *guide, int width, int height,
+                                   int implementation, float *row, int *not_compared, int *blended,
+                                   int *fallen_back) {
+    const int copy = hbao_finish_implementation(implementation);
+    const int counts = implementation == HBAO_IMPLEMENTATION_SCALAR;
+    int off = 0;
+    for (int j = 0; j < height; j++) {
+        hbao_upsample_row(copy, half, half_ao, guide, INFINITY, width, j, row);
+        for (int i = 0; i < width; i++) {
+            double sum, gap;
+            const double expected =
+                documented_upsample(half, half_ao, i, j, guide->data[j * width + i], &sum, &gap);
+            if (fabs(sum - 1e-6) < 1e-8) {
+                *not_compared += counts;
+                continue;
+            }
+            if (counts && gap > 0.05) {
+                *blended += sum > 1e-6 && sum <= 1e-5;
+                *fallen_back += sum > 1e-7 && sum <= 1e-6;
+            }
+            off += !(fabs(row[i] - expected) <= 1e-5);
+        }
+    }
+    return off;
+}
+
 /* The upsample weighs depth as docs/algorithm.md writes, to 1e-5 (float
  * rounding, which F's four squarings multiply by 16): full depths 0.7 to 1.3 times
  * their half-grid sample's, in front and behind, and some background on
@@ -549,26 +584,9 @@ TEST_CASE(upsample_weighs_depth_as_documented) {
         }
         for (int implementation = HBAO_IMPLEMENTATION_SCALAR;
              implementation <= HBAO_IMPLEMENTATION_AVX512; implementation++) {
-            const int copy = hbao_finish_implementation(implementation);
-            int off = 0;
-            for (int j = 0; j < height; j++) {
-                hbao_upsample_row(copy, &half, half_ao, &guide, INFINITY, width, j, row);
-                for (int i = 0; i < width; i++) {
-                    double sum, gap;
-                    const double expected = documented_upsample(
-                        &half, half_ao, i, j, full_depth[j * width + i], &sum, &gap);
-                    if (fabs(sum - 1e-6) < 1e-8) {
-                        near_threshold += implementation == HBAO_IMPLEMENTATION_SCALAR;
-                        continue;
-                    }
-                    if (implementation == HBAO_IMPLEMENTATION_SCALAR && gap > 0.05) {
-                        /* pixels a fallback at 1e-5 or 1e-7 would move by > 0.05 */
-                        blended += sum > 1e-6 && sum <= 1e-5;
-                        fallen_back += sum > 1e-7 && sum <= 1e-6;
-                    }
-                    off += !(fabs(row[i] - expected) <= 1e-5);
-                }
-            }
+            const int off =
+                upsample_off_documented(&half, half_ao, &guide, width, height, implementation, row,
+                                        &near_threshold, &blended, &fallen_back);
             if (off)
                 printf("  %dx%d, implementation %d: %d pixels off\n", width, height, implementation,
                        off);
@@ -579,6 +597,79 @@ TEST_CASE(upsample_weighs_depth_as_documented) {
            "0.05 or more from the other choice; %d not compared\n",
            blended, fallen_back, near_threshold);
     CHECK(blended >= 3 && fallen_back >= 3 && near_threshold <= compared / 100);
+}
+
+/* The half rows' skies of upsample_skips_only_skies: columns first to
+ * end - 1, but for one column of geometry (hole; -1: none). Over whole
+ * chunks of HBAO_UPSAMPLE_SKY_CHUNK pairs (each reads one column more),
+ * short of one by its first or its last column or by one in its middle, on
+ * one of a row's two half rows only, and over a whole row. */
+static const int sky_spans[12][3] = {{0, 17, -1},  {0, 16, -1}, {16, 49, -1}, {17, 49, -1},
+                                     {0, 68, -1},  {0, 68, 20}, {32, 68, -1}, {0, 33, -1},
+                                     {32, 65, -1}, {0, 68, 40}, {0, 68, -1},  {5, 60, -1}};
+
+/* For full row j of the half grid `half` (sky where its depth is 0): how
+ * many of the row's chunks are sky on every column they read on both half
+ * rows, and how many miss by one column or by one of the two rows. */
+static void count_sky_chunks(const hbao_grid *half, int width, int j, int *sky, int *near) {
+    const int r0 = j / 2, r1 = (j & 1) && r0 + 1 < half->height ? r0 + 1 : r0;
+    const int odd_count = width / 2;
+    const int pairs = odd_count < half->width - 1 ? odd_count : half->width - 1;
+    for (int first = 0; first + HBAO_UPSAMPLE_SKY_CHUNK <= pairs;
+         first += HBAO_UPSAMPLE_SKY_CHUNK) {
+        int top = 0, bottom = 0;
+        for (int k = first; k <= first + HBAO_UPSAMPLE_SKY_CHUNK; k++) {
+            top += half->depth[r0 * half->width + k] > 0.0f;
+            bottom += half->depth[r1 * half->width + k] > 0.0f;
+        }
+        *sky += top + bottom == 0;
+        *near += top + bottom == 1 ||
+                 (r0 != r1 && ((top == 0 && bottom > 0) || (bottom == 0 && top > 0)));
+    }
+}
+
+/* upsample.c writes 1 over a chunk of pairs whose half columns are
+ * background on both half rows, without weighing them. Half-grid skies
+ * (sky_spans) between geometry of AO 0.1 to 0.9, full depths within 10 %
+ * of their sample's and some background: every copy gives
+ * documented_upsample's AO to 1e-5 (pixels whose weights sum to within 1 %
+ * of the fallback's 1e-6 left out, as upsample_weighs_depth_as_documented
+ * does), with sky chunks and near misses among the rows. A chunk written 1
+ * where its last column or its lower row is not sky fails it. */
+TEST_CASE(upsample_skips_only_skies) {
+    enum { width = 135, height = 24 };
+    static float full_depth[width * height], half_depth[width * height];
+    static float half_ao[width * height], row[width];
+    const hbao_grid half = half_grid_of(width, height, half_depth);
+    const hbao_channel guide = {full_depth, 1, width};
+    CHECK(half.width == 68 && half.height == 12);
+    uint32_t state = 17u;
+    for (int r = 0; r < half.height; r++) {
+        for (int k = 0; k < half.width; k++) {
+            const int sky = k >= sky_spans[r][0] && k < sky_spans[r][1] && k != sky_spans[r][2];
+            half_depth[r * half.width + k] = sky ? 0.0f : 1.0f + 0.02f * (float)(k % 5);
+            half_ao[r * half.width + k] = 0.1f + (float)(next_random(&state) % 801) / 1000.0f;
+        }
+    }
+    for (int j = 0; j < height; j++) {
+        for (int i = 0; i < width; i++) {
+            const float u = (float)(next_random(&state) % 1000) / 1000.0f * 0.2f - 0.1f;
+            full_depth[j * width + i] = next_random(&state) % 20 == 0 ? 0.0f : 1.0f + u;
+        }
+    }
+    int sky = 0, near = 0, not_compared = 0, blended = 0, fallen_back = 0;
+    for (int j = 0; j < height; j++) count_sky_chunks(&half, width, j, &sky, &near);
+    for (int implementation = HBAO_IMPLEMENTATION_SCALAR;
+         implementation <= HBAO_IMPLEMENTATION_AVX512; implementation++) {
+        const int off =
+            upsample_off_documented(&half, half_ao, &guide, width, height, implementation, row,
+                                    &not_compared, &blended, &fallen_back);
+        if (off) printf("  implementation %d: %d pixels off\n", implementation, off);
+        CHECK(off == 0);
+    }
+    printf("  %d sky chunks, %d missing sky by a column or a row; %d pixels not compared\n", sky,
+           near, not_compared);
+    CHECK(sky >= 8 && near >= 8 && not_compared <= width * height / 100);
 }
 
 /* The normals hbao_compute_normals makes for a w x h image of `depth`
@@ -1371,7 +1462,7 @@ TEST_MAIN(TEST_ENTRY(blur_copies_agree_on_background_at_every_sharpness),
           TEST_ENTRY(blur_strips_give_the_same_floats), TEST_ENTRY(blur_follows_its_formula),
           TEST_ENTRY(half_resolution_blur_reaches_as_far),
           TEST_ENTRY(upsample_weights_are_bilinear_on_a_flat_depth),
-          TEST_ENTRY(upsample_weighs_depth_as_documented),
+          TEST_ENTRY(upsample_weighs_depth_as_documented), TEST_ENTRY(upsample_skips_only_skies),
           TEST_ENTRY(face_normals_keep_to_their_side_of_a_step),
           TEST_ENTRY(depth_precision_is_told_from_every_row),
           TEST_ENTRY(given_normals_too_short_give_the_face_normal),
