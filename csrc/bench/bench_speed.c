@@ -349,7 +349,7 @@ int main(int argc, char **argv) {
         bench_scene b;
         bench_scene_make(&b, 1920, 1080);
         const size_t pixels = (size_t)1920 * 1080;
-        enum { CASES = 5 };
+        enum { CASES = 7 };
         float *ao = malloc(pixels * sizeof(float)), *sky = malloc(pixels * sizeof(float));
         float *near = malloc(pixels * sizeof(float));
         double *wall = malloc((size_t)CASES * runs * sizeof(double));
@@ -368,20 +368,27 @@ int main(int argc, char **argv) {
         const struct {
             const char *what, *frame;
             float radius;
-            int depth; /* 0: the scene's; 1: sky; 2: one pixel near */
+            int depth;     /* 0: the scene's; 1: sky; 2: one pixel near */
+            int half;      /* half resolution */
+            int reference; /* the case whose time it is divided by */
         } cases[CASES] = {
-            {"nothing (reference)", "every pixel geometry, radius 0.5", 0.5f, 0},
-            {"background pixels and blocks", "upper half background, radius 0.5", 0.5f, 1},
-            {"steps that land on the same pixel", "radius 0.02 (about 10 pixels)", 0.02f, 0},
+            {"nothing (reference)", "every pixel geometry, radius 0.5", 0.5f, 0, 0, 0},
+            {"background pixels and blocks", "upper half background, radius 0.5", 0.5f, 1, 0, 0},
+            {"steps that land on the same pixel", "radius 0.02 (about 10 pixels)", 0.02f, 0, 0, 0},
             {"the horizon search (radius under a pixel but at one pixel)",
-             "radius 1e-4, one pixel near", 1e-4f, 2},
-            {"everything but the depths (radius under a pixel everywhere)", "radius 1e-4", 1e-4f,
-             0},
+             "radius 1e-4, one pixel near", 1e-4f, 2, 0, 0},
+            {"everything but the depths (radius under a pixel everywhere)", "radius 1e-4", 1e-4f, 0,
+             0, 0},
+            {"nothing (reference at half resolution)", "every pixel geometry, half resolution",
+             0.5f, 0, 1, 5},
+            {"background pixels, blocks and upsampled chunks",
+             "upper half background, half resolution", 0.5f, 1, 1, 5},
         };
         for (int round = -1; round < runs; round++) {
             for (int c = 0; c < CASES; c++) {
                 hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
                 p.radius = cases[c].radius;
+                p.half_resolution = cases[c].half;
                 p.implementation = all_columns[last_column].implementation;
                 p.threads = all_columns[last_column].threads;
                 b.depth = cases[c].depth == 1 ? sky : cases[c].depth == 2 ? near : full_depth;
@@ -393,7 +400,8 @@ int main(int argc, char **argv) {
         /* every ratio first: spread_of sorts a case's rounds out of their order */
         double relative[CASES];
         for (int c = 0; c < CASES; c++) {
-            for (int k = 0; k < runs; k++) ratio[k] = wall[c * runs + k] / wall[k];
+            for (int k = 0; k < runs; k++)
+                ratio[k] = wall[c * runs + k] / wall[cases[c].reference * runs + k];
             relative[c] = median_of(ratio, runs);
         }
         for (int c = 0; c < CASES; c++) {
