@@ -1213,39 +1213,39 @@ static void count_row(void *context, int row) {
     atomic_fetch_sub(&running_now, 1);
 }
 
+/* Runs `rows` jobs through `run` (hbao_parallel_rows or hbao_parallel_each)
+ * on `threads` and checks each ran once, on no more than `allowed` threads
+ * at once, and that `allowed` lies between 1 (0 without jobs) and
+ * `threads`. */
+static void check_parallel_run(const char *name,
+                               void (*run)(int threads, int rows, hbao_row_job job, void *context),
+                               int threads, int rows, int allowed) {
+    for (int k = 0; k < rows; k++) atomic_store(&rows_seen[k], 0);
+    atomic_store(&running_most, 0);
+    run(threads, rows, count_row, NULL);
+    int wrong = 0;
+    for (int k = 0; k < rows; k++) wrong += atomic_load(&rows_seen[k]) != 1;
+    if (wrong || atomic_load(&running_most) > allowed)
+        printf("  %s: %d threads, %d rows: %d rows not run once, %d at once (at most %d)\n", name,
+               threads, rows, wrong, atomic_load(&running_most), allowed);
+    CHECK(wrong == 0);
+    CHECK(atomic_load(&running_most) <= allowed);
+    CHECK(allowed >= 1 || rows == 0);
+    CHECK(allowed <= threads);
+}
+
 TEST_CASE(parallel_rows_run_each_row_once_on_the_threads_they_say) {
     const int threads[] = {1, 2, 3, 7, 64, HBAO_MAX_THREADS};
     const int rows[] = {0, 1, 5, 7, 8, 9, 31, 32, 33, 255, 256, 8192};
     for (size_t t = 0; t < sizeof threads / sizeof threads[0]; t++) {
         for (size_t r = 0; r < sizeof rows / sizeof rows[0]; r++) {
-            for (int k = 0; k < rows[r]; k++) atomic_store(&rows_seen[k], 0);
-            atomic_store(&running_most, 0);
-            hbao_parallel_rows(threads[t], rows[r], count_row, NULL);
-            int wrong = 0;
-            for (int k = 0; k < rows[r]; k++) wrong += atomic_load(&rows_seen[k]) != 1;
-            const int allowed = hbao_parallel_threads(threads[t], rows[r]);
-            if (wrong || atomic_load(&running_most) > allowed)
-                printf("  %d threads, %d rows: %d rows not run once, %d at once (at most %d)\n",
-                       threads[t], rows[r], wrong, atomic_load(&running_most), allowed);
-            CHECK(wrong == 0);
-            CHECK(atomic_load(&running_most) <= allowed);
-            CHECK(allowed >= 1 || rows[r] == 0);
-            CHECK(allowed <= threads[t]);
+            check_parallel_run("rows", hbao_parallel_rows, threads[t], rows[r],
+                               hbao_parallel_threads(threads[t], rows[r]));
             /* one a grab (the blur's jobs): each once, on no more threads
-             * than hbao_parallel_each_threads says */
-            for (int k = 0; k < rows[r]; k++) atomic_store(&rows_seen[k], 0);
-            atomic_store(&running_most, 0);
-            hbao_parallel_each(threads[t], rows[r], count_row, NULL);
+             * than hbao_parallel_each_threads says, nor more than jobs */
             const int each = hbao_parallel_each_threads(threads[t], rows[r]);
-            wrong = 0;
-            for (int k = 0; k < rows[r]; k++) wrong += atomic_load(&rows_seen[k]) != 1;
-            if (wrong || atomic_load(&running_most) > each)
-                printf("  each: %d threads, %d jobs: %d not run once, %d at once (at most %d)\n",
-                       threads[t], rows[r], wrong, atomic_load(&running_most), each);
-            CHECK(wrong == 0);
-            CHECK(atomic_load(&running_most) <= each);
-            CHECK(each >= 1 || rows[r] == 0);
-            CHECK(each <= threads[t] && each <= rows[r]);
+            check_parallel_run("each", hbao_parallel_each, threads[t], rows[r], each);
+            CHECK(each <= rows[r]);
         }
     }
 }
