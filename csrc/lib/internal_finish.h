@@ -119,8 +119,8 @@ void hbao_upsample_row(int implementation, const hbao_grid *half, const float *h
 /* The upsample's chunks of half columns: where the half grid is background
  * at a chunk's HBAO_UPSAMPLE_SKY_CHUNK + 1 columns on both of a row's half
  * rows, no pixel of the chunk has a usable sample, and it writes 1 there
- * without weighing any. 16 (32 pixels): whole vectors of SSE2's 4 lanes and
- * AVX-512's 16. */
+ * without weighing any. 16 (32 pixels): a sky narrower than a chunk, or
+ * a chunk with any geometry, is weighed as before. */
 #define HBAO_UPSAMPLE_SKY_CHUNK 16
 
 /* How many strips of columns the blur cuts a band's rows of `width`
