@@ -11,6 +11,8 @@
 # Builds build-fuzz/ with clang (cmake -DHBAO_BUILD_FUZZERS=ON), then runs each
 # target on one core for its share of SECONDS: 40% each for the two EXR
 # targets, 20% for the JSON parser, which runs ~100x more inputs per second.
+# The targets run side by side, $JOBS (2) at a time: on 2 cores the run takes
+# 60% of SECONDS.
 # Seeds: tests/fixtures and csrc/fuzz/corpus/<target> (kept in the repository);
 # what a run learns goes to build-fuzz/fuzz-corpus/<target>, so later runs
 # start from there. Prints executions per target and in total; a finding (crash,
@@ -31,9 +33,11 @@ CC=${FUZZ_CC:-clang} cmake -S "$repo" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebI
 cmake --build "$build" -j"${JOBS:-2}" --target $targets >/dev/null
 
 mkdir -p "$build/fuzz-artifacts"
-total=0
-findings=0
-for target in $targets; do
+
+# fuzz TARGET: runs TARGET for its share of SECONDS and writes "STATUS RUNS"
+# to its result file
+fuzz() {
+    target=$1
     case $target in
         fuzz_camera_json) share=$((seconds * 20 / 100)); dict=json.dict ;;
         *) share=$((seconds * 40 / 100)); dict=exr.dict ;;
@@ -42,8 +46,6 @@ for target in $targets; do
     work="$build/fuzz-corpus/$target"
     mkdir -p "$work"
     log="$build/fuzz-$target.log"
-    # -close_fd_mask=3: the tool's warnings would flood the log; libFuzzer
-    # keeps its own output and the sanitizers' reports on a copy of stderr.
     status=0
     ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=0 \
     UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
@@ -52,12 +54,35 @@ for target in $targets; do
         -dict="$repo/csrc/fuzz/$dict" -artifact_prefix="$build/fuzz-artifacts/$target-" \
         "$work" "$repo/csrc/fuzz/corpus/$target" "$repo/tests/fixtures" >"$log" 2>&1 || status=$?
     runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
-    runs=${runs:-0}
+    echo "$status ${runs:-0} $share" >"$build/fuzz-$target.result"
+}
+
+# Each target is one process on one core, so they run side by side, $JOBS
+# (2) at a time, in the order above: on 2 cores the two EXR targets
+# together, then the JSON parser. Each still has its share of SECONDS.
+jobs=${JOBS:-2}
+running=0
+for target in $targets; do
+    rm -f "$build/fuzz-$target.result"
+    fuzz "$target" &
+    running=$((running + 1))
+    if [ "$running" -ge "$jobs" ]; then
+        wait
+        running=0
+    fi
+done
+wait
+
+total=0
+findings=0
+for target in $targets; do
+    log="$build/fuzz-$target.log"
+    status=1 runs=0 share=0
+    if [ -f "$build/fuzz-$target.result" ]; then
+        read -r status runs share <"$build/fuzz-$target.result"
+    fi
     total=$((total + runs))
     if [ "$status" -eq 72 ] && grep -q "^==[0-9]*== libFuzzer: run interrupted" "$log"; then
-        # libFuzzer's exit status for a SIGINT or SIGTERM (-interrupted_exitcode):
-        # the run was stopped, nothing was found (a CI run cancelled in session 65
-        # read as a finding); the script still fails
         echo "fuzz.sh: $target: interrupted after $runs executions (a signal); log $log"
         exit 1
     elif [ "$status" -ne 0 ]; then
