@@ -18,6 +18,18 @@ REPO = Path(__file__).resolve().parents[1]
 BPY_RUNNER = REPO / "scripts" / "bpy_blender.py"
 # Run before every UI script: no splash over the window (Blender.command).
 NO_SPLASH = "import bpy; bpy.context.preferences.view.show_splash = False"
+# A UI run's X screen (xvfb-run), which Blender's window fills, and the 3D
+# view's anti-aliasing, off unless a run asks for it (Blender's default, 8
+# samples). On Mesa's llvmpipe the CPU draws every pixel, and the view drew
+# each sample again: a redraw of the default window took 0.72 CPU s at
+# 1280x1024 with it, 0.61 without, 0.38 without the view's overlays too,
+# 0.04 with the view closed. The Blender runs of test_ui, test_faults_ui and test_viewport
+# took 848 CPU s at 1280x1024 with the anti-aliasing (of 2550 CPU s for the
+# whole pytest stage), 608 at 1024x768, 486 with it off in every run too,
+# and 638 as here (test_viewport's runs ask for it): one run each, on 2
+# pytest workers.
+XVFB_SCREEN = (1024, 768)
+NO_VIEW_ANTI_ALIASING = "bpy.context.preferences.system.viewport_aa = 'OFF'"
 # Where scripts/setup_bpy.sh keeps its virtual environments: outside the
 # checkout, so that every clone (and CI's fresh clone) reuses one download.
 BPY_ROOT = Path(os.environ.get("HBAO_BPY_ROOT", Path.home() / ".cache" / "hbao" / "bpy"))
@@ -53,10 +65,12 @@ class Blender:
         return self.version_tuple >= (4, 2)
 
     def command(self, script=None, args=(), blend=None, addons=("hbao",), ui=False,
-                output=None, frame=None, animation=None):
+                output=None, frame=None, animation=None, view_anti_aliasing=False):
         """The command line that opens `blend` (or factory settings), enables
         `addons`, then renders `frame` or the `animation` (start, end) to
-        `output`, or runs `script` with `args` after `--`."""
+        `output`, or runs `script` with `args` after `--`. With `ui`, in a
+        window under Xvfb (XVFB_SCREEN), the 3D view anti-aliased only with
+        `view_anti_aliasing`."""
         if ui and not self.has_ui:
             raise ValueError(f"{self.name} has no user interface")
         if self.kind == "app":
@@ -89,11 +103,13 @@ class Blender:
                 # Setup), which would hide half of what the script's
                 # screenshots show. The preference is read when the splash
                 # is due, after the command line's scripts have run.
-                command += ["--python-expr", NO_SPLASH]
+                preferences = NO_SPLASH if view_anti_aliasing \
+                    else f"{NO_SPLASH}; {NO_VIEW_ANTI_ALIASING}"
+                command += ["--python-expr", preferences]
             command += ["--python", str(script), "--"] + [str(a) for a in args]
         if ui:
             command = ["xvfb-run", "-a", "--server-num", str(_first_display()),
-                       "-s", "-screen 0 1280x1024x24"] + command
+                       "-s", f"-screen 0 {XVFB_SCREEN[0]}x{XVFB_SCREEN[1]}x24"] + command
         return command
 
 

@@ -281,9 +281,11 @@ def pytest_terminal_summary(terminalreporter):
 
 def _runner(blender, user_scripts):
     def run(script, *args, blend=None, ui=False, addon=True, env=None, check=True,
-            timeout=BLENDER_TIMEOUT_S, debug_memory=False, addon_errors=False):
+            timeout=BLENDER_TIMEOUT_S, debug_memory=False, addon_errors=False,
+            view_anti_aliasing=False):
         command = blender.command(script, args, blend=blend, ui=ui,
-                                  addons=("hbao",) if addon else ())
+                                  addons=("hbao",) if addon else (),
+                                  view_anti_aliasing=view_anti_aliasing)
         if debug_memory and blender.kind == "app":  # bpy has no such option
             # Blender's allocator fills freed memory: reading it then crashes.
             command.insert(command.index(blender.executable) + 1, "--debug-memory")
@@ -294,13 +296,15 @@ def _runner(blender, user_scripts):
 @pytest.fixture(scope="session")
 def run_blender(blender_user_scripts):
     """run_blender(script, *args, blend=None, ui=False, addon=True, env=None,
-    debug_memory=False)
+    debug_memory=False, view_anti_aliasing=False)
 
     Runs `script` (a path) in Debian's Blender, factory settings, this
     checkout's add-on enabled unless addon=False. Headless, or with ui=True in
-    a real window under xvfb-run. Arguments after `--` reach the script via
-    sys.argv. Returns the CompletedProcess; fails the test on a non-zero exit,
-    showing Blender's output."""
+    a real window under xvfb-run (the 3D view anti-aliased as Blender's
+    default has it only with view_anti_aliasing=True: blenders.py).
+    Arguments after `--` reach the script via sys.argv. Returns the
+    CompletedProcess; fails the test on a non-zero exit, showing Blender's
+    output."""
     if DEBIAN_BLENDER is None:
         pytest.fail("blender not found: run scripts/setup.sh")
     return _runner(DEBIAN_BLENDER, blender_user_scripts)

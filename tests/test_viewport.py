@@ -18,6 +18,10 @@ from hbao.viewport import camera_sources, projection, shader_sources  # noqa: E4
 
 SCRIPTS = REPO / "tests" / "blender_scripts"
 ARTIFACTS = REPO / "out" / "test-artifacts"
+# A window's run, its 3D view anti-aliased as Blender's default has it (the
+# other UI tests draw theirs without: scripts/blenders.py): the preview is
+# seen as an artist sees it.
+IN_A_WINDOW = {"ui": True, "view_anti_aliasing": True}
 # One worker runs the module (its module fixtures run Blender once a worker).
 pytestmark = pytest.mark.xdist_group("test_viewport")
 
@@ -94,7 +98,8 @@ def blender_that_draws(request):
 def match_report(blender_that_draws, blender_user_scripts, built_library, tmp_path_factory):
     out = tmp_path_factory.mktemp("viewport_match") / "match.json"
     run = _runner(blender_that_draws, blender_user_scripts)
-    run(SCRIPTS / "viewport_match.py", out, ui=blender_that_draws.has_ui)
+    run(SCRIPTS / "viewport_match.py", out, ui=blender_that_draws.has_ui,
+        view_anti_aliasing=True)
     return json.loads(out.read_text())
 
 
@@ -157,7 +162,7 @@ def test_glsl_constants_match_the_library(name, glsl_value, source, define):
 def toggle_report(run_blender, tmp_path_factory):
     ARTIFACTS.mkdir(parents=True, exist_ok=True)
     out = tmp_path_factory.mktemp("viewport_toggle") / "toggle.json"
-    run_blender(SCRIPTS / "viewport_toggle.py", out, ARTIFACTS / "viewport_hbao.png", ui=True)
+    run_blender(SCRIPTS / "viewport_toggle.py", out, ARTIFACTS / "viewport_hbao.png", **IN_A_WINDOW)
     return json.loads(out.read_text())
 
 
@@ -220,7 +225,7 @@ def test_preview_comes_back_when_the_add_on_is_enabled_again(run_blender):
     view previews again at once, without a toggle (enabling registers the
     add-on where it may not read the file's data; the sync waits for the
     main loop)."""
-    log = run_blender(SCRIPTS / "viewport_reenable.py", ui=True).stdout
+    log = run_blender(SCRIPTS / "viewport_reenable.py", **IN_A_WINDOW).stdout
     assert "REENABLE: DONE" in log, log[-3000:]
     handlers = [line for line in log.splitlines() if line.startswith("HANDLER ")]
     assert handlers == ["HANDLER on True", "HANDLER enabled again True"], log[-3000:]
@@ -235,7 +240,7 @@ def test_a_closed_views_preview_goes_with_it(run_blender, tmp_path, case):
     7 of 8 views split off afterwards started with it on, and the draw
     handler stayed on with no view on. Now the closed view's settings are
     found by no other view, turn the handler off, and are not saved."""
-    log = run_blender(SCRIPTS / "viewport_close.py", case, tmp_path, ui=True).stdout
+    log = run_blender(SCRIPTS / "viewport_close.py", case, tmp_path, **IN_A_WINDOW).stdout
     assert "CLOSE: DONE" in log, log[-3000:]
     seen = {line.split(" ", 1)[0] + " " + line.split(" ", 2)[1]: line.split(" ", 2)[2]
             for line in log.splitlines() if line.startswith(("VIEWS ", "HANDLER ", "ENTRIES "))}
@@ -256,7 +261,7 @@ def test_x_ray_says_why_the_preview_draws_nothing(run_blender, tmp_path):
     """Solid shading's X-ray below alpha 1 writes no depth: the preview drew
     nothing and the panel said nothing (an exploratory run). The panel says
     why (draw.not_drawn); at alpha 1 the preview darkens the view."""
-    log = run_blender(SCRIPTS / "viewport_xray.py", tmp_path, ui=True).stdout
+    log = run_blender(SCRIPTS / "viewport_xray.py", tmp_path, **IN_A_WINDOW).stdout
     assert "XRAY: DONE" in log, log[-3000:]
     cases = {line.split(" ", 2)[1]: json.loads(line.split(" ", 2)[2])
              for line in log.splitlines() if line.startswith("XRAY ") and "{" in line}
@@ -276,7 +281,7 @@ def test_without_a_gpu_the_panel_says_what_a_frame_costs(run_blender, tmp_path):
     of the depth's upload alone would not tell them apart); the note names
     the time draw.py kept; and where the preview cannot draw (X-ray below
     alpha 1) the note is left out, as the panel then says why."""
-    log = run_blender(SCRIPTS / "viewport_software.py", tmp_path, ui=True).stdout
+    log = run_blender(SCRIPTS / "viewport_software.py", tmp_path, **IN_A_WINDOW).stdout
     assert "SOFTWARE: DONE" in log and "Traceback" not in log, log[-3000:]
     report = json_line(log, "SOFTWARE")
     assert report["software"] is True, "Xvfb's Blender draws with Mesa's llvmpipe"
@@ -301,7 +306,7 @@ def test_the_preview_darkens_the_scene_under_the_overlays_not_them(run_blender, 
     drawn there lose less than 0.4 times as much (0.19 in Blender 3.4:
     antialiased edges let some scene through); before, they lost more
     than the scene (1.36 times: they are brighter)."""
-    log = run_blender(SCRIPTS / "viewport_overlays.py", tmp_path, ui=True).stdout
+    log = run_blender(SCRIPTS / "viewport_overlays.py", tmp_path, **IN_A_WINDOW).stdout
     assert "OVERLAYS: DONE" in log, log[-3000:]
     result = json_line(log, "OVERLAYS")
     assert result["pixels"] >= 30, result
