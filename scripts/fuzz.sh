@@ -23,6 +23,8 @@ set -eu
 repo=$(cd "$(dirname "$0")/.." && pwd)
 seconds=${1:-60}
 case $seconds in ''|*[!0-9]*) echo "usage: scripts/fuzz.sh [SECONDS]" >&2; exit 2;; esac
+jobs=${JOBS:-2}
+case $jobs in ''|*[!0-9]*|0) echo "fuzz.sh: JOBS=$jobs: give a count of processes" >&2; exit 2;; esac
 build="$repo/build-fuzz"
 targets="fuzz_exr_compute fuzz_keep_input fuzz_camera_json"
 
@@ -30,12 +32,12 @@ CC=${FUZZ_CC:-clang} cmake -S "$repo" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebI
     -DHBAO_BUILD_FUZZERS=ON -DHBAO_BUILD_TOOL=ON -DHBAO_BUILD_TESTS=OFF \
     -DHBAO_BUILD_BENCHMARKS=OFF >/dev/null
 # shellcheck disable=SC2086
-cmake --build "$build" -j"${JOBS:-2}" --target $targets >/dev/null
+cmake --build "$build" -j"$jobs" --target $targets >/dev/null
 
 mkdir -p "$build/fuzz-artifacts"
 
-# fuzz TARGET: runs TARGET for its share of SECONDS and writes "STATUS RUNS"
-# to its result file
+# fuzz TARGET: runs TARGET for its share of SECONDS and writes "STATUS RUNS
+# SHARE" to its result file
 fuzz() {
     target=$1
     case $target in
@@ -46,6 +48,8 @@ fuzz() {
     work="$build/fuzz-corpus/$target"
     mkdir -p "$work"
     log="$build/fuzz-$target.log"
+    # -close_fd_mask=3: the tool's warnings would flood the log; libFuzzer
+    # keeps its own output and the sanitizers' reports on a copy of stderr.
     status=0
     ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=0 \
     UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
@@ -60,7 +64,6 @@ fuzz() {
 # Each target is one process on one core, so they run side by side, $JOBS
 # (2) at a time, in the order above: on 2 cores the two EXR targets
 # together, then the JSON parser. Each still has its share of SECONDS.
-jobs=${JOBS:-2}
 running=0
 for target in $targets; do
     rm -f "$build/fuzz-$target.result"
@@ -83,6 +86,9 @@ for target in $targets; do
     fi
     total=$((total + runs))
     if [ "$status" -eq 72 ] && grep -q "^==[0-9]*== libFuzzer: run interrupted" "$log"; then
+        # libFuzzer's exit status for a SIGINT or SIGTERM (-interrupted_exitcode):
+        # the run was stopped, nothing was found (a CI run cancelled in session 65
+        # read as a finding); the script still fails
         echo "fuzz.sh: $target: interrupted after $runs executions (a signal); log $log"
         exit 1
     elif [ "$status" -ne 0 ]; then

@@ -18,6 +18,7 @@ set -eu
 repo=$(cd "$(dirname "$0")/.." && pwd)
 cases=${1:-500}
 seed=${2:-1}
+case ${JOBS:-0} in *[!0-9]*) echo "fuzz_cli.sh: JOBS=$JOBS: give a count of processes" >&2; exit 2;; esac
 tool=${HBAO_TOOL:-}
 if [ -z "$tool" ]; then
     build="$repo/build-sanitize"
@@ -96,27 +97,24 @@ def run_case(source, case, content):
 counts = {0: 0, 1: 0}
 workers = int(jobs) if int(jobs) > 0 else (os.cpu_count() or 1)
 with concurrent.futures.ThreadPoolExecutor(workers) as pool:
-    pending = set()
-    for mutation in mutations():
-        pending.add(pool.submit(run_case, *mutation))
-        if len(pending) < 4 * workers:
-            continue
-        done, pending = concurrent.futures.wait(pending,
-                                                return_when=concurrent.futures.FIRST_COMPLETED)
-        for future in done:
+
+    def tally(futures):
+        for future in futures:
             statuses, failure = future.result()
-            if failure:
-                for other in pending:
-                    other.cancel()
+            if failure:  # the runs under way end; those not begun never start
+                pool.shutdown(wait=True, cancel_futures=True)
                 sys.exit(failure)
             for status in statuses:
                 counts[status] += 1
-    for future in concurrent.futures.as_completed(pending):
-        statuses, failure = future.result()
-        if failure:
-            sys.exit(failure)
-        for status in statuses:
-            counts[status] += 1
+
+    pending = set()
+    for mutation in mutations():  # a few cases a worker ahead, not all in memory
+        pending.add(pool.submit(run_case, *mutation))
+        if len(pending) >= 4 * workers:
+            done, pending = concurrent.futures.wait(
+                pending, return_when=concurrent.futures.FIRST_COMPLETED)
+            tally(done)
+    tally(concurrent.futures.as_completed(pending))
 print(f"fuzz_cli.sh: {len(sources)} fixtures, {sum(counts.values())} runs: "
       f"{counts[0]} succeeded, {counts[1]} clean errors, 0 crashes")
 PYTHON
