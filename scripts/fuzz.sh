@@ -23,8 +23,10 @@ set -eu
 repo=$(cd "$(dirname "$0")/.." && pwd)
 seconds=${1:-60}
 case $seconds in ''|*[!0-9]*) echo "usage: scripts/fuzz.sh [SECONDS]" >&2; exit 2;; esac
+# shellcheck source=jobs.sh
+. "$repo/scripts/jobs.sh"
+jobs_check fuzz.sh
 jobs=${JOBS:-2}
-case $jobs in ''|*[!0-9]*|0) echo "fuzz.sh: JOBS=$jobs: give a count of processes" >&2; exit 2;; esac
 build="$repo/build-fuzz"
 targets="fuzz_exr_compute fuzz_keep_input fuzz_camera_json"
 

@@ -18,7 +18,9 @@ set -eu
 repo=$(cd "$(dirname "$0")/.." && pwd)
 cases=${1:-500}
 seed=${2:-1}
-case ${JOBS:-0} in *[!0-9]*) echo "fuzz_cli.sh: JOBS=$JOBS: give a count of processes" >&2; exit 2;; esac
+# shellcheck source=jobs.sh
+. "$repo/scripts/jobs.sh"
+jobs_check fuzz_cli.sh
 tool=${HBAO_TOOL:-}
 if [ -z "$tool" ]; then
     build="$repo/build-sanitize"

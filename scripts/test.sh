@@ -14,6 +14,9 @@
 set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$REPO"
+# shellcheck source=jobs.sh
+. "$REPO/scripts/jobs.sh"
+jobs_check test.sh
 JOBS="${JOBS:-2}"
 # Debian's Python, which has the numpy and pytest that setup.sh installs (a
 # python3 earlier on PATH, e.g. pyenv's, may not).
