@@ -222,3 +222,24 @@ def test_a_save_during_f12_leaves_its_render_the_add_ons_scenes(run_blender, tmp
     assert set(json_line(log, "RENDERED")) >= set(written) | {"Scene"}, log[-3000:]
     line = timing_line_of(log)
     assert "guard band passes" in line and "back faces passes" in line, line
+
+
+def test_an_f12_renders_memory_is_held_for_the_next_then_released(run_blender, tmp_path):
+    """In a window the add-on holds the library's working memory after an
+    F12 render, so that the next render's AO does not fault it in again
+    (about 30 ms at 1080p: scripts/bench_memory_hold.py), and hands it back
+    once no render has ended for the hold (memory_hold.py; 3 s here): two
+    1080p renders half a second apart, both held; the release comes after
+    the hold, within its timer's look and the script's tick, and gives back
+    the library's buffers (about 24 bytes a pixel: 40 MB or more)."""
+    hold_s = 3.0
+    completed = run_blender(SCRIPTS / "ui_memory_hold.py", tmp_path / "hold", hold_s, 2, 0.5,
+                            1920, 1080, ui=True)
+    log = completed.stdout
+    assert "HOLD: DONE" in log, log[-3000:]
+    assert json_line(log, "ENDED 0")["held"] and json_line(log, "ENDED 1")["held"], log[-3000:]
+    assert len([line for line in log.splitlines() if "AO pass(es) 1920x1080" in line]) == 2, \
+        log[-3000:]
+    released = json_line(log, "RELEASED")
+    assert hold_s <= released["waited_s"] <= hold_s + 2.5, released
+    assert released["held_rss_mb"] - released["rss_mb"] >= 40.0, released

@@ -11,7 +11,7 @@ viewport.projection/shader_sources work in plain Python (tests, benchmarks).
                viewport.projection, viewport.shader_sources
     Blender    compat (every version difference), compat_nodes, writes, preferences, node,
                node_status, helper_lookup, helper_scene, socket_values, planning, handover,
-               helper_ao, engine, engine_guard, render_reports, handlers,
+               helper_ao, engine, memory_hold, engine_guard, render_reports, handlers,
                viewport.*
 """
 
@@ -56,10 +56,10 @@ def register():
         preferences.show(message)
         if not compat.version_is_new_enough():
             return  # the message says why; a traceback would not
-    from . import (engine, engine_guard, handlers, node, node_setup, node_status, pass_capture,
-                   recomposite, render_record, render_reports, report, writes)
+    from . import (engine, engine_guard, handlers, memory_hold, node, node_setup, node_status,
+                   pass_capture, recomposite, render_record, render_reports, report, writes)
     for module in (writes, node, node_status, node_setup, render_record, recomposite, engine,
-                   engine_guard, render_reports, pass_capture, handlers):
+                   memory_hold, engine_guard, render_reports, pass_capture, handlers):
         module.register()
         _registered.append(module)
     try:

@@ -14,7 +14,6 @@ import numpy as np
 from . import camera as camera_model
 from . import (compat, exr_passes, native, pass_encoding, recomposite, scratch_files,
                strip_cameras, timing_line)
-from .callback_guard import never_raises
 from .helper_ao import cache, compute_passes, main_of, original, report_warning
 from .helper_lookup import ENGINE_IDNAME, is_helper, pass_names_for_helper
 from .helper_scene import rendered_for_a_scene, scene_for_render
@@ -175,28 +174,12 @@ class HBAOPassEngine(bpy.types.RenderEngine):
         render_helper(self, depsgraph)
 
 
-@bpy.app.handlers.persistent
-@never_raises("release the library's memory after the render")
-def _on_render_end(*_args):
-    native.release_memory()  # kept from frame to frame of a render (a fifth of a frame)
-
-
-_HANDLERS = (bpy.app.handlers.render_complete, bpy.app.handlers.render_cancel)
-
-
 def register():
     if "bl_rna" not in HBAOPassEngine.__dict__:  # kept by unregister, below
         bpy.utils.register_class(HBAOPassEngine)
-    for handlers in _HANDLERS:
-        if _on_render_end not in handlers:
-            handlers.append(_on_render_end)
 
 
 def unregister():
-    for handlers in _HANDLERS:
-        if _on_render_end in handlers:
-            handlers.remove(_on_render_end)
     cache.clear()
-    native.release_memory()
     if not bpy.app.is_job_running("RENDER"):  # (3.4 crashed: blender-integration.md)
         bpy.utils.unregister_class(HBAOPassEngine)

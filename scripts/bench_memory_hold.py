@@ -1,0 +1,90 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""What holding the library's memory between F12 renders saves (the
+add-on's memory_hold.py): F12 renders in Debian's Blender with a window
+(Xvfb), at 1920x1080 unless --size, GAP seconds apart, once with the memory
+released after each render (a hold of 0 s, as the add-on did before) and
+once held (the add-on's hold). Prints the AO time of each render from the
+engine's timing line and the median of all but each run's first (the
+first AO of a process pays for its fresh memory either way).
+
+  scripts/bench_memory_hold.py [--renders 8] [--gap 2] [--size 1920x1080] [--rounds 1]
+
+Needs the build (build/libhbao.so and build/libhbao_exr.so, or the
+libraries that HBAO_LIBRARY and HBAO_EXR_LIBRARY name) and Debian's
+Blender with xvfb-run (scripts/setup.sh)."""
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO / "scripts"))
+sys.path.insert(0, str(REPO / "addon"))
+import blenders  # noqa: E402
+from hbao import timing_line  # noqa: E402  (bpy-free)
+
+INNER = REPO / "tests" / "blender_scripts" / "ui_memory_hold.py"
+# A hold longer than any run here: the memory stays from render to render.
+HELD_S = 600.0
+
+
+def ao_times(blender, user_scripts, out, hold_s, args):
+    """The AO milliseconds of each render of one run."""
+    env = dict(os.environ, BLENDER_USER_SCRIPTS=str(user_scripts), PYTHONUNBUFFERED="1")
+    env.setdefault("HBAO_LIBRARY", str(REPO / "build" / "libhbao.so"))
+    env.setdefault("HBAO_EXR_LIBRARY", str(REPO / "build" / "libhbao_exr.so"))
+    width, height = args.size
+    command = blender.command(INNER, [out, hold_s, args.renders, args.gap, width, height, "quit"],
+                              ui=True)
+    completed = subprocess.run(command, env=env, stdout=subprocess.PIPE,
+                               stderr=subprocess.STDOUT, text=True, timeout=1800)
+    times = [found["ao_ms"] for found in map(timing_line.parse, completed.stdout.splitlines())
+             if found is not None]
+    if completed.returncode != 0 or "HOLD: DONE" not in completed.stdout \
+            or len(times) != args.renders:
+        sys.stderr.write(completed.stdout[-3000:])
+        raise SystemExit(f"bench_memory_hold: the run with a hold of {hold_s} s failed")
+    return times
+
+
+def _size(text):
+    width, _, height = text.partition("x")
+    return int(width), int(height)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--renders", type=int, default=8)
+    parser.add_argument("--gap", type=float, default=2.0,
+                        help="seconds between renders (more than the add-on's 1 s timer)")
+    parser.add_argument("--size", type=_size, default=(1920, 1080))
+    parser.add_argument("--rounds", type=int, default=1, help="runs of each, alternating")
+    args = parser.parse_args()
+    if args.renders < 2:
+        raise SystemExit("bench_memory_hold: --renders must be 2 or more")
+    blender = blenders.debian_blender()
+    if blender is None:
+        raise SystemExit("bench_memory_hold: blender not found: run scripts/setup.sh")
+    results = {"released after each render": [], "held": []}
+    with tempfile.TemporaryDirectory() as folder:
+        user_scripts = Path(folder) / "scripts"
+        (user_scripts / "addons").mkdir(parents=True)
+        (user_scripts / "addons" / "hbao").symlink_to(REPO / "addon" / "hbao")
+        for round_ in range(args.rounds):
+            for name, hold_s in (("released after each render", 0.0), ("held", HELD_S)):
+                times = ao_times(blender, user_scripts, Path(folder) / "out", hold_s, args)
+                print(f"{name}, run {round_ + 1}: AO ms {times}", flush=True)
+                results[name] += times[1:]
+    print(f"{blender.name}, {args.size[0]}x{args.size[1]}, {args.renders} F12 renders a run "
+          f"{args.gap} s apart; AO ms of renders 2-{args.renders}:")
+    for name, times in results.items():
+        print(f"  {name}: median {statistics.median(times):.0f} "
+              f"(min {min(times)}, max {max(times)}, n {len(times)})")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,90 @@
+# SPDX-License-Identifier: GPL-2.0-or-later
+"""Run in a real Blender window (xvfb) by tests/test_ui.py and
+scripts/bench_memory_hold.py: F12 renders of the corner scene at
+WIDTH x HEIGHT, GAP_S seconds apart, the camera nudged before each (so that
+each render's passes differ and its AO is computed, not reused), with the
+add-on holding the library's memory HOLD_S seconds after a render
+(memory_hold.py). After each render it prints
+'ENDED <n> {"held": ..., "rss_mb": ...}'; after the last, it waits for the
+hold to end and prints 'RELEASED {"held_rss_mb": the process's resident
+memory at the last look while held, "rss_mb": right after, "waited_s":
+since the render's end}' (with a last argument "quit", it quits after the
+last render instead). The engine's timing line of each render (its AO
+time) is in the log.
+
+  blender --addons hbao --python ui_memory_hold.py -- \
+      OUT HOLD_S RENDERS GAP_S WIDTH HEIGHT [quit]
+"""
+import json
+import os
+import sys
+import time
+
+import bpy
+
+arguments = sys.argv[sys.argv.index("--") + 1:]
+out_dir = arguments[0]
+hold_s, renders, gap_s = float(arguments[1]), int(arguments[2]), float(arguments[3])
+width, height = int(arguments[4]), int(arguments[5])
+wait_for_release = arguments[6:] != ["quit"]
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import f12_job  # noqa: E402
+import timer_guard  # noqa: E402
+from process_memory import status_kib  # noqa: E402  (scripts/, on the path by f12_job)
+
+RENDER_TIMEOUT_S = 240.0
+# How long after the hold the release may come (the add-on's timer looks every second).
+RELEASE_LATE_S = 10.0
+TICK_S = 0.1
+# The camera's move before each render (scene units; the room is 8 wide).
+NUDGE = 0.002
+
+memory_hold = sys.modules["hbao.memory_hold"]
+memory_hold.HOLD_S = hold_s
+scene, _node = f12_job.corner_scene_with_node(out_dir)
+scene.render.resolution_x, scene.render.resolution_y = width, height
+scene.render.resolution_percentage = 100
+state = {"render": 0, "phase": "start", "since": None, "held_rss": None}
+job = f12_job.F12Job()
+
+
+def rss_mb():
+    return status_kib("VmRSS") / 1024
+
+
+def tick():
+    now = time.monotonic()
+    if state["phase"] == "start":
+        scene.camera.location.x += NUDGE
+        state.update(phase="render", since=now)
+        print(f"HOLD: render {state['render']}", flush=True)
+        job.start()
+    elif state["phase"] == "render":
+        if now - state["since"] > RENDER_TIMEOUT_S:
+            timer_guard.give_up("HOLD: TIMEOUT")
+        if job.finished():
+            print(f"ENDED {state['render']} "
+                  + json.dumps({"held": memory_hold.held(), "rss_mb": rss_mb()}), flush=True)
+            state["render"] += 1
+            if state["render"] == renders and not wait_for_release:
+                print("HOLD: DONE", flush=True)
+                timer_guard.quit_blender()
+                return None
+            state.update(phase="gap" if state["render"] < renders else "release", since=now)
+    elif state["phase"] == "gap":
+        if now - state["since"] >= gap_s:
+            state["phase"] = "start"
+    elif memory_hold.held():
+        if now - state["since"] > hold_s + RELEASE_LATE_S:
+            timer_guard.give_up("HOLD: NOT RELEASED")
+        state["held_rss"] = rss_mb()
+    else:
+        print("RELEASED " + json.dumps({"held_rss_mb": state["held_rss"], "rss_mb": rss_mb(),
+                                        "waited_s": now - state["since"]}), flush=True)
+        print("HOLD: DONE", flush=True)
+        timer_guard.quit_blender()
+        return None
+    return TICK_S
+
+
+timer_guard.guarded_timer(tick, 1.0)
