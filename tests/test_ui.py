@@ -230,7 +230,7 @@ def test_an_f12_renders_memory_is_held_for_the_next_then_released(run_blender, t
     (about 30 ms at 1080p: scripts/bench_memory_hold.py), and hands it back
     once no render has ended for the hold (memory_hold.py; 3 s here): two
     1080p renders half a second apart, both held; the release comes after
-    the hold, within its timer's look and the script's tick, and gives back
+    the hold, within a few of its timer's one-second looks, and gives back
     the library's buffers (about 24 bytes a pixel: 40 MB or more)."""
     hold_s = 3.0
     completed = run_blender(SCRIPTS / "ui_memory_hold.py", tmp_path / "hold", hold_s, 2, 0.5,
@@ -241,5 +241,6 @@ def test_an_f12_renders_memory_is_held_for_the_next_then_released(run_blender, t
     assert len([line for line in log.splitlines() if "AO pass(es) 1920x1080" in line]) == 2, \
         log[-3000:]
     released = json_line(log, "RELEASED")
-    assert hold_s <= released["waited_s"] <= hold_s + 2.5, released
+    # (the timer looks every second; under the suite's load a tick can come late)
+    assert hold_s <= released["waited_s"] <= hold_s + 5.0, released
     assert released["held_rss_mb"] - released["rss_mb"] >= 40.0, released
