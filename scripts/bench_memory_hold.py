@@ -6,15 +6,21 @@ add-on's memory_hold.py): F12 renders in Debian's Blender with a window
 released after each render (a hold of 0 s, as the add-on did before) and
 once held (the add-on's hold). Prints the AO time of each render from the
 engine's timing line and the median of all but each run's first (the
-first AO of a process pays for its fresh memory either way).
+first AO of a process pays for its fresh memory either way). With
+--recomposite: one F12 render, then RENDERS - 1 changes of the node's Radius
+GAP seconds apart with the compositor shown, each re-composited from the
+kept passes: the AO time of each change (computed before the helper's
+render, recomposite.py) and the medians.
 
   scripts/bench_memory_hold.py [--renders 8] [--gap 2] [--size 1920x1080] [--rounds 1]
+                               [--recomposite]
 
 Needs the build (build/libhbao.so and build/libhbao_exr.so, or the
 libraries that HBAO_LIBRARY and HBAO_EXR_LIBRARY name) and Debian's
 Blender with xvfb-run (scripts/setup.sh)."""
 import argparse
 import os
+import re
 import statistics
 import subprocess
 import sys
@@ -30,6 +36,8 @@ from hbao import timing_line  # noqa: E402  (bpy-free)
 INNER = REPO / "tests" / "blender_scripts" / "ui_memory_hold.py"
 # A hold longer than any run here: the memory stays from render to render.
 HELD_S = 600.0
+# A re-composite's AO, in its timing line (timing_line.format_line).
+_RECOMPOSITED_AO = re.compile(r"computed beforehand in (\d+) ms")
 
 
 def ao_times(blender, user_scripts, out, hold_s, args):
@@ -38,12 +46,17 @@ def ao_times(blender, user_scripts, out, hold_s, args):
     env.setdefault("HBAO_LIBRARY", str(REPO / "build" / "libhbao.so"))
     env.setdefault("HBAO_EXR_LIBRARY", str(REPO / "build" / "libhbao_exr.so"))
     width, height = args.size
-    command = blender.command(INNER, [out, hold_s, args.renders, args.gap, width, height, "quit"],
+    mode = "recomposite" if args.recomposite else "quit"
+    command = blender.command(INNER, [out, hold_s, args.renders, args.gap, width, height, mode],
                               ui=True)
     completed = subprocess.run(command, env=env, stdout=subprocess.PIPE,
                                stderr=subprocess.STDOUT, text=True, timeout=1800)
-    times = [found["ao_ms"] for found in map(timing_line.parse, completed.stdout.splitlines())
-             if found is not None]
+    times = []
+    for line in completed.stdout.splitlines():
+        found = timing_line.parse(line)
+        if found is not None:
+            kept = _RECOMPOSITED_AO.search(line) if found["recomposited"] else None
+            times.append(int(kept.group(1)) if kept else found["ao_ms"])
     if completed.returncode != 0 or "HOLD: DONE" not in completed.stdout \
             or len(times) != args.renders:
         sys.stderr.write(completed.stdout[-3000:])
@@ -63,6 +76,8 @@ def main():
                         help="seconds between renders (more than the add-on's 1 s timer)")
     parser.add_argument("--size", type=_size, default=(1920, 1080))
     parser.add_argument("--rounds", type=int, default=1, help="runs of each, alternating")
+    parser.add_argument("--recomposite", action="store_true",
+                        help="one render, then changes of the Radius, re-composited")
     args = parser.parse_args()
     if args.renders < 2:
         raise SystemExit("bench_memory_hold: --renders must be 2 or more")
@@ -79,8 +94,13 @@ def main():
                 times = ao_times(blender, user_scripts, Path(folder) / "out", hold_s, args)
                 print(f"{name}, run {round_ + 1}: AO ms {times}", flush=True)
                 results[name] += times[1:]
-    print(f"{blender.name}, {args.size[0]}x{args.size[1]}, {args.renders} F12 renders a run "
-          f"{args.gap} s apart; AO ms of renders 2-{args.renders}:")
+    if args.recomposite:
+        what = f"an F12 render and {args.renders - 1} changes of the Radius re-composited"
+        which = f"changes 1-{args.renders - 1}"
+    else:
+        what, which = f"{args.renders} F12 renders", f"renders 2-{args.renders}"
+    print(f"{blender.name}, {args.size[0]}x{args.size[1]}, {what} a run {args.gap} s apart; "
+          f"AO ms of {which}:")
     for name, times in results.items():
         print(f"  {name}: median {statistics.median(times):.0f} "
               f"(min {min(times)}, max {max(times)}, n {len(times)})")

@@ -27,6 +27,16 @@ def corner_scene_with_node(out_dir):
     return scene, blender_scenes.hbao_test_tree(scene, out_dir)
 
 
+def show_compositor():
+    """The largest area of the first window becomes the compositor's node
+    editor: Blender composites again on a change only where one shows the
+    tree."""
+    area = max(bpy.context.window_manager.windows[0].screen.areas,
+               key=lambda a: a.width * a.height)
+    area.type = "NODE_EDITOR"
+    area.ui_type = "CompositorNodeTree"
+
+
 class F12Job:
     def __init__(self):
         self.ended, self.started = False, False

@@ -8,12 +8,15 @@ add-on holding the library's memory HOLD_S seconds after a render
 'ENDED <n> {"held": ..., "rss_mb": ...}'; after the last, it waits for the
 hold to end and prints 'RELEASED {"held_rss_mb": the process's resident
 memory at the last look while held, "rss_mb": right after, "waited_s":
-since the render's end}' (with a last argument "quit", it quits after the
-last render instead). The engine's timing line of each render (its AO
-time) is in the log.
+since the render's end}'. MODE "quit": it quits after the last render
+instead; "recomposite": with the compositor shown, one F12 render, then
+RENDERS - 1 changes of the node's Radius GAP_S seconds apart, each of which
+the add-on re-composites from the kept passes (recomposite.py), and it
+quits GAP_S after the last. The engine's timing line of each render (its
+AO time; a re-composite's AO computed beforehand) is in the log.
 
   blender --addons hbao --python ui_memory_hold.py -- \
-      OUT HOLD_S RENDERS GAP_S WIDTH HEIGHT [quit]
+      OUT HOLD_S RENDERS GAP_S WIDTH HEIGHT [quit | recomposite]
 """
 import json
 import os
@@ -26,7 +29,7 @@ arguments = sys.argv[sys.argv.index("--") + 1:]
 out_dir = arguments[0]
 hold_s, renders, gap_s = float(arguments[1]), int(arguments[2]), float(arguments[3])
 width, height = int(arguments[4]), int(arguments[5])
-wait_for_release = arguments[6:] != ["quit"]
+mode = arguments[6] if len(arguments) > 6 else "wait"
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import f12_job  # noqa: E402
 import timer_guard  # noqa: E402
@@ -38,10 +41,12 @@ RELEASE_LATE_S = 10.0
 TICK_S = 0.1
 # The camera's move before each render (scene units; the room is 8 wide).
 NUDGE = 0.002
+# Each change's Radius, as a multiple of the one before.
+RADIUS_STEP = 1.1
 
 memory_hold = sys.modules["hbao.memory_hold"]
 memory_hold.HOLD_S = hold_s
-scene, _node = f12_job.corner_scene_with_node(out_dir)
+scene, node = f12_job.corner_scene_with_node(out_dir)
 scene.render.resolution_x, scene.render.resolution_y = width, height
 scene.render.resolution_percentage = 100
 state = {"render": 0, "phase": "start", "since": None, "held_rss": None}
@@ -55,6 +60,8 @@ def rss_mb():
 def tick():
     now = time.monotonic()
     if state["phase"] == "start":
+        if mode == "recomposite":
+            f12_job.show_compositor()
         scene.camera.location.x += NUDGE
         state.update(phase="render", since=now)
         print(f"HOLD: render {state['render']}", flush=True)
@@ -66,14 +73,27 @@ def tick():
             print(f"ENDED {state['render']} "
                   + json.dumps({"held": memory_hold.held(), "rss_mb": rss_mb()}), flush=True)
             state["render"] += 1
-            if state["render"] == renders and not wait_for_release:
+            if mode == "recomposite":
+                state.update(phase="changes", since=now)
+            elif state["render"] == renders and mode == "quit":
                 print("HOLD: DONE", flush=True)
                 timer_guard.quit_blender()
                 return None
-            state.update(phase="gap" if state["render"] < renders else "release", since=now)
+            else:
+                state.update(phase="gap" if state["render"] < renders else "release", since=now)
     elif state["phase"] == "gap":
         if now - state["since"] >= gap_s:
             state["phase"] = "start"
+    elif state["phase"] == "changes":
+        if now - state["since"] >= gap_s:
+            if state["render"] == renders:
+                print("HOLD: DONE", flush=True)
+                timer_guard.quit_blender()
+                return None
+            node.inputs["Radius"].default_value *= RADIUS_STEP
+            print(f"HOLD: change {state['render']}", flush=True)
+            state["render"] += 1
+            state["since"] = now
     elif memory_hold.held():
         if now - state["since"] > hold_s + RELEASE_LATE_S:
             timer_guard.give_up("HOLD: NOT RELEASED")

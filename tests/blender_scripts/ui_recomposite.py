@@ -43,15 +43,6 @@ job = f12_job.F12Job()
 state = {"phase": "start", "since": time.monotonic(), "images": 0}
 
 
-def show_compositor():
-    """The largest area becomes the compositor's node editor: Blender
-    composites again on a change only where one shows the tree."""
-    area = max(bpy.context.window_manager.windows[0].screen.areas,
-               key=lambda a: a.width * a.height)
-    area.type = "NODE_EDITOR"
-    area.ui_type = "CompositorNodeTree"
-
-
 def print_image(name):
     image = next(i for i in bpy.data.images if i.type == "RENDER_RESULT")
     settings = scene.render.image_settings
@@ -76,7 +67,7 @@ def tick():
     now = time.monotonic()
     phase = state["phase"]
     if phase == "start":
-        show_compositor()
+        f12_job.show_compositor()
         render("rendered")
     elif phase == "rendering":
         if now - state["since"] > RENDER_TIMEOUT_S:
