@@ -15,12 +15,14 @@ render, recomposite.py) and the medians.
   scripts/bench_memory_hold.py [--renders 8] [--gap 2] [--size 1920x1080] [--rounds 1]
                                [--recomposite]
 
+Rounds alternate which way runs first (released, held; then held,
+released; ...).
+
 Needs the build (build/libhbao.so and build/libhbao_exr.so, or the
 libraries that HBAO_LIBRARY and HBAO_EXR_LIBRARY name) and Debian's
 Blender with xvfb-run (scripts/setup.sh)."""
 import argparse
 import os
-import re
 import statistics
 import subprocess
 import sys
@@ -36,8 +38,6 @@ from hbao import timing_line  # noqa: E402  (bpy-free)
 INNER = REPO / "tests" / "blender_scripts" / "ui_memory_hold.py"
 # A hold longer than any run here: the memory stays from render to render.
 HELD_S = 600.0
-# A re-composite's AO, in its timing line (timing_line.format_line).
-_RECOMPOSITED_AO = re.compile(r"computed beforehand in (\d+) ms")
 
 
 def ao_times(blender, user_scripts, out, hold_s, args):
@@ -51,14 +51,14 @@ def ao_times(blender, user_scripts, out, hold_s, args):
                               ui=True)
     completed = subprocess.run(command, env=env, stdout=subprocess.PIPE,
                                stderr=subprocess.STDOUT, text=True, timeout=1800)
-    times = []
-    for line in completed.stdout.splitlines():
-        found = timing_line.parse(line)
-        if found is not None:
-            kept = _RECOMPOSITED_AO.search(line) if found["recomposited"] else None
-            times.append(int(kept.group(1)) if kept else found["ao_ms"])
+    lines = [found for found in map(timing_line.parse, completed.stdout.splitlines())
+             if found is not None]
+    # A re-composite's AO was computed before the helper's render, which reused it.
+    times = [found["kept_ms"] if found["recomposited"] else found["ao_ms"] for found in lines]
     if completed.returncode != 0 or "HOLD: DONE" not in completed.stdout \
-            or len(times) != args.renders:
+            or len(times) != args.renders \
+            or sum(found["recomposited"] for found in lines) != (args.renders - 1
+                                                                 if args.recomposite else 0):
         sys.stderr.write(completed.stdout[-3000:])
         raise SystemExit(f"bench_memory_hold: the run with a hold of {hold_s} s failed")
     return times
@@ -89,8 +89,9 @@ def main():
         user_scripts = Path(folder) / "scripts"
         (user_scripts / "addons").mkdir(parents=True)
         (user_scripts / "addons" / "hbao").symlink_to(REPO / "addon" / "hbao")
+        ways = [("released after each render", 0.0), ("held", HELD_S)]
         for round_ in range(args.rounds):
-            for name, hold_s in (("released after each render", 0.0), ("held", HELD_S)):
+            for name, hold_s in ways if round_ % 2 == 0 else ways[::-1]:
                 times = ao_times(blender, user_scripts, Path(folder) / "out", hold_s, args)
                 print(f"{name}, run {round_ + 1}: AO ms {times}", flush=True)
                 results[name] += times[1:]

@@ -1750,9 +1750,10 @@ def test_a_background_render_releases_the_librarys_memory_at_its_end(run_in_blen
     """In `-b` and bpy the add-on hands the library's working memory back
     when a render ends (memory_hold.py; a window holds it for the next F12
     render: test_ui.py): across the add-on's render_complete handler alone,
-    a 1080p render's resident memory drops by the library's buffers (about
-    24 bytes a pixel: 40 MB or more), and nothing is left held."""
-    completed = run_in_blender(SCRIPTS / "memory_release_b.py", tmp_path / "out", 1920, 1080)
+    a 1280x720 render's resident memory drops by the library's buffers
+    (about 24 bytes a pixel, 22 MB: 18 MB or more), and nothing is left
+    held."""
+    completed = run_in_blender(SCRIPTS / "memory_release_b.py", tmp_path / "out", 1280, 720)
     released = json_line(completed.stdout, "RELEASE_B")
     assert not released["held"], released
-    assert released["before_mb"] - released["after_mb"] >= 40.0, released
+    assert released["before_mb"] - released["after_mb"] >= 18.0, released

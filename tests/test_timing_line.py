@@ -18,7 +18,7 @@ def test_a_computed_frame():
     assert timing_line.parse("HBAO: " + line) == {
         "passes": 2, "width": 1920, "height": 1080, "total_ms": 192, "ao_ms": 122,
         "threads": 0, "search": "", "reused": 0, "handover_ms": 70, "save_ms": 50, "read_ms": 14,
-        "capture_ms": 0, "write_ms": 6, "recomposited": False, "extras_ms": {}}
+        "capture_ms": 0, "write_ms": 6, "kept_ms": 0, "recomposited": False, "extras_ms": {}}
 
 
 @pytest.mark.parametrize("extra, expected", [
@@ -28,12 +28,13 @@ def test_a_computed_frame():
     ({"threads": 4, "search": "AVX-512", "cached": 1},
      {"threads": 4, "search": "AVX-512", "reused": 1}),
     ({"threads": 1, "search": "generic"}, {"threads": 1, "search": "generic", "reused": 0}),
-    ({"cached": 2, "kept": 0.118}, {"reused": 2, "recomposited": True, "extras_ms": {}}),
+    ({"cached": 2, "kept": 0.118},
+     {"reused": 2, "recomposited": True, "kept_ms": 118, "extras_ms": {}}),
     ({"guard band save": 0.061, "guard band read": 0.0192, "back faces save": 0.05,
       "back faces read": 0.0204},
      {"reused": 0, "recomposited": False, "extras_ms": {"guard band": 80, "back faces": 70}}),
     ({"cached": 1, "kept": 0.2, "back faces save": 0.0334},
-     {"reused": 1, "recomposited": True, "extras_ms": {"back faces": 33}}),
+     {"reused": 1, "recomposited": True, "kept_ms": 200, "extras_ms": {"back faces": 33}}),
 ])
 def test_reuse_recompositing_and_extra_renders(extra, expected):
     line = timing_line.format_line(2, 640, 360, 0.25, dict(PLAIN, **extra))

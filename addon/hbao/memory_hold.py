@@ -1,63 +1,77 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
-"""When the library's working memory goes back to the system after a render.
+"""When the library's working memory goes back to the system after the
+library has computed.
 
 The library keeps a frame's buffers (about 24 bytes a pixel: 50 MB at
 1080p, at most 512 MB) for its next call; hbao_release_memory() hands them
 back. Released at each render's end, the next render's first AO faults
-every page in again: about 30 ms of a 1080p F12 render's AO on the
-project's VMs (docs/speed.md, session 68). So:
+every page in again: 30-50 ms of a 1080p F12 render's AO on the project's
+VMs (docs/speed.md, sessions 68 and 69). So, from each render's end and
+each re-composite's AO (start_hold):
 
-- In `-b` (and bpy), a render's end releases them at once: an animation
-  keeps them from frame to frame and releases them after its last, and the
-  process usually ends soon after anyway.
-- In a window, where the artist renders again after a look or a change,
-  they are held HOLD_S seconds after the last render ended, then released
-  by a timer (render handlers run in the render job's thread, where no
-  timer may be started); a render running then pushes the release back.
-  Disabling the add-on releases them at once.
+- In `-b` (and bpy) the memory goes back at once: an animation keeps it
+  from frame to frame and releases it after its last, and the process
+  usually ends soon after anyway.
+- In a window, where the artist renders again after a look or a change, it
+  is held HOLD_S seconds, then released by a timer (render handlers run in
+  the render job's thread, where no timer may be started); a render running
+  then pushes the release back. Disabling the add-on releases it at once.
 """
 import time
 
 import bpy
 
-from . import native
+from . import native, ui_timers
 from .callback_guard import never_raises
 
-# How long a window's Blender holds the memory after a render has ended.
+# How long a window's Blender holds the memory after the library's last use.
 HOLD_S = 60.0
 # How often the timer looks: the memory goes back within HOLD_S + _POLL_S.
 _POLL_S = 1.0
 
-# time.monotonic() at the end of the last render whose memory is still
-# held, or None when nothing is held. Written by the render handler (the
-# render job's thread in a window), read by the timer (the main thread).
-_state = {"ended": None}
+# time.monotonic() when the hold of the memory began, or None when nothing
+# is held. Written by the render handler (the render job's thread in a
+# window) and the re-composite's worker, read by the timer (the main thread).
+_state = {"since": None}
+
+
+def held_since():
+    """time.monotonic() when the memory now held began to be held, or None
+    (nothing held)."""
+    return _state["since"]
 
 
 def held():
-    """Whether the memory of an ended render is held for the next one."""
-    return _state["ended"] is not None
+    """Whether the memory of the library's last use is held for the next."""
+    return held_since() is not None
 
 
 def release():
     """Hand the library's kept memory back now (does not load the library)."""
-    _state["ended"] = None
+    _state["since"] = None
     native.release_memory()
+
+
+def start_hold():
+    """The library has just computed (a render has ended, a re-composite's
+    AO is done; any thread): in `-b` its memory goes back now, in a window
+    it is held HOLD_S seconds from now."""
+    if bpy.app.background:
+        release()
+    else:
+        _state["since"] = time.monotonic()
 
 
 @bpy.app.handlers.persistent
 @never_raises("release the library's memory after the render")
 def _on_render_end(*_args):
-    if bpy.app.background:
-        release()
-    else:
-        _state["ended"] = time.monotonic()
+    start_hold()
 
 
 @never_raises("release the library's memory after the render", result=_POLL_S)
 def _poll():
-    ended = _state["ended"]
-    if (ended is not None and time.monotonic() - ended >= HOLD_S
+    since = _state["since"]
+    if (since is not None and time.monotonic() - since >= HOLD_S
             and not bpy.app.is_job_running("RENDER")):
         release()
     return _POLL_S
@@ -70,13 +84,11 @@ def register():
     for handlers in _HANDLERS:
         if _on_render_end not in handlers:
             handlers.append(_on_render_end)
-    if not bpy.app.background and not bpy.app.timers.is_registered(_poll):
-        bpy.app.timers.register(_poll, first_interval=_POLL_S, persistent=True)
+    ui_timers.start(_poll, _POLL_S)
 
 
 def unregister():
-    if bpy.app.timers.is_registered(_poll):
-        bpy.app.timers.unregister(_poll)
+    ui_timers.stop(_poll)
     for handlers in _HANDLERS:
         while _on_render_end in handlers:
             handlers.remove(_on_render_end)

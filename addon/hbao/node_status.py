@@ -8,7 +8,7 @@ posted (report.post_node_messages) once no render job runs, and keeps the
 hint lines current; in `-b`, render_post shows it."""
 import bpy
 
-from . import compat, report, writes
+from . import compat, report, ui_timers, writes
 from .callback_guard import never_raises
 from .node import hbao_nodes
 
@@ -102,13 +102,11 @@ _HANDLERS = (("render_post", _on_render_done), ("render_complete", _on_render_do
 def register():
     for name, function in _HANDLERS:
         getattr(bpy.app.handlers, name).append(function)
-    if not bpy.app.background:  # `-b` shows nothing: render_post applies the messages
-        bpy.app.timers.register(_poll_node_messages, first_interval=_POLL_S, persistent=True)
+    ui_timers.start(_poll_node_messages, _POLL_S)  # `-b`: render_post applies the messages
 
 
 def unregister():
-    if bpy.app.timers.is_registered(_poll_node_messages):
-        bpy.app.timers.unregister(_poll_node_messages)
+    ui_timers.stop(_poll_node_messages)
     for name, function in _HANDLERS:
         handlers = getattr(bpy.app.handlers, name)
         while function in handlers:

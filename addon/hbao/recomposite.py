@@ -21,8 +21,8 @@ import time
 
 import bpy
 
-from . import (ao_cache, composite_trigger, handler_hold, helper_scene, layer_passes, node_status,
-               refresh_due, render_record, writes)
+from . import (ao_cache, composite_trigger, handler_hold, helper_scene, layer_passes, memory_hold,
+               node_status, refresh_due, render_record, writes)
 from .callback_guard import never_raises
 from .report import log
 
@@ -71,6 +71,8 @@ class _Computation:
         except Exception as error:  # reported by the main thread
             self.error = error
         self.seconds = time.perf_counter() - start
+        # (its AO may be dropped unrendered: a failure, or a change that needs a render)
+        memory_hold.start_hold()
 
     def done(self):
         return not self.thread.is_alive()

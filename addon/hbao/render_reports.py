@@ -8,7 +8,7 @@ operator run from Python stay with the caller), so the operator is modal:
 it reports on its first timer event."""
 import bpy
 
-from . import report, writes
+from . import report, ui_timers, writes
 from .callback_guard import never_raises
 
 _POLL_S = 0.25
@@ -62,12 +62,10 @@ def _poll():
 def register():
     bpy.utils.register_class(HBAO_OT_render_report)
     # `-b` has no Info editor: the console has every message already.
-    if not bpy.app.background:
-        bpy.app.timers.register(_poll, first_interval=_POLL_S, persistent=True)
+    ui_timers.start(_poll, _POLL_S)
 
 
 def unregister():
-    if bpy.app.timers.is_registered(_poll):
-        bpy.app.timers.unregister(_poll)
+    ui_timers.stop(_poll)
     bpy.utils.unregister_class(HBAO_OT_render_report)
     report.take_render_reports()

@@ -18,7 +18,8 @@ _LINE = re.compile(
     r"pass hand-over (?P<handover_ms>\d+) ms "
     r"\((?:save (?P<save_ms>\d+), read (?P<read_ms>\d+)|from memory (?P<capture_ms>\d+)), "
     r"write (?P<write_ms>\d+)\)"
-    r"(?P<recomposited>, re-composited)?")
+    r"(?P<recomposited>, re-composited[^(]*\(their AO computed beforehand in "
+    r"(?P<kept_ms>\d+) ms\))?")
 _EXTRA = re.compile(r", (?P<kind>[a-z ]+) passes (?P<ms>\d+) ms")
 
 
@@ -61,7 +62,8 @@ def parse(text):
     """The figures of the timing line found in `text` (a log line, with or
     without the "HBAO: " prefix), or None: passes, width, height and the
     milliseconds as ints (total_ms, ao_ms, handover_ms, save_ms, read_ms,
-    capture_ms: the passes taken from memory, write_ms; 0 where absent),
+    capture_ms: the passes taken from memory, write_ms, kept_ms: a
+    re-composite's AO, computed before its render; 0 where absent),
     threads (the AO's, 0 where the line has none), search (the horizon
     search's name, "" where the line has none), reused (passes whose AO
     was reused, 0 if none), recomposited (bool) and extras_ms ({kind: ms}

@@ -2,7 +2,7 @@
 """F12 from a script in a real Blender window (the ui_* scripts): an
 INVOKE render runs in the render job's thread, as the F12 key's does; this
 tracks when that job has ended. Also the corner test scene with its HBAO
-tree, which those scripts render.
+tree, which those scripts render, and show_compositor().
 
   sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
   import f12_job
