@@ -228,7 +228,7 @@ def test_an_f12_renders_memory_is_held_for_the_next_then_released(run_blender, t
     """In a window the add-on holds the library's working memory after an
     F12 render, so that the next render's AO does not fault it in again
     (30-50 ms at 1080p: scripts/bench_memory_hold.py), and hands it back
-    once no render has ended for the hold (memory_hold.py; 3 s here): two
+    once the library has not been used for the hold (memory_hold.py; 3 s here): two
     1080p renders half a second apart, both held; the release comes after
     the hold, within a few of its timer's one-second looks, and gives back
     the library's buffers (about 24 bytes a pixel: 40 MB or more)."""
