@@ -58,7 +58,8 @@ def ao_times(blender, user_scripts, out, hold_s, args):
     if completed.returncode != 0 or "HOLD: DONE" not in completed.stdout \
             or len(times) != args.renders \
             or sum(found["recomposited"] for found in lines) != (args.renders - 1
-                                                                 if args.recomposite else 0):
+                                                                 if args.recomposite else 0) \
+            or not all(found["kept_ms"] for found in lines if found["recomposited"]):
         sys.stderr.write(completed.stdout[-3000:])
         raise SystemExit(f"bench_memory_hold: the run with a hold of {hold_s} s failed")
     return times

@@ -1751,7 +1751,7 @@ def test_a_background_render_releases_the_librarys_memory_at_its_end(run_in_blen
     when a render ends (memory_hold.py; a window holds it for the next F12
     render: test_ui.py): across the add-on's render_complete handler alone,
     a 1280x720 render's resident memory drops by the library's buffers
-    (about 24 bytes a pixel, 22 MB: 18 MB or more), and nothing is left
+    (about 26 bytes a pixel, 23 MiB: 18 MiB or more), and nothing is left
     held."""
     completed = run_in_blender(SCRIPTS / "memory_release_b.py", tmp_path / "out", 1280, 720)
     released = json_line(completed.stdout, "RELEASE_B")

@@ -17,6 +17,7 @@ each re-composite's AO (start_hold):
   the render job's thread, where no timer may be started); a render running
   then pushes the release back. Disabling the add-on releases it at once.
 """
+import threading
 import time
 
 import bpy
@@ -29,10 +30,13 @@ HOLD_S = 60.0
 # How often the timer looks: the memory goes back within HOLD_S + _POLL_S.
 _POLL_S = 1.0
 
-# time.monotonic() when the hold of the memory began, or None when nothing
-# is held. Written by the render handler (the render job's thread in a
-# window) and the re-composite's worker, read by the timer (the main thread).
-_state = {"since": None}
+# since: time.monotonic() when the hold of the memory began, or None when
+# nothing is held; active: between register() and unregister(). Written by
+# the render handler (the render job's thread in a window), the
+# re-composite's worker and the timer (the main thread), under _lock: a
+# hold begun while the timer releases is not lost.
+_state = {"since": None, "active": False}
+_lock = threading.Lock()
 
 
 def held_since():
@@ -48,18 +52,21 @@ def held():
 
 def release():
     """Hand the library's kept memory back now (does not load the library)."""
-    _state["since"] = None
+    with _lock:
+        _state["since"] = None
     native.release_memory()
 
 
 def start_hold():
     """The library has just computed (a render has ended, a re-composite's
-    AO is done; any thread): in `-b` its memory goes back now, in a window
-    it is held HOLD_S seconds from now."""
-    if bpy.app.background:
-        release()
-    else:
-        _state["since"] = time.monotonic()
+    AO is done; any thread): in `-b`, or once the add-on is disabled (a
+    re-composite's worker may finish after that), its memory goes back now;
+    in a window it is held HOLD_S seconds from now."""
+    with _lock:
+        hold = _state["active"] and not bpy.app.background
+        _state["since"] = time.monotonic() if hold else None
+    if not hold:
+        native.release_memory()
 
 
 @bpy.app.handlers.persistent
@@ -70,10 +77,15 @@ def _on_render_end(*_args):
 
 @never_raises("release the library's memory after the render", result=_POLL_S)
 def _poll():
-    since = _state["since"]
-    if (since is not None and time.monotonic() - since >= HOLD_S
-            and not bpy.app.is_job_running("RENDER")):
-        release()
+    if bpy.app.is_job_running("RENDER"):
+        return _POLL_S
+    with _lock:
+        since = _state["since"]
+        due = since is not None and time.monotonic() - since >= HOLD_S
+        if due:
+            _state["since"] = None
+    if due:
+        native.release_memory()
     return _POLL_S
 
 
@@ -81,6 +93,7 @@ _HANDLERS = (bpy.app.handlers.render_complete, bpy.app.handlers.render_cancel)
 
 
 def register():
+    _state["active"] = True
     for handlers in _HANDLERS:
         if _on_render_end not in handlers:
             handlers.append(_on_render_end)
@@ -88,6 +101,7 @@ def register():
 
 
 def unregister():
+    _state["active"] = False
     ui_timers.stop(_poll)
     for handlers in _HANDLERS:
         while _on_render_end in handlers:

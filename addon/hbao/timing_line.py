@@ -18,8 +18,8 @@ _LINE = re.compile(
     r"pass hand-over (?P<handover_ms>\d+) ms "
     r"\((?:save (?P<save_ms>\d+), read (?P<read_ms>\d+)|from memory (?P<capture_ms>\d+)), "
     r"write (?P<write_ms>\d+)\)"
-    r"(?P<recomposited>, re-composited[^(]*\(their AO computed beforehand in "
-    r"(?P<kept_ms>\d+) ms\))?")
+    r"(?P<recomposited>, re-composited"
+    r"(?:[^(]*\(their AO computed beforehand in (?P<kept_ms>\d+) ms\))?)?")
 _EXTRA = re.compile(r", (?P<kind>[a-z ]+) passes (?P<ms>\d+) ms")
 
 

@@ -98,7 +98,7 @@ def tick():
             state["render"] += 1
             state["since"] = now
     elif state["phase"] == "release" and memory_hold.held():
-        if now - state["since"] > hold_s + RELEASE_LATE_S:
+        if now - memory_hold.held_since() > hold_s + RELEASE_LATE_S:
             timer_guard.give_up("HOLD: NOT RELEASED")
         state["held_rss"] = rss_mb()
     elif state["phase"] == "release":
