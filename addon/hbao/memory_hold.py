@@ -13,7 +13,9 @@ each re-composite's AO (start_hold):
   from frame to frame and releases it after its last, and the process
   usually ends soon after anyway.
 - In a window, where the artist renders again after a look or a change, it
-  is held HOLD_S seconds, then released by a timer (render handlers run in
+  is held for the add-on's preference Keep Memory After a Render (60 s
+  unless set: preferences.py; without an entry in the preferences, as with
+  `--addons`, 60 s), then released by a timer (render handlers run in
   the render job's thread, where no timer may be started); a render running
   then pushes the release back. Disabling the add-on releases it at once.
 """
@@ -22,12 +24,10 @@ import time
 
 import bpy
 
-from . import native, ui_timers
+from . import native, preferences, ui_timers
 from .callback_guard import never_raises
 
-# How long a window's Blender holds the memory after the library's last use.
-HOLD_S = 60.0
-# How often the timer looks: the memory goes back within HOLD_S + _POLL_S.
+# How often the timer looks: the memory goes back within the hold + _POLL_S.
 _POLL_S = 1.0
 
 # since: time.monotonic() when the hold of the memory began, or None when
@@ -61,7 +61,7 @@ def start_hold():
     """The library has just computed (a render has ended, a re-composite's
     AO is done; any thread): in `-b`, or once the add-on is disabled (a
     re-composite's worker may finish after that), its memory goes back now;
-    in a window it is held HOLD_S seconds from now."""
+    in a window it is held from now on (_poll)."""
     with _lock:
         hold = _state["active"] and not bpy.app.background
         _state["since"] = time.monotonic() if hold else None
@@ -79,9 +79,10 @@ def _on_render_end(*_args):
 def _poll():
     if bpy.app.is_job_running("RENDER"):
         return _POLL_S
+    hold_s = preferences.keep_memory_seconds()  # (read here: the main thread)
     with _lock:
         since = _state["since"]
-        due = since is not None and time.monotonic() - since >= HOLD_S
+        due = since is not None and time.monotonic() - since >= hold_s
         if due:
             _state["since"] = None
     if due:

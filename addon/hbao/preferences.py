@@ -1,13 +1,17 @@
 # SPDX-License-Identifier: GPL-2.0-or-later
 """The add-on's preferences panel: where a message about this Blender
-(too old, newer than tested) stays visible after the console has scrolled."""
+(too old, newer than tested) stays visible after the console has scrolled,
+and how long the library's memory is kept after a render (memory_hold)."""
 import bpy
+from bpy.props import IntProperty
 
 from . import ui_text
 from .report import log
 
 # Characters a line of the preferences holds at the window's usual width.
 LINE_CHARACTERS = 90
+# keep_memory_s's default (memory_hold.py: sessions 68 and 69 measured what it saves).
+KEEP_MEMORY_DEFAULT_S = 60
 
 # The package name Blender knows the add-on by: "hbao" as a legacy add-on,
 # "bl_ext.<repository>.hbao" as an extension.
@@ -25,15 +29,32 @@ def show(message):
 class HBAOPreferences(bpy.types.AddonPreferences):
     bl_idname = _ADDON_NAME
 
+    keep_memory_s: IntProperty(
+        name="Keep Memory After a Render (Seconds)", default=KEEP_MEMORY_DEFAULT_S, min=0,
+        max=3600,
+        description="Seconds the AO library keeps its working memory (about 24 bytes a pixel: "
+                    "50 MB at 1080p) after a render in this window, so that the next render or "
+                    "changed node value does not wait for it; 0 gives it back at once. Renders "
+                    "from the command line (-b) give it back at once")
+
     def draw(self, _context):
         layout = self.layout
         column = layout.column(align=True)
         column.label(text="Compositor node: Add > Filter > HBAO", icon="NODETREE")
         column.label(text="Viewport preview: 3D view sidebar (N), HBAO tab", icon="VIEW3D")
         _library_status(layout.column(align=True))
+        layout.prop(self, "keep_memory_s")
         for message in _messages:
             for sentence in message.split(". "):
                 layout.label(text=sentence.rstrip("."), icon="INFO")
+
+
+def keep_memory_seconds():
+    """The preference keep_memory_s, or its default where the add-on's
+    preferences cannot be read."""
+    addon = bpy.context.preferences.addons.get(_ADDON_NAME)
+    preferences = getattr(addon, "preferences", None)
+    return KEEP_MEMORY_DEFAULT_S if preferences is None else preferences.keep_memory_s
 
 
 def _library_status(layout):

@@ -3,7 +3,8 @@
 scripts/bench_memory_hold.py: F12 renders of the corner scene at WIDTH x
 HEIGHT, GAP_S seconds apart, the camera nudged before each (so that each
 render's passes differ and its AO is computed, not reused), with the add-on
-holding the library's memory HOLD_S seconds after a render (memory_hold.py).
+holding the library's memory HOLD_S seconds after a render (memory_hold.py;
+the add-on's preference Keep Memory After a Render, set here).
 After each render it prints 'ENDED <n> {"held": ..., "rss_mb": ...}'. MODE
 "wait" (the default): after the last render, it waits for the hold to end
 and prints 'RELEASED {"held_rss_mb": the process's resident memory at the
@@ -47,7 +48,13 @@ NUDGE = 0.002
 RADIUS_STEP = 1.1
 
 memory_hold = sys.modules["hbao.memory_hold"]
-memory_hold.HOLD_S = hold_s
+# `--addons` enables the add-on for the session without an entry in the
+# preferences (as Blender's own enabling does: Addons.new()); the artist's
+# enabling in the preferences makes one, which holds the add-on's settings.
+addons = bpy.context.preferences.addons
+if "hbao" not in addons:
+    addons.new().module = "hbao"
+addons["hbao"].preferences.keep_memory_s = round(hold_s)
 scene, node = f12_job.corner_scene_with_node(out_dir)
 scene.render.resolution_x, scene.render.resolution_y = width, height
 scene.render.resolution_percentage = 100
