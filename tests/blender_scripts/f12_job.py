@@ -9,6 +9,7 @@ tree, which those scripts render, and show_compositor().
 """
 import os
 import sys
+import time
 
 import bpy
 
@@ -37,9 +38,18 @@ def show_compositor():
     area.ui_type = "CompositorNodeTree"
 
 
+# How long a test's F12 render may take before the script gives up.
+RENDER_TIMEOUT_S = 240.0
+
+
 class F12Job:
-    def __init__(self):
-        self.ended, self.started = False, False
+    """An F12 render a script starts and waits for; one that has not ended
+    RENDER_TIMEOUT_S (or timeout_s) after start() ends Blender with
+    '<label>: TIMEOUT' (timer_guard.give_up)."""
+
+    def __init__(self, label, timeout_s=RENDER_TIMEOUT_S):
+        self.label, self.timeout_s = label, timeout_s
+        self.ended, self.started, self.since = False, False, None
         bpy.app.handlers.render_complete.append(self._end)
         bpy.app.handlers.render_cancel.append(self._end)
 
@@ -49,7 +59,7 @@ class F12Job:
     def start(self):
         """Start the render; where Blender refuses the operator for the
         moment (hbao.writes), finished() asks again."""
-        self.ended, self.started = False, False
+        self.ended, self.started, self.since = False, False, time.monotonic()
         self._try_start()
 
     def _try_start(self):
@@ -59,6 +69,8 @@ class F12Job:
     def finished(self):
         """Whether the job started last has ended (its handlers ran and no
         render job runs any more)."""
+        if self.since is not None and time.monotonic() - self.since > self.timeout_s:
+            timer_guard.give_up(f"{self.label}: TIMEOUT")
         if not self.started:
             self._try_start()
             return False

@@ -40,22 +40,14 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import f12_job  # noqa: E402
 import timer_guard  # noqa: E402
 
-RENDER_TIMEOUT_S = 240.0
 SETTLE_S = 3.0
 # The add-on's timer writes the hint when no render runs: at most this long
 HINT_WAIT_S = 20.0
 
 scene, node = f12_job.corner_scene_with_node(out_dir)
 node.inputs["Blur Size"].default_value = 0
-job = f12_job.F12Job()
+job = f12_job.F12Job("SLOTS")
 state = {"phase": "start", "since": time.monotonic()}
-
-
-def show_compositor():
-    area = max(bpy.context.window_manager.windows[0].screen.areas,
-               key=lambda a: a.width * a.height)
-    area.type = "NODE_EDITOR"
-    area.ui_type = "CompositorNodeTree"
 
 
 def slots():
@@ -85,8 +77,6 @@ def tick():
     now = time.monotonic()
     phase, elapsed = state["phase"], now - state["since"]
     if phase == "rendering":
-        if elapsed > RENDER_TIMEOUT_S:
-            timer_guard.give_up("SLOTS: TIMEOUT")
         if case == "switch" and state["after"] == "second_done" and elapsed > 0.7 \
                 and not state.get("switched"):
             slots().active_index = 0
@@ -99,7 +89,7 @@ def tick():
         if job.finished():
             state.update(phase=state["after"], since=now)
     elif phase == "start":
-        show_compositor()
+        f12_job.show_compositor()
         if case == "keep_ui":
             bpy.context.preferences.view.render_display_type = "NONE"
         render("first_done")

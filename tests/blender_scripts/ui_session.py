@@ -56,7 +56,7 @@ scene = f12_job.corner_scene_with_node(out_dir)[0]
 scene.node_tree.nodes["HBAO0"].inputs["Blur Size"].default_value = 0
 if case == "disable_during":
     scene.cycles.samples = 4000  # some seconds
-job = f12_job.F12Job()
+job = f12_job.F12Job("SESSION")
 started = time.monotonic()
 
 

@@ -60,7 +60,7 @@ scene = f12_job.corner_scene_with_node(out_dir)[0]
 node = scene.node_tree.nodes["HBAO0"]
 node.inputs["Blur Size"].default_value = 0
 radius = node.inputs["Radius"].default_value
-job = f12_job.F12Job()
+job = f12_job.F12Job("STUCK")
 
 draw_waits = threading.Event()
 draw_entered = threading.Event()
