@@ -31,6 +31,9 @@ import report
 import sweep
 from hbao import timing_line  # sweep puts the add-on on sys.path
 
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "scripts"))
+import blenders  # noqa: E402
+
 REPO = Path(__file__).resolve().parent.parent
 BENCH = REPO / "bench"
 BLENDER = os.environ.get("BLENDER", "blender")
@@ -228,9 +231,7 @@ def main():
     started = time.perf_counter()
     scenes = [s for s in args.scenes.split(",") if s]
 
-    user_scripts = Path(tempfile.mkdtemp(prefix="hbao-bench-scripts-"))
-    (user_scripts / "addons").mkdir()
-    (user_scripts / "addons" / "hbao").symlink_to(REPO / "addon" / "hbao")
+    user_scripts = blenders.user_scripts_with_addon(tempfile.mkdtemp(prefix="hbao-bench-scripts-"))
     env = blender_environment(user_scripts)
 
     jobs = accuracy_jobs(mode)

@@ -80,9 +80,7 @@ def main():
         raise SystemExit(f"bench_handover_passes: no Blender named {args.blender}* here")
     blender = found[-1]
     with tempfile.TemporaryDirectory(prefix="hbao-handover-") as folder:
-        user_scripts = Path(folder)
-        (user_scripts / "addons").mkdir()
-        (user_scripts / "addons" / "hbao").symlink_to(REPO / "addon" / "hbao")
+        user_scripts = blenders.user_scripts_with_addon(folder)
         print(f"bench_handover_passes: {blender.name}, interior {size[0]}x{size[1]}, "
               f"1 Cycles sample, "
               f"defaults; ms per render that computed the AO (median, least-greatest)")

@@ -87,9 +87,7 @@ def main():
         raise SystemExit("bench_memory_hold: blender not found: run scripts/setup.sh")
     results = {"released after each render": [], "held": []}
     with tempfile.TemporaryDirectory() as folder:
-        user_scripts = Path(folder) / "scripts"
-        (user_scripts / "addons").mkdir(parents=True)
-        (user_scripts / "addons" / "hbao").symlink_to(REPO / "addon" / "hbao")
+        user_scripts = blenders.user_scripts_with_addon(Path(folder) / "scripts")
         ways = [("released after each render", 0.0), ("held", HELD_S)]
         for round_ in range(args.rounds):
             for name, hold_s in ways if round_ % 2 == 0 else ways[::-1]:

@@ -23,7 +23,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from blenders import NO_SPLASH  # scripts/blenders.py, beside this script
+from blenders import NO_SPLASH, user_scripts_with_addon  # scripts/blenders.py, beside this one
 
 REPO = Path(__file__).resolve().parents[1]
 INNER = REPO / "scripts" / "bench_viewport_blender.py"
@@ -58,9 +58,8 @@ def main():
                          "HBAO_EXR_LIBRARY to built libraries")
             if subprocess.run(step, stdout=subprocess.DEVNULL).returncode != 0:
                 sys.exit(f"building the libraries failed: {' '.join(step)}")
-    with tempfile.TemporaryDirectory() as user_scripts:
-        (Path(user_scripts) / "addons").mkdir()
-        (Path(user_scripts) / "addons" / "hbao").symlink_to(REPO / "addon" / "hbao")
+    with tempfile.TemporaryDirectory() as folder:
+        user_scripts = str(user_scripts_with_addon(folder))
         env = dict(os.environ, BLENDER_USER_SCRIPTS=user_scripts, PYTHONUNBUFFERED="1")
         for name, path in libraries.items():
             env.setdefault(name, str(path))

@@ -140,6 +140,16 @@ def _version_of(command):
     return ""
 
 
+def user_scripts_with_addon(folder):
+    """Make `folder` (created where missing) a Blender user-scripts folder
+    whose addons/hbao is this checkout's add-on, for BLENDER_USER_SCRIPTS;
+    returns it as a Path."""
+    folder = Path(folder)
+    (folder / "addons").mkdir(parents=True, exist_ok=True)
+    (folder / "addons" / "hbao").symlink_to(REPO / "addon" / "hbao")
+    return folder
+
+
 def debian_blender():
     """Debian's blender (or $BLENDER), or None when it is not installed."""
     path = shutil.which(os.environ.get("BLENDER", "blender"))

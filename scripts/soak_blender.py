@@ -87,9 +87,7 @@ def choose_blender(name):
 
 def environment(root):
     """The add-on from this checkout, private preferences and a private temp folder."""
-    user_scripts = root / "user_scripts"
-    (user_scripts / "addons").mkdir(parents=True)
-    (user_scripts / "addons" / "hbao").symlink_to(REPO / "addon" / "hbao")
+    user_scripts = blenders.user_scripts_with_addon(root / "user_scripts")
     temp = root / "tmp"
     temp.mkdir()
     env = dict(os.environ)

@@ -114,10 +114,7 @@ def small_tmpfs(folder, size):
 @pytest.fixture(scope="session")
 def blender_user_scripts(tmp_path_factory):
     """A Blender user-scripts folder whose addons/hbao is this checkout's add-on."""
-    root = tmp_path_factory.mktemp("blender_user_scripts")
-    (root / "addons").mkdir()
-    (root / "addons" / "hbao").symlink_to(REPO / "addon" / "hbao")
-    return root
+    return blenders.user_scripts_with_addon(tmp_path_factory.mktemp("blender_user_scripts"))
 
 
 def _addon_deprecation_filters():
