@@ -67,6 +67,8 @@ def ao_times(blender, user_scripts, out, hold_s, args):
 
 def _size(text):
     width, _, height = text.partition("x")
+    if not (width.isdigit() and height.isdigit() and int(width) > 0 and int(height) > 0):
+        raise argparse.ArgumentTypeError(f"{text!r}: give WIDTHxHEIGHT, such as 1920x1080")
     return int(width), int(height)
 
 
@@ -80,8 +82,9 @@ def main():
     parser.add_argument("--recomposite", action="store_true",
                         help="one render, then changes of the Radius, re-composited")
     args = parser.parse_args()
-    if args.renders < 2:
-        raise SystemExit("bench_memory_hold: --renders must be 2 or more")
+    if args.renders < 2 or args.rounds < 1 or not args.gap >= 0.0:
+        raise SystemExit("bench_memory_hold: --renders must be 2 or more, --rounds 1 or more "
+                         "and --gap 0 or more")
     blender = blenders.debian_blender()
     if blender is None:
         raise SystemExit("bench_memory_hold: blender not found: run scripts/setup.sh")
