@@ -34,7 +34,7 @@ NO_VIEW_ANTI_ALIASING = "bpy.context.preferences.system.viewport_aa = 'OFF'"
 # checkout, so that every clone (and CI's fresh clone) reuses one download.
 BPY_ROOT = Path(os.environ.get("HBAO_BPY_ROOT", Path.home() / ".cache" / "hbao" / "bpy"))
 # The bpy environments setup_bpy.sh makes, by folder name, oldest first.
-BPY_ENVIRONMENTS = ("bpy-4.5", "bpy-5.0", "bpy-5-latest")
+BPY_ENVIRONMENTS = ("bpy-4.5", "bpy-5.0", "bpy-5.2", "bpy-5-latest")
 
 
 @dataclass(frozen=True)

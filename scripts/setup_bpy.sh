@@ -5,7 +5,8 @@
 # ~/.cache/hbao/bpy), reused between runs and clones:
 #   bpy-4.5       bpy 4.5 LTS   (needs Python 3.11)
 #   bpy-5.0       bpy 5.0       (needs Python 3.11)
-#   bpy-5-latest  the newest bpy 5.x PyPI has for Python 3.13
+#   bpy-5.2       bpy 5.2 LTS   (needs Python 3.13)
+#   bpy-5-latest  the newest bpy 5.x PyPI has, 5.3 or later (Python 3.13)
 # The Pythons come from pyenv when it has them, else from the system
 # (python3.11 / python3.13 on PATH). A missing Python or a failed install is an
 # error: the matrix must not shrink silently. Idempotent.
@@ -51,4 +52,5 @@ install_bpy() {  # install_bpy FOLDER PYTHON_MINOR REQUIREMENT
 
 install_bpy bpy-4.5 3.11 'bpy==4.5.*'
 install_bpy bpy-5.0 3.11 'bpy==5.0.*'
-install_bpy bpy-5-latest 3.13 'bpy>=5.1,<6'
+install_bpy bpy-5.2 3.13 'bpy==5.2.*'
+install_bpy bpy-5-latest 3.13 'bpy>=5.3,<6'

@@ -47,7 +47,7 @@ stage_summary() {
 trap stage_summary EXIT
 
 "$REPO/scripts/setup.sh"
-# PyPI's bpy 4.5 LTS, 5.0 and the newest 5.x for the Blender matrix (reused
+# PyPI's bpy 4.5 LTS, 5.0, 5.2 LTS and the newest 5.x for the Blender matrix (reused
 # from ~/.cache/hbao/bpy between runs).
 "$REPO/scripts/setup_bpy.sh"
 
@@ -83,8 +83,8 @@ clang-format --dry-run --Werror $(git ls-files 'csrc/*.c' 'csrc/*.h')
 stage "soak: a 50-frame animation with the node and 200 CLI runs (memory, time, leftovers)"
 scripts/soak.sh --frames 50 --runs 200 --report out/soak/test-report.md
 
-stage "Python tests (real Blender: Debian's blender and bpy 4.5, 5.0, newest 5.x)"
-# Debian's blender + the three bpy builds: a missing one fails the run. One
+stage "Python tests (real Blender: Debian's blender and bpy 4.5, 5.0, 5.2, newest 5.x)"
+# Debian's blender + the four bpy builds: a missing one fails the run. One
 # pytest-xdist worker a job: most tests wait on one Blender's start and a
 # small render, so two side by side took 0.6 of the time on 2 cores (a
 # module whose module fixtures run Blender stays on one worker: loadgroup).
@@ -95,4 +95,4 @@ if ! "$PYTHON" -c "import xdist" 2>/dev/null; then
     echo "test.sh: $PYTHON has no pytest-xdist: the Python tests run one at a time"
     WORKERS=()
 fi
-HBAO_EXPECTED_BLENDERS=4 "$PYTHON" -m pytest tests -q -p no:cacheprovider "${WORKERS[@]}"
+HBAO_EXPECTED_BLENDERS=5 "$PYTHON" -m pytest tests -q -p no:cacheprovider "${WORKERS[@]}"
