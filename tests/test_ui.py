@@ -244,3 +244,20 @@ def test_an_f12_renders_memory_is_held_for_the_next_then_released(run_blender, t
     # (the timer looks every second; under the suite's load a tick can come late)
     assert hold_s <= released["waited_s"] <= hold_s + 5.0, released
     assert released["held_rss_mb"] - released["rss_mb"] >= 40.0, released
+
+
+def test_the_memory_is_kept_while_a_recomposite_uses_the_library(run_blender):
+    """The add-on's timer does not hand the library's memory back while a
+    re-composite's worker computes (memory_hold.in_use), and the hold
+    starts at its end: a review found that a worker ending just as a hold
+    ran out could have its new buffers released, the add-on still counting
+    them held. With a hold of 0 s, a use of 2.5 s spans two or three of the
+    timer's looks, each of which would release: none comes during it, the
+    memory is held as it ends, and the timer releases it soon after."""
+    log = run_blender(SCRIPTS / "ui_memory_in_use.py", ui=True).stdout
+    assert "IN_USE: DONE" in log, log[-3000:]
+    report = json_line(log, "IN_USE")
+    assert report["releases_during"] == 0, report
+    assert report["held_at_end"] is True, report
+    # (the timer looks every second; under the suite's load a tick can come late)
+    assert report["release_after_s"] is not None and report["release_after_s"] <= 5.0, report

@@ -19,6 +19,7 @@ each re-composite's AO (start_hold):
   the render job's thread, where no timer may be started); a render running
   then pushes the release back. Disabling the add-on releases it at once.
 """
+import contextlib
 import threading
 import time
 
@@ -31,11 +32,13 @@ from .callback_guard import never_raises
 _POLL_S = 1.0
 
 # since: time.monotonic() when the hold of the memory began, or None when
-# nothing is held; active: between register() and unregister(). Written by
-# the render handler (the render job's thread in a window), the
-# re-composite's worker and the timer (the main thread), under _lock: a
-# hold begun while the timer releases is not lost.
-_state = {"since": None, "active": False}
+# nothing is held; active: between register() and unregister(); in_use: how
+# many uses of the library outside a render run now (in_use()), during
+# which the timer releases nothing. Written by the render handler (the
+# render job's thread in a window), the re-composite's worker and the timer
+# (the main thread), under _lock: a use that ends as the timer releases
+# either holds its memory after the release or keeps the timer from it.
+_state = {"since": None, "active": False, "in_use": 0}
 _lock = threading.Lock()
 
 
@@ -57,16 +60,40 @@ def release():
     native.release_memory()
 
 
+def _start_hold_locked():
+    """start_hold's state change, under _lock: whether the memory is held."""
+    hold = _state["active"] and not bpy.app.background
+    _state["since"] = time.monotonic() if hold else None
+    return hold
+
+
 def start_hold():
     """The library has just computed (a render has ended, a re-composite's
     AO is done; any thread): in `-b`, or once the add-on is disabled (a
     re-composite's worker may finish after that), its memory goes back now;
     in a window it is held from now on (_poll)."""
     with _lock:
-        hold = _state["active"] and not bpy.app.background
-        _state["since"] = time.monotonic() if hold else None
+        hold = _start_hold_locked()
     if not hold:
         native.release_memory()
+
+
+@contextlib.contextmanager
+def in_use():
+    """Around a use of the library outside a render (a re-composite's
+    worker; any thread): the timer releases nothing while it runs (a render
+    keeps it off by itself), and its end is start_hold's, in the same
+    step as the count's, so that no release falls between them."""
+    with _lock:
+        _state["in_use"] += 1
+    try:
+        yield
+    finally:
+        with _lock:
+            _state["in_use"] -= 1
+            hold = _start_hold_locked()
+        if not hold:
+            native.release_memory()
 
 
 @bpy.app.handlers.persistent
@@ -82,7 +109,8 @@ def _poll():
     hold_s = preferences.keep_memory_seconds()  # (read here: the main thread)
     with _lock:
         since = _state["since"]
-        due = since is not None and time.monotonic() - since >= hold_s
+        due = (since is not None and _state["in_use"] == 0
+               and time.monotonic() - since >= hold_s)
         if due:
             _state["since"] = None
     if due:

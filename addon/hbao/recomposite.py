@@ -61,18 +61,19 @@ class _Computation:
 
     def _run(self, work):
         start = time.perf_counter()
-        try:
-            for key, job, inputs, extra in work:
-                if self.cancelled:
-                    break
-                depth, normal = inputs.arrays[0], inputs.arrays[1]
-                self.results[key] = (inputs, layer_passes.compute(job, depth, normal,
-                                                                  inputs.camera, extra))
-        except Exception as error:  # reported by the main thread
-            self.error = error
+        # the library's memory held from the end (its AO may be dropped unrendered:
+        # a failure, or a change that needs a render)
+        with memory_hold.in_use():
+            try:
+                for key, job, inputs, extra in work:
+                    if self.cancelled:
+                        break
+                    depth, normal = inputs.arrays[0], inputs.arrays[1]
+                    self.results[key] = (inputs, layer_passes.compute(job, depth, normal,
+                                                                      inputs.camera, extra))
+            except Exception as error:  # reported by the main thread
+                self.error = error
         self.seconds = time.perf_counter() - start
-        # (its AO may be dropped unrendered: a failure, or a change that needs a render)
-        memory_hold.start_hold()
 
     def done(self):
         return not self.thread.is_alive()

@@ -24,8 +24,6 @@ import os
 import sys
 import time
 
-import bpy
-
 arguments = sys.argv[sys.argv.index("--") + 1:]
 out_dir = arguments[0]
 hold_s, renders, gap_s = float(arguments[1]), int(arguments[2]), float(arguments[3])
@@ -35,6 +33,7 @@ if mode not in ("wait", "quit", "recomposite"):
     raise SystemExit(f"ui_memory_hold.py: unknown mode {mode!r}")
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import f12_job  # noqa: E402
+from hbao_preferences import hbao_preferences  # noqa: E402
 import timer_guard  # noqa: E402
 from process_memory import status_kib  # noqa: E402  (scripts/, on the path by f12_job)
 
@@ -47,13 +46,7 @@ NUDGE = 0.002
 RADIUS_STEP = 1.1
 
 memory_hold = sys.modules["hbao.memory_hold"]
-# `--addons` enables the add-on for the session without an entry in the
-# preferences (as Blender's own enabling does: Addons.new()); the artist's
-# enabling in the preferences makes one, which holds the add-on's settings.
-addons = bpy.context.preferences.addons
-if "hbao" not in addons:
-    addons.new().module = "hbao"
-addons["hbao"].preferences.keep_memory_s = round(hold_s)
+hbao_preferences().keep_memory_s = round(hold_s)
 scene, node = f12_job.corner_scene_with_node(out_dir)
 scene.render.resolution_x, scene.render.resolution_y = width, height
 scene.render.resolution_percentage = 100
