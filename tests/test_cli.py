@@ -2375,6 +2375,48 @@ def test_sequence_refuses_an_output_that_links_to_another_frames_output(hbao_too
     assert (tmp_path / "a_2.exr").is_file() and not (tmp_path / "a_2.exr").is_symlink()
 
 
+def test_sequence_refuses_two_frames_that_write_one_new_file_by_other_paths(hbao_tool, tmp_path):
+    """-o 'd#/ao.exr' with d1 and d2 links to one folder, or -o
+    'e#/../ao.exr': frames 1 and 2 wrote one file that was not there yet,
+    the run exited 0 with frame 1's AO lost, and the same command then
+    refused the run (a review's runs; the check by file saw only files that
+    exist). Refused before any frame runs, the folder entry named; a
+    preview the same; each frame a file of its own runs."""
+    shutil.copyfile(fixture_path("cycles_float_zip"), tmp_path / "r_1.exr")
+    shutil.copyfile(fixture_path("ortho_float"), tmp_path / "r_2.exr")
+    (tmp_path / "shared").mkdir()
+    for frame in (1, 2):
+        (tmp_path / f"d{frame}").symlink_to("shared")
+        (tmp_path / f"e{frame}").mkdir()
+    before = sorted(str(p.relative_to(tmp_path)) for p in tmp_path.rglob("*"))
+
+    def run(output, *extra):
+        return run_tool(hbao_tool, tmp_path / "r_#.exr", "-o", tmp_path / output,
+                        "--frames", "1-2", "--no-normals", *extra)
+
+    for output, entry in (("d#/ao.exr", "shared/ao.exr"), ("e#/../ao.exr", "ao.exr")):
+        assert_clean_error(run(output), EXIT_USAGE, "-o of frame 2", "is the -o of frame 1",
+                           f"both {tmp_path / entry}")
+    assert_clean_error(run("e#/ao.exr", "--preview", tmp_path / "e#/../p.png"), EXIT_USAGE,
+                       "--preview of frame 2", "is the --preview of frame 1")
+    assert sorted(str(p.relative_to(tmp_path)) for p in tmp_path.rglob("*")) == before
+    run_ok(hbao_tool, tmp_path / "r_#.exr", "-o", tmp_path / "e#/ao.exr", "--frames", "1-2",
+           "--no-normals")
+    assert (tmp_path / "e1" / "ao.exr").is_file() and (tmp_path / "e2" / "ao.exr").is_file()
+
+
+def test_sequence_progress_lines_escape_the_path(hbao_tool, tmp_path):
+    """A frame's progress line printed its output's name raw, where every
+    message escapes it: an escape sequence in the name drove the terminal,
+    a newline split the frame's one line in two."""
+    shutil.copyfile(fixture_path("cycles_float_zip"), tmp_path / "r_1.exr")
+    completed = run_ok(hbao_tool, tmp_path / "r_#.exr", "-o", tmp_path / "a\x1b[31m\nb_#.exr",
+                       "--frames", "1", "--no-normals")
+    lines = [line for line in completed.stderr.splitlines() if "[1/1] frame 1" in line]
+    assert len(lines) == 1 and "a\\x1b[31m\\x0ab_1.exr" in lines[0], completed.stderr
+    assert "\x1b" not in completed.stderr and (tmp_path / "a\x1b[31m\nb_1.exr").is_file()
+
+
 EXPORT_CAMERAS = SCRIPTS / "export_cameras.py"
 SCRIPTS_IN_BLENDER = Path(__file__).resolve().parent / "blender_scripts"
 

@@ -151,8 +151,13 @@ static bool up_to_date(const cli_options *frame) {
            output_is_whole(frame, &input, settings, older_than_input);
 }
 
+/* A frame's progress line: one line, its path escaped as every message
+ * is (tool_escape: a name with a newline or an escape sequence would split
+ * the line or drive the terminal); `message` is escaped already. */
 static void report(sequence_run *run, const frame_outcome *outcome, const char *output,
                    const char *message) {
+    char escaped[4 * PATH_MAX + 1];
+    tool_escape(output, escaped, sizeof escaped);
     pthread_mutex_lock(&run->lock);
     const int64_t done = ++run->finished;
     flockfile(stderr);
@@ -161,7 +166,7 @@ static void report(sequence_run *run, const frame_outcome *outcome, const char *
                 (long long)run->to_run, outcome->frame, message);
     else
         fprintf(stderr, "hbao: [%lld/%lld] frame %d: %s%s\n", (long long)done,
-                (long long)run->to_run, outcome->frame, output,
+                (long long)run->to_run, outcome->frame, escaped,
                 outcome->skipped ? " is up to date, skipped" : "");
     funlockfile(stderr);
     pthread_mutex_unlock(&run->lock);
@@ -473,6 +478,102 @@ static bool is_shared_camera(const char *camera, const struct stat *camera_statu
            (status.st_nlink == 1 || same_resolved_path(path, camera));
 }
 
+/* A running frame's output or preview by the folder entry that writing it
+ * replaces: where links at its name lead (final_path), by its folder's
+ * identity (through folders' links, "..", a bind mount) and its name
+ * there. frames_files compares files that exist; two frames whose files
+ * are one entry not there yet (-o 'd#/ao.exr' with d1 and d2 links to one
+ * folder, or -o 'd#/../ao.exr') wrote one file, the run exited 0 with one
+ * frame's AO lost, and a rerun then refused it (a review's runs). */
+typedef struct write_entry {
+    dev_t device;
+    ino_t inode;
+    const char *name; /* within `where` */
+    int32_t frame;
+    int kind;    /* 0: -o, 1: --preview */
+    char *where; /* final_path (owned) */
+    char *path;  /* as the frame names it (owned) */
+} write_entry;
+
+static int compare_write_entries(const void *a, const void *b) {
+    const write_entry *x = a, *y = b;
+    if (x->device != y->device) return x->device < y->device ? -1 : 1;
+    if (x->inode != y->inode) return x->inode < y->inode ? -1 : 1;
+    return strcmp(x->name, y->name);
+}
+
+/* The write_entry of `path` into *entry (false where its folder cannot be
+ * resolved: the frame fails to write there, or no memory). */
+static bool write_entry_of(const char *path, int32_t frame, int kind, write_entry *entry) {
+    char where[PATH_MAX];
+    if (!final_path(path, where)) return false;
+    char *slash = strrchr(where, '/');
+    if (slash == NULL) return false; /* (final_path gives an absolute path) */
+    struct stat folder;
+    *slash = '\0';
+    const bool resolved = stat(slash == where ? "/" : where, &folder) == 0;
+    *slash = '/';
+    if (!resolved) return false;
+    entry->where = strdup(where);
+    entry->path = strdup(path);
+    if (entry->where == NULL || entry->path == NULL) {
+        free(entry->where);
+        free(entry->path);
+        return false;
+    }
+    entry->device = folder.st_dev;
+    entry->inode = folder.st_ino;
+    entry->name = entry->where + (slash - where) + 1;
+    entry->frame = frame;
+    entry->kind = kind;
+    return true;
+}
+
+/* Refuses two running frames whose outputs or previews (`patterns`, named
+ * by `flags`) are one folder entry (write_entry). */
+static int refuse_shared_entries(const sequence_run *run, const char *const patterns[2],
+                                 const char *const flags[2], tool_error *error) {
+    write_entry *entries = malloc((size_t)run->to_run * 2 * sizeof *entries);
+    if (entries == NULL) return TOOL_EXIT_SUCCESS; /* (out of memory: the names' checks ran) */
+    size_t count = 0;
+    char path[PATH_MAX];
+    for (int64_t i = 0; i < run->count; ++i) {
+        if (run->outcomes[i].missing) continue;
+        const int32_t frame = run->outcomes[i].frame;
+        for (int k = 0; k < 2; ++k)
+            if (patterns[k] != NULL && frame_pattern_path(patterns[k], frame, path, sizeof path) &&
+                write_entry_of(path, frame, k, &entries[count]))
+                ++count;
+    }
+    qsort(entries, count, sizeof *entries, compare_write_entries);
+    int status = TOOL_EXIT_SUCCESS;
+    for (size_t i = 0; i + 1 < count && status == TOOL_EXIT_SUCCESS; ++i) {
+        /* the same frame's output and preview as one file: ao_command's refusal */
+        for (size_t j = i + 1; j < count && compare_write_entries(&entries[i], &entries[j]) == 0;
+             ++j) {
+            if (entries[j].frame == entries[i].frame) continue;
+            const write_entry *a = &entries[i], *b = &entries[j];
+            if (a->frame > b->frame) {
+                const write_entry *first = b;
+                b = a;
+                a = first;
+            }
+            status = tool_fail(error, TOOL_EXIT_USAGE,
+                               "%s of frame %d (%s) is the %s of frame %d (%s) by another path, "
+                               "both %s: %s",
+                               flags[b->kind], (int)b->frame, b->path, flags[a->kind],
+                               (int)a->frame, a->path, a->where, clash_words(2));
+            break;
+        }
+    }
+    for (size_t i = 0; i < count; ++i) {
+        free(entries[i].where);
+        free(entries[i].path);
+    }
+    free(entries);
+    return status;
+}
+
 static int refuse_other_frames_files(const sequence_run *run, tool_error *error) {
     const cli_options *options = run->options;
     const bool camera_per_frame = run->camera_per_frame;
@@ -530,14 +631,15 @@ static int refuse_other_frames_files(const sequence_run *run, tool_error *error)
             const frame_file *same = other_frames_file(files, found, path, frame);
             if (same != NULL) {
                 status = tool_fail(error, TOOL_EXIT_USAGE,
-                                   "%s of frame %d (%s) is the %s of frame %d by another path (a "
-                                   "symbolic link): %s",
+                                   "%s of frame %d (%s) is the %s of frame %d by another path "
+                                   "(through a link or \"..\"): %s",
                                    flags[k], (int)frame, path, names_of[same->kind],
                                    (int)same->frame, clash_words(same->kind));
                 goto done;
             }
         }
     }
+    status = refuse_shared_entries(run, patterns, flags, error);
 done:
     free_frame_files(files, found);
     return status;
