@@ -24,9 +24,17 @@
 #define SYMLINK_HOPS_MAX 40
 
 /* --- removing temporary files when a signal ends the run -------------------
- * The handler may only use async-signal-safe calls: it reads paths written
- * before their flag was set (with the signals blocked), unlinks them and
- * re-raises the signal with its default action. */
+ * A thread of its own takes the signals (sigwait: take_signals): it waits
+ * for the slots (slots_lock), under which every thread creates, names,
+ * renames and removes its temporaries and records them, and keeps them, so
+ * that no thread makes a temporary after it has looked; it unlinks those
+ * recorded and ends the process by the same signal. A handler, which runs
+ * in whatever thread the signal lands and can take no lock, once did this:
+ * in a sequence its thread went over the slots while a worker created or
+ * named a temporary, and an interrupted run left a frame's whole file
+ * behind (a review's runs: 2 to 10 of 150 interrupted sequences). Where
+ * that thread cannot start, that handler is still used
+ * (remove_temporary_files); it may only use async-signal-safe calls. */
 
 #define CLEANUP_SLOTS ATOMIC_FILE_MAX_OPEN
 
@@ -39,15 +47,55 @@ static bool handlers_installed;
 /* Frames of a sequence write their outputs from several threads: the slots
  * and the handler installation take turns. */
 static pthread_mutex_t slots_lock = PTHREAD_MUTEX_INITIALIZER;
+/* The cleanup signals that take_signals waits for: those not ignored when
+ * installed (nohup's stay ignored). */
+static sigset_t taken_signals;
 
-static void remove_temporary_files(int signal_number) {
+static void unlink_recorded_temporaries(void) {
     for (int s = 0; s < CLEANUP_SLOTS; ++s)
         if (cleanup_active[s]) unlink(cleanup_paths[s]);
-    /* Die of the same signal, so that the parent (a shell, a render farm)
-     * sees that the run was interrupted rather than a normal exit. The signal
-     * is blocked while its handler runs, so it is delivered on return. */
+}
+
+/* Die of `signal_number`, so that the parent (a shell, a render farm) sees
+ * that the run was interrupted rather than a normal exit: its default
+ * action, unblocked in this thread (take_signals'). */
+static void die_of(int signal_number) {
+    signal(signal_number, SIG_DFL);
+    sigset_t one;
+    sigemptyset(&one);
+    sigaddset(&one, signal_number);
+    pthread_sigmask(SIG_UNBLOCK, &one, NULL);
+    raise(signal_number);
+    _exit(128 + signal_number); /* (not reached: the default action ends the process) */
+}
+
+static void remove_temporary_files(int signal_number) {
+    unlink_recorded_temporaries();
+    /* The signal is blocked while its handler runs: delivered on return. */
     signal(signal_number, SIG_DFL);
     raise(signal_number);
+}
+
+static void *take_signals(void *unused) {
+    (void)unused;
+    int signal_number = 0;
+    while (sigwait(&taken_signals, &signal_number) != 0) continue;
+    pthread_mutex_lock(&slots_lock); /* for good */
+    unlink_recorded_temporaries();
+    die_of(signal_number);
+    return NULL;
+}
+
+/* The fallback: the handler in every thread that does not block the signals. */
+static void install_handlers(void) {
+    for (int i = 0; i < CLEANUP_SIGNAL_COUNT; ++i) {
+        if (!sigismember(&taken_signals, cleanup_signals[i])) continue;
+        struct sigaction action;
+        memset(&action, 0, sizeof action);
+        action.sa_handler = remove_temporary_files;
+        sigfillset(&action.sa_mask); /* one handler at a time */
+        sigaction(cleanup_signals[i], &action, NULL);
+    }
 }
 
 void atomic_file_install_signal_handlers(void) {
@@ -57,16 +105,33 @@ void atomic_file_install_signal_handlers(void) {
         return;
     }
     handlers_installed = true;
+    sigemptyset(&taken_signals);
+    bool any = false;
     for (int i = 0; i < CLEANUP_SIGNAL_COUNT; ++i) {
         struct sigaction previous;
         /* A signal the caller chose to ignore (nohup) stays ignored. */
         if (sigaction(cleanup_signals[i], NULL, &previous) != 0 || previous.sa_handler == SIG_IGN)
             continue;
-        struct sigaction action;
-        memset(&action, 0, sizeof action);
-        action.sa_handler = remove_temporary_files;
-        sigfillset(&action.sa_mask); /* one handler at a time */
-        sigaction(cleanup_signals[i], &action, NULL);
+        sigaddset(&taken_signals, cleanup_signals[i]);
+        any = true;
+    }
+    if (any) {
+        /* blocked in this thread and every thread it starts from now on:
+         * take_signals alone takes them */
+        sigset_t previous;
+        pthread_sigmask(SIG_BLOCK, &taken_signals, &previous);
+        pthread_attr_t attributes;
+        bool started = false;
+        if (pthread_attr_init(&attributes) == 0) {
+            pthread_t thread;
+            started = pthread_attr_setdetachstate(&attributes, PTHREAD_CREATE_DETACHED) == 0 &&
+                      pthread_create(&thread, &attributes, take_signals, NULL) == 0;
+            pthread_attr_destroy(&attributes);
+        }
+        if (!started) {
+            pthread_sigmask(SIG_SETMASK, &previous, NULL);
+            install_handlers();
+        }
     }
     pthread_mutex_unlock(&slots_lock);
 }

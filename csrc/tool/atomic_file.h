@@ -21,10 +21,10 @@
  * - a directory, a block device or a socket: refused (TOOL_EXIT_USAGE).
  *
  * SIGINT, SIGTERM and SIGHUP while a temporary file exists remove it, then
- * end the process by the same signal (so its exit status says so). Several
- * threads may write files at once (the frames of a sequence): then only the
- * main thread should take the signals (atomic_file_block_signals() in the
- * others).
+ * end the process by the same signal (so its exit status says so). A thread
+ * of its own takes them (atomic_file_install_signal_handlers(), before any
+ * other thread starts: every later thread blocks them), so several threads
+ * may write files at once (the frames of a sequence).
  */
 #ifndef HBAO_TOOL_ATOMIC_FILE_H
 #define HBAO_TOOL_ATOMIC_FILE_H
@@ -81,8 +81,11 @@ bool atomic_file_same_destination(const atomic_file *a, const atomic_file *b);
 /** Remove the temporary file (no-op when nothing is pending). */
 void atomic_file_abort(atomic_file *file);
 
-/** Install the signal handlers now (atomic_file_begin() does it too): call
- *  before starting threads that write files. */
+/** Start the thread that takes the signals now, and block them in the
+ *  calling thread and so in every thread it starts later (where that thread
+ *  cannot start: signal handlers). atomic_file_begin() does it too; call it
+ *  before any thread starts (a thread started earlier could take a signal
+ *  and end the process without the cleanup). */
 void atomic_file_install_signal_handlers(void);
 
 /** Block (and restore) the signals that remove temporary files, in the

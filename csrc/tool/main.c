@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "ao_command.h"
+#include "atomic_file.h"
 #include "cli_options.h"
 #include "hbao.h"
 #include "info_command.h"
@@ -59,6 +60,11 @@ int main(int argc, char **argv) {
     cli_options options;
     tool_error error = {{0}};
     int status = cli_parse(argc, argv, &options, &error);
+    /* The runs that write files: the thread that takes the signals first,
+     * before the library's, the EXR writer's or the frames' threads */
+    if (status == TOOL_EXIT_SUCCESS &&
+        (options.mode == TOOL_MODE_COMPUTE || options.mode == TOOL_MODE_SEQUENCE))
+        atomic_file_install_signal_handlers();
     if (status == TOOL_EXIT_SUCCESS) {
         switch (options.mode) {
             case TOOL_MODE_HELP:
