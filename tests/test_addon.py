@@ -1757,3 +1757,10 @@ def test_a_background_render_releases_the_librarys_memory_at_its_end(run_in_blen
     released = json_line(completed.stdout, "RELEASE_B")
     assert not released["held"], released
     assert released["before_mb"] - released["after_mb"] >= 18.0, released
+    # The add-on disabled while a render runs: its engine outlives memory_hold's
+    # handler, and releases at the end of its AO itself (nothing else would
+    # before Blender quits; a review's find).
+    completed = run_in_blender(SCRIPTS / "memory_release_b.py", tmp_path / "outlived", 320, 180,
+                               "outlived")
+    released = json_line(completed.stdout, "RELEASE_B")
+    assert released == {"releases": 1, "held": False}, released

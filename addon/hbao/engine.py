@@ -12,7 +12,7 @@ import bpy
 import numpy as np
 
 from . import camera as camera_model
-from . import (compat, exr_passes, native, pass_encoding, recomposite, scratch_files,
+from . import (compat, exr_passes, memory_hold, native, pass_encoding, recomposite, scratch_files,
                strip_cameras, timing_line)
 from .helper_ao import cache, compute_passes, main_of, original, report_warning
 from .helper_lookup import ENGINE_IDNAME, is_helper, pass_names_for_helper
@@ -147,6 +147,7 @@ def render_helper(engine, depsgraph):
                 _fill_passes(result, {}, width, height, layouts)
         finally:
             engine.end_result(result)
+            memory_hold.release_if_inactive()
     timings = dict(engine.hbao_timings)
     timings["write"] = time.perf_counter() - write_start
     if results:

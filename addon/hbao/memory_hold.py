@@ -78,6 +78,17 @@ def start_hold():
         native.release_memory()
 
 
+def release_if_inactive():
+    """After the engine's AO: where the add-on was disabled while the render
+    ran (engine.py keeps the engine's class for that render, but the render
+    handler that would release is gone), the memory goes back now; nothing
+    else would release it before Blender quits."""
+    with _lock:
+        inactive = not _state["active"]
+    if inactive:
+        native.release_memory()
+
+
 @contextlib.contextmanager
 def in_use():
     """Around a use of the library outside a render (a re-composite's
