@@ -136,7 +136,7 @@ def exr_attribute(name, kind, payload):
 
 
 def scanline_exr(channels, width, height, claimed_size=None, display_window=None,
-                 data_origin=(0, 0), half=(), integers=()):
+                 data_origin=(0, 0), half=(), integers=(), attributes=b""):
     """A single-part, uncompressed scanline EXR of float channels (name ->
     float32 array of shape (height, width); those named in `half` are stored
     as half floats, those in `integers` as unsigned integers), written from the OpenEXR file
@@ -144,7 +144,8 @@ def scanline_exr(channels, width, height, claimed_size=None, display_window=None
     claimed size (claimed_size=(w, h)) the file does not hold: then no chunk
     table and no chunks follow. The data window starts at `data_origin`
     (x, y); the display window (min x, min y, max x, max y) is the data
-    window unless given."""
+    window unless given. `attributes`: more header attributes, as
+    exr_attribute makes them."""
     claimed_width, claimed_height = claimed_size or (width, height)
     names = sorted(channels)
     # chlist: name, pixel type (1 half, 2 float), pLinear, 3 reserved, x/y sampling.
@@ -162,7 +163,8 @@ def scanline_exr(channels, width, height, claimed_size=None, display_window=None
               + exr_attribute("lineOrder", "lineOrder", b"\0")
               + exr_attribute("pixelAspectRatio", "float", struct.pack("<f", 1.0))
               + exr_attribute("screenWindowCenter", "v2f", struct.pack("<ff", 0.0, 0.0))
-              + exr_attribute("screenWindowWidth", "float", struct.pack("<f", 1.0)) + b"\0")
+              + exr_attribute("screenWindowWidth", "float", struct.pack("<f", 1.0))
+              + attributes + b"\0")
     if claimed_size is not None:
         return header
     types = {0: "<u4", 1: "<f2", 2: "<f4"}
@@ -359,6 +361,20 @@ def test_keep_input_copies_every_channel_with_its_type(hbao_tool, tmp_path):
             # Same type, same decoded values: the copy is lossless.
             assert result[channel] == stats, channel
         assert result["AO"]["type"] == "float"
+
+
+def test_keep_input_copies_an_attribute_of_a_type_of_its_own(hbao_tool, tmp_path):
+    """A header attribute of a type OpenEXR does not know (a studio's own:
+    the format allows it, exrheader reads it) failed --keep-input after the
+    whole AO was computed ("the opaque type is not actually a built-in
+    type"; a review's find): copied as its bytes, the run succeeds."""
+    y, x = np.mgrid[0:12, 0:16].astype(np.float32)
+    tag = exr_attribute("studioTag", "customBlob", b"\x01\x02\x03\xff")
+    (tmp_path / "in.exr").write_bytes(scanline_exr(
+        {"ViewLayer.Depth.Z": 5.0 + 0.5 * np.sin(x / 3.0)}, 16, 12, attributes=tag))
+    run_ok(hbao_tool, tmp_path / "in.exr", "-o", tmp_path / "ao.exr", "--keep-input")
+    assert tag in (tmp_path / "ao.exr").read_bytes()
+    assert "ViewLayer.Depth.Z" in channels_by_name(info(hbao_tool, tmp_path / "ao.exr"))
 
 
 def test_keep_input_output_is_valid_for_the_reference_openexr(hbao_tool, tmp_path):

@@ -86,6 +86,30 @@ static int32_t lines_per_chunk_for(exr_compression_t compression) {
     }
 }
 
+/* The input's attributes of types OpenEXRCore does not know (opaque: a
+ * studio's own type), copied as their bytes, before
+ * exr_copy_unset_attributes, which refuses them (3.1.5: "the opaque type is
+ * not actually a built-in type") but leaves attributes already set alone: a
+ * valid render with one failed --keep-input after its whole AO was
+ * computed (a review's find). */
+static exr_result_t copy_opaque_attributes(exr_context_t context, int part,
+                                           exr_const_context_t source) {
+    int32_t count = 0;
+    exr_result_t result = exr_get_attribute_count(source, 0, &count);
+    for (int32_t i = 0; i < count && result == EXR_ERR_SUCCESS; ++i) {
+        const exr_attribute_t *attribute = NULL;
+        result = exr_get_attribute_by_index(source, 0, EXR_ATTR_LIST_FILE_ORDER, i, &attribute);
+        if (result != EXR_ERR_SUCCESS || attribute->type != EXR_ATTR_OPAQUE) continue;
+        const char *type = NULL;
+        int32_t size = 0;
+        const void *bytes = NULL;
+        result = exr_attr_get_user(source, 0, attribute->name, &type, &size, &bytes);
+        if (result == EXR_ERR_SUCCESS)
+            result = exr_attr_set_user(context, part, attribute->name, type, size, bytes);
+    }
+    return result;
+}
+
 /* A multi-part input's part header (Blender 5) carries chunkCount, the number
  * of chunks of that part at its compression. OpenEXRCore writes a copied one
  * unchanged into a single-part file, whose header would then contradict its
@@ -386,6 +410,8 @@ int exr_write_image(int fd, const char *name, const exr_output_layout *layout,
         CHECK_EXR(exr_attr_set_string(context, part, layout->stamp_name, layout->stamp_text),
                   "cannot add the settings attribute");
     if (layout->copy_attributes_from != NULL) {
+        CHECK_EXR(copy_opaque_attributes(context, part, layout->copy_attributes_from),
+                  "cannot copy the input's header attributes");
         CHECK_EXR(exr_copy_unset_attributes(context, part, layout->copy_attributes_from, 0),
                   "cannot copy the input's header attributes");
         CHECK_EXR(fix_copied_chunk_count(context, part, layout), "cannot set the chunk count");
