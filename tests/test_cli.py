@@ -363,6 +363,25 @@ def test_keep_input_copies_every_channel_with_its_type(hbao_tool, tmp_path):
         assert result["AO"]["type"] == "float"
 
 
+def test_an_output_named_by_the_inputs_descriptor_is_refused(hbao_tool, tmp_path):
+    """-o /dev/fd/3 (a wrapper that forgot its `3>file`) or --preview
+    /proc/self/fd/3: the tool opens its input as descriptor 3, so these
+    names are the input once it is open. Looked at before the input was
+    opened, they passed, and the rename replaced the input, exit 0 (an
+    earlier --keep-input output as the input, which the render check lets
+    through; a review's find). Refused as the input, which stays as it was."""
+    source = tmp_path / "keep.exr"
+    run_ok(hbao_tool, fixture_path("cycles_float_zip"), "-o", source, "--keep-input",
+           "--no-normals")
+    before = source.read_bytes()
+    for arguments in (["-o", "/dev/fd/3"], ["-o", tmp_path / "ao.exr", "--preview",
+                                            "/proc/self/fd/3"]):
+        completed = run_tool(hbao_tool, source, *arguments, "--no-normals")
+        assert_clean_error(completed, EXIT_USAGE, "is the input file")
+        assert source.read_bytes() == before
+    assert not (tmp_path / "ao.exr").exists()
+
+
 def test_keep_input_copies_an_attribute_of_a_type_of_its_own(hbao_tool, tmp_path):
     """A header attribute of a type OpenEXR does not know (a studio's own:
     the format allows it, exrheader reads it) failed --keep-input after the

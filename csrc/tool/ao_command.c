@@ -434,16 +434,22 @@ int ao_command(const cli_options *options, tool_error *error) {
             strchr(options->input_path, '#') != NULL ? " (for an image sequence, give --frames)"
                                                      : "");
     /* (an input that is not a regular file: exr_input_open says what it is) */
-    int status = refuse_overwriting_input(options->output_path, "-o", &input_status,
-                                          options->camera_path, error);
-    if (status == TOOL_EXIT_SUCCESS && options->preview_path != NULL)
-        status = refuse_overwriting_input(options->preview_path, "--preview", &input_status,
-                                          options->camera_path, error);
-    if (status != TOOL_EXIT_SUCCESS) return status;
-
     exr_input input;
-    status = exr_input_open(&input, options->input_path, error);
+    int status = exr_input_open(&input, options->input_path, error);
     if (status != TOOL_EXIT_SUCCESS) return status;
+    /* Once the input is open: an output named by a descriptor (/dev/fd/3,
+     * /proc/self/fd/3: a wrapper that forgot its `3>file`) is the input
+     * only now that the input has that descriptor; looked at before, it
+     * passed, and the rename replaced the input (a review's find). */
+    status = refuse_overwriting_input(options->output_path, "-o", &input.file_status,
+                                      options->camera_path, error);
+    if (status == TOOL_EXIT_SUCCESS && options->preview_path != NULL)
+        status = refuse_overwriting_input(options->preview_path, "--preview", &input.file_status,
+                                          options->camera_path, error);
+    if (status != TOOL_EXIT_SUCCESS) {
+        exr_input_close(&input);
+        return status;
+    }
 
     ao_buffers buffers = {0};
     exr_output_channel *outputs = NULL;
