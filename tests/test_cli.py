@@ -1185,6 +1185,24 @@ def test_output_and_preview_naming_one_file_are_refused(hbao_tool, tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["link.png", "sub"]
 
 
+def test_output_and_preview_through_a_bind_mount_are_one_file(hbao_tool, tmp_path):
+    """-o a/ao.exr and --preview b/ao.exr where b is a bind mount of a (or
+    one export mounted twice): realpath keeps the two names apart, and the
+    PNG replaced the EXR, exit 0 (a review's find). The folders compared by
+    device and inode: refused, nothing written. (A mount namespace of the
+    test's own: needs root, as the test machines have.)"""
+    first, second = tmp_path / "a", tmp_path / "b"
+    first.mkdir()
+    second.mkdir()
+    script = (f'mount --bind "{first}" "{second}" && exec "{hbao_tool}" '
+              f'"{fixture_path("cycles_float_zip")}" -o "{first}/ao.exr" '
+              f'--preview "{second}/ao.exr" --no-normals')
+    completed = subprocess.run(["unshare", "--mount", "sh", "-c", script], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True, timeout=TOOL_TIMEOUT_S)
+    assert_clean_error(completed, EXIT_USAGE, "name the same file")
+    assert list(first.iterdir()) == [] and list(second.iterdir()) == []
+
+
 def test_existing_output_is_replaced_only_on_success(hbao_tool, tmp_path):
     output = tmp_path / "ao.exr"
     preview = tmp_path / "ao.png"

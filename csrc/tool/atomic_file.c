@@ -482,8 +482,9 @@ bool atomic_file_same_destination(const atomic_file *a, const atomic_file *b) {
                first.st_ino == second.st_ino && first.st_rdev == second.st_rdev;
     }
     char first[PATH_MAX], second[PATH_MAX];
-    return canonical_path(a->destination, first) && canonical_path(b->destination, second) &&
-           strcmp(first, second) == 0;
+    return (canonical_path(a->destination, first) && canonical_path(b->destination, second) &&
+            strcmp(first, second) == 0) ||
+           canonical_same_entry(a->destination, b->destination);
 }
 
 /* Copy the whole temporary file to the FIFO or device, in order. */

@@ -13,4 +13,10 @@
  *  cannot be resolved (it does not exist) or the result does not fit. */
 bool canonical_path(const char *path, char out[PATH_MAX]);
 
+/** Whether `a` and `b` name one folder entry: the same name in one folder,
+ *  the folders compared by device and inode, so that two mount points of
+ *  one folder (a bind mount, one export mounted twice), which realpath
+ *  keeps apart, are one; false where a folder cannot be looked up. */
+bool canonical_same_entry(const char *a, const char *b);
+
 #endif /* HBAO_TOOL_CANONICAL_PATH_H */
