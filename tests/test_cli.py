@@ -1203,6 +1203,21 @@ def test_output_and_preview_through_a_bind_mount_are_one_file(hbao_tool, tmp_pat
     assert list(first.iterdir()) == [] and list(second.iterdir()) == []
 
 
+def test_a_preview_device_that_fails_leaves_the_output_as_it_was(hbao_tool, tmp_path):
+    """--preview /dev/full: a device's data is copied at the end, and the
+    copy fails (no space). -o was renamed into place first, so the run
+    failed with the output replaced (a review's find); a device's or FIFO's
+    destination is now written first, and its failure leaves -o as it was
+    and no temporary file."""
+    output = tmp_path / "ao.exr"
+    output.write_bytes(b"previous result")
+    completed = run_tool(hbao_tool, fixture_path("cycles_float_zip"), "-o", output,
+                         "--preview", "/dev/full", "--no-normals")
+    assert_clean_error(completed, EXIT_RUNTIME, "/dev/full")
+    assert output.read_bytes() == b"previous result"
+    assert leftover_temporary_files(tmp_path) == []
+
+
 def test_existing_output_is_replaced_only_on_success(hbao_tool, tmp_path):
     output = tmp_path / "ao.exr"
     preview = tmp_path / "ao.png"

@@ -341,11 +341,18 @@ static int write_outputs(const cli_options *options, const exr_input *input,
             output_seal_attach(files->png.fd, options->output_path, &exr_status);
     }
     /* Both files are complete: only now replace the destinations, unless the
-     * input changed while it was read. */
+     * input changed while it was read. A FIFO's or device's first (its data
+     * is copied at commit: a full device, a reader gone), so that its
+     * failure leaves a file's destination as it was: --preview /dev/full
+     * failed after -o had been replaced (a review's find). */
     if (status == TOOL_EXIT_SUCCESS) status = refuse_changed_input(input, error);
-    if (status == TOOL_EXIT_SUCCESS) status = atomic_file_commit(&files->exr, error);
-    if (status == TOOL_EXIT_SUCCESS && options->preview_path != NULL)
-        status = atomic_file_commit(&files->png, error);
+    atomic_file *order[2] = {&files->exr, &files->png};
+    if (files->png.active && files->png.write_through && !files->exr.write_through) {
+        order[0] = &files->png;
+        order[1] = &files->exr;
+    }
+    for (int k = 0; k < 2 && status == TOOL_EXIT_SUCCESS; ++k)
+        if (order[k]->active) status = atomic_file_commit(order[k], error);
     return status;
 }
 
