@@ -775,6 +775,13 @@ def test_a_single_view_file_and_the_layers_listed(hbao_tool, tmp_path):
     listed = run_tool(hbao_tool, source, "-o", tmp_path / "x.exr", "--back-layer", "C")
     assert_clean_error(listed, EXIT_RUNTIME, 'several view layers', '"A", "B"')
     assert '"C"' not in listed.stderr
+    # The --back-layer's the only layer with a Depth pass: it was listed as
+    # the one to choose (a review's find); the message says it is taken.
+    alone = run_tool(hbao_tool, tmp_path / "view.exr", "-o", tmp_path / "x.exr", "--back-layer",
+                     "ViewLayer")
+    assert_clean_error(alone, EXIT_RUNTIME, "no Depth pass but the --back-layer's",
+                       "(--layer NAME)")
+    assert "layers with a Depth pass" not in alone.stderr
 
 
 def test_passes_stored_as_integers_are_refused(hbao_tool, tmp_path):

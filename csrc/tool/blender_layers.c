@@ -181,14 +181,25 @@ static int fail_listing_layers(const exr_input *input, const char *problem, cons
     const int views = fail_on_views(input, NULL, 0, error);
     if (views != TOOL_EXIT_SUCCESS) return views;
     char list[600] = "";
+    bool excluded_has_depth = false;
     for (int c = 0; c < input->channels->num_channels; ++c) {
         const char *name = input->channels->entries[c].name.str;
         int length = depth_layer_length(name);
         if (length < 0) continue;
-        if (is_layer(name, length, excluded)) continue;
+        if (is_layer(name, length, excluded)) {
+            excluded_has_depth = true;
+            continue;
+        }
         size_t used = strlen(list);
         snprintf(list + used, sizeof list - used, "%s\"%.*s\"", used ? ", " : "", length, name);
     }
+    /* (the message listed the --back-layer's own layer as the one to use:
+     * a review's find) */
+    if (list[0] == '\0' && excluded_has_depth)
+        return tool_fail(error, TOOL_EXIT_RUNTIME,
+                         "%s: no Depth pass but the --back-layer's (\"%s\"): the front faces "
+                         "need a view layer of their own (--layer NAME)",
+                         input->path, excluded);
     if (list[0] == '\0')
         return tool_fail(error, TOOL_EXIT_RUNTIME,
                          "%s: %s; the file has no Depth pass (no channel "
@@ -253,5 +264,5 @@ int blender_find_passes(const exr_input *input, const char *requested, const cha
         if (exr_input_find_channel(input, plain_depth[i]) >= 0)
             return fill_passes(input, "", 0, plain_depth[i], i < 2, passes, error);
     if (one_view_passes(input, passes)) return TOOL_EXIT_SUCCESS;
-    return fail_listing_layers(input, "no Depth pass", NULL, error);
+    return fail_listing_layers(input, "no Depth pass", excluded, error);
 }
