@@ -75,6 +75,22 @@ def test_users_png_output_is_restored_after_the_pass_hand_over(run_in_blender, t
     assert node_outputs(out, 1)["ao"].min() < 0.9  # the AO itself was computed
 
 
+@pytest.mark.parametrize("case", ["colorspace", "movie"])
+def test_every_output_setting_is_as_it_was_after_the_hand_over_through_a_file(
+        run_in_blender, tmp_path, file_route, case):
+    """The hand-over through a file sets the artist's output to multilayer
+    EXR for its save and puts it back, but setting the format resets more
+    than the format: the output's linear colour space (4.5, 5.x: Linear
+    Rec.2020 became Rec.709, in the frame's own file and the saved .blend)
+    and, in 3.4, a movie's container and codec (QuickTime with PNG frames
+    became a lossy .mkv); a review's find. Every plain setting of the image
+    settings, of their linear colour space and of FFmpeg's is as it was."""
+    completed = run_in_blender(SCRIPTS / "output_settings_kept.py", tmp_path / "out", case)
+    seen = json_line(completed.stdout, "SETTINGS")
+    assert seen["after"] == seen["before"], seen
+    assert "AO pass(es)" in completed.stdout, completed.stdout[-3000:]
+
+
 @pytest.mark.parametrize("edit", ["rename_node", "rename_helper"])
 def test_renamed_node_or_helper_scene_still_renders_ao(run_in_blender, tmp_path, node_native,
                                                        no_leftovers, edit):

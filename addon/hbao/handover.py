@@ -69,6 +69,7 @@ def save_passes(scene, path, views=None):
                            f"keep slot {other[1]} shown while a render runs")
     settings = scene.render.image_settings
     saved = compat.saved_image_settings(settings)
+    saved_ffmpeg = compat.saved_ffmpeg_settings(scene.render)
     try:
         compat.set_multilayer_exr(settings)
         settings.color_depth = "32"
@@ -91,8 +92,10 @@ def save_passes(scene, path, views=None):
             ) from error
     finally:
         # The media type and format first, so that their options are valid
-        # when they are set; the user's PNG output stays PNG.
+        # when they are set; the user's PNG output stays PNG; a movie's
+        # container and codec after the format, which resets them (3.4).
         compat.restore_image_settings(settings, saved)
+        compat.restore_ffmpeg_settings(scene.render, saved_ffmpeg)
 
 
 def read_passes(scene, layers, views=None, threads=0):
