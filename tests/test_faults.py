@@ -256,6 +256,22 @@ def test_scratch_folder_that_cannot_be_written_says_which_and_how(run_in_blender
     assert "HBAO_TEMP_DIR names existing folders" in log
 
 
+def test_a_scratch_folder_too_long_for_blender_is_refused_and_left_empty(run_in_blender,
+                                                                         tmp_path, file_route):
+    """A scratch folder whose path with the file's name reaches Blender's
+    limit (1024 bytes): Blender cut the name, wrote a file of the cut name
+    each frame, which no removal found (no .exr), and the render had no AO
+    (a review's find). Refused before the save, the reason said, nothing
+    written there."""
+    folder = tmp_path / "s"
+    while len(os.fsencode(str(folder))) < 990:
+        folder = folder / ("d" * min(200, 990 - len(os.fsencode(str(folder)))))
+    folder.mkdir(parents=True)
+    log = render_with_scratch_folder(run_in_blender, tmp_path, folder)
+    assert "path is too long for Blender's save" in log, log[-3000:]
+    assert list(folder.iterdir()) == []
+
+
 def test_a_scratch_folder_that_does_not_exist_is_not_made(run_in_blender, tmp_path, node_native,
                                                           no_leftovers, file_route):
     """A mistyped HBAO_TEMP_DIR folder: Blender's save made it (parents too)

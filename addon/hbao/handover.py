@@ -107,11 +107,13 @@ def read_passes(scene, layers, views=None, threads=0):
     Taken from the engine's memory where pass_capture.py could ({"capture":
     seconds}), else saved in the first of scratch_files.folders() that
     takes the file."""
+    # (files a killed Blender left: in the background, whichever way the
+    # passes come; a process that takes them all from memory left them)
+    scratch_files.remove_stale_now_and_then()
     taken = pass_capture.take(scene, layers, views)
     if taken is not None:
         channels, seconds = taken
         return channels, {"capture": seconds}
-    scratch_files.remove_stale_now_and_then()
     scratch_files.wait_for_older_removals()
     folders = scratch_files.folders()
     for index, folder in enumerate(folders):
@@ -125,6 +127,12 @@ def read_passes(scene, layers, views=None, threads=0):
     return channels[None] if views is None else channels, timings
 
 
+# Blender's paths (FILE_MAX): a Render Result's save cut a longer one at
+# 1023 bytes and wrote a file of that name, without the .exr that the
+# removal of stale files looks for, every frame (a review's find).
+BLENDER_PATH_BYTES = 1024
+
+
 def _save_and_read(scene, layers, views, threads, folder):
     path = scratch_files.path_in(folder)
     files = view_files.files(path, views)
@@ -136,6 +144,12 @@ def _save_and_read(scene, layers, views, threads, folder):
                 f"the scratch folder {folder} "
                 f"{'is not a folder' if os.path.exists(folder) else 'does not exist'}; "
                 f"{scratch_files.SCRATCH_FOLDER_VARIABLE} names existing folders for the passes")
+        longest = max(len(os.fsencode(file)) for file in set(files.values()) | {path})
+        if longest >= BLENDER_PATH_BYTES:  # it would cut the name and write that file
+            raise ScratchFolderError(
+                f"the scratch folder {folder}'s path is too long for Blender's save "
+                f"({longest} bytes with the file's name; Blender takes {BLENDER_PATH_BYTES - 1}); "
+                f"{scratch_files.SCRATCH_FOLDER_VARIABLE} names a shorter one")
         start = _clock()
         save_passes(scene, path, views)
         timings["save"] = _clock() - start

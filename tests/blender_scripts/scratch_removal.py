@@ -216,4 +216,19 @@ scratch_files._stale_files_checked_at -= scratch_files.STALE_CHECK_INTERVAL_S
 hand_over()
 assert not os.path.exists(stale), \
     "a hand-over STALE_CHECK_INTERVAL_S later did not remove the stale file"
+
+# A hand-over from the engine's memory (pass_capture: 4.5+, Cycles) looks
+# too: a process whose renders all took their passes from memory left a
+# killed Blender's file (an EEVEE or border render's, up to a gigabyte of
+# /dev/shm) for good (a review's find). Here the capture hands back nothing.
+open(stale, "wb").close()
+os.utime(stale, (old, old))
+scratch_files._stale_files_checked_at -= scratch_files.STALE_CHECK_INTERVAL_S
+take = handover.pass_capture.take
+handover.pass_capture.take = lambda *args, **kwargs: ({}, 0.0)
+try:
+    hand_over()
+finally:
+    handover.pass_capture.take = take
+assert not os.path.exists(stale), "a hand-over from memory did not remove the stale file"
 print("REMOVAL OK", flush=True)
