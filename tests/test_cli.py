@@ -784,6 +784,32 @@ def test_a_single_view_file_and_the_layers_listed(hbao_tool, tmp_path):
     assert "layers with a Depth pass" not in alone.stderr
 
 
+def test_a_normal_pass_missing_a_channel_is_said(hbao_tool, tmp_path):
+    """A layer with part of a Normal pass (a channel lost in another
+    program's edit) was computed from reconstructed normals without a word
+    (a review's find): the warning says how many of the three are there.
+    A whole Normal pass, or none (Depth alone, by choice), says nothing, and
+    the partial pass gives the AO of none."""
+    depth = np.full((12, 16), 5.0, np.float32)
+    depth[4:8, 4:8] = 4.5
+    flat = np.zeros((12, 16), np.float32)
+    normal = {"X": flat, "Y": flat, "Z": np.ones((12, 16), np.float32)}
+    cases = {"partial": ("X", "Y"), "whole": ("X", "Y", "Z"), "none": ()}
+    ao = {}
+    for case, axes in cases.items():
+        channels = {"ViewLayer.Depth.Z": depth}
+        channels.update({f"ViewLayer.Normal.{axis}": normal[axis] for axis in axes})
+        (tmp_path / f"{case}.exr").write_bytes(scanline_exr(channels, 16, 12))
+        completed = run_ok(hbao_tool, tmp_path / f"{case}.exr", "-o", tmp_path / f"{case}_ao.exr",
+                           "--world-to-camera", "1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1")
+        said = "the Normal pass has 2 of its 3 channels (ViewLayer.Normal.X/Y/Z)"
+        assert (said in completed.stderr) == (case == "partial"), (case, completed.stderr)
+        assert ("warning" in completed.stderr) == (case == "partial"), (case, completed.stderr)
+        from hbao import exr_passes
+        ao[case] = exr_passes.read_channels(tmp_path / f"{case}_ao.exr", ["AO"])["AO"]
+    assert np.array_equal(ao["partial"], ao["none"])
+
+
 def test_passes_stored_as_integers_are_refused(hbao_tool, tmp_path):
     """A Depth or Normal channel of unsigned integers (an index or ID pass
     under that name, from another program) was read as floats and gave AO

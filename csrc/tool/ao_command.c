@@ -392,6 +392,14 @@ int ao_compute_input(const cli_options *options, exr_input *input, ao_buffers *b
                   "named with %d bytes or more",
                   input->path, (int)strlen(passes->normal[0]) - 1, passes->normal[0],
                   BLENDER_NORMAL_LAYER_NAME_MAX);
+    /* part of a Normal pass (a channel lost on the way: a compositor's or
+     * another program's edit) was set aside without a word (a review's find) */
+    else if (passes->normal_expected && !passes->has_normal && passes->normal_found > 0 &&
+             !options->ignore_normals)
+        tool_warn("%s: the Normal pass has %d of its 3 channels (%.*sX/Y/Z): normals are "
+                  "reconstructed from depth",
+                  input->path, passes->normal_found, (int)strlen(passes->normal[0]) - 1,
+                  passes->normal[0]);
     /* The passes are decoded with as many threads as the AO is computed. */
     input->threads = options->params.threads > 0 ? options->params.threads : exr_usable_cores();
     status = read_passes(input, passes, use_normals,

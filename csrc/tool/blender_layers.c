@@ -38,14 +38,15 @@ static int fill_passes(const exr_input *input, const char *layer, int layer_leng
     if (!set_name(passes->layer, layer, layer_length, "") ||
         !set_name(passes->depth, depth_channel, (int)strlen(depth_channel), ""))
         return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: channel name too long", input->path);
-    passes->has_normal = passes->normal_expected = look_for_normals;
-    for (int axis = 0; axis < 3 && passes->has_normal; ++axis) {
+    passes->normal_expected = look_for_normals;
+    for (int axis = 0; axis < 3 && look_for_normals; ++axis) {
         char prefix[BLENDER_CHANNEL_NAME_MAX];
         if (!set_name(prefix, layer, layer_length, layer_length > 0 ? "." : "") ||
             !set_name(passes->normal[axis], prefix, (int)strlen(prefix), normal_names[axis]))
             return tool_fail(error, TOOL_EXIT_RUNTIME, "%s: channel name too long", input->path);
-        passes->has_normal = exr_input_find_channel(input, passes->normal[axis]) >= 0;
+        passes->normal_found += exr_input_find_channel(input, passes->normal[axis]) >= 0;
     }
+    passes->has_normal = look_for_normals && passes->normal_found == 3;
     return TOOL_EXIT_SUCCESS;
 }
 
@@ -156,16 +157,16 @@ static bool one_view_passes(const exr_input *input, blender_passes *passes) {
     if (!set_name(passes->layer, depth, layer_length, "") ||
         !set_name(passes->depth, depth, (int)strlen(depth), ""))
         return false;
-    passes->has_normal = passes->normal_expected = true;
+    passes->normal_expected = true;
     static const char axes[3] = {'X', 'Y', 'Z'};
     for (int axis = 0; axis < 3; ++axis) {
         const int written =
             snprintf(passes->normal[axis], BLENDER_CHANNEL_NAME_MAX, "%.*s.Normal.%.*s.%c",
                      layer_length, depth, view_length, view, axes[axis]);
         if (written < 0 || written >= BLENDER_CHANNEL_NAME_MAX) return false;
-        passes->has_normal =
-            passes->has_normal && exr_input_find_channel(input, passes->normal[axis]) >= 0;
+        passes->normal_found += exr_input_find_channel(input, passes->normal[axis]) >= 0;
     }
+    passes->has_normal = passes->normal_found == 3;
     return true;
 }
 

@@ -25,6 +25,7 @@ typedef struct blender_passes {
     char normal[3][BLENDER_CHANNEL_NAME_MAX];
     bool has_normal;      /**< all three normal channels exist */
     bool normal_expected; /**< a layer (or Depth.Z / Depth.V): a Normal pass may be there */
+    int normal_found;     /**< how many of the three exist (normal[] names all three) */
 } blender_passes;
 
 /**
