@@ -277,14 +277,14 @@ def test_without_a_gpu_the_panel_says_what_a_frame_costs(run_blender, tmp_path):
     passes there, and the panel's note (panel.software_note) gives the last
     frame's time and, at full resolution, that Half Resolution takes about
     a third of it. Held: the renderer is a software one; every time is
-    positive; full resolution's fastest frame takes at least twice as long
-    as half's (a time of the depth's upload alone would not tell them apart;
-    the passes have 4 times the pixels, the upload the same: 3.5-3.8 times,
-    idle or with both cores busy; the two take turns, since a busy
-    neighbour had slowed the half frames alone, 1.9 times, session 70); the
-    note names the time draw.py kept; and where the preview cannot draw
-    (X-ray below alpha 1) the note is left out, as the panel then says
-    why."""
+    positive; full resolution's fastest frame takes at least 1.5 times as
+    long as half's (a time of the depth's upload alone would not tell them
+    apart, about 1; the passes have 4 times the pixels, the upload the
+    same: 3.5-3.8 times, idle or with both cores busy, and 1.9 in a test
+    command run beside two other jobs' Blenders, session 70; the two take
+    turns, so that a busy neighbour slows both); the note names the time
+    draw.py kept; and where the preview cannot draw (X-ray below alpha 1)
+    the note is left out, as the panel then says why."""
     log = run_blender(SCRIPTS / "viewport_software.py", tmp_path, **IN_A_WINDOW).stdout
     assert "SOFTWARE: DONE" in log and "Traceback" not in log, log[-3000:]
     report = json_line(log, "SOFTWARE")
@@ -294,7 +294,7 @@ def test_without_a_gpu_the_panel_says_what_a_frame_costs(run_blender, tmp_path):
         assert all(t is not None and 0.0 < t < 60000.0 for t in times), report
         assert report[f"{name}_note"].startswith("No GPU: "), report
         assert f"({times[-1]:.0f} ms a frame)" in report[f"{name}_note"], report
-    assert min(report["full_ms"]) > 2.0 * min(report["half_ms"]), report
+    assert min(report["full_ms"]) > 1.5 * min(report["half_ms"]), report
     assert "Half Resolution takes about a third" in report["full_note"], report
     assert "Half Resolution" not in report["half_note"], report
     assert report["xray_note"] is None, report
