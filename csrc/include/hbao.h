@@ -258,7 +258,9 @@ typedef struct hbao_camera {
     float pixel_aspect_y;
     /** Row-major 4x4 world-to-camera matrix (camera.matrix_world inverted).
      *  Only its rotation is used: it maps the world-space Normal pass into
-     *  camera space. Identity when the normals are already in camera space. */
+     *  camera space. Identity when the normals are already in camera space.
+     *  A camera's scale may be left in: rows of unequal length (scaled
+     *  unevenly) are each made unit length, as Blender renders the camera. */
     float world_to_camera[16];
 } hbao_camera;
 

@@ -472,10 +472,32 @@ static float detect_depth_precision(const hbao_settings *settings, const hbao_gr
     return atomic_load(&job.not_half) ? HBAO_FLOAT_DEPTH_PRECISION : HBAO_HALF_DEPTH_PRECISION;
 }
 
+/* world_to_camera's rotation rows made one length where a camera's uneven
+ * scale made them unequal: the inverse of camera.matrix_world (R S) is
+ * S^-1 R^T, whose rows are R^T's each over one axis's scale, and turned by
+ * it the normals leaned towards the shorter axes (up to 0.25 of AO; a
+ * review's find). Each such row is made unit length, which gives R^T; rows
+ * of one length (a rotation, or one scaled evenly, which the normals'
+ * normalisation undoes) are left as they are, to the bit. */
+#define UNEVEN_ROWS 1e-5
+static void even_rotation_rows(float m[16]) {
+    double length[3];
+    for (int r = 0; r < 3; r++)
+        length[r] = sqrt((double)m[4 * r] * m[4 * r] + (double)m[4 * r + 1] * m[4 * r + 1] +
+                         (double)m[4 * r + 2] * m[4 * r + 2]);
+    const double shortest = fmin(length[0], fmin(length[1], length[2]));
+    const double longest = fmax(length[0], fmax(length[1], length[2]));
+    if (!(longest - shortest > UNEVEN_ROWS * longest)) return;
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++) m[4 * r + c] = (float)(m[4 * r + c] / length[r]);
+}
+
 void hbao_compute_normals(const hbao_settings *settings, const hbao_camera *camera, hbao_grid *grid,
                           const hbao_channel *normal, int scale) {
     grid->depth_precision = detect_depth_precision(settings, grid);
-    normal_job job = {camera, grid, normal, scale,
+    hbao_camera turned = *camera;
+    even_rotation_rows(turned.world_to_camera);
+    normal_job job = {&turned, grid, normal, scale,
                       hbao_finish_implementation(settings->implementation)};
     hbao_parallel_rows(settings->threads, grid->height, normal_row, &job);
     float *padding = hbao_grid_normal_row(grid, grid->height, 0); /* past the last row */

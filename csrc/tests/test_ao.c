@@ -869,6 +869,38 @@ TEST_CASE(normals_of_any_finite_length_give_the_same_ao) {
     free(normal);
 }
 
+/* A camera scaled unevenly (or under a parent scaled so): world_to_camera
+ * as camera.matrix_world inverted has rotation rows each over one axis's
+ * scale. Its normals turn as the rotation's: the AO is that of the
+ * rotation alone, to float rounding; the rows taken as given leaned the
+ * normals towards the shorter axes (AO off by up to 0.25, a review's find). */
+TEST_CASE(an_unevenly_scaled_camera_turns_normals_as_its_rotation) {
+    scene_view view;
+    float *depth, *normal;
+    render_standard_view(boxes_scene(), 96, 64, &view, &depth, &normal);
+    hbao_params p = HBAO_PARAMS_DEFAULT_INITIALIZER;
+    float *reference = run(&p, &view, depth, normal);
+    const float scales[][3] = {{1.0f, 2.5f, 0.6f}, {3.0f, 3.0f, 0.2f}, {0.01f, 1.0f, 1.0f}};
+    for (size_t s = 0; s < sizeof scales / sizeof scales[0]; s++) {
+        scene_view scaled = view;
+        for (int r = 0; r < 3; r++)
+            for (int c = 0; c < 3; c++)
+                scaled.camera.world_to_camera[4 * r + c] =
+                    view.camera.world_to_camera[4 * r + c] / scales[s][r];
+        float *ao = run(&p, &scaled, depth, normal);
+        float largest = 0.0f;
+        for (int k = 0; k < view.width * view.height; k++)
+            largest = fmaxf(largest, fabsf(ao[k] - reference[k]));
+        printf("  scales %g %g %g: largest AO difference %g\n", scales[s][0], scales[s][1],
+               scales[s][2], largest);
+        CHECK(largest <= 1e-4f);
+        free(ao);
+    }
+    free(reference);
+    free(depth);
+    free(normal);
+}
+
 /* --- stages ---------------------------------------------------------------- */
 
 TEST_CASE(half_resolution_is_close_to_full) {
@@ -2005,6 +2037,7 @@ TEST_MAIN(TEST_ENTRY(plane_facing_camera_is_unoccluded), TEST_ENTRY(tilted_plane
           TEST_ENTRY(ao_computed_in_place_over_its_depth),
           TEST_ENTRY(normal_layouts_give_the_same_ao),
           TEST_ENTRY(normals_of_any_finite_length_give_the_same_ao),
+          TEST_ENTRY(an_unevenly_scaled_camera_turns_normals_as_its_rotation),
           TEST_ENTRY(half_resolution_is_close_to_full), TEST_ENTRY(blur_keeps_depth_edges),
           TEST_ENTRY(strength_is_a_power), TEST_ENTRY(background_never_occludes),
           TEST_ENTRY(tiny_projected_radius_gives_one),
