@@ -136,7 +136,7 @@ def exr_attribute(name, kind, payload):
 
 
 def scanline_exr(channels, width, height, claimed_size=None, display_window=None,
-                 data_origin=(0, 0), half=(), integers=(), attributes=b""):
+                 data_origin=(0, 0), half=(), integers=(), attributes=b"", pixel_aspect=1.0):
     """A single-part, uncompressed scanline EXR of float channels (name ->
     float32 array of shape (height, width); those named in `half` are stored
     as half floats, those in `integers` as unsigned integers), written from the OpenEXR file
@@ -145,7 +145,7 @@ def scanline_exr(channels, width, height, claimed_size=None, display_window=None
     table and no chunks follow. The data window starts at `data_origin`
     (x, y); the display window (min x, min y, max x, max y) is the data
     window unless given. `attributes`: more header attributes, as
-    exr_attribute makes them."""
+    exr_attribute makes them; `pixel_aspect`: pixelAspectRatio's."""
     claimed_width, claimed_height = claimed_size or (width, height)
     names = sorted(channels)
     # chlist: name, pixel type (1 half, 2 float), pLinear, 3 reserved, x/y sampling.
@@ -161,7 +161,7 @@ def scanline_exr(channels, width, height, claimed_size=None, display_window=None
               + exr_attribute("dataWindow", "box2i", box)
               + exr_attribute("displayWindow", "box2i", display)
               + exr_attribute("lineOrder", "lineOrder", b"\0")
-              + exr_attribute("pixelAspectRatio", "float", struct.pack("<f", 1.0))
+              + exr_attribute("pixelAspectRatio", "float", struct.pack("<f", pixel_aspect))
               + exr_attribute("screenWindowCenter", "v2f", struct.pack("<ff", 0.0, 0.0))
               + exr_attribute("screenWindowWidth", "float", struct.pack("<f", 1.0))
               + attributes + b"\0")
@@ -380,6 +380,32 @@ def test_an_output_named_by_the_inputs_descriptor_is_refused(hbao_tool, tmp_path
         assert_clean_error(completed, EXIT_USAGE, "is the input file")
         assert source.read_bytes() == before
     assert not (tmp_path / "ao.exr").exists()
+
+
+def test_one_pixel_aspect_flag_takes_blenders_default_for_the_other(hbao_tool, tmp_path):
+    """A render of pixel aspect X 1, Y 2 has the ratio 0.5 in its header.
+    --pixel-aspect-y 2 alone (or a camera file with only that key) kept the
+    header's 0.5 for X, counting the aspect twice (AO off by up to 0.25; a
+    review's find). Either value given, the other is Blender's default 1:
+    the header alone, both flags, and Y alone give the same AO; X alone
+    (1) gives square pixels, as its AO with a square header does."""
+    y, x = np.mgrid[0:48, 0:64].astype(np.float32)
+    depth = 5.0 + 0.6 * np.sin(x / 4.0) * np.cos(y / 3.0)
+    channels = {"ViewLayer.Depth.Z": depth}
+    (tmp_path / "tall.exr").write_bytes(scanline_exr(channels, 64, 48, pixel_aspect=0.5))
+    (tmp_path / "square.exr").write_bytes(scanline_exr(channels, 64, 48))
+    from hbao import exr_passes
+
+    def ao(source, *flags):
+        output = tmp_path / f"ao_{len(list(tmp_path.iterdir()))}.exr"
+        run_ok(hbao_tool, tmp_path / source, "-o", output, "--radius", "0.5", *flags)
+        return exr_passes.read_channels(output, ["AO"])["AO"]
+
+    header = ao("tall.exr")
+    assert np.array_equal(ao("tall.exr", "--pixel-aspect-x", "1", "--pixel-aspect-y", "2"), header)
+    assert np.array_equal(ao("tall.exr", "--pixel-aspect-y", "2"), header)
+    assert np.array_equal(ao("tall.exr", "--pixel-aspect-x", "1"), ao("square.exr"))
+    assert not np.array_equal(header, ao("square.exr"))
 
 
 def test_keep_input_copies_an_attribute_of_a_type_of_its_own(hbao_tool, tmp_path):

@@ -6,17 +6,14 @@
 
 #include "camera_json.h"
 
-/* Defaults, then the EXR header's pixel aspect, then the JSON file, then flags. */
+/* Defaults, then the JSON file, then flags; the EXR header's pixel aspect
+ * where neither gives a pixel aspect. Blender's pair (x, y) is one ratio in
+ * the header: given x or y alone, the other is Blender's default 1, not the
+ * header's ratio, which held both (--pixel-aspect-y 2 on a render of
+ * aspect 1:2 made the pixels 0.25 wide for 1 tall; a review's find). */
 static int resolve_camera(const cli_options *options, const exr_input *input,
                           camera_settings *resolved, tool_error *error) {
     camera_settings_init(resolved);
-    if (input->has_pixel_aspect_ratio && input->pixel_aspect_ratio > 0.0f &&
-        isfinite(input->pixel_aspect_ratio)) {
-        /* pixelAspectRatio = pixel width / pixel height = aspect_x / aspect_y. */
-        resolved->camera.pixel_aspect_x = input->pixel_aspect_ratio;
-        resolved->camera.pixel_aspect_y = 1.0f;
-        resolved->fields_set |= CAMERA_FIELD_PIXEL_ASPECT_X | CAMERA_FIELD_PIXEL_ASPECT_Y;
-    }
     if (options->camera_file != NULL) {
         camera_settings_apply(resolved, options->camera_file);
     } else if (options->camera_path != NULL) {
@@ -27,6 +24,14 @@ static int resolve_camera(const cli_options *options, const exr_input *input,
         camera_settings_apply(resolved, &from_file);
     }
     camera_settings_apply(resolved, &options->camera_flags);
+    const unsigned aspect = CAMERA_FIELD_PIXEL_ASPECT_X | CAMERA_FIELD_PIXEL_ASPECT_Y;
+    if ((resolved->fields_set & aspect) == 0 && input->has_pixel_aspect_ratio &&
+        input->pixel_aspect_ratio > 0.0f && isfinite(input->pixel_aspect_ratio)) {
+        /* pixelAspectRatio = pixel width / pixel height = aspect_x / aspect_y. */
+        resolved->camera.pixel_aspect_x = input->pixel_aspect_ratio;
+        resolved->camera.pixel_aspect_y = 1.0f;
+        resolved->fields_set |= aspect;
+    }
     return TOOL_EXIT_SUCCESS;
 }
 
