@@ -338,6 +338,10 @@ def test_clamping_happens_once_and_says_so(native):
         "Steps 500 is above the limit 64; using 64",
         "Directions 0 is below the limit 1; using 1",
         "Strength 20 is above the limit 16; using 16"])
+    # a half rounds up, as Blender rounds a keyframed integer socket (round()
+    # gave 2.5 -> 2 and 3.5 -> 4)
+    for fed, whole in ((2.5, 3), (3.5, 4), (-2.5, -2), (6.49, 6)):
+        assert native.resolve_params({"steps": fed})["steps"] == max(whole, 1), fed
     untouched = []
     native.resolve_params(native_module.default_params(), untouched)
     assert untouched == []

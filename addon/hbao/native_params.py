@@ -4,6 +4,7 @@ Blender spells them) to the struct and back, and resolve_params(), through
 which every front end (node, viewport, benchmark) has its values completed and
 clamped by the library's own resolver, hbao_params_resolve. Needs numpy, not bpy."""
 import ctypes
+import math
 
 import numpy as np
 
@@ -23,8 +24,10 @@ _FLOAT32_MAX = float(np.finfo(np.float32).max)
 
 def _int32(value):
     """A whole-number field's value: the nearest integer (a Value node may feed
-    7.6), kept inside int32 so that ctypes cannot wrap it; the library's
-    resolver then applies the field's limits."""
+    7.6), a half up, as Blender rounds a keyframed integer socket (round()
+    took 2.5 to 2 and 3.5 to 4: a review's find), kept inside int32 so that
+    ctypes cannot wrap it; the library's resolver then applies the field's
+    limits."""
     try:
         value = float(value)
     except (TypeError, ValueError):
@@ -33,7 +36,7 @@ def _int32(value):
         raise ValueError("is not a number")
     if value in (float("inf"), float("-inf")):
         raise ValueError("is infinite")  # as the library refuses it in a float field
-    return int(min(max(round(value), _INT32_RANGE[0]), _INT32_RANGE[1]))
+    return int(min(max(math.floor(value + 0.5), _INT32_RANGE[0]), _INT32_RANGE[1]))
 
 
 def params_struct(params):
