@@ -7,8 +7,8 @@ numpy arrays."""
 import os
 from time import perf_counter as _clock
 
-from . import (compat, exr_passes, pass_capture, render_slots, render_threads, scratch_files,
-               view_cameras, view_files)
+from . import (compat, exr_passes, output_settings, pass_capture, render_slots, render_threads,
+               scratch_files, view_cameras, view_files)
 from .report import log
 
 
@@ -68,8 +68,8 @@ def save_passes(scene, path, views=None):
                            f"writes slot {other[1]}, and Blender hands over the slot it shows; "
                            f"keep slot {other[1]} shown while a render runs")
     settings = scene.render.image_settings
-    saved = compat.saved_image_settings(settings)
-    saved_ffmpeg = compat.saved_ffmpeg_settings(scene.render)
+    saved = output_settings.saved_image_settings(settings)
+    saved_ffmpeg = output_settings.saved_ffmpeg_settings(scene.render)
     try:
         compat.set_multilayer_exr(settings)
         settings.color_depth = "32"
@@ -94,8 +94,8 @@ def save_passes(scene, path, views=None):
         # The media type and format first, so that their options are valid
         # when they are set; the user's PNG output stays PNG; a movie's
         # container and codec after the format, which resets them (3.4).
-        compat.restore_image_settings(settings, saved)
-        compat.restore_ffmpeg_settings(scene.render, saved_ffmpeg)
+        output_settings.restore_image_settings(settings, saved)
+        output_settings.restore_ffmpeg_settings(scene.render, saved_ffmpeg)
 
 
 def read_passes(scene, layers, views=None, threads=0):
