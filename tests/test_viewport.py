@@ -257,6 +257,19 @@ def test_a_closed_views_preview_goes_with_it(run_blender, tmp_path, case):
         assert seen["ENTRIES opened"] == '["View 2"]', seen
 
 
+def test_a_view_not_drawn_lets_go_of_its_targets(run_blender, tmp_path):
+    """A view whose preview is turned off, or set to a shading the preview
+    cannot draw, while another view keeps the preview on: its targets (some
+    230 MB of textures at 4K) were kept until every view was off, where the
+    README says the preview costs nothing while it is off (a review's
+    find). Now they go at its next redraw; the other view keeps its own."""
+    log = run_blender(SCRIPTS / "viewport_close.py", "targets", tmp_path, **IN_A_WINDOW).stdout
+    assert "CLOSE: DONE" in log, log[-3000:]
+    seen = {line.split(" ", 2)[1]: json.loads(line.split(" ", 2)[2])
+            for line in log.splitlines() if line.startswith("TARGETS ")}
+    assert seen == {"on": [True, True], "off": [True, False], "wireframe": [True, False]}, seen
+
+
 def test_x_ray_says_why_the_preview_draws_nothing(run_blender, tmp_path):
     """Solid shading's X-ray below alpha 1 writes no depth: the preview drew
     nothing and the panel said nothing (an exploratory run). The panel says

@@ -12,6 +12,10 @@ artist's clicks are:
           get the closed one's place or address) must start without it.
   saved   "shift" with the big view's preview turned on and off before,
           then the file saved and opened again.
+  targets both views' previews on, then the small view's off, then on in
+          Wireframe shading (which the preview cannot draw): after each,
+          'TARGETS <when> [big, small]', whether each view's region holds
+          the preview's targets (draw._pipelines).
 
 Prints 'VIEWS <when> {json}' (for each 3D view, big first: its settings'
 enabled, or null), 'HANDLER <when> <bool>' (the draw handler),
@@ -122,7 +126,37 @@ def saved_steps():
     yield from redrawn_report("opened")
 
 
-steps = {"shift": shift_steps, "split": split_steps, "saved": saved_steps}[case]()
+def targets_report(when):
+    draw = sys.modules["hbao.viewport.draw"]
+    for area in views_3d():
+        with override(area):
+            bpy.ops.wm.redraw_timer(type="DRAW_WIN_SWAP", iterations=1)
+    held = [any(r.as_pointer() in draw._pipelines for r in area.regions if r.type == "WINDOW")
+            for area in views_3d()]
+    print(f"TARGETS {when} {json.dumps(held)}", flush=True)
+
+
+def targets_steps():
+    timeline = next(a for a in window().screen.areas if a.type == "DOPESHEET_EDITOR")
+    timeline.type = "VIEW_3D"
+    yield
+    for area in views_3d():
+        toggle(area)
+    yield
+    targets_report("on")
+    yield
+    toggle(views_3d()[1])
+    yield
+    targets_report("off")
+    yield
+    toggle(views_3d()[1])
+    views_3d()[1].spaces.active.shading.type = "WIREFRAME"
+    yield
+    targets_report("wireframe")
+
+
+steps = {"shift": shift_steps, "split": split_steps, "saved": saved_steps,
+         "targets": targets_steps}[case]()
 
 
 def tick():

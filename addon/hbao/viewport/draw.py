@@ -123,16 +123,28 @@ def not_drawn(space):
     return None
 
 
+def _forget_region(region):
+    """Drop a region's targets and frame times: its view is not drawn (the
+    preview off in it, or a shading it cannot draw) while another view's
+    preview keeps the handler on. They were kept until every view was off,
+    some 230 MB of textures at 4K a view (a review's find)."""
+    key = region.as_pointer() if region is not None else None
+    for per_region in (_pipelines, _frame_ms, _shown_ms):
+        per_region.pop(key, None)
+
+
 def _draw():
     context = bpy.context
     space = context.space_data
     region_3d = context.region_data
     if space is None or region_3d is None or not_drawn(space) is not None:
         _forget_error(context.area)  # not drawn: nothing failed
+        _forget_region(context.region)
         return
     view_settings = view_entries.find(context.screen, context.area)
     if view_settings is None or not view_settings.enabled:
         _forget_error(context.area)
+        _forget_region(context.region)
         return
     try:
         key = context.region.as_pointer()
