@@ -257,6 +257,21 @@ def test_a_closed_views_preview_goes_with_it(run_blender, tmp_path, case):
         assert seen["ENTRIES opened"] == '["View 2"]', seen
 
 
+def test_a_file_opened_without_its_ui_keeps_each_views_preview(run_blender, tmp_path):
+    """Opened with Load UI off (or File > Revert so), a file keeps the
+    session's screens, where each view's preview was found again by the
+    position in the screen's areas written at the last save: after an area
+    before it closed and the view split, the preview and its settings went
+    to the new half (a review's find). Now the positions are written before
+    the load: the view that had it on keeps it, the other half has none."""
+    log = run_blender(SCRIPTS / "viewport_close.py", "noui", tmp_path, **IN_A_WINDOW).stdout
+    assert "CLOSE: DONE" in log, log[-3000:]
+    seen = {line.split(" ", 2)[1]: json.loads(line.split(" ", 2)[2])
+            for line in log.splitlines() if line.startswith("PLACES ")}
+    assert [on for _index, on in seen["before"]].count(True) == 1, seen
+    assert seen["opened"] == seen["before"], seen
+
+
 def test_a_view_not_drawn_lets_go_of_its_targets(run_blender, tmp_path):
     """A view whose preview is turned off, or set to a shading the preview
     cannot draw, while another view keeps the preview on: its targets (some

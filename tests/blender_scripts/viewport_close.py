@@ -12,6 +12,11 @@ artist's clicks are:
           get the closed one's place or address) must start without it.
   saved   "shift" with the big view's preview turned on and off before,
           then the file saved and opened again.
+  noui    the file saved; the preview on in the big view; the Properties
+          area (before it in the screen's areas) closed, the big view split;
+          the file opened again without its UI (Load UI off): 'PLACES
+          <when> [...]', each 3D view's position in the screen's areas and
+          whether its preview is on, before and after.
   targets both views' previews on, then the small view's off, then on in
           Wireframe shading (which the preview cannot draw): after each,
           'TARGETS <when> [big, small]', whether each view's region holds
@@ -126,6 +131,36 @@ def saved_steps():
     yield from redrawn_report("opened")
 
 
+def places_report(when):
+    places = []
+    for index, area in enumerate(window().screen.areas):
+        if area.type == "VIEW_3D":
+            with override(area):
+                bpy.ops.wm.redraw_timer(type="DRAW_WIN_SWAP", iterations=1)
+            places.append([index, enabled(area)])
+    print(f"PLACES {when} {json.dumps(places)}", flush=True)
+
+
+def no_ui_steps():
+    path = os.path.join(out_dir, "no_ui.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=path)
+    yield
+    toggle(views_3d()[0])
+    yield
+    properties = next(a for a in window().screen.areas if a.type == "PROPERTIES")
+    with override(properties):
+        bpy.ops.screen.area_close()
+    yield
+    with override(views_3d()[0]):
+        bpy.ops.screen.area_split(direction="VERTICAL", factor=0.5)
+    yield
+    places_report("before")
+    yield
+    bpy.ops.wm.open_mainfile(filepath=path, load_ui=False)
+    yield
+    places_report("opened")
+
+
 def targets_report(when):
     draw = sys.modules["hbao.viewport.draw"]
     for area in views_3d():
@@ -156,7 +191,7 @@ def targets_steps():
 
 
 steps = {"shift": shift_steps, "split": split_steps, "saved": saved_steps,
-         "targets": targets_steps}[case]()
+         "targets": targets_steps, "noui": no_ui_steps}[case]()
 
 
 def tick():

@@ -204,17 +204,30 @@ def refresh_area_indices(*_args):
             if (screen_pointer, views[index].name) in _orphans:
                 _orphans.discard((screen_pointer, views[index].name))
                 views.remove(index)
-        for index, area in enumerate(screen.areas):
-            name = _entry_by_area.get((screen_pointer, area.as_pointer()))
-            entry = views.get(name) if name is not None else None
-            if entry is not None and entry.area_index != index:
-                entry.area_index = index
+        _write_area_indices(screen)
+
+
+def _write_area_indices(screen):
+    """Each followed entry of `screen` at its area's current position."""
+    views = _views(screen)
+    screen_pointer = screen.as_pointer()
+    for index, area in enumerate(screen.areas):
+        name = _entry_by_area.get((screen_pointer, area.as_pointer()))
+        entry = views.get(name) if name is not None else None
+        if entry is not None and entry.area_index != index:
+            entry.area_index = index
 
 
 @persistent
 @never_raises("forget the viewport preview's views of the file closed")
 def forget_areas(*_args):
-    """After a load: areas are new objects; entries are found by position again."""
+    """Before a load: areas are new objects after it; entries are found by
+    position again. Opened without its UI (Load UI off, File > Revert so),
+    the file keeps these screens, whose entries' positions were written at
+    the last save only: an area closed or split since gave a view's preview
+    and settings to another view (a review's find). So they are written
+    first, as before a save, orphans removed."""
+    refresh_area_indices()
     _entry_by_area.clear()
     _space_by_area.clear()
     _entry_by_space.clear()
