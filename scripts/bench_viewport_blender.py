@@ -92,7 +92,7 @@ def run(options):
         def preview():
             with offscreen.bind():
                 gpu.state.viewport_set(0, 0, width, height)
-                draw.draw_preview(ao_pipeline, projection_matrix, state["params"])
+                draw.draw_preview(ao_pipeline, projection_matrix, state["params"], reuse=False)
                 _sync(gpu.state.active_framebuffer_get())
 
         with bpy.context.temp_override(window=window, area=area, region=region):

@@ -192,12 +192,15 @@ def _forget_views():
         per_region.clear()
 
 
-def draw_preview(ao_pipeline, matrix, params, timed=False):
+def draw_preview(ao_pipeline, matrix, params, timed=False, reuse=True):
     """AO of the bound framebuffer's depth (drawn with projection `matrix`),
-    multiplied over it, using `ao_pipeline`'s targets. Also the unit that
-    scripts/bench_viewport_blender.py times. `timed`: returns the ms from
-    the depth read back (which waits for Blender's own drawing) until the
-    composite is issued; else None."""
+    multiplied over it, using `ao_pipeline`'s targets; with `reuse`, the AO
+    of the pipeline's last frame where the view, `matrix`, `params` and the
+    depth are that frame's (AOPipeline.kept_ao: only the composite runs).
+    Also the unit that scripts/bench_viewport_blender.py times (reuse off).
+    `timed`: returns the ms from the depth read back (which waits for
+    Blender's own drawing) until the composite is issued, for a frame whose
+    AO was computed; else None."""
     framebuffer = gpu.state.active_framebuffer_get()
     x, y, width, height = gpu.state.viewport_get()
     if width < 1 or height < 1:
@@ -205,21 +208,26 @@ def draw_preview(ao_pipeline, matrix, params, timed=False):
     depth = framebuffer.read_depth(x, y, width, height)
     started = perf_counter()
     depth.dimensions = width * height
-    depth_buffer_texture = gpu.types.GPUTexture((width, height), format="R32F", data=depth)
-
-    frame = projection.frame_from_projection_matrix(matrix, width, height)
+    key = (x, y, width, height, tuple(tuple(row) for row in matrix), sorted(params.items()))
+    ao_texture = ao_pipeline.kept_ao(key, depth) if reuse else None
+    computed = ao_texture is None
 
     depth_test = gpu.state.depth_test_get()
     depth_mask = gpu.state.depth_mask_get()
     gpu.state.depth_test_set("NONE")
     gpu.state.depth_mask_set(False)
     try:
-        linear_depth = ao_pipeline.linearize(depth_buffer_texture,
-                                             projection.depth_coefficients(matrix),
-                                             half=bool(params.get("half_resolution")))
-        ao_texture = ao_pipeline.ambient_occlusion(
-            linear_depth, frame, params,
-            buffer_precision=projection.depth_buffer_precision(matrix))
+        if computed:
+            depth_buffer_texture = gpu.types.GPUTexture((width, height), format="R32F",
+                                                        data=depth)
+            frame = projection.frame_from_projection_matrix(matrix, width, height)
+            linear_depth = ao_pipeline.linearize(depth_buffer_texture,
+                                                 projection.depth_coefficients(matrix),
+                                                 half=bool(params.get("half_resolution")))
+            ao_texture = ao_pipeline.ambient_occlusion(
+                linear_depth, frame, params,
+                buffer_precision=projection.depth_buffer_precision(matrix))
+            ao_pipeline.keep(key, depth, ao_texture)
         # Our passes bound their own framebuffers; draw back into the view.
         gpu.state.viewport_set(x, y, width, height)
         pipeline.composite(ao_texture, params["strength"], (x, y))
@@ -228,7 +236,7 @@ def draw_preview(ao_pipeline, matrix, params, timed=False):
         gpu.state.depth_test_set(depth_test)
     # Timed on a software renderer only, which runs the passes as they are
     # issued: a pixel read back after them (to wait for them) added 3 %.
-    return (perf_counter() - started) * 1000.0 if timed else None
+    return (perf_counter() - started) * 1000.0 if timed and computed else None
 
 
 def unregister():

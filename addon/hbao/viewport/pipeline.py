@@ -7,6 +7,7 @@ region's size changes."""
 import math
 
 import gpu
+import numpy as np
 from gpu_extras.batch import batch_for_shader
 
 from .. import parameters
@@ -49,6 +50,25 @@ class AOPipeline:
         self.size = None
         self._linear_depth = self._normals = self._ao = self._blurred_rows = None
         self._half_depth = self._half_normals = self._half_ao = self._half_blurred_rows = None
+        self._kept = None  # (key, depth values, AO texture) of the last frame computed
+
+    def kept_ao(self, key, depth):
+        """The AO texture of the last frame computed, where `key` (the view's
+        place, projection and settings) and `depth` (a gpu Buffer of floats)
+        are that frame's; else None. Blender redraws a view once per
+        anti-aliasing sample after each change (8 in Solid, 16 in Material
+        Preview), each with the same depth: the passes ran for every one (a
+        review's find)."""
+        if self._kept is None or self._kept[0] != key:
+            return None
+        return self._kept[2] if np.array_equal(np.frombuffer(depth, np.float32),
+                                               self._kept[1]) else None
+
+    def keep(self, key, depth, ao_texture):
+        """Keep the frame just computed for kept_ao (a copy of its depth: 4
+        bytes a pixel); `ao_texture` stays this pipeline's until its next
+        computation."""
+        self._kept = (key, np.frombuffer(depth, np.float32).copy(), ao_texture)
 
     def _ensure_size(self, width, height, half=False):
         if self.size == (width, height, half):
