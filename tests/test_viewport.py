@@ -257,6 +257,23 @@ def test_a_closed_views_preview_goes_with_it(run_blender, tmp_path, case):
         assert seen["ENTRIES opened"] == '["View 2"]', seen
 
 
+def test_a_file_saved_with_the_view_maximized_keeps_its_preview(run_blender, tmp_path):
+    """A file saved while the previewed view was maximized (Ctrl+Space)
+    opened with that view showing no AO, and its Turn On made settings
+    that were lost on the way back (a review's find): the map from the
+    view to its entry on the home screen is the session's. Now the
+    temporary screen keeps the entry's name: opened, the view has its
+    preview on."""
+    log = run_blender(SCRIPTS / "viewport_close.py", "maximized", tmp_path,
+                      **IN_A_WINDOW).stdout
+    assert "CLOSE: DONE" in log, log[-3000:]
+    seen = {line.split(" ", 2)[1]: json.loads(line.split(" ", 2)[2])
+            for line in log.splitlines() if line.startswith("MAXIMIZED ")}
+    assert seen["before"]["screen"].endswith("-nonnormal") and seen["before"]["enabled"], seen
+    assert seen["opened"]["screen"] == seen["before"]["screen"], seen
+    assert seen["opened"]["enabled"] is True and seen["opened"]["handler"] is True, seen
+
+
 def test_a_file_opened_without_its_ui_keeps_each_views_preview(run_blender, tmp_path):
     """Opened with Load UI off (or File > Revert so), a file keeps the
     session's screens, where each view's preview was found again by the

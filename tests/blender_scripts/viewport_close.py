@@ -17,6 +17,10 @@ artist's clicks are:
           the file opened again without its UI (Load UI off): 'PLACES
           <when> [...]', each 3D view's position in the screen's areas and
           whether its preview is on, before and after.
+  maximized the big view's preview on, the view maximized (Ctrl+Space), the
+          file saved so and opened again: 'MAXIMIZED <when> {json}', the
+          window's screen, whether the maximized view's preview is on and
+          the draw handler, before the save and after the open.
   targets both views' previews on, then the small view's off, then on in
           Wireframe shading (which the preview cannot draw): after each,
           'TARGETS <when> [big, small]', whether each view's region holds
@@ -161,6 +165,31 @@ def no_ui_steps():
     places_report("opened")
 
 
+def maximized_report(when):
+    area = views_3d()[0]
+    with override(area):
+        bpy.ops.wm.redraw_timer(type="DRAW_WIN_SWAP", iterations=1)
+    draw = sys.modules["hbao.viewport.draw"]
+    print(f"MAXIMIZED {when} " + json.dumps({
+        "screen": window().screen.name, "enabled": enabled(area),
+        "handler": draw.handler_registered()}), flush=True)
+
+
+def maximized_steps():
+    toggle(views_3d()[0])
+    yield
+    with override(views_3d()[0]):
+        bpy.ops.screen.screen_full_area(use_hide_panels=False)
+    yield
+    maximized_report("before")
+    path = os.path.join(out_dir, "maximized.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=path)
+    yield
+    bpy.ops.wm.open_mainfile(filepath=path)
+    yield
+    maximized_report("opened")
+
+
 def targets_report(when):
     draw = sys.modules["hbao.viewport.draw"]
     for area in views_3d():
@@ -191,7 +220,7 @@ def targets_steps():
 
 
 steps = {"shift": shift_steps, "split": split_steps, "saved": saved_steps,
-         "targets": targets_steps, "noui": no_ui_steps}[case]()
+         "targets": targets_steps, "noui": no_ui_steps, "maximized": maximized_steps}[case]()
 
 
 def tick():

@@ -29,6 +29,12 @@ COLLECTION_NAME = "hbao_viewport_views"
 # Blender names a maximized or full-screen area's temporary screen
 # "<home screen>-nonnormal".
 TEMPORARY_SUFFIX = "-nonnormal"
+# A temporary screen's custom property, written before a save: the name of
+# its maximized view's entry on the home screen. Opened again, the view had
+# lost its preview (the map from its space to that entry is the session's,
+# and the home screen's place for it comes back as another kind of area;
+# a review's find).
+HOME_VIEW_PROPERTY = "hbao_home_view"
 
 # (screen pointer, area pointer) -> entry name, for the areas seen this session.
 _entry_by_area = {}
@@ -70,9 +76,15 @@ def find(screen, area):
         return entry
     if space is not None and _temporary(screen):
         home_name, name = _entry_by_space.get(space.as_pointer(), (None, None))
+        if home_name is None and screen.get(HOME_VIEW_PROPERTY):
+            # a file saved with the view maximized (refresh_area_indices)
+            home_name, name = screen.name[:-len(TEMPORARY_SUFFIX)], screen[HOME_VIEW_PROPERTY]
         home = bpy.data.screens.get(home_name) if home_name is not None else None
         if home is not None and home != screen:
-            return _views(home).get(name)
+            entry = _views(home).get(name)
+            if entry is not None:
+                _entry_by_space[space.as_pointer()] = (home.name, entry.name)
+            return entry
     return None
 
 
@@ -197,6 +209,8 @@ def refresh_area_indices(*_args):
     """Before a save: write each entry's current area position, so the file maps
     entries to the right areas when it is opened again, and remove orphans."""
     for screen in bpy.data.screens:
+        if _temporary(screen):
+            _note_home_view(screen)
         views = _views(screen)
         screen_pointer = screen.as_pointer()
         _note_closed_areas(screen)
@@ -205,6 +219,15 @@ def refresh_area_indices(*_args):
                 _orphans.discard((screen_pointer, views[index].name))
                 views.remove(index)
         _write_area_indices(screen)
+
+
+def _note_home_view(screen):
+    """HOME_VIEW_PROPERTY of temporary `screen`, from its view's entry."""
+    for area in screen.areas:
+        space = area.spaces.active if area.type == "VIEW_3D" else None
+        found = _entry_by_space.get(space.as_pointer()) if space is not None else None
+        if found is not None and screen.get(HOME_VIEW_PROPERTY) != found[1]:
+            screen[HOME_VIEW_PROPERTY] = found[1]
 
 
 def _write_area_indices(screen):
