@@ -60,20 +60,16 @@ def release():
     native.release_memory()
 
 
-def _start_hold_locked():
-    """start_hold's state change, under _lock: whether the memory is held."""
-    hold = _state["active"] and not bpy.app.background
-    _state["since"] = time.monotonic() if hold else None
-    return hold
-
-
-def start_hold():
+def start_hold(ended_uses=0):
     """The library has just computed (a render has ended, a re-composite's
     AO is done; any thread): in `-b`, or once the add-on is disabled (a
     re-composite's worker may finish after that), its memory goes back now;
-    in a window it is held from now on (_poll)."""
+    in a window it is held from now on (_poll). `ended_uses`: the in_use()
+    blocks this ends, counted off in the same step."""
     with _lock:
-        hold = _start_hold_locked()
+        _state["in_use"] -= ended_uses
+        hold = _state["active"] and not bpy.app.background
+        _state["since"] = time.monotonic() if hold else None
     if not hold:
         native.release_memory()
 
@@ -100,11 +96,7 @@ def in_use():
     try:
         yield
     finally:
-        with _lock:
-            _state["in_use"] -= 1
-            hold = _start_hold_locked()
-        if not hold:
-            native.release_memory()
+        start_hold(ended_uses=1)
 
 
 @bpy.app.handlers.persistent

@@ -232,3 +232,19 @@ def _quit_refused():
 
 def _quit_again():
     return REFUSED_RETRY_S if _quit_refused() else None
+
+
+def walk_steps(steps, label, interval=0.3, persistent=False):
+    """Runs the generator `steps` a step per timer tick, `interval` seconds
+    apart (the window redraws between them), then prints 'LABEL: DONE' and
+    quits Blender; a `persistent` walk goes on after a file is opened."""
+    def tick():
+        try:
+            next(steps)
+        except StopIteration:
+            print(f"{label}: DONE", flush=True)
+            quit_blender()
+            return None
+        return interval
+
+    guarded_timer(tick, 0.5, persistent=persistent)

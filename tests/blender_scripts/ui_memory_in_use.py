@@ -73,17 +73,4 @@ def steps():
     print(f"IN_USE {json.dumps(report)}", flush=True)
 
 
-def walk(generator):
-    def tick():
-        try:
-            next(generator)
-        except StopIteration:
-            print("IN_USE: DONE", flush=True)
-            timer_guard.quit_blender()
-            return None
-        return 0.1
-
-    timer_guard.guarded_timer(tick, 0.5)
-
-
-walk(steps())
+timer_guard.walk_steps(steps(), "IN_USE", interval=0.1)

@@ -74,15 +74,5 @@ def shot(out_dir, name):
 
 
 def walk_steps(steps, label):
-    """Runs the generator `steps` a step per timer tick (the window redraws
-    between them), then prints 'LABEL: DONE' and quits Blender."""
-    def tick():
-        try:
-            next(steps)
-        except StopIteration:
-            print(f"{label}: DONE", flush=True)
-            timer_guard.quit_blender()
-            return None
-        return 0.3
-
-    timer_guard.guarded_timer(tick, 0.5)
+    """timer_guard.walk_steps: a step per timer tick, then 'LABEL: DONE'."""
+    timer_guard.walk_steps(steps, label)

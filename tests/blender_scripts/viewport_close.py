@@ -223,14 +223,4 @@ steps = {"shift": shift_steps, "split": split_steps, "saved": saved_steps,
          "targets": targets_steps, "noui": no_ui_steps, "maximized": maximized_steps}[case]()
 
 
-def tick():
-    try:
-        next(steps)
-    except StopIteration:
-        print("CLOSE: DONE", flush=True)
-        timer_guard.quit_blender()
-        return None
-    return 0.3
-
-
-timer_guard.guarded_timer(tick, 0.5, persistent=True)
+timer_guard.walk_steps(steps, "CLOSE", persistent=True)
