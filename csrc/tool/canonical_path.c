@@ -23,14 +23,26 @@ static const char *split_folder(const char *path, char folder[PATH_MAX]) {
     return written < 0 || written >= PATH_MAX ? NULL : slash + 1;
 }
 
+bool canonical_entry_of(const char *path, canonical_entry *entry) {
+    char folder[PATH_MAX];
+    struct stat status;
+    entry->name = split_folder(path, folder);
+    if (entry->name == NULL || stat(folder, &status) != 0) return false;
+    entry->device = status.st_dev;
+    entry->inode = status.st_ino;
+    return true;
+}
+
+int canonical_entry_compare(const canonical_entry *a, const canonical_entry *b) {
+    if (a->device != b->device) return a->device < b->device ? -1 : 1;
+    if (a->inode != b->inode) return a->inode < b->inode ? -1 : 1;
+    return strcmp(a->name, b->name);
+}
+
 bool canonical_same_entry(const char *a, const char *b) {
-    char first[PATH_MAX], second[PATH_MAX];
-    const char *first_name = split_folder(a, first), *second_name = split_folder(b, second);
-    struct stat first_folder, second_folder;
-    return first_name != NULL && second_name != NULL && strcmp(first_name, second_name) == 0 &&
-           stat(first, &first_folder) == 0 && stat(second, &second_folder) == 0 &&
-           first_folder.st_dev == second_folder.st_dev &&
-           first_folder.st_ino == second_folder.st_ino;
+    canonical_entry first, second;
+    return canonical_entry_of(a, &first) && canonical_entry_of(b, &second) &&
+           canonical_entry_compare(&first, &second) == 0;
 }
 
 bool canonical_path(const char *path, char out[PATH_MAX]) {

@@ -486,9 +486,7 @@ static bool is_shared_camera(const char *camera, const struct stat *camera_statu
  * folder, or -o 'd#/../ao.exr') wrote one file, the run exited 0 with one
  * frame's AO lost, and a rerun then refused it (a review's runs). */
 typedef struct write_entry {
-    dev_t device;
-    ino_t inode;
-    const char *name; /* within `where` */
+    canonical_entry entry; /* its name within `where` */
     int32_t frame;
     int kind;    /* 0: -o, 1: --preview */
     char *where; /* final_path (owned) */
@@ -496,10 +494,8 @@ typedef struct write_entry {
 } write_entry;
 
 static int compare_write_entries(const void *a, const void *b) {
-    const write_entry *x = a, *y = b;
-    if (x->device != y->device) return x->device < y->device ? -1 : 1;
-    if (x->inode != y->inode) return x->inode < y->inode ? -1 : 1;
-    return strcmp(x->name, y->name);
+    return canonical_entry_compare(&((const write_entry *)a)->entry,
+                                   &((const write_entry *)b)->entry);
 }
 
 /* The write_entry of `path` into *entry (false where its folder cannot be
@@ -507,23 +503,14 @@ static int compare_write_entries(const void *a, const void *b) {
 static bool write_entry_of(const char *path, int32_t frame, int kind, write_entry *entry) {
     char where[PATH_MAX];
     if (!final_path(path, where)) return false;
-    char *slash = strrchr(where, '/');
-    if (slash == NULL) return false; /* (final_path gives an absolute path) */
-    struct stat folder;
-    *slash = '\0';
-    const bool resolved = stat(slash == where ? "/" : where, &folder) == 0;
-    *slash = '/';
-    if (!resolved) return false;
     entry->where = strdup(where);
     entry->path = strdup(path);
-    if (entry->where == NULL || entry->path == NULL) {
+    if (entry->where == NULL || entry->path == NULL ||
+        !canonical_entry_of(entry->where, &entry->entry)) {
         free(entry->where);
         free(entry->path);
         return false;
     }
-    entry->device = folder.st_dev;
-    entry->inode = folder.st_ino;
-    entry->name = entry->where + (slash - where) + 1;
     entry->frame = frame;
     entry->kind = kind;
     return true;
