@@ -1154,7 +1154,8 @@ def test_long_paths_keep_their_reason_and_say_which_path(hbao_tool, tmp_path):
     completed = run_tool(hbao_tool, fixture_path("cycles_float_zip"), "-o", deep,
                          "--no-normals")
     assert completed.returncode == EXIT_RUNTIME, completed.stderr
-    assert completed.stderr.rstrip().endswith("No such file or directory"), completed.stderr
+    assert completed.stderr.rstrip().endswith(
+        "does not exist (hbao makes no folders: make it first)"), completed.stderr
     for frame in (1, 2):
         shutil.copyfile(fixture_path("cycles_float_zip"), tmp_path / f"in_{frame}.exr")
     pattern = str(tmp_path / ("p" * 200)) + "/" * 2000 + "x" * 1900 + "_#.png"
@@ -1405,6 +1406,28 @@ def test_block_device_socket_and_directory_outputs_are_refused(hbao_tool, tmp_pa
     finally:
         server.close()
     assert not (tmp_path / "ok.exr").exists() and leftover_temporary_files(tmp_path) == []
+
+
+def test_an_output_in_no_folder_says_what_is_wrong(hbao_tool, tmp_path):
+    """`-o new.exr/` (a trailing '/') and `-o missing/ao.exr` were both
+    "cannot create a file next to ...: No such file or directory", which
+    names neither the stray '/' nor the folder (a review's find). Now each
+    says what is wrong, before any work, and nothing is made."""
+    (tmp_path / "plain").write_bytes(b"a file")
+    cases = [
+        (["-o", f"{tmp_path}/new.exr/"], EXIT_USAGE,
+         [f"{tmp_path}/new.exr/ ends in '/', so it names a folder, not a file"]),
+        (["-o", tmp_path / "ok.exr", "--preview", f"{tmp_path}/p.png/"], EXIT_USAGE,
+         [f"{tmp_path}/p.png/ ends in '/'"]),
+        (["-o", tmp_path / "missing" / "ao.exr"], EXIT_RUNTIME,
+         [f"its folder {tmp_path}/missing does not exist", "make it first"]),
+        (["-o", tmp_path / "plain" / "ao.exr"], EXIT_RUNTIME,
+         [f"path {tmp_path}/plain is not a folder"]),
+    ]
+    for arguments, status, fragments in cases:
+        completed = run_tool(hbao_tool, fixture_path("cycles_float_zip"), *arguments)
+        assert_clean_error(completed, status, *fragments)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["plain"]
 
 
 def test_longest_legal_output_name_works(hbao_tool, tmp_path):

@@ -332,6 +332,28 @@ static void remove_stale_temporaries(const char *directory) {
                   removed, removed == 1 ? "" : "s", directory);
 }
 
+/* The failure to create a temporary beside file->destination (errno
+ * `saved`), said by what is wrong: hbao makes no folders, as a missing one
+ * is more often a typo than a wish. */
+static int creation_failure(const atomic_file *file, int saved, tool_error *error) {
+    const char *slash = strrchr(file->destination, '/');
+    const int folder_length = slash == NULL                ? 1
+                              : slash == file->destination ? 1
+                                                           : (int)(slash - file->destination);
+    const char *folder = slash == NULL ? "." : file->destination;
+    if (saved == ENOENT)
+        return tool_fail(error, TOOL_EXIT_RUNTIME,
+                         "cannot write %s: its folder %.*s does not exist (hbao makes no "
+                         "folders: make it first)",
+                         file->name, folder_length, folder);
+    if (saved == ENOTDIR)
+        return tool_fail(error, TOOL_EXIT_RUNTIME,
+                         "cannot write %s: a part of its folder's path %.*s is not a folder",
+                         file->name, folder_length, folder);
+    return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot create a file in the folder of %s: %s",
+                     file->name, strerror(saved));
+}
+
 /* A temporary file in the destination's directory, so that rename() stays
  * on one file system; the leading dot keeps it out of casual listings. The
  * name has a fixed length, whatever the destination's. */
@@ -384,9 +406,7 @@ static int create_named_temporary(atomic_file *file, tool_error *error) {
         if (file->fd >= 0) file->cleanup_slot = claim_cleanup_slot(file->temporary_path);
         restore_signals(&previous);
     }
-    if (file->fd < 0)
-        return tool_fail(error, TOOL_EXIT_RUNTIME, "cannot create a file next to %s: %s",
-                         file->name, strerror(saved));
+    if (file->fd < 0) return creation_failure(file, saved, error);
     return TOOL_EXIT_SUCCESS;
 }
 
@@ -427,6 +447,12 @@ int atomic_file_begin(atomic_file *file, const char *destination, tool_error *er
     bool exists = stat(destination, &existing) == 0;
     if (exists && S_ISDIR(existing.st_mode))
         return tool_fail(error, TOOL_EXIT_USAGE, "%s is a directory", destination);
+    const size_t length = strlen(destination);
+    if (length > 0 && destination[length - 1] == '/')
+        return tool_fail(error, TOOL_EXIT_USAGE,
+                         "%s ends in '/', so it names a folder, not a file: give the file's "
+                         "name (without the last '/')",
+                         destination);
     if (exists && (S_ISBLK(existing.st_mode) || S_ISSOCK(existing.st_mode)))
         return tool_fail(error, TOOL_EXIT_USAGE,
                          "%s is a %s; hbao writes only regular files, FIFOs and character "
