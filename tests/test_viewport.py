@@ -274,6 +274,29 @@ def test_a_file_saved_with_the_view_maximized_keeps_its_preview(run_blender, tmp
     assert seen["opened"]["enabled"] is True and seen["opened"]["handler"] is True, seen
 
 
+@pytest.mark.parametrize("case", ["return", "fresh_return"])
+def test_a_maximized_view_opened_keeps_its_preview_back_home(run_blender, tmp_path, case):
+    """A file saved with a view maximized (Ctrl+Space) and opened again:
+    the view's radius set there (its preview turned on there first, in
+    "fresh_return"), the view returned to its layout (Ctrl+Space again)
+    keeps its preview and the radius, also after a save and open. Turned
+    on only after the open, the view lost both on return: Blender reads
+    the empty area it left in its layout back as an Info editor, which
+    the add-on did not take for the view's place (a review's find), and
+    made the settings on the temporary screen."""
+    log = run_blender(SCRIPTS / "viewport_close.py", case, tmp_path, **IN_A_WINDOW).stdout
+    assert "CLOSE: DONE" in log, log[-3000:]
+    seen = {line.split(" ", 2)[1]: json.loads(line.split(" ", 2)[2])
+            for line in log.splitlines() if line.startswith("RETURN ")}
+    maximized = seen["maximized"]
+    assert maximized["screen"].endswith("-nonnormal"), seen
+    assert maximized["enabled"] is True and maximized["radius"] == 0.55, seen
+    home = maximized["screen"][:-len("-nonnormal")]
+    for when in ("returned", "reopened"):
+        assert seen.get(when) == {"screen": home, "enabled": True, "radius": 0.55,
+                                  "handler": True}, (when, seen)
+
+
 def test_a_file_opened_without_its_ui_keeps_each_views_preview(run_blender, tmp_path):
     """Opened with Load UI off (or File > Revert so), a file keeps the
     session's screens, where each view's preview was found again by the

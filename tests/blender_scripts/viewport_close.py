@@ -21,6 +21,11 @@ artist's clicks are:
           file saved so and opened again: 'MAXIMIZED <when> {json}', the
           window's screen, whether the maximized view's preview is on and
           the draw handler, before the save and after the open.
+  return  "maximized" on, the radius set while maximized, the view returned
+          home (Ctrl+Space again), the file saved and opened again:
+          'RETURN <when> {json}', the window's screen, its view's preview
+          (null: no settings), radius and the draw handler.
+  fresh_return  "return" with the preview first turned on after the open.
   targets both views' previews on, then the small view's off, then on in
           Wireframe shading (which the preview cannot draw): after each,
           'TARGETS <when> [big, small]', whether each view's region holds
@@ -219,8 +224,55 @@ def targets_steps():
     targets_report("wireframe")
 
 
+def return_report(when):
+    """The window's screen, its 3D view's preview and radius, the handler."""
+    area = views_3d()[0]
+    with override(area):
+        bpy.ops.wm.redraw_timer(type="DRAW_WIN_SWAP", iterations=1)
+    found = entries().find(window().screen, area)
+    draw = sys.modules["hbao.viewport.draw"]
+    print(f"RETURN {when} " + json.dumps({
+        "screen": window().screen.name, "enabled": None if found is None else found.enabled,
+        "radius": None if found is None else round(found.radius, 3),
+        "handler": draw.handler_registered()}), flush=True)
+
+
+def return_steps(fresh):
+    """The big view maximized (its preview on unless `fresh`), the file
+    saved so and opened again; the preview turned on if `fresh`, the
+    radius set, the view returned home, the file saved and opened again."""
+    if not fresh:
+        toggle(views_3d()[0])
+        yield
+    with override(views_3d()[0]):
+        bpy.ops.screen.screen_full_area(use_hide_panels=False)
+    yield
+    path = os.path.join(out_dir, "maximized.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=path)
+    yield
+    bpy.ops.wm.open_mainfile(filepath=path)
+    yield
+    if fresh:
+        toggle(views_3d()[0])
+        yield
+    entries().find(window().screen, views_3d()[0]).radius = 0.55
+    return_report("maximized")
+    yield
+    with override(views_3d()[0]):
+        bpy.ops.screen.screen_full_area(use_hide_panels=False)
+    yield
+    return_report("returned")
+    bpy.ops.wm.save_as_mainfile(filepath=path)
+    yield
+    bpy.ops.wm.open_mainfile(filepath=path)
+    yield
+    return_report("reopened")
+
+
 steps = {"shift": shift_steps, "split": split_steps, "saved": saved_steps,
-         "targets": targets_steps, "noui": no_ui_steps, "maximized": maximized_steps}[case]()
+         "targets": targets_steps, "noui": no_ui_steps, "maximized": maximized_steps,
+         "return": lambda: return_steps(fresh=False),
+         "fresh_return": lambda: return_steps(fresh=True)}[case]()
 
 
 timer_guard.walk_steps(steps, "CLOSE", persistent=True)

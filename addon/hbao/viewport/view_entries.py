@@ -35,6 +35,12 @@ TEMPORARY_SUFFIX = "-nonnormal"
 # and the home screen's place for it comes back as another kind of area;
 # a review's find).
 HOME_VIEW_PROPERTY = "hbao_home_view"
+# Another, written with it: the position in the home screen's areas of the
+# place its view left. Blender saves that empty area without a space and
+# reads it back as an Info editor (which the view comes back into), so
+# opened again, a view turned on only then had its settings made on the
+# temporary screen, lost on return.
+HOME_PLACE_PROPERTY = "hbao_home_place"
 
 # (screen pointer, area pointer) -> entry name, for the areas seen this session.
 _entry_by_area = {}
@@ -97,15 +103,21 @@ def _temporary(screen):
 def _home_place(screen):
     """The home screen of temporary `screen` and the area there that its view
     left (Blender leaves an empty area in its place, and moves the view back
-    into it on return), or (None, None) where either is not found: a home
-    name too long to be kept whole, or no single empty area."""
+    into it on return; in a file opened, the Info editor at
+    HOME_PLACE_PROPERTY), or (None, None) where either is not found: a home
+    name too long to be kept whole, or no such area."""
     if not screen.name.endswith(TEMPORARY_SUFFIX):
         return None, None
     home = bpy.data.screens.get(screen.name[:-len(TEMPORARY_SUFFIX)])
     if home is None or home == screen:
         return None, None
     empty = [area for area in home.areas if area.type == "EMPTY"]
-    return (home, empty[0]) if len(empty) == 1 else (None, None)
+    if len(empty) == 1:
+        return home, empty[0]
+    index = screen.get(HOME_PLACE_PROPERTY, -1)
+    if not empty and 0 <= index < len(home.areas) and home.areas[index].type == "INFO":
+        return home, home.areas[index]
+    return None, None
 
 
 def _orphan(key):
@@ -222,7 +234,12 @@ def refresh_area_indices(*_args):
 
 
 def _note_home_view(screen):
-    """HOME_VIEW_PROPERTY of temporary `screen`, from its view's entry."""
+    """HOME_VIEW_PROPERTY of temporary `screen`, from its view's entry, and
+    HOME_PLACE_PROPERTY."""
+    home, place = _home_place(screen)
+    index = _area_index(home, place) if home is not None else -1
+    if index >= 0 and screen.get(HOME_PLACE_PROPERTY) != index:
+        screen[HOME_PLACE_PROPERTY] = index
     for area in screen.areas:
         space = area.spaces.active if area.type == "VIEW_3D" else None
         found = _entry_by_space.get(space.as_pointer()) if space is not None else None
