@@ -19,7 +19,7 @@ BPY_FREE_MODULES = ("hbao", "hbao.parameters", "hbao.library_loading", "hbao.nat
                     "hbao.viewport",
                     "hbao.viewport.projection", "hbao.viewport.shader_sources",
                     "hbao.viewport.horizon_sources", "hbao.viewport.normal_sources",
-                    "hbao.viewport.camera_sources")
+                    "hbao.viewport.camera_sources", "hbao.viewport.view_swaps")
 # Issue 8: a file past about 300 lines was doing several jobs.
 MAX_MODULE_LINES = 300
 

@@ -274,6 +274,27 @@ def test_a_file_saved_with_the_view_maximized_keeps_its_preview(run_blender, tmp
     assert seen["opened"]["enabled"] is True and seen["opened"]["handler"] is True, seen
 
 
+def test_a_swapped_views_preview_goes_with_it(run_blender, tmp_path):
+    """Swap Areas (Ctrl-drag of an area's corner) moves a 3D view into
+    another area: its preview and settings go with it, through a swap with
+    another 3D view, one with the Properties, one of two previewed views,
+    and a save and open. They stayed with the area (an exploratory run:
+    the view swapped in took the preview and radius over), which Blender
+    keeps, copying the views' contents across."""
+    log = run_blender(SCRIPTS / "viewport_close.py", "swap", tmp_path, **IN_A_WINDOW).stdout
+    assert "CLOSE: DONE" in log, log[-3000:]
+    seen = {line.split(" ", 2)[1]: json.loads(line.split(" ", 2)[2])
+            for line in log.splitlines() if line.startswith("SWAP ")}
+    # [lens, preview on (None: no settings), radius] of each view
+    one = {"views": [[33, None, None], [77, True, 0.77]], "handler": True}
+    assert seen["before"] == one, seen
+    for when in ("views", "properties"):
+        assert seen.get(when) == one, (when, seen)
+    both = {"views": [[33, True, 0.33], [77, True, 0.77]], "handler": True}
+    for when in ("both", "opened"):
+        assert seen.get(when) == both, (when, seen)
+
+
 @pytest.mark.parametrize("case", ["return", "fresh_return"])
 def test_a_maximized_view_opened_keeps_its_preview_back_home(run_blender, tmp_path, case):
     """A file saved with a view maximized (Ctrl+Space) and opened again:

@@ -26,6 +26,13 @@ artist's clicks are:
           'RETURN <when> {json}', the window's screen, its view's preview
           (null: no settings), radius and the draw handler.
   fresh_return  "return" with the preview first turned on after the open.
+  swap    the Timeline made a 3D view; the big view's preview on, its
+          radius set; the two views swapped (Swap Areas), the previewed
+          one then swapped with the Properties; the other view's preview
+          on, another radius, the two views swapped again; the file saved
+          and opened again: 'SWAP <when> {json}', for each 3D view (told
+          apart by its lens): its lens, preview (null: no settings) and
+          radius; and the draw handler.
   targets both views' previews on, then the small view's off, then on in
           Wireframe shading (which the preview cannot draw): after each,
           'TARGETS <when> [big, small]', whether each view's region holds
@@ -224,6 +231,83 @@ def targets_steps():
     targets_report("wireframe")
 
 
+def swap_report(when):
+    """Each 3D view (told apart by its lens, which moves with its content)
+    after it drew: [lens, preview on (null: no settings), radius]."""
+    for area in views_3d():
+        with override(area):
+            bpy.ops.wm.redraw_timer(type="DRAW_WIN_SWAP", iterations=1)
+    seen = []
+    for area in sorted(views_3d(), key=lambda a: a.spaces.active.lens):
+        found = entries().find(window().screen, area)
+        seen.append([round(area.spaces.active.lens), None if found is None else found.enabled,
+                     None if found is None else round(found.radius, 3)])
+    draw = sys.modules["hbao.viewport.draw"]
+    print(f"SWAP {when} " + json.dumps({"views": seen, "handler": draw.handler_registered()}),
+          flush=True)
+
+
+def _edge(low_a, size_a, low_b, size_b):
+    """The middle of the gap between ranges a and b where one ends before
+    the other starts, else None."""
+    if low_a + size_a <= low_b:
+        return (low_a + size_a + low_b) // 2
+    if low_b + size_b <= low_a:
+        return (low_b + size_b + low_a) // 2
+    return None
+
+
+def _overlap_middle(low_a, size_a, low_b, size_b):
+    return (max(low_a, low_b) + min(low_a + size_a, low_b + size_b)) // 2
+
+
+def swap(area, other):
+    """Blender's Swap Areas (Ctrl-drag of a corner) of neighbours `area` and
+    `other`: the operator swaps the two areas on either side of the edge at
+    its cursor."""
+    x = _edge(area.x, area.width, other.x, other.width)
+    if x is not None:
+        cursor = (x, _overlap_middle(area.y, area.height, other.y, other.height))
+    else:
+        cursor = (_overlap_middle(area.x, area.width, other.x, other.width),
+                  _edge(area.y, area.height, other.y, other.height))
+    with override(area):
+        assert bpy.ops.screen.area_swap(cursor=cursor) == {"FINISHED"}
+
+
+def swap_steps():
+    timeline = next(a for a in window().screen.areas if a.type == "DOPESHEET_EDITOR")
+    timeline.type = "VIEW_3D"
+    yield
+    big, small = views_3d()
+    big.spaces.active.lens, small.spaces.active.lens = 77, 33
+    toggle(big)
+    entries().find(window().screen, big).radius = 0.77
+    yield
+    swap_report("before")
+    swap(views_3d()[0], views_3d()[1])  # the 3D views swapped
+    yield
+    swap_report("views")
+    view = next(a for a in views_3d() if round(a.spaces.active.lens) == 77)
+    properties = next(a for a in window().screen.areas if a.type == "PROPERTIES")
+    swap(view, properties)  # the previewed view swapped with the Properties
+    yield
+    swap_report("properties")
+    other = next(a for a in views_3d() if round(a.spaces.active.lens) == 33)
+    toggle(other)
+    entries().find(window().screen, other).radius = 0.33
+    yield
+    swap(views_3d()[0], views_3d()[1])  # both previewed
+    yield
+    swap_report("both")
+    path = os.path.join(out_dir, "swapped.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=path)
+    yield
+    bpy.ops.wm.open_mainfile(filepath=path)
+    yield
+    swap_report("opened")
+
+
 def return_report(when):
     """The window's screen, its 3D view's preview and radius, the handler."""
     area = views_3d()[0]
@@ -271,7 +355,7 @@ def return_steps(fresh):
 
 steps = {"shift": shift_steps, "split": split_steps, "saved": saved_steps,
          "targets": targets_steps, "noui": no_ui_steps, "maximized": maximized_steps,
-         "return": lambda: return_steps(fresh=False),
+         "swap": swap_steps, "return": lambda: return_steps(fresh=False),
          "fresh_return": lambda: return_steps(fresh=True)}[case]()
 
 

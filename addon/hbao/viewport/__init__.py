@@ -8,6 +8,7 @@ sidebar's "HBAO" tab. No native library needed: it runs on the GPU.
     shaders.py, pipeline.py                           gpu passes
     settings.py                                       per-view settings on the Screen
     view_entries.py                                   which settings are whose view
+    view_swaps.py                                     views moved by Swap Areas (no bpy)
     draw.py                                           the draw handler (only while on)
     panel.py                                          sidebar panel and operator
 """

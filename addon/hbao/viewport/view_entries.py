@@ -14,6 +14,9 @@ long as the area exists), and the saved positions are refreshed just before
 every save. Per scene or per workspace settings would be simpler but are not per
 view: two 3D views side by side could not differ.
 
+Swap Areas copies two areas' contents across, the areas staying: an entry
+whose view so moved follows it to its new area (view_swaps.py tells).
+
 A closed area's entry is an orphan: Blender tells nothing when an area
 closes, so the entries are checked against their screen's areas whenever a
 view's settings are looked up; an orphan is never found again (a view that
@@ -24,6 +27,7 @@ import bpy
 from bpy.app.handlers import persistent
 
 from ..callback_guard import never_raises
+from . import view_swaps
 
 COLLECTION_NAME = "hbao_viewport_views"
 # Blender names a maximized or full-screen area's temporary screen
@@ -139,11 +143,22 @@ def _after_close():
 
 
 def _note_closed_areas(screen):
-    """Orphan the entries of `screen` whose areas are gone. Reads only."""
+    """Orphan the entries of `screen` whose areas are gone; an entry whose
+    view swapped areas (view_swaps) follows it. Reads only."""
     screen_pointer = screen.as_pointer()
     live = {area.as_pointer() for area in screen.areas}
     for key in [key for key in _entry_by_area if key[0] == screen_pointer and key[1] not in live]:
         _orphan(key)
+    for pair in view_swaps.swapped(screen_pointer, screen.areas):
+        keys = [(screen_pointer, area.as_pointer()) for area in pair]
+        names = [_entry_by_area.pop(key, None) for key in keys]
+        for key, area, name in zip(keys, pair, reversed(names)):
+            _space_by_area.pop(key, None)
+            space = area.spaces.active.as_pointer() if area.spaces.active is not None else 0
+            _entry_by_space.pop(space, None)  # (space addresses may be reused)
+            if name is not None:
+                _follow(key, space, name)
+                _entry_by_space[space] = (screen.name, name)
 
 
 def _find_on_screen(screen, area):
@@ -272,3 +287,4 @@ def forget_areas(*_args):
     _space_by_area.clear()
     _entry_by_space.clear()
     _orphans.clear()
+    view_swaps.forget()
