@@ -150,6 +150,17 @@ def user_scripts_with_addon(folder):
     return folder
 
 
+def private_config(user_scripts):
+    """The preferences folder beside `user_scripts`, for BLENDER_USER_CONFIG,
+    made where missing: Blender given a folder that does not exist quietly
+    reads and saves the real user's preferences instead, where those exist
+    (~/.config/blender/<version>/config; a review found the tests' recent
+    files and an install's preferences there)."""
+    folder = Path(user_scripts) / "config"
+    folder.mkdir(parents=True, exist_ok=True)
+    return folder
+
+
 def debian_blender():
     """Debian's blender (or $BLENDER), or None when it is not installed."""
     path = shutil.which(os.environ.get("BLENDER", "blender"))

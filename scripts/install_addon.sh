@@ -12,6 +12,11 @@ REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 if [ -n "${BLENDER_USER_SCRIPTS:-}" ] && [ -z "${BLENDER_USER_CONFIG:-}" ]; then
     export BLENDER_USER_CONFIG="$BLENDER_USER_SCRIPTS/config"
 fi
+# Made first: where BLENDER_USER_CONFIG is missing, Blender quietly saves
+# into the real user's config folder instead, if that one exists.
+if [ -n "${BLENDER_USER_CONFIG:-}" ]; then
+    mkdir -p "$BLENDER_USER_CONFIG"
+fi
 BUILD="${HBAO_BUILD_DIR:-$REPO/build}"
 BLENDER="${BLENDER:-blender}"
 # shellcheck source=addon_files.sh

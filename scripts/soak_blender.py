@@ -93,7 +93,7 @@ def environment(root):
     env = dict(os.environ)
     env.pop("PYTHONPATH", None)
     env.update(BLENDER_USER_SCRIPTS=str(user_scripts),
-               BLENDER_USER_CONFIG=str(user_scripts / "config"),
+               BLENDER_USER_CONFIG=str(blenders.private_config(user_scripts)),
                HBAO_LIBRARY=str(BUILD / "libhbao.so"),
                HBAO_EXR_LIBRARY=str(BUILD / "libhbao_exr.so"),
                PYTHONUNBUFFERED="1", TMPDIR=str(temp), TEMP=str(temp), TMP=str(temp))

@@ -141,7 +141,7 @@ def blender_environment(user_scripts, extra=None):
     env["PYTHONWARNINGS"] = _addon_deprecation_filters()
     env["BLENDER_USER_SCRIPTS"] = str(user_scripts)
     # Preferences beside the scripts folder: never the real user's.
-    env["BLENDER_USER_CONFIG"] = str(Path(user_scripts) / "config")
+    env["BLENDER_USER_CONFIG"] = str(blenders.private_config(user_scripts))
     env["HBAO_LIBRARY"] = str(LIBRARY)
     env["HBAO_EXR_LIBRARY"] = str(EXR_LIBRARY)
     env["PYTHONUNBUFFERED"] = "1"

@@ -36,6 +36,7 @@ CYCLES_BACKGROUND_DEPTH = 1e9
 pytestmark = pytest.mark.matrix
 
 
+import blenders  # noqa: E402  (conftest puts scripts/ on sys.path)
 from hbao import exr_passes as exr  # noqa: E402  (conftest puts addon/ on sys.path)
 from hbao import parameters as PARAMETERS  # noqa: E402
 from hbao import pass_encoding  # noqa: E402
@@ -1596,9 +1597,15 @@ def test_package_and_install(tmp_path):
         assert expected in names
     env = blender_environment(tmp_path / "scripts")
     # Only the scripts folder is given: the preferences must go beside it, not
-    # into the user's (a HOME of its own shows anything written there).
+    # into the user's (a HOME of its own shows anything written there). The
+    # user's own config folder exists, as on any machine where Blender ran:
+    # with the folder beside the scripts missing, Blender saved there (a
+    # review's find), so install_addon.sh must make it.
     env.pop("BLENDER_USER_CONFIG")
+    (tmp_path / "scripts" / "config").rmdir()
     env["HOME"] = str(tmp_path / "home")
+    version = blenders.debian_blender().version.rsplit(".", 1)[0]  # 3.4.1 -> 3.4
+    (tmp_path / "home" / ".config" / "blender" / version / "config").mkdir(parents=True)
     env.pop("HBAO_LIBRARY")  # the installed copy must find its own lib/libhbao.so
     completed = subprocess.run([str(REPO / "scripts" / "install_addon.sh")], env=env,
                                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)

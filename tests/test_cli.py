@@ -2841,8 +2841,9 @@ def test_export_cameras_does_not_replace_a_file_its_user_may_not_write(run_blend
         as_user = {"user": 65534, "group": 65534, "extra_groups": []} \
             if os.geteuid() == 0 else {}
         home = folder / "home"
-        home.mkdir(mode=0o777)
-        home.chmod(0o777)
+        for made in (home, home / "config"):  # (a config folder missing: the real user's)
+            made.mkdir(mode=0o777)
+            made.chmod(0o777)
         env = dict(os.environ, HOME=str(home), BLENDER_USER_SCRIPTS=str(home / "scripts"),
                    BLENDER_USER_CONFIG=str(home / "config"), PYTHONUNBUFFERED="1")
         env.pop("PYTHONPATH", None)
