@@ -1583,6 +1583,31 @@ def test_hook_lifecycle(run_in_blender, tmp_path):
     assert "LIFECYCLE OK" in completed.stdout, completed.stdout[-3000:]
 
 
+def test_a_bpy_script_ends_after_a_file_with_the_node(blender, blender_user_scripts, tmp_path):
+    """A pipeline's own Python script with `import bpy` (not Blender's
+    application) that enabled the add-on and opened a file holding an HBAO
+    node never ended in bpy 4.5, after writing its frames: the node type,
+    still registered, kept bpy alive through Python's shutdown, and bpy's
+    exit then waited forever on its own sound thread (a review's find; the
+    tests' bpy stand-in leaves through os._exit, which hid it). The script
+    now ends, in every Blender, within the time a frame of it takes."""
+    script = SCRIPTS / "module_exit.py"
+    env = blender_environment(blender_user_scripts)
+    path = tmp_path / "node.blend"
+    for step in ("make", "render"):
+        command = [blender.executable, str(script), step, str(path)] if blender.kind == "bpy" \
+            else [blender.executable, "-b", "--factory-startup", "-noaudio", "--python-exit-code",
+                  "1", "--python", str(script), "--", step, str(path)]
+        try:
+            completed = subprocess.run(command, env=env, cwd=tmp_path, stdout=subprocess.PIPE,
+                                       stderr=subprocess.STDOUT, text=True, timeout=60)
+        except subprocess.TimeoutExpired as expired:
+            pytest.fail(f"{step}: still running after 60 s: {expired.output}")
+        assert completed.returncode == 0, completed.stdout[-3000:]
+        assert f"MODULE_EXIT {step} DONE" in completed.stdout, completed.stdout[-3000:]
+    assert (tmp_path / "frame.png").exists()
+
+
 def test_package_and_install(tmp_path):
     """package_addon.sh makes an installable zip; install_addon.sh installs
     and enables the add-on for a (temporary) Blender user."""

@@ -34,6 +34,15 @@ VALUE_NODE_IDNAMES = ("CompositorNodeValue", "ShaderNodeValue")
 # it (keep_node_type_registered, docs/blender-integration.md). 4.5 and 5.x
 # are unaffected; the versions between are untested and treated as 3.4.
 NODE_TYPE_FREED_UNDER_EVALUATED_COPIES = VERSION < (4, 5, 0)
+# bpy 4.5's module (a Python script's `import bpy`, binary_path "") hangs at
+# exit, after the script's last line, where a Python node type is still
+# registered with nodes of it in the file: the type keeps bpy alive through
+# Python's shutdown, so bpy never stops its sound thread, and a C++
+# destructor then waits forever on the condition that thread waits on (a
+# review's find; 5.0 and later exit). There the node type goes at exit
+# (node.py), after which nothing of it is read: 4.5 frees an undefined node.
+NODE_TYPE_HOLDS_MODULE_AT_EXIT = (bpy.app.binary_path == ""
+                                  and (4, 5, 0) <= VERSION < (5, 0, 0))
 
 
 def _version_text(version):

@@ -7,6 +7,8 @@ and publishes through a Render Layers node. The group's inputs other than
 Image only carry the artist's values; the hook reads them. The node knows
 nothing of the hook: it announces that nodes came or went through
 `changed_callbacks`, which the hook subscribes to."""
+import atexit
+
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty
 
@@ -191,9 +193,20 @@ def _draw_add_menu(menu, context):
     operator.use_transform = True
 
 
+@never_raises("let go of the HBAO node type as Python exits")
+def _release_node_type_at_exit():
+    """compat.NODE_TYPE_HOLDS_MODULE_AT_EXIT: the type, registered or kept,
+    goes as the script's Python exits (atexit: before bpy's own exit)."""
+    if "bl_rna" in CompositorNodeHBAO.__dict__:
+        bpy.utils.unregister_class(CompositorNodeHBAO)
+
+
 def register():
     if "bl_rna" not in CompositorNodeHBAO.__dict__:  # kept (compat.keep_node_type_registered)
         bpy.utils.register_class(CompositorNodeHBAO)
+    if compat.NODE_TYPE_HOLDS_MODULE_AT_EXIT:
+        atexit.unregister(_release_node_type_at_exit)  # (once, enabled again or not)
+        atexit.register(_release_node_type_at_exit)
     bpy.utils.register_class(node_lines.HBAO_OT_node_status)
     for name, function in _HANDLERS:
         getattr(bpy.app.handlers, name).append(function)
@@ -211,5 +224,6 @@ def unregister():
         while function in handlers:
             handlers.remove(function)
     bpy.utils.unregister_class(node_lines.HBAO_OT_node_status)
-    if not compat.keep_node_type_registered(NODE_IDNAME):
+    if ("bl_rna" in CompositorNodeHBAO.__dict__  # (gone at exit: _release_node_type_at_exit)
+            and not compat.keep_node_type_registered(NODE_IDNAME)):
         bpy.utils.unregister_class(CompositorNodeHBAO)
