@@ -22,12 +22,21 @@ def _owner_and_name(struct, dotted):
     return (struct if struct is not None and hasattr(struct, name) else None), name
 
 
+# Read only where the output overrides the scene's colour management: 3.4
+# keeps no valid linear colour space otherwise, and each read of it logged
+# a warning ("current value '0' matches no enum"), four lines each frame.
+ONLY_WITH_AN_OVERRIDE = ("linear_colorspace_settings.name",)
+
+
 def saved_image_settings(settings):
     """[(name, value)] of the ImageFormatSettings `settings` that saving a
     Render Result reads or resets, as this version has them, in restoring
     order."""
     saved = []
+    override = getattr(settings, "color_management", "OVERRIDE") == "OVERRIDE"
     for dotted in SAVED_IMAGE_SETTINGS:
+        if dotted in ONLY_WITH_AN_OVERRIDE and not override:
+            continue
         owner, name = _owner_and_name(settings, dotted)
         if owner is not None:
             saved.append((dotted, getattr(owner, name)))
