@@ -592,12 +592,28 @@ def test_a_file_cut_short_after_it_was_opened(tmp_path):
 
 
 def test_binding_says_what_to_do_when_the_library_is_missing(tmp_path, monkeypatch):
-    monkeypatch.setenv(exr.LIBRARY_ENVIRONMENT_VARIABLE, str(tmp_path / "libhbao_exr.so"))
+    """The add-on's own copy missing: the add-on is incomplete. A path given
+    by the variable missing, or a folder: the variable is wrong (a review
+    found the first message for both)."""
+    monkeypatch.delenv(exr.LIBRARY_ENVIRONMENT_VARIABLE, raising=False)
+    monkeypatch.setattr(exr._LIBRARY, "default_path", tmp_path / "lib" / "libhbao_exr.so")
     exr.unload_library()
     try:
-        with pytest.raises(exr.EXRLibraryError, match="libhbao_exr not found at .*"
-                                                      "install_addon.sh"):
+        with pytest.raises(exr.EXRLibraryError, match="libhbao_exr not found at .*the add-on is "
+                                                      "incomplete.*install_addon.sh"):
             exr.read_channels(tmp_path / "any.exr", ["Z"])
+        monkeypatch.setenv(exr.LIBRARY_ENVIRONMENT_VARIABLE, str(tmp_path / "libhbao_exr.so"))
+        exr.unload_library()
+        with pytest.raises(exr.EXRLibraryError, match="libhbao_exr.so, which HBAO_EXR_LIBRARY "
+                                                      "names, does not exist. Point"):
+            exr.load_library()
+        monkeypatch.setenv(exr.LIBRARY_ENVIRONMENT_VARIABLE, str(tmp_path))
+        exr.unload_library()
+        with pytest.raises(exr.EXRLibraryError, match="which HBAO_EXR_LIBRARY names, is a "
+                                                      "folder, not a file"):
+            exr.load_library()
+        monkeypatch.setenv(exr.LIBRARY_ENVIRONMENT_VARIABLE, str(tmp_path / "libhbao_exr.so"))
+        exr.unload_library()
         (tmp_path / "libhbao_exr.so").write_bytes(b"not a library")
         with pytest.raises(exr.EXRLibraryError, match="could not be loaded"):
             exr.load_library()

@@ -120,6 +120,14 @@ class NativeLibrary:
 
     def _open(self, path):
         name = self.name
+        given = os.environ.get(self.environment_variable)
+        if given and not path.is_file():
+            # the artist's or pipeline's variable, not the add-on, is wrong
+            what = "is a folder, not a file" if path.is_dir() else "does not exist"
+            raise self.error_class(
+                f"{path}, which {self.environment_variable} names, {what}. Point "
+                f"{self.environment_variable} at a built {self.file_name}, or unset it to use "
+                f"the add-on's own copy of {name}.")
         if not path.is_file():
             raise self.error_class(
                 f"{name} not found at {path}: the add-on is incomplete. Reinstall it from its "
