@@ -558,11 +558,34 @@ def test_a_render_too_low_for_the_radius_says_so(run_in_blender, tmp_path, no_le
                                                  "nodes": [{"radius": 1.0}]})
     # the report's line: "Warning: HBAO: ..." in 3.4, "WARNING HBAO: ..." in bpy
     told = [line for line in log.splitlines()
-            if re.search(r"(Warning:|WARNING) HBAO: node 'HBAO0': at most pixels the radius "
-                         r"spans more pixels than the image's shorter side", line)]
+            if re.search(r"(Warning:|WARNING) HBAO node \"HBAO0\": at most of the image's "
+                         r"pixels the radius spans more pixels than the image's shorter side",
+                         line)]
     assert len(told) == 1, log[-3000:]
+    assert status_lines(log) == [{"node": "HBAO0", "status": "Radius past image: light"}]
     ao = node_outputs(out, 1)["ao"]
     assert np.all((ao >= 0.0) & (ao <= 1.0)), ao
+
+
+def status_lines(log):
+    """The STATUS lines addon_render.py printed: each node's status line."""
+    return [json.loads(line[len("STATUS "):]) for line in log.splitlines()
+            if line.startswith("STATUS ")]
+
+
+@pytest.mark.parametrize("radius", [0.0, 1e-5])
+def test_a_radius_under_a_pixel_says_why_there_is_no_ao(run_in_blender, tmp_path, radius):
+    """A Radius of 0, or one too small for the scene's units, samples
+    nothing: the AO is 1 everywhere, and nothing said why (a review's
+    find). The library notes it (HBAO_NOTE_RADIUS_UNDER_A_PIXEL): the
+    node's status line, the render's report and the console say so."""
+    out, log = render(run_in_blender, tmp_path, {"nodes": [{"radius": radius}]})
+    told = [line for line in log.splitlines()
+            if re.search(r"(Warning:|WARNING) HBAO node \"HBAO0\": at most of the image's "
+                         r"pixels the radius spans less than a pixel.*raise the radius", line)]
+    assert len(told) == 1, log[-3000:]
+    assert status_lines(log) == [{"node": "HBAO0", "status": "Radius < 1 pixel: no AO"}]
+    assert np.all(node_outputs(out, 1)["ao"] == 1.0)
 
 
 @pytest.fixture(scope="session")

@@ -473,7 +473,13 @@ def test_a_usual_compute_has_no_notes_and_each_note_has_words(native):
     library = native_module.load_library()
     assert b"the reference search computed the AO" in library.hbao_note_message(1)
     assert b"lower the radius" in library.hbao_note_message(2)
-    assert library.hbao_note_message(4) == b"unknown note"
+    assert b"raise the radius" in library.hbao_note_message(4)
+    assert library.hbao_note_message(8) == b"unknown note"
+    # the add-on's short forms, one for each of hbao.h's notes
+    header = (REPO / "csrc" / "include" / "hbao.h").read_text()
+    bits = {int(value) for value in re.findall(r"#define HBAO_NOTE_\w+ (\d+)u", header)}
+    assert bits == set(native_module.NOTE_SHORT_FORMS) == {1, 2, 4}
+    assert all(len(short) <= 24 for short in native_module.NOTE_SHORT_FORMS.values())
 
 
 def test_an_exr_library_of_another_interface_is_refused(monkeypatch, tmp_path):

@@ -13,11 +13,13 @@ from . import camera as camera_model
 from . import ao_cache, job_inputs, layer_passes, native, render_record
 from .helper_scene import scene_for_render
 from .planning import node_names, plan
-from .report import log, post_render_report
+from .report import NodeMessage, add_node_messages, log, post_render_report
 
 # The last render's passes and AO, reused for the same passes and settings,
 # and by re-compositing (recomposite.py).
 cache = ao_cache.last_render
+# ao_cache key -> the library's notes of the AO kept there (native.last_notes)
+_notes = {}
 
 
 def original(scene):
@@ -76,7 +78,7 @@ def compute_passes(engine, depsgraph, width, height, request=None):
     compute_time = 0.0
     timings["threads"] = max(job.threads for job in jobs)  # (the same for every job)
     timings["search"] = native.search_name()
-    fresh = {}
+    fresh, fresh_notes, noted = {}, {}, []
     every_job = [(view, job) for view in views for job in jobs]
     for index, (view, job) in enumerate(every_job):
         if engine.test_break():
@@ -98,11 +100,16 @@ def compute_passes(engine, depsgraph, width, height, request=None):
         ao = cache.get(key, inputs)
         if ao is None:
             ao = layer_passes.compute(job, depth, normal, inputs.camera, extra)
-            for note in native.last_notes():  # (this thread's compute)
-                log(f"node {job.node_name!r}: {note}")
-                report_warning(engine, f"HBAO: node {job.node_name!r}: {note}")
+            notes = native.last_notes()  # (this thread's compute)
         else:
             timings["cached"] = timings.get("cached", 0) + 1
+            notes = _notes.get(key, [])  # said again: the same AO, the same reason
+        fresh_notes[key] = notes
+        for bit, note in notes:
+            message = NodeMessage(job.node_name, note, native.NOTE_SHORT_FORMS.get(bit, note))
+            log(message)
+            report_warning(engine, f"HBAO {message}")
+            noted.append(message)
         fresh[key] = (inputs, ao)
         if border is not None:  # bottom-up rows, as the border's y
             x0, x1, y0, y1 = border
@@ -111,6 +118,10 @@ def compute_passes(engine, depsgraph, width, height, request=None):
         compute_time += time.perf_counter() - compute_start
         engine.update_progress((index + 1) / len(every_job))
     cache.keep_only(fresh)
+    _notes.clear()
+    _notes.update(fresh_notes)
+    if noted:  # the nodes' status lines show them with the plan's
+        add_node_messages(main.name, noted)
     timings["ao"] = compute_time
     engine.hbao_timings = timings
     if request is not None:

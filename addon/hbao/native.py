@@ -207,10 +207,16 @@ def compute_ao(depth, normal=None, *, params=None, camera=None, bottom_up=False,
     return out
 
 
+# hbao.h's HBAO_NOTE_* bits (tests/test_native.py holds them to the header),
+# each with the short form that fits a node's status line.
+NOTE_SHORT_FORMS = {1: "Low memory: slow search", 2: "Radius past image: light",
+                    4: "Radius < 1 pixel: no AO"}
+
+
 def last_notes():
-    """What the calling thread's last compute_ao did other than usual, with
-    the same result (hbao_last_notes), as the library words each note."""
+    """What the calling thread's last compute_ao did other than usual
+    (hbao_last_notes): [(bit, the library's words)]."""
     library = load_library()
     notes = library.hbao_last_notes()
-    return [library.hbao_note_message(1 << bit).decode("utf-8", "replace")
+    return [(1 << bit, library.hbao_note_message(1 << bit).decode("utf-8", "replace"))
             for bit in range(32) if notes & (1 << bit)]

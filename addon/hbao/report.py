@@ -93,6 +93,19 @@ def post_node_messages(scene_name, node_names, messages):
     _last_node_messages[scene_name] = statuses
 
 
+def add_node_messages(scene_name, messages):
+    """Add `messages` (NodeMessages) to what post_node_messages last posted
+    for scene `scene_name`: what the AO's computation found, after the plan
+    was posted. Any thread may call it."""
+    statuses = {name: list(found) for name, found in
+                _last_node_messages.get(scene_name, {}).items()}
+    for message in messages:
+        statuses.setdefault(message.node_name, []).append(message)
+    _pending_node_messages[scene_name] = statuses
+    _last_node_messages.pop(scene_name, None)
+    _last_node_messages[scene_name] = statuses
+
+
 def post_last_node_messages():
     """Post again what each scene's nodes were last told: an undo or redo
     restored older statuses."""

@@ -511,6 +511,12 @@ HBAO_EXPORT hbao_result hbao_compute_layers(const hbao_params *params, const hba
  *  very close to the surfaces): most samples then fall outside the image,
  *  so the AO comes out too light. The result is computed as usual. */
 #define HBAO_NOTE_RADIUS_BEYOND_IMAGE 2u
+/** HBAO_NOTE_RADIUS_UNDER_A_PIXEL: at most of the image's foreground pixels
+ *  (judged as above) the radius spans less than a pixel (one far too small
+ *  for the scene's units; a radius of 0 always), so nothing is sampled
+ *  there and the AO is 1: a frame without AO that would otherwise say
+ *  nothing. */
+#define HBAO_NOTE_RADIUS_UNDER_A_PIXEL 4u
 
 /** What the calling thread's last hbao_compute or hbao_compute_layers did
  *  other than usual (HBAO_NOTE_* bits; 0: nothing), for callers that tell

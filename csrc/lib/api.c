@@ -22,9 +22,13 @@ const char *hbao_note_message(uint32_t note) {
         return "not enough memory for the fast search's copy of the depths; the reference "
                "search computed the AO (the same result, several times slower)";
     if (note == HBAO_NOTE_RADIUS_BEYOND_IMAGE)
-        return "at most pixels the radius spans more pixels than the image's shorter side, so "
-               "most samples fall outside the image and the AO comes out too light: lower the "
-               "radius, or render more pixels";
+        return "at most of the image's pixels the radius spans more pixels than the image's "
+               "shorter side, so most samples fall outside the image and the AO comes out too "
+               "light: lower the radius, or render more pixels";
+    if (note == HBAO_NOTE_RADIUS_UNDER_A_PIXEL)
+        return "at most of the image's pixels the radius spans less than a pixel, so nothing "
+               "is sampled there and the AO is 1 (no occlusion): raise the radius (it is in "
+               "the scene's units), or render more pixels";
     return "unknown note";
 }
 

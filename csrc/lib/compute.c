@@ -219,7 +219,8 @@ hbao_result hbao_compute_layers(const hbao_params *params, const hbao_camera *ca
     if (result != HBAO_SUCCESS) return result;
     result = hbao_validate_camera(camera);
     if (result != HBAO_SUCCESS) return result;
-    if (s.radius == 0.0f) {
+    if (s.radius == 0.0f) { /* nothing sampled anywhere, depths unread */
+        last_notes = HBAO_NOTE_RADIUS_UNDER_A_PIXEL;
         fill_ones(&s, ao, ao_row_stride, width, height);
         return HBAO_SUCCESS;
     }
@@ -273,6 +274,7 @@ hbao_result hbao_compute_layers(const hbao_params *params, const hbao_camera *ca
     hbao_grid_set_projection(&grid, camera, width, height, scale);
     if (!hbao_grid_sampled(&s, &grid)) {
         /* every projected radius under a pixel: 1s, as the stages give */
+        last_notes = hbao_radius_notes(&s, &grid);
         fill_ones(&s, ao, ao_row_stride, width, height);
         goto done;
     }

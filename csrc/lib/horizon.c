@@ -627,22 +627,21 @@ int hbao_grid_sampled(const hbao_settings *s, const hbao_grid *g) {
     return atomic_load(&job.found);
 }
 
-/* HBAO_NOTE_RADIUS_BEYOND_IMAGE where, at more than half of the foreground
- * pixels among about 4096 spread over the grid (every k-th of every k-th
- * row), the projected radius exceeds the grid's shorter side. The radius is
- * in pixels along a row; a column's pixels are ycor times as tall. */
-static uint32_t radius_note(const hbao_settings *s, const hbao_grid *g) {
+uint32_t hbao_radius_notes(const hbao_settings *s, const hbao_grid *g) {
     const float shorter = fminf((float)g->width, (float)g->height * g->ycor);
     const int step_i = g->width / 64 + 1, step_j = g->height / 64 + 1;
-    long foreground = 0, beyond = 0;
+    long foreground = 0, beyond = 0, under = 0;
     for (int j = step_j / 2; j < g->height; j += step_j)
         for (int i = step_i / 2; i < g->width; i += step_i) {
             const float z = g->depth[(size_t)j * g->width + i];
-            if (!(z > 0.0f)) continue; /* background */
+            if (!(z > 0.0f && z < INFINITY)) continue; /* background */
             foreground++;
-            beyond += projected_radius(s, g, z) > shorter;
+            const float radius = projected_radius(s, g, z);
+            beyond += radius > shorter;
+            under += !(radius >= 1.0f); /* as hbao_block_step_at */
         }
-    return 2 * beyond > foreground ? HBAO_NOTE_RADIUS_BEYOND_IMAGE : 0u;
+    return (2 * beyond > foreground ? HBAO_NOTE_RADIUS_BEYOND_IMAGE : 0u) |
+           (2 * under > foreground ? HBAO_NOTE_RADIUS_UNDER_A_PIXEL : 0u);
 }
 
 int hbao_block_classes(const hbao_settings *s, const hbao_grid *g, const float z[HBAO_BLOCK_PIXELS],
@@ -893,7 +892,7 @@ uint32_t hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *g
     tiled.tiles_across = (grid->width + TILE_COLUMNS - 1) / TILE_COLUMNS;
     tiled.tiles_down = (grid->height + TILE_ROWS - 1) / TILE_ROWS;
     tiled.simd = choose_kernel(settings->implementation);
-    uint32_t notes = radius_note(settings, grid);
+    uint32_t notes = hbao_radius_notes(settings, grid);
     float *phase_depth = NULL, *phase_back = NULL;
     job.phase_depth = NULL;
     job.phase_back = NULL;

@@ -319,6 +319,12 @@ uint32_t hbao_compute_horizons(const hbao_settings *settings, const hbao_grid *g
  * computes nothing else. Stops once a row that has such a pixel is found
  * (its rows in the order and on the threads that horizon.c gives). */
 int hbao_grid_sampled(const hbao_settings *settings, const hbao_grid *grid);
+/* The HBAO_NOTE_RADIUS_* bits of a frame: where, at more than half of the
+ * foreground pixels among about 4096 spread over the grid (every k-th of
+ * every k-th row), the projected radius exceeds the grid's shorter side
+ * (BEYOND_IMAGE), or spans less than a pixel (UNDER_A_PIXEL). The radius is
+ * in pixels along a row; a column's pixels are ycor times as tall. */
+uint32_t hbao_radius_notes(const hbao_settings *settings, const hbao_grid *grid);
 
 /* What every horizon kernel needs: settings, grid and per-pattern-cell
  * tables (4x4 interleaved rotation and jitter, docs/algorithm.md). */

@@ -528,9 +528,19 @@ TEST_CASE(a_radius_past_the_image_is_noted) {
     p.half_resolution = 1;
     CHECK_RESULT(hbao_compute(&p, &camera, wide, low, &strip, NULL, out, wide), HBAO_SUCCESS);
     CHECK(hbao_last_notes() == HBAO_NOTE_RADIUS_BEYOND_IMAGE);
-    /* a radius of under a pixel there: nothing to note */
+    /* a radius of under a pixel there: noted too (nothing is sampled, AO 1:
+     * a review found radius 0 said nothing anywhere), and radius 0 */
     p.half_resolution = 0;
-    p.radius = 0.001f;
+    p.radius = 0.0005f; /* 0.7 pixels */
+    CHECK_RESULT(hbao_compute(&p, &camera, wide, low, &strip, NULL, out, wide), HBAO_SUCCESS);
+    CHECK(hbao_last_notes() == HBAO_NOTE_RADIUS_UNDER_A_PIXEL);
+    for (int k = 0; k < wide * low; k++) CHECK(out[k] == 1.0f);
+    p.radius = 0.0f;
+    CHECK_RESULT(hbao_compute(&p, &camera, wide, low, &strip, NULL, out, wide), HBAO_SUCCESS);
+    CHECK(hbao_last_notes() == HBAO_NOTE_RADIUS_UNDER_A_PIXEL);
+    CHECK(strstr(hbao_note_message(HBAO_NOTE_RADIUS_UNDER_A_PIXEL), "raise the radius") != NULL);
+    /* a radius that fits the strip's 5 rows (2.8 pixels): nothing to note */
+    p.radius = 0.002f;
     CHECK_RESULT(hbao_compute(&p, &camera, wide, low, &strip, NULL, out, wide), HBAO_SUCCESS);
     CHECK(hbao_last_notes() == 0);
     /* a usual frame: the radius spans 33 of its 80 rows */
