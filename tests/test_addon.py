@@ -597,7 +597,7 @@ def test_a_sheared_camera_turns_the_ao_off_and_says_why(run_in_blender, tmp_path
     assert "camera 'Camera' is sheared (its matrix's axes are not square" in log, log[-3000:]
     statuses = [json.loads(line[len("STATUS "):]) for line in log.splitlines()
                 if line.startswith("STATUS ")]
-    assert statuses == [{"node": "HBAO0", "status": "Camera: AO off"}], statuses
+    assert statuses == [{"node": "HBAO0", "status": "Sheared camera: AO off"}], statuses
     assert node_outputs(sheared, 1)["ao"].min() == 1.0
 
 

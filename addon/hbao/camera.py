@@ -6,7 +6,16 @@ from . import native
 
 
 class CameraError(ValueError):
-    """The scene has no camera the library can model."""
+    """The scene has no camera the library can model; `short`: the form
+    that fits the node's status line."""
+
+    def __init__(self, message, short="Camera: AO off"):
+        super().__init__(message)
+        self.short = short
+
+
+# Blender's camera types that the library does not model, as artists name them
+_CAMERA_KINDS = {"PANO": "panoramic"}
 
 
 def camera_from_blender(scene, camera_object=None):
@@ -14,19 +23,23 @@ def camera_from_blender(scene, camera_object=None):
     which may be an evaluated copy) with Blender's property names."""
     camera_object = camera_object or scene.camera
     if camera_object is None:
-        raise CameraError(f"scene {scene.name!r} has no camera")
+        raise CameraError(f"scene {scene.name!r} has no camera", "No camera: AO off")
     camera = camera_object.data
     if getattr(camera, "type", None) not in ("PERSP", "ORTHO"):
-        kind = getattr(camera, "type", "not a camera")
+        kind = getattr(camera, "type", None)
+        if kind is None:
+            raise CameraError(f"the scene's camera {camera_object.name!r} is not a camera")
+        kind = _CAMERA_KINDS.get(kind, str(kind).lower())
         raise CameraError(f"camera {camera_object.name!r} is {kind}: HBAO supports "
-                          f"perspective and orthographic cameras")
+                          f"perspective and orthographic cameras (Camera properties > Lens > "
+                          f"Type)", f"{kind.capitalize()} camera: AO off")
     to_world = model_matrix(camera_object.matrix_world)
     if shear(to_world) > SHEAR_TOLERANCE:
         raise CameraError(
             f"camera {camera_object.name!r} is sheared (its matrix's axes are not square: a "
             f"parent scaled unevenly with the camera turned inside it, or a constraint): "
             f"Blender renders a sheared view, which HBAO does not model. Apply the parent's "
-            f"scale (Object > Apply > Scale) or scale it evenly")
+            f"scale (Object > Apply > Scale) or scale it evenly", "Sheared camera: AO off")
     world_to_camera = to_world.inverted_safe()
     render = scene.render
     return {

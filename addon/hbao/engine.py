@@ -127,8 +127,7 @@ def render_helper(engine, depsgraph):
         except camera_model.CameraError as error:  # a camera the library cannot model
             results = {}
             _report_failure(engine, f"{error}. Rendering without AO.")
-            tell_all_nodes(main_of(scene, request), "Camera: AO off",
-                           f"{error}. Rendering without AO.")
+            tell_all_nodes(main_of(scene, request), error.short, f"{error}. Rendering without AO.")
         except Exception as error:  # the render must complete: no AO
             results = {}
             cache.clear()

@@ -30,8 +30,8 @@ SINGLE_LAYER_SHORT = "Single Layer on: AO off"
 # Use Nodes off in the compositor, Blender runs no compositor: no HBAO node
 # either, and the written render has no AO.
 COMPOSITING_OFF_DETAIL = ("Compositing is off (Output properties > Post Processing, or the "
-                          "compositor's Use Nodes): Blender runs no compositor, HBAO's nodes "
-                          "neither, and writes the render without AO. Turn it on for AO")
+                          "compositor's Use Nodes): Blender runs no compositor, so no HBAO node "
+                          "runs either, and the render is written without AO. Turn it on for AO")
 COMPOSITING_OFF_SHORT = "Compositing off: no AO"
 
 
