@@ -15,7 +15,7 @@ BPY_FREE_MODULES = ("hbao", "hbao.parameters", "hbao.library_loading", "hbao.nat
                     "hbao.exr_passes", "hbao.view_files", "hbao.camera",
                     "hbao.guard_geometry", "hbao.timing_line", "hbao.scratch_names",
                     "hbao.render_threads", "hbao.scratch_files", "hbao.stereo_eyes",
-                    "hbao.refusal_watch",
+                    "hbao.refusal_watch", "hbao.ui_text",
                     "hbao.viewport",
                     "hbao.viewport.projection", "hbao.viewport.shader_sources",
                     "hbao.viewport.horizon_sources", "hbao.viewport.normal_sources",

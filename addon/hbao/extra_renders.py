@@ -200,7 +200,7 @@ def _sync_kind(main, tree, nodes, helper, view_layer, kind):
         with writes.whole_or_removed(lambda: tree.nodes.remove(node)):
             node[kind.node_key] = True
             node.name = kind.node_name
-            node.label = f"{kind.node_name} (managed by the HBAO add-on)"
+            node.label = f"{kind.node_name}: leave in place"
             node.hide = True
             node.location = (nodes[0].location.x,
                              nodes[0].location.y - 520 - 40 * KINDS.index(kind))

@@ -153,7 +153,9 @@ def _ensure_managed_node(tree, nodes, helper):
         with writes.whole_or_removed(lambda: tree.nodes.remove(rlayers)):
             rlayers[MANAGED_NODE_KEY] = True
             rlayers.name = MANAGED_NODE_NAME
-            rlayers.label = "HBAO passes (managed by the HBAO add-on)"
+            # (short enough for the collapsed node: the longer label was cut
+            # before its "add-on"; a review's find)
+            rlayers.label = "HBAO passes: leave in place"
             # Below the first HBAO node, clear of the artist's Render Layers
             # node on its left.
             rlayers.location = (nodes[0].location.x,

@@ -6,9 +6,7 @@ Info editor."""
 import bpy
 from bpy.props import StringProperty
 
-# Status lines longer than this are cut with an ellipsis: about what the
-# node's default width shows at 100 % zoom (the full text is the tooltip).
-MAX_STATUS_CHARACTERS = 30
+from . import ui_text
 
 
 def draw(layout, short, details, icon):
@@ -17,9 +15,7 @@ def draw(layout, short, details, icon):
     full text that the short line stands for."""
     if not short:
         return
-    text = short
-    if len(text) > MAX_STATUS_CHARACTERS:
-        text = text[:MAX_STATUS_CHARACTERS - 1] + "\u2026"
+    text = ui_text.status_line(short)
     if not HBAO_OT_node_status.is_registered:  # the add-on disabled, its node type kept
         layout.label(text=text, icon=icon)
         return

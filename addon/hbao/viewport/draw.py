@@ -117,7 +117,10 @@ def not_drawn(space):
     preview drew nothing there, an exploratory run)."""
     shading = space.shading
     if shading.type not in SHADINGS:
-        return "Solid or Material Preview only"
+        # (it said "Solid or Material Preview only", which did not say what
+        # to do; a review's find)
+        return ("No AO in this shading: switch the view to Solid or Material Preview "
+                "shading")
     if shading.type == "SOLID" and shading.show_xray and shading.xray_alpha < 1.0:
         return "No AO through X-ray: turn X-ray off or its Alpha to 1"
     return None
