@@ -107,9 +107,10 @@ def compute_passes(engine, depsgraph, width, height, request=None):
         fresh_notes[key] = notes
         for bit, note in notes:
             message = NodeMessage(job.node_name, note, native.NOTE_SHORT_FORMS.get(bit, note))
-            log(message)
-            report_warning(engine, f"HBAO {message}")
-            noted.append(message)
+            if message not in noted:  # (once for a stereo render's views)
+                log(message)
+                report_warning(engine, f"HBAO {message}")
+                noted.append(message)
         fresh[key] = (inputs, ao)
         if border is not None:  # bottom-up rows, as the border's y
             x0, x1, y0, y1 = border

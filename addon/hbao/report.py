@@ -86,6 +86,10 @@ def post_node_messages(scene_name, node_names, messages):
     for message in messages:
         if isinstance(message, NodeMessage):
             statuses.setdefault(message.node_name, []).append(message)
+    _post(scene_name, statuses)
+
+
+def _post(scene_name, statuses):
     _pending_node_messages[scene_name] = statuses
     # (the latest last: scenes that share a tree, 5.x, post in turn, and the
     # last render's messages must be shown last again)
@@ -101,9 +105,7 @@ def add_node_messages(scene_name, messages):
                 _last_node_messages.get(scene_name, {}).items()}
     for message in messages:
         statuses.setdefault(message.node_name, []).append(message)
-    _pending_node_messages[scene_name] = statuses
-    _last_node_messages.pop(scene_name, None)
-    _last_node_messages[scene_name] = statuses
+    _post(scene_name, statuses)
 
 
 def post_last_node_messages():
