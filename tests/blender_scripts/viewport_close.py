@@ -20,7 +20,8 @@ artist's clicks are:
   maximized the big view's preview on, the view maximized (Ctrl+Space), the
           file saved so and opened again: 'MAXIMIZED <when> {json}', the
           window's screen, whether the maximized view's preview is on and
-          the draw handler, before the save and after the open.
+          the draw handler (and its radius), before the save and after the
+          open.
   return  "maximized" on, the radius set while maximized, the view returned
           home (Ctrl+Space again), the file saved and opened again:
           'RETURN <when> {json}', the window's screen, its view's preview
@@ -139,11 +140,7 @@ def split_steps():
 
 def saved_steps():
     yield from shift_steps(big_had_it=True)
-    path = os.path.join(out_dir, "closed.blend")
-    bpy.ops.wm.save_as_mainfile(filepath=path)
-    yield
-    bpy.ops.wm.open_mainfile(filepath=path)
-    yield
+    yield from saved_and_opened("closed.blend")
     yield from redrawn_report("opened")
 
 
@@ -177,14 +174,27 @@ def no_ui_steps():
     places_report("opened")
 
 
-def maximized_report(when):
+def view_report(label, when):
+    """'<label> <when> {json}': the window's screen, its first 3D view's
+    preview and radius (after a redraw), and whether the handler is on."""
     area = views_3d()[0]
     with override(area):
         bpy.ops.wm.redraw_timer(type="DRAW_WIN_SWAP", iterations=1)
+    found = entries().find(window().screen, area)
     draw = sys.modules["hbao.viewport.draw"]
-    print(f"MAXIMIZED {when} " + json.dumps({
-        "screen": window().screen.name, "enabled": enabled(area),
+    print(f"{label} {when} " + json.dumps({
+        "screen": window().screen.name, "enabled": None if found is None else found.enabled,
+        "radius": None if found is None else round(found.radius, 3),
         "handler": draw.handler_registered()}), flush=True)
+
+
+def saved_and_opened(name):
+    """Steps: the file saved as OUT/<name>, then opened again."""
+    path = os.path.join(out_dir, name)
+    bpy.ops.wm.save_as_mainfile(filepath=path)
+    yield
+    bpy.ops.wm.open_mainfile(filepath=path)
+    yield
 
 
 def maximized_steps():
@@ -193,13 +203,9 @@ def maximized_steps():
     with override(views_3d()[0]):
         bpy.ops.screen.screen_full_area(use_hide_panels=False)
     yield
-    maximized_report("before")
-    path = os.path.join(out_dir, "maximized.blend")
-    bpy.ops.wm.save_as_mainfile(filepath=path)
-    yield
-    bpy.ops.wm.open_mainfile(filepath=path)
-    yield
-    maximized_report("opened")
+    view_report("MAXIMIZED", "before")
+    yield from saved_and_opened("maximized.blend")
+    view_report("MAXIMIZED", "opened")
 
 
 def targets_report(when):
@@ -300,25 +306,8 @@ def swap_steps():
     swap(views_3d()[0], views_3d()[1])  # both previewed
     yield
     swap_report("both")
-    path = os.path.join(out_dir, "swapped.blend")
-    bpy.ops.wm.save_as_mainfile(filepath=path)
-    yield
-    bpy.ops.wm.open_mainfile(filepath=path)
-    yield
+    yield from saved_and_opened("swapped.blend")
     swap_report("opened")
-
-
-def return_report(when):
-    """The window's screen, its 3D view's preview and radius, the handler."""
-    area = views_3d()[0]
-    with override(area):
-        bpy.ops.wm.redraw_timer(type="DRAW_WIN_SWAP", iterations=1)
-    found = entries().find(window().screen, area)
-    draw = sys.modules["hbao.viewport.draw"]
-    print(f"RETURN {when} " + json.dumps({
-        "screen": window().screen.name, "enabled": None if found is None else found.enabled,
-        "radius": None if found is None else round(found.radius, 3),
-        "handler": draw.handler_registered()}), flush=True)
 
 
 def return_steps(fresh):
@@ -331,26 +320,19 @@ def return_steps(fresh):
     with override(views_3d()[0]):
         bpy.ops.screen.screen_full_area(use_hide_panels=False)
     yield
-    path = os.path.join(out_dir, "maximized.blend")
-    bpy.ops.wm.save_as_mainfile(filepath=path)
-    yield
-    bpy.ops.wm.open_mainfile(filepath=path)
-    yield
+    yield from saved_and_opened("maximized.blend")
     if fresh:
         toggle(views_3d()[0])
         yield
     entries().find(window().screen, views_3d()[0]).radius = 0.55
-    return_report("maximized")
+    view_report("RETURN", "maximized")
     yield
     with override(views_3d()[0]):
         bpy.ops.screen.screen_full_area(use_hide_panels=False)
     yield
-    return_report("returned")
-    bpy.ops.wm.save_as_mainfile(filepath=path)
-    yield
-    bpy.ops.wm.open_mainfile(filepath=path)
-    yield
-    return_report("reopened")
+    view_report("RETURN", "returned")
+    yield from saved_and_opened("maximized.blend")
+    view_report("RETURN", "reopened")
 
 
 steps = {"shift": shift_steps, "split": split_steps, "saved": saved_steps,
