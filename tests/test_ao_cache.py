@@ -24,8 +24,10 @@ def test_only_equal_inputs_get_the_stored_ao():
     ao = np.full((3, 4), 0.5, np.float32)
     cache = AOCache()
     assert cache.get("node", inputs(depth)) is None
-    cache.keep_only({"node": (inputs(depth), ao)})
-    assert cache.get("node", inputs(depth.copy())) is ao
+    notes = [(4, "under a pixel")]
+    cache.keep_only({"node": (inputs(depth), ao, notes)})
+    kept_ao, kept_notes = cache.get("node", inputs(depth.copy()))
+    assert kept_ao is ao and kept_notes is notes
     assert cache.get("other node", inputs(depth)) is None
     changed = depth.copy()
     changed[1, 2] = np.nextafter(changed[1, 2], np.float32(3))
@@ -40,14 +42,14 @@ def test_nan_matches_nan_and_keep_only_forgets():
     depth = np.ones((2, 2), np.float32)
     depth[0, 0] = np.nan
     cache = AOCache()
-    cache.keep_only({"node": (inputs(depth), np.ones((2, 2), np.float32))})
+    cache.keep_only({"node": (inputs(depth), np.ones((2, 2), np.float32), [])})
     # The library reads every NaN depth alike: the same passes, NaN included.
     assert cache.get("node", inputs(depth.copy())) is not None
     moved = depth.copy()
     moved[0, 0], moved[1, 1] = 1.0, np.nan
     assert cache.get("node", inputs(moved)) is None
     plain = np.ones((2, 2), np.float32)
-    cache.keep_only({"node": (inputs(plain), plain)})
+    cache.keep_only({"node": (inputs(plain), plain, [])})
     cache.keep_only({})
     assert cache.get("node", inputs(plain)) is None
 
@@ -56,7 +58,7 @@ def test_passes_are_compared_bit_for_bit():
     depth = np.linspace(1.0, 2.0, 3 * 5000, dtype=np.float32).reshape(3, 5000)
     depth[2, 4999] = 0.0
     cache = AOCache()
-    cache.keep_only({"node": (inputs(depth), np.ones_like(depth))})
+    cache.keep_only({"node": (inputs(depth), np.ones_like(depth), [])})
     # Past the first probe stride too: a change only the full comparison sees.
     late = depth.copy()
     late[2, 4998] = np.nextafter(late[2, 4998], np.float32(0))
@@ -76,14 +78,27 @@ def test_passes_handed_over_from_memory_compare_in_either_order():
     bottom_up = np.arange(4 * 6 * 3, dtype=np.float32).reshape(4, 6, 3)
     top_down_view = bottom_up[::-1]
     cache = AOCache()
-    cache.keep_only({"node": (inputs(top_down_view[..., 0], top_down_view), bottom_up)})
+    cache.keep_only({"node": (inputs(top_down_view[..., 0], top_down_view), bottom_up, [])})
     again = bottom_up.copy()
-    assert cache.get("node", inputs(again[::-1][..., 0], again[::-1])) is bottom_up
+    assert cache.get("node", inputs(again[::-1][..., 0], again[::-1]))[0] is bottom_up
     assert cache.get("node", inputs(np.ascontiguousarray(top_down_view[..., 0]),
-                                    np.ascontiguousarray(top_down_view))) is bottom_up
+                                    np.ascontiguousarray(top_down_view)))[0] is bottom_up
     for row in range(4):
         changed = bottom_up.copy()
         changed[row, 5, 2] += 1.0
         assert cache.get("node", inputs(changed[::-1][..., 0], changed[::-1])) is None
         assert cache.get("node", inputs(bottom_up[::-1][..., 0],
                                         np.ascontiguousarray(changed[::-1]))) is None
+
+
+def test_an_ao_put_in_its_place_brings_its_own_notes():
+    """A re-composite's AO (new settings, the kept passes) replaces the
+    render's with its own notes: the render's (say, a radius under a pixel)
+    were said again with the new AO when they lived beside the cache."""
+    depth = np.ones((2, 2), np.float32)
+    cache = AOCache()
+    cache.keep_only({"node": (inputs(depth), np.ones_like(depth), [(4, "under a pixel")])})
+    settled = inputs(depth, params=dict(PARAMS, steps=8))
+    cache.put("node", settled, np.zeros_like(depth), [])
+    assert cache.get("node", settled)[1] == []
+    assert cache.entry("node")[0] is settled

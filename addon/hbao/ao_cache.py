@@ -83,24 +83,28 @@ class AOCache:
         self._entries = {}
 
     def entry(self, key):
-        """(AOInputs, ao) stored under `key`, or None."""
+        """(AOInputs, ao, notes) stored under `key`, or None; notes: the
+        library's about that AO (native.last_notes), said again where the AO
+        is reused."""
         return self._entries.get(key)
 
     def get(self, key, inputs):
-        """The AO stored under `key` for the same inputs, or None."""
+        """(ao, notes) stored under `key` for the same inputs, or None."""
         entry = self._entries.get(key)
         if entry is None or not entry[0].same_as(inputs):
             return None
-        return entry[1]
+        return entry[1], entry[2]
 
-    def put(self, key, inputs, ao):
-        """Store `ao` as the AO of `inputs` under `key`, replacing what was there."""
+    def put(self, key, inputs, ao, notes):
+        """Store `ao` (with its notes) as the AO of `inputs` under `key`,
+        replacing what was there."""
         entries = dict(self._entries)
-        entries[key] = (inputs, ao)
+        entries[key] = (inputs, ao, notes)
         self._entries = entries
 
     def keep_only(self, entries):
-        """Forget everything but `entries` {key: (AOInputs, ao)}: this render's."""
+        """Forget everything but `entries` {key: (AOInputs, ao, notes)}: this
+        render's."""
         self._entries = dict(entries)
 
     def clear(self):

@@ -18,8 +18,6 @@ from .report import NodeMessage, add_node_messages, log, post_render_report
 # The last render's passes and AO, reused for the same passes and settings,
 # and by re-compositing (recomposite.py).
 cache = ao_cache.last_render
-# ao_cache key -> the library's notes of the AO kept there (native.last_notes)
-_notes = {}
 
 
 def original(scene):
@@ -78,7 +76,7 @@ def compute_passes(engine, depsgraph, width, height, request=None):
     compute_time = 0.0
     timings["threads"] = max(job.threads for job in jobs)  # (the same for every job)
     timings["search"] = native.search_name()
-    fresh, fresh_notes, noted = {}, {}, []
+    fresh, noted = {}, []
     every_job = [(view, job) for view in views for job in jobs]
     for index, (view, job) in enumerate(every_job):
         if engine.test_break():
@@ -97,21 +95,20 @@ def compute_passes(engine, depsgraph, width, height, request=None):
                                f"helper scene renders {width}x{height}")
         compute_start = time.perf_counter()
         key = ao_cache.key(main.name, job.pass_name, view)
-        ao = cache.get(key, inputs)
-        if ao is None:
+        kept = cache.get(key, inputs)
+        if kept is None:
             ao = layer_passes.compute(job, depth, normal, inputs.camera, extra)
             notes = native.last_notes()  # (this thread's compute)
         else:
             timings["cached"] = timings.get("cached", 0) + 1
-            notes = _notes.get(key, [])  # said again: the same AO, the same reason
-        fresh_notes[key] = notes
+            ao, notes = kept  # the notes said again: the same AO, the same reason
         for bit, note in notes:
             message = NodeMessage(job.node_name, note, native.NOTE_SHORT_FORMS.get(bit, note))
             if message not in noted:  # (once for a stereo render's views)
                 log(message)
                 report_warning(engine, f"HBAO {message}")
                 noted.append(message)
-        fresh[key] = (inputs, ao)
+        fresh[key] = (inputs, ao, notes)
         if border is not None:  # bottom-up rows, as the border's y
             x0, x1, y0, y1 = border
             ao = np.ascontiguousarray(ao[y0:y1, x0:x1])
@@ -119,8 +116,6 @@ def compute_passes(engine, depsgraph, width, height, request=None):
         compute_time += time.perf_counter() - compute_start
         engine.update_progress((index + 1) / len(every_job))
     cache.keep_only(fresh)
-    _notes.clear()
-    _notes.update(fresh_notes)
     if noted:  # the nodes' status lines show them with the plan's
         add_node_messages(main.name, noted)
     timings["ao"] = compute_time

@@ -22,7 +22,7 @@ import time
 import bpy
 
 from . import (ao_cache, composite_trigger, handler_hold, helper_scene, layer_passes, memory_hold,
-               node_status, refresh_due, render_record, writes)
+               native, node_status, refresh_due, render_record, writes)
 from .callback_guard import never_raises
 from .report import log
 
@@ -49,7 +49,7 @@ _failed = {}
 
 class _Computation:
     """The AO of a refresh's changed jobs, computed in a worker thread from
-    the kept passes: {cache key: (AOInputs, ao)}, or the error. Once
+    the kept passes: {cache key: (AOInputs, ao, notes)}, or the error. Once
     `cancelled` (cancel_all()), the worker starts no further job."""
 
     def __init__(self, due, work):
@@ -69,8 +69,8 @@ class _Computation:
                     if self.cancelled:
                         break
                     depth, normal = inputs.arrays[0], inputs.arrays[1]
-                    self.results[key] = (inputs, layer_passes.compute(job, depth, normal,
-                                                                      inputs.camera, extra))
+                    ao = layer_passes.compute(job, depth, normal, inputs.camera, extra)
+                    self.results[key] = (inputs, ao, native.last_notes())  # (this thread's)
             except Exception as error:  # reported by the main thread
                 self.error = error
         self.seconds = time.perf_counter() - start
@@ -132,12 +132,12 @@ def _render_helper(main, helper, frame, ao_seconds):
 def _install(computation):
     """Put a finished computation's AO in the cache; False when the cache
     no longer holds the arrays it was computed from (a render since)."""
-    for key, (inputs, _ao) in computation.results.items():
+    for key, (inputs, _ao, _notes) in computation.results.items():
         entry = ao_cache.last_render.entry(key)
         if entry is None or entry[0].arrays is not inputs.arrays:
             return False
-    for key, (inputs, ao) in computation.results.items():
-        ao_cache.last_render.put(key, inputs, ao)
+    for key, (inputs, ao, notes) in computation.results.items():
+        ao_cache.last_render.put(key, inputs, ao, notes)
     return True
 
 
