@@ -224,6 +224,15 @@ def engine_identifier(engine):
     return engine
 
 
+def engine_label(identifier):
+    """A render engine's name as Blender's menu shows it (an add-on's label)."""
+    for engine in bpy.types.RenderEngine.__subclasses__():
+        if getattr(engine, "bl_idname", None) == identifier:
+            return engine.bl_label
+    return {"CYCLES": "Cycles", "BLENDER_EEVEE": "EEVEE", "BLENDER_EEVEE_NEXT": "EEVEE",
+            "BLENDER_WORKBENCH": "Workbench"}.get(identifier, identifier)
+
+
 def motion_blur(scene):
     """(START, CENTER or END, shutter in frames) of the camera motion blur of
     the scene's engine, or None: 3.4's EEVEE keeps its own (scene.eevee),

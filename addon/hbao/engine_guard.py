@@ -25,14 +25,6 @@ KEPT_ENGINE_MESSAGE = ("\"{label}\" is the HBAO add-on's internal engine and ren
                        "Compositor (Add > Filter > HBAO).")
 
 
-def _engine_label(identifier):
-    for engine in bpy.types.RenderEngine.__subclasses__():
-        if getattr(engine, "bl_idname", None) == identifier:
-            return engine.bl_label
-    return {"CYCLES": "Cycles", "BLENDER_EEVEE": "EEVEE", "BLENDER_EEVEE_NEXT": "EEVEE",
-            "BLENDER_WORKBENCH": "Workbench"}.get(identifier, identifier)
-
-
 def _fallback_engine():
     cycles = "cycles" in bpy.context.preferences.addons.keys()
     return "CYCLES" if cycles else compat.engine_identifier("BLENDER_EEVEE")
@@ -66,8 +58,8 @@ def restore_engines():
             continue
         engine = _engines.get(scene.name) or _fallback_engine()
         scene.render.engine = engine
-        message = KEPT_ENGINE_MESSAGE.format(label=_engine_label(ENGINE_IDNAME),
-                                             scene=scene.name, engine=_engine_label(engine))
+        message = KEPT_ENGINE_MESSAGE.format(label=compat.engine_label(ENGINE_IDNAME),
+                                             scene=scene.name, engine=compat.engine_label(engine))
         _show(message)
         messages.append(message)
     remember_engines()

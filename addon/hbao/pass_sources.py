@@ -12,16 +12,6 @@ from .socket_values import MAX_REROUTES
 # (input, view layer attribute, label) of each pass a node reads
 PASSES = ((DEPTH_INPUT, "use_pass_z", "Depth"), (NORMAL_INPUT, "use_pass_normal", "Normal"))
 
-# Render engines by the names Blender's menu shows
-_ENGINE_NAMES = {"CYCLES": "Cycles", "BLENDER_EEVEE": "EEVEE", "BLENDER_EEVEE_NEXT": "EEVEE",
-                 "BLENDER_WORKBENCH": "Workbench"}
-
-
-def _engine_name(scene):
-    """The scene's render engine as an artist knows it."""
-    engine = scene.render.engine
-    return _ENGINE_NAMES.get(engine, f"the render engine ({engine})")
-
 
 def render_layers_refusal(node, scene, label):
     """(error, short error) of why an HBAO node in `scene`'s compositor takes
@@ -92,7 +82,7 @@ def pass_source(socket, scene, expected):
     # Blender 3.4 keeps a valid link to a pass the engine does not make, 5.x an invalid one
     if not source.enabled or not valid:
         return (None, f"{socket.name} is linked to the {expected} pass, which "
-                f"{_engine_name(scene)} does not make", "no pass")
+                f"{compat.engine_label(scene.render.engine)} does not make", "no pass")
     view = handover.named_view(scene)
     longest = handover.longest_layer_name(expected, view)
     if longest is None or len(node.layer.encode()) <= longest:
