@@ -245,6 +245,24 @@ def test_undo_and_redo_keep_the_hook(run_in_blender, tmp_path, case):
         assert json_line(log, "STATUS") == ""
 
 
+def test_a_status_whose_cause_is_fixed_leaves_the_node(run_in_blender, tmp_path):
+    """A render without AO says why on the node's status line; the artist
+    then fixes the cause without rendering (ui_session.py fixed_causes):
+    Compositing on again, the camera perspective again, Depth linked again.
+    The line stayed until the next render ("Compositing off: no AO" with
+    Compositing on), and but for Depth the hint line asked for no render
+    (the review of session 71). Observed: the line goes within a few
+    seconds, and the hint line asks for a render."""
+    out = tmp_path / "fixed_causes"
+    log = run_in_blender(SCRIPTS / "ui_session.py", "fixed_causes", out, ui=True).stdout
+    assert "SESSION DONE" in log, log[-3000:]
+    for key, said in (("COMPOSITING", "Compositing off: no AO"),
+                      ("CAMERA", "Panoramic camera: AO off"),
+                      ("DEPTH", "Depth not linked: AO off")):
+        assert json_line(log, f"STATUS_{key}")[0] == said, key
+        assert json_line(log, f"FIXED_{key}") == ["", "Fixed: render to update"], key
+
+
 def test_an_error_in_the_status_poll_does_not_stop_it(run_in_blender, tmp_path):
     """Blender drops a timer that raises, for the rest of the session: an
     error in the add-on's quarter-second poll (ui_session.py failing_refresher:

@@ -5,13 +5,41 @@ import numpy as np
 from . import native
 
 
+# CameraError.camera_name of an error about no one camera (strips that
+# disagree): no scene camera's name.
+NOT_ONE_CAMERA = object()
+
+
 class CameraError(ValueError):
     """The scene has no camera the library can model; `short`: the form
-    that fits the node's status line."""
+    that fits the node's status line; `camera_name`: the camera it is about
+    (None: there is none)."""
 
-    def __init__(self, message, short="Camera: AO off"):
+    def __init__(self, message, short="Camera: AO off", camera_name=NOT_ONE_CAMERA):
         super().__init__(message)
         self.short = short
+        self.camera_name = camera_name
+
+
+# A status line's cause (report.NodeMessage): the scene's own camera is one
+# the library cannot model (status_causes.py checks it again).
+SCENE_CAMERA_CAUSE = ("scene camera",)
+
+
+def scene_camera_cause(scene, error):
+    """SCENE_CAMERA_CAUSE where CameraError `error` is about `scene`'s own
+    camera (not a sequencer strip's or a stereo view's), else None."""
+    own = scene.camera.name if scene.camera is not None else None
+    return SCENE_CAMERA_CAUSE if error.camera_name == own else None
+
+
+def scene_camera_fails(scene):
+    """Whether the library cannot model `scene`'s own camera now."""
+    try:
+        camera_from_blender(scene)
+    except CameraError:
+        return True
+    return False
 
 
 # Blender's camera types that the library does not model, as artists name them
@@ -23,23 +51,25 @@ def camera_from_blender(scene, camera_object=None):
     which may be an evaluated copy) with Blender's property names."""
     camera_object = camera_object or scene.camera
     if camera_object is None:
-        raise CameraError(f"scene {scene.name!r} has no camera", "No camera: AO off")
+        raise CameraError(f"scene {scene.name!r} has no camera", "No camera: AO off", None)
     camera = camera_object.data
     if getattr(camera, "type", None) not in ("PERSP", "ORTHO"):
         kind = getattr(camera, "type", None)
         if kind is None:
-            raise CameraError(f"the scene's camera {camera_object.name!r} is not a camera")
+            raise CameraError(f"the scene's camera {camera_object.name!r} is not a camera",
+                              camera_name=camera_object.name)
         kind = _CAMERA_KINDS.get(kind, str(kind).lower())
         raise CameraError(f"camera {camera_object.name!r} is {kind}: HBAO supports "
                           f"perspective and orthographic cameras (Camera properties > Lens > "
-                          f"Type)", f"{kind.capitalize()} camera: AO off")
+                          f"Type)", f"{kind.capitalize()} camera: AO off", camera_object.name)
     to_world = model_matrix(camera_object.matrix_world)
     if shear(to_world) > SHEAR_TOLERANCE:
         raise CameraError(
             f"camera {camera_object.name!r} is sheared (its matrix's axes are not square: a "
             f"parent scaled unevenly with the camera turned inside it, or a constraint): "
             f"Blender renders a sheared view, which HBAO does not model. Apply the parent's "
-            f"scale (Object > Apply > Scale) or scale it evenly", "Sheared camera: AO off")
+            f"scale (Object > Apply > Scale) or scale it evenly", "Sheared camera: AO off",
+            camera_object.name)
     world_to_camera = to_world.inverted_safe()
     render = scene.render
     return {

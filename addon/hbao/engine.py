@@ -127,7 +127,9 @@ def render_helper(engine, depsgraph):
         except camera_model.CameraError as error:  # a camera the library cannot model
             results = {}
             _report_failure(engine, f"{error}. Rendering without AO.")
-            tell_all_nodes(main_of(scene, request), error.short, f"{error}. Rendering without AO.")
+            told = main_of(scene, request)
+            tell_all_nodes(told, error.short, f"{error}. Rendering without AO.",
+                           camera_model.scene_camera_cause(told, error) if told else None)
         except Exception as error:  # the render must complete: no AO
             results = {}
             cache.clear()

@@ -145,14 +145,16 @@ def _on_render_init(scene, *_args):
         settings = helper_render_settings
         off = None
         if nodes and not settings.compositor_runs(scene):
-            off = (settings.COMPOSITING_OFF_DETAIL, settings.COMPOSITING_OFF_SHORT)
+            off = (settings.COMPOSITING_OFF_DETAIL, settings.COMPOSITING_OFF_SHORT,
+                   settings.COMPOSITING_OFF_CAUSE)
         elif nodes and (effect_off := settings.effect_off_detail(scene)) is not None:
-            off = (effect_off, settings.EFFECT_OFF_SHORT)
+            off = (effect_off, settings.EFFECT_OFF_SHORT, settings.EFFECT_OFF_CAUSE)
         elif nodes and not settings.helper_renders(scene):
-            off = (settings.SINGLE_LAYER_DETAIL, settings.SINGLE_LAYER_SHORT)
+            off = (settings.SINGLE_LAYER_DETAIL, settings.SINGLE_LAYER_SHORT,
+                   settings.SINGLE_LAYER_CAUSE)
         if off is not None:
-            detail, short = off
-            statuses = [NodeMessage(n.name, detail, short) for n in nodes]
+            detail, short, cause = off
+            statuses = [NodeMessage(n.name, detail, short, cause) for n in nodes]
             post_node_messages(scene.name, [n.name for n in nodes], statuses)
             messages.append((detail, f"HBAO: {detail}"))
         for text, report_text in messages:

@@ -24,6 +24,7 @@ SINGLE_LAYER_DETAIL = ("Render Single Layer is on (View Layer properties): Blend
                        "no other scene, HBAO's helper neither; AO off (the node passes Image "
                        "through). Turn it off for AO")
 SINGLE_LAYER_SHORT = "Single Layer on: AO off"
+SINGLE_LAYER_CAUSE = ("single layer",)  # report.NodeMessage's cause (status_causes.py)
 
 
 # With Compositing off (Output properties, Post Processing), or, before 5.0,
@@ -33,6 +34,7 @@ COMPOSITING_OFF_DETAIL = ("Compositing is off (Output properties > Post Processi
                           "compositor's Use Nodes): Blender runs no compositor, so no HBAO node "
                           "runs either, and the render is written without AO. Turn it on for AO")
 COMPOSITING_OFF_SHORT = "Compositing off: no AO"
+COMPOSITING_OFF_CAUSE = ("compositing off",)
 
 
 # 5.3: the compositor effect that holds the HBAO nodes switched off for
@@ -41,6 +43,7 @@ EFFECT_OFF_DETAIL = ("The compositor effect \"{effect}\" is off for renders (its
                      "Render): Blender runs no HBAO node of it and writes the render without AO. "
                      "Turn it on for AO")
 EFFECT_OFF_SHORT = "Effect off for renders: no AO"
+EFFECT_OFF_CAUSE = ("effect off",)
 
 
 def effect_off_detail(scene):

@@ -51,7 +51,8 @@ def _cameras(engine, depsgraph, main):
     if views is None:
         return {None: camera_model.camera_for_render_result(main, camera)}
     if camera is None:
-        raise camera_model.CameraError(f"scene {main.name!r} has no camera", "No camera: AO off")
+        raise camera_model.CameraError(f"scene {main.name!r} has no camera", "No camera: AO off",
+                                       None)
     return {name: view_cameras.camera_of_view(engine, main, camera, name,
                                               lambda obj: _evaluated(obj, depsgraph))
             for name, _suffix in views}

@@ -8,25 +8,54 @@ posted (report.post_node_messages) once no render job runs, and keeps the
 hint lines current; in `-b`, render_post shows it."""
 import bpy
 
-from . import compat, report, ui_timers, writes
+from . import compat, report, status_causes, ui_timers, writes
 from .callback_guard import never_raises
 from .node import hbao_nodes
+
+
+def show_messages(node, messages, scene=None):
+    """Show `messages` (report.NodeMessage) on `node`: the first one's short
+    form, how many more there are, and every full text in the tooltip;
+    with `scene` (the node's), only those that still hold (status_causes).
+    Writes only what changed, since a write makes Blender composite again;
+    returns whether it wrote."""
+    if scene is not None:
+        messages = status_causes.holding(messages, scene, node)
+    status = messages[0].short if messages else ""
+    if len(messages) > 1:
+        status += f" (+{len(messages) - 1})"
+    details = "\n".join(messages)
+    if node.status == status and node.status_details == details:
+        return False
+    node.status, node.status_details = status, details
+    return True
+
+
+def drop_fixed_messages():
+    """Take from the nodes' status lines what no longer holds since the
+    last render (the artist turned Compositing on, relinked Depth): a
+    hint_refreshers entry. Returns whether it wrote."""
+    changed, seen = False, set()
+    # the latest first: of scenes that share a tree (5.x), the node shows
+    # the last render's messages (report._post)
+    for scene_name, statuses in reversed(report.last_node_messages_of_scenes()):
+        scene = bpy.data.scenes.get(scene_name)
+        for node in hbao_nodes(compat.compositor_tree(scene) if scene else None):
+            if node.name not in statuses or node.as_pointer() in seen:
+                continue
+            seen.add(node.as_pointer())
+            try:
+                changed |= show_messages(node, statuses[node.name], scene)
+            except (AttributeError, RuntimeError):  # a linked, read-only tree
+                continue
+    return changed
+
 
 # Called with no arguments by the timer, in the main thread when no render
 # runs, to bring the nodes' hint lines (hint, hint_details) up to date;
 # each returns whether it changed one (render_record.apply_hints;
-# writes.stuck_line_changed).
-hint_refreshers = [writes.stuck_line_changed]
-
-
-def show_messages(node, messages):
-    """Show `messages` (report.NodeMessage) on `node`: the first one's short
-    form, how many more there are, and every full text in the tooltip."""
-    status = messages[0].short if messages else ""
-    if len(messages) > 1:
-        status += f" (+{len(messages) - 1})"
-    node.status = status
-    node.status_details = "\n".join(messages)
+# writes.stuck_line_changed), and drop_fixed_messages the status lines.
+hint_refreshers = [writes.stuck_line_changed, drop_fixed_messages]
 
 
 @never_raises("update the HBAO nodes' status lines")
@@ -45,13 +74,13 @@ def apply_node_messages():
             if node.name not in statuses:
                 continue
             try:
-                show_messages(node, statuses[node.name])
+                written = show_messages(node, statuses[node.name], scene)
             except (AttributeError, RuntimeError) as error:
                 if writes.writes_refused(error):
                     report.return_node_messages(scene_name, statuses)
                     break
                 continue
-            changed = True
+            changed |= written
     if changed:
         _redraw_node_editors()
 

@@ -11,6 +11,12 @@ from .report import NodeMessage, post_node_messages, take_changes
 from .socket_values import node_params
 
 
+# A status line's cause (report.NodeMessage): what plan_node said of the node
+# at a frame, (PLAN_CAUSE, frame); it holds while plan_node still says it
+# (status_causes.py).
+PLAN_CAUSE = "plan"
+
+
 class Job:
     def __init__(self, node, layer, with_normal, params, threads):
         self.node_name = node.name
@@ -120,7 +126,11 @@ def plan(main, frame):
     the tree gets its own, or none: a good frame clears an old status)."""
     jobs, warnings = [], []
     for node in _computing_nodes(main):
-        job = plan_node(node, main, frame, warnings)
+        found = []
+        job = plan_node(node, main, frame, found)
+        for message in found:
+            message.cause = (PLAN_CAUSE, frame)
+        warnings += found
         if job is not None:
             jobs.append(job)
     # What the add-on changed (a pass turned on) after the problems, so that
@@ -130,10 +140,11 @@ def plan(main, frame):
     return jobs, warnings
 
 
-def tell_all_nodes(main, short, detail):
+def tell_all_nodes(main, short, detail, cause=None):
     """The same message on every HBAO node of `main` (None: nothing): a
     render whose AO failed as a whole."""
     if main is None:
         return
     names = node_names(main)
-    post_node_messages(main.name, names, [NodeMessage(name, detail, short) for name in names])
+    post_node_messages(main.name, names,
+                       [NodeMessage(name, detail, short, cause) for name in names])

@@ -12,7 +12,7 @@ writes the node's hint line, which the node only draws. The
 comparison is the render's own plan of the node (planning.plan_node), at the
 frame that was rendered, so a keyframed value that differs at another frame
 does not count as a change."""
-from . import compat, node, node_status, render_slots
+from . import compat, node, node_status, render_slots, status_causes
 from .planning import plan_node
 
 # (short, full): the node's line and its tooltip
@@ -84,16 +84,22 @@ def forget():
 def changed_since_render(hbao_node, main=None):
     """HINT when `hbao_node` (of `main`'s compositor tree; found when not
     given) would get another AO than the last render of `main` computed,
-    else None (also when `main` was not rendered since the add-on loaded, or
-    the node is muted or unused: the compositor shows those at once)."""
+    status_causes.FIXED_HINT where what that render said of it no longer
+    holds, else None (also when `main` was not rendered since the add-on
+    loaded, or the node is muted or unused: the compositor shows those at
+    once)."""
     if main is None:
         import bpy
         main = next((scene for scene in bpy.data.scenes
                      if compat.compositor_tree(scene) == hbao_node.id_data), None)
-    record = _records.get(main.name) if main is not None else None
-    if record is None:
+    if main is None or hbao_node.mute or not any(output.is_linked
+                                                 for output in hbao_node.outputs):
         return None
-    if hbao_node.mute or not any(output.is_linked for output in hbao_node.outputs):
+    fixed = status_causes.fixed_since_render(main, hbao_node)
+    if fixed is not None:
+        return fixed
+    record = _records.get(main.name)
+    if record is None:
         return None
     frame, signatures, _uid = record
     if hbao_node.name not in signatures:

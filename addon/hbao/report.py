@@ -69,12 +69,15 @@ class NodeMessage(str):
     """A message about one HBAO node. As a string it is the full text,
     'node "NAME": what happened; what it means', so that the engine's report
     reads 'HBAO node "HBAO": Depth is not linked; AO off'; `short` is the
-    form that fits the node's status line."""
+    form that fits the node's status line. `cause`, where given, names
+    what the message is about as plain values (status_causes.py checks
+    whether it still holds once the artist changes something)."""
 
-    def __new__(cls, node_name, detail, short):
+    def __new__(cls, node_name, detail, short, cause=None):
         message = super().__new__(cls, f'node "{node_name}": {detail}')
         message.node_name = node_name
         message.short = short
+        message.cause = cause
         return message
 
 
@@ -113,6 +116,17 @@ def post_last_node_messages():
     restored older statuses."""
     for scene_name, statuses in list(_last_node_messages.items()):
         _pending_node_messages.setdefault(scene_name, statuses)
+
+
+def last_node_messages(scene_name):
+    """{node name: [NodeMessage]} last posted for scene `scene_name`."""
+    return _last_node_messages.get(scene_name, {})
+
+
+def last_node_messages_of_scenes():
+    """(scene name, {node name: [NodeMessage]}) of every scene posted for,
+    the latest last."""
+    return list(_last_node_messages.items())
 
 
 def forget_node_messages():

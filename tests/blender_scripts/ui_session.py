@@ -31,6 +31,14 @@ REFRESHED {json} (whether the last one ran) a few seconds later. Blender
 dropped the poll timer at its first error, and the line stayed; then the
 poll went on, but stopped at the failing function every tick.
 
+CASE "fixed_causes": three times a render whose status line says why the
+node has no AO, then the cause fixed without rendering: Compositing off,
+F12, on again; the camera made panoramic, F12, perspective again; Depth
+unlinked, F12, linked again; prints STATUS_<CAUSE> {json} (the node's
+status line, hint line) after the render and FIXED_<CAUSE> {json} a few
+seconds after the fix. The render's line stayed until the next render, and
+the hint line said nothing of it but for Depth.
+
 Prints SESSION DONE at the end.
 
   blender --addons hbao --python ui_session.py -- CASE OUT_DIR
@@ -154,6 +162,40 @@ def failing_refresher():
     return SETTLE_S
 
 
+def camera_type(kind):
+    def step():
+        bpy.data.scenes["Scene"].camera.data.type = kind
+        operator("undo_push", message=f"camera {kind}")
+    return step
+
+
+unlinked = []
+
+
+def depth_link(linked):
+    def step():
+        tree = bpy.data.scenes["Scene"].node_tree
+        depth = tree.nodes["HBAO0"].inputs["Depth"]
+        if linked:
+            tree.links.new(unlinked.pop(), depth)
+        else:
+            unlinked.append(depth.links[0].from_socket)
+            tree.links.remove(depth.links[0])
+        operator("undo_push", message=f"depth linked {linked}")
+    return step
+
+
+def lines():
+    node = bpy.data.scenes["Scene"].node_tree.nodes["HBAO0"]
+    return [node.status, node.hint]
+
+
+def fixed(key, cause, fix):
+    """A render with `cause`, then `fix`: STATUS_KEY and FIXED_KEY."""
+    return [cause, render, rendered, report(f"STATUS_{key}", lines), fix, lambda: SETTLE_S,
+            report(f"FIXED_{key}", lines)]
+
+
 def report(key, value):
     def step():
         print(key, json.dumps(value()), flush=True)
@@ -177,6 +219,9 @@ STEPS = [built] + {
     "failing_refresher": [compositing(False), render, rendered, failing_refresher,
                           compositing(True), render, rendered, report("STATUS", status),
                           report("REFRESHED", lambda: refreshed[0] > 0)],
+    "fixed_causes": (fixed("COMPOSITING", compositing(False), compositing(True))
+                     + fixed("CAMERA", camera_type("PANO"), camera_type("PERSP"))
+                     + fixed("DEPTH", depth_link(False), depth_link(True))),
     "reenable": [render, rendered, lambda: keep("first"), addon(False), addon(True), render,
                  rendered, lambda: keep("after")],
     "disable_during": [render, disable_while_rendering, rendered, addon(True), render, rendered,
