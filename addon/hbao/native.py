@@ -209,8 +209,9 @@ def compute_ao(depth, normal=None, *, params=None, camera=None, bottom_up=False,
 
 # hbao.h's HBAO_NOTE_* bits (tests/test_native.py holds them to the header),
 # each with the short form that fits a node's status line.
+NOTE_RADIUS_UNDER_A_PIXEL = 4  # always for radius 0
 NOTE_SHORT_FORMS = {1: "Low memory: slow search", 2: "Radius past image: light",
-                    4: "Radius < 1 pixel: no AO"}
+                    NOTE_RADIUS_UNDER_A_PIXEL: "Radius < 1 pixel: no AO"}
 
 
 def last_notes():

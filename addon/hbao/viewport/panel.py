@@ -3,7 +3,7 @@
 preview on and off for one 3D view."""
 import bpy
 
-from .. import parameters, ui_text
+from .. import native, parameters, ui_text
 from . import draw, view_entries
 
 
@@ -71,14 +71,24 @@ def _length(context, value):
     return bpy.utils.units.to_string(unit.system, "LENGTH", value * unit.scale_length)
 
 
-def _node_summary(layout, context, view_settings, node):
+def _radius_note(layout, radius):
+    """At Radius 0 the preview draws no AO: the library's note for it (the
+    node says it after a render), which the panel says at once."""
+    if radius <= 0.0:
+        layout.label(text=native.NOTE_SHORT_FORMS[native.NOTE_RADIUS_UNDER_A_PIXEL],
+                     icon="INFO")
+
+
+def _node_summary(layout, context, view_settings, node, shown_error):
     """What the preview takes from `node` (its values at the current frame),
-    read-only: they are edited on the node."""
+    read-only: they are edited on the node. `shown_error`: the preview's
+    error, which the panel has shown above."""
     _wrapped_label(layout, context, f"Node \"{node.name}\"'s values (edit them there):",
                    "NODE")
     params, error = _params(view_settings, context.scene)
     if params is None:
-        _wrapped_label(layout, context, error, "ERROR")
+        if not (shown_error and error in shown_error):  # (said once: a review's find)
+            _wrapped_label(layout, context, error, "ERROR")
         return
     lines = [f"Radius {_length(context, params['radius'])}",
              f"Strength {params['strength']:g}",
@@ -93,6 +103,7 @@ def _node_summary(layout, context, view_settings, node):
         lines.append("Half resolution")
     for line in lines:
         layout.label(text=line)
+    _radius_note(layout, params["radius"])
 
 
 class VIEW3D_PT_hbao_preview(bpy.types.Panel):
@@ -133,11 +144,12 @@ class VIEW3D_PT_hbao_preview(bpy.types.Panel):
         if view_settings.use_node_settings and node is None:
             layout.label(text="No HBAO node: using these", icon="INFO")
         if node is not None:
-            _node_summary(layout.box(), context, view_settings, node)
+            _node_summary(layout.box(), context, view_settings, node, error)
             return
         column = layout.column()
         column.active = view_settings.enabled
         column.prop(view_settings, "radius")
+        _radius_note(column, view_settings.radius)
         column.prop(view_settings, "strength")
         column.prop(view_settings, "angle_bias_degrees")
         column.prop(view_settings, "thickness")
