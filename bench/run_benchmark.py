@@ -50,7 +50,7 @@ def blender_environment(user_scripts):
     env = dict(os.environ)
     env["HBAO_LIBRARY"] = str(REPO / "build/libhbao.so")
     env["HBAO_EXR_LIBRARY"] = str(REPO / "build/libhbao_exr.so")
-    env["BLENDER_USER_SCRIPTS"] = str(user_scripts)
+    env.update(blenders.user_folders(user_scripts))
     env["PYTHONUNBUFFERED"] = "1"
     return env
 

@@ -39,7 +39,7 @@ def run(blender, passes, route, repeats, user_scripts, size):
     spec = {"scene": "interior", "width": size[0], "height": size[1], "samples": 1,
             "repeats": repeats, "threads": 2, "passes": passes,
             "node": {"directions": 4, "steps": 16, "blur_size": 5}}
-    env = dict(os.environ, BLENDER_USER_SCRIPTS=str(user_scripts), PYTHONUNBUFFERED="1",
+    env = dict(os.environ, **blenders.user_folders(user_scripts), PYTHONUNBUFFERED="1",
                HBAO_PASSES_FROM_MEMORY=ROUTES[route])
     env.setdefault("HBAO_LIBRARY", str(REPO / "build/libhbao.so"))
     env.setdefault("HBAO_EXR_LIBRARY", str(REPO / "build/libhbao_exr.so"))

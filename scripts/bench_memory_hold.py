@@ -42,7 +42,7 @@ HELD_S = 600.0
 
 def ao_times(blender, user_scripts, out, hold_s, args):
     """The AO milliseconds of each render of one run."""
-    env = dict(os.environ, BLENDER_USER_SCRIPTS=str(user_scripts), PYTHONUNBUFFERED="1")
+    env = dict(os.environ, **blenders.user_folders(user_scripts), PYTHONUNBUFFERED="1")
     env.setdefault("HBAO_LIBRARY", str(REPO / "build" / "libhbao.so"))
     env.setdefault("HBAO_EXR_LIBRARY", str(REPO / "build" / "libhbao_exr.so"))
     width, height = args.size

@@ -23,7 +23,8 @@ import sys
 import tempfile
 from pathlib import Path
 
-from blenders import NO_SPLASH, user_scripts_with_addon  # scripts/blenders.py, beside this one
+# scripts/blenders.py, beside this one
+from blenders import NO_SPLASH, user_folders, user_scripts_with_addon
 
 REPO = Path(__file__).resolve().parents[1]
 INNER = REPO / "scripts" / "bench_viewport_blender.py"
@@ -60,7 +61,7 @@ def main():
                 sys.exit(f"building the libraries failed: {' '.join(step)}")
     with tempfile.TemporaryDirectory() as folder:
         user_scripts = str(user_scripts_with_addon(folder))
-        env = dict(os.environ, BLENDER_USER_SCRIPTS=user_scripts, PYTHONUNBUFFERED="1")
+        env = dict(os.environ, **user_folders(user_scripts), PYTHONUNBUFFERED="1")
         for name, path in libraries.items():
             env.setdefault(name, str(path))
         command = [blender, "--factory-startup", "-noaudio", "--addons", "hbao",

@@ -161,6 +161,14 @@ def private_config(user_scripts):
     return folder
 
 
+def user_folders(user_scripts):
+    """The environment that gives a Blender `user_scripts` and its private
+    preferences (private_config): every Blender this project starts, so
+    that none reads or writes the real user's."""
+    return {"BLENDER_USER_SCRIPTS": str(user_scripts),
+            "BLENDER_USER_CONFIG": str(private_config(user_scripts))}
+
+
 def debian_blender():
     """Debian's blender (or $BLENDER), or None when it is not installed."""
     path = shutil.which(os.environ.get("BLENDER", "blender"))

@@ -15,14 +15,17 @@ OUT="${1:-$REPO/out/demo}"
 cmake -S "$REPO" -B "$BUILD" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$BUILD" -j2 --target hbao hbao_exr
 
-# A private user-scripts folder whose addons/hbao is this checkout's add-on.
+# A private user-scripts folder whose addons/hbao is this checkout's add-on,
+# and private preferences beside it (blenders.private_config: Blender given
+# none reads the real user's).
 USER_SCRIPTS="$(mktemp -d)"
 trap 'rm -rf "$USER_SCRIPTS"' EXIT
-mkdir -p "$USER_SCRIPTS/addons"
+mkdir -p "$USER_SCRIPTS/addons" "$USER_SCRIPTS/config"
 ln -s "$REPO/addon/hbao" "$USER_SCRIPTS/addons/hbao"
 
 mkdir -p "$OUT"
-BLENDER_USER_SCRIPTS="$USER_SCRIPTS" HBAO_LIBRARY="$BUILD/libhbao.so" \
+BLENDER_USER_SCRIPTS="$USER_SCRIPTS" BLENDER_USER_CONFIG="$USER_SCRIPTS/config" \
+    HBAO_LIBRARY="$BUILD/libhbao.so" \
     HBAO_EXR_LIBRARY="$BUILD/libhbao_exr.so" \
     "$BLENDER" -b --factory-startup -noaudio --addons hbao --python-exit-code 1 \
     --python "$REPO/scripts/demo_render.py" -- "$OUT"

@@ -92,9 +92,8 @@ def environment(root):
     temp.mkdir()
     env = dict(os.environ)
     env.pop("PYTHONPATH", None)
-    env.update(BLENDER_USER_SCRIPTS=str(user_scripts),
-               BLENDER_USER_CONFIG=str(blenders.private_config(user_scripts)),
-               HBAO_LIBRARY=str(BUILD / "libhbao.so"),
+    env.update(blenders.user_folders(user_scripts))
+    env.update(HBAO_LIBRARY=str(BUILD / "libhbao.so"),
                HBAO_EXR_LIBRARY=str(BUILD / "libhbao_exr.so"),
                PYTHONUNBUFFERED="1", TMPDIR=str(temp), TEMP=str(temp), TMP=str(temp))
     return env, temp

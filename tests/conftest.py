@@ -139,9 +139,7 @@ def addon_deprecations(log):
 def blender_environment(user_scripts, extra=None):
     env = dict(os.environ)
     env["PYTHONWARNINGS"] = _addon_deprecation_filters()
-    env["BLENDER_USER_SCRIPTS"] = str(user_scripts)
-    # Preferences beside the scripts folder: never the real user's.
-    env["BLENDER_USER_CONFIG"] = str(blenders.private_config(user_scripts))
+    env.update(blenders.user_folders(user_scripts))  # never the real user's preferences
     env["HBAO_LIBRARY"] = str(LIBRARY)
     env["HBAO_EXR_LIBRARY"] = str(EXR_LIBRARY)
     env["PYTHONUNBUFFERED"] = "1"
