@@ -142,16 +142,7 @@ def _on_render_init(scene, *_args):
         messages += [(text, f"HBAO {text}")
                      for text in unseen_occluders.render_messages(scene, tree)]
         nodes = node.hbao_nodes(tree)
-        settings = helper_render_settings
-        off = None
-        if nodes and not settings.compositor_runs(scene):
-            off = (settings.COMPOSITING_OFF_DETAIL, settings.COMPOSITING_OFF_SHORT,
-                   settings.COMPOSITING_OFF_CAUSE)
-        elif nodes and (effect_off := settings.effect_off_detail(scene)) is not None:
-            off = (effect_off, settings.EFFECT_OFF_SHORT, settings.EFFECT_OFF_CAUSE)
-        elif nodes and not settings.helper_renders(scene):
-            off = (settings.SINGLE_LAYER_DETAIL, settings.SINGLE_LAYER_SHORT,
-                   settings.SINGLE_LAYER_CAUSE)
+        off = helper_render_settings.ao_off_by(scene) if nodes else None
         if off is not None:
             detail, short, cause = off
             statuses = [NodeMessage(n.name, detail, short, cause) for n in nodes]

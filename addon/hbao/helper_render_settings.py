@@ -52,6 +52,19 @@ def effect_off_detail(scene):
     return EFFECT_OFF_DETAIL.format(effect=effect.name) if effect is not None else None
 
 
+def ao_off_by(scene):
+    """(detail, short, cause) of the render setting of `scene` that leaves
+    its HBAO nodes without AO (Compositing off, the effect off for renders,
+    Render Single Layer on), or None."""
+    if not compositor_runs(scene):
+        return COMPOSITING_OFF_DETAIL, COMPOSITING_OFF_SHORT, COMPOSITING_OFF_CAUSE
+    if (effect_off := effect_off_detail(scene)) is not None:
+        return effect_off, EFFECT_OFF_SHORT, EFFECT_OFF_CAUSE
+    if not helper_renders(scene):
+        return SINGLE_LAYER_DETAIL, SINGLE_LAYER_SHORT, SINGLE_LAYER_CAUSE
+    return None
+
+
 def compositor_runs(scene):
     """Whether a render of `scene` runs its compositor."""
     return scene.render.use_compositing and (compat.HAS_COMPOSITING_NODE_GROUP
