@@ -263,6 +263,19 @@ def test_a_status_whose_cause_is_fixed_leaves_the_node(run_in_blender, tmp_path)
         assert json_line(log, f"FIXED_{key}") == ["", "Fixed: render to update"], key
 
 
+def test_a_status_kept_in_a_file_leaves_the_node_once_fixed(run_in_blender, tmp_path):
+    """The same, with the file saved after the render and opened again
+    before the fix (ui_session.py fixed_after_open): the status line the
+    file kept stayed until a render, as the messages' causes lived in
+    memory only. Observed: the line is the render's after opening, and
+    goes once Compositing is on."""
+    out = tmp_path / "fixed_after_open"
+    log = run_in_blender(SCRIPTS / "ui_session.py", "fixed_after_open", out, ui=True).stdout
+    assert "SESSION DONE" in log and "OPENED {'FINISHED'}" in log, log[-3000:]
+    assert json_line(log, "STATUS_OPENED")[0] == "Compositing off: no AO"
+    assert json_line(log, "FIXED_OPENED") == ["", "Fixed: render to update"]
+
+
 def test_an_error_in_the_status_poll_does_not_stop_it(run_in_blender, tmp_path):
     """Blender drops a timer that raises, for the rest of the session: an
     error in the add-on's quarter-second poll (ui_session.py failing_refresher:

@@ -10,8 +10,8 @@ the only chance such a render has to build the hook."""
 import bpy
 
 from . import (compat, helper_lookup, helper_render_settings, helper_scene, node, node_place,
-               older_blenders, pass_capture, pass_sources, planning, recomposite, render_slots,
-               saved_switch, strip_cameras, unseen_occluders, window_scenes, writes)
+               node_status, older_blenders, pass_capture, pass_sources, planning, recomposite,
+               render_slots, saved_switch, strip_cameras, unseen_occluders, window_scenes, writes)
 from .callback_guard import never_raises
 from .report import (NodeMessage, forget_node_messages, in_main_thread, log,
                      post_last_node_messages, post_node_messages, post_render_report)
@@ -104,7 +104,7 @@ def _on_undo_or_redo(*_args):
 def _on_load_post(*_args):
     global _sync_scheduled
     _sync_scheduled = False  # opening a file removed the timer, if it waited
-    forget_node_messages()
+    forget_node_messages(node_status.kept_messages())
     window_scenes.watch(_on_window_scene)
     strip_cameras.forget_jobs()
     _sync_all_or_later()

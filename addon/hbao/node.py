@@ -111,6 +111,10 @@ class CompositorNodeHBAO(bpy.types.CompositorNodeCustomGroup):
                            description="Last message from the render hook about this node")
     status_details: StringProperty(name="Status Details", default="",
                                    description="The full text of the render hook's messages")
+    status_record: StringProperty(name="Status Record", default="",
+                                  description="The status line's messages and what each is "
+                                              "about, for the add-on to check once the file "
+                                              "is opened again")
     hint: StringProperty(name="Hint", default="",
                          description="Whether the AO shown is still the last render's")
     hint_details: StringProperty(name="Hint Details", default="")

@@ -25,10 +25,24 @@ def show_messages(node, messages, scene=None):
     if len(messages) > 1:
         status += f" (+{len(messages) - 1})"
     details = "\n".join(messages)
-    if node.status == status and node.status_details == details:
+    record = report.record_of(messages)
+    if (node.status, node.status_details, node.status_record) == (status, details, record):
         return False
-    node.status, node.status_details = status, details
+    node.status, node.status_details, node.status_record = status, details, record
     return True
+
+
+def kept_messages():
+    """{scene name: {node name: [NodeMessage]}} of what the nodes of the file
+    just opened kept of their status lines (report.messages_in), so that
+    what the artist has fixed since is taken from them (drop_fixed_messages)."""
+    kept = {}
+    for scene in bpy.data.scenes:
+        statuses = {node.name: report.messages_in(node.name, node.status_record)
+                    for node in hbao_nodes(compat.compositor_tree(scene)) if node.status_record}
+        if statuses:
+            kept[scene.name] = statuses
+    return kept
 
 
 def drop_fixed_messages():

@@ -3,6 +3,7 @@
 messages about a node that read well after Blender's "HBAO " report prefix
 and carry a short form for the node's status line, and whether the caller
 may change Blender data (only the main thread may)."""
+import json
 import sys
 import threading
 
@@ -76,9 +77,30 @@ class NodeMessage(str):
     def __new__(cls, node_name, detail, short, cause=None):
         message = super().__new__(cls, f'node "{node_name}": {detail}')
         message.node_name = node_name
+        message.detail = detail
         message.short = short
         message.cause = cause
         return message
+
+
+def record_of(messages):
+    """`messages` (NodeMessages about one node) as text that a file keeps
+    (the node's status_record), so that their causes can be checked again
+    once the file is opened (messages_in)."""
+    return json.dumps([[message.detail, message.short,
+                        list(message.cause) if message.cause is not None else None]
+                       for message in messages]) if messages else ""
+
+
+def messages_in(node_name, record):
+    """The NodeMessages about node `node_name` that record_of() wrote into
+    `record`; none where it cannot be read (a file edited by hand)."""
+    try:
+        return [NodeMessage(node_name, str(detail), str(short),
+                            tuple(cause) if isinstance(cause, list) else None)
+                for detail, short, cause in json.loads(record or "[]")]
+    except (ValueError, TypeError):
+        return []
 
 
 def post_node_messages(scene_name, node_names, messages):
@@ -129,9 +151,11 @@ def last_node_messages_of_scenes():
     return list(_last_node_messages.items())
 
 
-def forget_node_messages():
-    """Another file is open: its scenes were told nothing yet."""
+def forget_node_messages(kept=None):
+    """Another file is open: its scenes were told only what its nodes kept,
+    `kept` ({scene name: {node name: [NodeMessage]}}, messages_in)."""
     _last_node_messages.clear()
+    _last_node_messages.update(kept or {})
 
 
 def has_node_messages():

@@ -39,6 +39,10 @@ status line, hint line) after the render and FIXED_<CAUSE> {json} a few
 seconds after the fix. The render's line stayed until the next render, and
 the hint line said nothing of it but for Depth.
 
+CASE "fixed_after_open": Compositing off, F12, the file saved and opened
+again, Compositing on; prints FIXED_OPENED {json} (status line, hint
+line) a few seconds later. The line a file kept stayed until a render.
+
 Prints SESSION DONE at the end.
 
   blender --addons hbao --python ui_session.py -- CASE OUT_DIR
@@ -196,6 +200,13 @@ def fixed(key, cause, fix):
             report(f"FIXED_{key}", lines)]
 
 
+def save_and_open():
+    path = os.path.join(out_dir, "saved.blend")
+    print("SAVED", bpy.ops.wm.save_as_mainfile(filepath=path), flush=True)
+    print("OPENED", bpy.ops.wm.open_mainfile(filepath=path), flush=True)
+    return SETTLE_S
+
+
 def report(key, value):
     def step():
         print(key, json.dumps(value()), flush=True)
@@ -222,6 +233,9 @@ STEPS = [built] + {
     "fixed_causes": (fixed("COMPOSITING", compositing(False), compositing(True))
                      + fixed("CAMERA", camera_type("PANO"), camera_type("PERSP"))
                      + fixed("DEPTH", depth_link(False), depth_link(True))),
+    "fixed_after_open": [compositing(False), render, rendered, save_and_open,
+                         report("STATUS_OPENED", lines), compositing(True), lambda: SETTLE_S,
+                         report("FIXED_OPENED", lines)],
     "reenable": [render, rendered, lambda: keep("first"), addon(False), addon(True), render,
                  rendered, lambda: keep("after")],
     "disable_during": [render, disable_while_rendering, rendered, addon(True), render, rendered,
@@ -248,4 +262,5 @@ def tick():
 
 
 node_editor(window())
-timer_guard.guarded_timer(tick, SETTLE_S)  # the add-on's sync makes the hook meanwhile
+# (persistent: fixed_after_open opens a file)
+timer_guard.guarded_timer(tick, SETTLE_S, persistent=True)  # the add-on's sync makes the hook
