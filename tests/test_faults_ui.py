@@ -276,6 +276,19 @@ def test_a_status_kept_in_a_file_leaves_the_node_once_fixed(run_in_blender, tmp_
     assert json_line(log, "FIXED_OPENED") == ["", "Fixed: render to update"]
 
 
+def test_a_pass_the_add_on_turns_on_stays_on_the_status_line(run_in_blender, tmp_path):
+    """After a render, the view layer's Normal pass turned off: the add-on
+    turns it on again for the node and says so on its status line
+    (ui_session.py pass_turned_on). Observed: the line says it seconds
+    later (the status timer, which re-shows the last render's messages
+    while checking their causes, would otherwise wipe a line written
+    beside it)."""
+    out = tmp_path / "pass_turned_on"
+    log = run_in_blender(SCRIPTS / "ui_session.py", "pass_turned_on", out, ui=True).stdout
+    assert "SESSION DONE" in log, log[-3000:]
+    assert json_line(log, "TURNED_ON")[0] == "Normal pass turned on"
+
+
 def test_an_error_in_the_status_poll_does_not_stop_it(run_in_blender, tmp_path):
     """Blender drops a timer that raises, for the rest of the session: an
     error in the add-on's quarter-second poll (ui_session.py failing_refresher:

@@ -6,7 +6,7 @@ on a pass the node reads but its view layer lacks."""
 from . import compat, handover
 from .helper_lookup import MANAGED_NODE_KEY
 from .node import DEPTH_INPUT, NORMAL_INPUT, hbao_nodes
-from .report import NodeMessage, in_main_thread, log, note_change
+from .report import NodeMessage, add_node_messages, in_main_thread, log, note_change
 from .socket_values import MAX_REROUTES
 
 # (input, view layer attribute, label) of each pass a node reads
@@ -129,6 +129,7 @@ def enable_needed_passes(scene, tree):
                     node.name, f"the {label} pass of view layer {view_layer.name!r} was off; "
                     f"the add-on turned it on (the node reads it)", f"{label} pass turned on")
                 note_change(scene.name, change)
-                if in_main_thread():  # outside a render: on the node now, as well
-                    node.status = change.short
+                if in_main_thread():  # outside a render: on the node now, as well (the
+                    # status timer shows it: one written here, it replaced at its next tick)
+                    add_node_messages(scene.name, [change])
     return messages

@@ -16,6 +16,11 @@ CASE "status_redo": Compositing off, F12 (the node says "Compositing off:
 no AO"), Compositing on, F12, Ctrl+Z, Ctrl+Shift+Z; prints STATUS {json}
 (the node's status line) a few seconds later. The old line came back.
 
+CASE "pass_turned_on": F12, then the view layer's Normal pass turned off,
+which the add-on turns on again for the node; prints TURNED_ON {json}
+(status line, hint line) a few seconds later. The status timer wiped the
+add-on's "Normal pass turned on" from the line at its next tick.
+
 CASE "reenable": F12 (kept as OUT/first), the add-on disabled and enabled
 in Preferences, F12 at once (kept as OUT/after). That render had no AO.
 
@@ -200,6 +205,12 @@ def fixed(key, cause, fix):
             report(f"FIXED_{key}", lines)]
 
 
+def normal_pass_off():
+    bpy.data.scenes["Scene"].view_layers[0].use_pass_normal = False
+    operator("undo_push", message="Normal pass off")
+    return SETTLE_S
+
+
 def save_and_open():
     path = os.path.join(out_dir, "saved.blend")
     print("SAVED", bpy.ops.wm.save_as_mainfile(filepath=path), flush=True)
@@ -236,6 +247,7 @@ STEPS = [built] + {
     "fixed_after_open": [compositing(False), render, rendered, save_and_open,
                          report("STATUS_OPENED", lines), compositing(True), lambda: SETTLE_S,
                          report("FIXED_OPENED", lines)],
+    "pass_turned_on": [render, rendered, normal_pass_off, report("TURNED_ON", lines)],
     "reenable": [render, rendered, lambda: keep("first"), addon(False), addon(True), render,
                  rendered, lambda: keep("after")],
     "disable_during": [render, disable_while_rendering, rendered, addon(True), render, rendered,
