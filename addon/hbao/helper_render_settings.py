@@ -52,17 +52,31 @@ def effect_off_detail(scene):
     return EFFECT_OFF_DETAIL.format(effect=effect.name) if effect is not None else None
 
 
-def ao_off_by(scene):
-    """(detail, short, cause) of the render setting of `scene` that leaves
-    its HBAO nodes without AO (Compositing off, the effect off for renders,
-    Render Single Layer on), or None."""
+# The causes (report.NodeMessage) of the render settings below.
+SETTING_CAUSES = (COMPOSITING_OFF_CAUSE, EFFECT_OFF_CAUSE, SINGLE_LAYER_CAUSE)
+
+
+def _settings_off(scene):
+    """(detail, short, cause) of each render setting of `scene` that leaves
+    its HBAO nodes without AO now (Compositing off, the effect off for
+    renders, Render Single Layer on), the one a render names first."""
     if not compositor_runs(scene):
-        return COMPOSITING_OFF_DETAIL, COMPOSITING_OFF_SHORT, COMPOSITING_OFF_CAUSE
+        yield COMPOSITING_OFF_DETAIL, COMPOSITING_OFF_SHORT, COMPOSITING_OFF_CAUSE
     if (effect_off := effect_off_detail(scene)) is not None:
-        return effect_off, EFFECT_OFF_SHORT, EFFECT_OFF_CAUSE
+        yield effect_off, EFFECT_OFF_SHORT, EFFECT_OFF_CAUSE
     if not helper_renders(scene):
-        return SINGLE_LAYER_DETAIL, SINGLE_LAYER_SHORT, SINGLE_LAYER_CAUSE
-    return None
+        yield SINGLE_LAYER_DETAIL, SINGLE_LAYER_SHORT, SINGLE_LAYER_CAUSE
+
+
+def ao_off_by(scene):
+    """(detail, short, cause) of the render setting that a render of
+    `scene` names for its nodes' missing AO, or None."""
+    return next(_settings_off(scene), None)
+
+
+def causes_now(scene):
+    """The SETTING_CAUSES that hold for `scene` now (status_causes.py)."""
+    return [cause for _detail, _short, cause in _settings_off(scene)]
 
 
 def compositor_runs(scene):

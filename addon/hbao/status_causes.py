@@ -19,13 +19,6 @@ FIXED_HINT = ("Fixed: render to update",
               "Since the last render, this no longer holds: {causes}. The compositor still "
               "shows that render's result: render again (F12) to update it.")
 
-_SCENE_CHECKS = {
-    settings.COMPOSITING_OFF_CAUSE: lambda scene: not settings.compositor_runs(scene),
-    settings.EFFECT_OFF_CAUSE: lambda scene: settings.effect_off_detail(scene) is not None,
-    settings.SINGLE_LAYER_CAUSE: lambda scene: not settings.helper_renders(scene),
-    camera_model.SCENE_CAMERA_CAUSE: camera_model.scene_camera_fails,
-}
-
 
 class _Plans:
     """What plan_node says of one node now, at each frame asked (computed
@@ -46,8 +39,11 @@ def _holds(message, scene, plans):
     cause = message.cause
     if cause[0] == planning.PLAN_CAUSE:
         return plans.says(cause[1], message)
-    check = _SCENE_CHECKS.get(cause)
-    return check is None or check(scene)
+    if cause in settings.SETTING_CAUSES:
+        return cause in settings.causes_now(scene)
+    if cause == camera_model.SCENE_CAMERA_CAUSE:
+        return camera_model.scene_camera_fails(scene)
+    return True
 
 
 def holding(messages, scene, node):
