@@ -468,6 +468,30 @@ def test_hbao_node_inside_a_node_group_says_why_it_gives_no_ao(run_in_blender, t
         assert np.abs(ao - expected).max() <= EXACT
 
 
+def _status_fixed(run_in_blender, tmp_path, case, said):
+    log = run_in_blender(REPO / "tests" / "blender_scripts" / "status_fixed.py", case,
+                         tmp_path / case).stdout
+    assert json_line(log, "RENDERED") == [said, ""], log[-3000:]
+    assert json_line(log, "FIXED") == ["", "Fixed: render to update"], log[-3000:]
+
+
+@pytest.mark.parametrize("case, said", [("compositing", "Compositing off: no AO"),
+                                        ("single_layer", "Single Layer on: AO off")])
+def test_a_render_setting_put_back_takes_its_status_away(run_in_blender, tmp_path, case, said):
+    """A render with Compositing off or Render Single Layer on says so on
+    the node; the setting put back without rendering, the add-on's status
+    timer (its steps run as its tick runs them: status_fixed.py) takes the
+    line away and asks for a render (status_causes.py; the line had stayed
+    until the next render)."""
+    _status_fixed(run_in_blender, tmp_path, case, said)
+
+
+@pytest.mark.min_blender(5, 3)
+def test_the_hbao_effect_on_again_takes_its_status_away(run_in_blender, tmp_path):
+    """The same with the HBAO compositor effect off for renders, then on."""
+    _status_fixed(run_in_blender, tmp_path, "effect", "Effect off for renders: no AO")
+
+
 def status_lines(log):
     return {entry["node"]: entry["status"] for entry in
             (json.loads(text[len("STATUS "):]) for text in log.splitlines()
